@@ -1,0 +1,27 @@
+"""Errors an operator can cause, and cancellation.
+
+Every error an operator can fix (a missing file, no overlap, a wrong CRS, a bad parameter) is a
+:class:`PhotodemError` whose message says what is wrong and what to do. The CLI prints it without
+a traceback and exits 2; QGIS and the standalone tool show it in their log.
+"""
+
+from __future__ import annotations
+
+
+class PhotodemError(Exception):
+    """An error the operator can fix; the message is shown as it is."""
+
+
+class InputError(PhotodemError):
+    """An input file, layer or parameter is missing or unusable."""
+
+
+class GeometryError(PhotodemError):
+    """The photogrammetric geometry does not allow the operation (no overlap, ray misses DEM…)."""
+
+
+class Cancelled(PhotodemError):
+    """The operator cancelled the run; no output was left behind."""
+
+    def __init__(self, message: str = "Cancelled by the operator; no output was written.") -> None:
+        super().__init__(message)

@@ -1,0 +1,1 @@
+"""Algorithm declarations, one module per domain (see ``registry.ALGORITHM_MODULES``)."""

@@ -1,0 +1,5 @@
+"""Algorithm declarations: geometry."""
+
+from __future__ import annotations
+
+ALGORITHMS: list = []

@@ -1,0 +1,5 @@
+"""Algorithm declarations: project."""
+
+from __future__ import annotations
+
+ALGORITHMS: list = []

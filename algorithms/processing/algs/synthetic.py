@@ -1,0 +1,5 @@
+"""Algorithm declarations: synthetic."""
+
+from __future__ import annotations
+
+ALGORITHMS: list = []

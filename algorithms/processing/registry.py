@@ -1,0 +1,89 @@
+"""The registry of all PhotoDEM algorithms, and the one function that runs them.
+
+Algorithm declarations live in :mod:`.algs` (one module per domain); each module lists its
+classes in ``ALGORITHMS``. Every face (QGIS provider, standalone toolbox, CLI, batch) asks this
+registry, so adding an algorithm is one class in one module.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from typing import Any, Dict, List, Optional
+
+from ..errors import InputError
+from .feedback import Feedback, ensure_feedback
+from .spec import Algorithm, json_ready, prepare_parameters
+
+#: Modules below ``algorithms/processing/algs`` that declare algorithms, in toolbox order.
+ALGORITHM_MODULES = (
+    "project",
+    "synthetic",
+    "geometry",
+)
+
+_CACHE: Dict[str, Algorithm] = {}
+
+
+def algorithms() -> Dict[str, Algorithm]:
+    """All algorithms by id, in declaration order."""
+    if not _CACHE:
+        for module_name in ALGORITHM_MODULES:
+            module = importlib.import_module(f"{__package__}.algs.{module_name}")
+            for cls in module.ALGORITHMS:
+                alg = cls()
+                if alg.id in _CACHE:
+                    raise RuntimeError(f"duplicate algorithm id {alg.id!r}")
+                _CACHE[alg.id] = alg
+    return dict(_CACHE)
+
+
+def get(algorithm_id: str) -> Algorithm:
+    """The algorithm with this id (a ``photodem:`` prefix is accepted).
+
+    Raises
+    ------
+    InputError
+        When no such algorithm exists; the message lists the known ids.
+    """
+    key = algorithm_id.split(":", 1)[1] if algorithm_id.startswith("photodem:") else algorithm_id
+    algs = algorithms()
+    if key not in algs:
+        raise InputError(
+            f"No algorithm '{algorithm_id}'. Known algorithms: {', '.join(algs)}."
+        )
+    return algs[key]
+
+
+def run(
+    algorithm_id: str,
+    params: Dict[str, Any],
+    feedback: Optional[Feedback] = None,
+) -> Dict[str, Any]:
+    """Run an algorithm from raw parameter values and return its JSON-ready outputs.
+
+    This is the single entry point of every face: parameters are checked and converted by
+    :func:`~.spec.prepare_parameters`, the algorithm runs, and its outputs are made JSON-ready.
+
+    Raises
+    ------
+    PhotodemError
+        For anything the operator can fix (including :class:`~..errors.Cancelled`).
+    """
+    alg = get(algorithm_id)
+    feedback = ensure_feedback(feedback)
+    prepared = prepare_parameters(alg, params)
+    start = time.perf_counter()
+    result = alg.run(prepared, feedback)
+    feedback.progress(100.0)
+    feedback.info(f"{alg.id} finished in {time.perf_counter() - start:.1f} s.")
+    return json_ready(result)
+
+
+def groups() -> List[str]:
+    """Group names in toolbox order."""
+    seen: List[str] = []
+    for alg in algorithms().values():
+        if alg.group not in seen:
+            seen.append(alg.group)
+    return seen

@@ -1,0 +1,342 @@
+"""One declaration per operation: typed parameters, typed outputs and a ``run`` function.
+
+From these specs the project builds its four faces: the QGIS Processing provider, the standalone
+toolbox, the ``photodem`` CLI and batch steps. A spec never imports Qt or QGIS.
+
+Parameter values reach :meth:`Algorithm.run` already checked and converted by
+:func:`prepare_parameters` (the same function for every face), so a run gives the same result
+whichever face started it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Dict, Optional, Sequence, Tuple
+
+from ..errors import InputError
+from .feedback import Feedback
+
+#: Parameter kinds. Paths are passed on as ``str``.
+INPUT_PATH_KINDS = ("raster", "vector", "file", "folder", "project")
+OUTPUT_KINDS = ("output_file", "output_folder", "output_raster", "output_vector")
+PARAMETER_KINDS = (
+    *INPUT_PATH_KINDS,
+    *OUTPUT_KINDS,
+    "model",  # name of a stereo model in the project, e.g. "0182_0184"
+    "image",  # name of an image in the project
+    "number",
+    "integer",
+    "enum",
+    "bool",
+    "crs",
+    "extent",
+    "string",
+    "multiple_rasters",
+)
+OUTPUT_VALUE_KINDS = ("file", "folder", "raster", "vector", "number", "string", "json")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A typed input of an algorithm.
+
+    Parameters
+    ----------
+    name : str
+        snake_case name; the CLI flag is ``--name-with-dashes``.
+    kind : str
+        One of :data:`PARAMETER_KINDS`.
+    description : str
+        Short label (English; translated in the GUIs), with the unit in brackets.
+    default : object, optional
+        Default value; ``None`` with ``optional=False`` means the parameter is required.
+    optional : bool
+        The parameter may be left empty (value ``None``).
+    minimum, maximum : float, optional
+        Bounds for ``number`` and ``integer``.
+    options : tuple of str
+        Choices of an ``enum``; the value is the option string.
+    unit : str
+        Unit of a number (``"m"``, ``"px"``, ``"%"``, ``"°"``); shown to the operator.
+    extensions : tuple of str
+        File name endings accepted for file parameters (``".csv"``); empty accepts all.
+    help : str
+        One or two sentences for the help text.
+    """
+
+    name: str
+    kind: str
+    description: str
+    default: Any = None
+    optional: bool = False
+    minimum: Optional[float] = None
+    maximum: Optional[float] = None
+    options: Tuple[str, ...] = ()
+    unit: str = ""
+    extensions: Tuple[str, ...] = ()
+    help: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in PARAMETER_KINDS:
+            raise ValueError(f"unknown parameter kind {self.kind!r} for {self.name!r}")
+        if self.kind == "enum" and not self.options:
+            raise ValueError(f"enum parameter {self.name!r} needs options")
+
+    @property
+    def flag(self) -> str:
+        """The CLI flag, ``--name-with-dashes``."""
+        return "--" + self.name.replace("_", "-")
+
+    @property
+    def required(self) -> bool:
+        return not self.optional and self.default is None
+
+    @property
+    def is_output(self) -> bool:
+        return self.kind in OUTPUT_KINDS
+
+    # -- conversion ---------------------------------------------------------------------------
+    def convert(self, value: Any) -> Any:
+        """Check ``value`` and convert it to the type ``run`` receives.
+
+        Strings (from the CLI or a batch file) are parsed; ``None`` and ``""`` mean "not given".
+
+        Raises
+        ------
+        InputError
+            With a message naming the parameter and the accepted values.
+        """
+        if value is None or (isinstance(value, str) and value.strip() == ""):
+            if self.default is not None:
+                value = self.default
+            elif self.optional:
+                return None
+            else:
+                raise InputError(f"Parameter '{self.name}' ({self.description}) is required.")
+        kind = self.kind
+        try:
+            if kind in INPUT_PATH_KINDS or kind in OUTPUT_KINDS:
+                return str(Path(str(value)).expanduser())
+            if kind in ("model", "image", "string", "crs"):
+                return str(value)
+            if kind == "number":
+                number = float(value)
+                self._check_range(number)
+                return number
+            if kind == "integer":
+                number = float(value)
+                if number != int(number):
+                    raise ValueError
+                self._check_range(number)
+                return int(number)
+            if kind == "bool":
+                return _to_bool(value)
+            if kind == "enum":
+                return self._to_option(value)
+            if kind == "extent":
+                return _to_extent(value)
+            if kind == "multiple_rasters":
+                items = value.split(",") if isinstance(value, str) else list(value)
+                return [str(Path(str(v).strip()).expanduser()) for v in items if str(v).strip()]
+        except InputError:
+            raise
+        except (TypeError, ValueError):
+            pass
+        raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
+
+    def _check_range(self, number: float) -> None:
+        if not math.isfinite(number):
+            raise InputError(f"Parameter '{self.name}' must be a finite number, not {number}.")
+        low = -math.inf if self.minimum is None else self.minimum
+        high = math.inf if self.maximum is None else self.maximum
+        if not low <= number <= high:
+            unit = f" {self.unit}" if self.unit else ""
+            raise InputError(
+                f"Parameter '{self.name}' = {number:g}{unit} is outside the allowed range "
+                f"{low:g}…{high:g}{unit}."
+            )
+
+    def _to_option(self, value: Any) -> str:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            index = int(value)
+            if 0 <= index < len(self.options) and index == value:
+                return self.options[index]
+        text = str(value).strip().lower()
+        for option in self.options:
+            if option.lower() == text:
+                return option
+        raise InputError(
+            f"Parameter '{self.name}': {value!r} is not one of {', '.join(self.options)}."
+        )
+
+    def _expected(self) -> str:
+        return {
+            "number": "number",
+            "integer": "whole number",
+            "bool": "yes/no value (true/false)",
+            "extent": "extent 'xmin,ymin,xmax,ymax'",
+        }.get(self.kind, self.kind)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """A JSON-friendly description (for ``photodem help --json`` and the GUIs)."""
+        return {
+            "name": self.name,
+            "kind": self.kind,
+            "description": self.description,
+            "default": self.default,
+            "optional": self.optional,
+            "minimum": self.minimum,
+            "maximum": self.maximum,
+            "options": list(self.options),
+            "unit": self.unit,
+            "extensions": list(self.extensions),
+            "help": self.help,
+        }
+
+
+@dataclass(frozen=True)
+class Output:
+    """A typed result of an algorithm (a key of the dict ``run`` returns)."""
+
+    name: str
+    kind: str
+    description: str
+
+    def __post_init__(self) -> None:
+        if self.kind not in OUTPUT_VALUE_KINDS:
+            raise ValueError(f"unknown output kind {self.kind!r} for {self.name!r}")
+
+
+class Algorithm:
+    """Base class of every PhotoDEM operation.
+
+    Subclasses set the class attributes and implement :meth:`run`. ``run`` receives the
+    converted parameters (see :func:`prepare_parameters`) and a :class:`Feedback`, and returns a
+    dict whose keys are the names of :attr:`outputs` (paths as ``str``, numbers, JSON-friendly
+    dicts). It must leave no output behind when it fails or is cancelled.
+    """
+
+    id: str = ""
+    name: str = ""
+    group: str = ""
+    group_id: str = ""
+    help: str = ""
+    parameters: Tuple[Parameter, ...] = ()
+    outputs: Tuple[Output, ...] = ()
+    #: Parameter that batch runs iterate over ("model" or "image"), if any.
+    iterates_over: Optional[str] = None
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        raise NotImplementedError
+
+    def to_dict(self) -> Dict[str, Any]:
+        return {
+            "id": self.id,
+            "name": self.name,
+            "group": self.group,
+            "help": self.help,
+            "parameters": [p.to_dict() for p in self.parameters],
+            "outputs": [{"name": o.name, "kind": o.kind, "description": o.description}
+                        for o in self.outputs],
+        }
+
+
+def prepare_parameters(algorithm: Algorithm, values: Dict[str, Any]) -> Dict[str, Any]:
+    """Check and convert raw parameter values for ``algorithm``.
+
+    Unknown names are an error (a typo must not silently fall back to a default); missing
+    optional ones become their default or ``None``; input paths must exist; an output may not
+    be one of the inputs.
+
+    Raises
+    ------
+    InputError
+        Naming the first parameter that is wrong.
+    """
+    known = {p.name for p in algorithm.parameters}
+    unknown = sorted(set(values) - known)
+    if unknown:
+        raise InputError(
+            f"{algorithm.id}: unknown parameter(s) {', '.join(unknown)}; "
+            f"known are {', '.join(sorted(known))}."
+        )
+    params = {p.name: p.convert(values.get(p.name)) for p in algorithm.parameters}
+    inputs = []
+    for p in algorithm.parameters:
+        value = params[p.name]
+        if value is None:
+            continue
+        paths = value if p.kind == "multiple_rasters" else [value]
+        if p.kind in INPUT_PATH_KINDS or p.kind == "multiple_rasters":
+            for path in paths:
+                if not Path(path).exists():
+                    raise InputError(f"Parameter '{p.name}': '{path}' does not exist.")
+                inputs.append(Path(path).resolve())
+    for p in algorithm.parameters:
+        if p.is_output and params[p.name] is not None:
+            out = Path(params[p.name]).resolve()
+            if out in inputs:
+                raise InputError(
+                    f"Parameter '{p.name}': the output '{out}' is also an input; "
+                    "PhotoDEM never overwrites its inputs. Choose another output."
+                )
+    return params
+
+
+def json_ready(value: Any) -> Any:
+    """Convert paths, numpy scalars/arrays and tuples so that ``json.dumps`` accepts them."""
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return json_ready(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _to_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)) and value in (0, 1):
+        return bool(value)
+    text = str(value).strip().lower()
+    if text in ("1", "true", "yes", "y", "on", "ja"):
+        return True
+    if text in ("0", "false", "no", "n", "off", "nein"):
+        return False
+    raise ValueError(value)
+
+
+def _to_extent(value: Any) -> Tuple[float, float, float, float]:
+    if isinstance(value, str):
+        text = value.split("[")[0]  # QGIS appends " [EPSG:xxxx]"
+        parts: Sequence[Any] = [v for v in text.replace(";", ",").split(",") if v.strip()]
+    else:
+        parts = list(value)
+    xmin, ymin, xmax, ymax = (float(v) for v in parts)
+    if not (xmin < xmax and ymin < ymax):
+        raise ValueError(value)
+    return (xmin, ymin, xmax, ymax)
+
+
+__all__ = [
+    "OUTPUT_KINDS",
+    "PARAMETER_KINDS",
+    "Algorithm",
+    "Output",
+    "Parameter",
+    "json_ready",
+    "prepare_parameters",
+]

@@ -1,0 +1,143 @@
+"""Raster and folder outputs that are never left half-written.
+
+Every product is written to a temporary name beside its target and renamed when complete
+(:func:`atomic_output`, :func:`staged_folder`), so a failed or cancelled run leaves nothing and an
+existing product is replaced only by a complete one. GeoTIFFs are tiled and compressed; final
+products can be Cloud-Optimised (overviews, :func:`write_raster` with ``overviews=True``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import uuid
+from pathlib import Path
+from typing import Any, Dict, Iterator, Optional, Union
+
+import numpy as np
+import rasterio
+from affine import Affine
+from numpy.typing import NDArray
+from rasterio.enums import Resampling
+
+PathLike = Union[str, Path]
+
+#: Creation options of every GeoTIFF product.
+GTIFF_PROFILE: Dict[str, Any] = {
+    "driver": "GTiff",
+    "tiled": True,
+    "blockxsize": 256,
+    "blockysize": 256,
+    "compress": "deflate",
+    "interleave": "pixel",
+    "BIGTIFF": "IF_SAFER",
+}
+
+
+def _temp_sibling(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.partial")
+
+
+@contextlib.contextmanager
+def atomic_output(path: PathLike) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; rename it to ``path`` only on success.
+
+    The suffix is kept (``.tif``) so that drivers recognise the format. On any exception
+    (including :class:`~photodem.algorithms.errors.Cancelled`) the temporary file is removed
+    and ``path`` stays as it was.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex[:8]}.partial{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        for leftover in (tmp, Path(str(tmp) + ".aux.xml"), Path(str(tmp) + ".ovr")):
+            if leftover.exists():
+                leftover.unlink()
+
+
+@contextlib.contextmanager
+def staged_folder(path: PathLike, replace: bool = False) -> Iterator[Path]:
+    """Yield a temporary folder beside ``path``; rename it to ``path`` only on success.
+
+    Parameters
+    ----------
+    path : path
+        The output folder.
+    replace : bool
+        Replace an existing folder of that name (after success). If False, an existing non-empty
+        folder is an error raised before any work is done.
+    """
+    from ..errors import InputError
+
+    path = Path(path)
+    if path.exists() and any(path.iterdir()) and not replace:
+        raise InputError(
+            f"The output folder '{path}' exists and is not empty; choose a new folder "
+            "(PhotoDEM does not overwrite earlier results)."
+        )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = _temp_sibling(path)
+    tmp.mkdir()
+    try:
+        yield tmp
+        if path.exists():
+            old = _temp_sibling(path)
+            os.replace(path, old)
+            os.replace(tmp, path)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def write_raster(
+    path: PathLike,
+    data: NDArray[Any],
+    transform: Optional[Affine] = None,
+    crs: Any = None,
+    nodata: Optional[float] = None,
+    overviews: bool = False,
+    **options: Any,
+) -> Path:
+    """Write a 2-D (rows, cols) or 3-D (bands, rows, cols) array as a tiled GeoTIFF, atomically.
+
+    Float rasters default to ``nodata = NaN``. ``overviews=True`` adds internal overviews
+    (factors 2, 4, 8, … down to ~256 px) for display.
+    """
+    arr = np.asarray(data)
+    if arr.ndim == 2:
+        arr = arr[None]
+    count, height, width = arr.shape
+    if nodata is None and np.issubdtype(arr.dtype, np.floating):
+        nodata = float("nan")
+    profile = dict(GTIFF_PROFILE)
+    profile.update(count=count, height=height, width=width, dtype=arr.dtype.name, nodata=nodata)
+    if transform is not None:
+        profile["transform"] = transform
+    if crs is not None and crs != "":
+        profile["crs"] = crs
+    if np.issubdtype(arr.dtype, np.floating):
+        profile["predictor"] = 3
+    if width < 256 or height < 256:  # tiles must not exceed tiny rasters
+        profile.update(tiled=False)
+        profile.pop("blockxsize")
+        profile.pop("blockysize")
+    profile.update(options)
+    with atomic_output(path) as tmp:
+        with rasterio.open(tmp, "w", **profile) as dst:
+            dst.write(arr)
+            if overviews:
+                factors = []
+                f = 2
+                while max(width, height) / f >= 256:
+                    factors.append(f)
+                    f *= 2
+                if factors:
+                    dst.build_overviews(factors, Resampling.average)
+    return Path(path)
