@@ -53,8 +53,17 @@ test-b: venv-qgis
 gui: venv
 	$(VENV)/bin/photodem gui
 
-bench: venv
-	$(VENV)/bin/python -m bench
+# Peers are installed in the bench environment only.
+VENV_BENCH := .venv-bench
+BENCH_PEERS := orthority opencv-python-headless
+$(VENV_BENCH)/.installed: pyproject.toml
+	$(PY) -m venv $(VENV_BENCH)
+	$(VENV_BENCH)/bin/pip install -q --upgrade pip
+	$(VENV_BENCH)/bin/pip install -q -e . $(BENCH_PEERS)
+	touch $@
+
+bench: $(VENV_BENCH)/.installed
+	$(VENV_BENCH)/bin/python -m bench
 
 lint: venv
 	$(VENV)/bin/ruff check .
@@ -63,4 +72,4 @@ zip: venv-qgis
 	$(VENV_QGIS)/bin/python tools/build_zip.py dist
 
 clean:
-	rm -rf $(VENV) $(VENV_QGIS) dist build demo-output .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(VENV_QGIS) $(VENV_BENCH) dist build demo-output .pytest_cache .ruff_cache

@@ -180,7 +180,9 @@ class Project:
             "format_version": FORMAT_VERSION,
             "crs": self.crs,
             "angle_unit": unit,
-            "rotation_convention": "PATB omega-phi-kappa, camera to world, R = Rx(omega) Ry(phi) Rz(kappa)",
+            "rotation_convention": (
+                "PATB omega-phi-kappa, camera to world, R = Rx(omega) Ry(phi) Rz(kappa)"
+            ),
         }
         if self.terrain_height is not None:
             head["terrain_height_m"] = float(self.terrain_height)

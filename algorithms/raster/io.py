@@ -129,15 +129,14 @@ def write_raster(
         profile.pop("blockxsize")
         profile.pop("blockysize")
     profile.update(options)
-    with atomic_output(path) as tmp:
-        with rasterio.open(tmp, "w", **profile) as dst:
-            dst.write(arr)
-            if overviews:
-                factors = []
-                f = 2
-                while max(width, height) / f >= 256:
-                    factors.append(f)
-                    f *= 2
-                if factors:
-                    dst.build_overviews(factors, Resampling.average)
+    with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+        dst.write(arr)
+        if overviews:
+            factors = []
+            f = 2
+            while max(width, height) / f >= 256:
+                factors.append(f)
+                f *= 2
+            if factors:
+                dst.build_overviews(factors, Resampling.average)
     return Path(path)
