@@ -59,8 +59,12 @@ def atomic_output(path: PathLike) -> Iterator[Path]:
                 leftover.unlink()
 
 
+#: Marker file in every folder a PhotoDEM algorithm wrote; only such folders are ever replaced.
+PRODUCT_MARKER = ".photodem-product.json"
+
+
 @contextlib.contextmanager
-def staged_folder(path: PathLike, replace: bool = False) -> Iterator[Path]:
+def staged_folder(path: PathLike, replace: bool = False, product: str = "") -> Iterator[Path]:
     """Yield a temporary folder beside ``path``; rename it to ``path`` only on success.
 
     Parameters
@@ -68,22 +72,43 @@ def staged_folder(path: PathLike, replace: bool = False) -> Iterator[Path]:
     path : path
         The output folder.
     replace : bool
-        Replace an existing folder of that name (after success). If False, an existing non-empty
-        folder is an error raised before any work is done.
+        Allow replacing an existing folder of that name (after success) — but only one that
+        PhotoDEM wrote itself (it holds :data:`PRODUCT_MARKER`): an operator's own folder is
+        never deleted. Projects are created with ``replace=False`` so that edits are never lost.
+    product : str
+        What is written (the algorithm id), recorded in the marker file.
+
+    Raises
+    ------
+    InputError
+        Before any work is done, when ``path`` exists, is not empty and may not be replaced.
     """
+    import json
+    import time
+
     from ..errors import InputError
 
     path = Path(path)
-    if path.exists() and any(path.iterdir()) and not replace:
-        raise InputError(
-            f"The output folder '{path}' exists and is not empty; choose a new folder "
-            "(PhotoDEM does not overwrite earlier results)."
-        )
+    if path.exists() and not path.is_dir():
+        raise InputError(f"The output '{path}' is a file, not a folder; choose a folder.")
+    if path.exists() and any(path.iterdir()):
+        if not replace:
+            raise InputError(
+                f"The output folder '{path}' exists and is not empty; choose a new folder "
+                "(PhotoDEM does not overwrite earlier results here)."
+            )
+        if not (path / PRODUCT_MARKER).is_file():
+            raise InputError(
+                f"The output folder '{path}' holds files PhotoDEM did not write; choose an empty "
+                "or new folder (PhotoDEM only replaces its own earlier results)."
+            )
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temp_sibling(path)
     tmp.mkdir()
     try:
         yield tmp
+        marker = {"product": product, "written": time.strftime("%Y-%m-%dT%H:%M:%S")}
+        (tmp / PRODUCT_MARKER).write_text(json.dumps(marker), encoding="utf-8")
         if path.exists():
             old = _temp_sibling(path)
             os.replace(path, old)

@@ -1,0 +1,373 @@
+r"""Epipolar (normal-case) resampling of a stereo pair.
+
+Both images are re-projected onto a common image plane of two *normal* cameras that keep the
+original projection centres :math:`C_l, C_r` but share one rotation :math:`R_n`
+(camera→world, PATB axes) with
+
+.. math::
+
+   x_n = \frac{C_r - C_l}{\|C_r - C_l\|},\quad
+   z_n = \frac{\bar z - (\bar z\cdot x_n)\,x_n}{\|\cdot\|},\quad y_n = z_n \times x_n ,
+
+where :math:`\bar z` is the mean of the two original camera z axes (so the normal image plane
+is as close as possible to both originals). In the normal case a world point has the same row
+in both images (no y-parallax) and its depth follows from the x-parallax.
+
+An epipolar pixel (col, row) of side s is the normal-camera direction
+:math:`v = (col - c_{x,s},\; -(row - c_y),\; -f_n)` (a common :math:`c_y` and height for both
+sides, a column offset :math:`c_{x,s}` and width per side). The map to the *undistorted*
+original pixel is the homography
+
+.. math:: H_s = P_s\,\mathrm{diag}(c_s, c_s, -1)\,R_s^T R_n\,M_n,\qquad
+          M_n = \begin{pmatrix}1&0&-c_{x,s}\\0&-1&c_y\\0&0&-f_n\end{pmatrix}
+
+with :math:`P_s` the (affine) image-mm → pixel map of the original camera. Lens distortion is
+then applied in the original camera (:meth:`EpipolarPair.to_original`), so the mapping is exact
+for distorted cameras too; :meth:`EpipolarPair.from_original` inverts it through the camera's
+undistortion.
+
+Triangulation in the normal case: with :math:`x_s = col_s - c_{x,s}`, parallax
+:math:`p = x_l - x_r` (px), depth :math:`D = f_n B / p`, and the point is
+:math:`X = C_l + R_n\,(x_l, -(row - c_y), -f_n)\,D / f_n`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Dict, Iterator, Optional, Tuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import GeometryError, InputError
+from .camera import Camera
+from .orientation import ExteriorOrientation
+
+Array = NDArray[np.float64]
+SIDES = ("left", "right")
+
+
+def _side_index(side: str) -> int:
+    if side not in SIDES:
+        raise InputError(f"Epipolar side must be 'left' or 'right', not {side!r}.")
+    return SIDES.index(side)
+
+
+def normal_rotation(eo_left: ExteriorOrientation, eo_right: ExteriorOrientation
+                    ) -> Tuple[Array, float]:
+    """Common camera→world rotation of the normal case and the base length (m)."""
+    b = eo_right.position - eo_left.position
+    base = float(np.linalg.norm(b))
+    if not base > 0:
+        raise GeometryError("The two images have the same projection centre: no stereo base.")
+    x = b / base
+    z_mean = eo_left.rotation[:, 2] + eo_right.rotation[:, 2]
+    z = z_mean - (z_mean @ x) * x
+    nz = np.linalg.norm(z)
+    if nz < 1e-6:
+        raise GeometryError("The stereo base is parallel to the viewing direction; the pair "
+                            "cannot be normalised (convergent or along-track oblique images).")
+    z /= nz
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z]), base
+
+
+def _pixel_affine(camera: Camera) -> Array:
+    """3×3 matrix of the affine image-mm (from the principal point) → pixel map."""
+    c0, r0 = camera.image_to_pixel(0.0, 0.0)
+    c1, r1 = camera.image_to_pixel(1.0, 0.0)
+    c2, r2 = camera.image_to_pixel(0.0, 1.0)
+    return np.array([[c1 - c0, c2 - c0, c0], [r1 - r0, r2 - r0, r0], [0.0, 0.0, 1.0]],
+                    dtype=float)
+
+
+@dataclass
+class EpipolarPair:
+    """A normalised stereo pair and its mappings to the original images.
+
+    Attributes
+    ----------
+    cameras, eos : (left, right)
+        The original interior and exterior orientations.
+    rotation : ndarray (3, 3)
+        Common camera→world rotation :math:`R_n` of the normal images.
+    base : float
+        Base length B (m), along the normal x axis from left to right.
+    focal_px : float
+        Principal distance :math:`f_n` of the normal images in pixels.
+    cx : (float, float)
+        Column of the normal principal point in the left and right epipolar image.
+    cy : float
+        Row of the normal principal point (common to both).
+    sizes : ((w_l, h), (w_r, h))
+        Epipolar image sizes in pixels.
+    homographies : ndarray (2, 3, 3)
+        Epipolar pixel → undistorted original pixel (see module notes).
+    """
+
+    cameras: Tuple[Camera, Camera]
+    eos: Tuple[ExteriorOrientation, ExteriorOrientation]
+    rotation: Array
+    base: float
+    focal_px: float
+    cx: Tuple[float, float]
+    cy: float
+    sizes: Tuple[Tuple[int, int], Tuple[int, int]]
+    homographies: Array
+    names: Tuple[str, str] = ("left", "right")
+
+    # -- construction --------------------------------------------------------------------------
+    @classmethod
+    def from_orientations(cls, camera_left: Camera, eo_left: ExteriorOrientation,
+                          camera_right: Camera, eo_right: ExteriorOrientation,
+                          scale: float = 1.0, names: Tuple[str, str] = ("left", "right"),
+                          border_samples: int = 64) -> EpipolarPair:
+        """Normalise a pair.
+
+        Parameters
+        ----------
+        scale : float
+            Epipolar pixel size relative to the originals: 1 keeps the mean resolution,
+            0.5 halves it.
+        border_samples : int
+            Points per image edge used to find the epipolar image extents (distortion bends
+            the edges, so the four corners are not enough).
+        """
+        if not scale > 0:
+            raise InputError(f"Epipolar scale must be positive, got {scale}.")
+        R_n, base = normal_rotation(eo_left, eo_right)
+        f_n = scale * 0.5 * (camera_left.focal_length_px + camera_right.focal_length_px)
+        pair = cls((camera_left, camera_right), (eo_left, eo_right), R_n, base, f_n,
+                   (0.0, 0.0), 0.0, ((1, 1), (1, 1)), np.zeros((2, 3, 3)), tuple(names))
+        # extents: original borders in normal coordinates (col with cx=0, row with cy=0)
+        u_rng, w_rng = [], []
+        for s, cam in enumerate(pair.cameras):
+            c = cam.corners()
+            t = np.linspace(0.0, 1.0, border_samples, endpoint=False)[:, None]
+            border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
+            u, w = pair._original_to_normal(s, border[:, 0], border[:, 1])
+            if not (np.isfinite(u).all() and np.isfinite(w).all()):
+                raise GeometryError("An image border looks away from the normal image plane; "
+                                    "the pair cannot be normalised.")
+            u_rng.append((u.min(), u.max()))
+            w_rng.append((w.min(), w.max()))
+        w_lo = min(r[0] for r in w_rng)
+        w_hi = max(r[1] for r in w_rng)
+        cy = float(np.ceil(w_hi))
+        height = int(cy - np.floor(w_lo)) + 1
+        cx, sizes = [], []
+        for lo, hi in u_rng:
+            cx.append(float(-np.floor(lo)))
+            sizes.append((int(np.ceil(hi) - np.floor(lo)) + 1, height))
+        pair.cx = (cx[0], cx[1])
+        pair.cy = cy
+        pair.sizes = (sizes[0], sizes[1])
+        pair.homographies = np.stack([pair._homography(0), pair._homography(1)])
+        return pair
+
+    def _homography(self, s: int) -> Array:
+        cam, eo = self.cameras[s], self.eos[s]
+        M_n = np.array([[1.0, 0.0, -self.cx[s]], [0.0, -1.0, self.cy], [0.0, 0.0, -self.focal_px]])
+        K = np.diag([cam.focal_length, cam.focal_length, -1.0])
+        H = _pixel_affine(cam) @ K @ eo.rotation.T @ self.rotation @ M_n
+        # normalise, keeping the sign so that q2 > 0 means "in front of the camera"
+        return H / abs(H[2, 2])
+
+    def _original_to_normal(self, s: int, col: ArrayLike, row: ArrayLike) -> Tuple[Array, Array]:
+        """Original pixel → normal image coordinates (u right, w up) in px, no offsets."""
+        cam, eo = self.cameras[s], self.eos[s]
+        v = cam.pixel_to_camera(col, row) @ eo.rotation.T @ self.rotation
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(v[..., 2] < 0, -self.focal_px / v[..., 2], np.nan)
+        return v[..., 0] * scale, v[..., 1] * scale
+
+    # -- mappings ------------------------------------------------------------------------------
+    @property
+    def height(self) -> int:
+        return self.sizes[0][1]
+
+    def from_original(self, side: str, col: ArrayLike, row: ArrayLike) -> Tuple[Array, Array]:
+        """Original pixel (col, row) of ``side`` → epipolar pixel (col, row)."""
+        s = _side_index(side)
+        u, w = self._original_to_normal(s, col, row)
+        return u + self.cx[s], self.cy - w
+
+    def to_original(self, side: str, col: ArrayLike, row: ArrayLike) -> Tuple[Array, Array]:
+        """Epipolar pixel (col, row) of ``side`` → original pixel (col, row), with distortion."""
+        s = _side_index(side)
+        cam = self.cameras[s]
+        H = self.homographies[s]
+        col = np.asarray(col, dtype=float)
+        row = np.asarray(row, dtype=float)
+        q0 = H[0, 0] * col + H[0, 1] * row + H[0, 2]
+        q1 = H[1, 0] * col + H[1, 1] * row + H[1, 2]
+        q2 = H[2, 0] * col + H[2, 1] * row + H[2, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            q2 = np.where(q2 > 0, q2, np.nan)  # behind the original camera
+            cu, ru = q0 / q2, q1 / q2
+        if not cam.has_distortion:
+            return cu, ru
+        return cam.image_to_pixel(*cam.distort(*cam.pixel_to_image(cu, ru)))
+
+    def original_map(self, side: str, row_start: int = 0, row_stop: Optional[int] = None
+                     ) -> Tuple[Array, Array]:
+        """Original (col, row) for every epipolar pixel of rows ``row_start:row_stop``.
+
+        NaN where the epipolar pixel falls outside the original image.
+        """
+        s = _side_index(side)
+        w, h = self.sizes[s]
+        row_stop = h if row_stop is None else min(row_stop, h)
+        rr, cc = np.mgrid[row_start:row_stop, 0:w].astype(float)
+        oc, orow = self.to_original(side, cc, rr)
+        cam = self.cameras[s]
+        inside = ((oc >= -0.5) & (oc <= cam.width - 0.5)
+                  & (orow >= -0.5) & (orow <= cam.height - 0.5))
+        return np.where(inside, oc, np.nan), np.where(inside, orow, np.nan)
+
+    def iter_resample(self, image: NDArray, side: str, chunk_rows: Optional[int] = None,
+                      max_pixels: int = 2_000_000
+                      ) -> Iterator[Tuple[int, NDArray, NDArray[np.bool_], Array, Array]]:
+        """Resample an original image to epipolar geometry, one block of rows at a time.
+
+        Yields ``(row_start, block (bands, rows, w), valid (rows, w), map_col, map_row)``;
+        bilinear interpolation (:func:`scipy.ndimage.map_coordinates`, order 1) of every band,
+        0 outside the original image. Integer inputs are rounded and clipped to their type.
+        """
+        from scipy.ndimage import map_coordinates
+
+        img = np.asarray(image)
+        if img.ndim == 2:
+            img = img[None]
+        s = _side_index(side)
+        cam = self.cameras[s]
+        if img.shape[1:] != (cam.height, cam.width):
+            raise InputError(
+                f"The {side} image is {img.shape[2]}×{img.shape[1]} px but its camera "
+                f"'{cam.name}' is {cam.width}×{cam.height} px."
+            )
+        w, h = self.sizes[s]
+        if chunk_rows is None:
+            chunk_rows = max(1, max_pixels // max(w, 1))
+        integer = np.issubdtype(img.dtype, np.integer)
+        info = np.iinfo(img.dtype) if integer else None
+        for r0 in range(0, h, chunk_rows):
+            r1 = min(r0 + chunk_rows, h)
+            mc, mr = self.original_map(side, r0, r1)
+            valid = np.isfinite(mc)
+            coords = np.stack([np.where(valid, mr, 0.0), np.where(valid, mc, 0.0)])
+            out = np.empty((img.shape[0], r1 - r0, w), dtype=img.dtype)
+            for b in range(img.shape[0]):
+                # interpolation runs in double precision whatever the input type
+                vals = map_coordinates(img[b], coords, output=np.float64, order=1,
+                                       mode="nearest")
+                vals = np.where(valid, vals, 0.0)
+                if info is not None:
+                    vals = np.clip(np.rint(vals), info.min, info.max)
+                out[b] = vals.astype(img.dtype)
+            yield r0, out, valid, mc, mr
+
+    def resample(self, image: NDArray, side: str, chunk_rows: Optional[int] = None
+                 ) -> Tuple[NDArray, NDArray[np.bool_]]:
+        """The whole epipolar image (bands, h, w) (2-D in → 2-D out) and its valid mask."""
+        s = _side_index(side)
+        w, h = self.sizes[s]
+        img = np.asarray(image)
+        bands = 1 if img.ndim == 2 else img.shape[0]
+        out = np.zeros((bands, h, w), dtype=img.dtype)
+        valid = np.zeros((h, w), dtype=bool)
+        for r0, block, ok, _, _ in self.iter_resample(img, side, chunk_rows):
+            out[:, r0:r0 + block.shape[1]] = block
+            valid[r0:r0 + block.shape[1]] = ok
+        return (out[0] if img.ndim == 2 else out), valid
+
+    # -- triangulation -------------------------------------------------------------------------
+    def epipolar_point_to_world(self, col_left: ArrayLike, row: ArrayLike,
+                                col_right: ArrayLike) -> Array:
+        """World points (..., 3) from matching epipolar columns on a common row.
+
+        NaN where the parallax is not positive (point at or behind infinity).
+        """
+        x_l = np.asarray(col_left, dtype=float) - self.cx[0]
+        x_r = np.asarray(col_right, dtype=float) - self.cx[1]
+        y = -(np.asarray(row, dtype=float) - self.cy)
+        p = x_l - x_r
+        with np.errstate(divide="ignore", invalid="ignore"):
+            depth = np.where(p > 0, self.focal_px * self.base / p, np.nan)
+        x_l, y, depth = np.broadcast_arrays(x_l, y, depth)
+        v = np.stack([x_l, y, np.full_like(x_l, -self.focal_px)], axis=-1) \
+            * (depth / self.focal_px)[..., None]
+        return self.eos[0].position + v @ self.rotation.T
+
+    def disparity_to_world(self, disparity: ArrayLike,
+                           col_left: Optional[ArrayLike] = None,
+                           row: Optional[ArrayLike] = None) -> Array:
+        """World points from disparities ``d = col_left − col_right`` (px).
+
+        With only ``disparity`` (a (h, w) map over the left epipolar image) the pixel grid
+        supplies the columns and rows; returns (h, w, 3), NaN where d is NaN.
+        """
+        d = np.asarray(disparity, dtype=float)
+        if col_left is None or row is None:
+            row, col_left = np.mgrid[0:d.shape[0], 0:d.shape[1]].astype(float)
+        return self.epipolar_point_to_world(col_left, row, np.asarray(col_left, float) - d)
+
+    def world_to_epipolar(self, points: ArrayLike, side: str) -> Tuple[Array, Array]:
+        """World points (..., 3) → epipolar pixel (col, row) of ``side`` (no distortion)."""
+        s = _side_index(side)
+        v = (np.asarray(points, dtype=float) - self.eos[s].position) @ self.rotation
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(v[..., 2] < 0, -self.focal_px / v[..., 2], np.nan)
+        return v[..., 0] * scale + self.cx[s], self.cy - v[..., 1] * scale
+
+    def disparity_range(self, z_min: float, z_max: float) -> Tuple[float, float]:
+        """Disparity interval for terrain between ``z_min`` and ``z_max`` (at the pair centre)."""
+        centre = 0.5 * (self.eos[0].position + self.eos[1].position)
+        pts = np.array([[centre[0], centre[1], z_min], [centre[0], centre[1], z_max]])
+        cl, _ = self.world_to_epipolar(pts, "left")
+        cr, _ = self.world_to_epipolar(pts, "right")
+        d = cl - cr
+        return float(np.nanmin(d)), float(np.nanmax(d))
+
+    # -- serialisation -------------------------------------------------------------------------
+    def to_dict(self) -> Dict[str, Any]:
+        """JSON-ready description (``epipolar.json``)."""
+        return {
+            "names": list(self.names),
+            "base_m": self.base,
+            "focal_px": self.focal_px,
+            "cx": list(self.cx),
+            "cy": self.cy,
+            "sizes": [list(s) for s in self.sizes],
+            "rotation": self.rotation.tolist(),
+            "homographies": {side: self.homographies[i].tolist()
+                             for i, side in enumerate(SIDES)},
+            "homography_maps": "epipolar pixel (col,row,1) -> undistorted original pixel; "
+                               "apply the original camera's distortion after it",
+            "disparity": "d = col_left - col_right; parallax p = d - (cx_left - cx_right); "
+                         "depth = focal_px * base_m / p",
+            "cameras": {side: {"name": self.cameras[i].name, **self.cameras[i].to_dict()}
+                        for i, side in enumerate(SIDES)},
+            "orientations": {side: {"position": self.eos[i].position.tolist(),
+                                    "rotation": self.eos[i].rotation.tolist()}
+                             for i, side in enumerate(SIDES)},
+        }
+
+    @classmethod
+    def from_dict(cls, d: Dict[str, Any]) -> EpipolarPair:
+        """Inverse of :meth:`to_dict`."""
+        cams = []
+        eos = []
+        for side in SIDES:
+            cd = dict(d["cameras"][side])
+            name = str(cd.pop("name"))
+            cams.append(Camera.from_dict(name, cd))
+            o = d["orientations"][side]
+            eos.append(ExteriorOrientation(np.asarray(o["position"]), np.asarray(o["rotation"])))
+        sizes = tuple(tuple(int(v) for v in s) for s in d["sizes"])
+        return cls((cams[0], cams[1]), (eos[0], eos[1]), np.asarray(d["rotation"], float),
+                   float(d["base_m"]), float(d["focal_px"]),
+                   (float(d["cx"][0]), float(d["cx"][1])), float(d["cy"]),
+                   sizes,  # type: ignore[arg-type]
+                   np.stack([np.asarray(d["homographies"][s], float) for s in SIDES]),
+                   tuple(d.get("names", SIDES)))  # type: ignore[arg-type]
