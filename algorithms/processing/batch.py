@@ -1,0 +1,761 @@
+"""Batch runs: ``photodem batch FILE.toml`` runs algorithms step by step over stereo models.
+
+A batch file is TOML::
+
+    [batch]
+    project = "../blocks/ngi"      # project folder (relative to the batch file)
+    workers = 2                      # worker processes (1 = run in this process)
+    output = "{project}/runs/night"  # run folder; default <project>/runs/<timestamp>/
+
+    [[steps]]
+    algorithm = "epipolar_pair"
+    name = "epipolar"                # optional, default: the algorithm id
+    models = "all"                   # or ["0182_0184", "0251_0253"]; ``images`` likewise
+    [steps.params]
+    output = "{project}/products/{step}/{model}"
+
+Semantics (kept simple on purpose):
+
+- **Tasks.** A step whose algorithm declares ``iterates_over`` (the name of its ``model`` or
+  ``image`` parameter) becomes one task per chosen model/image, with that parameter set; other
+  steps are one task. A ``project`` parameter that the step does not set gets the batch project.
+- **Placeholders** in parameter strings: ``{project}`` (project folder), ``{run}`` (run folder),
+  ``{step}`` (step name), ``{model}`` / ``{image}`` (the task's item). Other braces stay as they
+  are.
+- **Order.** Steps run one after the other; the tasks of one step run in parallel on ``workers``
+  processes (``spawn`` context; ``workers = 1`` runs them in this process). Every task calls
+  :func:`.registry.run`, so its result is the same as from Python, the CLI or QGIS.
+- **Failures.** A failed task does not stop the other tasks of its step. A later step's task for
+  the same model/image is not run (status ``failed``, "not run because …"); other tasks go on.
+  The batch status is ``failed`` and the CLI exits 1.
+- **Resume.** After each finished task its parameter hash and outputs are recorded in
+  ``<project>/.photodem/batch-state.json``. With ``resume`` (the default) a task is ``skipped``
+  when the record has the same hash (same algorithm and same parameters after placeholder
+  substitution) and every recorded file/folder output still exists. Outputs inside ``{run}``
+  therefore never resume (each run has a new folder); put products under ``{project}``. Input
+  file contents are not hashed.
+- **Cancel.** :meth:`Feedback.cancel` (Ctrl-C in the CLI) stops scheduling; running tasks are
+  asked to stop (a shared event their Feedback checks), which makes the algorithms discard their
+  staged outputs; workers that do not stop within ``grace`` seconds are terminated.
+- **Logs.** ``<run>/batch.log`` (the whole run), one log per task (``<run>/<step>.log`` or
+  ``<run>/<step>/<item>.log``) and ``<run>/summary.json`` with each task's status
+  (``done``/``skipped``/``failed``/``cancelled``), outputs, duration and error message.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import datetime as _dt
+import hashlib
+import importlib
+import json
+import multiprocessing
+import os
+import re
+import signal
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, TextIO, Union
+
+from ..errors import Cancelled, InputError, PhotodemError
+from ..project import toml_io
+from . import registry
+from .feedback import Feedback, ensure_feedback
+
+#: Environment variable with extra algorithm modules (comma-separated, importable names) that
+#: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
+EXTRA_ALGORITHMS_ENV = "PHOTODEM_EXTRA_ALGORITHMS"
+STATE_FILE = Path(".photodem") / "batch-state.json"
+SUMMARY_FILE = "summary.json"
+TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
+_FILE_OUTPUT_KINDS = ("file", "folder", "raster", "vector")
+_PLACEHOLDER = re.compile(r"\{(project|run|step|model|image)\}")
+_BATCH_KEYS = {"project", "workers", "output"}
+_STEP_KEYS = {"algorithm", "name", "models", "images", "params"}
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+# -- extra algorithm modules ---------------------------------------------------------------------
+def register_algorithm_modules(names: Iterable[str]) -> List[str]:
+    """Import modules that list ``ALGORITHMS`` and add them to the registry; return their ids."""
+    names = [n.strip() for n in names if n and n.strip()]
+    if not names:
+        return []
+    registry.algorithms()  # load the built-in ones first
+    ids = []
+    for name in names:
+        module = importlib.import_module(name)
+        for cls in module.ALGORITHMS:
+            alg = cls()
+            registry._CACHE[alg.id] = alg
+            ids.append(alg.id)
+    return ids
+
+
+def extra_modules_from_env() -> List[str]:
+    """Module names from :data:`EXTRA_ALGORITHMS_ENV`."""
+    return [n.strip() for n in os.environ.get(EXTRA_ALGORITHMS_ENV, "").split(",") if n.strip()]
+
+
+# -- the plan ------------------------------------------------------------------------------------
+@dataclass
+class Task:
+    """One algorithm run of a batch."""
+
+    index: int
+    step: str
+    algorithm: str
+    item: Optional[str]  # the model or image name of an iterating step
+    item_kind: Optional[str]  # "model" or "image"
+    params: Dict[str, Any]  # raw values, placeholders substituted
+    log: Path
+
+    @property
+    def key(self) -> str:
+        """Identity of the task across runs: ``step`` or ``step/item``."""
+        return self.step if self.item is None else f"{self.step}/{self.item}"
+
+    @property
+    def params_hash(self) -> str:
+        text = json.dumps({"algorithm": self.algorithm, "params": self.params},
+                          sort_keys=True, default=str)
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+@dataclass
+class BatchPlan:
+    """A parsed batch file: the project, the run folder, the steps and their tasks."""
+
+    project: Path
+    run_dir: Path
+    workers: int
+    steps: List[str]
+    tasks: List[Task] = field(default_factory=list)
+    file: Optional[Path] = None
+
+    def to_dict(self) -> Dict[str, Any]:
+        return {
+            "file": str(self.file) if self.file else None,
+            "project": str(self.project),
+            "run": str(self.run_dir),
+            "workers": self.workers,
+            "steps": list(self.steps),
+            "tasks": [
+                {"step": t.step, "algorithm": t.algorithm, "item": t.item, "params": t.params,
+                 "log": str(t.log), "hash": t.params_hash}
+                for t in self.tasks
+            ],
+        }
+
+
+def load_batch(path: PathLike, run_dir: Optional[PathLike] = None,
+               now: Optional[_dt.datetime] = None) -> BatchPlan:
+    """Read a batch TOML file and plan its tasks.
+
+    Relative paths in ``[batch]`` are relative to the batch file's folder.
+
+    Raises
+    ------
+    InputError
+        For an unreadable file, unknown keys, unknown algorithms, models or images.
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"Batch file '{file}' does not exist.")
+    try:
+        config = toml_io.loads(file.read_text(encoding="utf-8"))
+    except Exception as exc:  # tomllib.TOMLDecodeError
+        raise InputError(f"Cannot read batch file '{file}': {exc}") from exc
+    plan = plan_batch(config, base_dir=file.resolve().parent, run_dir=run_dir, now=now)
+    plan.file = file.resolve()
+    return plan
+
+
+def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
+               run_dir: Optional[PathLike] = None,
+               now: Optional[_dt.datetime] = None) -> BatchPlan:
+    """Plan the tasks of a batch given as a dict (the parsed TOML)."""
+    from ..project.model import Project  # numpy and friends only when a batch is planned
+
+    unknown = set(config) - {"batch", "steps"}
+    if unknown:
+        raise InputError(f"Batch file: unknown table(s) {', '.join(sorted(unknown))}; "
+                         "expected [batch] and [[steps]].")
+    head = dict(config.get("batch", {}))
+    _check_keys(head, _BATCH_KEYS, "[batch]")
+    if "project" not in head:
+        raise InputError("Batch file: [batch] needs project = \"<project folder>\".")
+    project_dir = (Path(base_dir) / Path(str(head["project"])).expanduser()).resolve()
+    project = Project.load(project_dir)
+    project_dir = project.root.resolve()
+    try:
+        workers = int(head.get("workers", 1))
+    except (TypeError, ValueError):
+        workers = 0
+    if workers < 1:
+        raise InputError(f"Batch file: workers = {head.get('workers')!r} must be a whole "
+                         "number ≥ 1.")
+    if run_dir is None:
+        if head.get("output"):
+            text = _PLACEHOLDER.sub(lambda m: str(project_dir) if m.group(1) == "project"
+                                    else m.group(0), str(head["output"]))
+            run_dir = Path(base_dir) / Path(text).expanduser()
+        else:
+            run_dir = _timestamped(project_dir / "runs", now)
+    run = Path(run_dir).resolve()
+
+    steps = config.get("steps", [])
+    if not isinstance(steps, list) or not steps:
+        raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
+    plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[])
+    for number, step in enumerate(steps, start=1):
+        if not isinstance(step, dict):
+            raise InputError(f"Batch file: step {number} is not a table.")
+        _plan_step(plan, project, step, number)
+    return plan
+
+
+def _check_keys(table: Dict[str, Any], allowed: set, where: str) -> None:
+    unknown = set(table) - allowed
+    if unknown:
+        raise InputError(f"Batch file: unknown key(s) {', '.join(sorted(unknown))} in {where}; "
+                         f"allowed are {', '.join(sorted(allowed))}.")
+
+
+def _timestamped(parent: Path, now: Optional[_dt.datetime]) -> Path:
+    stamp = (now or _dt.datetime.now()).strftime("%Y%m%d-%H%M%S")
+    candidate, n = parent / stamp, 2
+    while candidate.exists():
+        candidate, n = parent / f"{stamp}-{n}", n + 1
+    return candidate
+
+
+def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int) -> None:
+    _check_keys(step, _STEP_KEYS, f"step {number}")
+    if "algorithm" not in step:
+        raise InputError(f"Batch file: step {number} needs algorithm = \"id\".")
+    alg = registry.get(str(step["algorithm"]))
+    name = str(step.get("name") or alg.id)
+    if not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
+        raise InputError(f"Batch file: step name {name!r} may hold only letters, digits, "
+                         "'_', '-' and '.' (it names the log files).")
+    if name in plan.steps:
+        raise InputError(f"Batch file: two steps are named {name!r}; give them distinct names.")
+    plan.steps.append(name)
+    params = step.get("params", {})
+    if not isinstance(params, dict):
+        raise InputError(f"Batch file: params of step '{name}' must be a table.")
+    params = dict(params)
+    for p in alg.parameters:  # the batch project unless the step names another one
+        if p.kind == "project" and p.name not in params:
+            params[p.name] = "{project}"
+
+    iterate = alg.iterates_over
+    item_kind: Optional[str] = None
+    if iterate is not None:
+        item_kind = alg.parameter(iterate).kind
+        if item_kind not in ("model", "image"):
+            raise InputError(f"{alg.id}: iterates_over names '{iterate}', which is neither a "
+                             "model nor an image parameter.")
+    for key in ("models", "images"):
+        if key in step and (item_kind is None or key != item_kind + "s"):
+            raise InputError(
+                f"Batch file: step '{name}' sets {key}, but {alg.id} "
+                + ("does not iterate." if item_kind is None else f"iterates over {item_kind}s.")
+            )
+    items: List[Optional[str]] = [None]
+    if item_kind is not None and iterate not in params:
+        available = ([m.name for m in project.models] if item_kind == "model"
+                     else [i.name for i in project.images])
+        chosen = step.get(item_kind + "s", "all")
+        if chosen == "all":
+            items = list(available)
+        elif isinstance(chosen, list):
+            missing = [c for c in chosen if str(c) not in available]
+            if missing:
+                raise InputError(
+                    f"Batch file: step '{name}': {item_kind}(s) {', '.join(map(str, missing))} "
+                    f"not in the project; it has {', '.join(available) or 'none'}."
+                )
+            items = [str(c) for c in chosen]
+        else:
+            raise InputError(f"Batch file: step '{name}': {item_kind}s must be \"all\" or a "
+                             "list of names.")
+        if not items:
+            raise InputError(f"Batch file: step '{name}': the project has no {item_kind}s.")
+
+    for item in items:
+        values = {"project": str(plan.project), "run": str(plan.run_dir), "step": name}
+        if item is not None:
+            values[item_kind] = item  # type: ignore[index]
+        task_params = {k: _substitute(v, values, name) for k, v in params.items()}
+        if item is not None:
+            task_params[iterate] = item  # type: ignore[index]
+        log = plan.run_dir / (f"{name}.log" if item is None else f"{name}/{_safe(item)}.log")
+        plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
+                               item_kind=item_kind, params=task_params, log=log))
+
+
+def _safe(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
+
+
+def _substitute(value: Any, values: Dict[str, str], step: str) -> Any:
+    if isinstance(value, list):
+        return [_substitute(v, values, step) for v in value]
+    if not isinstance(value, str):
+        return value
+
+    def repl(match: re.Match) -> str:
+        key = match.group(1)
+        if key not in values:
+            raise InputError(f"Batch file: step '{step}' uses {{{key}}}, but it does not run "
+                             f"per {key}.")
+        return values[key]
+
+    return _PLACEHOLDER.sub(repl, value)
+
+
+# -- resume state --------------------------------------------------------------------------------
+def _state_path(project: Path) -> Path:
+    return project / STATE_FILE
+
+
+def _read_state(project: Path) -> Dict[str, Any]:
+    path = _state_path(project)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    tasks = data.get("tasks", {}) if isinstance(data, dict) else {}
+    return tasks if isinstance(tasks, dict) else {}
+
+
+def _write_state(project: Path, tasks: Dict[str, Any]) -> None:
+    path = _state_path(project)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps({"format_version": 1, "tasks": tasks}, indent=1), encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _output_paths(algorithm: str, outputs: Dict[str, Any]) -> List[str]:
+    """The file/folder outputs of a result (by the algorithm's output kinds)."""
+    try:
+        alg = registry.get(algorithm)
+    except PhotodemError:
+        return []
+    paths = []
+    for out in alg.outputs:
+        value = outputs.get(out.name)
+        if out.kind in _FILE_OUTPUT_KINDS and isinstance(value, str) and value:
+            paths.append(value)
+    return paths
+
+
+def _resumable(task: Task, state: Dict[str, Any]) -> Optional[Dict[str, Any]]:
+    """The recorded outputs when ``task`` is complete from an earlier run, else ``None``."""
+    record = state.get(task.key)
+    if not isinstance(record, dict) or record.get("hash") != task.params_hash:
+        return None
+    outputs = record.get("outputs", {})
+    if not isinstance(outputs, dict):
+        return None
+    if all(Path(p).exists() for p in _output_paths(task.algorithm, outputs)):
+        return outputs
+    return None
+
+
+# -- running one task (in this process or in a worker) ------------------------------------------
+class _TaskFeedback(Feedback):
+    """Writes a task's log file; cancellation and progress come from / go to the batch."""
+
+    def __init__(self, log: TextIO, is_canceled: Callable[[], bool],
+                 on_progress: Optional[Callable[[float], None]] = None) -> None:
+        super().__init__(on_progress=on_progress)
+        self._log = log
+        self._is_canceled = is_canceled
+
+    def is_canceled(self) -> bool:
+        return self._cancel.is_set() or self._is_canceled()
+
+    def _write(self, level: str, message: str) -> None:
+        stamp = time.strftime("%H:%M:%S")
+        self._log.write(f"{stamp} {level:7s} {message}\n")
+        self._log.flush()
+
+    def info(self, message: str) -> None:
+        super().info(message)
+        self._write("INFO", message)
+
+    def warning(self, message: str) -> None:
+        super().warning(message)
+        self._write("WARNING", message)
+
+
+def execute_task(algorithm: str, params: Dict[str, Any], log_path: PathLike,
+                 is_canceled: Callable[[], bool],
+                 on_progress: Optional[Callable[[float], None]] = None) -> Dict[str, Any]:
+    """Run one task through :func:`.registry.run`, logging to ``log_path``.
+
+    Returns ``{"status", "outputs", "duration_s", "error", "warnings"}``; never raises for
+    errors of the algorithm (they become status ``failed``; cancellation ``cancelled``).
+    """
+    log_path = Path(log_path)
+    log_path.parent.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    with open(log_path, "a", encoding="utf-8") as log:
+        feedback = _TaskFeedback(log, is_canceled, on_progress)
+        feedback._write("INFO", f"{algorithm} {json.dumps(params, default=str)}")
+        result: Dict[str, Any] = {"status": "done", "outputs": {}, "error": None}
+        try:
+            result["outputs"] = registry.run(algorithm, params, feedback)
+        except Cancelled as exc:
+            result.update(status="cancelled", error=str(exc))
+        except PhotodemError as exc:
+            result.update(status="failed", error=str(exc))
+        except Exception as exc:  # a bug: keep the traceback in the task log
+            result.update(status="failed", error=f"{type(exc).__name__}: {exc}")
+            log.write(traceback.format_exc())
+        if result["error"]:
+            feedback._write("ERROR" if result["status"] == "failed" else "INFO", result["error"])
+        result["duration_s"] = round(time.perf_counter() - start, 3)
+        result["warnings"] = list(feedback.warnings)
+    return result
+
+
+_worker_cancel: Any = None
+_worker_queue: Any = None
+
+
+def _init_worker(cancel_event: Any, queue: Any, modules: Sequence[str]) -> None:
+    """Worker start: the parent handles Ctrl-C (and tells us through ``cancel_event``)."""
+    global _worker_cancel, _worker_queue
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _worker_cancel, _worker_queue = cancel_event, queue
+    register_algorithm_modules(modules)
+
+
+def _worker_run(index: int, algorithm: str, params: Dict[str, Any], log: str) -> Dict[str, Any]:
+    last = [-1.0]
+
+    def progress(pct: float) -> None:
+        if pct - last[0] >= 1.0 or pct >= 100.0:  # at most ~100 messages per task
+            last[0] = pct
+            _worker_queue.put((index, pct))
+
+    return execute_task(algorithm, params, log, _worker_cancel.is_set, progress)
+
+
+# -- the batch -----------------------------------------------------------------------------------
+class _Progress:
+    """Overall progress = mean of the task fractions; forwarded without raising Cancelled."""
+
+    def __init__(self, feedback: Feedback, n: int) -> None:
+        self.feedback = feedback
+        self.fraction = [0.0] * n
+
+    def set(self, index: int, pct: float) -> None:
+        # never backwards: a worker's last queued report may arrive after its task finished
+        self.fraction[index] = max(self.fraction[index], min(max(pct / 100.0, 0.0), 1.0))
+        total = 100.0 * sum(self.fraction) / max(len(self.fraction), 1)
+        with contextlib.suppress(Cancelled):  # the batch loop checks is_canceled() itself
+            self.feedback.progress(total)
+
+
+def run_batch(
+    plan: BatchPlan,
+    feedback: Optional[Feedback] = None,
+    workers: Optional[int] = None,
+    resume: bool = True,
+    extra_modules: Sequence[str] = (),
+    grace: float = 10.0,
+) -> Dict[str, Any]:
+    """Run a planned batch and return its summary (also written to ``<run>/summary.json``).
+
+    Parameters
+    ----------
+    plan : BatchPlan
+        From :func:`load_batch`.
+    feedback : Feedback, optional
+        Receives the overall progress (share of tasks finished, including the running tasks'
+        own progress), one log line per task, and cancellation.
+    workers : int, optional
+        Worker processes; default ``plan.workers``. ``1`` runs the tasks in this process.
+    resume : bool
+        Skip tasks that an earlier run completed with the same parameters.
+    extra_modules : sequence of str
+        Modules with extra ``ALGORITHMS`` to register in the workers (besides those named in
+        :data:`EXTRA_ALGORITHMS_ENV`, which workers inherit).
+    grace : float
+        Seconds that running tasks get to stop after a cancel before their workers are
+        terminated.
+
+    Returns
+    -------
+    dict
+        ``status`` (``done``, ``failed`` or ``cancelled``), ``counts`` per task status, the
+        ``run`` folder, ``summary`` path and ``tasks`` (step, algorithm, item, status, outputs,
+        duration_s, error, log).
+    """
+    feedback = ensure_feedback(feedback)
+    n_workers = max(1, int(workers if workers is not None else plan.workers))
+    plan.run_dir.mkdir(parents=True, exist_ok=True)
+    started = _dt.datetime.now().isoformat(timespec="seconds")
+    t0 = time.perf_counter()
+    state = _read_state(plan.project) if resume else {}
+    records: List[Dict[str, Any]] = [
+        {"step": t.step, "algorithm": t.algorithm, "item": t.item, "status": "cancelled",
+         "outputs": {}, "duration_s": 0.0, "error": None, "log": str(t.log),
+         "hash": t.params_hash}
+        for t in plan.tasks
+    ]
+    progress = _Progress(feedback, len(plan.tasks))
+    batch_log = open(plan.run_dir / "batch.log", "a", encoding="utf-8")  # noqa: SIM115
+
+    def log(message: str, warning: bool = False) -> None:
+        batch_log.write(f"{time.strftime('%H:%M:%S')} {message}\n")
+        batch_log.flush()
+        (feedback.warning if warning else feedback.info)(message)
+
+    def finish(task: Task, result: Dict[str, Any]) -> None:
+        record = records[task.index]
+        record.update({k: result.get(k) for k in ("status", "outputs", "duration_s", "error")})
+        if result.get("warnings"):
+            record["warnings"] = result["warnings"]
+        if record["status"] != "cancelled":
+            progress.set(task.index, 100.0)
+        label = task.key
+        if record["status"] == "done":
+            state_all = _read_state(plan.project)
+            state_all[task.key] = {"hash": task.params_hash, "algorithm": task.algorithm,
+                                   "outputs": record["outputs"], "run": str(plan.run_dir),
+                                   "finished": _dt.datetime.now().isoformat(timespec="seconds")}
+            _write_state(plan.project, state_all)
+            log(f"{label}: done in {record['duration_s']:.1f} s")
+        elif record["status"] == "failed":
+            log(f"{label}: FAILED: {record['error']}", warning=True)
+        elif record["status"] == "cancelled":
+            log(f"{label}: cancelled")
+
+    log(f"batch {plan.file or ''}: {len(plan.tasks)} task(s) in {len(plan.steps)} step(s), "
+        f"{n_workers} worker(s), run folder {plan.run_dir}")
+    failed_items: Dict[tuple, str] = {}
+    pool: Optional[_Pool] = None
+    try:
+        for step in plan.steps:
+            if feedback.is_canceled():
+                break
+            todo: List[Task] = []
+            for task in (t for t in plan.tasks if t.step == step):
+                blocker = failed_items.get((task.item_kind, task.item))
+                if task.item is not None and blocker is not None:
+                    finish(task, {"status": "failed", "duration_s": 0.0, "outputs": {},
+                                  "error": f"not run because step '{blocker}' failed for "
+                                           f"{task.item_kind} '{task.item}'"})
+                    continue
+                outputs = _resumable(task, state) if resume else None
+                if outputs is not None:
+                    finish(task, {"status": "skipped", "outputs": outputs, "duration_s": 0.0,
+                                  "error": None})
+                    log(f"{task.key}: skipped (complete from an earlier run)")
+                    continue
+                todo.append(task)
+            if not todo:
+                continue
+            log(f"step {step}: {len(todo)} task(s)")
+            if n_workers == 1:
+                _run_in_process(todo, feedback, progress, finish)
+            else:
+                if pool is None:
+                    pool = _Pool(n_workers, [*extra_modules, *extra_modules_from_env()])
+                pool.run(todo, feedback, progress, finish, grace)
+            for task in todo:
+                if records[task.index]["status"] == "failed" and task.item is not None:
+                    failed_items.setdefault((task.item_kind, task.item), step)
+    finally:
+        if pool is not None:
+            pool.close()
+        counts = {s: sum(r["status"] == s for r in records) for s in TASK_STATUSES}
+        if feedback.is_canceled() or counts["cancelled"]:
+            status = "cancelled"
+        elif counts["failed"]:
+            status = "failed"
+        else:
+            status = "done"
+        summary = {
+            "file": str(plan.file) if plan.file else None,
+            "project": str(plan.project),
+            "run": str(plan.run_dir),
+            "status": status,
+            "started": started,
+            "duration_s": round(time.perf_counter() - t0, 3),
+            "workers": n_workers,
+            "resume": resume,
+            "counts": counts,
+            "summary": str(plan.run_dir / SUMMARY_FILE),
+            "tasks": records,
+        }
+        _atomic_json(plan.run_dir / SUMMARY_FILE, summary)
+        batch_log.write(f"{time.strftime('%H:%M:%S')} batch {status}: "
+                        + ", ".join(f"{v} {k}" for k, v in counts.items() if v) + "\n")
+        batch_log.close()
+    return summary
+
+
+def _atomic_json(path: Path, data: Dict[str, Any]) -> None:
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(json.dumps(data, indent=2, default=str), encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
+                    finish: Callable[[Task, Dict[str, Any]], None]) -> None:
+    for task in tasks:
+        if feedback.is_canceled():
+            return  # the records of the tasks not started say "cancelled"
+        result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
+                              lambda pct, i=task.index: progress.set(i, pct))
+        finish(task, result)
+
+
+class _Pool:
+    """Worker processes (spawn context) with a shared cancel event and a progress queue."""
+
+    def __init__(self, n: int, modules: Sequence[str]) -> None:
+        ctx = multiprocessing.get_context("spawn")
+        self.cancel_event = ctx.Event()
+        self.queue = ctx.Queue()
+        self.executor = cf.ProcessPoolExecutor(
+            max_workers=n, mp_context=ctx, initializer=_init_worker,
+            initargs=(self.cancel_event, self.queue, tuple(modules)),
+        )
+        self.broken = False
+
+    def _drain(self, progress: _Progress) -> None:
+        while True:
+            try:
+                index, pct = self.queue.get_nowait()
+            except Exception:  # queue.Empty (and EOF when a worker died)
+                return
+            progress.set(index, min(pct, 99.0))
+
+    def run(self, tasks: List[Task], feedback: Feedback, progress: _Progress,
+            finish: Callable[[Task, Dict[str, Any]], None], grace: float) -> None:
+        futures = {
+            self.executor.submit(_worker_run, t.index, t.algorithm, t.params, str(t.log)): t
+            for t in tasks
+        }
+        pending = set(futures)
+        cancel_deadline: Optional[float] = None
+        while pending:
+            done, pending = cf.wait(pending, timeout=0.1, return_when=cf.FIRST_COMPLETED)
+            self._drain(progress)
+            for future in done:
+                task = futures[future]
+                if future.cancelled():
+                    continue  # recorded as cancelled already
+                try:
+                    finish(task, future.result())
+                except Exception as exc:  # the worker process died (BrokenProcessPool)
+                    self.broken = True
+                    status = "cancelled" if feedback.is_canceled() else "failed"
+                    finish(task, {"status": status, "outputs": {}, "duration_s": 0.0,
+                                  "error": f"worker process ended: {type(exc).__name__}: {exc}"})
+            if feedback.is_canceled() and cancel_deadline is None:
+                self.cancel_event.set()  # running tasks stop at their next progress check
+                for future in list(pending):
+                    if future.cancel():
+                        pending.discard(future)
+                cancel_deadline = time.monotonic() + grace
+            if cancel_deadline is not None and pending and time.monotonic() > cancel_deadline:
+                self.terminate()
+                for future in pending:
+                    finish(futures[future], {"status": "cancelled", "outputs": {},
+                                             "duration_s": 0.0,
+                                             "error": "worker terminated after cancel"})
+                return
+
+    def terminate(self) -> None:
+        self.broken = True
+        for process in list(getattr(self.executor, "_processes", {}).values()):
+            if process.is_alive():
+                process.terminate()
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):  # a broken pool on shutdown
+            self.executor.shutdown(wait=not self.broken, cancel_futures=True)
+        self.queue.close()
+
+
+# -- template ------------------------------------------------------------------------------------
+def batch_template(project: PathLike) -> str:
+    """An example batch file for ``project`` (``photodem batch --template PROJECT``).
+
+    The example steps use algorithms of the registry: for each, the required parameters are
+    filled in (outputs below ``{project}/products/{step}/…``) and the optional ones are listed
+    as comments with their defaults.
+    """
+    lines = [
+        "# PhotoDEM batch file: run with  photodem batch THIS_FILE.toml",
+        "# Placeholders in parameter values: {project} {run} {step} {model} {image}",
+        "",
+        "[batch]",
+        f"project = {_toml_string(str(project))}",
+        "workers = 2",
+        "# output = \"{project}/runs/my-run\"   # default: <project>/runs/<timestamp>/",
+        "",
+    ]
+    algs = registry.algorithms()
+    chosen = [a for a in ("project_info", "epipolar_pair") if a in algs]
+    if not chosen:
+        chosen = [a.id for a in algs.values() if a.iterates_over][:1] or list(algs)[:1]
+    for alg_id in chosen:
+        alg = algs[alg_id]
+        lines += ["[[steps]]", f"algorithm = {_toml_string(alg.id)}   # {alg.name}",
+                  f"name = {_toml_string(alg.id)}"]
+        if alg.iterates_over:
+            kind = alg.parameter(alg.iterates_over).kind
+            lines.append(f"{kind}s = \"all\"   # or a list: [\"name1\", \"name2\"]")
+        lines.append("[steps.params]")
+        for p in alg.parameters:
+            if p.kind == "project" or p.name == alg.iterates_over:
+                continue
+            if p.is_output:
+                value = "{project}/products/{step}"
+                if alg.iterates_over:
+                    value += "/{" + alg.parameter(alg.iterates_over).kind + "}"
+                if p.kind != "output_folder":
+                    value += "/" + p.name + (p.extensions[0] if p.extensions else "")
+                lines.append(f"{p.name} = {_toml_string(value)}")
+            elif p.required:
+                lines.append(f"{p.name} = \"\"   # required: {p.description}")
+            else:
+                default = "" if p.default is None else f" (default {p.default!r})"
+                lines.append(f"# {p.name} = …   # {p.description}{default}")
+        lines.append("")
+    if not chosen:
+        lines += ["[[steps]]", "algorithm = \"project_info\"", ""]
+    return "\n".join(lines)
+
+
+def _toml_string(text: str) -> str:
+    return json.dumps(text, ensure_ascii=False)  # a JSON string is a valid TOML basic string
+
+
+__all__ = [
+    "EXTRA_ALGORITHMS_ENV",
+    "BatchPlan",
+    "Task",
+    "batch_template",
+    "execute_task",
+    "extra_modules_from_env",
+    "load_batch",
+    "plan_batch",
+    "register_algorithm_modules",
+    "run_batch",
+]

@@ -1,0 +1,36 @@
+"""Start the standalone toolbox (``photodem gui`` or ``python -m photodem.plugin.app.main``)."""
+
+from __future__ import annotations
+
+import sys
+from typing import List, Optional
+
+from ..i18n import install_translator
+from ..qt import QtWidgets
+
+_windows: list = []
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    """Create the application (or reuse a running one), show the toolbox, run the event loop."""
+    argv = list(sys.argv if argv is None else argv)
+    app = QtWidgets.QApplication.instance()
+    owns_app = app is None
+    if owns_app:
+        app = QtWidgets.QApplication(argv)
+    app.setOrganizationName("PhotoDEM")
+    app.setApplicationName("PhotoDEM toolbox")
+    install_translator()  # German when the system locale is German and i18n/*.qm exists
+
+    from .main_window import ToolboxWindow  # after the translator: labels are translated once
+
+    window = ToolboxWindow()
+    _windows.append(window)  # keep a reference when the caller runs the event loop
+    window.show()
+    if not owns_app:
+        return 0
+    return int(app.exec_())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

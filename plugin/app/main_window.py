@@ -1,0 +1,220 @@
+"""The standalone toolbox: algorithm tree, generated parameter form, run panel.
+
+Everything shown comes from the registry, so a new algorithm appears here (and in QGIS and the
+CLI) without any GUI code.
+"""
+
+from __future__ import annotations
+
+import html
+from typing import Dict, Optional
+
+from ...algorithms.processing import registry
+from ...algorithms.processing.spec import Algorithm
+from ..i18n import tr
+from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
+from ..widgets.parameter_form import ParameterForm
+from ..widgets.run_panel import RunPanel
+
+ALG_ROLE = QtCore.Qt.UserRole + 1
+
+
+class ToolboxWindow(QtWidgets.QMainWindow):
+    """Main window of ``photodem gui``.
+
+    Parameters
+    ----------
+    message_boxes : bool
+        Show operator errors in a message box as well as in the log (tests switch it off).
+    """
+
+    algorithm_selected = pyqtSignal(str)
+
+    def __init__(self, parent: Optional[QtWidgets.QWidget] = None,
+                 message_boxes: bool = True) -> None:
+        super().__init__(parent)
+        self.message_boxes = message_boxes
+        self.setWindowTitle(tr("PhotoDEM toolbox"))
+        self.resize(1100, 720)
+        self.form: Optional[ParameterForm] = None
+        self.algorithm: Optional[Algorithm] = None
+
+        # left: filter + algorithm tree
+        self.filter_edit = QtWidgets.QLineEdit()
+        self.filter_edit.setPlaceholderText(tr("Search algorithms …"))
+        self.filter_edit.setClearButtonEnabled(True)
+        self.tree = QtWidgets.QTreeWidget()
+        self.tree.setHeaderHidden(True)
+        self.tree.setUniformRowHeights(True)
+        left = QtWidgets.QWidget()
+        left_layout = QtWidgets.QVBoxLayout(left)
+        left_layout.setContentsMargins(6, 6, 0, 6)
+        left_layout.addWidget(self.filter_edit)
+        left_layout.addWidget(self.tree, 1)
+
+        # right: title, help, form (scrolling), run panel
+        self.title = QtWidgets.QLabel()
+        font = self.title.font()
+        font.setPointSizeF(font.pointSizeF() * 1.35)
+        font.setBold(True)
+        self.title.setFont(font)
+        self.help_label = QtWidgets.QLabel()
+        self.help_label.setWordWrap(True)
+        self.help_label.setTextFormat(QtCore.Qt.RichText)
+        self.help_label.setAlignment(QtCore.Qt.AlignTop | QtCore.Qt.AlignLeft)
+        self.help_label.setStyleSheet("color: #555;")
+        self.form_area = QtWidgets.QScrollArea()
+        self.form_area.setWidgetResizable(True)
+        self.form_area.setFrameShape(QtWidgets.QFrame.StyledPanel)
+        self.run_panel = RunPanel()
+        self.run_panel.setEnabled(False)
+
+        top = QtWidgets.QWidget()
+        top_layout = QtWidgets.QVBoxLayout(top)
+        top_layout.setContentsMargins(6, 6, 6, 0)
+        top_layout.addWidget(self.title)
+        top_layout.addWidget(self.help_label)
+        top_layout.addWidget(self.form_area, 1)
+        right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
+        right.addWidget(top)
+        bottom = QtWidgets.QWidget()
+        bottom_layout = QtWidgets.QVBoxLayout(bottom)
+        bottom_layout.setContentsMargins(6, 0, 6, 6)
+        bottom_layout.addWidget(self.run_panel)
+        right.addWidget(bottom)
+        right.setStretchFactor(0, 3)
+        right.setStretchFactor(1, 2)
+        right.setSizes([470, 230])
+
+        splitter = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
+        splitter.addWidget(left)
+        splitter.addWidget(right)
+        splitter.setStretchFactor(0, 1)
+        splitter.setStretchFactor(1, 3)
+        splitter.setSizes([270, 830])
+        self.setCentralWidget(splitter)
+
+        self._build_menu()
+        self.statusBar().showMessage(tr("Choose an algorithm on the left."))
+        self.populate()
+
+        self.tree.currentItemChanged.connect(self._on_current_item)
+        self.filter_edit.textChanged.connect(self._apply_filter)
+        self.run_panel.run_requested.connect(self.run_current)
+        self.run_panel.run_finished.connect(self._on_run_finished)
+
+    # -- building --------------------------------------------------------------------------------
+    def _build_menu(self) -> None:
+        file_menu = self.menuBar().addMenu(tr("&File"))
+        quit_action = file_menu.addAction(tr("&Quit"))
+        quit_action.setShortcut(QtGui.QKeySequence.Quit)
+        quit_action.triggered.connect(self.close)
+        help_menu = self.menuBar().addMenu(tr("&Help"))
+        about = help_menu.addAction(tr("&About PhotoDEM"))
+        about.triggered.connect(self._about)
+
+    def populate(self) -> None:
+        """Fill the tree: one node per group, the algorithms below it."""
+        self.tree.clear()
+        groups: Dict[str, QtWidgets.QTreeWidgetItem] = {}
+        folder_icon = self.style().standardIcon(QtWidgets.QStyle.SP_DirIcon)
+        alg_icon = self.style().standardIcon(QtWidgets.QStyle.SP_FileIcon)
+        for alg in registry.algorithms().values():
+            group = alg.group or tr("Other")
+            if group not in groups:
+                node = QtWidgets.QTreeWidgetItem([tr(group)])
+                node.setIcon(0, folder_icon)
+                node.setFlags(node.flags() & ~QtCore.Qt.ItemIsSelectable)
+                self.tree.addTopLevelItem(node)
+                groups[group] = node
+            item = QtWidgets.QTreeWidgetItem([tr(alg.name)])
+            item.setIcon(0, alg_icon)
+            item.setData(0, ALG_ROLE, alg.id)
+            item.setToolTip(0, f"{alg.id}\n{tr(alg.help)}" if alg.help else alg.id)
+            groups[group].addChild(item)
+        self.tree.expandAll()
+
+    def _apply_filter(self, text: str) -> None:
+        needle = text.strip().lower()
+        for i in range(self.tree.topLevelItemCount()):
+            group = self.tree.topLevelItem(i)
+            visible = 0
+            for j in range(group.childCount()):
+                item = group.child(j)
+                hay = f"{item.text(0)} {item.data(0, ALG_ROLE)}".lower()
+                hidden = bool(needle) and needle not in hay
+                item.setHidden(hidden)
+                visible += not hidden
+            group.setHidden(visible == 0)
+
+    # -- selection -------------------------------------------------------------------------------
+    def _on_current_item(self, item: Optional[QtWidgets.QTreeWidgetItem], _prev: object) -> None:
+        if item is None:
+            return
+        alg_id = item.data(0, ALG_ROLE)
+        if alg_id:
+            self.select_algorithm(str(alg_id))
+
+    def select_algorithm(self, algorithm_id: str) -> ParameterForm:
+        """Show the form of ``algorithm_id`` (also selects it in the tree)."""
+        alg = registry.get(algorithm_id)
+        self.algorithm = alg
+        self.title.setText(tr(alg.name))
+        help_text = html.escape(tr(alg.help)) if alg.help else ""
+        self.help_label.setText(
+            f"{help_text}<br><span style='color:gray'>photodem run {alg.id}</span>")
+        self.form = ParameterForm(alg)
+        container = QtWidgets.QWidget()
+        layout = QtWidgets.QVBoxLayout(container)
+        layout.addWidget(self.form)
+        layout.addStretch(1)
+        self.form_area.setWidget(container)
+        self.run_panel.setEnabled(True)
+        self.statusBar().showMessage(alg.id)
+        self._select_in_tree(alg.id)
+        self.algorithm_selected.emit(alg.id)
+        return self.form
+
+    def _select_in_tree(self, algorithm_id: str) -> None:
+        iterator = QtWidgets.QTreeWidgetItemIterator(self.tree)
+        while iterator.value():
+            item = iterator.value()
+            if item.data(0, ALG_ROLE) == algorithm_id and self.tree.currentItem() is not item:
+                self.tree.blockSignals(True)
+                self.tree.setCurrentItem(item)
+                self.tree.blockSignals(False)
+                return
+            iterator += 1
+
+    # -- running ---------------------------------------------------------------------------------
+    def run_current(self) -> None:
+        """Run the selected algorithm with the values of the form."""
+        if self.algorithm is None or self.form is None or self.run_panel.is_running():
+            return
+        self.form.setEnabled(False)
+        self.tree.setEnabled(False)
+        self.statusBar().showMessage(tr("Running {0} …").format(self.algorithm.id))
+        self.run_panel.start(self.algorithm.id, self.form.values())
+
+    def _on_run_finished(self, status: str, payload: object) -> None:
+        if self.form is not None:
+            self.form.setEnabled(True)
+        self.tree.setEnabled(True)
+        messages = {"done": tr("{0} finished."), "failed": tr("{0} failed."),
+                    "cancelled": tr("{0} was cancelled.")}
+        text = messages.get(status, "{0}").format(self.run_panel.algorithm_id)
+        self.statusBar().showMessage(text)
+        if status == "failed" and self.message_boxes:
+            QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(payload))
+
+    def closeEvent(self, event: QtGui.QCloseEvent) -> None:
+        if self.run_panel.is_running():
+            self.run_panel.cancel()
+            self.run_panel.wait(30000)
+        super().closeEvent(event)
+
+    def _about(self) -> None:
+        QtWidgets.QMessageBox.about(
+            self, tr("About PhotoDEM"),
+            tr("PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, "
+               "orthophoto mosaics and automatic georeferencing."))

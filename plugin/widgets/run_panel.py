@@ -1,0 +1,195 @@
+"""Run / Cancel buttons, a progress bar, the log pane and the result of a run."""
+
+from __future__ import annotations
+
+import html
+import json
+from typing import Any, Dict, Optional
+
+from ..i18n import tr
+from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
+from .worker import AlgorithmWorker, start_in_thread
+
+_LEVEL_COLOURS = {"info": None, "warning": "#b35c00", "error": "#c0392b", "ok": "#1e7d32"}
+
+
+class RunPanel(QtWidgets.QWidget):
+    """Starts :class:`AlgorithmWorker` runs and shows their progress, log and outputs.
+
+    Signals
+    -------
+    run_requested()
+        The Run button was pressed (the owner collects the parameters and calls :meth:`start`).
+    run_finished(str, object)
+        ``(status, payload)`` with status ``done`` (payload: output dict), ``failed``
+        (message), ``cancelled`` (message).
+    """
+
+    run_requested = pyqtSignal()
+    run_finished = pyqtSignal(str, object)
+
+    def __init__(self, parent: Optional[QtWidgets.QWidget] = None) -> None:
+        super().__init__(parent)
+        self._worker: Optional[AlgorithmWorker] = None
+        self._thread: Optional[QtCore.QThread] = None
+        self._status = ""
+        self._payload: Any = None
+        self.algorithm_id = ""
+
+        self.run_button = QtWidgets.QPushButton(tr("Run"), self)
+        self.run_button.setDefault(True)
+        self.run_button.setIcon(self.style().standardIcon(QtWidgets.QStyle.SP_MediaPlay))
+        self.cancel_button = QtWidgets.QPushButton(tr("Cancel"), self)
+        self.cancel_button.setIcon(self.style().standardIcon(QtWidgets.QStyle.SP_BrowserStop))
+        self.cancel_button.setEnabled(False)
+        self.progress_bar = QtWidgets.QProgressBar(self)
+        self.progress_bar.setRange(0, 1000)
+        self.progress_bar.setValue(0)
+        self.progress_bar.setFormat("%p %")
+        self.progress_bar.setTextVisible(True)
+
+        self.log_view = QtWidgets.QPlainTextEdit(self)
+        self.log_view.setReadOnly(True)
+        self.log_view.setMaximumBlockCount(5000)
+        self.log_view.setPlaceholderText(tr("The log of the run appears here."))
+        font = QtGui.QFontDatabase.systemFont(QtGui.QFontDatabase.FixedFont)
+        self.log_view.setFont(font)
+        self.result_view = QtWidgets.QTreeWidget(self)
+        self.result_view.setColumnCount(2)
+        self.result_view.setHeaderLabels([tr("Output"), tr("Value")])
+        self.result_view.setRootIsDecorated(True)
+        self.result_view.setAlternatingRowColors(True)
+
+        self.tabs = QtWidgets.QTabWidget(self)
+        self.tabs.addTab(self.log_view, tr("Log"))
+        self.tabs.addTab(self.result_view, tr("Result"))
+
+        buttons = QtWidgets.QHBoxLayout()
+        buttons.addWidget(self.progress_bar, 1)
+        buttons.addWidget(self.cancel_button)
+        buttons.addWidget(self.run_button)
+        layout = QtWidgets.QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addLayout(buttons)
+        layout.addWidget(self.tabs, 1)
+
+        self.run_button.clicked.connect(self.run_requested)
+        self.cancel_button.clicked.connect(self.cancel)
+
+    # -- state -----------------------------------------------------------------------------------
+    def is_running(self) -> bool:
+        return self._worker is not None
+
+    @property
+    def status(self) -> str:
+        """Status of the last run: '', 'running', 'done', 'failed', 'cancelled'."""
+        return self._status
+
+    @property
+    def result(self) -> Any:
+        return self._payload
+
+    # -- running ---------------------------------------------------------------------------------
+    def start(self, algorithm_id: str, params: Dict[str, Any]) -> AlgorithmWorker:
+        """Run ``algorithm_id`` with raw ``params`` in a worker thread."""
+        if self.is_running():
+            raise RuntimeError("a run is already going on")
+        self.algorithm_id = algorithm_id
+        self.result_view.clear()
+        self.progress_bar.setValue(0)
+        self.tabs.setCurrentWidget(self.log_view)
+        self.append_log("ok", tr("Running {0} …").format(algorithm_id))
+        self.append_log("info", json.dumps(params, ensure_ascii=False, default=str))
+        worker = AlgorithmWorker(algorithm_id, params)
+        worker.progress.connect(self._on_progress)
+        worker.log.connect(self.append_log)
+        worker.finished.connect(self._on_finished)
+        worker.failed.connect(self._on_failed)
+        worker.cancelled.connect(self._on_cancelled)
+        worker.done.connect(self._on_done)
+        self._worker = worker
+        self._status = "running"
+        self._payload = None
+        self.run_button.setEnabled(False)
+        self.cancel_button.setEnabled(True)
+        self._thread = start_in_thread(worker)
+        return worker
+
+    def cancel(self) -> None:
+        """Ask the running algorithm to stop; it discards its staged outputs."""
+        if self._worker is not None:
+            self._worker.cancel()
+            self.cancel_button.setEnabled(False)
+            self.append_log("warning", tr("Cancelling …"))
+
+    def wait(self, msecs: int = 30000) -> bool:
+        """Block until the worker thread ended (used when the window closes)."""
+        thread = self._thread
+        if thread is None:
+            return True
+        try:
+            return bool(thread.wait(msecs))
+        except RuntimeError:  # already deleted
+            return True
+
+    # -- slots -----------------------------------------------------------------------------------
+    def _on_progress(self, pct: float) -> None:
+        self.progress_bar.setValue(round(pct * 10))
+
+    def append_log(self, level: str, message: str) -> None:
+        colour = _LEVEL_COLOURS.get(level)
+        text = html.escape(message).replace("\n", "<br>")
+        if level == "warning":
+            text = tr("Warning: ") + text
+        if colour:
+            text = f'<span style="color:{colour}">{text}</span>'
+        self.log_view.appendHtml(text)
+
+    def _on_finished(self, result: Dict[str, Any]) -> None:
+        self._status, self._payload = "done", result
+        self.progress_bar.setValue(1000)
+        self.show_result(result)
+        self.append_log("ok", tr("Finished."))
+
+    def _on_failed(self, message: str, operator_error: bool) -> None:
+        self._status, self._payload = "failed", message
+        if operator_error:
+            self.append_log("error", tr("Error: ") + message)
+        else:
+            self.append_log("error", tr("Unexpected error (please report it):") + "\n" + message)
+
+    def _on_cancelled(self, message: str) -> None:
+        self._status, self._payload = "cancelled", message
+        self.progress_bar.setValue(0)
+        self.append_log("warning", message)
+
+    def _on_done(self) -> None:
+        self._worker = None
+        self.run_button.setEnabled(True)
+        self.cancel_button.setEnabled(False)
+        self.run_finished.emit(self._status, self._payload)
+
+    def show_result(self, result: Dict[str, Any]) -> None:
+        """Show an output dict as a tree (nested dicts and lists expand)."""
+        self.result_view.clear()
+        for key, value in result.items():
+            self.result_view.addTopLevelItem(_tree_item(str(key), value))
+        self.result_view.expandToDepth(0)
+        self.result_view.resizeColumnToContents(0)
+        self.tabs.setCurrentWidget(self.result_view)
+
+
+def _tree_item(key: str, value: Any) -> QtWidgets.QTreeWidgetItem:
+    if isinstance(value, dict):
+        item = QtWidgets.QTreeWidgetItem([key, f"{{{len(value)}}}"])
+        for k, v in value.items():
+            item.addChild(_tree_item(str(k), v))
+    elif isinstance(value, list) and value and isinstance(value[0], (dict, list)):
+        item = QtWidgets.QTreeWidgetItem([key, f"[{len(value)}]"])
+        for i, v in enumerate(value):
+            item.addChild(_tree_item(str(i), v))
+    else:
+        text = json.dumps(value, ensure_ascii=False) if isinstance(value, list) else str(value)
+        item = QtWidgets.QTreeWidgetItem([key, text])
+        item.setToolTip(1, text)
+    return item

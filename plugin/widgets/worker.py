@@ -1,0 +1,93 @@
+"""Running an algorithm off the GUI thread: a QObject worker in a QThread.
+
+The worker calls :func:`photodem.algorithms.processing.registry.run` — the same call as the CLI,
+batch and QGIS — with a :class:`~photodem.algorithms.processing.feedback.Feedback` whose
+``on_progress``/``on_log`` emit Qt signals (queued across threads, so widgets are only touched in
+the GUI thread). Cancel is :meth:`Feedback.cancel`; the algorithm stops at its next progress
+check and discards its staged outputs.
+"""
+
+from __future__ import annotations
+
+import traceback
+from typing import Any, Dict, Optional
+
+from ...algorithms.errors import Cancelled, PhotodemError
+from ...algorithms.processing import registry
+from ...algorithms.processing.feedback import Feedback
+from ..qt import QObject, QThread, pyqtSignal, pyqtSlot
+
+
+class AlgorithmWorker(QObject):
+    """Runs one algorithm; emits exactly one of finished/failed/cancelled, then ``done``.
+
+    Signals
+    -------
+    progress(float)
+        Percent 0–100.
+    log(str, str)
+        ``(level, message)``; level ``info``, ``warning`` or ``error``.
+    finished(object)
+        The JSON-ready output dict.
+    failed(str, bool)
+        The message and whether it is an operator error (``False``: a bug, with traceback).
+    cancelled(str)
+        The run was cancelled; no output was left behind.
+    done()
+        Last signal of every run.
+    """
+
+    progress = pyqtSignal(float)
+    log = pyqtSignal(str, str)
+    finished = pyqtSignal(object)
+    failed = pyqtSignal(str, bool)
+    cancelled = pyqtSignal(str)
+    done = pyqtSignal()
+
+    def __init__(self, algorithm_id: str, params: Dict[str, Any],
+                 parent: Optional[QObject] = None) -> None:
+        super().__init__(parent)
+        self.algorithm_id = algorithm_id
+        self.params = dict(params)
+        self._last_pct = -1.0
+        self.feedback = Feedback(on_progress=self._emit_progress, on_log=self.log.emit)
+
+    def _emit_progress(self, pct: float) -> None:
+        # A tenth of a percent is as fine as a progress bar shows; spare the event queue.
+        if abs(pct - self._last_pct) >= 0.1 or pct >= 100.0:
+            self._last_pct = pct
+            self.progress.emit(pct)
+
+    def cancel(self) -> None:
+        """Ask the running algorithm to stop (thread-safe)."""
+        self.feedback.cancel()
+
+    @pyqtSlot()
+    def run(self) -> None:
+        try:
+            result = registry.run(self.algorithm_id, self.params, self.feedback)
+        except Cancelled as exc:
+            self.cancelled.emit(str(exc))
+        except PhotodemError as exc:
+            self.failed.emit(str(exc), True)
+        except Exception:  # a bug: show the traceback, keep the GUI alive
+            self.failed.emit(traceback.format_exc(), False)
+        else:
+            self.finished.emit(result)
+        finally:
+            self.done.emit()
+
+
+def start_in_thread(worker: AlgorithmWorker, parent: Optional[QObject] = None) -> QThread:
+    """Move ``worker`` to a new QThread, start it, and clean both up when the run is done.
+
+    The caller keeps references to the worker and the returned thread until ``done``.
+    """
+    thread = QThread(parent)
+    worker.moveToThread(thread)
+    thread.started.connect(worker.run)
+    worker.done.connect(thread.quit)
+    worker.done.connect(worker.deleteLater)
+    thread.finished.connect(thread.deleteLater)
+    thread.start()
+    return thread

@@ -1,0 +1,176 @@
+"""Batch runner: planning, running in-process and on worker processes, resume, cancel."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+
+import pytest
+
+from photodem.algorithms.errors import InputError
+from photodem.algorithms.processing import batch
+from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.project import toml_io
+
+
+def _config(project_dir, steps, **head):
+    return {"batch": {"project": str(project_dir), **head}, "steps": steps}
+
+
+def _sleep_step(**params):
+    return {"algorithm": "fake_sleep_write", "name": "sleep",
+            "params": {"seconds": 0.05, "output": "{project}/products/{step}/{model}.json",
+                       **params}}
+
+
+def _fail_step():
+    return {"algorithm": "fake_fail_on", "name": "check", "models": ["a_b", "b_c"],
+            "params": {"fail": "a_b", "output": "{project}/products/{step}/{model}.txt"}}
+
+
+def test_plan_expands_models_and_placeholders(fake_algs, project_dir, tmp_path):
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(note="{run}|{step}|{model}")]),
+                            run_dir=tmp_path / "run")
+    assert [t.item for t in plan.tasks] == ["a_b", "b_c", "c_d"]
+    t = plan.tasks[1]
+    assert t.params["model"] == "b_c"
+    assert t.params["project"] == str(project_dir.resolve())
+    assert t.params["output"] == f"{project_dir.resolve()}/products/sleep/b_c.json"
+    assert t.params["note"] == f"{(tmp_path / 'run').resolve()}|sleep|b_c"
+    assert t.log == (tmp_path / "run").resolve() / "sleep" / "b_c.log"
+    assert t.key == "sleep/b_c"
+    # default run folder: <project>/runs/<timestamp>
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step()]))
+    assert plan.run_dir.parent == project_dir.resolve() / "runs"
+
+
+@pytest.mark.parametrize(("steps", "message"), [
+    ([{"algorithm": "nope"}], "No algorithm"),
+    ([{"algorithm": "fake_sleep_write", "models": ["x_y"]}], "not in the project"),
+    ([{"algorithm": "fake_sleep_write", "images": "all"}], "iterates over models"),
+    ([{"algorithm": "fake_crash", "models": "all"}], "does not iterate"),
+    ([{"algorithm": "fake_crash", "params": {"x": "{model}"}}], "does not run per model"),
+    ([{"algorithm": "fake_crash", "nmae": "x"}], "unknown key"),
+    ([{"algorithm": "fake_crash"}, {"algorithm": "fake_crash"}], "two steps are named"),
+    ([], "no [[steps]]"),
+])
+def test_plan_errors_are_operator_errors(fake_algs, project_dir, steps, message):
+    with pytest.raises(InputError, match=message.replace("[", r"\[")):
+        batch.plan_batch(_config(project_dir, steps))
+
+
+def test_load_batch_relative_project_and_bad_workers(fake_algs, project_dir):
+    file = project_dir.parent / "b.toml"
+    file.write_text('[batch]\nproject = "proj"\nworkers = 0\n[[steps]]\nalgorithm = "fake_crash"\n')
+    with pytest.raises(InputError, match="workers"):
+        batch.load_batch(file)
+    file.write_text('[batch]\nproject = "proj"\noutput = "{project}/runs/x"\n'
+                    '[[steps]]\nalgorithm = "fake_crash"\n')
+    plan = batch.load_batch(file)
+    assert plan.project == project_dir.resolve()
+    assert plan.run_dir == project_dir.resolve() / "runs" / "x"
+    with pytest.raises(InputError, match="not a PhotoDEM project"):
+        batch.plan_batch({"batch": {"project": str(project_dir / "missing")},
+                          "steps": [{"algorithm": "fake_crash"}]})
+
+
+def test_run_in_process_failures_logs_summary_and_resume(fake_algs, project_dir, tmp_path):
+    steps = [_fail_step(), _sleep_step()]
+    plan = batch.plan_batch(_config(project_dir, steps), run_dir=tmp_path / "r1")
+    seen = []
+    summary = batch.run_batch(plan, Feedback(on_progress=seen.append), workers=1)
+    status = {(t["step"], t["item"]): t["status"] for t in summary["tasks"]}
+    assert status == {("check", "a_b"): "failed", ("check", "b_c"): "done",
+                      ("sleep", "a_b"): "failed", ("sleep", "b_c"): "done",
+                      ("sleep", "c_d"): "done"}
+    assert summary["status"] == "failed"
+    assert summary["counts"] == {"done": 3, "skipped": 0, "failed": 2, "cancelled": 0}
+    errors = {(t["step"], t["item"]): t["error"] for t in summary["tasks"]}
+    assert "a_b is broken" in errors[("check", "a_b")]
+    assert "not run because step 'check' failed" in errors[("sleep", "a_b")]
+    assert seen and seen[-1] == pytest.approx(100.0) and seen == sorted(seen)
+    on_disk = json.loads((tmp_path / "r1" / "summary.json").read_text())
+    assert on_disk["counts"] == summary["counts"]
+    assert "a_b is broken" in (tmp_path / "r1" / "check" / "a_b.log").read_text()
+    assert "model b_c done" in (tmp_path / "r1" / "sleep" / "b_c.log").read_text()
+    assert (project_dir / "products" / "sleep" / "c_d.json").is_file()
+    assert not (project_dir / "products" / "sleep" / "a_b.json").exists()
+
+    # resume: completed tasks are skipped, the failed ones run again
+    (project_dir / "products" / "sleep" / "c_d.json").unlink()  # an output went missing
+    plan = batch.plan_batch(_config(project_dir, steps), run_dir=tmp_path / "r2")
+    summary = batch.run_batch(plan, workers=1)
+    status = {(t["step"], t["item"]): t["status"] for t in summary["tasks"]}
+    assert status[("check", "b_c")] == "skipped"
+    assert status[("sleep", "b_c")] == "skipped"
+    assert status[("sleep", "c_d")] == "done"
+    assert status[("check", "a_b")] == "failed"
+    skipped = next(t for t in summary["tasks"] if t["status"] == "skipped")
+    assert skipped["outputs"]["output"].endswith(".txt")
+
+    # changed parameters or --no-resume: run again
+    steps[1]["params"]["seconds"] = 0.01
+    plan = batch.plan_batch(_config(project_dir, steps), run_dir=tmp_path / "r3")
+    summary = batch.run_batch(plan, workers=1)
+    status = {(t["step"], t["item"]): t["status"] for t in summary["tasks"]}
+    assert status[("sleep", "b_c")] == "done" and status[("check", "b_c")] == "skipped"
+    summary = batch.run_batch(plan, workers=1, resume=False)
+    assert summary["counts"]["skipped"] == 0
+
+
+def test_run_on_two_worker_processes(fake_algs, project_dir, tmp_path):
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=0.3)], workers=2),
+                            run_dir=tmp_path / "run")
+    seen = []
+    start = time.perf_counter()
+    summary = batch.run_batch(plan, Feedback(on_progress=seen.append))
+    elapsed = time.perf_counter() - start
+    assert summary["status"] == "done", summary
+    assert summary["workers"] == 2
+    for name in ("a_b", "b_c", "c_d"):
+        data = json.loads((project_dir / "products" / "sleep" / f"{name}.json").read_text())
+        assert data["model"] == name
+    assert seen[-1] == pytest.approx(100.0)
+    assert any(0 < p < 100 for p in seen)  # intra-task progress came through the queue
+    assert elapsed < 20
+
+
+def _no_outputs(project_dir):
+    products = project_dir / "products"
+    return [] if not products.exists() else [p for p in products.rglob("*") if p.is_file()]
+
+
+def test_cancel_in_process_leaves_no_output(fake_algs, project_dir, tmp_path):
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=2.0, steps=100)]),
+                            run_dir=tmp_path / "run")
+    feedback = Feedback()
+    feedback._on_progress = lambda pct: feedback.cancel() if pct > 5 else None
+    summary = batch.run_batch(plan, feedback, workers=1)
+    assert summary["status"] == "cancelled"
+    assert summary["counts"]["cancelled"] == 3
+    assert _no_outputs(project_dir) == []
+
+
+def test_cancel_worker_processes_leaves_no_output(fake_algs, project_dir, tmp_path):
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=5.0, steps=100)],
+                                    workers=2), run_dir=tmp_path / "run")
+    feedback = Feedback()
+    timer = threading.Timer(1.5, feedback.cancel)
+    timer.start()
+    start = time.perf_counter()
+    summary = batch.run_batch(plan, feedback)
+    timer.cancel()
+    assert summary["status"] == "cancelled"
+    assert [t["status"] for t in summary["tasks"]] == ["cancelled"] * 3
+    assert time.perf_counter() - start < 5.0  # stopped cooperatively, not after 5 s
+    assert _no_outputs(project_dir) == []
+
+
+def test_template_is_a_valid_batch_file(fake_algs, project_dir):
+    text = batch.batch_template(project_dir)
+    config = toml_io.loads(text)
+    assert config["batch"]["project"] == str(project_dir)
+    assert config["steps"]
+    for step in config["steps"]:
+        assert step["algorithm"]
