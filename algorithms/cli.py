@@ -122,6 +122,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--template", metavar="PROJECT", help="print an example batch file")
 
     sub.add_parser("gui", help="start the standalone toolbox")
+
+    p = sub.add_parser("demo", help="run the whole chain on a synthetic block")
+    p.add_argument("output", nargs="?", default="demo-output", metavar="FOLDER",
+                   help="demo folder (default: demo-output)")
+    p.add_argument("--size", default="small", choices=("tiny", "small", "medium", "large"),
+                   help="synthetic block size (default: small)")
+    p.add_argument("--seed", type=int, default=1, help="random seed (default: 1)")
+    p.add_argument("--workers", type=int, default=2, help="batch worker processes (default: 2)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress or log lines")
     return parser
 
 
@@ -281,6 +291,27 @@ def _print_result(result: Dict[str, Any], as_json: bool) -> None:
         print(f"{key}: {value}")
 
 
+def cmd_demo(args: argparse.Namespace) -> int:
+    from .demo import run_demo
+
+    if args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: give a whole number ≥ 1")
+    feedback = CliFeedback(quiet=args.quiet)
+    with _cancel_on_sigint(feedback):
+        try:
+            with _stdout_to_stderr():
+                summary = run_demo(args.output, size=args.size, seed=args.seed,
+                                   workers=args.workers, feedback=feedback)
+        finally:
+            feedback.close()
+    if args.json:
+        _print_result(summary, True)
+    else:
+        print(Path(summary["summary"]).read_text(encoding="utf-8"))
+        print(f"{PROG}: demo done; summary in {summary['summary']}")
+    return EXIT_OK
+
+
 def cmd_batch(args: argparse.Namespace) -> int:
     if args.template:
         print(batch_mod.batch_template(args.template), end="")
@@ -402,6 +433,8 @@ def main(argv: Optional[List[str]] = None) -> int:
             return cmd_batch(args)
         if args.command == "gui":
             return cmd_gui()
+        if args.command == "demo":
+            return cmd_demo(args)
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     except Cancelled:

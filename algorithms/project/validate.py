@@ -154,7 +154,7 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
 
 
 def _check_files(project: Project, records: List[Any], rep: ValidationReport) -> None:
-    import rasterio
+    from ..raster.io import open_image
 
     for rec in records:
         path = project.image_path(rec)
@@ -162,7 +162,7 @@ def _check_files(project: Project, records: List[Any], rep: ValidationReport) ->
             rep.errors.append(f"Image '{rec.name}': file '{path}' not found.")
             continue
         try:
-            with rasterio.open(path) as src:
+            with open_image(path) as src:
                 w, h = src.width, src.height
         except Exception as exc:  # rasterio.errors.RasterioIOError
             rep.errors.append(f"Image '{rec.name}': '{path}' cannot be read as a raster ({exc}).")

@@ -12,6 +12,7 @@ import contextlib
 import os
 import shutil
 import uuid
+import warnings
 from pathlib import Path
 from typing import Any, Dict, Iterator, Optional, Union
 
@@ -121,6 +122,21 @@ def staged_folder(path: PathLike, replace: bool = False, product: str = "") -> I
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+@contextlib.contextmanager
+def open_image(path: PathLike, mode: str = "r", **profile: Any) -> Iterator[Any]:
+    """``rasterio.open`` for rasters in image space (aerial images, epipolar images).
+
+    Such rasters have no georeference on purpose, so rasterio's ``NotGeoreferencedWarning`` is
+    noise there and is silenced; everything else is as ``rasterio.open``.
+    """
+    from rasterio.errors import NotGeoreferencedWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, mode, **profile) as dataset:
+            yield dataset
+
+
 def write_raster(
     path: PathLike,
     data: NDArray[Any],
@@ -132,7 +148,8 @@ def write_raster(
 ) -> Path:
     """Write a 2-D (rows, cols) or 3-D (bands, rows, cols) array as a tiled GeoTIFF, atomically.
 
-    Float rasters default to ``nodata = NaN``. ``overviews=True`` adds internal overviews
+    Without ``transform`` the raster lives in image space (pixel coordinates). Float rasters
+    default to ``nodata = NaN``. ``overviews=True`` adds internal overviews
     (factors 2, 4, 8, … down to ~256 px) for display.
     """
     arr = np.asarray(data)
@@ -154,7 +171,7 @@ def write_raster(
         profile.pop("blockxsize")
         profile.pop("blockysize")
     profile.update(options)
-    with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+    with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
         dst.write(arr)
         if overviews:
             factors = []

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 from typing import Any, Dict
 
@@ -12,7 +11,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.epipolar import SIDES, EpipolarPair
 from ...project.model import Project
-from ...raster.io import GTIFF_PROFILE, staged_folder
+from ...raster.io import GTIFF_PROFILE, open_image, staged_folder
 from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, json_ready
 
@@ -54,8 +53,6 @@ def _write_side(pair: EpipolarPair, side: str, img: np.ndarray, folder: Path,
 
     Returns the updated count of rows written (for the progress of both sides).
     """
-    import rasterio
-    from rasterio.errors import NotGeoreferencedWarning
     from rasterio.windows import Window
 
     w, h = pair.sizes[SIDES.index(side)]
@@ -65,20 +62,18 @@ def _write_side(pair: EpipolarPair, side: str, img: np.ndarray, folder: Path,
     img_profile = _profile(w, h, bands + 1, img.dtype.name, photometric=photometric, alpha="YES")
     map_profile = _profile(w, h, 2, "float32", nodata=float("nan"), predictor=3)
     alpha_max = np.iinfo(img.dtype).max if np.issubdtype(img.dtype, np.integer) else 1.0
-    with warnings.catch_warnings():
-        # epipolar images live in image space: no geotransform, on purpose
-        warnings.simplefilter("ignore", NotGeoreferencedWarning)
-        with rasterio.open(folder / f"{side}.tif", "w", **img_profile) as dst, \
-                rasterio.open(folder / f"{side}_map.tif", "w", **map_profile) as dmap:
-            dmap.descriptions = ("original_col", "original_row")
-            for r0, block, valid, mc, mr in pair.iter_resample(img, side, chunk):
-                rows = block.shape[1]
-                window = Window(0, r0, w, rows)
-                alpha = np.where(valid, alpha_max, 0).astype(img.dtype)
-                dst.write(np.concatenate([block, alpha[None]]), window=window)
-                dmap.write(np.stack([mc, mr]).astype(np.float32), window=window)
-                done_rows += rows
-                feedback.progress(99.0 * done_rows / total_rows)  # also checks cancel
+    # epipolar images live in image space: no geotransform, on purpose
+    with open_image(folder / f"{side}.tif", "w", **img_profile) as dst, \
+            open_image(folder / f"{side}_map.tif", "w", **map_profile) as dmap:
+        dmap.descriptions = ("original_col", "original_row")
+        for r0, block, valid, mc, mr in pair.iter_resample(img, side, chunk):
+            rows = block.shape[1]
+            window = Window(0, r0, w, rows)
+            alpha = np.where(valid, alpha_max, 0).astype(img.dtype)
+            dst.write(np.concatenate([block, alpha[None]]), window=window)
+            dmap.write(np.stack([mc, mr]).astype(np.float32), window=window)
+            done_rows += rows
+            feedback.progress(99.0 * done_rows / total_rows)  # also checks cancel
     return done_rows
 
 
@@ -118,8 +113,6 @@ class EpipolarPairAlgorithm(Algorithm):
     iterates_over = "model"
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        import rasterio
-
         project = Project.load(params["project"])
         model = project.model(params["model"])
         recs = [project.image(model.left), project.image(model.right)]
@@ -136,7 +129,7 @@ class EpipolarPairAlgorithm(Algorithm):
             if not path.is_file():
                 raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
                                  "fix its path in project.toml.")
-            with rasterio.open(path) as src:
+            with open_image(path) as src:
                 if (src.width, src.height) != (cam.width, cam.height):
                     raise InputError(
                         f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
