@@ -7,8 +7,8 @@ tier-A tests) from PyQt5. Every other module imports Qt only from here::
 
 "Inside QGIS" means ``qgis.core`` is already imported by the time this module loads: then mixing
 bindings would be fatal, so we must follow QGIS. (Not just ``qgis``: a folder ``tests/qgis`` on
-``sys.path`` is importable as a namespace package of that name.) When PyQt5 is missing we fall back to
-``qgis.PyQt`` as well.
+``sys.path`` is importable as a namespace package of that name.) When PyQt5 is missing we fall
+back to ``qgis.PyQt`` as well.
 """
 
 from __future__ import annotations

@@ -1,0 +1,1 @@
+"""The QGIS face of PhotoDEM: plugin class, Processing provider, generic algorithm."""

@@ -1,0 +1,607 @@
+<?xml version="1.0" encoding="utf-8"?>
+<!DOCTYPE TS>
+<TS version="2.1" language="de_DE" sourcelanguage="en">
+    <context>
+        <name>photodem</name>
+        <message>
+            <source>Create project</source>
+            <extracomment>project_create: name</extracomment>
+            <translation>Projekt anlegen</translation>
+        </message>
+        <message>
+            <source>Project</source>
+            <extracomment>project_create: group; project_info: group</extracomment>
+            <translation>Projekt</translation>
+        </message>
+        <message>
+            <source>Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their orientation: an OPK CSV or text file with the camera YAML (orthority format), or an OpenSfM/ODM reconstruction.json. The block is validated and its stereo models are detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first).</source>
+            <extracomment>project_create: help</extracomment>
+            <translation>Legt ein PhotoDEM-Projekt (project.toml + edits.gpkg) aus einem Bildordner und der Orientierung der Bilder an: eine OPK-CSV- oder Textdatei mit der Kamera-YAML (Orthority-Format) oder eine OpenSfM/ODM-reconstruction.json. Der Bildverband wird geprüft und seine Stereomodelle werden bestimmt (Überlappung ≥ 25 %, B/H 0,2–1,2, Nachbarn im selben Streifen zuerst).</translation>
+        </message>
+        <message>
+            <source>Images folder</source>
+            <extracomment>project_create.images: description</extracomment>
+            <translation>Bildordner</translation>
+        </message>
+        <message>
+            <source>Exterior orientation (OPK CSV/text or reconstruction.json)</source>
+            <extracomment>project_create.exterior: description</extracomment>
+            <translation>Äußere Orientierung (OPK-CSV/-Text oder reconstruction.json)</translation>
+        </message>
+        <message>
+            <source>x, y, z in the project CRS; omega, phi, kappa PATB (camera to world).</source>
+            <extracomment>project_create.exterior: help</extracomment>
+            <translation>x, y, z im Projekt-KBS; Omega, Phi, Kappa nach PATB (Kamera → Objektraum).</translation>
+        </message>
+        <message>
+            <source>Interior orientation (camera YAML)</source>
+            <extracomment>project_create.interior: description</extracomment>
+            <translation>Innere Orientierung (Kamera-YAML)</translation>
+        </message>
+        <message>
+            <source>Orthority interior-parameter YAML; not needed for OpenSfM.</source>
+            <extracomment>project_create.interior: help</extracomment>
+            <translation>YAML mit den Parametern der inneren Orientierung (Orthority); für OpenSfM nicht nötig.</translation>
+        </message>
+        <message>
+            <source>Project CRS</source>
+            <extracomment>project_create.crs: description; project_info output crs</extracomment>
+            <translation>Projekt-KBS</translation>
+        </message>
+        <message>
+            <source>Optional when a .prj file lies beside the exterior file.</source>
+            <extracomment>project_create.crs: help</extracomment>
+            <translation>Optional, wenn neben der Datei der äußeren Orientierung eine .prj-Datei liegt.</translation>
+        </message>
+        <message>
+            <source>Angle unit of omega, phi, kappa</source>
+            <extracomment>project_create.angle_unit: description</extracomment>
+            <translation>Winkeleinheit von Omega, Phi, Kappa</translation>
+        </message>
+        <message>
+            <source>degrees</source>
+            <extracomment>project_create.angle_unit: option</extracomment>
+            <translation>Grad</translation>
+        </message>
+        <message>
+            <source>gon</source>
+            <extracomment>project_create.angle_unit: option</extracomment>
+            <translation>Gon</translation>
+        </message>
+        <message>
+            <source>radians</source>
+            <extracomment>project_create.angle_unit: option</extracomment>
+            <translation>Radiant</translation>
+        </message>
+        <message>
+            <source>DEM for terrain heights and footprints</source>
+            <extracomment>project_create.dem: description</extracomment>
+            <translation>Geländemodell für Geländehöhen und Bildfußabdrücke</translation>
+        </message>
+        <message>
+            <source>Mean terrain height [m]</source>
+            <extracomment>project_create.terrain_height: description</extracomment>
+            <translation>Mittlere Geländehöhe [m]</translation>
+        </message>
+        <message>
+            <source>Used when no DEM is given.</source>
+            <extracomment>project_create.terrain_height: help</extracomment>
+            <translation>Wird verwendet, wenn kein Geländemodell angegeben ist.</translation>
+        </message>
+        <message>
+            <source>Project folder</source>
+            <extracomment>project_create output project; project_create.output: description; project_info.project: description; synthetic_block output project</extracomment>
+            <translation>Projektordner</translation>
+        </message>
+        <message>
+            <source>Number of images</source>
+            <extracomment>project_create output images; synthetic_block output images</extracomment>
+            <translation>Anzahl der Bilder</translation>
+        </message>
+        <message>
+            <source>Number of cameras</source>
+            <extracomment>project_create output cameras</extracomment>
+            <translation>Anzahl der Kameras</translation>
+        </message>
+        <message>
+            <source>Names of the stereo models</source>
+            <extracomment>project_create output models</extracomment>
+            <translation>Namen der Stereomodelle</translation>
+        </message>
+        <message>
+            <source>Validation warnings</source>
+            <extracomment>project_create output warnings</extracomment>
+            <translation>Warnungen der Prüfung</translation>
+        </message>
+        <message>
+            <source>Project information</source>
+            <extracomment>project_info: name</extracomment>
+            <translation>Projektinformationen</translation>
+        </message>
+        <message>
+            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation.</source>
+            <extracomment>project_info: help</extracomment>
+            <translation>Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf.</translation>
+        </message>
+        <message>
+            <source>Project name</source>
+            <extracomment>project_info output name</extracomment>
+            <translation>Projektname</translation>
+        </message>
+        <message>
+            <source>Images</source>
+            <extracomment>project_info output images</extracomment>
+            <translation>Bilder</translation>
+        </message>
+        <message>
+            <source>Cameras</source>
+            <extracomment>project_info output cameras</extracomment>
+            <translation>Kameras</translation>
+        </message>
+        <message>
+            <source>Stereo models</source>
+            <extracomment>project_info output models</extracomment>
+            <translation>Stereomodelle</translation>
+        </message>
+        <message>
+            <source>Validation errors and warnings</source>
+            <extracomment>project_info output validation</extracomment>
+            <translation>Fehler und Warnungen der Prüfung</translation>
+        </message>
+        <message>
+            <source>Synthetic block with ground truth</source>
+            <extracomment>synthetic_block: name</extracomment>
+            <translation>Synthetischer Bildverband mit Referenzdaten</translation>
+        </message>
+        <message>
+            <source>Synthetic data</source>
+            <extracomment>synthetic_block: group</extracomment>
+            <translation>Synthetische Daten</translation>
+        </message>
+        <message>
+            <source>Generates a deterministic synthetic aerial block: terrain (gentle, dunes or steep), an embankment and a ditch with breaklines, buildings, trees and a forest patch, textured ground with bright check-point discs, frame images in two or more strips (60 % forward, 30 % side overlap) rendered by ray casting against the true DSM. Writes a complete project (project.toml, images, edits.gpkg, in-strip stereo models) and the ground truth (DTM, DSM, land cover, building footprints, 3-D breaklines, check points) below truth/. The same seed always gives the same block.</source>
+            <extracomment>synthetic_block: help</extracomment>
+            <translation>Erzeugt einen deterministischen synthetischen Bildflug: Gelände (flach, Dünen oder steil), einen Damm und einen Graben mit Bruchkanten, Gebäude, Bäume und ein Waldstück, texturierten Boden mit hellen Kontrollpunktscheiben sowie Reihenmessbilder in zwei oder mehr Streifen (60 % Längs-, 30 % Querüberdeckung), gerendert durch Strahlverfolgung gegen das wahre Oberflächenmodell. Schreibt ein vollständiges Projekt (project.toml, Bilder, edits.gpkg, Stereomodelle im Streifen) und die Referenzdaten (Geländemodell, Oberflächenmodell, Landbedeckung, Gebäudegrundrisse, 3D-Bruchkanten, Kontrollpunkte) unter truth/. Derselbe Startwert ergibt immer denselben Bildverband.</translation>
+        </message>
+        <message>
+            <source>Output project folder</source>
+            <extracomment>synthetic_block.output: description</extracomment>
+            <translation>Ausgabe-Projektordner</translation>
+        </message>
+        <message>
+            <source>Block size</source>
+            <extracomment>synthetic_block.size: description</extracomment>
+            <translation>Größe des Bildverbands</translation>
+        </message>
+        <message>
+            <source>tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: 1408×2000 px; large: 2400×3400 px (≈ 8 Mpx).</source>
+            <extracomment>synthetic_block.size: help</extracomment>
+            <translation>winzig: Bilder mit 224×288 px (Tests); klein: 704×1000 px (Demo); mittel: 1408×2000 px; groß: 2400×3400 px (≈ 8 Mpx).</translation>
+        </message>
+        <message>
+            <source>tiny</source>
+            <extracomment>synthetic_block.size: option</extracomment>
+            <translation>winzig</translation>
+        </message>
+        <message>
+            <source>small</source>
+            <extracomment>synthetic_block.size: option</extracomment>
+            <translation>klein</translation>
+        </message>
+        <message>
+            <source>medium</source>
+            <extracomment>synthetic_block.size: option</extracomment>
+            <translation>mittel</translation>
+        </message>
+        <message>
+            <source>large</source>
+            <extracomment>synthetic_block.size: option</extracomment>
+            <translation>groß</translation>
+        </message>
+        <message>
+            <source>Terrain type</source>
+            <extracomment>synthetic_block.terrain: description</extracomment>
+            <translation>Geländetyp</translation>
+        </message>
+        <message>
+            <source>steep: relief &gt; 100 m with slopes of 45° and more (flown 2.5× higher).</source>
+            <extracomment>synthetic_block.terrain: help</extracomment>
+            <translation>steil: Relief &gt; 100 m mit Hangneigungen von 45° und mehr (2,5-fache Flughöhe).</translation>
+        </message>
+        <message>
+            <source>gentle</source>
+            <extracomment>synthetic_block.terrain: option</extracomment>
+            <translation>flach</translation>
+        </message>
+        <message>
+            <source>dunes</source>
+            <extracomment>synthetic_block.terrain: option</extracomment>
+            <translation>Dünen</translation>
+        </message>
+        <message>
+            <source>steep</source>
+            <extracomment>synthetic_block.terrain: option</extracomment>
+            <translation>steil</translation>
+        </message>
+        <message>
+            <source>Random seed</source>
+            <extracomment>synthetic_block.seed: description</extracomment>
+            <translation>Startwert des Zufallsgenerators</translation>
+        </message>
+        <message>
+            <source>Direction of the field furrows [°]</source>
+            <extracomment>synthetic_block.texture_direction: description</extracomment>
+            <translation>Richtung der Ackerfurchen [°]</translation>
+        </message>
+        <message>
+            <source>Counter-clockwise from the flight direction (+X): 0 = furrows along the base, 90 = across it.</source>
+            <extracomment>synthetic_block.texture_direction: help</extracomment>
+            <translation>Gegen den Uhrzeigersinn von der Flugrichtung (+X): 0 = Furchen entlang der Basis, 90 = quer dazu.</translation>
+        </message>
+        <message>
+            <source>True DTM</source>
+            <extracomment>synthetic_block output truth_dtm</extracomment>
+            <translation>Wahres Geländemodell (DGM)</translation>
+        </message>
+        <message>
+            <source>True DSM</source>
+            <extracomment>synthetic_block output truth_dsm</extracomment>
+            <translation>Wahres Oberflächenmodell (DOM)</translation>
+        </message>
+        <message>
+            <source>Land cover (1 open, 2 road, 3 building, 4 tree/forest, 5 water/ditch, 6 embankment, 7 field)</source>
+            <extracomment>synthetic_block output truth_landcover</extracomment>
+            <translation>Landbedeckung (1 offen, 2 Straße, 3 Gebäude, 4 Baum/Wald, 5 Wasser/Graben, 6 Damm, 7 Acker)</translation>
+        </message>
+        <message>
+            <source>Building footprints</source>
+            <extracomment>synthetic_block output truth_buildings</extracomment>
+            <translation>Gebäudegrundrisse</translation>
+        </message>
+        <message>
+            <source>3-D breaklines</source>
+            <extracomment>synthetic_block output truth_breaklines</extracomment>
+            <translation>3D-Bruchkanten</translation>
+        </message>
+        <message>
+            <source>Check points (3-D)</source>
+            <extracomment>synthetic_block output truth_checkpoints</extracomment>
+            <translation>Kontrollpunkte (3D)</translation>
+        </message>
+        <message>
+            <source>Number of stereo models</source>
+            <extracomment>synthetic_block output models</extracomment>
+            <translation>Anzahl der Stereomodelle</translation>
+        </message>
+        <message>
+            <source>Ground sample distance [m]</source>
+            <extracomment>synthetic_block output gsd_m</extracomment>
+            <translation>Bodenauflösung (GSD) [m]</translation>
+        </message>
+        <message>
+            <source>Flying height above mean terrain [m]</source>
+            <extracomment>synthetic_block output flying_height_m</extracomment>
+            <translation>Flughöhe über mittlerem Gelände [m]</translation>
+        </message>
+        <message>
+            <source>Epipolar pair</source>
+            <extracomment>epipolar_pair: name</extracomment>
+            <translation>Epipolarbildpaar</translation>
+        </message>
+        <message>
+            <source>Geometry</source>
+            <extracomment>epipolar_pair: group</extracomment>
+            <translation>Geometrie</translation>
+        </message>
+        <message>
+            <source>Resamples the two images of a stereo model to normal-case (epipolar) geometry: both images share one rotation with x along the base, so a ground point has the same row in both. Writes left.tif and right.tif (input bands plus an alpha band), left_map.tif and right_map.tif (original col, row of every epipolar pixel, NaN outside) and epipolar.json (homographies, focal length in px, base, sizes) for matching and triangulation.</source>
+            <extracomment>epipolar_pair: help</extracomment>
+            <translation>Bildet die beiden Bilder eines Stereomodells in den Normalfall (Epipolargeometrie) um: beide Bilder erhalten dieselbe Drehung mit x entlang der Basis, sodass ein Geländepunkt in beiden Bildern in derselben Zeile liegt. Schreibt left.tif und right.tif (Eingangskanäle plus Alphakanal), left_map.tif und right_map.tif (ursprüngliche Spalte, Zeile jedes Epipolarpixels, außerhalb NaN) und epipolar.json (Homographien, Kamerakonstante in px, Basis, Größen) für Bildzuordnung und Vorwärtsschnitt.</translation>
+        </message>
+        <message>
+            <source>Project folder or project.toml</source>
+            <extracomment>epipolar_pair.project: description</extracomment>
+            <translation>Projektordner oder project.toml</translation>
+        </message>
+        <message>
+            <source>Stereo model</source>
+            <extracomment>epipolar_pair.model: description</extracomment>
+            <translation>Stereomodell</translation>
+        </message>
+        <message>
+            <source>Output folder</source>
+            <extracomment>epipolar_pair output folder; epipolar_pair.output: description</extracomment>
+            <translation>Ausgabeordner</translation>
+        </message>
+        <message>
+            <source>Default: &lt;project&gt;/products/epipolar/&lt;model&gt;/. Must not exist or be empty.</source>
+            <extracomment>epipolar_pair.output: help</extracomment>
+            <translation>Vorgabe: &lt;Projekt&gt;/products/epipolar/&lt;Modell&gt;/. Darf nicht existieren oder muss leer sein.</translation>
+        </message>
+        <message>
+            <source>Resolution scale</source>
+            <extracomment>epipolar_pair.scale: description</extracomment>
+            <translation>Auflösungsfaktor</translation>
+        </message>
+        <message>
+            <source>Epipolar pixel density relative to the originals (0.5 = half resolution).</source>
+            <extracomment>epipolar_pair.scale: help</extracomment>
+            <translation>Pixeldichte der Epipolarbilder relativ zu den Originalen (0,5 = halbe Auflösung).</translation>
+        </message>
+        <message>
+            <source>Left epipolar image</source>
+            <extracomment>epipolar_pair output left</extracomment>
+            <translation>Linkes Epipolarbild</translation>
+        </message>
+        <message>
+            <source>Right epipolar image</source>
+            <extracomment>epipolar_pair output right</extracomment>
+            <translation>Rechtes Epipolarbild</translation>
+        </message>
+        <message>
+            <source>Left map to original pixels (col, row)</source>
+            <extracomment>epipolar_pair output left_map</extracomment>
+            <translation>Linke Zuordnung zu den Originalpixeln (Spalte, Zeile)</translation>
+        </message>
+        <message>
+            <source>Right map to original pixels (col, row)</source>
+            <extracomment>epipolar_pair output right_map</extracomment>
+            <translation>Rechte Zuordnung zu den Originalpixeln (Spalte, Zeile)</translation>
+        </message>
+        <message>
+            <source>epipolar.json</source>
+            <extracomment>epipolar_pair output metadata</extracomment>
+            <translation>epipolar.json</translation>
+        </message>
+        <message>
+            <source>Largest y-parallax of check points (px)</source>
+            <extracomment>epipolar_pair output y_parallax_check_px</extracomment>
+            <translation>Größte y-Parallaxe der Kontrollpunkte (px)</translation>
+        </message>
+        <message>
+            <source>Epipolar image size [w, h] (left)</source>
+            <extracomment>epipolar_pair output size</extracomment>
+            <translation>Größe des Epipolarbilds [B, H] (links)</translation>
+        </message>
+        <message>
+            <source>PhotoDEM toolbox</source>
+            <extracomment>plugin/app/main_window.py:37</extracomment>
+            <translation>PhotoDEM-Werkzeugkasten</translation>
+        </message>
+        <message>
+            <source>Search algorithms …</source>
+            <extracomment>plugin/app/main_window.py:44</extracomment>
+            <translation>Algorithmen suchen …</translation>
+        </message>
+        <message>
+            <source>Choose an algorithm on the left.</source>
+            <extracomment>plugin/app/main_window.py:98</extracomment>
+            <translation>Links einen Algorithmus wählen.</translation>
+        </message>
+        <message>
+            <source>&amp;File</source>
+            <extracomment>plugin/app/main_window.py:108</extracomment>
+            <translation>&amp;Datei</translation>
+        </message>
+        <message>
+            <source>&amp;Quit</source>
+            <extracomment>plugin/app/main_window.py:109</extracomment>
+            <translation>&amp;Beenden</translation>
+        </message>
+        <message>
+            <source>&amp;Help</source>
+            <extracomment>plugin/app/main_window.py:112</extracomment>
+            <translation>&amp;Hilfe</translation>
+        </message>
+        <message>
+            <source>&amp;About PhotoDEM</source>
+            <extracomment>plugin/app/main_window.py:113</extracomment>
+            <translation>&amp;Über PhotoDEM</translation>
+        </message>
+        <message>
+            <source>{0} finished.</source>
+            <extracomment>plugin/app/main_window.py:203</extracomment>
+            <translation>{0} ist fertig.</translation>
+        </message>
+        <message>
+            <source>{0} failed.</source>
+            <extracomment>plugin/app/main_window.py:203</extracomment>
+            <translation>{0} ist fehlgeschlagen.</translation>
+        </message>
+        <message>
+            <source>{0} was cancelled.</source>
+            <extracomment>plugin/app/main_window.py:204</extracomment>
+            <translation>{0} wurde abgebrochen.</translation>
+        </message>
+        <message>
+            <source>About PhotoDEM</source>
+            <extracomment>plugin/app/main_window.py:218</extracomment>
+            <translation>Über PhotoDEM</translation>
+        </message>
+        <message>
+            <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
+            <extracomment>plugin/app/main_window.py:219</extracomment>
+            <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
+        </message>
+        <message>
+            <source>Other</source>
+            <extracomment>plugin/app/main_window.py:123</extracomment>
+            <translation>Sonstiges</translation>
+        </message>
+        <message>
+            <source>PhotoDEM</source>
+            <extracomment>plugin/app/main_window.py:208</extracomment>
+            <translation>PhotoDEM</translation>
+        </message>
+        <message>
+            <source>Running {0} …</source>
+            <extracomment>plugin/app/main_window.py:196; plugin/widgets/run_panel.py:101</extracomment>
+            <translation>{0} läuft …</translation>
+        </message>
+        <message>
+            <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
+            <extracomment>plugin/qgis/plugin.py:43</extracomment>
+            <translation>PhotoDEM benötigt Python-Pakete, die QGIS nicht findet: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: mit dem OSGeo4W-Installer installieren.</translation>
+        </message>
+        <message>
+            <source>PhotoDEM algorithms</source>
+            <extracomment>plugin/qgis/plugin.py:92</extracomment>
+            <translation>PhotoDEM-Algorithmen</translation>
+        </message>
+        <message>
+            <source>Show the PhotoDEM algorithms in the Processing Toolbox</source>
+            <extracomment>plugin/qgis/plugin.py:94</extracomment>
+            <translation>Die PhotoDEM-Algorithmen im Verarbeitungswerkzeugkasten zeigen</translation>
+        </message>
+        <message>
+            <source>PhotoDEM aerial photogrammetry</source>
+            <extracomment>plugin/qgis/provider.py:34</extracomment>
+            <translation>PhotoDEM Luftbildphotogrammetrie</translation>
+        </message>
+        <message>
+            <source>Browse</source>
+            <extracomment>plugin/widgets/parameter_form.py:59</extracomment>
+            <translation>Durchsuchen</translation>
+        </message>
+        <message>
+            <source>All files (*)</source>
+            <extracomment>plugin/widgets/parameter_form.py:76; plugin/widgets/parameter_form.py:78</extracomment>
+            <translation>Alle Dateien (*)</translation>
+        </message>
+        <message>
+            <source>Supported files</source>
+            <extracomment>plugin/widgets/parameter_form.py:78</extracomment>
+            <translation>Unterstützte Dateien</translation>
+        </message>
+        <message>
+            <source>Choose a folder</source>
+            <extracomment>plugin/widgets/parameter_form.py:84</extracomment>
+            <translation>Ordner wählen</translation>
+        </message>
+        <message>
+            <source>project folder (with project.toml)</source>
+            <extracomment>plugin/widgets/parameter_form.py:128</extracomment>
+            <translation>Projektordner (mit project.toml)</translation>
+        </message>
+        <message>
+            <source>optional</source>
+            <extracomment>plugin/widgets/parameter_form.py:159; plugin/widgets/parameter_form.py:202; plugin/widgets/parameter_form.py:292</extracomment>
+            <translation>optional</translation>
+        </message>
+        <message>
+            <source>choose a project first</source>
+            <extracomment>plugin/widgets/parameter_form.py:192</extracomment>
+            <translation>zuerst ein Projekt wählen</translation>
+        </message>
+        <message>
+            <source>image name</source>
+            <extracomment>plugin/widgets/parameter_form.py:192</extracomment>
+            <translation>Bildname</translation>
+        </message>
+        <message>
+            <source>required</source>
+            <extracomment>plugin/widgets/parameter_form.py:292</extracomment>
+            <translation>erforderlich</translation>
+        </message>
+        <message>
+            <source>several files, separated by commas</source>
+            <extracomment>plugin/widgets/parameter_form.py:130</extracomment>
+            <translation>mehrere Dateien, durch Kommas getrennt</translation>
+        </message>
+        <message>
+            <source>e.g. EPSG:25832</source>
+            <extracomment>plugin/widgets/parameter_form.py:200</extracomment>
+            <translation>z. B. EPSG:25832</translation>
+        </message>
+        <message>
+            <source>xmin,ymin,xmax,ymax</source>
+            <extracomment>plugin/widgets/parameter_form.py:201</extracomment>
+            <translation>xmin,ymin,xmax,ymax</translation>
+        </message>
+        <message>
+            <source>type a name</source>
+            <extracomment>plugin/widgets/parameter_form.py:347</extracomment>
+            <translation>Namen eingeben</translation>
+        </message>
+        <message>
+            <source>no project found</source>
+            <extracomment>plugin/widgets/parameter_form.py:347</extracomment>
+            <translation>kein Projekt gefunden</translation>
+        </message>
+        <message>
+            <source>Save as</source>
+            <extracomment>plugin/widgets/parameter_form.py:86</extracomment>
+            <translation>Speichern unter</translation>
+        </message>
+        <message>
+            <source>Choose files</source>
+            <extracomment>plugin/widgets/parameter_form.py:88</extracomment>
+            <translation>Dateien wählen</translation>
+        </message>
+        <message>
+            <source>Choose a file</source>
+            <extracomment>plugin/widgets/parameter_form.py:91</extracomment>
+            <translation>Datei wählen</translation>
+        </message>
+        <message>
+            <source>Run</source>
+            <extracomment>plugin/widgets/run_panel.py:39</extracomment>
+            <translation>Ausführen</translation>
+        </message>
+        <message>
+            <source>Cancel</source>
+            <extracomment>plugin/widgets/run_panel.py:42</extracomment>
+            <translation>Abbrechen</translation>
+        </message>
+        <message>
+            <source>The log of the run appears here.</source>
+            <extracomment>plugin/widgets/run_panel.py:54</extracomment>
+            <translation>Hier erscheint das Protokoll des Laufs.</translation>
+        </message>
+        <message>
+            <source>Log</source>
+            <extracomment>plugin/widgets/run_panel.py:64</extracomment>
+            <translation>Protokoll</translation>
+        </message>
+        <message>
+            <source>Result</source>
+            <extracomment>plugin/widgets/run_panel.py:65</extracomment>
+            <translation>Ergebnis</translation>
+        </message>
+        <message>
+            <source>Finished.</source>
+            <extracomment>plugin/widgets/run_panel.py:152</extracomment>
+            <translation>Fertig.</translation>
+        </message>
+        <message>
+            <source>Output</source>
+            <extracomment>plugin/widgets/run_panel.py:59</extracomment>
+            <translation>Ausgabe</translation>
+        </message>
+        <message>
+            <source>Value</source>
+            <extracomment>plugin/widgets/run_panel.py:59</extracomment>
+            <translation>Wert</translation>
+        </message>
+        <message>
+            <source>Cancelling …</source>
+            <extracomment>plugin/widgets/run_panel.py:123</extracomment>
+            <translation>Wird abgebrochen …</translation>
+        </message>
+        <message>
+            <source>Warning: </source>
+            <extracomment>plugin/widgets/run_panel.py:143</extracomment>
+            <translation>Warnung: </translation>
+        </message>
+        <message>
+            <source>Error: </source>
+            <extracomment>plugin/widgets/run_panel.py:157</extracomment>
+            <translation>Fehler: </translation>
+        </message>
+        <message>
+            <source>Unexpected error (please report it):</source>
+            <extracomment>plugin/widgets/run_panel.py:159</extracomment>
+            <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+    </context>
+</TS>

@@ -1,0 +1,140 @@
+"""The QGIS plugin class: Processing provider, Raster menu, toolbar button.
+
+QGIS desktop calls ``classFactory(iface)`` then :meth:`PhotodemPlugin.initGui`; ``qgis_process``
+calls ``classFactory(None)`` then only :meth:`PhotodemPlugin.initProcessing`. So
+``initProcessing`` never touches ``iface``, ``initGui`` calls it, and :meth:`unload` undoes both.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from typing import Any, List, Optional
+
+from qgis.core import Qgis, QgsApplication, QgsMessageLog
+
+from ...algorithms.processing import registry
+from ..i18n import install_translator, remove_translator, tr
+from ..qt import QAction, QIcon
+from .provider import ICON_PATH, PROVIDER_ID, PhotodemProvider
+
+MENU_TITLE = "&PhotoDEM"
+#: Python packages the core needs (import name → Debian package).
+DEPENDENCIES = {
+    "numpy": "python3-numpy",
+    "scipy": "python3-scipy",
+    "skimage": "python3-skimage",
+    "rasterio": "python3-rasterio",
+    "affine": "python3-affine",
+    "fiona": "python3-fiona",
+    "shapely": "python3-shapely",
+    "pyproj": "python3-pyproj",
+    "yaml": "python3-yaml",
+}
+
+
+def missing_dependencies() -> List[str]:
+    """Import names of the core's dependencies that this QGIS Python cannot find."""
+    return [name for name in DEPENDENCIES if importlib.util.find_spec(name) is None]
+
+
+def dependency_message(missing: List[str]) -> str:
+    """One operator-readable line: what is missing and how to install it."""
+    debian = " ".join(DEPENDENCIES[m] for m in missing)
+    return tr("PhotoDEM needs Python packages that QGIS cannot find: {0}. "
+              "Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W "
+              "installer.").format(", ".join(missing), debian)
+
+
+class PhotodemPlugin:
+    """PhotoDEM inside QGIS.
+
+    Parameters
+    ----------
+    iface : QgisInterface or None
+        ``None`` under ``qgis_process``.
+    """
+
+    def __init__(self, iface: Any) -> None:
+        self.iface = iface
+        # References are kept on purpose: sip/GC would otherwise drop the provider, the
+        # translator or the actions and the algorithms would silently vanish.
+        self.provider: Optional[PhotodemProvider] = None
+        self.actions: List[QAction] = []
+        self.toolbox_action: Optional[QAction] = None
+        self.translator = install_translator()
+        self.missing = missing_dependencies()
+
+    # -- Processing (desktop and qgis_process) --------------------------------------------------
+    def initProcessing(self) -> None:
+        """Register the provider ``photodem``; safe to call twice; never uses ``iface``.
+
+        Without the core's dependencies no provider is registered; the reason goes to the QGIS
+        message log (and to the message bar in :meth:`initGui`).
+        """
+        if self.missing:
+            QgsMessageLog.logMessage(dependency_message(self.missing), "PhotoDEM", Qgis.Critical)
+            return
+        if self.provider is None:
+            self.provider = PhotodemProvider()
+            QgsApplication.processingRegistry().addProvider(self.provider)
+
+    # -- desktop --------------------------------------------------------------------------------
+    def initGui(self) -> None:
+        """Provider, a PhotoDEM entry per algorithm in the Raster menu, a toolbar button."""
+        self.initProcessing()
+        if self.iface is None:
+            return
+        if self.missing:
+            self.iface.messageBar().pushCritical("PhotoDEM", dependency_message(self.missing))
+            return
+        parent = self.iface.mainWindow()
+        icon = QIcon(str(ICON_PATH))
+        self.toolbox_action = QAction(icon, tr("PhotoDEM algorithms"), parent)
+        self.toolbox_action.setObjectName("photodemShowToolbox")
+        self.toolbox_action.setToolTip(tr("Show the PhotoDEM algorithms in the Processing Toolbox"))
+        self.toolbox_action.triggered.connect(self.show_toolbox)
+        self.iface.addToolBarIcon(self.toolbox_action)
+        self.iface.addPluginToRasterMenu(MENU_TITLE, self.toolbox_action)
+        self.actions.append(self.toolbox_action)
+        for spec in registry.algorithms().values():
+            action = QAction(icon, tr(spec.name or spec.id) + "…", parent)
+            action.setObjectName(f"photodem_{spec.id}")
+            action.triggered.connect(lambda _checked=False, i=spec.id: self.open_dialog(i))
+            self.iface.addPluginToRasterMenu(MENU_TITLE, action)
+            self.actions.append(action)
+
+    def open_dialog(self, algorithm_id: str) -> None:
+        """Open the Processing dialog of ``photodem:<algorithm_id>``."""
+        import processing  # QGIS's processing plugin; only present in the desktop application
+
+        processing.execAlgorithmDialog(f"{PROVIDER_ID}:{algorithm_id}")
+
+    def show_toolbox(self) -> None:
+        """Show the Processing Toolbox filtered to PhotoDEM (best effort; UI only)."""
+        from qgis.PyQt.QtWidgets import QDockWidget
+
+        dock = self.iface.mainWindow().findChild(QDockWidget, "ProcessingToolbox")
+        if dock is None:
+            return
+        dock.setVisible(True)
+        dock.raise_()
+        search = getattr(dock, "searchBox", None)
+        if search is not None:
+            search.setText("photodem")
+
+    def unload(self) -> None:
+        """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if self.iface is not None:
+            for action in self.actions:
+                self.iface.removePluginRasterMenu(MENU_TITLE, action)
+            if self.toolbox_action is not None:
+                self.iface.removeToolBarIcon(self.toolbox_action)
+        for action in self.actions:
+            action.deleteLater()
+        self.actions = []
+        self.toolbox_action = None
+        if self.provider is not None:
+            QgsApplication.processingRegistry().removeProvider(self.provider)
+            self.provider = None
+        remove_translator()
+        self.translator = None

@@ -1,0 +1,178 @@
+"""The plugin loads like QGIS loads it: qgis_process path and desktop path; unload is complete."""
+
+from __future__ import annotations
+
+import configparser
+import time
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.qgis
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class FakeIface:
+    """Records what the plugin asks of QGIS's desktop interface (beside the real provider test)."""
+
+    def __init__(self) -> None:
+        from qgis.PyQt.QtWidgets import QMainWindow
+
+        self.window = QMainWindow()
+        self.calls: list = []
+
+    def mainWindow(self):  # noqa: N802 (QGIS API)
+        return self.window
+
+    def addToolBarIcon(self, action):  # noqa: N802
+        self.calls.append(("addToolBarIcon", action.objectName()))
+
+    def removeToolBarIcon(self, action):  # noqa: N802
+        self.calls.append(("removeToolBarIcon", action.objectName()))
+
+    def addPluginToRasterMenu(self, menu, action):  # noqa: N802
+        self.calls.append(("addPluginToRasterMenu", menu, action.objectName()))
+
+    def removePluginRasterMenu(self, menu, action):  # noqa: N802
+        self.calls.append(("removePluginRasterMenu", menu, action.objectName()))
+
+    def __getattr__(self, name):  # anything else would be an unexpected use of iface
+        raise AssertionError(f"the plugin used iface.{name}, which the fake does not provide")
+
+
+def _registry():
+    from qgis.core import QgsApplication
+
+    return QgsApplication.processingRegistry()
+
+
+def test_loaded_the_qgis_process_way(plugin, provider):
+    """loadPlugin + startProcessingPlugin = classFactory(None) → initProcessing."""
+    assert plugin.iface is None
+    assert provider is not None and provider.id() == "photodem"
+    assert _registry().providerById("photodem") is provider
+    assert not plugin.actions  # no GUI without iface
+
+
+def test_class_factory_none_then_init_processing_and_unload(qgis_app, plugin):
+    """A second instance, driven by hand: registers its own provider, unload removes it."""
+    import photodem
+
+    registry = _registry()
+    registry.removeProvider(plugin.provider)  # make room: provider ids are unique
+    plugin.provider = None
+    try:
+        start = time.perf_counter()
+        second = photodem.classFactory(None)
+        second.initProcessing()
+        elapsed = time.perf_counter() - start
+        assert registry.providerById("photodem") is second.provider
+        for algorithm_id in _ids():
+            assert registry.algorithmById("photodem:" + algorithm_id) is not None
+        second.initProcessing()  # idempotent
+        assert len([p for p in registry.providers() if p.id() == "photodem"]) == 1
+        second.unload()
+        assert registry.providerById("photodem") is None
+        assert second.provider is None
+        print(f"classFactory(None) + initProcessing: {elapsed * 1000:.1f} ms")
+    finally:
+        plugin.initProcessing()  # restore the session's provider
+    assert registry.providerById("photodem") is plugin.provider
+
+
+def _ids() -> list:
+    from photodem.algorithms.processing import registry
+
+    return list(registry.algorithms())
+
+
+def test_desktop_init_gui_and_unload(qgis_app, plugin):
+    """initGui → initProcessing + one menu entry per algorithm + a toolbar button; unload undoes."""
+    import photodem
+    from photodem.algorithms.processing import registry as core_registry
+
+    registry = _registry()
+    registry.removeProvider(plugin.provider)
+    plugin.provider = None
+    iface = FakeIface()
+    try:
+        desktop = photodem.classFactory(iface)
+        assert not iface.calls  # the constructor does not touch iface
+        desktop.initGui()
+        assert registry.providerById("photodem") is desktop.provider
+        added = [c for c in iface.calls if c[0] == "addPluginToRasterMenu"]
+        names = {c[2] for c in added}
+        assert {f"photodem_{i}" for i in core_registry.algorithms()} <= names
+        assert ("addToolBarIcon", "photodemShowToolbox") in iface.calls
+        assert all(c[1] == "&PhotoDEM" for c in added)
+        iface.calls.clear()
+        desktop.unload()
+        removed = [c for c in iface.calls if c[0] == "removePluginRasterMenu"]
+        assert {c[2] for c in removed} == names
+        assert ("removeToolBarIcon", "photodemShowToolbox") in iface.calls
+        assert registry.providerById("photodem") is None
+        assert desktop.actions == []
+    finally:
+        plugin.initProcessing()
+    assert registry.providerById("photodem") is plugin.provider
+
+
+def test_provider_lists_every_registry_algorithm(provider, fixture_alg):
+    from photodem.algorithms.processing import registry
+
+    listed = {a.id() for a in provider.algorithms()}
+    expected = {f"photodem:{i}" for i in registry.algorithms()}
+    assert expected == listed
+    assert "photodem:fixture_all_kinds" in listed
+    for alg in provider.algorithms():
+        assert _registry().algorithmById(alg.id()) is not None
+
+
+def test_provider_identity_and_icon(provider):
+    from photodem.plugin.qgis.provider import ICON_PATH
+
+    assert provider.name() == "PhotoDEM"
+    assert ICON_PATH.is_file()
+    assert not provider.icon().isNull()
+    assert provider.defaultRasterFileExtension() == "tif"
+
+
+def test_metadata_is_complete():
+    meta = configparser.ConfigParser()
+    meta.read(ROOT / "metadata.txt", encoding="utf-8")
+    general = meta["general"]
+    for key in ("name", "qgisMinimumVersion", "description", "about", "version", "author",
+                "email", "repository", "tracker", "category", "tags", "hasProcessingProvider",
+                "license", "icon"):
+        assert general.get(key), key
+    assert general["qgisMinimumVersion"] == "3.22"
+    assert general["hasProcessingProvider"] == "yes"
+    assert (ROOT / general["icon"]).is_file()
+    assert (ROOT / "LICENSE").is_file()
+    import photodem.algorithms as core
+
+    assert general["version"] == core.__version__
+
+
+def test_missing_dependencies_give_one_clear_message(qgis_app, plugin, monkeypatch):
+    """No provider and one message naming the packages when the core cannot import."""
+    import photodem
+    from photodem.plugin.qgis import plugin as plugin_module
+
+    monkeypatch.setattr(plugin_module, "missing_dependencies", lambda: ["rasterio", "skimage"])
+    messages = []
+
+    class Bar:
+        def pushCritical(self, title, text):  # noqa: N802 (QGIS API)
+            messages.append(text)
+
+    iface = FakeIface()
+    iface.messageBar = lambda: Bar()
+    broken = photodem.classFactory(iface)
+    broken.initGui()
+    assert broken.provider is None and not broken.actions
+    assert len(messages) == 1
+    assert "rasterio, skimage" in messages[0] and "python3-rasterio python3-skimage" in messages[0]
+    broken.unload()
+    assert _registry().providerById("photodem") is plugin.provider  # the session's is untouched
