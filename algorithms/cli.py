@@ -418,7 +418,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     try:
-        batch_mod.register_algorithm_modules(batch_mod.extra_modules_from_env())
+        registry.add_modules(registry.extra_modules())  # also when the cache is filled already
         try:
             args = parser.parse_args(argv)
         except SystemExit as exc:  # --help and --version

@@ -48,7 +48,6 @@ import concurrent.futures as cf
 import contextlib
 import datetime as _dt
 import hashlib
-import importlib
 import json
 import multiprocessing
 import os
@@ -58,7 +57,7 @@ import time
 import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, TextIO, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO, Union
 
 from ..errors import Cancelled, InputError, PhotodemError
 from ..project import toml_io
@@ -67,7 +66,6 @@ from .feedback import Feedback, ensure_feedback
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
-EXTRA_ALGORITHMS_ENV = "PHOTODEM_EXTRA_ALGORITHMS"
 STATE_FILE = Path(".photodem") / "batch-state.json"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
@@ -77,28 +75,6 @@ _BATCH_KEYS = {"project", "workers", "output"}
 _STEP_KEYS = {"algorithm", "name", "models", "images", "params"}
 
 PathLike = Union[str, "os.PathLike[str]"]
-
-
-# -- extra algorithm modules ---------------------------------------------------------------------
-def register_algorithm_modules(names: Iterable[str]) -> List[str]:
-    """Import modules that list ``ALGORITHMS`` and add them to the registry; return their ids."""
-    names = [n.strip() for n in names if n and n.strip()]
-    if not names:
-        return []
-    registry.algorithms()  # load the built-in ones first
-    ids = []
-    for name in names:
-        module = importlib.import_module(name)
-        for cls in module.ALGORITHMS:
-            alg = cls()
-            registry._CACHE[alg.id] = alg
-            ids.append(alg.id)
-    return ids
-
-
-def extra_modules_from_env() -> List[str]:
-    """Module names from :data:`EXTRA_ALGORITHMS_ENV`."""
-    return [n.strip() for n in os.environ.get(EXTRA_ALGORITHMS_ENV, "").split(",") if n.strip()]
 
 
 # -- the plan ------------------------------------------------------------------------------------
@@ -437,7 +413,7 @@ def _init_worker(cancel_event: Any, queue: Any, modules: Sequence[str]) -> None:
     global _worker_cancel, _worker_queue
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _worker_cancel, _worker_queue = cancel_event, queue
-    register_algorithm_modules(modules)
+    registry.add_modules(modules)
 
 
 def _worker_run(index: int, algorithm: str, params: Dict[str, Any], log: str) -> Dict[str, Any]:
@@ -490,7 +466,7 @@ def run_batch(
         Skip tasks that an earlier run completed with the same parameters.
     extra_modules : sequence of str
         Modules with extra ``ALGORITHMS`` to register in the workers (besides those named in
-        :data:`EXTRA_ALGORITHMS_ENV`, which workers inherit).
+        :data:`.registry.EXTRA_MODULES_ENV`, which workers inherit).
     grace : float
         Seconds that running tasks get to stop after a cancel before their workers are
         terminated.
@@ -572,7 +548,7 @@ def run_batch(
                 _run_in_process(todo, feedback, progress, finish)
             else:
                 if pool is None:
-                    pool = _Pool(n_workers, [*extra_modules, *extra_modules_from_env()])
+                    pool = _Pool(n_workers, [*extra_modules, *registry.extra_modules()])
                 pool.run(todo, feedback, progress, finish, grace)
             for task in todo:
                 if records[task.index]["status"] == "failed" and task.item is not None:
@@ -748,14 +724,11 @@ def _toml_string(text: str) -> str:
 
 
 __all__ = [
-    "EXTRA_ALGORITHMS_ENV",
     "BatchPlan",
     "Task",
     "batch_template",
     "execute_task",
-    "extra_modules_from_env",
     "load_batch",
     "plan_batch",
-    "register_algorithm_modules",
     "run_batch",
 ]

@@ -8,8 +8,9 @@ registry, so adding an algorithm is one class in one module.
 from __future__ import annotations
 
 import importlib
+import os
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, Iterable, List, Optional
 
 from ..errors import InputError
 from .feedback import Feedback, ensure_feedback
@@ -22,11 +23,14 @@ ALGORITHM_MODULES = (
     "geometry",
 )
 
+#: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).
+EXTRA_MODULES_ENV = "PHOTODEM_EXTRA_ALGORITHMS"
+
 _CACHE: Dict[str, Algorithm] = {}
 
 
 def algorithms() -> Dict[str, Algorithm]:
-    """All algorithms by id, in declaration order."""
+    """All algorithms by id, in declaration order (built-in ones, then extra modules)."""
     if not _CACHE:
         for module_name in ALGORITHM_MODULES:
             module = importlib.import_module(f"{__package__}.algs.{module_name}")
@@ -35,7 +39,35 @@ def algorithms() -> Dict[str, Algorithm]:
                 if alg.id in _CACHE:
                     raise RuntimeError(f"duplicate algorithm id {alg.id!r}")
                 _CACHE[alg.id] = alg
+        add_modules(extra_modules())
     return dict(_CACHE)
+
+
+def extra_modules() -> List[str]:
+    """Module names from :data:`EXTRA_MODULES_ENV`."""
+    return [n.strip() for n in os.environ.get(EXTRA_MODULES_ENV, "").split(",") if n.strip()]
+
+
+def add(algorithm: Algorithm) -> Algorithm:
+    """Register one more algorithm (replacing one with the same id); returns it."""
+    algorithms()  # the built-in ones first
+    _CACHE[algorithm.id] = algorithm
+    return algorithm
+
+
+def remove(algorithm_id: str) -> None:
+    """Unregister an algorithm added with :func:`add` (no error if absent)."""
+    _CACHE.pop(algorithm_id, None)
+
+
+def add_modules(names: Iterable[str]) -> List[str]:
+    """Import modules that list ``ALGORITHMS`` and register them; returns their ids."""
+    ids = []
+    for name in (n.strip() for n in names if n and n.strip()):
+        module = importlib.import_module(name)
+        for cls in module.ALGORITHMS:
+            ids.append(add(cls()).id)
+    return ids
 
 
 def get(algorithm_id: str) -> Algorithm:

@@ -135,9 +135,8 @@ from photodem.algorithms.processing import registry  # noqa: E402
 _spec = importlib.util.spec_from_file_location("_fixture_algs", os.environ["PHOTODEM_TEST_FIXTURE"])
 _module = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_module)
-registry.algorithms()
 for _cls in _module.ALGORITHMS:
-    registry._CACHE[_cls.id] = _cls()
+    registry.add(_cls())
 '''
 
 

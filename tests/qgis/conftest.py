@@ -122,11 +122,10 @@ def fixture_alg(provider) -> Iterator[Any]:
 
     from photodem.algorithms.processing import registry
 
-    registry.algorithms()  # fill the cache first, else adding would hide the real algorithms
-    registry._CACHE[FIXTURE_ID] = FixtureAllKinds()
+    spec = registry.add(FixtureAllKinds())
     provider.refreshAlgorithms()
     try:
-        yield registry._CACHE[FIXTURE_ID]
+        yield spec
     finally:
-        registry._CACHE.pop(FIXTURE_ID, None)
+        registry.remove(FIXTURE_ID)
         provider.refreshAlgorithms()

@@ -62,12 +62,11 @@ def test_run_equals_python(qp_env, tmp_path):
     raw = _fixture_inputs(tmp_path)
     out_py, out_qp = tmp_path / "py", tmp_path / "qp"
     # The in-process run needs the fixture in this process's registry as well.
-    registry.algorithms()
-    registry._CACHE[spec.id] = spec
+    registry.add(spec)
     try:
         expected = registry.run(spec.id, {**raw, **_outputs(out_py)})
     finally:
-        registry._CACHE.pop(spec.id, None)
+        registry.remove(spec.id)
     got = qgis_process_results(qp_env, spec.id, to_cli_args(spec, {**raw, **_outputs(out_qp)}))
     map_py, map_qp = {str(out_py): "<OUT>"}, {str(out_qp): "<OUT>"}
     assert normalise(got, map_qp, DIGITS) == normalise(expected, map_py, DIGITS)

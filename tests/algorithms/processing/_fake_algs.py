@@ -130,7 +130,6 @@ ALGORITHMS = [SleepWrite, FailOn, Crash, Chatty]
 
 def install(monkeypatch) -> None:
     """Add the fake algorithms to the registry cache for the duration of a test."""
-    algs = registry.algorithms()
+    monkeypatch.setattr(registry, "_CACHE", registry.algorithms())  # restored after the test
     for cls in ALGORITHMS:
-        algs[cls.id] = cls()
-    monkeypatch.setattr(registry, "_CACHE", algs)
+        registry.add(cls())
