@@ -1,0 +1,462 @@
+r"""Objects of a synthetic scene: embankment, ditch, road, fields, buildings, trees, check points.
+
+All heights are written into the truth rasters on the fine grid; the vector truth (footprints,
+3-D breaklines, check points) is kept alongside.
+
+* **Embankment** — trapezoid on the terrain along a straight axis: crest height
+  :math:`h_e` = 5.5–7.5 m, crest width 8–10 m, side slopes 1 : 1.5, so at signed distance
+  :math:`d` from the axis :math:`\Delta z = h_e - \max(0, |d| - w_c/2)/1.5` (clipped at 0).
+  Breaklines: both crest edges (``embankment_crest``) and both toes (``embankment_toe``).
+* **Ditch** — trapezoid cut: depth 2–3 m, top width 6–10 m, bottom width 2 m; breaklines at
+  both top edges (``ditch_edge``) and the bottom edges (``ditch_bottom``).
+* **Road** — 6 m wide, at ground level, parallel to the embankment.
+* **Buildings** — rectangles 8×10 … 12×16 m, gabled (ridge along the long side, pitch 30–45°,
+  eaves 5–7 m) or flat (4–10 m). Each stands on a level platform: the DTM inside the footprint
+  is set to the footprint's mean height and blended back over 4 m around it, so that
+  DSM − DTM inside the footprint equals the roof height exactly.
+* **Trees** — isolated crowns (height 5–15 m, radius 2–5 m, profile
+  :math:`h\,(1 - (d/r)^2)^{0.6}`) and a closed forest patch (dense crowns 12–20 m).
+* **Land cover** codes: :data:`LANDCOVER`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+from scipy import ndimage
+
+from .terrain import Grid
+
+#: Land-cover class codes of ``truth/landcover.tif``.
+LANDCOVER: Dict[int, str] = {
+    0: "nodata",
+    1: "open (meadow, bare ground, rock)",
+    2: "road",
+    3: "building",
+    4: "tree / forest",
+    5: "water / ditch",
+    6: "embankment",
+    7: "field",
+}
+OPEN, ROAD, BUILDING, TREE, WATER, EMBANKMENT, FIELD = 1, 2, 3, 4, 5, 6, 7
+
+#: Field (parcel) types used by the texture: meadow, furrowed, crop, bare soil.
+PARCEL_TYPES = ("meadow", "furrowed", "crop", "bare")
+
+
+@dataclass
+class Line:
+    """A straight axis: point (x, y) and direction angle ``a`` (radians, from +X)."""
+
+    x: float
+    y: float
+    a: float
+
+    @property
+    def e(self) -> np.ndarray:
+        return np.array([np.cos(self.a), np.sin(self.a)])
+
+    @property
+    def n(self) -> np.ndarray:
+        return np.array([-np.sin(self.a), np.cos(self.a)])
+
+    def across(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """Signed distance from the axis (left of the direction is positive)."""
+        n = self.n
+        return (X - self.x) * n[0] + (Y - self.y) * n[1]
+
+    def along(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        e = self.e
+        return (X - self.x) * e[0] + (Y - self.y) * e[1]
+
+    def offset_polyline(self, offset: float, grid: Grid, spacing: float) -> Optional[np.ndarray]:
+        """Vertices (N, 2) of the parallel at ``offset`` inside the grid (1 cell margin)."""
+        xmin, ymin, xmax, ymax = grid.bounds
+        m = 1.5 * grid.cell
+        xmin, ymin, xmax, ymax = xmin + m, ymin + m, xmax - m, ymax - m
+        p = np.array([self.x, self.y]) + offset * self.n
+        e = self.e
+        lo, hi = -np.inf, np.inf
+        for k, (a, b) in enumerate(((xmin, xmax), (ymin, ymax))):
+            if abs(e[k]) < 1e-12:
+                if not a <= p[k] <= b:
+                    return None
+                continue
+            s0, s1 = sorted(((a - p[k]) / e[k], (b - p[k]) / e[k]))
+            lo, hi = max(lo, s0), min(hi, s1)
+        if not hi - lo > spacing:
+            return None
+        n = int(np.ceil((hi - lo) / spacing)) + 1
+        s = np.linspace(lo, hi, n)
+        return p[None, :] + s[:, None] * e[None, :]
+
+
+@dataclass
+class Building:
+    id: int
+    x: float
+    y: float
+    angle: float  # long axis direction (radians)
+    length: float
+    width: float
+    roof: str  # "gabled" | "flat"
+    height: float  # eaves (flat: roof) height above the platform (m)
+    ridge_height: float  # highest point above the platform (m)
+    base_z: float = 0.0
+
+    def corners(self) -> np.ndarray:
+        """Footprint corners (4, 2), counter-clockwise."""
+        e = np.array([np.cos(self.angle), np.sin(self.angle)])
+        n = np.array([-e[1], e[0]])
+        hl, hw = self.length / 2.0, self.width / 2.0
+        c = np.array([self.x, self.y])
+        return np.array([c - hl * e - hw * n, c + hl * e - hw * n, c + hl * e + hw * n,
+                         c - hl * e + hw * n])
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * float(np.hypot(self.length, self.width))
+
+    def local(self, X: np.ndarray, Y: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """Coordinates along (u) and across (v) the long axis from the centre."""
+        c, s = np.cos(self.angle), np.sin(self.angle)
+        dx, dy = X - self.x, Y - self.y
+        return dx * c + dy * s, -dx * s + dy * c
+
+    def roof_height(self, v: np.ndarray) -> np.ndarray:
+        """Roof height above the platform at across-axis coordinate v (inside the footprint)."""
+        if self.roof == "flat":
+            return np.full(np.shape(v), self.height)
+        return self.height + (self.ridge_height - self.height) * (
+            1.0 - np.abs(v) / (self.width / 2.0))
+
+
+@dataclass
+class SceneObjects:
+    """Everything placed on the terrain, for texture and truth output."""
+
+    embankment: Line
+    embankment_height: float
+    crest_width: float
+    ditch: Line
+    ditch_depth: float
+    ditch_top: float
+    ditch_bottom: float
+    road: Line
+    road_width: float
+    parcel_angle: float
+    parcel_size: Tuple[float, float]
+    parcel_types: np.ndarray  # (nu, nv) type index into PARCEL_TYPES
+    parcel_origin: Tuple[float, float]
+    buildings: List[Building] = field(default_factory=list)
+    trees: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # x, y, radius, height
+    breaklines: List[Tuple[str, np.ndarray]] = field(default_factory=list)  # kind, (N, 3)
+
+    @property
+    def toe_half_width(self) -> float:
+        return self.crest_width / 2.0 + 1.5 * self.embankment_height
+
+
+def _parcels(grid: Grid, obj: SceneObjects) -> Tuple[np.ndarray, np.ndarray]:
+    """Parcel indices (iu, iv) of every cell."""
+    c, s = np.cos(obj.parcel_angle), np.sin(obj.parcel_angle)
+    dx = grid.xs - obj.parcel_origin[0]
+    dy = grid.ys - obj.parcel_origin[1]
+    iu = np.floor((dx * c + dy * s) / obj.parcel_size[0]).astype(np.int64)
+    iv = np.floor((-dx * s + dy * c) / obj.parcel_size[1]).astype(np.int64)
+    nu, nv = obj.parcel_types.shape
+    return np.clip(iu, 0, nu - 1), np.clip(iv, 0, nv - 1)
+
+
+def parcel_type_map(grid: Grid, obj: SceneObjects) -> np.ndarray:
+    """Parcel type index (uint8) of every cell, see :data:`PARCEL_TYPES`."""
+    iu, iv = _parcels(grid, obj)
+    return obj.parcel_types[iu, iv].astype(np.uint8)
+
+
+def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float
+                  ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, SceneObjects]:
+    """Modify the terrain, build the DSM and land cover, and return the object list.
+
+    Parameters
+    ----------
+    grid : Grid
+    dtm : ndarray (float64)
+        Natural terrain; a modified copy is returned.
+    rng : numpy.random.Generator
+    extent_core : float
+        Size (m) of the area covered by the images; object counts scale with its square.
+
+    Returns
+    -------
+    dtm, dsm : ndarray float64
+    landcover : ndarray uint8
+    objects : SceneObjects
+    """
+    dtm = dtm.copy()
+    X, Y = grid.xs, grid.ys
+    xmin, ymin, xmax, ymax = grid.bounds
+    cx, cy = (xmin + xmax) / 2.0, (ymin + ymax) / 2.0
+
+    # -- linear features ------------------------------------------------------------------------
+    a_e = rng.uniform(np.radians(20), np.radians(70)) * rng.choice([-1.0, 1.0])
+    n_e = np.array([-np.sin(a_e), np.cos(a_e)])
+    off_e = rng.uniform(0.15, 0.25) * extent_core
+    emb = Line(cx - off_e * n_e[0], cy - off_e * n_e[1], a_e)
+    h_e, w_c = rng.uniform(5.5, 7.5), rng.uniform(8.0, 10.0)
+    off_d = rng.uniform(0.2, 0.28) * extent_core
+    ditch = Line(cx + off_d * n_e[0], cy + off_d * n_e[1], a_e + rng.uniform(-0.05, 0.05))
+    depth, top_w, bot_w = rng.uniform(2.0, 3.0), rng.uniform(6.0, 10.0), 2.0
+    toe = w_c / 2.0 + 1.5 * h_e
+    road_w = 6.0
+    road = Line(emb.x + (toe + 4.0 + road_w / 2.0) * n_e[0],
+                emb.y + (toe + 4.0 + road_w / 2.0) * n_e[1], a_e)
+
+    # parcels in a frame aligned with the road
+    pu, pv = rng.uniform(30.0, 60.0), rng.uniform(18.0, 35.0)
+    diag = float(np.hypot(xmax - xmin, ymax - ymin))
+    porigin = (cx - diag * (np.cos(a_e) - np.sin(a_e)) / 2.0 * 1.0,
+               cy - diag * (np.sin(a_e) + np.cos(a_e)) / 2.0 * 1.0)
+    nu, nv = int(np.ceil(2 * diag / pu)) + 1, int(np.ceil(2 * diag / pv)) + 1
+    ptypes = rng.choice(len(PARCEL_TYPES), size=(nu, nv), p=[0.35, 0.3, 0.2, 0.15])
+    obj = SceneObjects(emb, h_e, w_c, ditch, depth, top_w, bot_w, road, road_w, a_e, (pu, pv),
+                       ptypes, porigin)
+
+    d_e = emb.across(X, Y)
+    dtm += np.clip(h_e - np.maximum(np.abs(d_e) - w_c / 2.0, 0.0) / 1.5, 0.0, None)
+    d_d = ditch.across(X, Y)
+    cut = np.clip((top_w / 2.0 - np.abs(d_d)) / ((top_w - bot_w) / 2.0), 0.0, 1.0) * depth
+    dtm -= cut
+
+    ptype = parcel_type_map(grid, obj)
+    landcover = np.where(ptype == 0, OPEN, FIELD).astype(np.uint8)
+    del ptype
+    landcover[np.abs(road.across(X, Y)) <= road_w / 2.0] = ROAD
+    landcover[np.abs(d_e) <= toe] = EMBANKMENT
+    landcover[np.abs(d_d) <= top_w / 2.0] = WATER
+    del d_e, d_d, cut
+
+    def clear_of_lines(px: float, py: float, r: float) -> bool:
+        return (abs(float(emb.across(px, py))) > toe + r + 3.0
+                and abs(float(ditch.across(px, py))) > top_w / 2.0 + r + 3.0
+                and abs(float(road.across(px, py))) > road_w / 2.0 + r + 2.0)
+
+    area = extent_core ** 2
+    taken: List[Tuple[float, float, float]] = []  # x, y, keep-out radius
+    margin = 8.0
+    # -- forest patch (placed first: it needs the most room) ---------------------------------
+    trees: List[Tuple[float, float, float, float]] = []
+    radius_f = float(np.clip(0.1 * extent_core, 10.0, 60.0))
+    for _ in range(500):
+        fx = rng.uniform(xmin + radius_f + margin, xmax - radius_f - margin)
+        fy = rng.uniform(ymin + radius_f + margin, ymax - radius_f - margin)
+        if clear_of_lines(fx, fy, radius_f) and all(
+                np.hypot(fx - tx, fy - ty) > radius_f + tr for tx, ty, tr in taken):
+            break
+    else:
+        fx = fy = None  # type: ignore[assignment]
+    if fx is not None:
+        taken.append((fx, fy, radius_f + 4.0))
+        spacing = 4.5
+        g = np.arange(-radius_f, radius_f + 1e-9, spacing)
+        gx, gy = np.meshgrid(g, g)
+        gx = gx + rng.uniform(-1.2, 1.2, gx.shape)
+        gy = gy + rng.uniform(-1.2, 1.2, gy.shape)
+        ecc = rng.uniform(0.7, 1.0)
+        keep = (gx / radius_f) ** 2 + (gy / (ecc * radius_f)) ** 2 <= 1.0
+        for tx, ty in zip(gx[keep], gy[keep]):
+            trees.append((fx + tx, fy + ty, rng.uniform(2.5, 4.0), rng.uniform(12.0, 20.0)))
+
+    # -- buildings on level platforms ------------------------------------------------------------
+    n_buildings = int(np.clip(area / 2500.0, 4, 400))
+    for _ in range(40 * n_buildings):
+        if len(obj.buildings) >= n_buildings:
+            break
+        length, width = rng.uniform(10.0, 16.0), rng.uniform(8.0, 12.0)
+        if width > length:
+            length, width = width, length
+        px = rng.uniform(xmin + margin + length, xmax - margin - length)
+        py = rng.uniform(ymin + margin + length, ymax - margin - length)
+        r = 0.5 * float(np.hypot(length, width)) + 5.0
+        if not clear_of_lines(px, py, r):
+            continue
+        if any(np.hypot(px - tx, py - ty) < r + tr for tx, ty, tr in taken):
+            continue
+        # both roof types always occur: the first two buildings are flat, then gabled
+        gabled = rng.uniform() < 0.65 if len(obj.buildings) > 1 else len(obj.buildings) == 1
+        if gabled:
+            eaves = rng.uniform(5.0, 7.0)
+            ridge = eaves + 0.5 * width * np.tan(np.radians(rng.uniform(30.0, 45.0)))
+        else:
+            eaves = ridge = rng.uniform(4.0, 10.0)
+        angle = a_e + rng.choice([0.0, np.pi / 2]) + rng.normal(0.0, np.radians(3.0))
+        b = Building(len(obj.buildings) + 1, px, py, float(angle), length, width,
+                     "gabled" if gabled else "flat", float(eaves), float(ridge))
+        taken.append((px, py, r))
+        obj.buildings.append(b)
+
+    for b in obj.buildings:  # platforms first (they change the DTM)
+        rows, cols = grid.window(b.x - b.radius - 6, b.y - b.radius - 6, b.x + b.radius + 6,
+                                 b.y + b.radius + 6)
+        u, v = b.local(X[:, cols], Y[rows, :])
+        inside = (np.abs(u) <= b.length / 2.0) & (np.abs(v) <= b.width / 2.0)
+        sub = dtm[rows, cols]
+        b.base_z = float(sub[inside].mean()) if inside.any() else float(sub.mean())
+        dist = np.hypot(np.maximum(np.abs(u) - b.length / 2.0, 0.0),
+                        np.maximum(np.abs(v) - b.width / 2.0, 0.0))
+        w = np.clip(1.0 - (dist - 1.0) / 4.0, 0.0, 1.0)
+        dtm[rows, cols] = w * b.base_z + (1.0 - w) * sub
+
+    dsm = dtm.copy()
+    for b in obj.buildings:
+        rows, cols = grid.window(b.x - b.radius, b.y - b.radius, b.x + b.radius, b.y + b.radius)
+        u, v = b.local(X[:, cols], Y[rows, :])
+        inside = (np.abs(u) <= b.length / 2.0) & (np.abs(v) <= b.width / 2.0)
+        roof = b.base_z + b.roof_height(v)
+        dsm[rows, cols] = np.where(inside, roof, dsm[rows, cols])
+        lc = landcover[rows, cols]
+        lc[inside] = BUILDING
+
+    # -- isolated trees ------------------------------------------------------------------------
+    n_trees = int(np.clip(area / 1500.0, 5, 400))
+    n_isolated = 0
+    for _ in range(30 * n_trees):
+        if n_isolated >= n_trees:
+            break
+        r, h = rng.uniform(2.0, 5.0), rng.uniform(5.0, 15.0)
+        tx = rng.uniform(xmin + margin, xmax - margin)
+        ty = rng.uniform(ymin + margin, ymax - margin)
+        if not clear_of_lines(tx, ty, r - 2.0):
+            continue
+        if any(np.hypot(tx - bx, ty - by) < br + r - 3.0 for bx, by, br in taken):
+            continue
+        trees.append((tx, ty, r, h))
+        taken.append((tx, ty, r + 1.0))
+        n_isolated += 1
+
+    obj.trees = np.array(trees, dtype=float).reshape(-1, 4)
+    for tx, ty, r, h in obj.trees:
+        rows, cols = grid.window(tx - r, ty - r, tx + r, ty + r)
+        d2 = ((X[:, cols] - tx) ** 2 + (Y[rows, :] - ty) ** 2) / (r * r)
+        crown = h * np.clip(1.0 - d2, 0.0, None) ** 0.6
+        sub_dtm = dtm[rows, cols]
+        sub_dsm = dsm[rows, cols]
+        top = sub_dtm + crown
+        higher = (crown > 0.05) & (top > sub_dsm)
+        sub_dsm[higher] = top[higher]
+        lc = landcover[rows, cols]
+        lc[(crown > 0.05) & (lc != BUILDING)] = TREE
+
+    # -- breaklines (3-D, heights from the final DTM) --------------------------------------------
+    from ..raster.sample import bilinear_grid
+
+    spacing = max(2.0, 4 * grid.cell)
+    lines = [("embankment_crest", emb, -w_c / 2.0), ("embankment_crest", emb, w_c / 2.0),
+             ("embankment_toe", emb, -toe), ("embankment_toe", emb, toe),
+             ("ditch_edge", ditch, -top_w / 2.0), ("ditch_edge", ditch, top_w / 2.0),
+             ("ditch_bottom", ditch, -bot_w / 2.0), ("ditch_bottom", ditch, bot_w / 2.0)]
+    for kind, line, offset in lines:
+        xy = line.offset_polyline(offset, grid, spacing)
+        if xy is None:
+            continue
+        col, row = grid.index(xy[:, 0], xy[:, 1])
+        z = bilinear_grid(dtm, col, row)
+        ok = np.isfinite(z)
+        if ok.sum() >= 2:
+            obj.breaklines.append((kind, np.column_stack([xy[ok], z[ok]])))
+    return dtm, dsm, landcover, obj
+
+
+def choose_checkpoints(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndarray,
+                       region, n: int, pad_radius: float, rng: np.random.Generator,
+                       clearance: float = 14.0, spacing: float = 12.0) -> np.ndarray:
+    """Sites (N, 3) for bright check-point discs on open, flat ground, away from tall objects.
+
+    A site needs: its dark pad (radius ``pad_radius``) plus 1 m entirely on open ground or
+    fields, no object higher than 0.5 m within ``clearance`` (relaxed step by step when the
+    scene is too crowded), a slope below 15°, a place inside ``region`` (a shapely polygon:
+    the area seen by stereo models) and ``spacing`` to the other sites. Heights are the
+    bilinear DTM (= DSM) at the site.
+    """
+    from shapely.geometry import Point
+
+    from ..raster.sample import bilinear_grid
+
+    f = max(1, round(1.0 / grid.cell))  # work on ~1 m blocks
+    nr, nc = grid.nrows // f, grid.ncols // f
+
+    def blocks(a: np.ndarray) -> np.ndarray:
+        return a[:nr * f, :nc * f].reshape(nr, f, nc, f)
+
+    tall = blocks(dsm - dtm > 0.5).any(axis=(1, 3))
+    bad = blocks((landcover != OPEN) & (landcover != FIELD)).any(axis=(1, 3)) | tall
+    cell = grid.cell * f
+    far = np.full(tall.shape, 1e9)
+    d_tall = ndimage.distance_transform_edt(~tall) * cell if tall.any() else far
+    d_bad = ndimage.distance_transform_edt(~bad) * cell if bad.any() else far
+    zb = blocks(dtm).mean(axis=(1, 3))
+    gy, gx = np.gradient(zb, cell)
+    slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    base_ok = (d_bad > pad_radius + 3.5 + cell) & (slope < 15.0)  # + flattening blend
+    sites: List[Tuple[float, float]] = []
+    c = clearance
+    while len(sites) < n and c >= pad_radius:
+        ok = base_ok & (d_tall > c)
+        rr, cc = np.nonzero(ok)
+        order = rng.permutation(len(rr))
+        for k in order:
+            x = grid.x0 + (cc[k] + 0.5) * cell + rng.uniform(-0.3, 0.3) * cell
+            y = grid.y1 - (rr[k] + 0.5) * cell + rng.uniform(-0.3, 0.3) * cell
+            if any(np.hypot(x - sx, y - sy) < spacing for sx, sy in sites):
+                continue
+            if region is not None and not region.contains(Point(x, y)):
+                continue
+            sites.append((x, y))
+            if len(sites) >= n:
+                break
+        c *= 0.7
+    if not sites:
+        return np.zeros((0, 3))
+    xy = np.array(sites)
+    col, row = grid.index(xy[:, 0], xy[:, 1])
+    z = bilinear_grid(dtm, col, row)
+    return np.column_stack([xy, z])
+
+
+def flatten_sites(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, sites: np.ndarray,
+                  radius: float, blend: float = 2.0) -> np.ndarray:
+    r"""Level the ground under check-point targets (in place) and return their 3-D centres.
+
+    Targets are laid on flat ground: within ``radius`` of a site the terrain becomes its
+    least-squares plane :math:`z = a + b\,\Delta x + c\,\Delta y` (fitted over radius + blend),
+    blended back to the natural terrain over ``blend`` metres. On a rough surface the image of a
+    disc would be bent by relief displacement; on a plane its centroid is the projection of its
+    centre. The sites lie on open ground, so the DSM follows the DTM there.
+    """
+    from ..raster.sample import bilinear_grid
+
+    out = np.asarray(sites, dtype=float).reshape(-1, 3).copy()
+    X, Y = grid.xs, grid.ys
+    outer = radius + blend
+    for x, y, _z in out:
+        rows, cols = grid.window(x - outer, y - outer, x + outer, y + outer)
+        dx = X[:, cols] - x
+        dy = Y[rows, :] - y
+        dx, dy = np.broadcast_arrays(dx, dy)
+        d = np.hypot(dx, dy)
+        sub = dtm[rows, cols]
+        fit = d <= outer
+        A = np.column_stack([np.ones(fit.sum()), dx[fit], dy[fit]])
+        coef = np.linalg.lstsq(A, sub[fit], rcond=None)[0]
+        plane = coef[0] + coef[1] * dx + coef[2] * dy
+        w = np.clip((outer - d) / blend, 0.0, 1.0)
+        ground = dsm[rows, cols] == sub
+        new = w * plane + (1.0 - w) * sub
+        sub[...] = new
+        dsm_sub = dsm[rows, cols]
+        dsm_sub[ground] = new[ground]
+    col, row = grid.index(out[:, 0], out[:, 1])
+    out[:, 2] = bilinear_grid(dtm, col, row)
+    return out
