@@ -18,16 +18,10 @@ from typing import Any, Dict, Iterator
 import pytest
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-# In a venv sys.prefix is the venv, so Debian's pyproj cannot find /usr/share/proj by itself
-# ("UserWarning: Valid PROJ data directory not found"); QGIS finds it, pyproj does not.
-if "PROJ_DATA" not in os.environ and Path("/usr/share/proj").is_dir():
-    os.environ["PROJ_DATA"] = "/usr/share/proj"
-# Never touch the user's QGIS profile (QgsApplication writes qgis.db, auth db, styles…).
-os.environ.setdefault("QGIS_CUSTOM_CONFIG_PATH", tempfile.mkdtemp(prefix="photodem-qgis-"))
 
 try:
     import qgis.core  # noqa: F401
-except ImportError:  # tier A: nothing here can run
+except ImportError:  # tier A: nothing here can run, and nothing here may change the process
     # This folder itself is importable as a namespace package "qgis"; do not leave it behind.
     for _name in [m for m in sys.modules if m == "qgis" or m.startswith("qgis.")]:
         del sys.modules[_name]
@@ -35,6 +29,13 @@ except ImportError:  # tier A: nothing here can run
     HAVE_QGIS = False
 else:
     HAVE_QGIS = True
+    # In a venv sys.prefix is the venv, so Debian's pyproj cannot find /usr/share/proj by itself
+    # ("UserWarning: Valid PROJ data directory not found"); QGIS finds it, pyproj does not.
+    # Only here: PyPI wheels (tier A) bring their own, newer proj.db.
+    if "PROJ_DATA" not in os.environ and Path("/usr/share/proj").is_dir():
+        os.environ["PROJ_DATA"] = "/usr/share/proj"
+    # Never touch the user's QGIS profile (QgsApplication writes qgis.db, auth db, styles…).
+    os.environ.setdefault("QGIS_CUSTOM_CONFIG_PATH", tempfile.mkdtemp(prefix="photodem-qgis-"))
 
 ROOT = Path(__file__).resolve().parents[2]
 PLUGIN_NAME = "photodem"
