@@ -108,9 +108,9 @@ def tree_digest(folder: Path, mapping: Dict[str, str],
                 text = _canonical(text, suffix, digits)
             digest[rel] = hashlib.sha256(text.encode()).hexdigest()
         elif suffix in (".tif", ".tiff"):
-            import rasterio
+            from photodem.algorithms.raster.io import open_image
 
-            with rasterio.open(path) as src:
+            with open_image(path) as src:  # images and epipolar images have no georeference
                 data = src.read()
                 h = hashlib.sha256(data.tobytes())
                 h.update(str((src.crs, tuple(src.transform), src.dtypes, src.nodata)).encode())
