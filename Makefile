@@ -35,7 +35,7 @@ apt:
 venv-qgis: $(STAMP_B)
 $(STAMP_B): pyproject.toml | apt
 	$(SYS_PY) -m venv --system-site-packages $(VENV_QGIS)
-	$(VENV_QGIS)/bin/pip install -q --no-deps --no-build-isolation -e .
+	$(VENV_QGIS)/bin/pip install -q --no-deps -e .
 	touch $@
 
 demo: venv

@@ -10,7 +10,7 @@
         </message>
         <message>
             <source>Project</source>
-            <extracomment>project_create: group; project_info: group</extracomment>
+            <extracomment>project_create: group; project_info: group; stereo_models: group</extracomment>
             <translation>Projekt</translation>
         </message>
         <message>
@@ -75,7 +75,7 @@
         </message>
         <message>
             <source>DEM for terrain heights and footprints</source>
-            <extracomment>project_create.dem: description</extracomment>
+            <extracomment>project_create.dem: description; stereo_models.dem: description</extracomment>
             <translation>Geländemodell für Geländehöhen und Bildfußabdrücke</translation>
         </message>
         <message>
@@ -90,7 +90,7 @@
         </message>
         <message>
             <source>Project folder</source>
-            <extracomment>project_create output project; project_create.output: description; project_info.project: description; synthetic_block output project</extracomment>
+            <extracomment>project_create output project; project_create.output: description; project_info.project: description; stereo_models.project: description; synthetic_block output project</extracomment>
             <translation>Projektordner</translation>
         </message>
         <message>
@@ -140,13 +140,83 @@
         </message>
         <message>
             <source>Stereo models</source>
-            <extracomment>project_info output models</extracomment>
+            <extracomment>project_info output models; stereo_models output models; stereo_models: name</extracomment>
             <translation>Stereomodelle</translation>
         </message>
         <message>
             <source>Validation errors and warnings</source>
             <extracomment>project_info output validation</extracomment>
             <translation>Fehler und Warnungen der Prüfung</translation>
+        </message>
+        <message>
+            <source>Sets the stereo models of a project: detected automatically from the image footprints (overlap, B/H and strip thresholds as given; in-strip neighbours first) and/or chosen by hand as pairs of images. The models are written to project.toml; the images, orientations and edits are not touched.</source>
+            <extracomment>stereo_models: help</extracomment>
+            <translation>Legt die Stereomodelle eines Projekts fest: automatisch aus den Bildfußabdrücken ermittelt (Überlappung, B/H und Streifenschwellen wie angegeben; Nachbarn im Streifen zuerst) und/oder von Hand als Bildpaare gewählt. Die Modelle werden in project.toml geschrieben; Bilder, Orientierungen und Editierungen bleiben unverändert.</translation>
+        </message>
+        <message>
+            <source>Detect models automatically</source>
+            <extracomment>stereo_models.detect: description</extracomment>
+            <translation>Modelle automatisch ermitteln</translation>
+        </message>
+        <message>
+            <source>Minimum overlap [%]</source>
+            <extracomment>stereo_models.min_overlap: description</extracomment>
+            <translation>Mindestüberlappung [%]</translation>
+        </message>
+        <message>
+            <source>Share of the smaller footprint that both images cover.</source>
+            <extracomment>stereo_models.min_overlap: help</extracomment>
+            <translation>Anteil des kleineren Fußabdrucks, den beide Bilder abdecken.</translation>
+        </message>
+        <message>
+            <source>Minimum B/H</source>
+            <extracomment>stereo_models.b_h_min: description</extracomment>
+            <translation>Kleinstes B/H</translation>
+        </message>
+        <message>
+            <source>Maximum B/H</source>
+            <extracomment>stereo_models.b_h_max: description</extracomment>
+            <translation>Größtes B/H</translation>
+        </message>
+        <message>
+            <source>Strip direction tolerance [°]</source>
+            <extracomment>stereo_models.strip_angle_tolerance: description</extracomment>
+            <translation>Toleranz der Streifenrichtung [°]</translation>
+        </message>
+        <message>
+            <source>A pair is in-strip when its base is this close to the strip direction.</source>
+            <extracomment>stereo_models.strip_angle_tolerance: help</extracomment>
+            <translation>Ein Paar liegt im Streifen, wenn seine Basis höchstens so weit von der Streifenrichtung abweicht.</translation>
+        </message>
+        <message>
+            <source>In-strip models only</source>
+            <extracomment>stereo_models.in_strip_only: description</extracomment>
+            <translation>Nur Modelle im Streifen</translation>
+        </message>
+        <message>
+            <source>Manual pairs</source>
+            <extracomment>stereo_models.manual: description</extracomment>
+            <translation>Manuelle Bildpaare</translation>
+        </message>
+        <message>
+            <source>Image pairs 'left,right; left,right' (image names or their short labels as in the model names), added as kind 'manual'.</source>
+            <extracomment>stereo_models.manual: help</extracomment>
+            <translation>Bildpaare 'links,rechts; links,rechts' (Bildnamen oder ihre Kurzbezeichnungen wie in den Modellnamen), als Art 'manual' hinzugefügt.</translation>
+        </message>
+        <message>
+            <source>Default: the project's mean terrain height.</source>
+            <extracomment>stereo_models.dem: help</extracomment>
+            <translation>Standard: die mittlere Geländehöhe des Projekts.</translation>
+        </message>
+        <message>
+            <source>Number of stereo models</source>
+            <extracomment>stereo_models output count; synthetic_block output models</extracomment>
+            <translation>Anzahl der Stereomodelle</translation>
+        </message>
+        <message>
+            <source>Images without a stereo partner</source>
+            <extracomment>stereo_models output unpaired</extracomment>
+            <translation>Bilder ohne Stereopartner</translation>
         </message>
         <message>
             <source>Synthetic block with ground truth</source>
@@ -267,11 +337,6 @@
             <source>Check points (3-D)</source>
             <extracomment>synthetic_block output truth_checkpoints</extracomment>
             <translation>Kontrollpunkte (3D)</translation>
-        </message>
-        <message>
-            <source>Number of stereo models</source>
-            <extracomment>synthetic_block output models</extracomment>
-            <translation>Anzahl der Stereomodelle</translation>
         </message>
         <message>
             <source>Ground sample distance [m]</source>

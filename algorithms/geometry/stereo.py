@@ -174,7 +174,7 @@ def image_footprint(camera: Camera, eo: ExteriorOrientation, height: Optional[fl
     return footprint_and_height(camera, eo, height=height, dem=dem)[0]
 
 
-def _block_bounds(project: Any) -> Tuple[float, float, float, float]:
+def block_bounds(project: Any) -> Tuple[float, float, float, float]:
     """Generous world bounds of all footprints (vertical images, terrain ≥ −500 m)."""
     xs, ys = [], []
     for rec in project.images:
@@ -202,7 +202,7 @@ def block_footprints(project: Any, dem: DemLike = None, height: Optional[float] 
     The terrain comes from ``dem`` (mean height under each footprint), else ``height``, else
     ``project.terrain_height``, else 0 m.
     """
-    sampler = load_dem(dem, _block_bounds(project)) if dem is not None else None
+    sampler = load_dem(dem, block_bounds(project)) if dem is not None else None
     h = _terrain_default(project) if height is None else float(height)
     wanted = None if names is None else set(names)
     out: Footprints = {}
@@ -441,6 +441,7 @@ def detect_stereo_models(
 
 
 __all__ = [
+    "block_bounds",
     "block_footprints",
     "detect_stereo_models",
     "dominant_direction",

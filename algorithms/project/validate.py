@@ -179,12 +179,12 @@ def _check_files(project: Project, records: List[Any], rep: ValidationReport) ->
 
 def _check_heights(project: Project, records: List[Any], dem: Any,
                    rep: ValidationReport) -> None:
-    from ..geometry.stereo import _block_bounds, footprint_and_height, load_dem
+    from ..geometry.stereo import block_bounds, footprint_and_height, load_dem
 
     sampler = None
     if dem is not None and records:
         try:
-            sampler = load_dem(dem, _block_bounds(project))
+            sampler = load_dem(dem, block_bounds(project))
         except Exception as exc:  # a DEM that does not cover the block
             rep.errors.append(f"The DEM cannot be used for this block: {exc}")
             return

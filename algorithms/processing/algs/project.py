@@ -50,7 +50,7 @@ class ProjectCreate(Algorithm):
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...geometry.stereo import (
-            _block_bounds,
+            block_bounds,
             block_footprints,
             detect_stereo_models,
             load_dem,
@@ -81,7 +81,7 @@ class ProjectCreate(Algorithm):
 
         dem = params.get("dem")
         if dem is not None:
-            dem = load_dem(dem, _block_bounds(project))
+            dem = load_dem(dem, block_bounds(project))
             footprints = block_footprints(project, dem=dem)
             project.terrain_height = round(mean_terrain_height(footprints), 3)
             feedback.info(f"Mean terrain height under the footprints (DEM): "
@@ -179,4 +179,88 @@ class ProjectInfo(Algorithm):
             "validation": report.to_dict(),
         }
 
-ALGORITHMS: list = [ProjectCreate, ProjectInfo]
+class StereoModels(Algorithm):
+    id = "stereo_models"
+    name = "Stereo models"
+    group = "Project"
+    group_id = "project"
+    help = (
+        "Sets the stereo models of a project: detected automatically from the image footprints "
+        "(overlap, B/H and strip thresholds as given; in-strip neighbours first) and/or chosen "
+        "by hand as pairs of images. The models are written to project.toml; the images, "
+        "orientations and edits are not touched."
+    )
+    parameters = (
+        Parameter("project", "project", "Project folder"),
+        Parameter("detect", "bool", "Detect models automatically", default=True),
+        Parameter("min_overlap", "number", "Minimum overlap [%]", default=25.0, minimum=0.0,
+                  maximum=100.0, unit="%",
+                  help="Share of the smaller footprint that both images cover."),
+        Parameter("b_h_min", "number", "Minimum B/H", default=0.2, minimum=0.0, maximum=10.0),
+        Parameter("b_h_max", "number", "Maximum B/H", default=1.2, minimum=0.0, maximum=10.0),
+        Parameter("strip_angle_tolerance", "number", "Strip direction tolerance [°]",
+                  default=20.0, minimum=0.0, maximum=90.0, unit="°",
+                  help="A pair is in-strip when its base is this close to the strip direction."),
+        Parameter("in_strip_only", "bool", "In-strip models only", default=False),
+        Parameter("manual", "string", "Manual pairs", optional=True,
+                  help="Image pairs 'left,right; left,right' (image names or their short "
+                       "labels as in the model names), added as kind 'manual'."),
+        Parameter("dem", "raster", "DEM for terrain heights and footprints", optional=True,
+                  help="Default: the project's mean terrain height."),
+    )
+    outputs = (
+        Output("models", "json", "Stereo models"),
+        Output("count", "number", "Number of stereo models"),
+        Output("unpaired", "json", "Images without a stereo partner"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from ...geometry.stereo import (
+            block_bounds,
+            detect_stereo_models,
+            image_labels,
+            load_dem,
+            manual_model,
+        )
+
+        project = Project.load(params["project"])
+        if params["b_h_min"] >= params["b_h_max"]:
+            raise InputError(f"Minimum B/H ({params['b_h_min']:g}) must be below the maximum "
+                             f"({params['b_h_max']:g}).")
+        dem = load_dem(params["dem"], block_bounds(project)) if params["dem"] else None
+        models = []
+        if params["detect"]:
+            models = detect_stereo_models(
+                project, dem=dem, min_overlap=params["min_overlap"] / 100.0,
+                b_h_range=(params["b_h_min"], params["b_h_max"]),
+                strip_angle_tolerance=params["strip_angle_tolerance"],
+                in_strip_only=params["in_strip_only"])
+        feedback.progress(60)
+        by_label = {label: name for name, label in
+                    image_labels([r.name for r in project.images]).items()}
+        seen = {frozenset((m.left, m.right)) for m in models}
+        for pair in (params["manual"] or "").replace("\n", ";").split(";"):
+            if not pair.strip():
+                continue
+            parts = [p.strip() for p in pair.split(",")]
+            if len(parts) != 2:
+                raise InputError(f"Manual pair '{pair.strip()}': give two image names "
+                                 "separated by a comma, pairs separated by ';'.")
+            left, right = (by_label.get(p, p) for p in parts)
+            m = manual_model(project, project.image(left).name, project.image(right).name,
+                             dem=dem)
+            if frozenset((m.left, m.right)) not in seen:
+                seen.add(frozenset((m.left, m.right)))
+                models.append(m)
+        project.models = models
+        project.save()  # atomic: the old project.toml stays until the new one is complete
+        paired = {m.left for m in models} | {m.right for m in models}
+        unpaired = [r.name for r in project.images if r.name not in paired]
+        for name in unpaired:
+            feedback.warning(f"Image '{name}' has no stereo partner.")
+        feedback.info(f"{len(models)} stereo models written to {project.project_file}.")
+        return {"models": [m.to_dict() for m in models], "count": len(models),
+                "unpaired": unpaired}
+
+
+ALGORITHMS: list = [ProjectCreate, ProjectInfo, StereoModels]

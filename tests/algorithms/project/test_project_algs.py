@@ -163,3 +163,33 @@ def test_project_create_from_opensfm(tmp_path: Path) -> None:
     assert project.crs == "EPSG:32633"
     assert [m.kind for m in project.models][:2] == ["in-strip", "in-strip"]
     assert project.models[0].b_h == pytest.approx(0.6, rel=1e-3)
+
+
+def test_stereo_models_thresholds_and_manual_pairs(ngi_block: Path, tmp_path: Path) -> None:
+    ngi = ngi_block
+    out = tmp_path / "ngi"
+    registry.run("project_create", {
+        "images": str(ngi / "ngi"), "exterior": str(ngi / "io" / "ngi_xyz_opk.csv"),
+        "interior": str(ngi / "io" / "ngi_int_param.yaml"), "angle_unit": "degrees",
+        "dem": str(ngi / "ngi" / "dem.tif"), "output": str(out)})
+    edits = (out / "edits.gpkg").read_bytes()
+    only_strip = registry.run("stereo_models", {"project": str(out), "in_strip_only": True})
+    assert [m["name"] for m in only_strip["models"]] == ["0182_0184", "0251_0253"]
+    assert only_strip["unpaired"] == []
+    # a B/H window that excludes the cross-strip pairs (B/H ≈ 0.86) but keeps in-strip (0.54)
+    narrow = registry.run("stereo_models", {"project": str(out), "b_h_max": 0.7})
+    assert {m["kind"] for m in narrow["models"]} == {"in-strip"}
+    # nothing detected, one pair by hand (short labels accepted)
+    manual = registry.run("stereo_models", {"project": str(out), "detect": False,
+                                            "manual": "0184, 0251"})
+    assert [(m["name"], m["kind"]) for m in manual["models"]] == [("0184_0251", "manual")]
+    assert len(manual["unpaired"]) == 2
+    info = registry.run("project_info", {"project": str(out)})
+    assert [m["name"] for m in info["models"]] == ["0184_0251"]
+    assert (out / "edits.gpkg").read_bytes() == edits  # the operator's edits are untouched
+    with pytest.raises(InputError, match="two image names"):
+        registry.run("stereo_models", {"project": str(out), "manual": "0182"})
+    with pytest.raises(InputError, match="not in project"):
+        registry.run("stereo_models", {"project": str(out), "manual": "0182,9999"})
+    with pytest.raises(InputError, match="must be below"):
+        registry.run("stereo_models", {"project": str(out), "b_h_min": 0.8, "b_h_max": 0.5})
