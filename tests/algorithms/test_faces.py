@@ -107,6 +107,19 @@ def test_epipolar_pair_python_equals_cli(block, tmp_path) -> None:
     _same_files(tmp_path / "py", tmp_path / "cli")
 
 
+def test_stereo_models_python_equals_cli(block, tmp_path) -> None:
+    import shutil
+
+    params = {"min_overlap": 20.0, "b_h_max": 1.0, "manual": "0101,0201"}
+    for face in ("py", "cli"):
+        shutil.copytree(block["py"]["project"], tmp_path / face / "project")
+    py = registry.run("stereo_models", {**params, "project": str(tmp_path / "py" / "project")})
+    cli = _cli("stereo_models", {**params, "project": str(tmp_path / "cli" / "project")})
+    assert cli == py
+    assert any(m["kind"] == "manual" for m in py["models"])
+    _same_files(tmp_path / "py", tmp_path / "cli")
+
+
 def test_project_create_python_equals_cli(ngi_block: Path, tmp_path: Path) -> None:
     ngi = ngi_block
     params = {"images": str(ngi / "ngi"), "exterior": str(ngi / "io" / "ngi_xyz_opk.csv"),

@@ -69,8 +69,21 @@ def _ngi() -> Path:
     return path
 
 
+def _project_copy(project: Path, out: Path) -> Path:
+    """A private copy for algorithms that update the project itself."""
+    import shutil
+
+    copy = out / "project"
+    if not copy.exists():
+        shutil.copytree(project, copy)
+    return copy
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
+    "stereo_models": lambda out, req: {
+        "project": str(_project_copy(req("project"), out)), "min_overlap": 20.0,
+        "b_h_max": 1.0, "manual": "0101,0201"},
     "synthetic_block": lambda out, req: {
         "output": str(out / "block"), "size": "tiny", "terrain": "gentle", "seed": 3},
     "project_info": lambda out, req: {"project": str(req("project"))},
@@ -106,6 +119,12 @@ def qp_plain_env(tmp_path_factory):
     proc = run_qgis_process(env, "plugins", "enable", "photodem")
     assert proc.returncode == 0, proc.stderr
     return env
+
+
+def test_every_algorithm_has_a_case(plugin):
+    from photodem.algorithms.processing import registry
+
+    assert set(registry.algorithms()) <= set(CASES) | {"fixture_all_kinds"}
 
 
 @pytest.mark.parametrize("algorithm_id", sorted(CASES))
