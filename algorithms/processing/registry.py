@@ -21,6 +21,7 @@ ALGORITHM_MODULES = (
     "project",
     "synthetic",
     "geometry",
+    "quality",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).
