@@ -168,6 +168,8 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
             q.setMinimum(p.minimum)
         if p.maximum is not None:
             q.setMaximum(p.maximum)
+        if kind == "number":  # QGIS shows 6 decimals otherwise ("25.000000")
+            q.setMetadata({"widget_wrapper": {"decimals": 3}})
     elif kind == "enum":
         index = None
         if default is not None:
