@@ -1,0 +1,433 @@
+r"""Windowed comparison of a DEM with a reference DEM (the engine of ``dem_compare``).
+
+The comparison grid is the **reference grid restricted to the common area**: the DEM is
+interpolated onto the reference cells (bilinear, reprojected with GDAL through a ``WarpedVRT``
+when the CRS or the grid differ — seed-000 §5.2 "one DEM is the reference; the other is
+interpolated onto its grid"), and :math:`\Delta h = h_{DEM} - h_{ref}` at each cell. Nothing is
+read whole: the grid is processed in windows of ``window_size`` cells (the reference with a
+1-cell margin for its slope), and the statistics are accumulated by
+:class:`~.stats.DifferenceAccumulator` within ``memory_budget``.
+
+With ``coregister=True`` the shift of the DEM is estimated first (:func:`~.coregister.nuth_kaab`)
+on the stable cells of a grid of at most ``coreg_max_cells`` cells (the reference grid averaged by
+an integer factor when larger), and the comparison then samples the DEM at the shifted positions
+(:math:`h'(\mathbf p) = h(\mathbf p - \mathbf d) + d_z`, the destination grid of the warp moved
+by :math:`-\mathbf d`), so that the shift is applied exactly whatever the DEM's CRS.
+
+Per-class statistics use class polygons (any vector format fiona reads, any CRS, attribute
+``class_field``; rasterised per window, cell centres inside; later polygons win where they
+overlap) or a class raster (nearest neighbour); per-slope statistics use the slope of the
+reference (:data:`~.stats.SLOPE_CLASSES_DEG`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import rasterio
+from affine import Affine
+from numpy.typing import NDArray
+from rasterio.enums import Resampling
+from rasterio.vrt import WarpedVRT
+from rasterio.windows import Window
+
+from ..errors import InputError
+from ..processing.feedback import Feedback, ensure_feedback
+from ..raster.io import GTIFF_PROFILE, atomic_output
+from .coregister import nuth_kaab
+from .stats import SLOPE_LABELS, DifferenceAccumulator, _label_key, slope_class_index
+
+PathLike = Union[str, Path]
+Array = NDArray[np.float64]
+
+VECTOR_SUFFIXES = {".gpkg", ".shp", ".geojson", ".json", ".kml", ".gml", ".fgb", ".sqlite"}
+RASTER_SUFFIXES = {".tif", ".tiff", ".vrt", ".img", ".asc", ".nc", ".jp2", ".png"}
+
+
+# -- inputs ---------------------------------------------------------------------------------------
+
+
+def _open_raster(stack: contextlib.ExitStack, path: PathLike, what: str) -> Any:
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"The {what} '{p}' does not exist; give an existing raster file.")
+    try:
+        src = stack.enter_context(rasterio.open(p))
+    except Exception as exc:  # rasterio raises RasterioIOError and others for unreadable files
+        raise InputError(f"The {what} '{p}' cannot be read as a raster ({exc}).") from None
+    if src.crs is None or not src.crs.to_wkt():
+        raise InputError(f"The {what} '{p}' has no coordinate reference system; assign one "
+                         "(e.g. in QGIS: Raster › Projections › Assign Projection) and retry.")
+    if src.transform.b != 0 or src.transform.d != 0:
+        raise InputError(f"The {what} '{p}' has a rotated geotransform; warp it to a north-up "
+                         "grid first.")
+    return src
+
+
+def _read_window(src: Any, row: int, col: int, h: int, w: int) -> Array:
+    """Band 1 of ``src``, rows ``row…row+h``, cols ``col…col+w``: float64, NaN outside/nodata."""
+    out = np.full((h, w), np.nan)
+    r0, c0 = max(row, 0), max(col, 0)
+    r1, c1 = min(row + h, src.height), min(col + w, src.width)
+    if r1 > r0 and c1 > c0:
+        a = src.read(1, window=Window(c0, r0, c1 - c0, r1 - r0), masked=True)
+        out[r0 - row:r1 - row, c0 - col:c1 - col] = np.ma.filled(a.astype(np.float64), np.nan)
+    return out
+
+
+def _vrt(src: Any, crs: Any, transform: Affine, width: int, height: int,
+         resampling: Resampling) -> WarpedVRT:
+    kw: Dict[str, Any] = {}
+    if src.nodata is not None:
+        kw["src_nodata"] = src.nodata
+    return WarpedVRT(src, crs=crs, transform=transform, width=width, height=height,
+                     resampling=resampling, nodata=np.nan, dtype="float64", **kw)
+
+
+class _GridReader:
+    """Reads a raster on (a window of) the comparison grid: directly if aligned, else warped."""
+
+    def __init__(self, stack: contextlib.ExitStack, src: Any, crs: Any, transform: Affine,
+                 width: int, height: int, resampling: Resampling,
+                 shift: Tuple[float, float] = (0.0, 0.0)) -> None:
+        self.src = src
+        self.offset: Optional[Tuple[int, int]] = None
+        t = src.transform
+        if shift == (0.0, 0.0) and src.crs == crs and math.isclose(t.a, transform.a) \
+                and math.isclose(t.e, transform.e):
+            col, row = ~t * (transform.c, transform.f)
+            if abs(col - round(col)) < 1e-6 and abs(row - round(row)) < 1e-6:
+                self.offset = (round(row), round(col))
+        if self.offset is None:
+            dst = Affine.translation(-shift[0], -shift[1]) * transform
+            self.vrt = stack.enter_context(_vrt(src, crs, dst, width, height, resampling))
+
+    def read(self, row: int, col: int, h: int, w: int) -> Array:
+        if self.offset is not None:
+            return _read_window(self.src, row + self.offset[0], col + self.offset[1], h, w)
+        return _read_window(self.vrt, row, col, h, w)
+
+
+def _common_grid(dem: Any, ref: Any) -> Tuple[Window, Affine]:
+    """Window of the reference covering the common area (whole cells), and its transform."""
+    from rasterio.warp import transform_bounds
+    from rasterio.windows import from_bounds
+
+    try:
+        b = transform_bounds(dem.crs, ref.crs, *dem.bounds, densify_pts=21)
+    except Exception as exc:
+        raise InputError(f"The DEM's CRS cannot be transformed to the reference CRS ({exc}).") \
+            from None
+    rb = ref.bounds
+    left, bottom = max(b[0], rb.left), max(b[1], rb.bottom)
+    right, top = min(b[2], rb.right), min(b[3], rb.top)
+    if not (np.all(np.isfinite([left, bottom, right, top])) and right > left and top > bottom):
+        raise InputError("The DEM and the reference DEM do not overlap; check that both cover "
+                         "the same area and carry the right CRS.")
+    win = from_bounds(left, bottom, right, top, transform=ref.transform)
+    c0 = max(math.floor(win.col_off + 1e-6), 0)
+    r0 = max(math.floor(win.row_off + 1e-6), 0)
+    c1 = min(math.ceil(win.col_off + win.width - 1e-6), ref.width)
+    r1 = min(math.ceil(win.row_off + win.height - 1e-6), ref.height)
+    if c1 <= c0 or r1 <= r0:
+        raise InputError("The DEM and the reference DEM overlap by less than one cell.")
+    window = Window(c0, r0, c1 - c0, r1 - r0)
+    return window, ref.window_transform(window)
+
+
+def _vector_kind(path: PathLike) -> bool:
+    """True if ``path`` is a vector layer, False if a raster."""
+    suffix = Path(path).suffix.lower()
+    if suffix in VECTOR_SUFFIXES:
+        return True
+    if suffix in RASTER_SUFFIXES:
+        return False
+    try:
+        with rasterio.open(path):
+            return False
+    except Exception:
+        return True
+
+
+def _reproject_geometry(geom: Any, transformer: Any) -> Any:
+    """``geom`` with its coordinates transformed (shapely 2 and 1.8)."""
+    import shapely
+
+    if hasattr(shapely, "transform"):  # shapely ≥ 2: vectorised over all vertices
+        return shapely.transform(geom, lambda xy: np.column_stack(
+            transformer.transform(xy[:, 0], xy[:, 1])))
+    from shapely.ops import transform
+
+    return transform(transformer.transform, geom)
+
+
+def _read_polygons(path: PathLike, crs: Any, field: Optional[str], what: str,
+                   feedback: Feedback) -> Tuple[List[Any], List[Any]]:
+    """Geometries (in ``crs``) and attribute values (or 1 when ``field`` is None)."""
+    import fiona
+    from pyproj import CRS, Transformer
+    from shapely.geometry import shape
+
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"The {what} '{p}' does not exist; give an existing vector layer.")
+    try:
+        layer = fiona.open(p)
+    except Exception as exc:
+        raise InputError(f"The {what} '{p}' cannot be read as a vector layer ({exc}).") from None
+    with layer:
+        fields = list(layer.schema["properties"])
+        if field is not None and field not in fields:
+            raise InputError(f"The {what} '{p.name}' has no attribute '{field}'; available "
+                             f"fields: {', '.join(fields) or '(none)'}.")
+        wkt = layer.crs_wkt
+        tr = None
+        dst = CRS.from_wkt(crs.to_wkt())
+        if wkt:
+            srcc = CRS.from_wkt(wkt)
+            if not srcc.equals(dst):
+                tr = Transformer.from_crs(srcc, dst, always_xy=True)
+        else:
+            feedback.warning(f"The {what} '{p.name}' has no CRS; assuming the reference CRS.")
+        geoms, values = [], []
+        for feat in layer:
+            if feat["geometry"] is None:
+                continue
+            g = shape(feat["geometry"])
+            if g.is_empty or g.geom_type not in ("Polygon", "MultiPolygon"):
+                continue
+            if tr is not None:
+                g = _reproject_geometry(g, tr)
+            geoms.append(g)
+            values.append(feat["properties"][field] if field is not None else 1)
+    return geoms, values
+
+
+class _PolygonRasteriser:
+    """Rasterises polygons window by window (cell centres inside), values = polygon indices."""
+
+    def __init__(self, geoms: List[Any], values: List[int]) -> None:
+        self.geoms = geoms
+        self.values = np.asarray(values, dtype=np.int64)
+        self.bounds = np.array([g.bounds for g in geoms]).reshape(-1, 4)
+
+    def labels(self, transform: Affine, h: int, w: int) -> Array:
+        from rasterio.features import rasterize
+
+        x0, y1 = transform * (0, 0)
+        x1, y0 = transform * (w, h)
+        b = self.bounds
+        hit = np.nonzero((b[:, 0] <= max(x0, x1)) & (b[:, 2] >= min(x0, x1))
+                         & (b[:, 1] <= max(y0, y1)) & (b[:, 3] >= min(y0, y1)))[0]
+        out = np.full((h, w), np.nan)
+        if hit.size:
+            r = rasterize(((self.geoms[i], int(self.values[i])) for i in hit), out_shape=(h, w),
+                          transform=transform, fill=-1, dtype="int32")
+            out[r >= 0] = r[r >= 0]
+        return out
+
+
+# -- the engine -----------------------------------------------------------------------------------
+
+
+def _slope_deg(ref_padded: Array, res_x: float, res_y: float) -> Array:
+    gr, gc = np.gradient(ref_padded)
+    s = np.degrees(np.arctan(np.hypot(gc / res_x, gr / res_y)))
+    return s[1:-1, 1:-1]
+
+
+def _coregister(stack: contextlib.ExitStack, dem: Any, ref: Any, grid: Affine, width: int,
+                height: int, stable: Optional[PathLike], max_cells: int,
+                feedback: Feedback) -> Dict[str, Any]:
+    k = max(1, math.ceil(math.sqrt(width * height / max_cells)))
+    t = grid * Affine.scale(k)
+    w, h = math.ceil(width / k), math.ceil(height / k)
+    res = Resampling.bilinear if k == 1 else Resampling.average
+    ref_c = _GridReader(stack, ref, ref.crs, t, w, h,
+                        Resampling.nearest if k == 1 else Resampling.average).read(0, 0, h, w)
+    dem_c = _GridReader(stack, dem, ref.crs, t, w, h, res).read(0, 0, h, w)
+    mask = None
+    if stable is not None:
+        if _vector_kind(stable):
+            from rasterio.features import geometry_mask
+
+            geoms, _ = _read_polygons(stable, ref.crs, None, "stable-area layer", feedback)
+            if not geoms:
+                raise InputError(f"The stable-area layer '{stable}' holds no polygons.")
+            mask = geometry_mask(geoms, out_shape=(h, w), transform=t, invert=True)
+        else:
+            src = _open_raster(stack, stable, "stable-area mask")
+            m = _GridReader(stack, src, ref.crs, t, w, h, Resampling.nearest).read(0, 0, h, w)
+            mask = np.isfinite(m) & (m != 0)
+        if not mask.any():
+            raise InputError("The stable area does not overlap the common area of the DEMs.")
+    if k > 1:
+        feedback.info(f"Co-registration on a grid averaged {k}×{k} ({w} × {h} cells).")
+    r = nuth_kaab(dem_c, ref_c, t, stable=mask)
+    feedback.info(f"Co-registration (Nuth & Kääb): dx = {r.dx:.3f}, dy = {r.dy:.3f}, "
+                  f"dz = {r.dz:.3f} after {r.iterations} iterations"
+                  + ("" if r.converged else " (not converged)"))
+    if not r.converged:
+        feedback.warning("The co-registration did not converge; the shift may be unreliable.")
+    return {"dx": r.dx, "dy": r.dy, "dz": r.dz, "iterations": r.iterations,
+            "converged": r.converged, "residual_nmad": r.residual_nmad}
+
+
+def compare_dems(
+    dem: PathLike,
+    reference: PathLike,
+    *,
+    coregister: bool = False,
+    stable: Optional[PathLike] = None,
+    classes: Optional[PathLike] = None,
+    class_field: Optional[str] = None,
+    flying_height: Optional[float] = None,
+    difference_path: Optional[PathLike] = None,
+    window_size: int = 1024,
+    memory_budget: int = 512 * 2**20,
+    coreg_max_cells: int = 4_000_000,
+    feedback: Optional[Feedback] = None,
+) -> Dict[str, Any]:
+    """Compare a DEM with a reference DEM on the reference grid, window by window.
+
+    Parameters
+    ----------
+    dem, reference : path
+        Rasters (band 1 = heights in metres); any CRS, grid and extent; nodata → ignored.
+    coregister : bool
+        Estimate and remove the DEM's horizontal and vertical shift first (Nuth & Kääb).
+    stable : path, optional
+        Stable terrain for the co-registration: a mask raster (non-zero = stable) or polygons.
+    classes : path, optional
+        Class polygons (with ``class_field``) or a class raster.
+    class_field : str, optional
+        Attribute of the class polygons that holds the class.
+    flying_height : float, optional
+        Flying height above ground (m): statistics also in ‰ of it.
+    difference_path : path, optional
+        Write Δh (float32, NaN = no data, tiled GeoTIFF, atomically) on the comparison grid.
+    window_size : int
+        Window edge (cells) of the processing; memory per window ≈ 60 bytes × window_size².
+    memory_budget : int
+        Bytes of differences kept for exact quantiles (beyond: 0.5 mm histograms).
+    coreg_max_cells : int
+        Cells of the (averaged) grid the co-registration sees.
+    feedback : Feedback, optional
+        Progress per window; cancelling raises Cancelled and leaves no difference raster.
+
+    Returns
+    -------
+    dict
+        ``{"stats", "shift" (dx, dy, dz, iterations, converged, residual_nmad) or None,
+        "per_class", "per_slope", "grid" {"crs", "transform", "width", "height",
+        "resolution"}, "difference", "precision"}``; statistics as
+        :func:`~.stats.difference_stats`.
+
+    Raises
+    ------
+    InputError
+        Unreadable files, missing CRS, no overlap, no valid heights, missing class attribute.
+    """
+    fb = ensure_feedback(feedback)
+    if classes is not None and _vector_kind(classes) and not class_field:
+        raise InputError("Class polygons need the attribute that holds the class "
+                         "(class_field); give its name.")
+    with contextlib.ExitStack() as stack:
+        ref = _open_raster(stack, reference, "reference DEM")
+        src = _open_raster(stack, dem, "DEM")
+        gwin, grid = _common_grid(src, ref)
+        width, height = int(gwin.width), int(gwin.height)
+        r_off, c_off = int(gwin.row_off), int(gwin.col_off)
+        fb.info(f"Comparison grid: {width} × {height} cells of the reference "
+                f"({abs(grid.a):g} × {abs(grid.e):g}), {ref.crs.to_string()}.")
+
+        shift = None
+        if coregister:
+            shift = _coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
+                                fb.step(0, 10))
+        dz0 = shift["dz"] if shift else 0.0
+        dem_reader = _GridReader(stack, src, ref.crs, grid, width, height, Resampling.bilinear,
+                                 (shift["dx"], shift["dy"]) if shift else (0.0, 0.0))
+
+        class_names: Optional[Dict[str, str]] = None
+        polys: Optional[_PolygonRasteriser] = None
+        class_reader: Optional[_GridReader] = None
+        if classes is not None:
+            if _vector_kind(classes):
+                geoms, values = _read_polygons(classes, ref.crs, class_field, "class layer", fb)
+                keys = sorted({_label_key(v) for v in values if v is not None})
+                index = {k: i for i, k in enumerate(keys)}
+                keep = [i for i, v in enumerate(values) if v is not None]
+                polys = _PolygonRasteriser([geoms[i] for i in keep],
+                                           [index[_label_key(values[i])] for i in keep])
+                class_names = {str(i): k for k, i in index.items()}
+            else:
+                csrc = _open_raster(stack, classes, "class raster")
+                class_reader = _GridReader(stack, csrc, ref.crs, grid, width, height,
+                                           Resampling.nearest)
+
+        acc = DifferenceAccumulator(memory_budget=memory_budget)
+        out_ds = None
+        if difference_path is not None:
+            tmp = stack.enter_context(atomic_output(difference_path))
+            profile = dict(GTIFF_PROFILE)
+            profile.update(count=1, width=width, height=height, dtype="float32",
+                           nodata=float("nan"), crs=ref.crs, transform=grid, predictor=3)
+            if width < 256 or height < 256:
+                profile.update(tiled=False)
+                profile.pop("blockxsize")
+                profile.pop("blockysize")
+            out_ds = stack.enter_context(rasterio.open(tmp, "w", **profile))
+
+        step = max(16, int(window_size))
+        wins = [(r, c, min(step, height - r), min(step, width - c))
+                for r in range(0, height, step) for c in range(0, width, step)]
+        n_ref = n_dem = 0
+        base = 10.0 if coregister else 0.0
+        for i, (r, c, h, w) in enumerate(wins):
+            refp = _read_window(ref, r_off + r - 1, c_off + c - 1, h + 2, w + 2)
+            z_ref = refp[1:-1, 1:-1]
+            z_dem = dem_reader.read(r, c, h, w) + dz0
+            dz = z_dem - z_ref
+            n_ref += int(np.count_nonzero(np.isfinite(z_ref)))
+            n_dem += int(np.count_nonzero(np.isfinite(z_dem)))
+            groups = {"slope": slope_class_index(_slope_deg(refp, grid.a, grid.e))}
+            wt = grid * Affine.translation(c, r)
+            if polys is not None:
+                groups["class"] = polys.labels(wt, h, w)
+            elif class_reader is not None:
+                groups["class"] = class_reader.read(r, c, h, w)
+            acc.add(dz, groups)
+            if out_ds is not None:
+                out_ds.write(dz.astype(np.float32), 1, window=Window(c, r, w, h))
+            fb.progress(base + (100.0 - base) * (i + 1) / len(wins))
+        if n_ref == 0:
+            raise InputError(f"The reference DEM '{reference}' has no valid heights in the area "
+                             "it shares with the DEM (all nodata).")
+        if n_dem == 0:
+            raise InputError(f"The DEM '{dem}' has no valid heights in the area it shares with "
+                             "the reference (all nodata).")
+        if acc.total.n == 0:
+            raise InputError("The DEM and the reference have no valid heights at the same "
+                             "cells; nothing to compare.")
+        res = acc.result(flying_height)
+
+    per_slope = {SLOPE_LABELS[int(k)]: v for k, v in res.get("per_slope", {}).items()}
+    per_class = res.get("per_class", {})
+    if class_names is not None:
+        per_class = {class_names[k]: v for k, v in per_class.items()}
+    return {
+        "stats": res["stats"],
+        "shift": shift,
+        "per_class": per_class,
+        "per_slope": per_slope,
+        "grid": {"crs": ref.crs.to_string(), "transform": list(grid)[:6], "width": width,
+                 "height": height, "resolution": [abs(grid.a), abs(grid.e)]},
+        "difference": str(difference_path) if difference_path is not None else None,
+        "precision": res["precision"],
+    }
+
