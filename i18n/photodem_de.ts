@@ -375,7 +375,7 @@
         </message>
         <message>
             <source>Output folder</source>
-            <extracomment>epipolar_pair output folder; epipolar_pair.output: description</extracomment>
+            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; point_compare.output: description</extracomment>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
@@ -427,6 +427,241 @@
             <source>Epipolar image size [w, h] (left)</source>
             <extracomment>epipolar_pair output size</extracomment>
             <translation>Größe des Epipolarbilds [B, H] (links)</translation>
+        </message>
+        <message>
+            <source>Compare DEM with reference</source>
+            <extracomment>dem_compare: name</extracomment>
+            <translation>DGM mit Referenzmodell vergleichen</translation>
+        </message>
+        <message>
+            <source>Quality control</source>
+            <extracomment>dem_compare: group; dem_profile: group; point_compare: group</extracomment>
+            <translation>Qualitätskontrolle</translation>
+        </message>
+        <message>
+            <source>Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference may have another grid, extent or CRS (the DEM is resampled onto it). Optionally co-registers the DEM first (horizontal shift and vertical bias after Nuth &amp; Kääb, estimated on stable terrain). Writes the difference model Δh = DEM − reference (with a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope class, in m and in ‰ of the flying height, and an HTML report with plots.</source>
+            <extracomment>dem_compare: help</extracomment>
+            <translation>Vergleicht ein Höhenmodell (DOM oder DGM) im gemeinsamen Gebiet mit einem Referenzmodell; das Referenzmodell darf ein anderes Raster, eine andere Ausdehnung oder ein anderes KBS haben (das Höhenmodell wird darauf umgerechnet). Optional wird das Höhenmodell vorher koregistriert (Lageverschiebung und Höhenversatz nach Nuth &amp; Kääb, geschätzt auf stabilem Gelände). Schreibt das Differenzmodell Δh = Höhenmodell − Referenz (mit QGIS-Stil), eine Schummerung und ein Neigungsraster des Höhenmodells, Statistiken (Mittel, Median, Standardabweichung, RMS, NMAD, Quantile von |Δh|, 0,5-m-Klassen) insgesamt, je Klasse und je Neigungsklasse, in m und in ‰ der Flughöhe, sowie einen HTML-Bericht mit Diagrammen.</translation>
+        </message>
+        <message>
+            <source>DEM to check</source>
+            <extracomment>dem_compare.dem: description; point_compare.dem: description</extracomment>
+            <translation>Zu prüfendes Höhenmodell</translation>
+        </message>
+        <message>
+            <source>Reference DEM</source>
+            <extracomment>dem_compare.reference: description</extracomment>
+            <translation>Referenzmodell</translation>
+        </message>
+        <message>
+            <source>Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, report.html, stats.json and stats.csv.</source>
+            <extracomment>dem_compare.output: help</extracomment>
+            <translation>Erhält difference.tif (+ .qml-Stil), hillshade.tif, slope.tif, report.html, stats.json und stats.csv.</translation>
+        </message>
+        <message>
+            <source>Co-register before comparing</source>
+            <extracomment>dem_compare.coregister: description</extracomment>
+            <translation>Vor dem Vergleich koregistrieren</translation>
+        </message>
+        <message>
+            <source>Estimate and remove a horizontal shift and a vertical bias (Nuth &amp; Kääb) on stable terrain first.</source>
+            <extracomment>dem_compare.coregister: help</extracomment>
+            <translation>Zuerst Lageverschiebung und Höhenversatz (Nuth &amp; Kääb) auf stabilem Gelände schätzen und entfernen.</translation>
+        </message>
+        <message>
+            <source>Stable terrain (mask raster or polygons)</source>
+            <extracomment>dem_compare.stable: description</extracomment>
+            <translation>Stabiles Gelände (Maskenraster oder Polygone)</translation>
+        </message>
+        <message>
+            <source>Where the terrain has not changed (co-registration only): a raster (non-zero = stable) or polygons. Default: the whole common area.</source>
+            <extracomment>dem_compare.stable: help</extracomment>
+            <translation>Wo sich das Gelände nicht verändert hat (nur für die Koregistrierung): ein Raster (ungleich null = stabil) oder Polygone. Standard: das ganze gemeinsame Gebiet.</translation>
+        </message>
+        <message>
+            <source>Classes (polygons or raster)</source>
+            <extracomment>dem_compare.classes: description</extracomment>
+            <translation>Klassen (Polygone oder Raster)</translation>
+        </message>
+        <message>
+            <source>Statistics per class: a class raster such as land cover, or polygons with a class attribute.</source>
+            <extracomment>dem_compare.classes: help</extracomment>
+            <translation>Statistik je Klasse: ein Klassenraster wie die Landbedeckung oder Polygone mit einem Klassenattribut.</translation>
+        </message>
+        <message>
+            <source>Class attribute of the polygons</source>
+            <extracomment>dem_compare.class_field: description</extracomment>
+            <translation>Klassenattribut der Polygone</translation>
+        </message>
+        <message>
+            <source>Attribute of the class polygons that names the class.</source>
+            <extracomment>dem_compare.class_field: help</extracomment>
+            <translation>Attribut der Klassenpolygone, das die Klasse benennt.</translation>
+        </message>
+        <message>
+            <source>Flying height above ground [m]</source>
+            <extracomment>dem_compare.flying_height: description; point_compare.flying_height: description</extracomment>
+            <translation>Flughöhe über Grund [m]</translation>
+        </message>
+        <message>
+            <source>For the statistics in ‰ of the flying height.</source>
+            <extracomment>dem_compare.flying_height: help; point_compare.flying_height: help</extracomment>
+            <translation>Für die Statistik in ‰ der Flughöhe.</translation>
+        </message>
+        <message>
+            <source>Statistics of Δh [m]</source>
+            <extracomment>dem_compare output stats</extracomment>
+            <translation>Statistik von Δh [m]</translation>
+        </message>
+        <message>
+            <source>Co-registration shift dx, dy, dz [m]</source>
+            <extracomment>dem_compare output shift</extracomment>
+            <translation>Verschiebung der Koregistrierung dx, dy, dz [m]</translation>
+        </message>
+        <message>
+            <source>Statistics per class</source>
+            <extracomment>dem_compare output per_class</extracomment>
+            <translation>Statistik je Klasse</translation>
+        </message>
+        <message>
+            <source>Statistics per slope class</source>
+            <extracomment>dem_compare output per_slope</extracomment>
+            <translation>Statistik je Neigungsklasse</translation>
+        </message>
+        <message>
+            <source>Difference model (DEM − reference)</source>
+            <extracomment>dem_compare output difference</extracomment>
+            <translation>Differenzmodell (Höhenmodell − Referenz)</translation>
+        </message>
+        <message>
+            <source>Hillshade of the DEM</source>
+            <extracomment>dem_compare output hillshade</extracomment>
+            <translation>Schummerung des Höhenmodells</translation>
+        </message>
+        <message>
+            <source>Slope of the DEM [°]</source>
+            <extracomment>dem_compare output slope</extracomment>
+            <translation>Geländeneigung des Höhenmodells [°]</translation>
+        </message>
+        <message>
+            <source>HTML report</source>
+            <extracomment>dem_compare output report</extracomment>
+            <translation>HTML-Bericht</translation>
+        </message>
+        <message>
+            <source>Statistics as JSON</source>
+            <extracomment>dem_compare output json; point_compare output json</extracomment>
+            <translation>Statistik als JSON</translation>
+        </message>
+        <message>
+            <source>Statistics as CSV</source>
+            <extracomment>dem_compare output csv; point_compare output csv</extracomment>
+            <translation>Statistik als CSV</translation>
+        </message>
+        <message>
+            <source>DEM profiles along a line</source>
+            <extracomment>dem_profile: name</extracomment>
+            <translation>Höhenprofile entlang einer Linie</translation>
+        </message>
+        <message>
+            <source>Samples several DEMs (bilinear) along a line at a constant spacing and writes the table profile.csv (distance, x, y, one height column per DEM) and the plot profile.png. The line is the first line feature of a vector file (any CRS) or a list of coordinates in the first DEM's CRS.</source>
+            <extracomment>dem_profile: help</extracomment>
+            <translation>Tastet mehrere Höhenmodelle (bilinear) entlang einer Linie in festem Abstand ab und schreibt die Tabelle profile.csv (Distanz, x, y, eine Höhenspalte je Höhenmodell) und das Diagramm profile.png. Die Linie ist das erste Linienobjekt einer Vektordatei (beliebiges KBS) oder eine Koordinatenliste im KBS des ersten Höhenmodells.</translation>
+        </message>
+        <message>
+            <source>DEMs</source>
+            <extracomment>dem_profile.dems: description</extracomment>
+            <translation>Höhenmodelle</translation>
+        </message>
+        <message>
+            <source>Profile line (vector file)</source>
+            <extracomment>dem_profile.line: description</extracomment>
+            <translation>Profillinie (Vektordatei)</translation>
+        </message>
+        <message>
+            <source>Its first line feature is the profile; it is transformed to the first DEM's CRS.</source>
+            <extracomment>dem_profile.line: help</extracomment>
+            <translation>Ihr erstes Linienobjekt ist das Profil; es wird in das KBS des ersten Höhenmodells transformiert.</translation>
+        </message>
+        <message>
+            <source>Profile line as coordinates</source>
+            <extracomment>dem_profile.coordinates: description</extracomment>
+            <translation>Profillinie als Koordinaten</translation>
+        </message>
+        <message>
+            <source>'x1,y1;x2,y2;…' in the first DEM's CRS (when no line file is given).</source>
+            <extracomment>dem_profile.coordinates: help</extracomment>
+            <translation>'x1,y1;x2,y2;…' im KBS des ersten Höhenmodells (wenn keine Liniendatei angegeben ist).</translation>
+        </message>
+        <message>
+            <source>Sample spacing [m]</source>
+            <extracomment>dem_profile.spacing: description</extracomment>
+            <translation>Abtastabstand [m]</translation>
+        </message>
+        <message>
+            <source>Default: the finest cell size of the DEMs.</source>
+            <extracomment>dem_profile.spacing: help</extracomment>
+            <translation>Standard: die kleinste Zellgröße der Höhenmodelle.</translation>
+        </message>
+        <message>
+            <source>Profile table (CSV)</source>
+            <extracomment>dem_profile output csv</extracomment>
+            <translation>Profiltabelle (CSV)</translation>
+        </message>
+        <message>
+            <source>Profile plot (PNG)</source>
+            <extracomment>dem_profile output png</extracomment>
+            <translation>Profildiagramm (PNG)</translation>
+        </message>
+        <message>
+            <source>Line length [m]</source>
+            <extracomment>dem_profile output length</extracomment>
+            <translation>Linienlänge [m]</translation>
+        </message>
+        <message>
+            <source>Number of samples</source>
+            <extracomment>dem_profile output samples</extracomment>
+            <translation>Anzahl der Abtastpunkte</translation>
+        </message>
+        <message>
+            <source>Compare points with DEM</source>
+            <extracomment>point_compare: name</extracomment>
+            <translation>Punkte mit Höhenmodell vergleichen</translation>
+        </message>
+        <message>
+            <source>Compares points (check points or matched points) with a DEM: Δz = DEM − point, the DEM interpolated bilinearly. Reads XYZ text ('x y z' or 'id x y z', whitespace or commas, '#' comments), CSV with a header (columns x, y, z by name) or a GeoPackage of 3-D points (or with a height field). Writes residuals.csv (points outside the DEM are listed as such) and the same statistics as the DEM comparison.</source>
+            <extracomment>point_compare: help</extracomment>
+            <translation>Vergleicht Punkte (Kontrollpunkte oder Zuordnungspunkte) mit einem Höhenmodell: Δz = Höhenmodell − Punkt, das Höhenmodell bilinear interpoliert. Liest XYZ-Text ('x y z' oder 'id x y z', Leerraum oder Kommas, '#'-Kommentare), CSV mit Kopfzeile (Spalten x, y, z nach Namen) oder ein GeoPackage mit 3D-Punkten (oder mit einem Höhenfeld). Schreibt residuals.csv (Punkte außerhalb des Höhenmodells werden als solche aufgeführt) und dieselbe Statistik wie der Höhenmodellvergleich.</translation>
+        </message>
+        <message>
+            <source>Points (XYZ text, CSV or GeoPackage)</source>
+            <extracomment>point_compare.points: description</extracomment>
+            <translation>Punkte (XYZ-Text, CSV oder GeoPackage)</translation>
+        </message>
+        <message>
+            <source>Statistics of Δz [m]</source>
+            <extracomment>point_compare output stats</extracomment>
+            <translation>Statistik von Δz [m]</translation>
+        </message>
+        <message>
+            <source>Points read</source>
+            <extracomment>point_compare output points</extracomment>
+            <translation>Gelesene Punkte</translation>
+        </message>
+        <message>
+            <source>Points on the DEM</source>
+            <extracomment>point_compare output used</extracomment>
+            <translation>Punkte auf dem Höhenmodell</translation>
+        </message>
+        <message>
+            <source>Points outside the DEM</source>
+            <extracomment>point_compare output outside</extracomment>
+            <translation>Punkte außerhalb des Höhenmodells</translation>
+        </message>
+        <message>
+            <source>Residual table (CSV)</source>
+            <extracomment>point_compare output residuals</extracomment>
+            <translation>Residuentabelle (CSV)</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

@@ -138,8 +138,9 @@ class Parameter:
             if kind == "extent":
                 return _to_extent(value)
             if kind == "multiple_rasters":
-                items = value.split(",") if isinstance(value, str) else list(value)
-                return [str(Path(str(v).strip()).expanduser()) for v in items if str(v).strip()]
+                items = [value] if isinstance(value, str) else list(value)
+                parts = [p for v in items for p in str(v).split(",")]  # "a.tif,b.tif" or a list
+                return [str(Path(p.strip()).expanduser()) for p in parts if p.strip()]
         except InputError:
             raise
         except (TypeError, ValueError):

@@ -132,3 +132,54 @@ def test_project_create_python_equals_cli(ngi_block: Path, tmp_path: Path) -> No
     _same_files(tmp_path / "py", tmp_path / "cli")
     with rasterio.open(ngi / "ngi" / "dem.tif"):
         pass  # the input is untouched and still readable
+
+
+def _quality_inputs(block) -> Dict[str, str]:
+    truth = Path(block["py"]["project"]) / "truth"
+    with rasterio.open(truth / "dtm.tif") as src:
+        b = src.bounds
+    dx, dy = b.right - b.left, b.top - b.bottom
+    line = (f"{b.left + 0.1 * dx:.3f},{b.bottom + 0.2 * dy:.3f};"
+            f"{b.left + 0.9 * dx:.3f},{b.bottom + 0.7 * dy:.3f}")
+    return {"dsm": str(truth / "dsm.tif"), "dtm": str(truth / "dtm.tif"),
+            "landcover": str(truth / "landcover.tif"),
+            "checkpoints": str(truth / "checkpoints.gpkg"), "line": line}
+
+
+def test_dem_compare_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"dem": q["dsm"], "reference": q["dtm"], "classes": q["landcover"],
+              "flying_height": 75.0}
+    py = registry.run("dem_compare", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("dem_compare", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")  # the HTML report byte for byte
+
+
+def test_dem_profile_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"coordinates": q["line"]}
+    py = registry.run("dem_profile", {**params, "dems": [q["dsm"], q["dtm"]],
+                                      "output": str(tmp_path / "py")})
+    argv = [*CLI, "run", "dem_profile", "--json", "--quiet", "--dems", q["dsm"], q["dtm"],
+            "--coordinates", q["line"], "--output", str(tmp_path / "cli")]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    cli = json.loads(done.stdout)
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    # a comma-separated list as the help text says: the same result
+    comma = _cli("dem_profile", {**params, "dems": f"{q['dsm']},{q['dtm']}",
+                                 "output": str(tmp_path / "comma")})
+    assert _swap(comma, str(tmp_path / "comma"), "<out>") == \
+        _swap(py, str(tmp_path / "py"), "<out>")
+
+
+def test_point_compare_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"points": q["checkpoints"], "dem": q["dsm"], "flying_height": 75.0}
+    py = registry.run("point_compare", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("point_compare", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["used"] == py["points"] > 0 and abs(py["stats"]["mean"]) < 0.01

@@ -79,6 +79,26 @@ def _project_copy(project: Path, out: Path) -> Path:
     return copy
 
 
+def _truth(project: Path, name: str) -> str:
+    """A ground-truth file of the synthetic block (``truth/`` beside project.toml)."""
+    path = Path(project) / "truth" / name
+    if not path.exists():
+        pytest.skip(f"the synthetic project has no {path}")
+    return str(path)
+
+
+def _diagonal(raster: str) -> str:
+    """'x1,y1;x2,y2' across the inner part of a raster (profile coordinates)."""
+    import rasterio
+
+    with rasterio.open(raster) as src:
+        b = src.bounds
+    dx, dy = b.right - b.left, b.top - b.bottom
+    return (f"{b.left + 0.1 * dx:.3f},{b.bottom + 0.2 * dy:.3f};"
+            f"{b.left + 0.5 * dx:.3f},{b.bottom + 0.5 * dy:.3f};"
+            f"{b.left + 0.9 * dx:.3f},{b.bottom + 0.6 * dy:.3f}")
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_models": lambda out, req: {
@@ -97,6 +117,18 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
         "angle_unit": "degrees",
         "dem": str(_ngi() / "ngi" / "dem.tif"),
         "output": str(out / "ngi_project")},
+    "dem_compare": lambda out, req: {
+        "dem": _truth(req("project"), "dsm.tif"), "reference": _truth(req("project"), "dtm.tif"),
+        "classes": _truth(req("project"), "landcover.tif"), "flying_height": 75.0,
+        "output": str(out / "compare")},
+    "dem_profile": lambda out, req: {
+        "dems": [_truth(req("project"), "dsm.tif"), _truth(req("project"), "dtm.tif")],
+        "coordinates": _diagonal(_truth(req("project"), "dtm.tif")), "spacing": 0.5,
+        "output": str(out / "profile")},
+    "point_compare": lambda out, req: {
+        "points": _truth(req("project"), "checkpoints.gpkg"),
+        "dem": _truth(req("project"), "dsm.tif"), "flying_height": 75.0,
+        "output": str(out / "points")},
 }
 
 

@@ -2,4 +2,207 @@
 
 from __future__ import annotations
 
-ALGORITHMS: list = []
+from pathlib import Path
+from typing import Any, Dict
+
+from ...raster.io import staged_folder
+from ..feedback import Feedback
+from ..spec import Algorithm, Output, Parameter
+
+GROUP = "Quality control"
+GROUP_ID = "quality"
+
+
+class DemCompare(Algorithm):
+    id = "dem_compare"
+    name = "Compare DEM with reference"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference "
+        "may have another grid, extent or CRS (the DEM is resampled onto it). Optionally "
+        "co-registers the DEM first (horizontal shift and vertical bias after Nuth & Kääb, "
+        "estimated on stable terrain). Writes the difference model Δh = DEM − reference (with "
+        "a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, "
+        "std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope "
+        "class, in m and in ‰ of the flying height, and an HTML report with plots."
+    )
+    parameters = (
+        Parameter("dem", "raster", "DEM to check"),
+        Parameter("reference", "raster", "Reference DEM"),
+        Parameter("output", "output_folder", "Output folder",
+                  help="Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, "
+                       "report.html, stats.json and stats.csv."),
+        Parameter("coregister", "bool", "Co-register before comparing", default=False,
+                  help="Estimate and remove a horizontal shift and a vertical bias (Nuth & "
+                       "Kääb) on stable terrain first."),
+        Parameter("stable", "file", "Stable terrain (mask raster or polygons)", optional=True,
+                  help="Where the terrain has not changed (co-registration only): a raster "
+                       "(non-zero = stable) or polygons. Default: the whole common area."),
+        Parameter("classes", "file", "Classes (polygons or raster)", optional=True,
+                  help="Statistics per class: a class raster such as land cover, or polygons "
+                       "with a class attribute."),
+        Parameter("class_field", "string", "Class attribute of the polygons", optional=True,
+                  help="Attribute of the class polygons that names the class."),
+        Parameter("flying_height", "number", "Flying height above ground [m]", optional=True,
+                  minimum=1.0, unit="m",
+                  help="For the statistics in ‰ of the flying height."),
+    )
+    outputs = (
+        Output("stats", "json", "Statistics of Δh [m]"),
+        Output("shift", "json", "Co-registration shift dx, dy, dz [m]"),
+        Output("per_class", "json", "Statistics per class"),
+        Output("per_slope", "json", "Statistics per slope class"),
+        Output("difference", "raster", "Difference model (DEM − reference)"),
+        Output("hillshade", "raster", "Hillshade of the DEM"),
+        Output("slope", "raster", "Slope of the DEM [°]"),
+        Output("report", "file", "HTML report"),
+        Output("json", "file", "Statistics as JSON"),
+        Output("csv", "file", "Statistics as CSV"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from ...quality.compare import compare_dems
+        from ...quality.rasters import write_difference_style, write_hillshade, write_slope
+        from ...quality.report import write_csv, write_json, write_report
+
+        out = Path(params["output"])
+        height = params.get("flying_height")
+        names = {"difference": "difference.tif", "hillshade": "hillshade.tif",
+                 "slope": "slope.tif", "report": "report.html", "json": "stats.json",
+                 "csv": "stats.csv"}
+        with staged_folder(out, replace=True, product=self.id) as tmp:
+            result = compare_dems(
+                params["dem"], params["reference"], coregister=bool(params["coregister"]),
+                stable=params.get("stable"), classes=params.get("classes"),
+                class_field=params.get("class_field"), flying_height=height,
+                difference_path=tmp / names["difference"], feedback=feedback.step(0.0, 60.0))
+            write_difference_style(tmp / names["difference"])
+            write_hillshade(params["dem"], tmp / names["hillshade"],
+                            feedback=feedback.step(60.0, 68.0))
+            write_slope(params["dem"], tmp / names["slope"], feedback=feedback.step(68.0, 75.0))
+            summary = {
+                "dem": Path(params["dem"]).name,
+                "reference": Path(params["reference"]).name,
+                "flying_height": height,
+                **{k: v for k, v in result.items() if k != "difference"},
+                "files": {k: v for k, v in names.items() if k != "json"},
+            }
+            write_json(tmp / names["json"], summary)
+            write_csv(tmp / names["csv"], result, height)
+            write_report(tmp / names["report"], result, dem=Path(params["dem"]).name,
+                         reference=Path(params["reference"]).name,
+                         difference=tmp / names["difference"],
+                         hillshade=tmp / names["hillshade"], flying_height=height,
+                         feedback=feedback.step(75.0, 99.0))
+        stats = result.get("stats") or {}
+        feedback.info(f"Δh over {stats.get('count', 0)} cells: mean {stats.get('mean', 0):+.3f} "
+                      f"m, NMAD {stats.get('nmad', 0):.3f} m, RMS {stats.get('rms', 0):.3f} m.")
+        return {
+            "stats": result.get("stats"),
+            "shift": result.get("shift"),
+            "per_class": result.get("per_class"),
+            "per_slope": result.get("per_slope"),
+            **{k: str(out / v) for k, v in names.items()},
+        }
+
+
+class DemProfile(Algorithm):
+    id = "dem_profile"
+    name = "DEM profiles along a line"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Samples several DEMs (bilinear) along a line at a constant spacing and writes the "
+        "table profile.csv (distance, x, y, one height column per DEM) and the plot "
+        "profile.png. The line is the first line feature of a vector file (any CRS) or a list "
+        "of coordinates in the first DEM's CRS."
+    )
+    parameters = (
+        Parameter("dems", "multiple_rasters", "DEMs"),
+        Parameter("line", "file", "Profile line (vector file)", optional=True,
+                  help="Its first line feature is the profile; it is transformed to the "
+                       "first DEM's CRS."),
+        Parameter("coordinates", "string", "Profile line as coordinates", optional=True,
+                  help="'x1,y1;x2,y2;…' in the first DEM's CRS (when no line file is given)."),
+        Parameter("spacing", "number", "Sample spacing [m]", optional=True, minimum=0.001,
+                  unit="m", help="Default: the finest cell size of the DEMs."),
+        Parameter("output", "output_folder", "Output folder"),
+    )
+    outputs = (
+        Output("csv", "file", "Profile table (CSV)"),
+        Output("png", "file", "Profile plot (PNG)"),
+        Output("length", "number", "Line length [m]"),
+        Output("samples", "number", "Number of samples"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from ...quality.profile import dem_profile
+
+        out = Path(params["output"])
+        with staged_folder(out, replace=True, product=self.id) as tmp:
+            result = dem_profile(params["dems"], csv_path=tmp / "profile.csv",
+                                 png_path=tmp / "profile.png", line=params.get("line"),
+                                 coordinates=params.get("coordinates"),
+                                 spacing=params.get("spacing"), feedback=feedback)
+        feedback.info(f"Profile of {result['length']:.1f} m, {result['samples']} samples every "
+                      f"{result['spacing']:g} m.")
+        return {"csv": str(out / "profile.csv"), "png": str(out / "profile.png"),
+                "length": result["length"], "samples": result["samples"]}
+
+
+class PointCompare(Algorithm):
+    id = "point_compare"
+    name = "Compare points with DEM"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Compares points (check points or matched points) with a DEM: Δz = DEM − point, the "
+        "DEM interpolated bilinearly. Reads XYZ text ('x y z' or 'id x y z', whitespace or "
+        "commas, '#' comments), CSV with a header (columns x, y, z by name) or a GeoPackage of "
+        "3-D points (or with a height field). Writes residuals.csv (points outside the DEM "
+        "are listed as such) and the same statistics as the DEM comparison."
+    )
+    parameters = (
+        Parameter("points", "file", "Points (XYZ text, CSV or GeoPackage)"),
+        Parameter("dem", "raster", "DEM to check"),
+        Parameter("output", "output_folder", "Output folder"),
+        Parameter("flying_height", "number", "Flying height above ground [m]", optional=True,
+                  minimum=1.0, unit="m",
+                  help="For the statistics in ‰ of the flying height."),
+    )
+    outputs = (
+        Output("stats", "json", "Statistics of Δz [m]"),
+        Output("points", "number", "Points read"),
+        Output("used", "number", "Points on the DEM"),
+        Output("outside", "number", "Points outside the DEM"),
+        Output("residuals", "file", "Residual table (CSV)"),
+        Output("json", "file", "Statistics as JSON"),
+        Output("csv", "file", "Statistics as CSV"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from ...quality.points import point_compare
+        from ...quality.report import write_csv, write_json
+
+        out = Path(params["output"])
+        height = params.get("flying_height")
+        with staged_folder(out, replace=True, product=self.id) as tmp:
+            result = point_compare(params["points"], params["dem"],
+                                   residuals_path=tmp / "residuals.csv", flying_height=height,
+                                   feedback=feedback)
+            summary = {"points_file": Path(params["points"]).name,
+                       "dem": Path(params["dem"]).name, "flying_height": height,
+                       **{k: v for k, v in result.items() if k != "residuals"},
+                       "files": {"residuals": "residuals.csv", "csv": "stats.csv"}}
+            write_json(tmp / "stats.json", summary)
+            write_csv(tmp / "stats.csv", {"stats": result["stats"]}, height)
+        stats = result["stats"]
+        feedback.info(f"{result['used']} of {result['points']} points on the DEM: mean Δz "
+                      f"{stats.get('mean', 0):+.3f} m, RMS {stats.get('rms', 0):.3f} m.")
+        return {"stats": stats, "points": result["points"], "used": result["used"],
+                "outside": result["outside"], "residuals": str(out / "residuals.csv"),
+                "json": str(out / "stats.json"), "csv": str(out / "stats.csv")}
+
+
+ALGORITHMS: list = [DemCompare, DemProfile, PointCompare]
