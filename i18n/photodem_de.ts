@@ -395,12 +395,12 @@
         </message>
         <message>
             <source>Left epipolar image</source>
-            <extracomment>epipolar_pair output left</extracomment>
+            <extracomment>epipolar_pair output left; stereo_disparity.left: description</extracomment>
             <translation>Linkes Epipolarbild</translation>
         </message>
         <message>
             <source>Right epipolar image</source>
-            <extracomment>epipolar_pair output right</extracomment>
+            <extracomment>epipolar_pair output right; stereo_disparity.right: description</extracomment>
             <translation>Rechtes Epipolarbild</translation>
         </message>
         <message>
@@ -662,6 +662,156 @@
             <source>Residual table (CSV)</source>
             <extracomment>point_compare output residuals</extracomment>
             <translation>Residuentabelle (CSV)</translation>
+        </message>
+        <message>
+            <source>Stereo disparity (dense matching)</source>
+            <extracomment>stereo_disparity: name</extracomment>
+            <translation>Stereo-Disparität (dichte Zuordnung)</translation>
+        </message>
+        <message>
+            <source>Matching</source>
+            <extracomment>stereo_disparity: group</extracomment>
+            <translation>Bildzuordnung</translation>
+        </message>
+        <message>
+            <source>Dense matching of an epipolar (rectified) image pair, e.g. left.tif and right.tif of 'Epipolar pair': a disparity d = x_left − x_right for every pixel of the left image, by semi-global matching with radiometric normalisation, left–right check, sub-pixel refinement, speckle removal and filling of narrow gaps along the epipolar lines. Alpha bands and nodata are honoured. Works in tiles, so large images fit in memory.</source>
+            <extracomment>stereo_disparity: help</extracomment>
+            <translation>Dichte Zuordnung eines Epipolarbildpaars (Normalfall), z. B. left.tif und right.tif aus „Epipolarbildpaar“: eine Disparität d = x_links − x_rechts für jedes Pixel des linken Bildes, durch Semi-Global Matching mit radiometrischer Normierung, Links-rechts-Prüfung, Subpixel-Verfeinerung, Entfernen kleiner Störflecken und Füllen schmaler Lücken entlang der Epipolarlinien. Alphakanäle und NoData werden beachtet. Arbeitet in Kacheln, sodass auch große Bilder in den Speicher passen.</translation>
+        </message>
+        <message>
+            <source>Minimum disparity [px]</source>
+            <extracomment>stereo_disparity.min_disparity: description</extracomment>
+            <translation>Minimale Disparität [px]</translation>
+        </message>
+        <message>
+            <source>Smallest x_left − x_right searched; may be negative.</source>
+            <extracomment>stereo_disparity.min_disparity: help</extracomment>
+            <translation>Kleinstes gesuchtes x_links − x_rechts; darf negativ sein.</translation>
+        </message>
+        <message>
+            <source>Maximum disparity [px]</source>
+            <extracomment>stereo_disparity.max_disparity: description</extracomment>
+            <translation>Maximale Disparität [px]</translation>
+        </message>
+        <message>
+            <source>Largest x_left − x_right searched.</source>
+            <extracomment>stereo_disparity.max_disparity: help</extracomment>
+            <translation>Größtes gesuchtes x_links − x_rechts.</translation>
+        </message>
+        <message>
+            <source>Method</source>
+            <extracomment>stereo_disparity.method: description</extracomment>
+            <translation>Verfahren</translation>
+        </message>
+        <message>
+            <source>sgm: 8-path semi-global matching with radiometric normalisation, left–right check and gap filling; opencv_sgbm: plain OpenCV StereoSGBM for comparison.</source>
+            <extracomment>stereo_disparity.method: help</extracomment>
+            <translation>sgm: Semi-Global Matching über 8 Pfade mit radiometrischer Normierung, Links-rechts-Prüfung und Lückenfüllung; opencv_sgbm: unverändertes OpenCV StereoSGBM zum Vergleich.</translation>
+        </message>
+        <message>
+            <source>sgm</source>
+            <extracomment>stereo_disparity.method: option</extracomment>
+            <translation>sgm</translation>
+        </message>
+        <message>
+            <source>opencv_sgbm</source>
+            <extracomment>stereo_disparity.method: option</extracomment>
+            <translation>opencv_sgbm</translation>
+        </message>
+        <message>
+            <source>Disparity raster</source>
+            <extracomment>stereo_disparity output disparity; stereo_disparity.output: description</extracomment>
+            <translation>Disparitätsraster</translation>
+        </message>
+        <message>
+            <source>Float32 GeoTIFF in left-image geometry, NaN where no disparity.</source>
+            <extracomment>stereo_disparity.output: help</extracomment>
+            <translation>Float32-GeoTIFF in der Geometrie des linken Bildes, NaN ohne Disparität.</translation>
+        </message>
+        <message>
+            <source>Block size [px]</source>
+            <extracomment>stereo_disparity.block_size: description</extracomment>
+            <translation>Blockgröße [px]</translation>
+        </message>
+        <message>
+            <source>Odd side of the matching window.</source>
+            <extracomment>stereo_disparity.block_size: help</extracomment>
+            <translation>Ungerade Seitenlänge des Korrelationsfensters.</translation>
+        </message>
+        <message>
+            <source>Penalty P1</source>
+            <extracomment>stereo_disparity.p1: description</extracomment>
+            <translation>Strafterm P1</translation>
+        </message>
+        <message>
+            <source>SGM penalty for 1 px disparity steps. Default: 8 × block size².</source>
+            <extracomment>stereo_disparity.p1: help</extracomment>
+            <translation>SGM-Strafterm für Disparitätssprünge von 1 px. Standard: 8 × Blockgröße².</translation>
+        </message>
+        <message>
+            <source>Penalty P2</source>
+            <extracomment>stereo_disparity.p2: description</extracomment>
+            <translation>Strafterm P2</translation>
+        </message>
+        <message>
+            <source>SGM penalty for larger disparity steps. Default: 32 × block size².</source>
+            <extracomment>stereo_disparity.p2: help</extracomment>
+            <translation>SGM-Strafterm für größere Disparitätssprünge. Standard: 32 × Blockgröße².</translation>
+        </message>
+        <message>
+            <source>Uniqueness [%]</source>
+            <extracomment>stereo_disparity.uniqueness: description</extracomment>
+            <translation>Eindeutigkeit [%]</translation>
+        </message>
+        <message>
+            <source>Percent by which the best match must beat the second best.</source>
+            <extracomment>stereo_disparity.uniqueness: help</extracomment>
+            <translation>Prozent, um die die beste Zuordnung besser sein muss als die zweitbeste.</translation>
+        </message>
+        <message>
+            <source>Left–right tolerance [px]</source>
+            <extracomment>stereo_disparity.lr_max_diff: description</extracomment>
+            <translation>Links-rechts-Toleranz [px]</translation>
+        </message>
+        <message>
+            <source>Largest difference of left and right disparity; negative = no check.</source>
+            <extracomment>stereo_disparity.lr_max_diff: help</extracomment>
+            <translation>Größter Unterschied zwischen linker und rechter Disparität; negativ = keine Prüfung.</translation>
+        </message>
+        <message>
+            <source>Fill gaps up to [px]</source>
+            <extracomment>stereo_disparity.fill_max_width: description</extracomment>
+            <translation>Lücken füllen bis [px]</translation>
+        </message>
+        <message>
+            <source>Invalid runs along a row up to this width get the farther (smaller) neighbouring disparity; 0 = no filling.</source>
+            <extracomment>stereo_disparity.fill_max_width: help</extracomment>
+            <translation>Ungültige Abschnitte einer Zeile bis zu dieser Breite erhalten die entferntere (kleinere) benachbarte Disparität; 0 = nicht füllen.</translation>
+        </message>
+        <message>
+            <source>Memory per tile [MB]</source>
+            <extracomment>stereo_disparity.memory_mb: description</extracomment>
+            <translation>Speicher je Kachel [MB]</translation>
+        </message>
+        <message>
+            <source>Bounds the memory of the matching; sets the tile size.</source>
+            <extracomment>stereo_disparity.memory_mb: help</extracomment>
+            <translation>Begrenzt den Speicherbedarf der Zuordnung; bestimmt die Kachelgröße.</translation>
+        </message>
+        <message>
+            <source>Share of pixels with a disparity</source>
+            <extracomment>stereo_disparity output valid_share</extracomment>
+            <translation>Anteil der Pixel mit Disparität</translation>
+        </message>
+        <message>
+            <source>Smallest disparity [px]</source>
+            <extracomment>stereo_disparity output min</extracomment>
+            <translation>Kleinste Disparität [px]</translation>
+        </message>
+        <message>
+            <source>Largest disparity [px]</source>
+            <extracomment>stereo_disparity output max</extracomment>
+            <translation>Größte Disparität [px]</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

@@ -22,6 +22,7 @@ ALGORITHM_MODULES = (
     "synthetic",
     "geometry",
     "quality",
+    "matching",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).

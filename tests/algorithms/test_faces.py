@@ -183,3 +183,17 @@ def test_point_compare_python_equals_cli(block, tmp_path) -> None:
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
     _same_files(tmp_path / "py", tmp_path / "cli")
     assert py["used"] == py["points"] > 0 and abs(py["stats"]["mean"]) < 0.01
+
+
+def test_stereo_disparity_python_equals_cli(block, tmp_path) -> None:
+    project = block["py"]["project"]
+    model = registry.run("project_info", {"project": project})["models"][0]["name"]
+    epi = registry.run("epipolar_pair", {"project": project, "model": model,
+                                         "output": str(tmp_path / "epipolar")})
+    params = {"left": epi["left"], "right": epi["right"], "min_disparity": 80,
+              "max_disparity": 130}
+    py = registry.run("stereo_disparity", {**params, "output": str(tmp_path / "py" / "d.tif")})
+    cli = _cli("stereo_disparity", {**params, "output": str(tmp_path / "cli" / "d.tif")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["valid_share"] > 0.3

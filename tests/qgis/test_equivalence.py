@@ -99,6 +99,17 @@ def _diagonal(raster: str) -> str:
             f"{b.left + 0.9 * dx:.3f},{b.bottom + 0.6 * dy:.3f}")
 
 
+def _epipolar(project: Path) -> Dict[str, Any]:
+    """The epipolar pair of the first model of the synthetic block, made once beside it."""
+    from photodem.algorithms.processing import registry
+
+    folder = Path(project).parent / "epipolar_for_matching"
+    if not (folder / "epipolar.json").is_file():
+        registry.run("epipolar_pair", {"project": str(project), "model": _first_model(project),
+                                       "output": str(folder)})
+    return {"left": str(folder / "left.tif"), "right": str(folder / "right.tif")}
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_models": lambda out, req: {
@@ -129,6 +140,9 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
         "points": _truth(req("project"), "checkpoints.gpkg"),
         "dem": _truth(req("project"), "dsm.tif"), "flying_height": 75.0,
         "output": str(out / "points")},
+    "stereo_disparity": lambda out, req: {
+        **_epipolar(req("project")), "min_disparity": 80, "max_disparity": 130,
+        "method": "sgm", "output": str(out / "disparity" / "disparity.tif")},
 }
 
 

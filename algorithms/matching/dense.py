@@ -1,0 +1,339 @@
+"""Dense matching of a rectified (epipolar) pair: per-pixel disparities by semi-global matching.
+
+The disparity is ``d = x_left − x_right`` (pixels) in left-image geometry: the left pixel
+``(col, row)`` shows the same ground point as the right pixel ``(col − d, row)``. Invalid pixels
+are NaN.
+
+Method (``method="sgm"``)
+-------------------------
+1. **Radiometric normalisation** (ZNCC-like): each image is replaced by its local z-score
+   ``g' = (g − μ_w) / (σ_w + ε)`` over a ``normalise_window`` square, so that a gain/offset
+   difference between the two images (``g_r = a·g_l + b``, usual between aerial images) leaves
+   the matching cost unchanged. ``g'`` is mapped to 8 bit as ``128 + 32·g'`` (±4 σ).
+2. **Semi-global matching** (Hirschmüller 2008) by OpenCV's StereoSGBM in its full 8-path mode
+   (``MODE_HH``): cost ``C(p, d)`` = Birchfield–Tomasi difference of the x-gradient and of the
+   grey values over ``block_size²`` windows; aggregation along 8 paths
+   ``L_r(p, d) = C(p, d) + min(L_r(p−r, d), L_r(p−r, d±1) + P1, min_k L_r(p−r, k) + P2)
+   − min_k L_r(p−r, k)``, ``S = Σ_r L_r``; winner ``d* = argmin S`` with a uniqueness test and a
+   parabola through ``S(d*−1), S(d*), S(d*+1)`` for the sub-pixel part
+   ``δ = (S₋ − S₊) / (2·(S₋ − 2S₀ + S₊))``.
+3. **Left–right consistency**: the same matching from the right image (both images mirrored) gives
+   ``d_R``; a left disparity survives only if ``|d(x) − d_R(x − d(x))| ≤ lr_max_diff``.
+4. **Speckle removal**: connected disparity regions smaller than ``speckle_window`` px (with
+   steps ≤ ``speckle_range``) are removed.
+5. **Hole filling** along the epipolar lines: an invalid run no wider than ``fill_max_width``
+   gets the smaller (= farther, background) of its two valid neighbours — occlusions are
+   background by construction. Masked pixels are never filled.
+
+``method="opencv_sgbm"`` is plain OpenCV StereoSGBM (5 paths, no steps 1, 3, 5) for comparison.
+
+Tiling: the image is processed in tiles of the left image with an overlap margin (SGM paths need
+context); only the tile cores are kept. The cost volume of one tile (``w·h·D``) is bounded by
+``max_memory_mb``; the volume of the whole image never exists.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Iterator, Optional, Tuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..processing.feedback import Feedback, ensure_feedback
+
+#: Matching methods; the first is the default.
+METHODS = ("sgm", "opencv_sgbm")
+
+Array = NDArray[Any]
+#: A grey image source: ``source(row0, row1, col0, col1)`` → float32 block, NaN = masked.
+#: Rows/columns outside the image are returned as NaN.
+GreySource = Callable[[int, int, int, int], Array]
+
+
+def _cv2() -> Any:
+    try:
+        import cv2
+    except ImportError as exc:  # pragma: no cover - dependency is declared
+        raise InputError("Dense matching needs OpenCV: install 'opencv-python-headless' "
+                         "(PyPI) or 'python3-opencv' (Debian).") from exc
+    return cv2
+
+
+def array_source(image: Array) -> Tuple[GreySource, Tuple[int, int]]:
+    """A :data:`GreySource` over an in-memory 2-D array (NaN = masked); returns it and (h, w)."""
+    img = np.asarray(image)
+    h, w = img.shape
+
+    def source(r0: int, r1: int, c0: int, c1: int) -> Array:
+        out = np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+        rr0, rr1, cc0, cc1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
+        if rr1 > rr0 and cc1 > cc0:
+            out[rr0 - r0:rr1 - r0, cc0 - c0:cc1 - c0] = img[rr0:rr1, cc0:cc1]
+        return out
+
+    return source, (h, w)
+
+
+def normalise_local(grey: Array, window: int) -> Array:
+    """Local z-score ``(g − μ_w) / (σ_w + ε)`` mapped to uint8 as ``128 + 32·z``; NaN → 128.
+
+    Means are NaN-aware (weighted by the valid share of the window), so a mask edge does not bias
+    the statistics. ``ε`` = 1 % of the global standard deviation plus 0.5 grey values keeps
+    flat areas from being amplified into noise.
+    """
+    cv2 = _cv2()
+    valid = np.isfinite(grey)
+    g = np.where(valid, grey, 0.0).astype(np.float32)
+    wgt = valid.astype(np.float32)
+    k = (int(window), int(window))
+    n = cv2.boxFilter(wgt, -1, k, normalize=True, borderType=cv2.BORDER_REFLECT)
+    n = np.maximum(n, 1e-6)
+    mean = cv2.boxFilter(g, -1, k, normalize=True, borderType=cv2.BORDER_REFLECT) / n
+    sq = cv2.boxFilter(g * g, -1, k, normalize=True, borderType=cv2.BORDER_REFLECT) / n
+    std = np.sqrt(np.maximum(sq - mean * mean, 0.0))
+    gstd = float(np.std(g[valid])) if valid.any() else 1.0
+    z = (g - mean) / (std + 0.01 * gstd + 0.5)
+    out = np.clip(128.0 + 32.0 * z, 0, 255)
+    out[~valid] = 128.0
+    return out.astype(np.uint8)
+
+
+def _to_uint8(grey: Array) -> Array:
+    """Grey values to uint8 without normalisation (NaN → 0)."""
+    g = np.nan_to_num(grey, nan=0.0)
+    return np.clip(np.rint(g), 0, 255).astype(np.uint8)
+
+
+def fill_holes_rows(disp: Array, masked: Array, max_width: int) -> Array:
+    """Fill invalid runs along rows with the smaller of the two valid neighbours.
+
+    A run of NaN (not masked) no wider than ``max_width`` px gets
+    ``min(d_left_neighbour, d_right_neighbour)`` (only one neighbour at an image or mask edge).
+    Masked pixels stay NaN and are barriers.
+    """
+    if max_width <= 0:
+        return disp
+    h, w = disp.shape
+    valid = np.isfinite(disp)
+    stop = valid | masked  # pixels that end a run
+    cols = np.arange(w)[None, :]
+    left_idx = np.maximum.accumulate(np.where(stop, cols, -1), axis=1)
+    right_idx = np.flip(np.minimum.accumulate(np.flip(np.where(stop, cols, w), axis=1), axis=1),
+                        axis=1)
+    rows = np.arange(h)[:, None]
+    lv = np.where(left_idx >= 0, disp[rows, np.clip(left_idx, 0, w - 1)], np.nan)
+    rv = np.where(right_idx < w, disp[rows, np.clip(right_idx, 0, w - 1)], np.nan)
+    width = right_idx - left_idx - 1
+    with np.errstate(invalid="ignore"):
+        fill = np.fmin(lv, rv)
+    todo = ~stop & (width <= max_width) & np.isfinite(fill)
+    out = disp.copy()
+    out[todo] = fill[todo]
+    return out
+
+
+def _sgbm(cv2: Any, min_d: int, num_d: int, block: int, p1: int, p2: int, uniqueness: int,
+          speckle_window: int, speckle_range: int, mode: int) -> Any:
+    return cv2.StereoSGBM_create(
+        minDisparity=int(min_d), numDisparities=int(num_d), blockSize=int(block), P1=int(p1),
+        P2=int(p2), disp12MaxDiff=-1, preFilterCap=63, uniquenessRatio=int(uniqueness),
+        speckleWindowSize=int(speckle_window), speckleRange=int(speckle_range), mode=mode)
+
+
+def _num_disparities(min_d: int, max_d: int) -> int:
+    return int(math.ceil((max_d - min_d + 1) / 16.0) * 16)
+
+
+def tile_size_for(memory_mb: float, min_d: int, max_d: int, margin: int) -> int:
+    """Side of the square tile core whose 8-path SGM fits in ``memory_mb``.
+
+    OpenCV's full-DP mode keeps the cost and the aggregated cost (int16 each) plus path buffers:
+    about ``8·D`` bytes per pixel of the extended tile, whose width also carries the disparity
+    range.
+    """
+    num_d = _num_disparities(min_d, max_d)
+    budget = memory_mb * 1e6 / (8.0 * num_d)
+    # (s + 2m) · (s + 2m + D) ≤ budget → s
+    side = (-num_d + math.sqrt(num_d * num_d + 4.0 * budget)) / 2.0 - 2 * margin
+    return int(max(64, side))
+
+
+def iter_disparity_tiles(
+    left: GreySource,
+    right: GreySource,
+    left_shape: Tuple[int, int],
+    right_shape: Tuple[int, int],
+    min_disparity: int,
+    max_disparity: int,
+    method: str = "sgm",
+    block_size: int = 5,
+    p1: Optional[int] = None,
+    p2: Optional[int] = None,
+    uniqueness: int = 10,
+    lr_max_diff: float = 1.0,
+    normalise_window: int = 9,
+    speckle_window: int = 100,
+    speckle_range: int = 2,
+    fill_max_width: int = 0,
+    max_memory_mb: float = 256.0,
+    tile_size: Optional[int] = None,
+    margin: int = 48,
+    feedback: Optional[Feedback] = None,
+) -> Iterator[Tuple[int, int, Array]]:
+    """Disparity of the left image tile by tile: yields ``(row0, col0, block)``.
+
+    Parameters
+    ----------
+    left, right : GreySource
+        Grey value readers (NaN = masked / no data).
+    left_shape, right_shape : (int, int)
+        (height, width) of the two epipolar images; rows correspond.
+    min_disparity, max_disparity : int
+        Search range of ``d = x_left − x_right`` (px); negative values are allowed.
+    method : {"sgm", "opencv_sgbm"}
+        See the module docstring.
+    block_size : int
+        Odd matching window side (px).
+    p1, p2 : int, optional
+        SGM penalties for disparity steps of 1 and > 1 px (default ``8·b²``, ``32·b²``).
+    uniqueness : int
+        Percent by which the best cost must beat the second best.
+    lr_max_diff : float
+        Left–right check tolerance (px); ``< 0`` switches the check off.
+    normalise_window : int
+        Window of the local radiometric normalisation (px); 0 = off.
+    speckle_window, speckle_range : int
+        Speckle filter: region size (px) and disparity step (px) within a region.
+    fill_max_width : int
+        Widest invalid run along a row that is filled (px); 0 = no filling.
+    max_memory_mb : float
+        Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
+    tile_size : int, optional
+        Side of the tile core (px).
+    margin : int
+        Overlap of the tiles (px of context on each side, discarded afterwards).
+    feedback : Feedback, optional
+        Progress per tile; cancelling raises :class:`~photodem.algorithms.errors.Cancelled`.
+    """
+    cv2 = _cv2()
+    feedback = ensure_feedback(feedback)
+    if method not in METHODS:
+        raise InputError(f"Unknown dense matching method '{method}'; use one of "
+                         f"{', '.join(METHODS)}.")
+    min_d, max_d = int(min_disparity), int(max_disparity)
+    if max_d < min_d:
+        raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
+                         "give min_disparity ≤ max_disparity.")
+    block = int(block_size) | 1
+    p1 = int(8 * block * block if p1 is None else p1)
+    p2 = int(32 * block * block if p2 is None else p2)
+    if p2 <= p1:
+        raise InputError(f"P2 ({p2}) must be larger than P1 ({p1}).")
+    num_d = _num_disparities(min_d, max_d)
+    ours = method == "sgm"
+    mode = cv2.STEREO_SGBM_MODE_HH if ours else cv2.STEREO_SGBM_MODE_SGBM
+    sp_range = int(speckle_range) * (16 if ours else 1)  # on 1/16-px values inside SGBM
+    # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the plain mode
+    matcher = _sgbm(cv2, min_d, num_d, block, p1, p2, uniqueness,
+                    0 if ours else speckle_window, sp_range if not ours else 0, mode)
+    h, w = left_shape  # the right source pads with NaN outside its own right_shape
+    side = int(tile_size) if tile_size else tile_size_for(max_memory_mb, min_d, max_d, margin)
+    ty, tx = max(1, math.ceil(h / side)), max(1, math.ceil(w / side))
+    th, tw = math.ceil(h / ty), math.ceil(w / tx)
+    n_tiles, done = ty * tx, 0
+    lead = num_d + block  # left columns SGBM leaves without disparity
+    for iy in range(ty):
+        for ix in range(tx):
+            feedback.progress(100.0 * done / n_tiles)
+            r0, r1 = iy * th, min(h, (iy + 1) * th)
+            c0, c1 = ix * tw, min(w, (ix + 1) * tw)
+            R0, R1 = r0 - margin, r1 + margin
+            C0, C1 = c0 - margin, c1 + margin
+            # common frame: left pixel u ↔ right pixel u − d; start so that SGBM's dead lead
+            # columns and the largest disparity lie left of the left content
+            f0 = C0 - max(max_d, 0) - lead
+            f1 = max(C1, C1 - min_d) + 1
+            lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
+            lg[:, C0 - f0:C1 - f0] = left(R0, R1, C0, C1)
+            rg = right(R0, R1, f0, f1)
+            disp = _match_frame(cv2, matcher, lg, rg, min_d, max_d, num_d, ours, block,
+                                lr_max_diff, normalise_window, speckle_window,
+                                int(speckle_range), fill_max_width)
+            # back to the tile core
+            core = disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]
+            done += 1
+            yield r0, c0, core
+    feedback.progress(100.0)
+
+
+def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d: int,
+                 num_d: int, ours: bool, block: int, lr_max_diff: float, normalise_window: int,
+                 speckle_window: int, speckle_range: int, fill_max_width: int) -> Array:
+    """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape)."""
+    lmask = ~np.isfinite(lg)
+    rmask = ~np.isfinite(rg)
+    if ours and normalise_window > 1:
+        l8 = normalise_local(lg, normalise_window)
+        r8 = normalise_local(rg, normalise_window)
+    else:
+        l8, r8 = _to_uint8(lg), _to_uint8(rg)
+    invalid16 = (min_d - 1) * 16
+    raw = matcher.compute(l8, r8)
+    bad = raw == invalid16
+    h, w = raw.shape
+    cols = np.arange(w)[None, :]
+    rows = np.arange(h)[:, None]
+    if ours and lr_max_diff >= 0:
+        rraw = np.fliplr(matcher.compute(np.ascontiguousarray(np.fliplr(r8)),
+                                         np.ascontiguousarray(np.fliplr(l8))))
+        rbad = rraw == invalid16
+        d = raw.astype(np.float32) / 16.0
+        xr = np.rint(cols - d).astype(np.int64)
+        inside = (xr >= 0) & (xr < w)
+        xr = np.clip(xr, 0, w - 1)
+        d_r = rraw[rows, xr].astype(np.float32) / 16.0
+        consistent = inside & ~rbad[rows, xr] & (np.abs(d - d_r) <= lr_max_diff)
+        bad |= ~consistent
+    if ours and speckle_window > 0:
+        cleaned = raw.copy()
+        cleaned[bad] = invalid16
+        cv2.filterSpeckles(cleaned, invalid16, int(speckle_window), int(speckle_range) * 16)
+        bad |= cleaned == invalid16
+    disp = raw.astype(np.float32) / 16.0
+    disp[bad | (disp > max_d) | (disp < min_d)] = np.nan
+    # no disparity where the left pixel or its right partner is masked (window half-size kept)
+    near = cv2.dilate(rmask.astype(np.uint8), np.ones((1, block), np.uint8)).astype(bool)
+    xr = np.clip(np.rint(cols - np.nan_to_num(disp)).astype(np.int64), 0, w - 1)
+    disp[near[rows, xr]] = np.nan
+    if ours and fill_max_width > 0:
+        disp = fill_holes_rows(disp, lmask, fill_max_width)
+    disp[lmask] = np.nan
+    return disp
+
+
+def sgm_disparity(
+    left: Array,
+    right: Array,
+    min_disparity: int,
+    max_disparity: int,
+    feedback: Optional[Feedback] = None,
+    **options: Any,
+) -> Array:
+    """Disparity ``x_left − x_right`` of two in-memory grey images (NaN = masked).
+
+    ``options`` are those of :func:`iter_disparity_tiles`. Returns a float32 array of the left
+    image's shape, NaN where invalid.
+    """
+    left = np.asarray(left, np.float32)
+    right = np.asarray(right, np.float32)
+    if left.ndim != 2 or right.ndim != 2:
+        raise InputError("Dense matching needs two single-band (grey) images.")
+    src_l, shape_l = array_source(left)
+    src_r, shape_r = array_source(right)
+    out = np.full(shape_l, np.nan, np.float32)
+    for r0, c0, block in iter_disparity_tiles(src_l, src_r, shape_l, shape_r, min_disparity,
+                                              max_disparity, feedback=feedback, **options):
+        out[r0:r0 + block.shape[0], c0:c0 + block.shape[1]] = block
+    return out

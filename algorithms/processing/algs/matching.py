@@ -1,0 +1,150 @@
+"""Algorithm declarations: image matching."""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, Tuple
+
+import numpy as np
+
+from ...errors import InputError
+from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
+from ...raster.io import GTIFF_PROFILE, atomic_output, open_image
+from ..feedback import Feedback
+from ..spec import Algorithm, Output, Parameter
+
+GROUP = "Matching"
+GROUP_ID = "matching"
+
+
+def _grey_source(src: Any) -> Tuple[GreySource, Tuple[int, int]]:
+    """Window reader of a rasterio dataset: mean of the colour bands, NaN where masked.
+
+    The mask is GDAL's (alpha band, nodata value or internal mask): 0 → no data.
+    """
+    from rasterio.enums import ColorInterp
+    from rasterio.windows import Window
+
+    interp = list(src.colorinterp)
+    bands = [i + 1 for i, c in enumerate(interp) if c != ColorInterp.alpha] or [1]
+    bands = bands[:3]
+    h, w = src.height, src.width
+
+    def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        out = np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+        rr0, rr1, cc0, cc1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
+        if rr1 <= rr0 or cc1 <= cc0:
+            return out
+        win = Window(cc0, rr0, cc1 - cc0, rr1 - rr0)
+        grey = src.read(bands, window=win).astype(np.float32).mean(axis=0)
+        mask = src.read_masks(bands[0], window=win) == 0
+        grey[mask | ~np.isfinite(grey)] = np.nan
+        out[rr0 - r0:rr1 - r0, cc0 - c0:cc1 - c0] = grey
+        return out
+
+    return read, (h, w)
+
+
+class StereoDisparity(Algorithm):
+    id = "stereo_disparity"
+    name = "Stereo disparity (dense matching)"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Dense matching of an epipolar (rectified) image pair, e.g. left.tif and right.tif of "
+        "'Epipolar pair': a disparity d = x_left − x_right for every pixel of the left image, by "
+        "semi-global matching with radiometric normalisation, left–right check, sub-pixel "
+        "refinement, speckle removal and filling of narrow gaps along the epipolar lines. "
+        "Alpha bands and nodata are honoured. Works in tiles, so large images fit in memory."
+    )
+    parameters = (
+        Parameter("left", "raster", "Left epipolar image"),
+        Parameter("right", "raster", "Right epipolar image"),
+        Parameter("min_disparity", "integer", "Minimum disparity [px]", default=0, unit="px",
+                  minimum=-100000, maximum=100000,
+                  help="Smallest x_left − x_right searched; may be negative."),
+        Parameter("max_disparity", "integer", "Maximum disparity [px]", default=63, unit="px",
+                  minimum=-100000, maximum=100000,
+                  help="Largest x_left − x_right searched."),
+        Parameter("method", "enum", "Method", default=METHODS[0], options=METHODS,
+                  help="sgm: 8-path semi-global matching with radiometric normalisation, "
+                       "left–right check and gap filling; opencv_sgbm: plain OpenCV StereoSGBM "
+                       "for comparison."),
+        Parameter("output", "output_raster", "Disparity raster", extensions=(".tif",),
+                  help="Float32 GeoTIFF in left-image geometry, NaN where no disparity."),
+        Parameter("block_size", "integer", "Block size [px]", default=5, minimum=1, maximum=11,
+                  unit="px", help="Odd side of the matching window."),
+        Parameter("p1", "integer", "Penalty P1", optional=True, minimum=1,
+                  help="SGM penalty for 1 px disparity steps. Default: 8 × block size²."),
+        Parameter("p2", "integer", "Penalty P2", optional=True, minimum=2,
+                  help="SGM penalty for larger disparity steps. Default: 32 × block size²."),
+        Parameter("uniqueness", "integer", "Uniqueness [%]", default=10, minimum=0, maximum=100,
+                  unit="%", help="Percent by which the best match must beat the second best."),
+        Parameter("lr_max_diff", "number", "Left–right tolerance [px]", default=1.0,
+                  minimum=-1.0, maximum=100.0, unit="px",
+                  help="Largest difference of left and right disparity; negative = no check."),
+        Parameter("fill_max_width", "integer", "Fill gaps up to [px]", default=32, minimum=0,
+                  unit="px", help="Invalid runs along a row up to this width get the farther "
+                                  "(smaller) neighbouring disparity; 0 = no filling."),
+        Parameter("memory_mb", "number", "Memory per tile [MB]", default=256.0, minimum=16.0,
+                  unit="MB", help="Bounds the memory of the matching; sets the tile size."),
+    )
+    outputs = (
+        Output("disparity", "raster", "Disparity raster"),
+        Output("valid_share", "number", "Share of pixels with a disparity"),
+        Output("min", "number", "Smallest disparity [px]"),
+        Output("max", "number", "Largest disparity [px]"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        out_path = params["output"]
+        if not str(out_path).lower().endswith((".tif", ".tiff")):
+            raise InputError(f"The output '{out_path}' must be a GeoTIFF (.tif).")
+        if int(params["max_disparity"]) < int(params["min_disparity"]):
+            raise InputError("max_disparity must not be smaller than min_disparity.")
+        with open_image(params["left"]) as src_l, open_image(params["right"]) as src_r:
+            if src_l.height != src_r.height:
+                feedback.warning(f"The images have {src_l.height} and {src_r.height} rows; "
+                                 "rows are matched by index (epipolar images share rows).")
+            left, shape_l = _grey_source(src_l)
+            right, shape_r = _grey_source(src_r)
+            h, w = shape_l
+            profile = dict(GTIFF_PROFILE)
+            profile.update(width=w, height=h, count=1, dtype="float32", nodata=float("nan"),
+                           predictor=3)
+            if w < 256 or h < 256:
+                profile.update(tiled=False)
+                profile.pop("blockxsize")
+                profile.pop("blockysize")
+            if src_l.crs is not None:  # keep a georeference if the left image has one
+                profile.update(crs=src_l.crs, transform=src_l.transform)
+            n_valid, d_min, d_max = 0, math.inf, -math.inf
+            with atomic_output(out_path) as tmp, open_image(tmp, "w", **profile) as dst:
+                from rasterio.windows import Window
+
+                tiles = iter_disparity_tiles(
+                    left, right, shape_l, shape_r, params["min_disparity"],
+                    params["max_disparity"], method=params["method"],
+                    block_size=params["block_size"], p1=params.get("p1"), p2=params.get("p2"),
+                    uniqueness=params["uniqueness"], lr_max_diff=params["lr_max_diff"],
+                    fill_max_width=params["fill_max_width"],
+                    max_memory_mb=params["memory_mb"], feedback=feedback)
+                for r0, c0, block in tiles:
+                    dst.write(block[None], window=Window(c0, r0, block.shape[1],
+                                                         block.shape[0]))
+                    ok = np.isfinite(block)
+                    if ok.any():
+                        n_valid += int(ok.sum())
+                        d_min = min(d_min, float(block[ok].min()))
+                        d_max = max(d_max, float(block[ok].max()))
+        share = n_valid / float(max(h * w, 1))
+        feedback.info(f"Disparity for {100.0 * share:.1f} % of the pixels.")
+        return {
+            "disparity": str(out_path),
+            "valid_share": share,
+            "min": d_min if n_valid else None,
+            "max": d_max if n_valid else None,
+        }
+
+
+ALGORITHMS = [StereoDisparity]

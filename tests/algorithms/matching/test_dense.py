@@ -1,0 +1,201 @@
+"""Dense matching: synthetic pair with a known disparity field, tiles, masks, cancel, registry."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Dict, Tuple
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.matching.dense import (
+    fill_holes_rows,
+    sgm_disparity,
+)
+from photodem.algorithms.processing import registry
+from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.raster.io import open_image, write_raster
+
+H, W = 150, 240
+
+
+def _pair(shift: float = 0.0, seed: int = 1) -> Dict[str, np.ndarray]:
+    """Left/right grey images and the true left disparity (NaN where occluded).
+
+    The disparity is defined on the right image, ``d_R = 9 + 3·sin(2πy/H)·cos(πx/W) + 6·[x > W/2]
+    + shift``; the right image is ``T(x + d_R, y)`` of a texture ``T`` (the left image), with a
+    gain of 1.3, an offset of −25 and noise σ = 2. The left truth follows by inverting
+    ``x_l = x_r + d_R(x_r)`` along each row.
+    """
+    rng = np.random.default_rng(seed)
+    base = ndimage.gaussian_filter(rng.normal(size=(H, W + 80)), 1.2)
+    base = 120.0 + 45.0 * base / base.std()
+    yy, xr = np.mgrid[0:H, 0:W].astype(float)
+    d_r = 9.0 + 3.0 * np.sin(2 * np.pi * yy / H) * np.cos(np.pi * xr / W) + 6.0 * (xr > W / 2)
+    d_r += shift
+    off = 40.0  # the texture starts 40 px left of image column 0
+    left = base[:, 40:40 + W]
+    right = ndimage.map_coordinates(base, [yy, xr + d_r + off], order=3, mode="reflect")
+    right = 1.3 * right - 25.0 + rng.normal(0.0, 2.0, size=right.shape)
+    truth = np.full((H, W), np.nan)
+    xl = xr + d_r
+    cols = np.arange(W, dtype=float)
+    for r in range(H):  # a test-side inversion, one row at a time
+        d = np.interp(cols, xl[r], d_r[r], left=np.nan, right=np.nan)
+        # occluded: left pixels jumped over at the step (no right pixel maps near them)
+        gap = np.diff(xl[r]) > 1.5
+        for i in np.nonzero(gap)[0]:
+            d[(cols > xl[r, i] - 2) & (cols < xl[r, i + 1] + 2)] = np.nan
+        truth[r] = d
+    truth[:, :4] = np.nan
+    truth[:4], truth[-4:] = np.nan, np.nan
+    return {"left": left.astype(np.float32), "right": right.astype(np.float32), "truth": truth}
+
+
+@pytest.fixture(scope="module")
+def pair() -> Dict[str, np.ndarray]:
+    return _pair()
+
+
+def _score(disp: np.ndarray, truth: np.ndarray) -> Tuple[float, float]:
+    ok = np.isfinite(truth)
+    has = np.isfinite(disp[ok])
+    err = disp[ok][has] - truth[ok][has]
+    return float(np.sqrt(np.mean(err ** 2))), float(has.mean())
+
+
+def test_known_disparity_field(pair) -> None:
+    disp = sgm_disparity(pair["left"], pair["right"], 0, 31)
+    assert disp.dtype == np.float32 and disp.shape == (H, W)
+    rms, valid = _score(disp, pair["truth"])
+    assert rms < 0.3, rms
+    assert valid >= 0.95, valid
+
+
+def test_negative_disparities() -> None:
+    p = _pair(shift=-20.0, seed=2)
+    disp = sgm_disparity(p["left"], p["right"], -16, 0)
+    rms, valid = _score(disp, p["truth"])
+    assert rms < 0.3 and valid >= 0.95, (rms, valid)
+    assert np.nanmax(disp) <= 0.0
+
+
+def test_gain_offset_needs_normalisation(pair) -> None:
+    """Without the local normalisation the gain/offset change costs accuracy or coverage."""
+    ours = _score(sgm_disparity(pair["left"], pair["right"], 0, 31), pair["truth"])
+    raw = _score(sgm_disparity(pair["left"], pair["right"], 0, 31, normalise_window=0),
+                 pair["truth"])
+    assert ours[1] >= raw[1] - 0.01
+
+
+def test_tiles_equal_one_tile(pair) -> None:
+    one = sgm_disparity(pair["left"], pair["right"], 0, 31)
+    tiled = sgm_disparity(pair["left"], pair["right"], 0, 31, tile_size=64, margin=48)
+    both = np.isfinite(one) & np.isfinite(tiled)
+    assert both.sum() > 0.9 * np.isfinite(one).sum()
+    diff = np.abs(one - tiled)[both]
+    assert np.mean(diff > 0.25) < 0.01, np.mean(diff > 0.25)
+    # at the tile borders (columns/rows 64, 128, …) just as well
+    border = np.zeros_like(both)
+    border[:, [63, 64, 127, 128, 191, 192]] = True
+    border[[63, 64, 127, 128], :] = True
+    assert np.mean(np.abs(one - tiled)[both & border] > 0.25) < 0.02
+    rms, valid = _score(tiled, pair["truth"])
+    assert rms < 0.3 and valid >= 0.95
+
+
+def test_memory_budget_sets_tiles(pair) -> None:
+    small = sgm_disparity(pair["left"], pair["right"], 0, 31, max_memory_mb=16)
+    rms, valid = _score(small, pair["truth"])
+    assert rms < 0.3 and valid >= 0.95
+
+
+def test_masks_honoured(pair) -> None:
+    left, right = pair["left"].copy(), pair["right"].copy()
+    left[40:70, 30:90] = np.nan  # no data in the left image
+    right[100:130, 150:200] = np.nan  # no data in the right image
+    disp = sgm_disparity(left, right, 0, 31, fill_max_width=50)
+    assert np.isnan(disp[40:70, 30:90]).all()
+    # left pixels whose partner lies in the masked right area have no disparity
+    cols = np.mgrid[100:130, 0:W][1]
+    partner = cols - pair["truth"][100:130]
+    inside = (partner > 152) & (partner < 198)
+    assert np.isnan(disp[100:130][inside]).all()
+    rms, _ = _score(disp, pair["truth"])
+    assert rms < 0.3
+
+
+def test_fill_holes_rows() -> None:
+    d = np.array([[5.0, np.nan, np.nan, 2.0, np.nan, np.nan, np.nan, np.nan, 7.0]])
+    masked = np.zeros_like(d, bool)
+    out = fill_holes_rows(d, masked, 2)
+    assert out[0, 1] == out[0, 2] == 2.0  # the smaller neighbour
+    assert np.isnan(out[0, 4:8]).all()  # too wide
+    masked[0, 5] = True
+    out = fill_holes_rows(d, masked, 2)
+    assert out[0, 4] == 2.0 and np.isnan(out[0, 5]) and out[0, 6] == out[0, 7] == 7.0
+
+
+def test_bad_range() -> None:
+    with pytest.raises(InputError):
+        sgm_disparity(np.zeros((20, 20)), np.zeros((20, 20)), 5, 4)
+
+
+def _write_pair(folder: Path, pair) -> Tuple[str, str]:
+    """RGB + alpha GeoTIFFs in image space, as written by epipolar_pair."""
+    out = []
+    for side in ("left", "right"):
+        g = np.clip(pair[side], 0, 255).astype(np.uint8)
+        alpha = np.full(g.shape, 255, np.uint8)
+        if side == "left":
+            alpha[:, :20] = 0
+        path = folder / f"{side}.tif"
+        write_raster(path, np.stack([g, g, g, alpha]), photometric="RGB", alpha="YES")
+        out.append(str(path))
+    return out[0], out[1]
+
+
+def test_algorithm_through_registry(pair, tmp_path) -> None:
+    left, right = _write_pair(tmp_path, pair)
+    out = tmp_path / "disp.tif"
+    res = registry.run("stereo_disparity", {"left": left, "right": right, "min_disparity": 0,
+                                            "max_disparity": 31, "output": str(out)})
+    assert res["disparity"] == str(out) and out.is_file()
+    with open_image(out) as src:
+        assert src.dtypes[0] == "float32" and (src.width, src.height) == (W, H)
+        disp = src.read(1)
+    assert np.isnan(disp[:, :20]).all()  # alpha = 0 → no disparity
+    truth = pair["truth"].copy()
+    truth[:, :20] = np.nan
+    rms, valid = _score(disp, truth)
+    assert rms < 0.35 and valid >= 0.95
+    assert 0.8 < res["valid_share"] <= 1.0
+    assert 0.0 <= res["min"] < 10.0 and 16.0 < res["max"] <= 31.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["disp.tif", "left.tif", "right.tif"]
+
+
+def test_cancel_leaves_no_output(pair, tmp_path) -> None:
+    left, right = _write_pair(tmp_path, pair)
+    out = tmp_path / "disp.tif"
+    fb = Feedback()
+    fb.cancel()
+    with pytest.raises(Cancelled):
+        registry.run("stereo_disparity", {"left": left, "right": right, "min_disparity": 0,
+                                          "max_disparity": 31, "output": str(out)}, fb)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left.tif", "right.tif"]
+
+
+def test_cancel_mid_run(pair) -> None:
+    calls = []
+    fb = Feedback(on_progress=calls.append)
+
+    def cancel_after_first(p: float) -> None:
+        calls.append(p)
+        if len(calls) > 2:
+            fb.cancel()
+
+    fb._on_progress = cancel_after_first
+    with pytest.raises(Cancelled):
+        sgm_disparity(pair["left"], pair["right"], 0, 31, tile_size=64, feedback=fb)
