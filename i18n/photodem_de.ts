@@ -365,17 +365,17 @@
         </message>
         <message>
             <source>Project folder or project.toml</source>
-            <extracomment>epipolar_pair.project: description</extracomment>
+            <extracomment>epipolar_pair.project: description; match_model.project: description</extracomment>
             <translation>Projektordner oder project.toml</translation>
         </message>
         <message>
             <source>Stereo model</source>
-            <extracomment>epipolar_pair.model: description</extracomment>
+            <extracomment>epipolar_pair.model: description; match_model.model: description</extracomment>
             <translation>Stereomodell</translation>
         </message>
         <message>
             <source>Output folder</source>
-            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; point_compare.output: description</extracomment>
+            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; match_model.output: description; point_compare.output: description</extracomment>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
@@ -670,7 +670,7 @@
         </message>
         <message>
             <source>Matching</source>
-            <extracomment>stereo_disparity: group</extracomment>
+            <extracomment>match_model: group; stereo_disparity: group</extracomment>
             <translation>Bildzuordnung</translation>
         </message>
         <message>
@@ -700,7 +700,7 @@
         </message>
         <message>
             <source>Method</source>
-            <extracomment>stereo_disparity.method: description</extracomment>
+            <extracomment>match_model.method: description; stereo_disparity.method: description</extracomment>
             <translation>Verfahren</translation>
         </message>
         <message>
@@ -812,6 +812,96 @@
             <source>Largest disparity [px]</source>
             <extracomment>stereo_disparity output max</extracomment>
             <translation>Größte Disparität [px]</translation>
+        </message>
+        <message>
+            <source>Match stereo model (DSM)</source>
+            <extracomment>match_model: name</extracomment>
+            <translation>Stereomodell zuordnen (DOM)</translation>
+        </message>
+        <message>
+            <source>Matches the two images of a stereo model and grids the points to a DSM. dense: epipolar resampling, semi-global matching with left–right check, triangulation of every valid disparity, median per DSM cell, interpolation of small gaps that does not cross breaklines; exclusion areas and boundaries of edits.gpkg are honoured (NaN). Writes dsm.tif (float32, NaN = no height), count.tif (points per cell) and report.json (points, coverage, valid disparities, timings).</source>
+            <extracomment>match_model: help</extracomment>
+            <translation>Ordnet die beiden Bilder eines Stereomodells zu und rastert die Punkte zu einem DOM. dense: Epipolarumbildung, Semi-Global Matching mit Links–Rechts-Prüfung, Vorwärtsschnitt jeder gültigen Disparität, Median je DOM-Zelle, Interpolation kleiner Lücken, die Bruchkanten nicht überquert; Ausschlussflächen und Begrenzungen aus edits.gpkg werden beachtet (NaN). Schreibt dsm.tif (float32, NaN = keine Höhe), count.tif (Punkte je Zelle) und report.json (Punkte, Abdeckung, gültige Disparitäten, Zeiten).</translation>
+        </message>
+        <message>
+            <source>dense: semi-global matching of every pixel on the epipolar pair.</source>
+            <extracomment>match_model.method: help</extracomment>
+            <translation>dense: Semi-Global Matching jedes Pixels im Epipolarpaar.</translation>
+        </message>
+        <message>
+            <source>dense</source>
+            <extracomment>match_model.method: option</extracomment>
+            <translation>dense</translation>
+        </message>
+        <message>
+            <source>Default: &lt;project&gt;/products/dsm/&lt;model&gt;/.</source>
+            <extracomment>match_model.output: help</extracomment>
+            <translation>Standard: &lt;Projekt&gt;/products/dsm/&lt;Modell&gt;/.</translation>
+        </message>
+        <message>
+            <source>DSM spacing [m]</source>
+            <extracomment>match_model.spacing: description</extracomment>
+            <translation>DOM-Gitterweite [m]</translation>
+        </message>
+        <message>
+            <source>Default: 1 × the model's ground sample distance.</source>
+            <extracomment>match_model.spacing: help</extracomment>
+            <translation>Standard: 1 × Bodenpixelgröße des Modells.</translation>
+        </message>
+        <message>
+            <source>Lowest height [m]</source>
+            <extracomment>match_model.min_height: description</extracomment>
+            <translation>Niedrigste Höhe [m]</translation>
+        </message>
+        <message>
+            <source>Lowest terrain/object height searched. Default: terrain height − 0.3 × flying height above ground.</source>
+            <extracomment>match_model.min_height: help</extracomment>
+            <translation>Niedrigste gesuchte Gelände-/Objekthöhe. Standard: Geländehöhe − 0,3 × Flughöhe über Grund.</translation>
+        </message>
+        <message>
+            <source>Highest height [m]</source>
+            <extracomment>match_model.max_height: description</extracomment>
+            <translation>Höchste Höhe [m]</translation>
+        </message>
+        <message>
+            <source>Highest terrain/object height searched. Default: terrain height + 0.3 × flying height above ground.</source>
+            <extracomment>match_model.max_height: help</extracomment>
+            <translation>Höchste gesuchte Gelände-/Objekthöhe. Standard: Geländehöhe + 0,3 × Flughöhe über Grund.</translation>
+        </message>
+        <message>
+            <source>Interpolate gaps up to [m]</source>
+            <extracomment>match_model.max_gap: description</extracomment>
+            <translation>Lücken interpolieren bis [m]</translation>
+        </message>
+        <message>
+            <source>Larger gaps stay empty (NaN). Default: 10 × spacing.</source>
+            <extracomment>match_model.max_gap: help</extracomment>
+            <translation>Größere Lücken bleiben leer (NaN). Standard: 10 × Gitterweite.</translation>
+        </message>
+        <message>
+            <source>DSM</source>
+            <extracomment>match_model output dsm</extracomment>
+            <translation>DOM</translation>
+        </message>
+        <message>
+            <source>Points per cell</source>
+            <extracomment>match_model output count</extracomment>
+            <translation>Punkte je Zelle</translation>
+        </message>
+        <message>
+            <source>Points (not written yet)</source>
+            <extracomment>match_model output points</extracomment>
+            <translation>Punkte (noch nicht geschrieben)</translation>
+        </message>
+        <message>
+            <source>Report (JSON)</source>
+            <extracomment>match_model output report</extracomment>
+            <translation>Bericht (JSON)</translation>
+        </message>
+        <message>
+            <source>Metrics</source>
+            <extracomment>match_model output metrics</extracomment>
+            <translation>Kennzahlen</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

@@ -197,3 +197,21 @@ def test_stereo_disparity_python_equals_cli(block, tmp_path) -> None:
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
     _same_files(tmp_path / "py", tmp_path / "cli")
     assert py["valid_share"] > 0.3
+
+
+def test_match_model_python_equals_cli(block, tmp_path) -> None:
+    project = block["py"]["project"]
+    model = registry.run("project_info", {"project": project})["models"][0]["name"]
+    params = {"project": project, "model": model, "method": "dense"}
+    py = registry.run("match_model", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("match_model", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    for name in ("dsm.tif", "count.tif"):
+        with open_image(tmp_path / "py" / name) as x, open_image(tmp_path / "cli" / name) as y:
+            assert np.array_equal(x.read(), y.read(), equal_nan=True), name
+            assert x.transform == y.transform and x.crs == y.crs, name
+    reports = [json.loads((tmp_path / f / "report.json").read_text()) for f in ("py", "cli")]
+    for r in reports:
+        r.pop("seconds")  # wall-clock times
+    assert reports[0] == reports[1]
+    assert py["metrics"]["coverage_pct"] > 50

@@ -143,6 +143,9 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_disparity": lambda out, req: {
         **_epipolar(req("project")), "min_disparity": 80, "max_disparity": 130,
         "method": "sgm", "output": str(out / "disparity" / "disparity.tif")},
+    "match_model": lambda out, req: {
+        "project": str(req("project")), "model": _first_model(req("project")),
+        "method": "dense", "output": str(out / "dsm")},
 }
 
 

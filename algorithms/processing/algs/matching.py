@@ -147,4 +147,66 @@ class StereoDisparity(Algorithm):
         }
 
 
-ALGORITHMS = [StereoDisparity]
+
+class MatchModel(Algorithm):
+    id = "match_model"
+    name = "Match stereo model (DSM)"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Matches the two images of a stereo model and grids the points to a DSM. dense: "
+        "epipolar resampling, semi-global matching with left–right check, triangulation of "
+        "every valid disparity, median per DSM cell, interpolation of small gaps that does not "
+        "cross breaklines; exclusion areas and boundaries of edits.gpkg are honoured (NaN). "
+        "Writes dsm.tif (float32, NaN = no height), count.tif (points per cell) and report.json "
+        "(points, coverage, valid disparities, timings)."
+    )
+    parameters = (
+        Parameter("project", "project", "Project folder or project.toml"),
+        Parameter("model", "model", "Stereo model"),
+        Parameter("method", "enum", "Method", default="dense", options=("dense",),
+                  help="dense: semi-global matching of every pixel on the epipolar pair."),
+        Parameter("output", "output_folder", "Output folder", optional=True,
+                  help="Default: <project>/products/dsm/<model>/."),
+        Parameter("spacing", "number", "DSM spacing [m]", optional=True, minimum=0.0,
+                  unit="m", help="Default: 1 × the model's ground sample distance."),
+        Parameter("min_height", "number", "Lowest height [m]", optional=True, unit="m",
+                  minimum=-100000.0, maximum=100000.0,
+                  help="Lowest terrain/object height searched. Default: terrain height − 0.3 × "
+                       "flying height above ground."),
+        Parameter("max_height", "number", "Highest height [m]", optional=True, unit="m",
+                  minimum=-100000.0, maximum=100000.0,
+                  help="Highest terrain/object height searched. Default: terrain height + 0.3 × "
+                       "flying height above ground."),
+        Parameter("max_gap", "number", "Interpolate gaps up to [m]", optional=True,
+                  minimum=0.0, unit="m",
+                  help="Larger gaps stay empty (NaN). Default: 10 × spacing."),
+    )
+    outputs = (
+        Output("dsm", "raster", "DSM"),
+        Output("count", "raster", "Points per cell"),
+        Output("points", "file", "Points (not written yet)"),
+        Output("report", "file", "Report (JSON)"),
+        Output("metrics", "json", "Metrics"),
+    )
+    iterates_over = "model"
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from pathlib import Path
+
+        from ...matching.dense_model import match_model_dense
+        from ...project.model import Project
+
+        project = Project.load(params["project"])
+        model = project.model(params["model"])
+        out = Path(params["output"]) if params.get("output") else \
+            project.products_dir("dsm") / model.name
+        if params.get("method", "dense") != "dense":
+            raise InputError(f"Unknown matching method '{params['method']}'; use 'dense'.")
+        return match_model_dense(project, model.name, out, spacing=params.get("spacing") or None,
+                                 min_height=params.get("min_height"),
+                                 max_height=params.get("max_height"),
+                                 max_gap=params.get("max_gap"), feedback=feedback)
+
+
+ALGORITHMS = [StereoDisparity, MatchModel]

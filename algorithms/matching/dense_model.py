@@ -1,0 +1,319 @@
+r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation → gridding.
+
+1. The model's images are normalised (:class:`~..geometry.epipolar.EpipolarPair`, scale 1) and
+   resampled to grey epipolar images block by block into scratch GeoTIFFs (bounded memory).
+2. The disparity search range follows from the height range ``[z_min, z_max]``
+   (:meth:`EpipolarPair.disparity_range`), widened by ``disparity_margin`` px and by 10 % for
+   the variation of depth across the image. Default heights: the project's terrain height
+   ``Z_t`` and the flying height above ground ``H`` as ``Z_t − 0.3·H … Z_t + 0.3·H``.
+3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`); every valid disparity of a
+   tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and streamed into a
+   :class:`~..surface.gridding.GridAccumulator` (median per cell).
+4. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
+   barriers of the gap interpolation (gaps up to ``max_gap`` m).
+
+Outputs in a staged folder (nothing is left behind on error or cancel): ``dsm.tif`` (float32,
+NaN, project CRS, overviews), ``count.tif`` (points per cell, uint16), ``report.json``.
+Coverage is the share of the cells of the stereo overlap (at the terrain height, inside the
+boundary, outside exclusions) that hold a height.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Dict, Optional, Tuple, Union
+
+import numpy as np
+
+from ..errors import GeometryError, InputError
+from ..geometry.epipolar import SIDES, EpipolarPair
+from ..processing.feedback import Feedback, ensure_feedback
+from ..surface.gridding import Grid, GridAccumulator, finish_grid, polygon_mask, write_grid
+from .dense import iter_disparity_tiles
+
+PathLike = Union[str, Path]
+
+#: Pixels per resampled block of the scratch epipolar images.
+_BLOCK_PIXELS = 1_000_000
+
+
+def _read_images(project: Any, recs: Any, cams: Any) -> list:
+    from ..raster.io import open_image
+
+    images = []
+    for rec, cam in zip(recs, cams):
+        path = project.image_path(rec)
+        if not path.is_file():
+            raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
+                             "fix its path in project.toml.")
+        with open_image(path) as src:
+            if (src.width, src.height) != (cam.width, cam.height):
+                raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
+                                 f"'{cam.name}' is {cam.width}×{cam.height} px.")
+            from rasterio.enums import ColorInterp
+
+            bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
+            images.append(src.read((bands or [1])[:3]))
+    return images
+
+
+def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
+                feedback: Feedback) -> None:
+    """Grey (band mean) epipolar image as float32, NaN outside the original image."""
+    from rasterio.windows import Window
+
+    from ..raster.io import GTIFF_PROFILE, open_image
+
+    w, h = pair.sizes[SIDES.index(side)]
+    profile = dict(GTIFF_PROFILE)
+    profile.update(width=w, height=h, count=1, dtype="float32", nodata=float("nan"),
+                   compress="none")
+    if w < 256 or h < 256:
+        profile.update(tiled=False)
+        profile.pop("blockxsize")
+        profile.pop("blockysize")
+    chunk = max(1, _BLOCK_PIXELS // max(w, 1))
+    with open_image(path, "w", **profile) as dst:
+        for r0, block, valid, _, _ in pair.iter_resample(image, side, chunk):
+            grey = block.astype(np.float32).mean(axis=0)
+            grey[~valid] = np.nan
+            dst.write(grey[None], window=Window(0, r0, w, grey.shape[0]))
+            feedback.check()
+
+
+def _window_source(src: Any):
+    from rasterio.windows import Window
+
+    h, w = src.height, src.width
+
+    def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        out = np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+        rr0, rr1, cc0, cc1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
+        if rr1 > rr0 and cc1 > cc0:
+            out[rr0 - r0:rr1 - r0, cc0 - c0:cc1 - c0] = src.read(
+                1, window=Window(cc0, rr0, cc1 - cc0, rr1 - rr0))
+        return out
+
+    return read, (h, w)
+
+
+def _footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
+    """Image footprint polygon on the plane Z = ``height``."""
+    from shapely.geometry import Polygon
+
+    from ..geometry.projection import ray_at_height
+
+    c = cam.corners()
+    t = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
+    border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
+    pts = ray_at_height(border[:, 0], border[:, 1], height, cam, eo)
+    ok = np.isfinite(pts).all(axis=1)
+    if ok.sum() < 3:
+        return Polygon()
+    return Polygon(pts[ok, :2]).buffer(0)
+
+
+def _edits(project: Any) -> Tuple[list, list, list]:
+    """Exclusion polygons (action ≠ 'keep'), boundary polygons, breaklines of edits.gpkg."""
+    from ..project.edits import read_layer
+
+    path = project.edits_path
+    if not Path(path).is_file():
+        return [], [], []
+    import fiona
+
+    layers = fiona.listlayers(str(path))
+
+    def layer(name: str) -> list:
+        return read_layer(path, name) if name in layers else []
+
+    excl = [g for g, p in layer("exclusion_areas") if (p.get("action") or "exclude") != "keep"]
+    bounds = [g for g, _ in layer("boundaries")]
+    lines = [g for g, _ in layer("breaklines")]
+    return excl, bounds, lines
+
+
+def match_model_dense(project: Any, model: str, output_dir: PathLike,
+                      spacing: Optional[float] = None, feedback: Optional[Feedback] = None,
+                      min_height: Optional[float] = None, max_height: Optional[float] = None,
+                      max_gap: Optional[float] = None, disparity_margin: int = 4,
+                      memory_mb: float = 256.0, **dense_options: Any) -> Dict[str, Any]:
+    """Dense DSM of a stereo model (see the module notes).
+
+    Parameters
+    ----------
+    project : Project or path
+        The project (or its folder / project.toml).
+    model : str
+        Stereo model name.
+    output_dir : path
+        Output folder (created or replaced if PhotoDEM wrote it).
+    spacing : float, optional
+        DSM cell size (m); default 1 × the model's GSD.
+    min_height, max_height : float, optional
+        Height range of the terrain and objects (m); default terrain height ∓/± 0.3 H.
+    max_gap : float, optional
+        Largest gap (m, inscribed diameter) that is interpolated; default 10 × spacing.
+    disparity_margin : int
+        Extra disparities (px) searched on either side of the range.
+    memory_mb : float
+        Memory per matching tile and for buffered points.
+    **dense_options
+        Options of :func:`.dense.iter_disparity_tiles` (method, block_size, p1, p2, …).
+
+    Returns
+    -------
+    dict
+        ``{"dsm", "count", "report", "points", "metrics"}``.
+    """
+    from ..project.model import Project
+    from ..raster.io import open_image, staged_folder
+
+    feedback = ensure_feedback(feedback)
+    t_start = time.perf_counter()
+    if not isinstance(project, Project):
+        project = Project.load(project)
+    m = project.model(model)
+    recs = [project.image(m.left), project.image(m.right)]
+    cams = [project.camera_of(r) for r in recs]
+    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
+                                          names=(recs[0].name, recs[1].name))
+    mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
+    terrain = project.terrain_height
+    H = m.height_above_ground
+    if terrain is None:
+        terrain = mean_z - (H if np.isfinite(H) else 10.0 * pair.base)
+    if not np.isfinite(H):
+        H = mean_z - float(terrain)
+    z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
+    z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
+    if not z_max > z_min:
+        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
+    if z_max >= mean_z:
+        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
+                         "give a lower max_height.")
+    # overlap of the two footprints: empty → the images do not form a stereo model
+    z_mid = float(np.clip(float(terrain), z_min, z_max))
+    fp = [_footprint(c, r.eo, z_mid) for c, r in zip(cams, recs)]
+    overlap = fp[0].intersection(fp[1])
+    if overlap.is_empty or overlap.area <= 0:
+        raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
+                            f"'{m.name}' do not overlap; check the model or the orientations.")
+    gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
+    spacing = float(spacing) if spacing else float(gsd)
+    if not spacing > 0:
+        raise InputError(f"The spacing must be positive, got {spacing}.")
+    max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
+    d_lo, d_hi = pair.disparity_range(z_min, z_max)
+    if not (np.isfinite(d_lo) and np.isfinite(d_hi)):
+        raise GeometryError(f"Model '{m.name}': the height range {z_min:.1f}…{z_max:.1f} m "
+                            "gives no disparity; check min_height/max_height.")
+    widen = 0.1 * (d_hi - d_lo)
+    min_d = math.floor(d_lo - widen) - int(disparity_margin)
+    max_d = math.ceil(d_hi + widen) + int(disparity_margin)
+
+    excl, bounds, lines = _edits(project)
+    # grid: the overlap at the lowest and highest heights, cut to the boundary
+    areas = []
+    for z in (z_min, z_max):
+        a = _footprint(cams[0], recs[0].eo, z).intersection(_footprint(cams[1], recs[1].eo, z))
+        if not a.is_empty:
+            areas.append(a)
+    from shapely.ops import unary_union
+
+    extent = unary_union(areas)
+    if bounds:
+        extent = extent.intersection(unary_union(bounds))
+        if extent.is_empty:
+            raise InputError(f"The boundaries of edits.gpkg do not touch model '{m.name}'.")
+    grid = Grid.from_bounds(*extent.bounds, spacing=spacing)
+    feedback.info(f"Model {m.name}: heights {z_min:.1f}…{z_max:.1f} m → disparities "
+                  f"{min_d}…{max_d} px; DSM {grid.width}×{grid.height} cells at "
+                  f"{spacing:.3f} m.")
+
+    images = _read_images(project, recs, cams)
+    out = Path(output_dir)
+    timings: Dict[str, float] = {}
+    with staged_folder(out, replace=True, product="match_model") as tmp, \
+            tempfile.TemporaryDirectory(prefix="photodem-dense-", dir=str(tmp.parent)) as work:
+        work = Path(work)
+        t0 = time.perf_counter()
+        grey = {}
+        for i, side in enumerate(SIDES):
+            grey[side] = work / f"{side}.tif"
+            _write_grey(pair, side, images[i], grey[side], feedback.step(10 * i, 10 * i + 10))
+        del images
+        timings["epipolar"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
+        n_left = n_valid = 0
+        t_match = 0.0
+        with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
+            left, shape_l = _window_source(src_l)
+            right, shape_r = _window_source(src_r)
+            tiles = iter_disparity_tiles(left, right, shape_l, shape_r, min_d, max_d,
+                                         max_memory_mb=memory_mb,
+                                         feedback=feedback.step(20, 85), **dense_options)
+            while True:
+                t1 = time.perf_counter()
+                try:
+                    r0, c0, block = next(tiles)
+                except StopIteration:
+                    break
+                t_match += time.perf_counter() - t1
+                n_left += int(np.isfinite(left(r0, r0 + block.shape[0], c0,
+                                               c0 + block.shape[1])).sum())
+                ok = np.isfinite(block)
+                n_valid += int(ok.sum())
+                if not ok.any():
+                    continue
+                rr, cc = np.nonzero(ok)
+                pts = pair.disparity_to_world(block[ok], cc + c0, rr + r0)
+                acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
+        timings["matching"] = t_match
+        timings["triangulation"] = time.perf_counter() - t0 - t_match
+        t0 = time.perf_counter()
+        zg, count = acc.reduce(feedback.step(85, 92))
+        res = finish_grid(zg, count, grid, max_gap, excl, bounds, lines)
+        feedback.check()
+        area_geom = overlap
+        if bounds:
+            area_geom = area_geom.intersection(unary_union(bounds))
+        area = polygon_mask([area_geom], grid) & ~polygon_mask(excl, grid)
+        n_area = int(area.sum())
+        n_have = int((np.isfinite(res.z) & area).sum())
+        coverage = 100.0 * n_have / n_area if n_area else 0.0
+        write_grid(tmp / "dsm.tif", res.z, grid, crs=project.crs)
+        write_grid(tmp / "count.tif", np.minimum(res.count, 65535).astype(np.uint16), grid,
+                   crs=project.crs, overviews=False)
+        timings["gridding"] = time.perf_counter() - t0
+        timings["total"] = time.perf_counter() - t_start
+        metrics = {
+            "points": int(acc.points),
+            "coverage_pct": coverage,
+            "valid_disparity_pct": 100.0 * n_valid / n_left if n_left else 0.0,
+            "filled_pct": 100.0 * int(res.filled.sum()) / n_area if n_area else 0.0,
+            "spacing_m": spacing,
+            "cells": [grid.width, grid.height],
+            "disparity_range_px": [min_d, max_d],
+            "height_range_m": [z_min, z_max],
+            "max_gap_m": max_gap,
+            "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
+        }
+        report = {"model": m.name, "images": [recs[0].name, recs[1].name],
+                  "method": "dense", "crs": project.crs, "metrics": metrics,
+                  "options": {k: v for k, v in dense_options.items() if v is not None},
+                  "seconds": timings}
+        (tmp / "report.json").write_text(json.dumps(report, indent=1), encoding="utf-8")
+        feedback.progress(100.0)
+    feedback.info(f"Model {m.name}: {metrics['points']} points, coverage "
+                  f"{coverage:.1f} %, valid disparities {metrics['valid_disparity_pct']:.1f} %.")
+    return {"dsm": str(out / "dsm.tif"), "count": str(out / "count.tif"),
+            "report": str(out / "report.json"), "points": None, "metrics": metrics}
+
+
+__all__ = ["match_model_dense"]
