@@ -286,8 +286,12 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     cols = np.arange(w)[None, :]
     rows = np.arange(h)[:, None]
     if ours and lr_max_diff >= 0:
-        rraw = np.fliplr(matcher.compute(np.ascontiguousarray(np.fliplr(r8)),
-                                         np.ascontiguousarray(np.fliplr(l8))))
+        # Right-to-left on mirrored images. SGBM leaves its first min_d + num_d columns without
+        # disparity; mirrored, those are where the content lies, so pad them away first.
+        pad = num_d + block + abs(min_d)
+        rf = np.pad(np.fliplr(r8), ((0, 0), (pad, 0)))
+        lf = np.pad(np.fliplr(l8), ((0, 0), (pad, 0)))
+        rraw = np.fliplr(matcher.compute(rf, lf)[:, pad:])
         rbad = rraw == invalid16
         d = raw.astype(np.float32) / 16.0
         xr = np.rint(cols - d).astype(np.int64)
