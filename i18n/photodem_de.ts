@@ -635,7 +635,7 @@
         </message>
         <message>
             <source>Points (XYZ text, CSV or GeoPackage)</source>
-            <extracomment>point_compare.points: description</extracomment>
+            <extracomment>interpolate_dem.points: description; point_compare.points: description</extracomment>
             <translation>Punkte (XYZ-Text, CSV oder GeoPackage)</translation>
         </message>
         <message>
@@ -645,7 +645,7 @@
         </message>
         <message>
             <source>Points read</source>
-            <extracomment>point_compare output points</extracomment>
+            <extracomment>interpolate_dem output points; point_compare output points</extracomment>
             <translation>Gelesene Punkte</translation>
         </message>
         <message>
@@ -870,7 +870,7 @@
         </message>
         <message>
             <source>Interpolate gaps up to [m]</source>
-            <extracomment>match_model.max_gap: description</extracomment>
+            <extracomment>interpolate_dem.max_gap: description; match_model.max_gap: description</extracomment>
             <translation>Lücken interpolieren bis [m]</translation>
         </message>
         <message>
@@ -885,7 +885,7 @@
         </message>
         <message>
             <source>Points per cell</source>
-            <extracomment>match_model output count</extracomment>
+            <extracomment>interpolate_dem output count; match_model output count</extracomment>
             <translation>Punkte je Zelle</translation>
         </message>
         <message>
@@ -902,6 +902,186 @@
             <source>Metrics</source>
             <extracomment>match_model output metrics</extracomment>
             <translation>Kennzahlen</translation>
+        </message>
+        <message>
+            <source>Merge DSMs</source>
+            <extracomment>dsm_merge: name</extracomment>
+            <translation>DOMs zusammenführen</translation>
+        </message>
+        <message>
+            <source>Surfaces</source>
+            <extracomment>dsm_merge: group; interpolate_dem: group</extracomment>
+            <translation>Oberflächen</translation>
+        </message>
+        <message>
+            <source>Merges model DSMs into one DSM on a common grid: the union of their extents at the finest input cell size (or at the given spacing), in the CRS of the first input; inputs with another grid or CRS are resampled bilinearly, window by window. Modes: median or mean of the heights per cell; best_sigma takes the height of the input with the smallest σ, where σ is a second band of the input or a raster &lt;name&gt;_sigma.tif or sigma.tif beside it — inputs without σ are used only where no input with σ has a height (as their median), so without any σ best_sigma is the median. Writes the DSM, &lt;name&gt;_count.tif (inputs per cell) and the seam statistics of every overlapping pair (Δh = a − b: count, mean, median, std, RMS, NMAD) as &lt;name&gt;_seams.json and .csv.</source>
+            <extracomment>dsm_merge: help</extracomment>
+            <translation>Führt Modell-DOMs auf einem gemeinsamen Raster zu einem DOM zusammen: die Vereinigung ihrer Ausdehnungen mit der feinsten Zellgröße der Eingaben (oder der angegebenen Zellgröße), im KBS der ersten Eingabe; Eingaben mit anderem Raster oder KBS werden fensterweise bilinear umgetastet. Modi: Median oder Mittel der Höhen je Zelle; best_sigma nimmt die Höhe der Eingabe mit dem kleinsten σ, wobei σ ein zweiter Kanal der Eingabe oder ein Raster &lt;Name&gt;_sigma.tif oder sigma.tif daneben ist — Eingaben ohne σ werden nur dort verwendet, wo keine Eingabe mit σ eine Höhe hat (als ihr Median), ohne jedes σ ist best_sigma also der Median. Schreibt das DOM, &lt;Name&gt;_count.tif (Eingaben je Zelle) und die Nahtstatistik jedes überlappenden Paars (Δh = a − b: Anzahl, Mittel, Median, Standardabweichung, RMS, NMAD) als &lt;Name&gt;_seams.json und .csv.</translation>
+        </message>
+        <message>
+            <source>Input DSMs</source>
+            <extracomment>dsm_merge.inputs: description</extracomment>
+            <translation>Eingabe-DOMs</translation>
+        </message>
+        <message>
+            <source>Model DSMs (NaN or nodata = no height), any extents, grids and CRSs.</source>
+            <extracomment>dsm_merge.inputs: help</extracomment>
+            <translation>Modell-DOMs (NaN oder NoData = keine Höhe), beliebige Ausdehnungen, Raster und KBS.</translation>
+        </message>
+        <message>
+            <source>Merged DSM</source>
+            <extracomment>dsm_merge output dsm; dsm_merge.output: description</extracomment>
+            <translation>Zusammengeführtes DOM</translation>
+        </message>
+        <message>
+            <source>Float32 GeoTIFF, NaN where no input has a height.</source>
+            <extracomment>dsm_merge.output: help</extracomment>
+            <translation>Float32-GeoTIFF, NaN, wo keine Eingabe eine Höhe hat.</translation>
+        </message>
+        <message>
+            <source>Merge mode</source>
+            <extracomment>dsm_merge.mode: description</extracomment>
+            <translation>Zusammenführungsmodus</translation>
+        </message>
+        <message>
+            <source>median: robust against one wrong model where three or more overlap; mean: average; best_sigma: the height with the smallest σ.</source>
+            <extracomment>dsm_merge.mode: help</extracomment>
+            <translation>median: robust gegen ein falsches Modell, wo sich drei oder mehr überlappen; mean: Mittelwert; best_sigma: die Höhe mit dem kleinsten σ.</translation>
+        </message>
+        <message>
+            <source>median</source>
+            <extracomment>dsm_merge.mode: option</extracomment>
+            <translation>Median</translation>
+        </message>
+        <message>
+            <source>mean</source>
+            <extracomment>dsm_merge.mode: option</extracomment>
+            <translation>Mittelwert</translation>
+        </message>
+        <message>
+            <source>best_sigma</source>
+            <extracomment>dsm_merge.mode: option</extracomment>
+            <translation>bestes σ</translation>
+        </message>
+        <message>
+            <source>Cell size [m]</source>
+            <extracomment>dsm_merge.spacing: description; interpolate_dem.spacing: description</extracomment>
+            <translation>Zellgröße [m]</translation>
+        </message>
+        <message>
+            <source>Default: the finest cell size of the inputs.</source>
+            <extracomment>dsm_merge.spacing: help</extracomment>
+            <translation>Standard: die feinste Zellgröße der Eingaben.</translation>
+        </message>
+        <message>
+            <source>Inputs per cell</source>
+            <extracomment>dsm_merge output count</extracomment>
+            <translation>Eingaben je Zelle</translation>
+        </message>
+        <message>
+            <source>Seam statistics per overlapping pair</source>
+            <extracomment>dsm_merge output seams</extracomment>
+            <translation>Nahtstatistik je überlappendem Paar</translation>
+        </message>
+        <message>
+            <source>Seam statistics (JSON)</source>
+            <extracomment>dsm_merge output report</extracomment>
+            <translation>Nahtstatistik (JSON)</translation>
+        </message>
+        <message>
+            <source>Seam statistics (CSV)</source>
+            <extracomment>dsm_merge output csv</extracomment>
+            <translation>Nahtstatistik (CSV)</translation>
+        </message>
+        <message>
+            <source>Share of cells with a height</source>
+            <extracomment>dsm_merge output coverage; interpolate_dem output coverage</extracomment>
+            <translation>Anteil der Zellen mit Höhe</translation>
+        </message>
+        <message>
+            <source>Interpolate DEM from points</source>
+            <extracomment>interpolate_dem: name</extracomment>
+            <translation>DHM aus Punkten interpolieren</translation>
+        </message>
+        <message>
+            <source>Grids points (XYZ text, CSV with x, y, z columns, or 3-D points in a GeoPackage) to a DEM: the median of the points in each cell, then membrane interpolation of the empty cells that does not cross breaklines (3-D breaklines give their own heights). Exclusion areas are NaN, and so is everything outside the boundary polygons. Breaklines, exclusion areas and boundaries come from the project's edits.gpkg and/or from the given vector files. Writes the DEM and &lt;name&gt;_count.tif (points per cell).</source>
+            <extracomment>interpolate_dem: help</extracomment>
+            <translation>Rastert Punkte (XYZ-Text, CSV mit Spalten x, y, z oder 3-D-Punkte in einem GeoPackage) zu einem DHM: der Median der Punkte jeder Zelle, dann Membran-Interpolation der leeren Zellen, die Bruchkanten nicht überquert (3-D-Bruchkanten liefern ihre eigenen Höhen). Ausschlussflächen sind NaN, ebenso alles außerhalb der Begrenzungspolygone. Bruchkanten, Ausschlussflächen und Begrenzungen kommen aus der edits.gpkg des Projekts und/oder aus den angegebenen Vektordateien. Schreibt das DHM und &lt;Name&gt;_count.tif (Punkte je Zelle).</translation>
+        </message>
+        <message>
+            <source>DEM</source>
+            <extracomment>interpolate_dem output dem; interpolate_dem.output: description</extracomment>
+            <translation>DHM</translation>
+        </message>
+        <message>
+            <source>Float32 GeoTIFF, NaN where there is no height.</source>
+            <extracomment>interpolate_dem.output: help</extracomment>
+            <translation>Float32-GeoTIFF, NaN, wo keine Höhe vorliegt.</translation>
+        </message>
+        <message>
+            <source>CRS</source>
+            <extracomment>interpolate_dem.crs: description</extracomment>
+            <translation>KBS</translation>
+        </message>
+        <message>
+            <source>CRS of the DEM and of text points. Default: the project's, else the points' own.</source>
+            <extracomment>interpolate_dem.crs: help</extracomment>
+            <translation>KBS des DHM und von Textpunkten. Standard: das des Projekts, sonst das der Punkte.</translation>
+        </message>
+        <message>
+            <source>Project (edits.gpkg)</source>
+            <extracomment>interpolate_dem.project: description</extracomment>
+            <translation>Projekt (edits.gpkg)</translation>
+        </message>
+        <message>
+            <source>Its breaklines, exclusion areas and boundaries are honoured.</source>
+            <extracomment>interpolate_dem.project: help</extracomment>
+            <translation>Seine Bruchkanten, Ausschlussflächen und Begrenzungen werden beachtet.</translation>
+        </message>
+        <message>
+            <source>Breaklines (vector file)</source>
+            <extracomment>interpolate_dem.breaklines: description</extracomment>
+            <translation>Bruchkanten (Vektordatei)</translation>
+        </message>
+        <message>
+            <source>(3-D) lines the interpolation does not cross.</source>
+            <extracomment>interpolate_dem.breaklines: help</extracomment>
+            <translation>(3-D-)Linien, die die Interpolation nicht überquert.</translation>
+        </message>
+        <message>
+            <source>Exclusion areas (vector file)</source>
+            <extracomment>interpolate_dem.exclusions: description</extracomment>
+            <translation>Ausschlussflächen (Vektordatei)</translation>
+        </message>
+        <message>
+            <source>Polygons that stay empty (NaN).</source>
+            <extracomment>interpolate_dem.exclusions: help</extracomment>
+            <translation>Polygone, die leer bleiben (NaN).</translation>
+        </message>
+        <message>
+            <source>Boundary (vector file)</source>
+            <extracomment>interpolate_dem.boundary: description</extracomment>
+            <translation>Begrenzung (Vektordatei)</translation>
+        </message>
+        <message>
+            <source>Polygons of the measuring area; NaN outside.</source>
+            <extracomment>interpolate_dem.boundary: help</extracomment>
+            <translation>Polygone des Messgebiets; außerhalb NaN.</translation>
+        </message>
+        <message>
+            <source>Larger gaps stay empty (NaN). Default: every gap is interpolated.</source>
+            <extracomment>interpolate_dem.max_gap: help</extracomment>
+            <translation>Größere Lücken bleiben leer (NaN). Standard: jede Lücke wird interpoliert.</translation>
+        </message>
+        <message>
+            <source>Points in the grid</source>
+            <extracomment>interpolate_dem output used</extracomment>
+            <translation>Punkte im Raster</translation>
+        </message>
+        <message>
+            <source>Interpolated cells</source>
+            <extracomment>interpolate_dem output filled</extracomment>
+            <translation>Interpolierte Zellen</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

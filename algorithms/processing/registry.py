@@ -23,6 +23,7 @@ ALGORITHM_MODULES = (
     "geometry",
     "quality",
     "matching",
+    "surface",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).

@@ -215,3 +215,28 @@ def test_match_model_python_equals_cli(block, tmp_path) -> None:
         r.pop("seconds")  # wall-clock times
     assert reports[0] == reports[1]
     assert py["metrics"]["coverage_pct"] > 50
+
+
+def test_dsm_merge_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    py = registry.run("dsm_merge", {"inputs": [q["dsm"], q["dtm"]], "mode": "median",
+                                    "spacing": 0.5, "output": str(tmp_path / "py" / "m.tif")})
+    cli = _cli("dsm_merge", {"inputs": f"{q['dsm']},{q['dtm']}", "mode": "median",
+                             "spacing": 0.5, "output": str(tmp_path / "cli" / "m.tif")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    seam = py["seams"][0]  # DSM − DTM: objects are above the terrain
+    assert seam["count"] > 0 and seam["mean"] > 0 and seam["min"] >= -0.01
+
+
+def test_interpolate_dem_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    truth = Path(q["dtm"]).parent
+    params = {"points": q["checkpoints"], "project": block["py"]["project"],
+              "breaklines": str(truth / "breaklines.gpkg"), "spacing": 2.0}
+    py = registry.run("interpolate_dem", {**params, "output": str(tmp_path / "py" / "d.tif")})
+    cli = _cli("interpolate_dem", {**params, "output": str(tmp_path / "cli" / "d.tif")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    # compartments between breaklines without a point stay empty
+    assert py["used"] == py["points"] > 0 and py["coverage"] > 0.5 and py["filled"] > 0

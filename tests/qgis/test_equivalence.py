@@ -146,6 +146,13 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "match_model": lambda out, req: {
         "project": str(req("project")), "model": _first_model(req("project")),
         "method": "dense", "output": str(out / "dsm")},
+    "dsm_merge": lambda out, req: {
+        "inputs": [_truth(req("project"), "dsm.tif"), _truth(req("project"), "dtm.tif")],
+        "mode": "median", "spacing": 0.5, "output": str(out / "merge" / "merged.tif")},
+    "interpolate_dem": lambda out, req: {
+        "points": _truth(req("project"), "checkpoints.gpkg"), "project": str(req("project")),
+        "breaklines": _truth(req("project"), "breaklines.gpkg"), "spacing": 2.0,
+        "max_gap": 100.0, "output": str(out / "dem" / "dem.tif")},
 }
 
 
