@@ -21,7 +21,13 @@ Method (``method="sgm"``)
    ``d_R``; a left disparity survives only if ``|d(x) − d_R(x − d(x))| ≤ lr_max_diff``.
 4. **Speckle removal**: connected disparity regions smaller than ``speckle_window`` px (with
    steps ≤ ``speckle_range``) are removed.
-5. **Hole filling** along the epipolar lines: an invalid run no wider than ``fill_max_width``
+5. **Border and range filters** (off by default): disparities at the border of a valid region
+   (within ``edge_erosion`` px of an invalid or masked pixel: half of the matching window there
+   straddles an occlusion, a depth step or the image edge, where SGM drags the foreground
+   disparity over the background — "foreground fattening") and disparities within
+   ``range_guard`` px of either end of the search range (a minimum at the range limit is
+   usually a cut-off minimum, not a true one) are removed.
+6. **Hole filling** along the epipolar lines: an invalid run no wider than ``fill_max_width``
    gets the smaller (= farther, background) of its two valid neighbours — occlusions are
    background by construction. Masked pixels are never filled.
 
@@ -177,6 +183,8 @@ def iter_disparity_tiles(
     speckle_window: int = 100,
     speckle_range: int = 2,
     fill_max_width: int = 0,
+    edge_erosion: int = 0,
+    range_guard: float = 0.0,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -208,6 +216,12 @@ def iter_disparity_tiles(
         Speckle filter: region size (px) and disparity step (px) within a region.
     fill_max_width : int
         Widest invalid run along a row that is filled (px); 0 = no filling.
+    edge_erosion : int
+        Disparities within this many px (chessboard distance) of an invalid or masked pixel are
+        removed before filling (method "sgm"); 0 = off.
+    range_guard : float
+        Disparities closer than this (px) to ``min_disparity`` or ``max_disparity`` are
+        removed; 0 = off.
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size : int, optional
@@ -260,7 +274,8 @@ def iter_disparity_tiles(
             rg = right(R0, R1, f0, f1)
             disp = _match_frame(cv2, matcher, lg, rg, min_d, max_d, num_d, ours, block,
                                 lr_max_diff, normalise_window, speckle_window,
-                                int(speckle_range), fill_max_width)
+                                int(speckle_range), fill_max_width, int(edge_erosion),
+                                float(range_guard))
             # back to the tile core
             core = disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]
             done += 1
@@ -270,7 +285,8 @@ def iter_disparity_tiles(
 
 def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d: int,
                  num_d: int, ours: bool, block: int, lr_max_diff: float, normalise_window: int,
-                 speckle_window: int, speckle_range: int, fill_max_width: int) -> Array:
+                 speckle_window: int, speckle_range: int, fill_max_width: int,
+                 edge_erosion: int = 0, range_guard: float = 0.0) -> Array:
     """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape)."""
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
@@ -311,6 +327,16 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     near = cv2.dilate(rmask.astype(np.uint8), np.ones((1, block), np.uint8)).astype(bool)
     xr = np.clip(np.rint(cols - np.nan_to_num(disp)).astype(np.int64), 0, w - 1)
     disp[near[rows, xr]] = np.nan
+    if range_guard > 0:
+        with np.errstate(invalid="ignore"):
+            disp[(disp < min_d + range_guard) | (disp > max_d - range_guard)] = np.nan
+    if ours and edge_erosion > 0:
+        # the frame outside the image is masked (NaN), so image borders are eroded too
+        ok = (np.isfinite(disp) & ~lmask).astype(np.uint8)
+        k = 2 * int(edge_erosion) + 1
+        ok = cv2.erode(ok, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                       borderValue=0)
+        disp[ok == 0] = np.nan
     if ours and fill_max_width > 0:
         disp = fill_holes_rows(disp, lmask, fill_max_width)
     disp[lmask] = np.nan

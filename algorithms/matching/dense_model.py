@@ -8,9 +8,16 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    ``Z_t`` and the flying height above ground ``H`` as ``Z_t − 0.3·H … Z_t + 0.3·H``.
 3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`); every valid disparity of a
    tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and streamed into a
-   :class:`~..surface.gridding.GridAccumulator` (median per cell).
-4. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
-   barriers of the gap interpolation (gaps up to ``max_gap`` m).
+   :class:`~..surface.gridding.GridAccumulator` (median per cell). Disparities within 2 px
+   of a hole, a mask or the image border are dropped first (``edge_erosion``: foreground
+   fattening at occlusions and depth steps, half windows at borders).
+4. With about one point per cell the median cannot remove blunders: measured cells that deviate
+   from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
+   (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
+   cells; ``t = outlier_threshold``, default the height of 1 px of parallax ``GSD·H/B``).
+5. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
+   barriers of the gap interpolation (gaps up to ``max_gap`` m), which also re-fills the
+   rejected cells.
 
 Outputs in a staged folder (nothing is left behind on error or cancel): ``dsm.tif`` (float32,
 NaN, project CRS, overviews), ``count.tif`` (points per cell, uint16), ``report.json``.
@@ -36,6 +43,11 @@ from ..surface.gridding import Grid, GridAccumulator, finish_grid, polygon_mask,
 from .dense import iter_disparity_tiles
 
 PathLike = Union[str, Path]
+
+#: Matching options of the DSM path that differ from :func:`.dense.iter_disparity_tiles`:
+#: disparities within 2 px of a hole, of a mask or of the image border are dropped (foreground
+#: fattening at occlusions and depth steps); the gridding fills the small gaps again.
+_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2}
 
 #: Pixels per resampled block of the scratch epipolar images.
 _BLOCK_PIXELS = 1_000_000
@@ -141,7 +153,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       spacing: Optional[float] = None, feedback: Optional[Feedback] = None,
                       min_height: Optional[float] = None, max_height: Optional[float] = None,
                       max_gap: Optional[float] = None, disparity_margin: int = 4,
-                      memory_mb: float = 256.0, **dense_options: Any) -> Dict[str, Any]:
+                      memory_mb: float = 256.0, outlier_radius: Optional[float] = None,
+                      outlier_threshold: Optional[float] = None, outlier_k: float = 3.0,
+                      **dense_options: Any) -> Dict[str, Any]:
     """Dense DSM of a stereo model (see the module notes).
 
     Parameters
@@ -162,6 +176,14 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         Extra disparities (px) searched on either side of the range.
     memory_mb : float
         Memory per matching tile and for buffered points.
+    outlier_radius : float, optional
+        Half side (m) of the neighbourhood of the DSM outlier test
+        (:func:`~..surface.gridding.reject_outliers`); default 5 × spacing; 0 = off.
+    outlier_threshold : float, optional
+        Smallest height deviation (m) from the neighbourhood median that is rejected; default
+        the height of 1 px of parallax, ``GSD · H / B``.
+    outlier_k : float
+        Multiple of the local robust spread (1.4826 · MAD) a rejected deviation must exceed.
     **dense_options
         Options of :func:`.dense.iter_disparity_tiles` (method, block_size, p1, p2, …).
 
@@ -208,6 +230,11 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     if not spacing > 0:
         raise InputError(f"The spacing must be positive, got {spacing}.")
     max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
+    outlier_radius = 5.0 * spacing if outlier_radius is None else float(outlier_radius)
+    if outlier_threshold is None:
+        outlier_threshold = float(gsd) * H / pair.base  # 1 px of parallax in height
+    for key, value in _DENSE_DEFAULTS.items():
+        dense_options.setdefault(key, value)
     d_lo, d_hi = pair.disparity_range(z_min, z_max)
     if not (np.isfinite(d_lo) and np.isfinite(d_hi)):
         raise GeometryError(f"Model '{m.name}': the height range {z_min:.1f}…{z_max:.1f} m "
@@ -278,7 +305,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         timings["triangulation"] = time.perf_counter() - t0 - t_match
         t0 = time.perf_counter()
         zg, count = acc.reduce(feedback.step(85, 92))
-        res = finish_grid(zg, count, grid, max_gap, excl, bounds, lines)
+        res = finish_grid(zg, count, grid, max_gap, excl, bounds, lines,
+                          outlier_radius=outlier_radius, outlier_threshold=outlier_threshold,
+                          outlier_k=outlier_k)
         feedback.check()
         area_geom = overlap
         if bounds:
@@ -302,6 +331,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
             "disparity_range_px": [min_d, max_d],
             "height_range_m": [z_min, z_max],
             "max_gap_m": max_gap,
+            "outlier_radius_m": outlier_radius,
+            "outlier_threshold_m": outlier_threshold,
             "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
         }
         report = {"model": m.name, "images": [recs[0].name, recs[1].name],

@@ -17,6 +17,17 @@ Streaming
     tile at a time (``lexsort`` by cell and z), so the peak memory is one tile's points plus
     the output grid, whatever the number of points.
 
+Outlier rejection (optional, before the gap interpolation)
+    With one or few points per cell the median cannot remove blunders, so measured cells are
+    tested against their neighbourhood: with :math:`\tilde z` the median of the cells within
+    a square window of side ``2·radius`` and :math:`\mathrm{MAD}` the median of
+    :math:`|z - \tilde z|` in the same window, a cell is rejected (emptied) if
+    :math:`|z - \tilde z| > \max(t,\ k \cdot 1.4826 \cdot \mathrm{MAD})`. ``t`` (m) is the
+    smallest deviation that counts as a blunder; the MAD term keeps rough surfaces (steps at
+    buildings, trees) whose neighbourhood spread is large. Empty cells of the window take the
+    nearest measured height. Rejected cells are gaps like any other and may be re-filled by
+    the interpolation below.
+
 Gap interpolation
     Empty cells form gaps (4-connected). A gap is filled only if it is *small*: its inscribed
     diameter ``2·max_p dist(p, nearest measured cell)·s ≤ max_gap``; larger gaps stay NaN.
@@ -285,6 +296,45 @@ def line_barrier(lines: Iterable[Any], grid: Grid) -> Tuple[Array, Array]:
     return barrier, zline
 
 
+# -- outliers ----------------------------------------------------------------------------------
+def reject_outliers(z: Array, spacing: float, radius: float, threshold: float,
+                    k: float = 3.0) -> Array:
+    """Mask of the measured cells that deviate from their neighbourhood (see the module notes).
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights, NaN = empty.
+    spacing : float
+        Cell size (m).
+    radius : float
+        Half side of the square neighbourhood (m); at least one cell.
+    threshold : float
+        Smallest rejected deviation ``t`` (m) from the neighbourhood median.
+    k : float
+        Multiple of the robust local spread (1.4826·MAD) that a deviation must also exceed.
+
+    Returns
+    -------
+    ndarray of bool
+        True where a measured cell is an outlier.
+    """
+    from scipy import ndimage
+
+    z = np.asarray(z, np.float32)
+    valid = np.isfinite(z)
+    if radius <= 0 or not valid.any() or valid.sum() < 3:
+        return np.zeros(z.shape, bool)
+    # empty cells take the nearest measured height so that the filters see no NaN
+    _, (nr, nc) = ndimage.distance_transform_edt(~valid, return_indices=True)
+    zf = z[nr, nc]
+    size = 2 * max(1, int(radius / spacing + 0.5)) + 1
+    med = ndimage.median_filter(zf, size=size, mode="nearest")
+    dev = np.abs(zf - med)
+    mad = ndimage.median_filter(dev, size=size, mode="nearest")
+    return valid & (dev > np.maximum(float(threshold), k * 1.4826 * mad))
+
+
 # -- gap filling -------------------------------------------------------------------------------
 def fill_gaps(z: Array, spacing: float, max_gap: float, domain: Optional[Array] = None,
               barrier: Optional[Array] = None, barrier_z: Optional[Array] = None
@@ -400,14 +450,23 @@ class GridResult:
 
 def finish_grid(z: Array, count: Array, grid: Grid, max_gap: float = 0.0,
                 exclusions: Sequence[Any] = (), boundary: Sequence[Any] = (),
-                breaklines: Sequence[Any] = ()) -> GridResult:
-    """Masks (exclusions → NaN, outside the boundary polygons → NaN) and gap filling."""
+                breaklines: Sequence[Any] = (), outlier_radius: float = 0.0,
+                outlier_threshold: float = 0.0, outlier_k: float = 3.0) -> GridResult:
+    """Masks (exclusions → NaN, outside the boundary polygons → NaN), outliers, gap filling.
+
+    ``outlier_radius`` (m, 0 = off), ``outlier_threshold`` (m) and ``outlier_k``: see
+    :func:`reject_outliers`; rejected cells get count 0 and are gaps.
+    """
     domain = ~polygon_mask(exclusions, grid)
     if len(boundary):
         domain &= polygon_mask(boundary, grid)
     barrier, bz = line_barrier(breaklines, grid)
     z = np.where(domain, z, np.nan).astype(np.float32)
     count = np.where(domain, count, 0).astype(np.uint32)
+    if outlier_radius > 0:
+        bad = reject_outliers(z, grid.spacing, outlier_radius, outlier_threshold, outlier_k)
+        z[bad] = np.nan
+        count[bad] = 0
     zf, filled = fill_gaps(z, grid.spacing, max_gap, domain, barrier, bz)
     return GridResult(zf, count, filled, grid)
 
@@ -458,4 +517,4 @@ def write_grid(path: PathLike, z: Array, grid: Grid, crs: Any = None,
 
 
 __all__ = ["Grid", "GridAccumulator", "GridResult", "fill_gaps", "finish_grid", "grid_points",
-           "line_barrier", "polygon_mask", "write_grid"]
+           "line_barrier", "polygon_mask", "reject_outliers", "write_grid"]

@@ -127,6 +127,24 @@ def test_masks_honoured(pair) -> None:
     assert rms < 0.3
 
 
+def test_edge_erosion_and_range_guard(pair) -> None:
+    left = pair["left"].copy()
+    left[40:70, 100:140] = np.nan  # a masked area: its rim loses 2 px of disparities
+    plain = sgm_disparity(left, pair["right"], 0, 31)
+    eroded = sgm_disparity(left, pair["right"], 0, 31, edge_erosion=2)
+    ok = np.isfinite(eroded)
+    assert np.array_equal(eroded[ok], plain[ok])  # only removes, never changes
+    assert np.isnan(eroded[38:72, 98:142]).all()
+    assert np.isfinite(plain[38:72, 98:142]).any()
+    rms_p, _ = _score(plain, pair["truth"])
+    rms_e, valid_e = _score(eroded, pair["truth"])
+    assert rms_e <= rms_p + 1e-6 and valid_e > 0.85
+    # the guard removes disparities near the range ends: here all below 6 and above 25
+    guarded = sgm_disparity(pair["left"], pair["right"], 0, 31, range_guard=6.0)
+    g = guarded[np.isfinite(guarded)]
+    assert g.size and g.min() >= 6.0 and g.max() <= 25.0
+
+
 def test_fill_holes_rows() -> None:
     d = np.array([[5.0, np.nan, np.nan, 2.0, np.nan, np.nan, np.nan, np.nan, 7.0]])
     masked = np.zeros_like(d, bool)

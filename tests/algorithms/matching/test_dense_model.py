@@ -63,6 +63,18 @@ def test_dense_dsm_matches_truth_on_open_terrain(block, dsm) -> None:
     with rasterio.open(dsm["dsm"]) as src:
         assert src.dtypes[0] == "float32" and np.isnan(src.nodata) and src.crs is not None
     assert Path(dsm["report"]).is_file() and dsm["points"] is None
+    assert m["outlier_radius_m"] == pytest.approx(5.0 * m["spacing_m"])
+    assert m["outlier_threshold_m"] > 0
+
+
+def test_blunder_filters_lower_the_rms(block, dsm, tmp_path) -> None:
+    # edge erosion and the outlier test off: the old path, with more blunders near objects
+    raw = match_model_dense(block["project"], MODEL, tmp_path / "raw", edge_erosion=0,
+                            outlier_radius=0.0)
+    rms_raw = _open_stats(block, raw["dsm"], 100.0)[0]
+    rms = _open_stats(block, dsm["dsm"], 100.0)[0]
+    print(f"RMS raw {rms_raw:.3f} m, filtered {rms:.3f} m")
+    assert rms <= rms_raw
 
 
 def test_exclusion_area_is_nan_and_cancel_leaves_nothing(block, tmp_path) -> None:

@@ -11,6 +11,7 @@ from photodem.algorithms.surface.gridding import (
     GridAccumulator,
     fill_gaps,
     grid_points,
+    reject_outliers,
     write_grid,
 )
 
@@ -127,3 +128,37 @@ def test_write_grid(tmp_path) -> None:
     with rasterio.open(path) as src:
         assert src.crs.to_epsg() == 25832 and src.transform == res.transform
         assert src.dtypes[0] == "float32" and np.isnan(src.nodata)
+
+
+def test_reject_outliers_removes_spikes_but_keeps_steps_and_planes() -> None:
+    # plane with a 5 m step (a building edge) and two isolated blunders
+    yy, xx = np.mgrid[0:60, 0:80].astype(float)
+    z = 100.0 + 0.05 * xx - 0.02 * yy + 5.0 * (xx >= 40)
+    z = z.astype(np.float32)
+    z[10, 10] += 3.0
+    z[30, 60] -= 2.0
+    z[5:8, 70:73] = np.nan  # empty cells are neither rejected nor a problem
+    bad = reject_outliers(z, spacing=0.5, radius=2.5, threshold=1.0)
+    assert bad[10, 10] and bad[30, 60]
+    assert bad.sum() == 2  # the step and the tilted plane stay
+    assert not reject_outliers(z, 0.5, 0.0, 1.0).any()  # radius 0 = off
+    # a deviation below the threshold stays
+    z2 = z.copy()
+    z2[10, 10] -= 2.5
+    assert not reject_outliers(z2, 0.5, 2.5, 1.0)[10, 10]
+
+
+def test_grid_points_outlier_cells_are_refilled() -> None:
+    x, y, z = _plane_points()
+    z = z.copy()
+    hit = (np.abs(x - 25.2) < 0.4) & (np.abs(y - 25.2) < 0.4)
+    z[hit] += 10.0  # a blunder cluster covering one cell
+    res = grid_points(x, y, z, spacing=1.0, bounds=(0, 0, 50, 50), max_gap=3.0)
+    from photodem.algorithms.surface.gridding import finish_grid
+    g = res.grid
+    r, c = g.cell_of([25.2], [25.2])
+    assert res.z[r[0], c[0]] > 105.0  # without the test the blunder survives the median
+    clean = finish_grid(res.z, res.count, g, max_gap=3.0, outlier_radius=3.0,
+                        outlier_threshold=1.0)
+    assert abs(clean.z[r[0], c[0]] - (100.0 + 0.1 * 25.5 - 0.05 * 24.5)) < 0.05
+    assert clean.filled[r[0], c[0]] and clean.count[r[0], c[0]] == 0
