@@ -2,9 +2,9 @@
 
 Synthetic band-limited texture, a known affine + radiometric change and noise (SNR 10); start
 values 1.5 px off. Reported: points per second for the epipolar (3+2) and the affine (6+2)
-models, 15×15 and 21×21 windows, both Jacobian modes, the shift RMSE, and OpenCV's NCC
-(cv2.matchTemplate, TM_CCOEFF_NORMED on a ±3 px search window per point, a Python loop over
-points as a typical user would write it) for the same points, as a ratio.
+models, 15×15 and 21×21 windows, both Jacobian modes (best of ``REPEATS`` runs each), the shift
+RMSE, and OpenCV's NCC (cv2.matchTemplate, TM_CCOEFF_NORMED on a ±3 px search window per point,
+a Python loop over points as a typical user would write it) for the same points, as a ratio.
 """
 
 from __future__ import annotations
@@ -13,6 +13,9 @@ import time
 
 import numpy as np
 from scipy import ndimage
+
+#: timing runs per case; the best is reported (the 2-core machine is shared)
+REPEATS = 3
 
 
 def _data(n: int, size: int = 1000, seed: int = 0):
@@ -43,10 +46,12 @@ def run() -> dict:
     for window in (15, 21):
         for model in ("epipolar", "affine"):
             for jac in ("template", "search"):
-                t0 = time.perf_counter()
-                res = lsm_match(left, right, c, r, start, r, window=window, model=model,
-                                jacobian=jac)
-                dt = time.perf_counter() - t0
+                dt = np.inf
+                for _ in range(REPEATS):  # shared machine: best of a few runs
+                    t0 = time.perf_counter()
+                    res = lsm_match(left, right, c, r, start, r, window=window, model=model,
+                                    jacobian=jac)
+                    dt = min(dt, time.perf_counter() - t0)
                 v = res.valid
                 speeds[(window, model, jac)] = n / dt
                 rows.append({"case": f"LSM {model} {window}x{window} ({jac} gradients)",

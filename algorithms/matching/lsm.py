@@ -137,38 +137,98 @@ def describe_flags(flags: int) -> str:
     return ", ".join(names) if names else "ok"
 
 
-def _bilinear(flat: NDArray, width: int, height: int, x: NDArray, y: NDArray):
-    """Bilinear samples of an image (flattened float32) at (x, y), shape (n, m).
+def _affine_sampler(flat: NDArray, width: int, height: int, p: NDArray, grid: NDArray,
+                    reach: float):
+    r"""Bilinear samples of a flattened float32 image on affinely mapped grids, shape (n, m).
 
-    Returns the samples (float32) and, per row (point), whether all its samples are inside
-    [0, width−1] × [0, height−1]. Positions are split into an integer base per point and
-    float32 offsets, which keeps the per-sample arithmetic in 32 bit.
+    Sample j of point i is at :math:`x = a_0 + a_1\xi_j + a_2\eta_j`,
+    :math:`y = b_0 + b_1\xi_j + b_2\eta_j` with ``p[i] = (a0, a1, a2, b0, b1, b2, …)`` and
+    ``grid = (ξ, η)`` (float32, −reach … reach). Bilinear:
+    :math:`g = (1-f_y)[(1-f_x)v_{00} + f_x v_{01}] + f_y[(1-f_x)v_{10} + f_x v_{11}]`.
+
+    Positions are split into an integer base per point, :math:`\lfloor a_0\rfloor,
+    \lfloor b_0\rfloor`, and float32 local coordinates relative to it, so all per-sample
+    arithmetic is 32 bit, and the four neighbours are gathered from shifted views of the image
+    (no index arithmetic per neighbour). An axis whose mapping is the identity for all points
+    (rows of epipolar images, both axes of the shift model and of template extraction) has
+    integer sample offsets and one fraction per point: no per-sample floor for it. The
+    ``inside`` test is exact per point: an affine map of the square grid has its extremes at
+    the corners, :math:`a_0 \pm reach\,(|a_1| + |a_2|)`. Rows that are not inside are sampled
+    at the image origin (their values are meaningless; the caller flags them).
+
+    Returns
+    -------
+    values : (n, m) float32
+    inside : (n,) bool — all samples lie in [0, width−1] × [0, height−1].
     """
-    bx = np.floor(x[:, :1])
-    by = np.floor(y[:, :1])
-    xl = (x - bx).astype(np.float32)
-    yl = (y - by).astype(np.float32)
-    inside = ((bx[:, 0] + xl.min(axis=1) >= 0) & (bx[:, 0] + xl.max(axis=1) <= width - 1)
-              & (by[:, 0] + yl.min(axis=1) >= 0) & (by[:, 0] + yl.max(axis=1) <= height - 1))
-    xf = np.floor(xl)
-    yf = np.floor(yl)
-    fx = xl - xf
-    fy = yl - yf
-    base = (by * width + bx).astype(np.int64)
-    idx = base + (yf * width + xf).astype(np.int64)
-    # outside points are flagged by the caller; keep their indices in range
-    np.clip(idx, 0, flat.size - width - 2, out=idx)
-    # np.take is much faster than fancy indexing for flat gathers
-    v00 = np.take(flat, idx)
-    idx += 1
-    v01 = np.take(flat, idx)
-    idx += width
-    v11 = np.take(flat, idx)
-    idx -= 1
-    v10 = np.take(flat, idx)
-    top = v00 + fx * (v01 - v00)
-    bot = v10 + fx * (v11 - v10)
-    return top + fy * (bot - top), inside
+    n = p.shape[0]
+    ext_x = reach * (np.abs(p[:, 1]) + np.abs(p[:, 2]))
+    ext_y = reach * (np.abs(p[:, 4]) + np.abs(p[:, 5]))
+    inside = ((p[:, 0] - ext_x >= 0) & (p[:, 0] + ext_x <= width - 1)
+              & (p[:, 3] - ext_y >= 0) & (p[:, 3] + ext_y <= height - 1)
+              & np.isfinite(p[:, :6]).all(axis=1))
+    q = np.where(inside[:, None], p[:, :6], np.array([0.0, 1, 0, 0, 0, 1]))
+    bx = np.floor(q[:, 0])
+    by = np.floor(q[:, 3])
+    base = (by * width + bx).astype(np.int64)[:, None]
+    xi, eta = grid
+
+    def axis(f0, c_xi, c_eta, ident):
+        # integer offsets (float32, exact) and fractions of one axis
+        if ident is not None:  # x = base + f0 + ξ (or η): integer offsets, one fraction/point
+            return ident[None, :], f0.astype(np.float32)[:, None]
+        # elementwise rather than a K = 3 matrix product: BLAS threading makes that erratic
+        loc = np.multiply.outer(c_xi.astype(np.float32), xi)
+        loc += np.multiply.outer(c_eta.astype(np.float32), eta)
+        loc += f0.astype(np.float32)[:, None]
+        whole = np.floor(loc)
+        loc -= whole
+        return whole, loc
+
+    ident_x = xi if np.all(q[:, 1] == 1) and np.all(q[:, 2] == 0) else None
+    ident_y = eta if np.all(q[:, 4] == 0) and np.all(q[:, 5] == 1) else None
+    xw, fx = axis(q[:, 0] - bx, q[:, 1], q[:, 2], ident_x)
+    yw, fy = axis(q[:, 3] - by, q[:, 4], q[:, 5], ident_y)
+    # index offsets are exact in float32 while |off| < 2**24 (always, unless the windows are
+    # huge or extremely distorted in a very wide image: then 64 bit)
+    big = (np.max(ext_y[inside], initial=0.0) + 2) * width + np.max(ext_x[inside], initial=0.0)
+    off = yw * (np.float32(width) if big < 2**23 else np.float64(width))
+    if off.shape == np.broadcast(off, xw).shape:
+        off += xw
+    else:
+        off = off + xw
+    if off.shape[0] == n:
+        idx = off.astype(np.int64)
+        idx += base
+    else:  # integer offsets on both axes (shift): one index row for all points
+        idx = off.astype(np.int64) + base
+    if not np.all((p[inside, 0] - ext_x[inside] >= 1) & (p[inside, 0] + ext_x[inside] < width - 2)
+                  & (p[inside, 3] - ext_y[inside] >= 1)
+                  & (p[inside, 3] + ext_y[inside] < height - 2)):
+        # a window within a pixel of the border: float32 rounding must not leave the image
+        np.clip(idx, 0, flat.size - width - 2, out=idx)
+    # gathers from shifted views of the image: no index arithmetic per neighbour
+    v00 = flat[idx]
+    v01 = flat[1:][idx]
+    v10 = flat[width:][idx]
+    v11 = flat[width + 1:][idx]
+    v01 -= v00
+    v01 *= fx
+    v01 += v00  # top row
+    v11 -= v10
+    v11 *= fx
+    v11 += v10  # bottom row
+    v11 -= v01
+    v11 *= fy
+    v11 += v01
+    return v11, inside
+
+
+def _grid(half: int) -> NDArray:
+    """(ξ, η) of a (2·half+1)² window, row-major, shape (2, m) float32."""
+    off = np.arange(-half, half + 1, dtype=np.float32)
+    xi, eta = np.meshgrid(off, off)
+    return np.stack((xi.ravel(), eta.ravel()))
 
 
 def extract_windows(image: NDArray, cols: ArrayLike, rows: ArrayLike, half: int):
@@ -181,23 +241,14 @@ def extract_windows(image: NDArray, cols: ArrayLike, rows: ArrayLike, half: int)
     """
     img = np.ascontiguousarray(image, dtype=np.float32)
     height, width = img.shape
-    c = np.asarray(cols, dtype=np.float64).reshape(-1, 1)
-    r = np.asarray(rows, dtype=np.float64).reshape(-1, 1)
-    off = np.arange(-half, half + 1, dtype=np.float64)
-    xi, eta = np.meshgrid(off, off)
-    vals, ins = _bilinear(img.ravel(), width, height, c + xi.ravel(), r + eta.ravel())
+    c = np.atleast_1d(np.asarray(cols, dtype=np.float64))
+    r = np.atleast_1d(np.asarray(rows, dtype=np.float64))
+    p = np.zeros((c.size, 6))
+    p[:, 0], p[:, 3] = c, r
+    p[:, 1] = p[:, 5] = 1.0
+    vals, ins = _affine_sampler(img.ravel(), width, height, p, _grid(half), half)
     size = 2 * half + 1
     return vals.reshape(-1, size, size), ins
-
-
-def _corrcoef_rows(a: NDArray, b: NDArray) -> NDArray:
-    """Correlation coefficient of corresponding rows of a and b, shape (n, m)."""
-    az = a - a.mean(axis=1, keepdims=True)
-    bz = b - b.mean(axis=1, keepdims=True)
-    num = np.einsum("ij,ij->i", az, bz)
-    den = np.sqrt(np.einsum("ij,ij->i", az, az) * np.einsum("ij,ij->i", bz, bz))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
 
 
 def lsm_match(template_image: NDArray, search_image: NDArray,
@@ -208,7 +259,7 @@ def lsm_match(template_image: NDArray, search_image: NDArray,
               max_iter: int = 20, tol_shift: float = 0.01, max_shift: float = 3.0,
               min_corr: float = 0.7, max_sigma: float = 0.2, min_contrast: float = 1e-3,
               scale_range: tuple = (0.5, 2.0), contrast_range: tuple = (0.3, 3.0),
-              jacobian: str = "template", chunk: int = 4096) -> LSMResult:
+              jacobian: str = "template", chunk: Optional[int] = None) -> LSMResult:
     r"""Least-squares matching of many points as one batch (Gauss–Newton, bilinear resampling).
 
     Parameters
@@ -249,8 +300,10 @@ def lsm_match(template_image: NDArray, search_image: NDArray,
         mapped by the current affine and contrast (A = A0·T(p), so AᵀA = Tᵀ(A0ᵀA0)T and only
         A0ᵀΔg is formed per iteration); both converge to the same solution for
         noise-free data, and their precision agrees within a few per cent.
-    chunk : int
-        Points processed together (bounds the memory: about 60 · chunk · window² bytes).
+    chunk : int, optional
+        Points processed together (bounds the memory: about 60 · chunk · window² bytes). The
+        default, 2¹⁸ / (window + 2)² (≈ 900 points for 15 × 15), keeps a chunk's per-sample
+        arrays in the CPU cache: larger chunks are markedly slower, not faster.
 
     Returns
     -------
@@ -288,7 +341,9 @@ def lsm_match(template_image: NDArray, search_image: NDArray,
         "iters": np.zeros(n, np.int16),
         "flags": np.zeros(n, np.uint8),
     }
-    for start in range(0, n, chunk):
+    if chunk is None:
+        chunk = max(16, 2**18 // (window + 2) ** 2)
+    for start in range(0, n, int(chunk)):
         sl = slice(start, min(n, start + chunk))
         _lsm_chunk(tpl, srch, cols[sl], rows[sl], p0[sl], idx, half, max_iter, tol_shift,
                    max_shift, min_corr, max_sigma, min_contrast, scale_range, contrast_range,
@@ -301,28 +356,52 @@ def lsm_match(template_image: NDArray, search_image: NDArray,
                      out["sig_r"], out["cov"], out["corr"], out["iters"], flags, flags == 0)
 
 
+def _singular(Ns: NDArray, eps: float = 1e-7) -> NDArray:
+    """Per matrix: is the smallest eigenvalue of the (unit-diagonal) normal matrix ≤ eps?
+
+    λ_min > eps ⇔ Ns − eps·I is positive definite ⇔ its Cholesky factorisation exists; that
+    batch test is several times cheaper than eigenvalues, which are computed only when some
+    matrix of the batch fails it.
+    """
+    u = Ns.shape[-1]
+    if np.isfinite(Ns).all():
+        try:
+            np.linalg.cholesky(Ns - eps * np.eye(u))
+            return np.zeros(Ns.shape[0], bool)
+        except np.linalg.LinAlgError:
+            pass
+    with np.errstate(invalid="ignore"):
+        safe = np.where(np.isfinite(Ns), Ns, 0.0)
+        return ~(np.linalg.eigvalsh(safe)[:, 0] > eps) | ~np.isfinite(Ns).all(axis=(1, 2))
+
+
 def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_shift, min_corr,
                max_sigma, min_contrast, scale_range, contrast_range, jacobian, out, sl):
-    """Gauss–Newton for one chunk of points; writes into ``out[...][sl]``."""
+    """Gauss–Newton for one chunk of points; writes into ``out[...][sl]``.
+
+    Per-point arrays (template, Jacobian, normal matrix) are kept compacted to the points still
+    iterating, so converged and failed points cost nothing in later iterations.
+    """
     n = cols.size
     size = 2 * half + 1
     m = size * size
     u = len(idx)
     height, width = srch.shape
     flat = srch.ravel()
-    # template (fixed) and the template-frame grids
+    # template (fixed) with one extra pixel for the gradients, and the template-frame grids
     ge1, t_inside = extract_windows(tpl, cols, rows, half + 1)
     g1 = np.ascontiguousarray(ge1[:, 1:-1, 1:-1]).reshape(n, m)
-    off = np.arange(-half - 1, half + 2, dtype=np.float32)
-    xi_e, eta_e = np.meshgrid(off, off)  # extended grid: one extra pixel for the gradients
-    xi_e, eta_e = xi_e.ravel(), eta_e.ravel()
-    xi = xi_e.reshape(size + 2, size + 2)[1:-1, 1:-1].ravel()
-    eta = eta_e.reshape(size + 2, size + 2)[1:-1, 1:-1].ravel()
+    grid_e = _grid(half + 1)
+    grid = _grid(half)
+    xi, eta = grid
 
     p = p0.copy()
     flags = np.zeros(n, np.uint8)
     flags[~t_inside] |= FLAG_OUTSIDE
-    flags[g1.std(axis=1) < min_contrast] |= FLAG_TEXTURELESS
+    # template statistics for the correlation coefficient: Σg1, Σ(g1 − ḡ1)²
+    g1_mean = g1.mean(axis=1, dtype=np.float64)
+    g1_q = np.einsum("ij,ij->i", g1, g1, dtype=np.float64) - m * g1_mean**2
+    flags[~(np.sqrt(np.maximum(g1_q, 0.0) / m) >= min_contrast)] |= FLAG_TEXTURELESS
     iters = np.zeros(n, np.int16)
     converged = np.zeros(n, bool)
     last_N = np.zeros((n, u, u))
@@ -333,39 +412,52 @@ def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_sh
     smin, smax = scale_range
     cmin, cmax = contrast_range
 
+    # compacted per-point arrays: row k belongs to point loc[k]
+    loc = active
+    g1c = g1[loc]
     if jacobian == "template":
         # A0: the Jacobian columns built from the template itself (fixed over the iterations);
         # the current Jacobian is A0·T(p), so only A0ᵀΔg has to be formed per iteration.
-        t_xi = (0.5 * (ge1[:, 1:-1, 2:] - ge1[:, 1:-1, :-2])).reshape(n, m)
-        t_eta = (0.5 * (ge1[:, 2:, 1:-1] - ge1[:, :-2, 1:-1])).reshape(n, m)
-        A0 = np.stack((t_xi, t_xi * xi, t_xi * eta, t_eta, t_eta * xi, t_eta * eta,
-                       np.ones_like(g1), g1), axis=2)  # (n, m, 8) float32
-        N0 = np.matmul(A0.transpose(0, 2, 1), A0).astype(np.float64)
-        A0t = np.ascontiguousarray(A0.transpose(0, 2, 1))  # (n, 8, m)
-        del A0
-        loc = np.arange(n)  # point index of each row of A0t / N0
+        ge1a = ge1[loc]
+        t_xi = (0.5 * (ge1a[:, 1:-1, 2:] - ge1a[:, 1:-1, :-2])).reshape(-1, m)
+        t_eta = (0.5 * (ge1a[:, 2:, 1:-1] - ge1a[:, :-2, 1:-1])).reshape(-1, m)
+        del ge1a
+        A0t = np.empty((len(loc), 8, m), np.float32)  # (n, 8, m): Jacobian transposed
+        A0t[:, 0], A0t[:, 3] = t_xi, t_eta
+        np.multiply(t_xi, xi, out=A0t[:, 1])
+        np.multiply(t_xi, eta, out=A0t[:, 2])
+        np.multiply(t_eta, xi, out=A0t[:, 4])
+        np.multiply(t_eta, eta, out=A0t[:, 5])
+        A0t[:, 6] = 1.0
+        A0t[:, 7] = g1c
+        del t_xi, t_eta
+        N0 = np.matmul(A0t, A0t.transpose(0, 2, 1)).astype(np.float64)
+    del ge1
 
     for it in range(max_iter):
         if active.size == 0:
             break
+        if len(active) < len(loc):  # compact to the points still iterating
+            keep = np.searchsorted(loc, active)
+            g1c = g1c[keep]
+            if jacobian == "template":
+                A0t, N0 = A0t[keep], N0[keep]
+            loc = active
         pa = p[active]
-        a0, a1, a2 = pa[:, 0:1], pa[:, 1:2], pa[:, 2:3]
-        b0, b1, b2 = pa[:, 3:4], pa[:, 4:5], pa[:, 5:6]
+        a1, a2 = pa[:, 1:2], pa[:, 2:3]
+        b1, b2 = pa[:, 4:5], pa[:, 5:6]
         r0, r1 = pa[:, 6:7], pa[:, 7:8]
         det = a1 * b2 - a2 * b1
         inv_det = 1.0 / np.where(np.abs(det) > 1e-6, det, 1e-6)
         if jacobian == "template":
-            x2 = a0 + a1 * xi + a2 * eta
-            y2 = b0 + b1 * xi + b2 * eta
-            g2, ins = _bilinear(flat, width, height, x2, y2)
+            g2, ins = _affine_sampler(flat, width, height, pa, grid, half)
             outside = ~ins
-            resid = g1[active] - (r0.astype(np.float32) + r1.astype(np.float32) * g2)
-            if len(active) < 0.8 * len(loc):  # compact the per-point arrays to the active set
-                keep = np.searchsorted(loc, active)
-                A0t, N0, loc = A0t[keep], N0[keep], active
-            sel = np.searchsorted(loc, active)
-            At_a = A0t if len(sel) == len(loc) else A0t[sel]
-            bfull = np.einsum("nkm,nm->nk", At_a, resid).astype(np.float64)
+            resid = g2
+            resid *= -r1.astype(np.float32)
+            resid -= r0.astype(np.float32)
+            resid += g1c  # Δg = g1 − (r0 + r1·g2), in place of g2
+            bfull = np.matmul(A0t, resid[:, :, None])[:, :, 0].astype(np.float64)
+            s_res, s_g1res = bfull[:, 6], bfull[:, 7]  # Σ Δg, Σ g1·Δg (columns 1 and g1)
             # r1·(gx, gy) ≈ J⁻ᵀ (∂g1/∂ξ, ∂g1/∂η) and g2 ≈ (g1 − r0)/r1  →  A = A0·T
             c00, c01 = b2[:, 0] * inv_det[:, 0], -b1[:, 0] * inv_det[:, 0]
             c10, c11 = -a2[:, 0] * inv_det[:, 0], a1[:, 0] * inv_det[:, 0]
@@ -377,35 +469,49 @@ def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_sh
             T[:, 7, 7] = 1.0 / r1[:, 0]
             T[:, 6, 7] = -r0[:, 0] / r1[:, 0]
             T = T[:, :, idx]
-            N = np.einsum("nki,nkl,nlj->nij", T, N0[sel], T, optimize=True)
-            b = np.einsum("nki,nk->ni", T, bfull)
+            N = np.matmul(T.transpose(0, 2, 1), np.matmul(N0, T))
+            b = np.matmul(bfull[:, None, :], T)[:, 0]
         else:
             # resample the extended search window (one extra pixel for the gradients)
-            x2 = a0 + a1 * xi_e + a2 * eta_e
-            y2 = b0 + b1 * xi_e + b2 * eta_e
-            ge, ins = _bilinear(flat, width, height, x2, y2)
+            ge, ins = _affine_sampler(flat, width, height, pa, grid_e, half + 1)
             outside = ~ins
             ge = ge.reshape(-1, size + 2, size + 2)
-            g2 = ge[:, 1:-1, 1:-1].reshape(-1, m)
-            gxi = (0.5 * (ge[:, 1:-1, 2:] - ge[:, 1:-1, :-2])).reshape(-1, m)
-            geta = (0.5 * (ge[:, 2:, 1:-1] - ge[:, :-2, 1:-1])).reshape(-1, m)
-            # ∂g/∂ξ = gx·a1 + gy·b1, ∂g/∂η = gx·a2 + gy·b2  →  solve for (gx, gy)
-            f = (inv_det * r1).astype(np.float32)
-            gx = (gxi * b2.astype(np.float32) - geta * b1.astype(np.float32)) * f
-            gy = (geta * a1.astype(np.float32) - gxi * a2.astype(np.float32)) * f
-            all_cols = (gx, gx * xi, gx * eta, gy, gy * xi, gy * eta, np.ones_like(g2), g2)
-            A = np.stack([all_cols[k] for k in idx], axis=2)  # (na, m, u) float32
-            resid = g1[active] - (r0.astype(np.float32) + r1.astype(np.float32) * g2)
-            At = A.transpose(0, 2, 1)
-            N = np.matmul(At, A).astype(np.float64)
-            b = np.matmul(At, resid[:, :, None]).astype(np.float64)[:, :, 0]
+            na = len(active)
+            At = np.empty((na, u, m), np.float32)  # Jacobian transposed, filled row by row
+            g2 = ge[:, 1:-1, 1:-1]
+            # window differences along ξ and η (central differences = half of these)
+            dxi = (ge[:, 1:-1, 2:] - ge[:, 1:-1, :-2]).reshape(na, m)
+            deta = (ge[:, 2:, 1:-1] - ge[:, :-2, 1:-1]).reshape(na, m)
+            # ∂g/∂ξ = gx·a1 + gy·b1, ∂g/∂η = gx·a2 + gy·b2  →  solve for (gx, gy), times r1
+            f = 0.5 * inv_det * r1
+            for j0, own, c_own, other, c_other in ((0, dxi, b2 * f, deta, -b1 * f),
+                                                   (3, deta, a1 * f, dxi, -a2 * f)):
+                if j0 not in idx:
+                    continue
+                k = idx.index(j0)
+                g = np.multiply(own, c_own.astype(np.float32), out=At[:, k])
+                if np.any(c_other != 0):  # zero for the rows of epipolar images
+                    g += other * c_other.astype(np.float32)
+                for j, w in ((j0 + 1, xi), (j0 + 2, eta)):
+                    if j in idx:
+                        np.multiply(g, w, out=At[:, idx.index(j)])
+            At[:, idx.index(6)] = 1.0
+            g2_rows = At[:, idx.index(7)]
+            g2_rows.reshape(na, size, size)[...] = g2
+            resid = np.multiply(g2_rows, -r1.astype(np.float32))
+            resid -= r0.astype(np.float32)
+            resid += g1c  # Δg = g1 − (r0 + r1·g2)
+            g2 = g2_rows
+            N = np.matmul(At, At.transpose(0, 2, 1)).astype(np.float64)
+            b = np.matmul(At, resid[:, :, None])[:, :, 0].astype(np.float64)
+            s_res = b[:, idx.index(6)]
+            s_g1res = np.einsum("ij,ij->i", g1c, resid).astype(np.float64)
         # Jacobi-scaled normal matrix for a scale-free singularity test (first iteration only in
         # the template mode, where N changes only by the small transformation T)
         d = np.sqrt(np.maximum(np.einsum("nii->ni", N), 1e-30))
         Ns = N / (d[:, :, None] * d[:, None, :])
         if it == 0 or jacobian != "template":
-            ev_min = np.linalg.eigvalsh(Ns)[:, 0]
-            singular = ~(ev_min > 1e-7)
+            singular = _singular(Ns)
         else:
             singular = np.zeros(len(active), bool)
         Ns_safe = np.where(singular[:, None, None], np.eye(u), Ns)
@@ -414,9 +520,17 @@ def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_sh
 
         # bookkeeping of the state *at* the current parameters (used if this is the last step)
         last_N[active] = N
-        vv = np.einsum("ij,ij->i", resid, resid, dtype=np.float64)
+        vv = np.einsum("ij,ij->i", resid, resid).astype(np.float64)
         last_vv[active] = vv
-        last_corr[active] = _corrcoef_rows(g1[active], g2)
+        # correlation of g1 and g2 from sums already at hand: g2 = (g1 − r0 − Δg)/r1, so with
+        # centred values (z) ρ = sign(r1)·(q − Σg1zΔg) / sqrt(q·(q − 2Σg1zΔg + Σ(Δg_z)²)),
+        # q = Σ g1z², Σg1zΔg = Σg1Δg − ḡ1ΣΔg, Σ(Δg_z)² = vv − (ΣΔg)²/m
+        q = g1_q[active]
+        s_zr = s_g1res - g1_mean[active] * s_res
+        den2 = q * (q - 2 * s_zr + (vv - s_res**2 / m))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = np.sign(r1[:, 0]) * (q - s_zr) / np.sqrt(np.where(den2 > 0, den2, np.inf))
+        last_corr[active] = np.clip(corr, -1.0, 1.0)
 
         full = np.zeros((len(active), 8))
         full[:, idx] = dx
