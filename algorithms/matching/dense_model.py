@@ -53,26 +53,6 @@ _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2}
 _BLOCK_PIXELS = 1_000_000
 
 
-def _read_images(project: Any, recs: Any, cams: Any) -> list:
-    from ..raster.io import open_image
-
-    images = []
-    for rec, cam in zip(recs, cams):
-        path = project.image_path(rec)
-        if not path.is_file():
-            raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
-                             "fix its path in project.toml.")
-        with open_image(path) as src:
-            if (src.width, src.height) != (cam.width, cam.height):
-                raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
-                                 f"'{cam.name}' is {cam.width}×{cam.height} px.")
-            from rasterio.enums import ColorInterp
-
-            bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
-            images.append(src.read((bands or [1])[:3]))
-    return images
-
-
 def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
                 feedback: Feedback) -> None:
     """Grey (band mean) epipolar image as float32, NaN outside the original image."""
@@ -262,7 +242,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                   f"{min_d}…{max_d} px; DSM {grid.width}×{grid.height} cells at "
                   f"{spacing:.3f} m.")
 
-    images = _read_images(project, recs, cams)
+    images = [project.read_image(rec, colour_only=True) for rec in recs]
     out = Path(output_dir)
     timings: Dict[str, float] = {}
     with staged_folder(out, replace=True, product="match_model") as tmp, \

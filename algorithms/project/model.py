@@ -153,6 +153,35 @@ class Project:
         p = Path(rec.path)
         return p if p.is_absolute() else (self.root / p)
 
+    def read_image(self, image: Union[str, ImageRecord], colour_only: bool = False) -> Any:
+        """The pixels of an image, (bands, rows, cols), checked against its camera.
+
+        ``colour_only`` drops alpha bands and keeps at most three bands.
+
+        Raises
+        ------
+        InputError
+            When the file is missing or its size differs from the camera's.
+        """
+        from ..raster.io import open_image
+
+        rec = self.image(image) if isinstance(image, str) else image
+        cam = self.camera_of(rec)
+        path = self.image_path(rec)
+        if not path.is_file():
+            raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
+                             "fix its path in project.toml.")
+        with open_image(path) as src:
+            if (src.width, src.height) != (cam.width, cam.height):
+                raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
+                                 f"'{cam.name}' is {cam.width}×{cam.height} px.")
+            if not colour_only:
+                return src.read()
+            from rasterio.enums import ColorInterp
+
+            bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
+            return src.read((bands or [1])[:3])
+
     @property
     def project_file(self) -> Path:
         return self.root / PROJECT_FILE

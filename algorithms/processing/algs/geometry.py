@@ -8,7 +8,6 @@ from typing import Any, Dict
 
 import numpy as np
 
-from ...errors import InputError
 from ...geometry.epipolar import SIDES, EpipolarPair
 from ...project.model import Project
 from ...raster.io import GTIFF_PROFILE, open_image, staged_folder
@@ -123,19 +122,7 @@ class EpipolarPairAlgorithm(Algorithm):
                                               scale=float(params["scale"]),
                                               names=(recs[0].name, recs[1].name))
         # read both inputs first: a bad file fails before any output exists
-        images = []
-        for rec, cam in zip(recs, cams):
-            path = project.image_path(rec)
-            if not path.is_file():
-                raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
-                                 "fix its path in project.toml.")
-            with open_image(path) as src:
-                if (src.width, src.height) != (cam.width, cam.height):
-                    raise InputError(
-                        f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
-                        f"'{cam.name}' is {cam.width}×{cam.height} px."
-                    )
-                images.append(src.read())
+        images = [project.read_image(rec) for rec in recs]
         feedback.info(f"Epipolar pair {model.name}: base {pair.base:.2f} m, "
                       f"f {pair.focal_px:.2f} px, sizes {pair.sizes[0]} / {pair.sizes[1]}.")
         height = project.terrain_height
