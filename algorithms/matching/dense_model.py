@@ -32,7 +32,7 @@ import math
 import tempfile
 import time
 from pathlib import Path
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, Optional, Union
 
 import numpy as np
 
@@ -107,26 +107,6 @@ def _footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
     if ok.sum() < 3:
         return Polygon()
     return Polygon(pts[ok, :2]).buffer(0)
-
-
-def _edits(project: Any) -> Tuple[list, list, list]:
-    """Exclusion polygons (action ≠ 'keep'), boundary polygons, breaklines of edits.gpkg."""
-    from ..project.edits import read_layer
-
-    path = project.edits_path
-    if not Path(path).is_file():
-        return [], [], []
-    import fiona
-
-    layers = fiona.listlayers(str(path))
-
-    def layer(name: str) -> list:
-        return read_layer(path, name) if name in layers else []
-
-    excl = [g for g, p in layer("exclusion_areas") if (p.get("action") or "exclude") != "keep"]
-    bounds = [g for g, _ in layer("boundaries")]
-    lines = [g for g, _ in layer("breaklines")]
-    return excl, bounds, lines
 
 
 def match_model_dense(project: Any, model: str, output_dir: PathLike,
@@ -223,7 +203,10 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     min_d = math.floor(d_lo - widen) - int(disparity_margin)
     max_d = math.ceil(d_hi + widen) + int(disparity_margin)
 
-    excl, bounds, lines = _edits(project)
+    from ..project.edits import read_constraints
+
+    excl, bounds, lines = (read_constraints(project.edits_path)
+                           if Path(project.edits_path).is_file() else ([], [], []))
     # grid: the overlap at the lowest and highest heights, cut to the boundary
     areas = []
     for z in (z_min, z_max):

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections import OrderedDict
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Tuple, Union
+from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 
 import fiona
 from shapely.geometry import mapping, shape
@@ -142,3 +142,58 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
 
 
 __all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features", "create_edits", "read_layer"]
+
+
+def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
+                    layers: Optional[Tuple[str, ...]] = None,
+                    skip_keep: bool = False) -> List[Any]:
+    """Shapely geometries of the given kinds (``"Polygon"``, ``"LineString"``) from a vector file.
+
+    Every layer (or only ``layers``) is read; geometries are transformed to ``crs`` when the
+    file has another CRS. ``skip_keep`` drops features whose ``action`` is ``keep`` (exclusion
+    areas of edits.gpkg).
+    """
+    from rasterio.crs import CRS
+    from rasterio.warp import transform_geom
+
+    if crs is not None and not isinstance(crs, CRS):
+        crs = CRS.from_user_input(crs)
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"Vector file '{path}' does not exist.")
+    try:
+        names = fiona.listlayers(str(path))
+    except Exception as exc:  # driver-specific errors
+        raise InputError(f"Cannot read the vector file '{path.name}': {exc}") from exc
+    out: List[Any] = []
+    for name in names:
+        if layers is not None and name not in layers:
+            continue
+        with fiona.open(str(path), layer=name) as src:
+            src_crs = CRS.from_wkt(src.crs_wkt) if src.crs_wkt else None
+            for feat in src:
+                geom = feat["geometry"]
+                if geom is None:
+                    continue
+                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
+                if not any(k in geom["type"] for k in kinds):
+                    continue
+                if skip_keep and (dict(feat["properties"]).get("action") or "") == "keep":
+                    continue
+                if crs is not None and src_crs is not None and src_crs != crs:
+                    geom = transform_geom(src_crs, crs, geom)
+                out.append(shape(geom))
+    return out
+
+
+def read_constraints(path: PathLike, crs: Any = None) -> Tuple[List[Any], List[Any], List[Any]]:
+    """The operator's matching/interpolation constraints from ``edits.gpkg``.
+
+    Returns exclusion polygons (without those whose ``action`` is ``keep``: there the surface
+    stays as measured), boundary polygons and breaklines (3-D where digitised), transformed to
+    ``crs`` when given. A missing layer gives an empty list.
+    """
+    return (read_geometries(path, ("Polygon",), crs, ("exclusion_areas",), skip_keep=True),
+            read_geometries(path, ("Polygon",), crs, ("boundaries",)),
+            read_geometries(path, ("LineString",), crs, ("breaklines",)))

@@ -22,12 +22,13 @@ Grid
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
+from ..project.edits import read_constraints, read_geometries
 from ..quality.points import read_points
 from ..raster.io import atomic_output, write_raster
 from .gridding import Grid, GridAccumulator, finish_grid
@@ -46,47 +47,6 @@ def _crs(value: Any) -> Any:
         return CRS.from_user_input(value)
     except Exception as exc:  # rasterio raises CRSError
         raise InputError(f"'{value}' is not a CRS (give e.g. EPSG:25832).") from exc
-
-
-def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
-                    layers: Optional[Tuple[str, ...]] = None,
-                    skip_keep: bool = False) -> List[Any]:
-    """Shapely geometries of the given kinds (``"Polygon"``, ``"LineString"``) from a vector file.
-
-    Every layer (or only ``layers``) is read; geometries are transformed to ``crs`` when the
-    file has another CRS. ``skip_keep`` drops features whose ``action`` is ``keep`` (exclusion
-    areas of edits.gpkg).
-    """
-    import fiona
-    from rasterio.warp import transform_geom
-    from shapely.geometry import shape
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"Vector file '{path}' does not exist.")
-    try:
-        names = fiona.listlayers(str(path))
-    except Exception as exc:  # driver-specific errors
-        raise InputError(f"Cannot read the vector file '{path.name}': {exc}") from exc
-    out: List[Any] = []
-    for name in names:
-        if layers is not None and name not in layers:
-            continue
-        with fiona.open(str(path), layer=name) as src:
-            src_crs = _crs(src.crs_wkt) if src.crs_wkt else None
-            for feat in src:
-                geom = feat["geometry"]
-                if geom is None:
-                    continue
-                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-                if not any(k in geom["type"] for k in kinds):
-                    continue
-                if skip_keep and (dict(feat["properties"]).get("action") or "") == "keep":
-                    continue
-                if crs is not None and src_crs is not None and src_crs != crs:
-                    geom = transform_geom(src_crs, crs, geom)
-                out.append(shape(geom))
-    return out
 
 
 def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
@@ -156,9 +116,7 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     bnds: List[Any] = []
     lines: List[Any] = []
     if edits is not None and edits.is_file():
-        excl += read_geometries(edits, ("Polygon",), target, ("exclusion_areas",), True)
-        bnds += read_geometries(edits, ("Polygon",), target, ("boundaries",))
-        lines += read_geometries(edits, ("LineString",), target, ("breaklines",))
+        excl, bnds, lines = read_constraints(edits, target)
     if exclusions:
         excl += read_geometries(exclusions, ("Polygon",), target, skip_keep=True)
     if boundary:
@@ -224,4 +182,4 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     return result
 
 
-__all__ = ["interpolate_dem", "read_geometries"]
+__all__ = ["interpolate_dem"]
