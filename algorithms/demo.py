@@ -5,7 +5,12 @@
 3. a batch file runs ``epipolar_pair`` over every model (the batch runner, as operators use it);
 4. the check-point discs are measured in every epipolar pair (intensity centroids), which gives
    the residual y-parallax measured in the images and the heights of the check points by the
-   normal case, compared with the truth in metres and ‰ of the flying height.
+   normal case, compared with the truth in metres and ‰ of the flying height;
+5. the same batch matches every model (``match_model``, fbm_lsm: hierarchical feature-based
+   matching + LSM, groundels, finite-element surface); ``dsm_merge`` merges the model DSMs and
+   ``dem_compare`` compares the merged DSM with the true DSM;
+6. ``filter_lowpass`` filters the merged DSM to a DTM (honouring the project's edits) and
+   ``dem_compare`` compares it with the true DTM.
 
 The summary is written as ``summary.json`` and ``summary.md`` into the demo folder.
 """
@@ -41,6 +46,15 @@ models = "all"
 
 [steps.params]
 output = "{{project}}/products/epipolar/{{model}}"
+
+[[steps]]
+algorithm = "match_model"
+name = "matching"
+models = "all"
+
+[steps.params]
+method = "fbm_lsm"
+output = "{{project}}/products/dsm/{{model}}"
 """
 
 
@@ -143,7 +157,9 @@ def run_demo(output: Union[str, Path], size: str = "small", seed: int = 1, worke
         check = measure_checkpoints(project, folder, xyz, disc_radius)
         models.append({**m, "epipolar": str(folder), "checkpoints": check})
         feedback.progress(92 + 8 * (k + 1) / max(len(info["models"]), 1))
+    surfaces = _surfaces(project, info, block, out, feedback)
     summary = {
+        "surfaces": surfaces,
         "project": str(project_dir),
         "images": len(info["images"]),
         "gsd_m": block.get("gsd_m"),
@@ -158,6 +174,44 @@ def run_demo(output: Union[str, Path], size: str = "small", seed: int = 1, worke
     (out / "summary.md").write_text(_markdown(summary), encoding="utf-8")
     summary["summary"] = str(out / "summary.md")
     return summary
+
+
+def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out: Path,
+              feedback: Feedback) -> Dict[str, Any]:
+    """Merge the model DSMs, filter the merged DSM to a DTM, compare both with the truth."""
+    dsms = [project.products_dir("dsm") / m["name"] / "dsm.tif" for m in info["models"]]
+    reports = [json.loads((p.parent / "report.json").read_text(encoding="utf-8"))
+               for p in dsms]
+    merged = registry.run("dsm_merge", {"inputs": [str(p) for p in dsms], "mode": "median",
+                                        "output": str(out / "dsm_merged.tif")})
+    height = float(block["flying_height_m"])
+    dsm_cmp = registry.run("dem_compare", {
+        "dem": merged["dsm"],
+        "reference": block["truth_dsm"], "classes": block["truth_landcover"],
+        "flying_height": height, "output": str(out / "compare_dsm")})
+    feedback.info("Filtering the merged DSM to a DTM …")
+    dtm = registry.run("filter_lowpass", {"input": str(out / "dsm_merged.tif"),
+                                          "output": str(out / "dtm"),
+                                          "project": str(project.root)})
+    dtm_cmp = registry.run("dem_compare", {
+        "dem": dtm["dtm"], "reference": block["truth_dtm"],
+        "classes": block["truth_landcover"], "flying_height": height,
+        "output": str(out / "compare_dtm")})
+
+    def stats(c: Dict[str, Any]) -> Dict[str, Any]:
+        s = c["stats"]
+        return {k: s.get(k) for k in ("count", "mean", "rms", "nmad", "q95")} | {
+            "rms_permille_H": 1000.0 * s["rms"] / height, "report": c["report"]}
+
+    return {
+        "models": [{"name": r["model"], "points": r["metrics"]["points_raw"],
+                    "coverage_pct": r["metrics"]["coverage_pct"],
+                    "measured_pct": r["metrics"].get("measured_pct"),
+                    "sigma2_m": r["metrics"].get("sigma2_m"),
+                    "seconds": r["seconds"]["total"]} for r in reports],
+        "dsm_merged": str(out / "dsm_merged.tif"), "dsm_vs_truth": stats(dsm_cmp),
+        "dtm": dtm["dtm"], "dtm_vs_truth": stats(dtm_cmp),
+    }
 
 
 def _markdown(s: Dict[str, Any]) -> str:
@@ -188,6 +242,22 @@ def _markdown(s: Dict[str, Any]) -> str:
             f"{c['measured']} | {c['y_parallax_rms_px']:.3f} | {c['y_parallax_max_px']:.3f} | "
             f"{c['height_rmse_m']:.3f} | {c['height_rmse_permille_H']:.3f} |"
         )
+    f = s["surfaces"]
+    lines += ["", "DSMs by `match_model` (fbm_lsm) and their merge, the DTM by `filter_lowpass`, "
+              "against the truth (all cells, buildings and trees included):", "",
+              "| model | points | coverage % | measured % | σ2 m | seconds |",
+              "|---|---|---|---|---|---|"]
+    for m in f["models"]:
+        lines.append(f"| {m['name']} | {m['points']} | {m['coverage_pct']:.1f} | "
+                     f"{(m['measured_pct'] or 0):.1f} | {(m['sigma2_m'] or 0):.3f} | "
+                     f"{m['seconds']:.1f} |")
+    lines += ["", "| surface | against | mean m | RMS m | NMAD m | RMS ‰ H | report |",
+              "|---|---|---|---|---|---|---|"]
+    for name, key, ref in (("merged DSM", "dsm_vs_truth", "true DSM"),
+                           ("DTM", "dtm_vs_truth", "true DTM")):
+        c = f[key]
+        lines.append(f"| {name} | {ref} | {c['mean']:.3f} | {c['rms']:.3f} | "
+                     f"{c['nmad']:.3f} | {c['rms_permille_H']:.3f} | `{c['report']}` |")
     lines += ["", "Truth files: " + ", ".join(f"`{Path(v).name}`" for v in s["truth"].values()),
               ""]
     return "\n".join(lines)

@@ -42,6 +42,7 @@ def _synthetic(tmp: Path) -> dict:
     for m in info["models"]:
         t0 = time.perf_counter()
         r = registry.run("match_model", {"project": block["project"], "model": m["name"],
+                                         "method": "dense",
                                          "output": str(tmp / "dsm" / m["name"])})
         dt = time.perf_counter() - t0
         h = m["height_above_ground_m"]
@@ -77,8 +78,8 @@ def _ngi(tmp: Path) -> dict:
     for spacing in (None, 24.0):
         t0 = time.perf_counter()
         r = registry.run("match_model", {"project": str(proj), "model": model["name"],
-                                         "min_height": 100.0, "max_height": 850.0,
-                                         "spacing": spacing,
+                                         "method": "dense", "min_height": 100.0,
+                                         "max_height": 850.0, "spacing": spacing,
                                          "output": str(tmp / f"ngi_dsm_{spacing}")})
         dt = time.perf_counter() - t0
         c = compare_dems(r["dsm"], DATA / "ngi" / "dem.tif")

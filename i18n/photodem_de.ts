@@ -130,7 +130,7 @@
         </message>
         <message>
             <source>Images</source>
-            <extracomment>project_info output images</extracomment>
+            <extracomment>project_info output images; refine_object_space.images: description</extracomment>
             <translation>Bilder</translation>
         </message>
         <message>
@@ -229,9 +229,9 @@
             <translation>Synthetische Daten</translation>
         </message>
         <message>
-            <source>Generates a deterministic synthetic aerial block: terrain (gentle, dunes or steep), an embankment and a ditch with breaklines, buildings, trees and a forest patch, textured ground with bright check-point discs, frame images in two or more strips (60 % forward, 30 % side overlap) rendered by ray casting against the true DSM. Writes a complete project (project.toml, images, edits.gpkg, in-strip stereo models) and the ground truth (DTM, DSM, land cover, building footprints, 3-D breaklines, check points) below truth/. The same seed always gives the same block.</source>
+            <source>Generates a deterministic synthetic aerial block: terrain (gentle, dunes or steep), an embankment and a ditch with breaklines, buildings, trees and a forest patch, textured ground with bright check-point discs, frame images in two or more strips (60 % forward, 30 % side overlap; aerial: one strip of three windowed film frames) rendered by ray casting against the true DSM. Writes a complete project (project.toml, images, edits.gpkg, in-strip stereo models) and the ground truth (DTM, DSM, land cover, building footprints, 3-D breaklines, check points) below truth/. The same seed always gives the same block.</source>
             <extracomment>synthetic_block: help</extracomment>
-            <translation>Erzeugt einen deterministischen synthetischen Bildflug: Gelände (flach, Dünen oder steil), einen Damm und einen Graben mit Bruchkanten, Gebäude, Bäume und ein Waldstück, texturierten Boden mit hellen Kontrollpunktscheiben sowie Reihenmessbilder in zwei oder mehr Streifen (60 % Längs-, 30 % Querüberdeckung), gerendert durch Strahlverfolgung gegen das wahre Oberflächenmodell. Schreibt ein vollständiges Projekt (project.toml, Bilder, edits.gpkg, Stereomodelle im Streifen) und die Referenzdaten (Geländemodell, Oberflächenmodell, Landbedeckung, Gebäudegrundrisse, 3D-Bruchkanten, Kontrollpunkte) unter truth/. Derselbe Startwert ergibt immer denselben Bildverband.</translation>
+            <translation>Erzeugt einen deterministischen synthetischen Bildflug: Gelände (flach, Dünen oder steil), einen Damm und einen Graben mit Bruchkanten, Gebäude, Bäume und ein Waldstück, texturierten Boden mit hellen Kontrollpunktscheiben sowie Reihenmessbilder in zwei oder mehr Streifen (60 % Längs-, 30 % Querüberdeckung; Luftbild: ein Streifen aus drei Filmbildern, von denen je ein Ausschnitt berechnet wird), gerendert durch Strahlverfolgung gegen das wahre Oberflächenmodell. Schreibt ein vollständiges Projekt (project.toml, Bilder, edits.gpkg, Stereomodelle im Streifen) und die Referenzdaten (Geländemodell, Oberflächenmodell, Landbedeckung, Gebäudegrundrisse, 3D-Bruchkanten, Kontrollpunkte) unter truth/. Derselbe Startwert ergibt immer denselben Bildverband.</translation>
         </message>
         <message>
             <source>Output project folder</source>
@@ -244,9 +244,9 @@
             <translation>Größe des Bildverbands</translation>
         </message>
         <message>
-            <source>tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: 1408×2000 px; large: 2400×3400 px (≈ 8 Mpx).</source>
+            <source>tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: 1408×2000 px; large: 2400×3400 px (≈ 8 Mpx); aerial: three wide-angle film frames in one strip (11500 px, c = 153 mm, B/H 0.6, base 4600 px, H ≈ 1150 m) of which a 1024×1024 px window over the common ground patch is rendered — for height accuracy in ‰ of H.</source>
             <extracomment>synthetic_block.size: help</extracomment>
-            <translation>winzig: Bilder mit 224×288 px (Tests); klein: 704×1000 px (Demo); mittel: 1408×2000 px; groß: 2400×3400 px (≈ 8 Mpx).</translation>
+            <translation>winzig: Bilder mit 224×288 px (Tests); klein: 704×1000 px (Demo); mittel: 1408×2000 px; groß: 2400×3400 px (≈ 8 Mpx); Luftbild: drei Weitwinkel-Filmbilder in einem Streifen (11500 px, c = 153 mm, B/H 0,6, Basis 4600 px, H ≈ 1150 m), von denen ein Fenster von 1024×1024 px über dem gemeinsam abgebildeten Geländeausschnitt gerendert wird — für die Höhengenauigkeit in ‰ von H.</translation>
         </message>
         <message>
             <source>tiny</source>
@@ -267,6 +267,11 @@
             <source>large</source>
             <extracomment>synthetic_block.size: option</extracomment>
             <translation>groß</translation>
+        </message>
+        <message>
+            <source>aerial</source>
+            <extracomment>synthetic_block.size: option</extracomment>
+            <translation>Luftbild</translation>
         </message>
         <message>
             <source>Terrain type</source>
@@ -290,7 +295,7 @@
         </message>
         <message>
             <source>steep</source>
-            <extracomment>synthetic_block.terrain: option</extracomment>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; synthetic_block.terrain: option</extracomment>
             <translation>steil</translation>
         </message>
         <message>
@@ -349,6 +354,16 @@
             <translation>Flughöhe über mittlerem Gelände [m]</translation>
         </message>
         <message>
+            <source>Mean model base in pixels B/GSD (σZ/H = σpx/base_px)</source>
+            <extracomment>synthetic_block output base_px</extracomment>
+            <translation>Mittlere Modellbasis in Pixeln B/GSD (σZ/H = σpx/base_px)</translation>
+        </message>
+        <message>
+            <source>Mean base-to-height ratio B/H of the models</source>
+            <extracomment>synthetic_block output b_h</extracomment>
+            <translation>Mittleres Basis-Höhen-Verhältnis B/H der Modelle</translation>
+        </message>
+        <message>
             <source>Epipolar pair</source>
             <extracomment>epipolar_pair: name</extracomment>
             <translation>Epipolarbildpaar</translation>
@@ -365,7 +380,7 @@
         </message>
         <message>
             <source>Project folder or project.toml</source>
-            <extracomment>epipolar_pair.project: description; match_model.project: description</extracomment>
+            <extracomment>epipolar_pair.project: description; match_model.project: description; refine_object_space.project: description</extracomment>
             <translation>Projektordner oder project.toml</translation>
         </message>
         <message>
@@ -375,7 +390,7 @@
         </message>
         <message>
             <source>Output folder</source>
-            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; match_model.output: description; point_compare.output: description</extracomment>
+            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; filter_evaluate.output: description; filter_linear_prediction.output: description; filter_lowpass.output: description; match_model.output: description; point_compare.outp</extracomment>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
@@ -819,14 +834,19 @@
             <translation>Stereomodell zuordnen (DOM)</translation>
         </message>
         <message>
-            <source>Matches the two images of a stereo model and grids the points to a DSM. dense: epipolar resampling, semi-global matching with left–right check, triangulation of every valid disparity, median per DSM cell, interpolation of small gaps that does not cross breaklines; exclusion areas and boundaries of edits.gpkg are honoured (NaN). Writes dsm.tif (float32, NaN = no height), count.tif (points per cell) and report.json (points, coverage, valid disparities, timings).</source>
+            <source>Matches the two images of a stereo model and grids the points to a DSM. fbm_lsm: image pyramids coarse to fine from the start points of edits.gpkg (or the height range), Förstner points, feature-based matching with robust consistency and a left–right check, least-squares matching at the finest level; failed windows are marked and matching goes on around them; groundel reduction (robust plane, σ1, σ2) and a finite-element surface that honours breaklines. dense: semi-global matching of every pixel of the epipolar pair, median per cell. Exclusion areas and boundaries of edits.gpkg are honoured (NaN). Writes dsm.tif, count.tif, report.json and report.html; fbm_lsm also sigma.tif and the raw and reduced points.</source>
             <extracomment>match_model: help</extracomment>
-            <translation>Ordnet die beiden Bilder eines Stereomodells zu und rastert die Punkte zu einem DOM. dense: Epipolarumbildung, Semi-Global Matching mit Links–Rechts-Prüfung, Vorwärtsschnitt jeder gültigen Disparität, Median je DOM-Zelle, Interpolation kleiner Lücken, die Bruchkanten nicht überquert; Ausschlussflächen und Begrenzungen aus edits.gpkg werden beachtet (NaN). Schreibt dsm.tif (float32, NaN = keine Höhe), count.tif (Punkte je Zelle) und report.json (Punkte, Abdeckung, gültige Disparitäten, Zeiten).</translation>
+            <translation>Ordnet die beiden Bilder eines Stereomodells zu und rastert die Punkte zu einem DOM. fbm_lsm: Bildpyramiden von grob nach fein, ausgehend von den Startpunkten aus edits.gpkg (oder vom Höhenbereich), Förstner-Punkte, merkmalsbasierte Zuordnung mit robuster Konsistenzprüfung und Links-rechts-Prüfung, Kleinste-Quadrate-Zuordnung (LSM) auf der feinsten Stufe; fehlgeschlagene Fenster werden markiert und die Zuordnung wird um sie herum fortgesetzt; Reduktion je Geländeelement (robuste Ebene, σ1, σ2) und eine Finite-Elemente-Fläche, die Bruchkanten berücksichtigt. dense: Semi-Global Matching jedes Pixels des Epipolarbildpaars, Median je Zelle. Ausschlussflächen und Begrenzungen aus edits.gpkg werden beachtet (NaN). Schreibt dsm.tif, count.tif, report.json und report.html; fbm_lsm zusätzlich sigma.tif sowie die Roh- und die reduzierten Punkte.</translation>
         </message>
         <message>
-            <source>dense: semi-global matching of every pixel on the epipolar pair.</source>
+            <source>fbm_lsm: hierarchical feature-based matching + LSM under the operator's control; dense: semi-global matching of every pixel.</source>
             <extracomment>match_model.method: help</extracomment>
-            <translation>dense: Semi-Global Matching jedes Pixels im Epipolarpaar.</translation>
+            <translation>fbm_lsm: hierarchische merkmalsbasierte Zuordnung + LSM unter Kontrolle des Operateurs; dense: Semi-Global Matching jedes Pixels.</translation>
+        </message>
+        <message>
+            <source>fbm_lsm</source>
+            <extracomment>match_model.method: option</extracomment>
+            <translation>fbm_lsm</translation>
         </message>
         <message>
             <source>dense</source>
@@ -840,13 +860,13 @@
         </message>
         <message>
             <source>DSM spacing [m]</source>
-            <extracomment>match_model.spacing: description</extracomment>
+            <extracomment>match_model.spacing: description; refine_object_space.spacing: description</extracomment>
             <translation>DOM-Gitterweite [m]</translation>
         </message>
         <message>
-            <source>Default: 1 × the model's ground sample distance.</source>
+            <source>Default: 2 × the model's ground sample distance for fbm_lsm, 1 × for dense.</source>
             <extracomment>match_model.spacing: help</extracomment>
-            <translation>Standard: 1 × Bodenpixelgröße des Modells.</translation>
+            <translation>Standard: 2 × Bodenpixelgröße des Modells für fbm_lsm, 1 × für dense.</translation>
         </message>
         <message>
             <source>Lowest height [m]</source>
@@ -874,9 +894,134 @@
             <translation>Lücken interpolieren bis [m]</translation>
         </message>
         <message>
-            <source>Larger gaps stay empty (NaN). Default: 10 × spacing.</source>
+            <source>Larger gaps stay empty (NaN). Default: 3 × the groundel size for fbm_lsm, 10 × spacing for dense.</source>
             <extracomment>match_model.max_gap: help</extracomment>
-            <translation>Größere Lücken bleiben leer (NaN). Standard: 10 × Gitterweite.</translation>
+            <translation>Größere Lücken bleiben leer (NaN). Standard: 3 × Größe der Geländeelemente für fbm_lsm, 10 × Gitterweite für dense.</translation>
+        </message>
+        <message>
+            <source>Strategy preset (fbm_lsm)</source>
+            <extracomment>match_model.preset: description</extracomment>
+            <translation>Strategievorgabe (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>flat: large windows and groundels, smooth surface; hilly: medium; urban: small windows and groundels, median, sharp edges; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <extracomment>match_model.preset: help</extracomment>
+            <translation>flach: große Fenster und Geländeelemente, glatte Fläche; hügelig: mittlere; städtisch: kleine Fenster und Geländeelemente, Median, scharfe Kanten; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+        </message>
+        <message>
+            <source>flat</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
+            <translation>flach</translation>
+        </message>
+        <message>
+            <source>hilly</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
+            <translation>hügelig</translation>
+        </message>
+        <message>
+            <source>urban</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
+            <translation>städtisch</translation>
+        </message>
+        <message>
+            <source>forest</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
+            <translation>Wald</translation>
+        </message>
+        <message>
+            <source>Matching window [px] (fbm_lsm)</source>
+            <extracomment>match_model.fbm_window: description</extracomment>
+            <translation>Zuordnungsfenster [px] (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>Side of the window of the robust consistency. Default: the preset's.</source>
+            <extracomment>match_model.fbm_window: help</extracomment>
+            <translation>Seitenlänge des Fensters der robusten Konsistenzprüfung. Standard: laut Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Minimum correlation (fbm_lsm)</source>
+            <extracomment>match_model.rho_min: description</extracomment>
+            <translation>Mindestkorrelation (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>Candidates with a smaller correlation coefficient are dropped. Default: 0.6.</source>
+            <extracomment>match_model.rho_min: help</extracomment>
+            <translation>Kandidaten mit kleinerem Korrelationskoeffizienten werden verworfen. Standard: 0,6.</translation>
+        </message>
+        <message>
+            <source>Refine by least-squares matching (fbm_lsm)</source>
+            <extracomment>match_model.lsm: description</extracomment>
+            <translation>Durch Kleinste-Quadrate-Zuordnung verfeinern (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>LSM at every point of the finest level; points whose LSM fails keep their feature-based value and a flag.</source>
+            <extracomment>match_model.lsm: help</extracomment>
+            <translation>LSM an jedem Punkt der feinsten Stufe; Punkte, bei denen die LSM fehlschlägt, behalten ihren merkmalsbasierten Wert und werden markiert.</translation>
+        </message>
+        <message>
+            <source>Groundel size [m] (fbm_lsm)</source>
+            <extracomment>match_model.groundel: description</extracomment>
+            <translation>Größe der Geländeelemente [m] (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (flat: 40 × GSD).</source>
+            <extracomment>match_model.groundel: help</extracomment>
+            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (flach: 40 × GSD).</translation>
+        </message>
+        <message>
+            <source>Groundel reduction (fbm_lsm)</source>
+            <extracomment>match_model.reduction: description</extracomment>
+            <translation>Reduktion je Geländeelement (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>l1: robust tilted plane; median; lower: lower envelope (vegetation). Default: the preset's.</source>
+            <extracomment>match_model.reduction: help</extracomment>
+            <translation>l1: robuste geneigte Ebene; Median; untere Hülle: untere Einhüllende (Vegetation). Standard: laut Vorgabe.</translation>
+        </message>
+        <message>
+            <source>l1</source>
+            <extracomment>match_model.reduction: option</extracomment>
+            <translation>l1</translation>
+        </message>
+        <message>
+            <source>median</source>
+            <extracomment>dsm_merge.mode: option; match_model.reduction: option</extracomment>
+            <translation>Median</translation>
+        </message>
+        <message>
+            <source>lower</source>
+            <extracomment>match_model.reduction: option</extracomment>
+            <translation>untere Hülle</translation>
+        </message>
+        <message>
+            <source>Point format (fbm_lsm)</source>
+            <extracomment>match_model.points_format: description</extracomment>
+            <translation>Punktformat (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>GeoPackage, or LAS (needs the Python package laspy).</source>
+            <extracomment>match_model.points_format: help</extracomment>
+            <translation>GeoPackage oder LAS (erfordert das Python-Paket laspy).</translation>
+        </message>
+        <message>
+            <source>gpkg</source>
+            <extracomment>match_model.points_format: option</extracomment>
+            <translation>gpkg</translation>
+        </message>
+        <message>
+            <source>las</source>
+            <extracomment>match_model.points_format: option</extracomment>
+            <translation>las</translation>
+        </message>
+        <message>
+            <source>Use start points (fbm_lsm)</source>
+            <extracomment>match_model.use_start_points: description</extracomment>
+            <translation>Startpunkte verwenden (fbm_lsm)</translation>
+        </message>
+        <message>
+            <source>Start from the start points of edits.gpkg; without any, the whole height range is searched at the coarsest level.</source>
+            <extracomment>match_model.use_start_points: help</extracomment>
+            <translation>Von den Startpunkten aus edits.gpkg ausgehen; ohne Startpunkte wird auf der gröbsten Stufe der gesamte Höhenbereich durchsucht.</translation>
         </message>
         <message>
             <source>DSM</source>
@@ -889,18 +1034,33 @@
             <translation>Punkte je Zelle</translation>
         </message>
         <message>
-            <source>Points (not written yet)</source>
+            <source>σ of the heights [m]</source>
+            <extracomment>match_model output sigma; refine_object_space output sigma</extracomment>
+            <translation>σ der Höhen [m]</translation>
+        </message>
+        <message>
+            <source>Points</source>
             <extracomment>match_model output points</extracomment>
-            <translation>Punkte (noch nicht geschrieben)</translation>
+            <translation>Punkte</translation>
+        </message>
+        <message>
+            <source>Reduced points</source>
+            <extracomment>match_model output reduced</extracomment>
+            <translation>Reduzierte Punkte</translation>
         </message>
         <message>
             <source>Report (JSON)</source>
-            <extracomment>match_model output report</extracomment>
+            <extracomment>filter_evaluate output report; filter_linear_prediction output report; filter_lowpass output report; match_model output report; refine_object_space output report</extracomment>
             <translation>Bericht (JSON)</translation>
         </message>
         <message>
+            <source>Report (HTML)</source>
+            <extracomment>match_model output report_html</extracomment>
+            <translation>Bericht (HTML)</translation>
+        </message>
+        <message>
             <source>Metrics</source>
-            <extracomment>match_model output metrics</extracomment>
+            <extracomment>match_model output metrics; refine_object_space output metrics</extracomment>
             <translation>Kennzahlen</translation>
         </message>
         <message>
@@ -910,7 +1070,7 @@
         </message>
         <message>
             <source>Surfaces</source>
-            <extracomment>dsm_merge: group; interpolate_dem: group</extracomment>
+            <extracomment>dsm_merge: group; interpolate_dem: group; refine_object_space: group</extracomment>
             <translation>Oberflächen</translation>
         </message>
         <message>
@@ -947,11 +1107,6 @@
             <source>median: robust against one wrong model where three or more overlap; mean: average; best_sigma: the height with the smallest σ.</source>
             <extracomment>dsm_merge.mode: help</extracomment>
             <translation>median: robust gegen ein falsches Modell, wo sich drei oder mehr überlappen; mean: Mittelwert; best_sigma: die Höhe mit dem kleinsten σ.</translation>
-        </message>
-        <message>
-            <source>median</source>
-            <extracomment>dsm_merge.mode: option</extracomment>
-            <translation>Median</translation>
         </message>
         <message>
             <source>mean</source>
@@ -1030,7 +1185,7 @@
         </message>
         <message>
             <source>Project (edits.gpkg)</source>
-            <extracomment>interpolate_dem.project: description</extracomment>
+            <extracomment>filter_linear_prediction.project: description; filter_lowpass.project: description; interpolate_dem.project: description</extracomment>
             <translation>Projekt (edits.gpkg)</translation>
         </message>
         <message>
@@ -1074,6 +1229,36 @@
             <translation>Größere Lücken bleiben leer (NaN). Standard: jede Lücke wird interpoliert.</translation>
         </message>
         <message>
+            <source>Interpolation method</source>
+            <extracomment>interpolate_dem.method: description</extracomment>
+            <translation>Interpolationsverfahren</translation>
+        </message>
+        <message>
+            <source>membrane: median per cell, empty cells by membrane interpolation; fe: finite elements fitted to all points with curvature regularisation (smooth between sparse points, breaklines allow kinks).</source>
+            <extracomment>interpolate_dem.method: help</extracomment>
+            <translation>membrane: Median je Zelle, leere Zellen durch Membran-Interpolation; fe: an alle Punkte angepasste finite Elemente mit Krümmungsregularisierung (glatt zwischen spärlichen Punkten, Bruchkanten erlauben Knicke).</translation>
+        </message>
+        <message>
+            <source>membrane</source>
+            <extracomment>interpolate_dem.method: option</extracomment>
+            <translation>membrane</translation>
+        </message>
+        <message>
+            <source>fe</source>
+            <extracomment>interpolate_dem.method: option</extracomment>
+            <translation>fe</translation>
+        </message>
+        <message>
+            <source>Smoothing (fe)</source>
+            <extracomment>interpolate_dem.smoothing: description</extracomment>
+            <translation>Glättung (fe)</translation>
+        </message>
+        <message>
+            <source>Weight of the curvature equations relative to a point (fe only): 0.01–0.1 interpolates, 1–10 smooths noisy points.</source>
+            <extracomment>interpolate_dem.smoothing: help</extracomment>
+            <translation>Gewicht der Krümmungsgleichungen relativ zu einem Punkt (nur fe): 0,01–0,1 interpoliert, 1–10 glättet verrauschte Punkte.</translation>
+        </message>
+        <message>
             <source>Points in the grid</source>
             <extracomment>interpolate_dem output used</extracomment>
             <translation>Punkte im Raster</translation>
@@ -1082,6 +1267,431 @@
             <source>Interpolated cells</source>
             <extracomment>interpolate_dem output filled</extracomment>
             <translation>Interpolierte Zellen</translation>
+        </message>
+        <message>
+            <source>Refine DSM in object space (multi-image LSM)</source>
+            <extracomment>refine_object_space: name</extracomment>
+            <translation>DOM im Objektraum verfeinern (Mehrbild-LSM)</translation>
+        </message>
+        <message>
+            <source>Refines a DSM with all images that see it (2 … N) by least-squares matching in object space: per DSM tile, heights on geometry nodes (every facet_px image pixels), object grey values on a finer grid and a gain and offset per image are adjusted together (Gauss–Newton, conjugate gradients) so that every image shows the same grey values at the projection of the surface, with curvature regularisation, coarse to fine over image-pyramid levels. The input DSM must be within a few pixels of parallax. Writes dsm.tif (refined heights, float32, NaN where not refined), sigma.tif (σ of the height per cell from the normal equations, m) and report.json (images and iterations per tile, σ0 in grey values, mean/median σ, failures). Exclusion areas and cells outside the boundaries of edits.gpkg are NaN.</source>
+            <extracomment>refine_object_space: help</extracomment>
+            <translation>Verfeinert ein DOM mit allen Bildern, die es sehen (2 … N), durch Kleinste-Quadrate-Zuordnung im Objektraum: je DOM-Kachel werden Höhen auf Geometrieknoten (alle facet_px Bildpixel), Objektgrauwerte auf einem feineren Raster sowie Verstärkung und Offset je Bild gemeinsam ausgeglichen (Gauß–Newton, konjugierte Gradienten), sodass jedes Bild an der Projektion der Oberfläche dieselben Grauwerte zeigt, mit Krümmungsregularisierung, grob nach fein über die Stufen der Bildpyramide. Das Eingangs-DOM muss bis auf wenige Pixel Parallaxe stimmen. Schreibt dsm.tif (verfeinerte Höhen, float32, NaN wo nicht verfeinert), sigma.tif (σ der Höhe je Zelle aus den Normalgleichungen, m) und report.json (Bilder und Iterationen je Kachel, σ0 in Grauwerten, mittleres/medianes σ, Fehlschläge). Ausschlussflächen und Zellen außerhalb der Begrenzungen von edits.gpkg sind NaN.</translation>
+        </message>
+        <message>
+            <source>DSM to refine</source>
+            <extracomment>refine_object_space.dsm: description</extracomment>
+            <translation>Zu verfeinerndes DOM</translation>
+        </message>
+        <message>
+            <source>Float GeoTIFF in the project CRS (e.g. dsm.tif of 'Match stereo model').</source>
+            <extracomment>refine_object_space.dsm: help</extracomment>
+            <translation>Gleitkomma-GeoTIFF im Projekt-KBS (z. B. dsm.tif von „Stereomodell zuordnen“).</translation>
+        </message>
+        <message>
+            <source>Default: &lt;project&gt;/products/dsm_refined/&lt;DSM name&gt;/.</source>
+            <extracomment>refine_object_space.output: help</extracomment>
+            <translation>Standard: &lt;Projekt&gt;/products/dsm_refined/&lt;DOM-Name&gt;/.</translation>
+        </message>
+        <message>
+            <source>Cell size of the refined DSM. Default: the input DSM's.</source>
+            <extracomment>refine_object_space.spacing: help</extracomment>
+            <translation>Zellengröße des verfeinerten DOM. Standard: die des Eingangs-DOM.</translation>
+        </message>
+        <message>
+            <source>Pyramid levels</source>
+            <extracomment>refine_object_space.levels: description</extracomment>
+            <translation>Pyramidenstufen</translation>
+        </message>
+        <message>
+            <source>Image-pyramid levels, coarse to fine; each level doubles the pull-in range (≈ 2 px of parallax on the top level).</source>
+            <extracomment>refine_object_space.levels: help</extracomment>
+            <translation>Stufen der Bildpyramide, grob nach fein; jede Stufe verdoppelt den Konvergenzbereich (≈ 2 px Parallaxe auf der obersten Stufe).</translation>
+        </message>
+        <message>
+            <source>Iterations per level</source>
+            <extracomment>refine_object_space.max_iter: description</extracomment>
+            <translation>Iterationen je Stufe</translation>
+        </message>
+        <message>
+            <source>Gauss–Newton iterations per level at most.</source>
+            <extracomment>refine_object_space.max_iter: help</extracomment>
+            <translation>Höchstens so viele Gauß–Newton-Iterationen je Stufe.</translation>
+        </message>
+        <message>
+            <source>Regularisation share</source>
+            <extracomment>refine_object_space.regularisation: description</extracomment>
+            <translation>Anteil der Regularisierung</translation>
+        </message>
+        <message>
+            <source>Weight of the curvature regularisation relative to the image data on the height diagonal of the normal equations (0 = none).</source>
+            <extracomment>refine_object_space.regularisation: help</extracomment>
+            <translation>Gewicht der Krümmungsregularisierung relativ zu den Bilddaten auf der Höhendiagonale der Normalgleichungen (0 = keine).</translation>
+        </message>
+        <message>
+            <source>Regularisation</source>
+            <extracomment>refine_object_space.regularisation_mode: description</extracomment>
+            <translation>Regularisierung</translation>
+        </message>
+        <message>
+            <source>curvature: smooth surface (thesis); correction: smooth only the change to the input DSM (keeps buildings and edges).</source>
+            <extracomment>refine_object_space.regularisation_mode: help</extracomment>
+            <translation>curvature: glatte Oberfläche (wie in der Dissertation); correction: nur die Änderung am Eingangs-DOM glätten (erhält Gebäude und Kanten).</translation>
+        </message>
+        <message>
+            <source>curvature</source>
+            <extracomment>refine_object_space.regularisation_mode: option</extracomment>
+            <translation>Krümmung</translation>
+        </message>
+        <message>
+            <source>correction</source>
+            <extracomment>refine_object_space.regularisation_mode: option</extracomment>
+            <translation>Korrektur</translation>
+        </message>
+        <message>
+            <source>Geometry facet [px]</source>
+            <extracomment>refine_object_space.facet_px: description</extracomment>
+            <translation>Geometriefacette [px]</translation>
+        </message>
+        <message>
+            <source>Spacing of the height unknowns in image pixels (thesis: 8).</source>
+            <extracomment>refine_object_space.facet_px: help</extracomment>
+            <translation>Abstand der Höhenunbekannten in Bildpixeln (Dissertation: 8).</translation>
+        </message>
+        <message>
+            <source>Grey-value facet [px]</source>
+            <extracomment>refine_object_space.grey_px: description</extracomment>
+            <translation>Grauwertfacette [px]</translation>
+        </message>
+        <message>
+            <source>Spacing of the object grey values in image pixels (thesis: 2).</source>
+            <extracomment>refine_object_space.grey_px: help</extracomment>
+            <translation>Abstand der Objektgrauwerte in Bildpixeln (Dissertation: 2).</translation>
+        </message>
+        <message>
+            <source>Comma-separated image names. Default: every image whose footprint covers a tile.</source>
+            <extracomment>refine_object_space.images: help</extracomment>
+            <translation>Bildnamen, durch Kommas getrennt. Standard: jedes Bild, dessen Fußabdruck eine Kachel überdeckt.</translation>
+        </message>
+        <message>
+            <source>Tile size [cells]</source>
+            <extracomment>refine_object_space.tile: description</extracomment>
+            <translation>Kachelgröße [Zellen]</translation>
+        </message>
+        <message>
+            <source>Side of the computation windows (plus overlap); bounds the memory.</source>
+            <extracomment>refine_object_space.tile: help</extracomment>
+            <translation>Seitenlänge der Rechenfenster (zuzüglich Überlappung); begrenzt den Speicherbedarf.</translation>
+        </message>
+        <message>
+            <source>Refined DSM</source>
+            <extracomment>refine_object_space output dsm</extracomment>
+            <translation>Verfeinertes DOM</translation>
+        </message>
+        <message>
+            <source>Filter DSM to DTM (iterative low-pass)</source>
+            <extracomment>filter_lowpass: name</extracomment>
+            <translation>DOM zu DGM filtern (iterativer Tiefpass)</translation>
+        </message>
+        <message>
+            <source>DTM filtering</source>
+            <extracomment>filter_evaluate: group; filter_linear_prediction: group; filter_lowpass: group</extracomment>
+            <translation>DGM-Filterung</translation>
+        </message>
+        <message>
+            <source>Iterative robust low-pass filtering (the 'Phoenics' method): the surface is smoothed with a window that shrinks from iteration to iteration (a least-squares plane through the remaining cells of the window), the difference model DSM − smoothed surface is formed, cells higher than the iteration's threshold (buildings, vegetation) or far below it (blunders) are eliminated, and the holes are filled from the surrounding ground by membrane interpolation. Exclusion areas with action 'keep' keep the DSM as DTM (embankments, dams); 'remove' areas are eliminated before the first iteration and bridged (forests); manual ground points are hard constraints (the DTM passes through them); smoothing and hole filling do not cross breaklines. The largest window should be 2–3 × the largest building width. Writes dtm.tif, ndsm.tif, mask.tif or labels.txt, report.json/html and, optionally, the difference model of every iteration.</source>
+            <extracomment>filter_lowpass: help</extracomment>
+            <translation>Iterative robuste Tiefpassfilterung (das „Phoenics“-Verfahren): Die Oberfläche wird mit einem Fenster geglättet, das von Iteration zu Iteration kleiner wird (eine ausgleichende Ebene durch die verbliebenen Zellen des Fensters), das Differenzmodell DOM − geglättete Oberfläche wird gebildet, Zellen, die höher als die Schwelle der Iteration liegen (Gebäude, Vegetation) oder weit darunter (Fehlmessungen), werden eliminiert, und die Löcher werden aus dem umgebenden Gelände durch Membraninterpolation gefüllt. Ausschlussflächen mit der Aktion 'keep' behalten das DOM als DGM (Dämme, Bahndämme); 'remove'-Flächen werden vor der ersten Iteration eliminiert und überbrückt (Wälder); manuelle Bodenpunkte sind feste Bedingungen (das DGM geht durch sie hindurch); Glättung und Lochfüllung greifen nicht über Bruchkanten. Das größte Fenster sollte 2–3 × so breit wie das breiteste Gebäude sein. Schreibt dtm.tif, ndsm.tif, mask.tif oder labels.txt, report.json/html und auf Wunsch das Differenzmodell jeder Iteration.</translation>
+        </message>
+        <message>
+            <source>DSM raster or points</source>
+            <extracomment>filter_linear_prediction.input: description; filter_lowpass.input: description</extracomment>
+            <translation>DOM-Raster oder Punkte</translation>
+        </message>
+        <message>
+            <source>A DSM GeoTIFF (nodata = no height), or points: XYZ text with whitespace, comma, semicolon or tab separators (extra columns ignored), GeoPackage points from matching (with sigma_z), LAS/LAZ when laspy is installed.</source>
+            <extracomment>filter_linear_prediction.input: help; filter_lowpass.input: help</extracomment>
+            <translation>Ein DOM als GeoTIFF (NoData = keine Höhe) oder Punkte: XYZ-Text mit Leerzeichen, Komma, Semikolon oder Tabulator als Trennzeichen (weitere Spalten werden ignoriert), GeoPackage-Punkte aus der Zuordnung (mit sigma_z), LAS/LAZ, wenn laspy installiert ist.</translation>
+        </message>
+        <message>
+            <source>Receives dtm.tif, ndsm.tif, mask.tif (raster input) or labels.txt (point input), report.json and report.html. Written completely or not at all.</source>
+            <extracomment>filter_linear_prediction.output: help; filter_lowpass.output: help</extracomment>
+            <translation>Erhält dtm.tif, ndsm.tif, mask.tif (Rastereingabe) oder labels.txt (Punkteingabe), report.json und report.html. Wird vollständig oder gar nicht geschrieben.</translation>
+        </message>
+        <message>
+            <source>Parameter preset</source>
+            <extracomment>filter_linear_prediction.preset: description; filter_lowpass.preset: description</extracomment>
+            <translation>Parametervorgabe</translation>
+        </message>
+        <message>
+            <source>default serves all terrain types; flat, hilly, urban, forest and steep are tuned variants. Options given below override the preset.</source>
+            <extracomment>filter_linear_prediction.preset: help; filter_lowpass.preset: help</extracomment>
+            <translation>default dient allen Geländetypen; flat, hilly, urban, forest und steep sind abgestimmte Varianten. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+        </message>
+        <message>
+            <source>default</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option</extracomment>
+            <translation>Standard</translation>
+        </message>
+        <message>
+            <source>Its exclusion areas (keep/remove), manual ground points and breaklines are honoured.</source>
+            <extracomment>filter_linear_prediction.project: help; filter_lowpass.project: help</extracomment>
+            <translation>Seine Ausschlussflächen (keep/remove), manuellen Bodenpunkte und Bruchkanten werden berücksichtigt.</translation>
+        </message>
+        <message>
+            <source>Grid spacing for point input [m]</source>
+            <extracomment>filter_linear_prediction.spacing: description; filter_lowpass.spacing: description</extracomment>
+            <translation>Rasterweite für Punkteingabe [m]</translation>
+        </message>
+        <message>
+            <source>Default: about the mean point spacing. Ignored for raster input.</source>
+            <extracomment>filter_linear_prediction.spacing: help; filter_lowpass.spacing: help</extracomment>
+            <translation>Standard: etwa der mittlere Punktabstand. Wird bei Rastereingabe ignoriert.</translation>
+        </message>
+        <message>
+            <source>CRS of point input</source>
+            <extracomment>filter_linear_prediction.crs: description; filter_lowpass.crs: description</extracomment>
+            <translation>KBS der Punkteingabe</translation>
+        </message>
+        <message>
+            <source>CRS of text points. Default: the project's, else the input's own.</source>
+            <extracomment>filter_linear_prediction.crs: help; filter_lowpass.crs: help</extracomment>
+            <translation>KBS von Textpunkten. Standard: das des Projekts, sonst das der Eingabe.</translation>
+        </message>
+        <message>
+            <source>Largest smoothing window [m]</source>
+            <extracomment>filter_lowpass.max_window: description</extracomment>
+            <translation>Größtes Glättungsfenster [m]</translation>
+        </message>
+        <message>
+            <source>Window of the first iteration; 2–3 × the largest building width. The windows of later iterations shrink in the preset's proportions.</source>
+            <extracomment>filter_lowpass.max_window: help</extracomment>
+            <translation>Fenster der ersten Iteration; 2–3 × die Breite des breitesten Gebäudes. Die Fenster späterer Iterationen schrumpfen in den Verhältnissen der Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Iterations</source>
+            <extracomment>filter_lowpass.iterations: description</extracomment>
+            <translation>Iterationen</translation>
+        </message>
+        <message>
+            <source>Number of smoothing/elimination iterations.</source>
+            <extracomment>filter_lowpass.iterations: help</extracomment>
+            <translation>Anzahl der Glättungs-/Eliminationsiterationen.</translation>
+        </message>
+        <message>
+            <source>Final height threshold [m]</source>
+            <extracomment>filter_lowpass.threshold: description</extracomment>
+            <translation>Letzte Höhenschwelle [m]</translation>
+        </message>
+        <message>
+            <source>Cells higher than this above the smoothed surface are objects in the last iteration; earlier iterations use the preset's larger thresholds.</source>
+            <extracomment>filter_lowpass.threshold: help</extracomment>
+            <translation>Zellen, die mehr als dies über der geglätteten Oberfläche liegen, sind in der letzten Iteration Objekte; frühere Iterationen verwenden die größeren Schwellen der Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Terrain slope allowance [%]</source>
+            <extracomment>filter_linear_prediction.slope: description; filter_lowpass.slope: description</extracomment>
+            <translation>Zuschlag für Geländeneigung [%]</translation>
+        </message>
+        <message>
+            <source>Allowance for breaks of slope (ridges, hill tops): every threshold grows by slope/100 × window/4.</source>
+            <extracomment>filter_lowpass.slope: help</extracomment>
+            <translation>Zuschlag für Neigungswechsel (Kämme, Kuppen): jede Schwelle wächst um Neigung/100 × Fenster/4.</translation>
+        </message>
+        <message>
+            <source>Write difference model of every iteration</source>
+            <extracomment>filter_lowpass.write_iterations: description</extracomment>
+            <translation>Differenzmodell jeder Iteration schreiben</translation>
+        </message>
+        <message>
+            <source>Writes diff_01.tif, diff_02.tif … (DSM − smoothed surface) for inspection.</source>
+            <extracomment>filter_lowpass.write_iterations: help</extracomment>
+            <translation>Schreibt diff_01.tif, diff_02.tif … (DOM − geglättete Oberfläche) zur Kontrolle.</translation>
+        </message>
+        <message>
+            <source>DTM</source>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm</extracomment>
+            <translation>DGM</translation>
+        </message>
+        <message>
+            <source>Normalised DSM (DSM − DTM)</source>
+            <extracomment>filter_linear_prediction output ndsm; filter_lowpass output ndsm</extracomment>
+            <translation>Normalisiertes DOM (DOM − DGM)</translation>
+        </message>
+        <message>
+            <source>Object mask (raster input)</source>
+            <extracomment>filter_linear_prediction output mask; filter_lowpass output mask</extracomment>
+            <translation>Objektmaske (Rastereingabe)</translation>
+        </message>
+        <message>
+            <source>Labels per input point (point input)</source>
+            <extracomment>filter_linear_prediction output labels; filter_lowpass output labels</extracomment>
+            <translation>Klassen je Eingabepunkt (Punkteingabe)</translation>
+        </message>
+        <message>
+            <source>Eliminated share, parameters, ground-point check</source>
+            <extracomment>filter_lowpass output metrics</extracomment>
+            <translation>Eliminierter Anteil, Parameter, Bodenpunktprüfung</translation>
+        </message>
+        <message>
+            <source>Evaluate ground filtering (Type I/II, kappa, DTM accuracy)</source>
+            <extracomment>filter_evaluate: name</extracomment>
+            <translation>Bodenfilterung bewerten (Typ I/II, Kappa, DGM-Genauigkeit)</translation>
+        </message>
+        <message>
+            <source>Compares a filter's ground/object labels with reference labels using the ISPRS filter test measures (Sithole &amp; Vosselman 2004): Type I = ground rejected / all ground, Type II = objects accepted as ground / all objects, total error and Cohen's kappa, in percent. Labels: the filter's labels.txt (one 0/1 per input point) or mask.tif; reference: a text file whose last column (or the given column) is the label, e.g. the ISPRS samples 'X Y Z label' (0 = ground, 1 = object), or a reference mask raster. With a DTM, its differences to a reference DTM (mean, std, RMS, NMAD, 95 % |Δh|) and, for a reference with coordinates, at the reference ground points are reported. Writes report.json and report.csv.</source>
+            <extracomment>filter_evaluate: help</extracomment>
+            <translation>Vergleicht die Boden-/Objekt-Klassifikation eines Filters mit Referenzklassen nach den Maßen des ISPRS-Filtertests (Sithole &amp; Vosselman 2004): Typ I = verworfener Boden / gesamter Boden, Typ II = als Boden angenommene Objekte / alle Objekte, Gesamtfehler und Cohens Kappa, in Prozent. Klassen: labels.txt des Filters (eine 0/1 je Eingabepunkt) oder mask.tif; Referenz: eine Textdatei, deren letzte (oder die angegebene) Spalte die Klasse ist, z. B. die ISPRS-Proben „X Y Z Klasse“ (0 = Boden, 1 = Objekt), oder ein Referenz-Maskenraster. Mit einem DGM werden seine Differenzen zu einem Referenz-DGM (Mittel, Standardabweichung, RMS, NMAD, 95 % |Δh|) und, bei einer Referenz mit Koordinaten, an den Referenz-Bodenpunkten ausgegeben. Schreibt report.json und report.csv.</translation>
+        </message>
+        <message>
+            <source>Filter labels (labels.txt or mask raster)</source>
+            <extracomment>filter_evaluate.labels: description</extracomment>
+            <translation>Klassen des Filters (labels.txt oder Maskenraster)</translation>
+        </message>
+        <message>
+            <source>0 = ground, 1 = object; a text file lists the same points in the same order as the reference.</source>
+            <extracomment>filter_evaluate.labels: help</extracomment>
+            <translation>0 = Boden, 1 = Objekt; eine Textdatei führt dieselben Punkte in derselben Reihenfolge wie die Referenz.</translation>
+        </message>
+        <message>
+            <source>Reference labels (text or mask raster)</source>
+            <extracomment>filter_evaluate.reference: description</extracomment>
+            <translation>Referenzklassen (Text oder Maskenraster)</translation>
+        </message>
+        <message>
+            <source>Text with the label in the last column (or the column below), e.g. 'X Y Z label'; or a mask raster (1 = object, 0 = ground).</source>
+            <extracomment>filter_evaluate.reference: help</extracomment>
+            <translation>Text mit der Klasse in der letzten Spalte (oder der unten angegebenen), z. B. „X Y Z Klasse“; oder ein Maskenraster (1 = Objekt, 0 = Boden).</translation>
+        </message>
+        <message>
+            <source>Label column of the reference text</source>
+            <extracomment>filter_evaluate.column: description</extracomment>
+            <translation>Klassenspalte des Referenztextes</translation>
+        </message>
+        <message>
+            <source>1 = first column. Default: a column named label/class, else the last.</source>
+            <extracomment>filter_evaluate.column: help</extracomment>
+            <translation>1 = erste Spalte. Standard: eine Spalte namens label/class, sonst die letzte.</translation>
+        </message>
+        <message>
+            <source>Filtered DTM</source>
+            <extracomment>filter_evaluate.dtm: description</extracomment>
+            <translation>Gefiltertes DGM</translation>
+        </message>
+        <message>
+            <source>The filter's dtm.tif, checked against the reference DTM and/or the reference ground points.</source>
+            <extracomment>filter_evaluate.dtm: help</extracomment>
+            <translation>dtm.tif des Filters, geprüft gegen das Referenz-DGM und/oder die Referenz-Bodenpunkte.</translation>
+        </message>
+        <message>
+            <source>Reference DTM</source>
+            <extracomment>filter_evaluate.reference_dtm: description</extracomment>
+            <translation>Referenz-DGM</translation>
+        </message>
+        <message>
+            <source>Δh = DTM − reference DTM on the reference grid.</source>
+            <extracomment>filter_evaluate.reference_dtm: help</extracomment>
+            <translation>Δh = DGM − Referenz-DGM im Raster der Referenz.</translation>
+        </message>
+        <message>
+            <source>Receives report.json and report.csv (written completely or not at all).</source>
+            <extracomment>filter_evaluate.output: help</extracomment>
+            <translation>Erhält report.json und report.csv (vollständig oder gar nicht geschrieben).</translation>
+        </message>
+        <message>
+            <source>Report (CSV, one row)</source>
+            <extracomment>filter_evaluate output csv</extracomment>
+            <translation>Bericht (CSV, eine Zeile)</translation>
+        </message>
+        <message>
+            <source>Type I/II, total error, kappa [%], DTM statistics</source>
+            <extracomment>filter_evaluate output metrics</extracomment>
+            <translation>Typ I/II, Gesamtfehler, Kappa [%], DGM-Statistik</translation>
+        </message>
+        <message>
+            <source>Filter DSM to DTM (robust linear prediction)</source>
+            <extracomment>filter_linear_prediction: name</extracomment>
+            <translation>DOM zu DGM filtern (robuste lineare Prädiktion)</translation>
+        </message>
+        <message>
+            <source>Hierarchical robust linear prediction (Kraus &amp; Pfeifer): on a pyramid of the DSM (lowest cell of every 2×2 block, up to the preset's coarse cell size) the terrain is predicted level by level, coarse to fine. At every level a trend (a robust plane, then the coarser level's DTM) is removed, a Gaussian covariance (signal variance, noise share, correlation length) is estimated from the data, and the heights are predicted with filtering; robust iterations give cells below the surface full weight and cells above it less (zero beyond the cut-off), so the surface sinks onto the ground and buildings and woods are bridged. Exclusion areas 'keep' keep the DSM as DTM, 'remove' areas are bridged, manual ground points are hard constraints and breaklines stop the prediction from reaching across. Writes dtm.tif, ndsm.tif, mask.tif or labels.txt, report.json/html and, optionally, the DTM of every level.</source>
+            <extracomment>filter_linear_prediction: help</extracomment>
+            <translation>Hierarchische robuste lineare Prädiktion (Kraus &amp; Pfeifer): Auf einer Pyramide des DOM (tiefste Zelle jedes 2×2-Blocks, bis zur groben Zellgröße des Parametersatzes) wird das Gelände Stufe für Stufe von grob nach fein prädiziert. Auf jeder Stufe wird ein Trend (eine robuste Ebene, danach das DGM der gröberen Stufe) abgezogen, eine Gauß-Kovarianz (Signalvarianz, Rauschanteil, Korrelationslänge) aus den Daten geschätzt und die Höhen werden mit Filterung prädiziert; robuste Iterationen geben Zellen unter der Fläche volles Gewicht und Zellen darüber weniger (null oberhalb der Abschneidegrenze), sodass die Fläche auf den Boden sinkt und Gebäude und Wälder überbrückt werden. Ausschlussgebiete „keep“ übernehmen das DOM als DGM, „remove“-Gebiete werden überbrückt, manuelle Bodenpunkte sind harte Bedingungen und Bruchkanten verhindern, dass die Prädiktion über sie hinweg reicht. Schreibt dtm.tif, ndsm.tif, mask.tif oder labels.txt, report.json/html und wahlweise das DGM jeder Stufe.</translation>
+        </message>
+        <message>
+            <source>Coarsest pyramid cell [m]</source>
+            <extracomment>filter_linear_prediction.coarse_spacing: description</extracomment>
+            <translation>Gröbste Pyramidenzelle [m]</translation>
+        </message>
+        <message>
+            <source>About the width of the largest building or wood to bridge.</source>
+            <extracomment>filter_linear_prediction.coarse_spacing: help</extracomment>
+            <translation>Etwa die Breite des größten zu überbrückenden Gebäudes oder Waldstücks.</translation>
+        </message>
+        <message>
+            <source>Weight cut-off above the surface [m]</source>
+            <extracomment>filter_linear_prediction.cutoff: description</extracomment>
+            <translation>Gewichtsgrenze über der Fläche [m]</translation>
+        </message>
+        <message>
+            <source>Cells more than this above the predicted surface (plus its shift) get weight 0 (objects).</source>
+            <extracomment>filter_linear_prediction.cutoff: help</extracomment>
+            <translation>Zellen, die mehr als dies über der prädizierten Fläche (plus ihrer Verschiebung) liegen, erhalten das Gewicht 0 (Objekte).</translation>
+        </message>
+        <message>
+            <source>Half-weight residual [m]</source>
+            <extracomment>filter_linear_prediction.half_weight: description</extracomment>
+            <translation>Residuum bei halbem Gewicht [m]</translation>
+        </message>
+        <message>
+            <source>Residual above the surface at which a cell keeps half its weight.</source>
+            <extracomment>filter_linear_prediction.half_weight: help</extracomment>
+            <translation>Residuum über der Fläche, bei dem eine Zelle die Hälfte ihres Gewichts behält.</translation>
+        </message>
+        <message>
+            <source>Widens the cut-off and the candidate band at coarse levels by slope × cell/2, so hill tops and embankment edges are not cut.</source>
+            <extracomment>filter_linear_prediction.slope: help</extracomment>
+            <translation>Erweitert die Gewichtsgrenze und das Kandidatenband auf groben Stufen um Neigung × Zelle/2, damit Kuppen und Dammkanten nicht abgeschnitten werden.</translation>
+        </message>
+        <message>
+            <source>Noise share (0 = pure interpolation)</source>
+            <extracomment>filter_linear_prediction.noise_share: description</extracomment>
+            <translation>Rauschanteil (0 = reine Interpolation)</translation>
+        </message>
+        <message>
+            <source>Fixed σ²_noise / variance; empty = estimated from the data.</source>
+            <extracomment>filter_linear_prediction.noise_share: help</extracomment>
+            <translation>Fester Anteil σ²_Rauschen / Varianz; leer = aus den Daten geschätzt.</translation>
+        </message>
+        <message>
+            <source>Robust iterations per level</source>
+            <extracomment>filter_linear_prediction.iterations: description</extracomment>
+            <translation>Robuste Iterationen je Stufe</translation>
+        </message>
+        <message>
+            <source>Ground tolerance [m]</source>
+            <extracomment>filter_linear_prediction.ground_tolerance: description</extracomment>
+            <translation>Bodentoleranz [m]</translation>
+        </message>
+        <message>
+            <source>Cells and points within this of the DTM are labelled ground.</source>
+            <extracomment>filter_linear_prediction.ground_tolerance: help</extracomment>
+            <translation>Zellen und Punkte, die höchstens so weit vom DGM abweichen, gelten als Boden.</translation>
+        </message>
+        <message>
+            <source>Write the DTM of every pyramid level</source>
+            <extracomment>filter_linear_prediction.write_levels: description</extracomment>
+            <translation>DGM jeder Pyramidenstufe schreiben</translation>
+        </message>
+        <message>
+            <source>Writes level_0.tif … level_k.tif for inspection.</source>
+            <extracomment>filter_linear_prediction.write_levels: help</extracomment>
+            <translation>Schreibt level_0.tif … level_k.tif zur Kontrolle.</translation>
+        </message>
+        <message>
+            <source>Eliminated share, covariance per level, ground-point check</source>
+            <extracomment>filter_linear_prediction output metrics</extracomment>
+            <translation>Eliminierter Anteil, Kovarianz je Stufe, Prüfung der Bodenpunkte</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>
@@ -1322,6 +1932,34 @@
             <source>Unexpected error (please report it):</source>
             <extracomment>plugin/widgets/run_panel.py:159</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>Generates a deterministic synthetic aerial block: terrain (gentle, dunes or steep), an embankment and a ditch with breaklines, buildings, trees and a forest patch, textured ground with bright check-point discs, frame images in two or more strips (60 % forward, 30 % side overlap) rendered by ray casting against the true DSM. Writes a complete project (project.toml, images, edits.gpkg, in-strip stereo models) and the ground truth (DTM, DSM, land cover, building footprints, 3-D breaklines, check points) below truth/. The same seed always gives the same block.</source>
+            <translation type="vanished">Erzeugt einen deterministischen synthetischen Bildflug: Gelände (flach, Dünen oder steil), einen Damm und einen Graben mit Bruchkanten, Gebäude, Bäume und ein Waldstück, texturierten Boden mit hellen Kontrollpunktscheiben sowie Reihenmessbilder in zwei oder mehr Streifen (60 % Längs-, 30 % Querüberdeckung), gerendert durch Strahlverfolgung gegen das wahre Oberflächenmodell. Schreibt ein vollständiges Projekt (project.toml, Bilder, edits.gpkg, Stereomodelle im Streifen) und die Referenzdaten (Geländemodell, Oberflächenmodell, Landbedeckung, Gebäudegrundrisse, 3D-Bruchkanten, Kontrollpunkte) unter truth/. Derselbe Startwert ergibt immer denselben Bildverband.</translation>
+        </message>
+        <message>
+            <source>tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: 1408×2000 px; large: 2400×3400 px (≈ 8 Mpx).</source>
+            <translation type="vanished">winzig: Bilder mit 224×288 px (Tests); klein: 704×1000 px (Demo); mittel: 1408×2000 px; groß: 2400×3400 px (≈ 8 Mpx).</translation>
+        </message>
+        <message>
+            <source>Matches the two images of a stereo model and grids the points to a DSM. dense: epipolar resampling, semi-global matching with left–right check, triangulation of every valid disparity, median per DSM cell, interpolation of small gaps that does not cross breaklines; exclusion areas and boundaries of edits.gpkg are honoured (NaN). Writes dsm.tif (float32, NaN = no height), count.tif (points per cell) and report.json (points, coverage, valid disparities, timings).</source>
+            <translation type="vanished">Ordnet die beiden Bilder eines Stereomodells zu und rastert die Punkte zu einem DOM. dense: Epipolarumbildung, Semi-Global Matching mit Links–Rechts-Prüfung, Vorwärtsschnitt jeder gültigen Disparität, Median je DOM-Zelle, Interpolation kleiner Lücken, die Bruchkanten nicht überquert; Ausschlussflächen und Begrenzungen aus edits.gpkg werden beachtet (NaN). Schreibt dsm.tif (float32, NaN = keine Höhe), count.tif (Punkte je Zelle) und report.json (Punkte, Abdeckung, gültige Disparitäten, Zeiten).</translation>
+        </message>
+        <message>
+            <source>dense: semi-global matching of every pixel on the epipolar pair.</source>
+            <translation type="vanished">dense: Semi-Global Matching jedes Pixels im Epipolarpaar.</translation>
+        </message>
+        <message>
+            <source>Default: 1 × the model's ground sample distance.</source>
+            <translation type="vanished">Standard: 1 × Bodenpixelgröße des Modells.</translation>
+        </message>
+        <message>
+            <source>Larger gaps stay empty (NaN). Default: 10 × spacing.</source>
+            <translation type="vanished">Größere Lücken bleiben leer (NaN). Standard: 10 × Gitterweite.</translation>
+        </message>
+        <message>
+            <source>Points (not written yet)</source>
+            <translation type="vanished">Punkte (noch nicht geschrieben)</translation>
         </message>
     </context>
 </TS>

@@ -320,10 +320,21 @@ class EpipolarPair:
             scale = np.where(v[..., 2] < 0, -self.focal_px / v[..., 2], np.nan)
         return v[..., 0] * scale + self.cx[s], self.cy - v[..., 1] * scale
 
-    def disparity_range(self, z_min: float, z_max: float) -> Tuple[float, float]:
-        """Disparity interval for terrain between ``z_min`` and ``z_max`` (at the pair centre)."""
-        centre = 0.5 * (self.eos[0].position + self.eos[1].position)
-        pts = np.array([[centre[0], centre[1], z_min], [centre[0], centre[1], z_max]])
+    def disparity_range(self, z_min: float, z_max: float,
+                        xy: Optional[ArrayLike] = None) -> Tuple[float, float]:
+        """Disparity interval for terrain between ``z_min`` and ``z_max``.
+
+        Evaluated at the ground points ``xy`` ((n, 2), e.g. the vertices of the stereo overlap)
+        at both heights, by default below the midpoint of the projection centres only. With
+        tilted images the disparity of one height varies across the overlap, so give ``xy``
+        where it matters.
+        """
+        if xy is None:
+            centre = 0.5 * (self.eos[0].position + self.eos[1].position)
+            xy = centre[None, :2]
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        pts = np.concatenate([np.column_stack([xy, np.full(len(xy), z)])
+                              for z in (z_min, z_max)])
         cl, _ = self.world_to_epipolar(pts, "left")
         cr, _ = self.world_to_epipolar(pts, "right")
         d = cl - cr

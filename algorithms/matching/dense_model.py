@@ -20,15 +20,14 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    rejected cells.
 
 Outputs in a staged folder (nothing is left behind on error or cancel): ``dsm.tif`` (float32,
-NaN, project CRS, overviews), ``count.tif`` (points per cell, uint16), ``report.json``.
+NaN, project CRS, overviews), ``count.tif`` (points per cell, uint16), ``report.json`` and
+``report.html`` (:func:`.model_report.write_model_report`).
 Coverage is the share of the cells of the stereo overlap (at the terrain height, inside the
 boundary, outside exclusions) that hold a height.
 """
 
 from __future__ import annotations
 
-import json
-import math
 import tempfile
 import time
 from pathlib import Path
@@ -36,10 +35,9 @@ from typing import Any, Dict, Optional, Union
 
 import numpy as np
 
-from ..errors import GeometryError, InputError
 from ..geometry.epipolar import SIDES, EpipolarPair
 from ..processing.feedback import Feedback, ensure_feedback
-from ..surface.gridding import Grid, GridAccumulator, finish_grid, polygon_mask, write_grid
+from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from .dense import iter_disparity_tiles
 
 PathLike = Union[str, Path]
@@ -93,22 +91,6 @@ def _window_source(src: Any):
     return read, (h, w)
 
 
-def _footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
-    """Image footprint polygon on the plane Z = ``height``."""
-    from shapely.geometry import Polygon
-
-    from ..geometry.projection import ray_at_height
-
-    c = cam.corners()
-    t = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
-    border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
-    pts = ray_at_height(border[:, 0], border[:, 1], height, cam, eo)
-    ok = np.isfinite(pts).all(axis=1)
-    if ok.sum() < 3:
-        return Polygon()
-    return Polygon(pts[ok, :2]).buffer(0)
-
-
 def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       spacing: Optional[float] = None, feedback: Optional[Feedback] = None,
                       min_height: Optional[float] = None, max_height: Optional[float] = None,
@@ -152,75 +134,24 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     dict
         ``{"dsm", "count", "report", "points", "metrics"}``.
     """
-    from ..project.model import Project
     from ..raster.io import open_image, staged_folder
+    from .model_setup import prepare_model
 
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
-    if not isinstance(project, Project):
-        project = Project.load(project)
-    m = project.model(model)
-    recs = [project.image(m.left), project.image(m.right)]
-    cams = [project.camera_of(r) for r in recs]
-    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
-                                          names=(recs[0].name, recs[1].name))
-    mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
-    terrain = project.terrain_height
-    H = m.height_above_ground
-    if terrain is None:
-        terrain = mean_z - (H if np.isfinite(H) else 10.0 * pair.base)
-    if not np.isfinite(H):
-        H = mean_z - float(terrain)
-    z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
-    z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
-    if not z_max > z_min:
-        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
-    if z_max >= mean_z:
-        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
-                         "give a lower max_height.")
-    # overlap of the two footprints: empty → the images do not form a stereo model
-    z_mid = float(np.clip(float(terrain), z_min, z_max))
-    fp = [_footprint(c, r.eo, z_mid) for c, r in zip(cams, recs)]
-    overlap = fp[0].intersection(fp[1])
-    if overlap.is_empty or overlap.area <= 0:
-        raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
-                            f"'{m.name}' do not overlap; check the model or the orientations.")
-    gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
-    spacing = float(spacing) if spacing else float(gsd)
-    if not spacing > 0:
-        raise InputError(f"The spacing must be positive, got {spacing}.")
+    setup = prepare_model(project, model, spacing=spacing, spacing_gsd=1.0,
+                          min_height=min_height, max_height=max_height,
+                          disparity_margin=disparity_margin)
+    project, m, recs, pair = setup.project, setup.model, setup.records, setup.pair
+    grid, spacing, gsd, H = setup.grid, setup.spacing, setup.gsd, setup.flying_height
+    z_min, z_max, min_d, max_d = setup.z_min, setup.z_max, setup.min_d, setup.max_d
+    excl, bounds, lines = setup.exclusions, setup.boundaries, setup.breaklines
     max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
     outlier_radius = 5.0 * spacing if outlier_radius is None else float(outlier_radius)
     if outlier_threshold is None:
         outlier_threshold = float(gsd) * H / pair.base  # 1 px of parallax in height
     for key, value in _DENSE_DEFAULTS.items():
         dense_options.setdefault(key, value)
-    d_lo, d_hi = pair.disparity_range(z_min, z_max)
-    if not (np.isfinite(d_lo) and np.isfinite(d_hi)):
-        raise GeometryError(f"Model '{m.name}': the height range {z_min:.1f}…{z_max:.1f} m "
-                            "gives no disparity; check min_height/max_height.")
-    widen = 0.1 * (d_hi - d_lo)
-    min_d = math.floor(d_lo - widen) - int(disparity_margin)
-    max_d = math.ceil(d_hi + widen) + int(disparity_margin)
-
-    from ..project.edits import read_constraints
-
-    excl, bounds, lines = (read_constraints(project.edits_path)
-                           if Path(project.edits_path).is_file() else ([], [], []))
-    # grid: the overlap at the lowest and highest heights, cut to the boundary
-    areas = []
-    for z in (z_min, z_max):
-        a = _footprint(cams[0], recs[0].eo, z).intersection(_footprint(cams[1], recs[1].eo, z))
-        if not a.is_empty:
-            areas.append(a)
-    from shapely.ops import unary_union
-
-    extent = unary_union(areas)
-    if bounds:
-        extent = extent.intersection(unary_union(bounds))
-        if extent.is_empty:
-            raise InputError(f"The boundaries of edits.gpkg do not touch model '{m.name}'.")
-    grid = Grid.from_bounds(*extent.bounds, spacing=spacing)
     feedback.info(f"Model {m.name}: heights {z_min:.1f}…{z_max:.1f} m → disparities "
                   f"{min_d}…{max_d} px; DSM {grid.width}×{grid.height} cells at "
                   f"{spacing:.3f} m.")
@@ -272,10 +203,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                           outlier_radius=outlier_radius, outlier_threshold=outlier_threshold,
                           outlier_k=outlier_k)
         feedback.check()
-        area_geom = overlap
-        if bounds:
-            area_geom = area_geom.intersection(unary_union(bounds))
-        area = polygon_mask([area_geom], grid) & ~polygon_mask(excl, grid)
+        area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(excl, grid)
         n_area = int(area.sum())
         n_have = int((np.isfinite(res.z) & area).sum())
         coverage = 100.0 * n_have / n_area if n_area else 0.0
@@ -302,12 +230,17 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                   "method": "dense", "crs": project.crs, "metrics": metrics,
                   "options": {k: v for k, v in dense_options.items() if v is not None},
                   "seconds": timings}
-        (tmp / "report.json").write_text(json.dumps(report, indent=1), encoding="utf-8")
+        report["flying_height_m"] = H
+        from .model_report import write_model_report
+
+        write_model_report(tmp, report, dsm=tmp / "dsm.tif", count=tmp / "count.tif",
+                           exclusions=excl)
         feedback.progress(100.0)
     feedback.info(f"Model {m.name}: {metrics['points']} points, coverage "
                   f"{coverage:.1f} %, valid disparities {metrics['valid_disparity_pct']:.1f} %.")
-    return {"dsm": str(out / "dsm.tif"), "count": str(out / "count.tif"),
-            "report": str(out / "report.json"), "points": None, "metrics": metrics}
+    return {"dsm": str(out / "dsm.tif"), "count": str(out / "count.tif"), "sigma": None,
+            "report": str(out / "report.json"), "report_html": str(out / "report.html"),
+            "points": None, "reduced": None, "metrics": metrics}
 
 
 __all__ = ["match_model_dense"]

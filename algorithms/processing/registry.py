@@ -24,6 +24,7 @@ ALGORITHM_MODULES = (
     "quality",
     "matching",
     "surface",
+    "filtering",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).

@@ -19,6 +19,8 @@ Point files operators have:
   ``id``/``name``).
 * Vector files (GeoPackage, Shapefile, GeoJSON): 3-D points, or 2-D points with a height field;
   reprojected to the DEM's CRS when both CRSs are known.
+* LAS / LAZ point clouds (when laspy is installed; LAZ needs a LAZ backend such as lazrs):
+  x, y, z and the CRS from the WKT/GeoTIFF VLR; the ids are the point numbers 1…n.
 
 Text files carry no CRS: their coordinates must be in the DEM's CRS.
 """
@@ -42,6 +44,9 @@ PathLike = Union[str, Path]
 
 #: File endings read with fiona; everything else is read as text.
 VECTOR_SUFFIXES = (".gpkg", ".shp", ".geojson", ".json", ".gml", ".sqlite", ".fgb", ".kml")
+
+#: Point-cloud file endings read with laspy (:func:`..surface.point_output.read_las`).
+LAS_SUFFIXES = (".las", ".laz")
 
 #: Accepted column / field names (lower case) of the coordinates and the id.
 COLUMN_NAMES: Dict[str, Tuple[str, ...]] = {
@@ -206,8 +211,39 @@ def _read_vector(path: Path) -> PointSet:
     return PointSet(ids, arr[:, 0], arr[:, 1], arr[:, 2], crs, skipped)
 
 
+class _RowIds(Sequence[str]):
+    """Ids "1" … "n" made on demand (no list of 10⁷ strings for a point cloud)."""
+
+    def __init__(self, n: int) -> None:
+        self._n = int(n)
+
+    def __len__(self) -> int:
+        return self._n
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return [str(i + 1) for i in range(*index.indices(self._n))]
+        i = int(index)
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError(index)
+        return str(i + 1)
+
+
+def _read_las(path: Path) -> PointSet:
+    from ..surface.point_output import read_las
+
+    x, y, z, crs, _ = read_las(path)
+    ok = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
+    if not ok.all():
+        x, y, z = x[ok], y[ok], z[ok]
+    return PointSet(_RowIds(x.size), x, y, z, crs,  # type: ignore[arg-type]
+                    int(np.count_nonzero(~ok)))
+
+
 def read_points(path: PathLike) -> PointSet:
-    """Read check points from XYZ text, CSV with a header, or a vector file.
+    """Read check points from XYZ text, CSV with a header, a vector file or LAS/LAZ.
 
     Raises
     ------
@@ -217,7 +253,9 @@ def read_points(path: PathLike) -> PointSet:
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Points file '{path}' does not exist.")
-    if path.suffix.lower() in VECTOR_SUFFIXES:
+    if path.suffix.lower() in LAS_SUFFIXES:
+        points = _read_las(path)
+    elif path.suffix.lower() in VECTOR_SUFFIXES:
         points = _read_vector(path)
     else:
         points = _read_text(path)

@@ -9,6 +9,12 @@ not cross breaklines (3-D breakline heights are used on the breakline cells), le
 areas and everything outside the boundary polygons NaN, and fills only gaps whose inscribed
 diameter is at most ``max_gap`` (default: every gap).
 
+``method="fe"`` instead fits finite elements to all the points (:func:`.fe_grid.fe_interpolate`:
+bilinear elements on the cell centres, thin-plate curvature regularisation of weight
+``smoothing``, breaklines allow slope and height jumps and give their 3-D heights, optional
+robust reweighting), the same masks and gap rule. It uses every point rather than one median per
+cell and bends smoothly between sparse points, where the membrane has kinks at the data.
+
 CRS
     The DEM's CRS is ``crs`` if given, else the project's, else the points'. Points and vector
     files that carry another CRS are transformed to it; text points carry none and are taken
@@ -31,7 +37,8 @@ from ..processing.feedback import Feedback, ensure_feedback
 from ..project.edits import read_constraints, read_geometries
 from ..quality.points import read_points
 from ..raster.io import atomic_output, write_raster
-from .gridding import Grid, GridAccumulator, finish_grid
+from .fe_grid import fe_interpolate
+from .gridding import Grid, GridAccumulator, GridResult, finish_grid
 
 PathLike = Union[str, Path]
 
@@ -54,6 +61,7 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
                     breaklines: Optional[PathLike] = None,
                     exclusions: Optional[PathLike] = None,
                     boundary: Optional[PathLike] = None, max_gap: Optional[float] = None,
+                    method: str = "membrane", smoothing: float = 0.1, robust: bool = False,
                     feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Grid points to a DEM that honours breaklines, exclusion areas and boundaries.
 
@@ -74,6 +82,13 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
         Vector files with (3-D) lines / polygons, in addition to the project's.
     max_gap : float, optional
         Largest gap (inscribed diameter, m) that is interpolated; default every gap.
+    method : {"membrane", "fe"}
+        Median per cell + membrane gap filling, or finite elements over all points.
+    smoothing : float
+        ``fe`` only: dimensionless weight of the curvature equations relative to a point
+        (see :mod:`.fe_grid`); 0.01–0.1 interpolates, 1–10 smooths noisy points.
+    robust : bool
+        ``fe`` only: iteratively reweighted fit that ignores blunders.
     feedback : Feedback, optional
 
     Returns
@@ -81,7 +96,8 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     dict
         ``dem, count`` (paths), ``points`` (read), ``used`` (in the grid), ``width, height,
         spacing, cells, measured, filled, coverage``, ``breaklines, exclusions, boundaries``
-        (numbers of geometries).
+        (numbers of geometries), ``method``; with ``fe`` also ``residual_rms``,
+        ``residual_sigma_mad`` (m) and ``downweighted`` (points).
     """
     feedback = ensure_feedback(feedback)
     output = Path(output)
@@ -89,6 +105,10 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
         raise InputError(f"The output '{output}' must be a GeoTIFF (.tif).")
     if not spacing or not spacing > 0:
         raise InputError(f"The spacing must be positive, got {spacing}.")
+    if method not in ("membrane", "fe"):
+        raise InputError(f"Unknown interpolation method '{method}'; use 'membrane' or 'fe'.")
+    if method == "fe" and not (smoothing is not None and smoothing > 0):
+        raise InputError(f"The smoothing must be positive, got {smoothing}.")
     pts = read_points(points)
     edits: Optional[Path] = None
     target = _crs(crs)
@@ -146,16 +166,27 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     if grid.width * grid.height > 2 ** 28:
         raise InputError(f"The DEM would have {grid.width} × {grid.height} cells; give a larger "
                          "spacing.")
-    acc = GridAccumulator(grid)
-    try:
-        acc.add(x[ok], y[ok], z[ok])
-        used = acc.points
-        zg, count = acc.reduce(feedback.step(10.0, 40.0))
-    finally:
-        acc.close()
-    feedback.progress(45.0)
     gap = float("inf") if max_gap is None else float(max_gap)
-    res = finish_grid(zg, count, grid, gap, exclusions=excl, boundary=bnds, breaklines=lines)
+    fe_info: Dict[str, Any] = {}
+    if method == "fe":
+        zf, fe_info = fe_interpolate(x[ok], y[ok], z[ok], grid, smoothing=float(smoothing),
+                                     breaklines=lines, exclusions=excl, boundaries=bnds,
+                                     max_gap=gap, robust=robust,
+                                     feedback=feedback.step(10.0, 90.0))
+        count = fe_info["count"]
+        used = fe_info["used"]
+        res = GridResult(zf, count, np.isfinite(zf) & (count == 0), grid)
+    else:
+        acc = GridAccumulator(grid)
+        try:
+            acc.add(x[ok], y[ok], z[ok])
+            used = acc.points
+            zg, count = acc.reduce(feedback.step(10.0, 40.0))
+        finally:
+            acc.close()
+        feedback.progress(45.0)
+        res = finish_grid(zg, count, grid, gap, exclusions=excl, boundary=bnds,
+                          breaklines=lines)
     feedback.progress(90.0)
     count_path = output.with_name(f"{output.stem}_count.tif")
     counts = np.minimum(res.count, np.iinfo(np.uint16).max).astype(np.uint16)
@@ -172,11 +203,20 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
         "width": grid.width, "height": grid.height, "spacing": float(spacing), "cells": cells,
         "measured": measured, "filled": int(res.filled.sum()), "coverage": valid / float(cells),
         "breaklines": len(lines), "exclusions": len(excl), "boundaries": len(bnds),
+        "method": method,
     }
+    if fe_info:
+        result.update(residual_rms=fe_info["rms"], residual_sigma_mad=fe_info["sigma_mad"],
+                      downweighted=fe_info["downweighted"])
     feedback.progress(100.0)
     feedback.info(f"DEM {grid.width} × {grid.height} cells of {spacing:g} m from {used} points: "
                   f"{measured} cells measured, {result['filled']} interpolated, "
                   f"{100.0 * result['coverage']:.1f} % with a height.")
+    if fe_info:
+        feedback.info(f"Finite elements (smoothing {smoothing:g}): point residuals RMS "
+                      f"{fe_info['rms']:.3f} m, σ(MAD) {fe_info['sigma_mad']:.3f} m"
+                      + (f", {fe_info['downweighted']} point(s) down-weighted as blunders."
+                         if robust else "."))
     if used < len(pts):
         feedback.warning(f"{len(pts) - used} point(s) lie outside the grid (boundary).")
     return result

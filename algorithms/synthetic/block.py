@@ -9,6 +9,8 @@ cancellation leaves nothing behind.
 Output layout::
 
     <output>/project.toml          cameras, images (PATB ω-φ-κ), in-strip stereo models
+                                   (size ``aerial``: one window camera per image, see
+                                   :mod:`.flight`; window offsets in the ``synthetic`` preset)
     <output>/edits.gpkg            empty operator edits
     <output>/images/<name>.tif     8-bit RGB, not georeferenced
     <output>/truth/dtm.tif         float32, NaN nodata, project CRS, cell = GSD/2
@@ -17,6 +19,11 @@ Output layout::
     <output>/truth/buildings.gpkg  footprints with roof type, heights, platform height
     <output>/truth/breaklines.gpkg 3-D lines with kind (embankment_crest/_toe, ditch_edge/_bottom)
     <output>/truth/checkpoints.gpkg, checkpoints.csv   3-D centres of the bright target discs
+
+Size ``aerial`` (:mod:`.flight`): three wide-angle film frames (11 500 px, c = 153 mm,
+B/H = 0.6, B_px = B/GSD = 4600 px) of which only a window over the common ground patch is
+rendered; the truth grid (cell GSD/2) covers that patch — the windows on the lowest and the
+highest plausible terrain, because the outer windows look 30° off-nadir.
 
 Memory: the truth grid (cell GSD/2) holds a handful of float32/float64 rasters, ≈ 80 bytes
 per cell at the peak (measured: 1.0 GB for the 13.7 M cells of ``small``), i.e. ≈ 12 GB for the
@@ -87,6 +94,8 @@ class BlockResult:
     gsd: float
     flying_height: float
     seconds: float
+    base_px: float = float("nan")  # mean model base / GSD (px): σ_Z/H = σ_px / base_px
+    b_h: float = float("nan")  # mean B/H of the models
 
     def outputs(self) -> Dict[str, Any]:
         """The ``synthetic_block`` outputs."""
@@ -97,6 +106,8 @@ class BlockResult:
             "models": self.models,
             "gsd_m": round(self.gsd, 4),
             "flying_height_m": round(self.flying_height, 2),
+            "base_px": round(self.base_px, 1),
+            "b_h": round(self.b_h, 4),
         }
 
 
@@ -107,13 +118,17 @@ def _polygon(points: np.ndarray):
 
 
 def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
-                texture_direction: float = 0.0, feedback: Optional[Feedback] = None) -> Scene:
+                texture_direction: float = 0.0, feedback: Optional[Feedback] = None,
+                window: Optional[int] = None) -> Scene:
     """Build the scene and the flight plan (everything but the images) in memory.
+
+    ``window`` (px) overrides the rendered window size of a windowed size (``aerial``), e.g.
+    smaller for tests; the flight geometry does not change.
 
     Raises
     ------
     InputError
-        For an unknown size or terrain type.
+        For an unknown size or terrain type, or a window with a non-windowed size.
     """
     if size not in SIZES:
         raise InputError(f"Unknown block size '{size}'; use one of {', '.join(SIZES)}.")
@@ -121,6 +136,8 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
         raise InputError(f"Unknown terrain '{terrain}'; use one of {', '.join(TERRAIN_TYPES)}.")
     feedback = ensure_feedback(feedback)
     spec = SIZES[size]
+    if window is not None:
+        spec = spec.with_window(window)
     streams = np.random.SeedSequence(int(seed)).spawn(6)
     layout, t_rng, o_rng, c_rng, x_rng = (np.random.default_rng(s) for s in streams[:5])
 
@@ -130,9 +147,11 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
     base = float(np.round(layout.uniform(*_BASE[terrain]), 1))
     plan = plan_flight(spec, size, gsd, origin, base, layout)
 
-    # grid: all footprints on the lowest plausible terrain, plus a margin
-    pts = np.concatenate([footprint_points(plan.camera, im.eo, base - _LOW[terrain])
-                          for im in plan.images])
+    # grid: all footprints on the lowest plausible terrain, plus a margin; windows looking
+    # off-nadir also on the highest (terrain is centred on its mean, objects add ≤ 25 m)
+    planes = [base - _LOW[terrain]] + ([base + _LOW[terrain] + 25.0] if spec.windowed else [])
+    pts = np.concatenate([footprint_points(plan.camera_of(im), im.eo, z)
+                          for im in plan.images for z in planes])
     cell = gsd / 2.0
     margin = 0.03 * float(np.ptp(pts[:, 0])) + 20 * cell
     x0 = np.floor((pts[:, 0].min() - margin) / cell) * cell
@@ -143,11 +162,17 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
     feedback.info(f"Synthetic {size}/{terrain} block, seed {seed}: {len(plan.images)} images of "
                   f"{spec.width}×{spec.height} px, GSD {gsd:.3f} m, truth grid {ncols}×{nrows} "
                   f"cells of {cell:.3f} m.")
+    if spec.windowed:
+        feedback.info(f"Windows of {spec.frame}×{spec.frame} px frames (c = {spec.focal_mm} mm): "
+                      f"H = {plan.flying_height:.1f} m, B = {plan.base:.1f} m, "
+                      f"B/H = {plan.base / plan.flying_height:.3f}, "
+                      f"B_px = {plan.base_px:.0f} px.")
     feedback.progress(2.0)
 
     dtm = make_terrain(terrain, grid, t_rng, base)
     feedback.progress(6.0)
-    footprints = [_polygon(footprint_points(plan.camera, im.eo, base)) for im in plan.images]
+    footprints = [_polygon(footprint_points(plan.camera_of(im), im.eo, base))
+                  for im in plan.images]
     from shapely.ops import unary_union
 
     covered = unary_union(footprints)
@@ -183,9 +208,9 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
     """
     from ..raster.sample import bilinear_grid
 
-    cam = plan.camera
     fps, heights = [], []
     for im in plan.images:
+        cam = plan.camera_of(im)
         pts = footprint_points(cam, im.eo, plan.terrain_height)
         pts = np.vstack([pts, im.eo.position[None, :2]])
         z = bilinear_grid(dtm, *grid.index(pts[:, 0], pts[:, 1]))
@@ -206,7 +231,7 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
         models.append(StereoModel(
             name=f"{left.name}_{right.name}", left=left.name, right=right.name, kind="in-strip",
             base=base, b_h=base / h, overlap=float(overlap),
-            gsd=float(cam.gsd(h)), height_above_ground=h))
+            gsd=float(plan.camera_of(a).gsd(h)), height_above_ground=h))
     return models
 
 
@@ -266,15 +291,17 @@ def checkpoint_ids(n: int) -> List[str]:
 
 def generate_block(output: Union[str, Path], size: str = "small", terrain: str = "gentle",
                    seed: int = 1, texture_direction: float = 0.0,
-                   feedback: Optional[Feedback] = None, replace: bool = False) -> BlockResult:
+                   feedback: Optional[Feedback] = None, replace: bool = False,
+                   window: Optional[int] = None) -> BlockResult:
     """Generate a synthetic block with ground truth into the folder ``output``.
 
     Parameters
     ----------
     output : path
         Output folder (must not exist or be empty unless ``replace``).
-    size : {"tiny", "small", "medium", "large"}
-        Image size and block layout, see :data:`.flight.SIZES`.
+    size : {"tiny", "small", "medium", "large", "aerial"}
+        Image size and block layout, see :data:`.flight.SIZES`; ``aerial`` renders windows of
+        a real wide-angle film geometry (B_px ≈ 4600 px).
     terrain : {"gentle", "dunes", "steep"}
     seed : int
         Seed of every random choice; equal seeds give byte-identical results.
@@ -282,6 +309,8 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
         Direction of the field furrows, degrees counter-clockwise from the flight direction.
     feedback : Feedback, optional
         Progress per image tile; cancellation leaves no output.
+    window : int, optional
+        Window size (px) of a windowed size (``aerial``), default that of the size.
 
     Returns
     -------
@@ -291,7 +320,7 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
     start = time.perf_counter()
     out = Path(output)
     with staged_folder(out, replace=replace) as tmp:
-        scene = build_scene(size, terrain, seed, texture_direction, feedback)
+        scene = build_scene(size, terrain, seed, texture_direction, feedback, window)
         plan = scene.plan
         renderer = Renderer(scene.grid, scene.dsm, scene.albedo, scene.checkpoints,
                             scene.disc_radius)
@@ -305,7 +334,8 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
             def progress(frac: float, k: int = k) -> None:
                 feedback.progress(20.0 + 75.0 * (k + frac) / n)
 
-            image, misses = render_image(renderer, plan.camera, im.eo, scene.supersample,
+            camera = plan.camera_of(im)
+            image, misses = render_image(renderer, camera, im.eo, scene.supersample,
                                          scene.tile_rays, seeds[k], plan.gsd / scene.supersample,
                                          progress)
             total_miss += misses
@@ -313,21 +343,21 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
             with warnings.catch_warnings():  # images carry no georeference on purpose
                 warnings.simplefilter("ignore", NotGeoreferencedWarning)
                 write_raster(path, image, photometric="RGB")
-            records.append(ImageRecord(im.name, f"images/{im.name}.tif", plan.camera.name,
-                                       im.eo))
+            records.append(ImageRecord(im.name, f"images/{im.name}.tif", camera.name, im.eo))
         if total_miss:
             feedback.warning(f"{total_miss} rays missed the truth DSM (rendered black).")
         feedback.info(f"Rendered {n} images in {time.perf_counter() - start:.1f} s.")
 
         project = Project(root=tmp, name=f"synthetic_{size}_{terrain}_{seed}", crs=CRS,
-                          cameras={plan.camera.name: plan.camera}, images=records,
+                          cameras=plan.cameras, images=records,
                           models=list(scene.models), terrain_height=plan.terrain_height)
         project.models = _detected_models(project, scene, feedback)
         project.presets["synthetic"] = {"size": size, "terrain": terrain, "seed": int(seed),
                                         "texture_direction_deg": float(texture_direction),
                                         "disc_radius_m": scene.disc_radius,
                                         "landcover_codes": {str(k): v for k, v in
-                                                            LANDCOVER.items()}}
+                                                            LANDCOVER.items()},
+                                        **_geometry_summary(scene, project.models)}
         project.save()
         _create_edits(tmp)
 
@@ -340,12 +370,35 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
         vec = _write_vectors(scene, truth)
         feedback.progress(99.0)
         names = {"dtm": "dtm.tif", "dsm": "dsm.tif", "landcover": "landcover.tif"}
-        n_models = len(scene.models)
+        n_models = len(project.models)
         gsd, height = plan.gsd, plan.flying_height
+        figures = _geometry_summary(scene, project.models)
     truth_paths = {k: out / "truth" / v for k, v in names.items()}
     truth_paths.update({k: out / "truth" / p.name for k, p in vec.items()
                         if k != "checkpoints_csv"})
-    return BlockResult(out, truth_paths, n, n_models, gsd, height, time.perf_counter() - start)
+    return BlockResult(out, truth_paths, n, n_models, gsd, height, time.perf_counter() - start,
+                       figures["base_px"], figures["b_h"])
+
+
+def _geometry_summary(scene: Scene, models: List[StereoModel]) -> Dict[str, Any]:
+    """Flight figures for the ``synthetic`` preset and the outputs: GSD, H, mean B/H and
+    base_px = B/GSD over the models (σ_Z/H = σ_px/base_px), per model, and the windows."""
+    plan = scene.plan
+    per_model = {m.name: {"base_px": round(m.base / m.gsd, 1), "b_h": round(m.b_h, 4)}
+                 for m in models}
+    out: Dict[str, Any] = {
+        "gsd_m": round(plan.gsd, 4),
+        "flying_height_m": round(plan.flying_height, 2),
+        "base_px": round(float(np.mean([m.base / m.gsd for m in models])), 1) if models
+        else float("nan"),
+        "b_h": round(float(np.mean([m.b_h for m in models])), 4) if models else float("nan"),
+        "models": per_model,
+    }
+    windows = {im.name: list(im.window) for im in plan.images if im.window is not None}
+    if windows:
+        out["frame_px"] = [plan.camera.width, plan.camera.height]
+        out["windows"] = windows  # top-left (col, row) of each window in its frame
+    return out
 
 
 def _detected_models(project: Project, scene: Scene, feedback: Feedback) -> List[StereoModel]:
@@ -387,6 +440,10 @@ def scene_summary(scene: Scene) -> Dict[str, Any]:
         "checkpoints": int(scene.checkpoints.shape[0]),
         "models": [m.name for m in scene.models],
         "relief": float(np.ptp(scene.dtm)),
+        "gsd": scene.plan.gsd,
+        "flying_height": scene.plan.flying_height,
+        "base_px": scene.plan.base_px,
+        "b_h": {m.name: m.b_h for m in scene.models},
     }
 
 

@@ -16,15 +16,51 @@ with :math:`H_{px}` the across-track format (pixels), :math:`c` the principal di
 :data:`FORMAT_OVER_FOCAL` × c, so :math:`B/H = (1-p)\cdot 0.9 = 0.36` at 60 % overlap — a
 normal-angle frame camera. Small random tilts (ω, φ ≈ N(0, 0.8°), clipped to ±2°), κ jitter and
 position jitter make the orientation realistic.
+
+**Height precision and the "aerial" size.** In the normal case the depth is
+:math:`D = f B / p` (f in px, parallax p in px), so a parallax error :math:`\sigma_{px}` gives
+
+.. math::
+
+   \sigma_Z = \frac{D^2}{f B}\,\sigma_{px}
+   \quad\Longrightarrow\quad
+   \frac{\sigma_Z}{H} = \frac{\sigma_{px}}{B_{px}}, \qquad
+   B_{px} = \frac{B}{\mathrm{GSD}} = (1-p)\,W .
+
+The small sizes have :math:`B_{px} = 0.4\,W` ≈ 90 px (tiny) … 960 px (large); a target of
+0.1 ‰ H would need :math:`\sigma_{px}` ≈ 0.01–0.1 px. A real film camera (23 cm format scanned
+at 20 µm: W = 11 500 px) has :math:`B_{px}` = 4600 px at 60 % overlap, where 0.1 ‰ H means
+:math:`\sigma_{px}` ≈ 0.46 px — what matching actually delivers. The size ``aerial`` therefore
+flies a *real* wide-angle geometry — format 11 500 × 11 500 px, pixel 20 µm, c = 153 mm
+(f = 7650 px), B/H = 0.4 · 230/153 = 0.60, GSD 0.15 m → H = 1147.5 m, B = 690 m — with three
+images in one strip, but renders only a **window** (crop, default 1024 × 1024 px) of each
+frame. All three windows are centred on the image of the same ground point, the planned nadir of
+the middle image at the mean terrain height (the triple-overlap area), so every point of the
+patch is seen by three images, the in-strip models 1–2 and 2–3 have B_px ≈ 4600 px, and the
+render cost is that of three small images instead of three 132-Mpx frames.
+
+A window is an ordinary :class:`~..geometry.camera.Camera` whose width/height are the window
+size and whose principal point is shifted by the window position. With the window's top-left
+pixel at (c₀, r₀) of the full frame (W_f × H_f px, pitch δ):
+
+.. math::
+
+   x_p = \left(\tfrac{W_f - 1}{2} - c_0 - \tfrac{w - 1}{2}\right)\delta,\qquad
+   y_p = \left(r_0 + \tfrac{h - 1}{2} - \tfrac{H_f - 1}{2}\right)\delta,
+
+so that window pixel (c, r) is exactly frame pixel (c₀ + c, r₀ + r); distortion (none here) is
+centred on the principal point, which lies outside the windows of the outer images. Each image
+gets its own camera (``synthetic_aerial_<image>``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Dict, List, Tuple
+from dataclasses import dataclass, replace
+from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from ..errors import GeometryError, InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
 
@@ -40,7 +76,8 @@ class SizeSpec:
     Attributes
     ----------
     width, height : int
-        Image size in pixels (width along track, height across track).
+        Image size in pixels (width along track, height across track); for a windowed size
+        (``frame > 0``) the size of the rendered window.
     gsd : float
         Nominal ground sample distance (m) on gentle terrain (steep terrain uses 2.5 ×).
     strips, images_per_strip : int
@@ -49,6 +86,13 @@ class SizeSpec:
         Sub-samples per pixel and axis (area average of ss × ss rays).
     tile_rays : int
         Rays traced at once (bounds the render memory: ≈ 200 bytes per ray).
+    frame : int
+        0: the image is the whole frame of a normal-angle camera (format 0.9 c along track).
+        > 0: a square film-like frame of ``frame`` × ``frame`` px with ``pixel_mm`` and
+        ``focal_mm``, of which only a ``width`` × ``height`` window over the common ground
+        patch is rendered (module notes).
+    pixel_mm, focal_mm : float
+        Pixel pitch and principal distance (mm) of the windowed frame camera.
     """
 
     width: int
@@ -58,6 +102,21 @@ class SizeSpec:
     images_per_strip: int
     supersample: int
     tile_rays: int = 1 << 20
+    frame: int = 0
+    pixel_mm: float = 0.0
+    focal_mm: float = FOCAL_LENGTH_MM
+
+    @property
+    def windowed(self) -> bool:
+        return self.frame > 0
+
+    def with_window(self, size: int) -> SizeSpec:
+        """The same windowed size with a ``size`` × ``size`` px window (e.g. smaller for tests)."""
+        if not self.windowed:
+            raise InputError("Only a windowed block size (aerial) accepts a window size.")
+        if not 64 <= int(size) <= self.frame:
+            raise InputError(f"The window size must be 64…{self.frame} px, got {size}.")
+        return replace(self, width=int(size), height=int(size))
 
 
 SIZES: Dict[str, SizeSpec] = {
@@ -65,6 +124,9 @@ SIZES: Dict[str, SizeSpec] = {
     "small": SizeSpec(704, 1000, 0.20, 2, 3, 2, 1 << 20),
     "medium": SizeSpec(1408, 2000, 0.15, 2, 4, 2, 1 << 20),
     "large": SizeSpec(2400, 3400, 0.12, 2, 4, 2, 1 << 20),
+    # 23 cm film scanned at 20 µm, wide angle c = 153 mm: B/H = 0.6, B_px = 4600 at 60 %
+    "aerial": SizeSpec(1024, 1024, 0.15, 1, 3, 2, 1 << 20, frame=11500, pixel_mm=0.020,
+                       focal_mm=153.0),
 }
 
 #: GSD factor of the steep terrain type (flying higher keeps the relief < ½ flying height)
@@ -73,17 +135,27 @@ STEEP_GSD_FACTOR = 2.5
 
 @dataclass
 class PlannedImage:
-    """One image of the flight plan."""
+    """One image of the flight plan.
+
+    ``camera`` is the image's own (window) camera of a windowed size, else None (the plan's
+    camera); ``window`` the (col, row) of the window's top-left pixel in the full frame.
+    """
 
     name: str
     strip: int
     index: int
     eo: ExteriorOrientation
+    camera: Optional[Camera] = None
+    window: Optional[Tuple[int, int]] = None
 
 
 @dataclass
 class FlightPlan:
-    """Camera and images of a synthetic block."""
+    """Camera and images of a synthetic block.
+
+    ``camera`` is the common camera; for a windowed size the full frame (not rendered), each
+    image then carries its window camera (:meth:`camera_of`).
+    """
 
     camera: Camera
     images: List[PlannedImage]
@@ -97,12 +169,54 @@ class FlightPlan:
     def projection_height(self) -> float:
         return self.terrain_height + self.flying_height
 
+    @property
+    def base_px(self) -> float:
+        """Planned base in pixels, B / GSD (σ_Z/H = σ_px / B_px)."""
+        return self.base / self.gsd
+
+    def camera_of(self, image: PlannedImage) -> Camera:
+        """The camera an image is rendered with."""
+        return self.camera if image.camera is None else image.camera
+
+    @property
+    def cameras(self) -> Dict[str, Camera]:
+        """Cameras of the rendered images by camera name (project order)."""
+        out: Dict[str, Camera] = {}
+        for im in self.images:
+            cam = self.camera_of(im)
+            out.setdefault(cam.name, cam)
+        return out
+
 
 def make_camera(spec: SizeSpec, name: str) -> Camera:
-    """A distortion-free frame camera with along-track format 0.9 c (c = 100 mm)."""
+    """The block's camera, distortion-free.
+
+    Normal sizes: along-track format 0.9 c (c = 100 mm). Windowed sizes: the full square frame
+    (``spec.frame`` px of ``spec.pixel_mm``, c = ``spec.focal_mm``).
+    """
+    if spec.windowed:
+        return Camera(name=name, width=spec.frame, height=spec.frame, focal_length=spec.focal_mm,
+                      pixel_size=(spec.pixel_mm, spec.pixel_mm))
     pixel = FORMAT_OVER_FOCAL * FOCAL_LENGTH_MM / spec.width
     return Camera(name=name, width=spec.width, height=spec.height, focal_length=FOCAL_LENGTH_MM,
                   pixel_size=(pixel, pixel))
+
+
+def window_camera(frame: Camera, name: str, col0: int, row0: int, width: int, height: int
+                  ) -> Camera:
+    """A ``width`` × ``height`` window of ``frame`` whose top-left pixel is frame pixel
+    (``col0``, ``row0``): same c, pitch and distortion, principal point shifted (module notes).
+    """
+    if frame.fiducial_affine is not None:
+        raise InputError("A window of a fiducial-calibrated camera is not supported.")
+    px, py = frame.pixel_size
+    xp0, yp0 = frame.principal_point
+    xp = xp0 + ((frame.width - 1) / 2.0 - col0 - (width - 1) / 2.0) * px
+    yp = yp0 + (row0 + (height - 1) / 2.0 - (frame.height - 1) / 2.0) * py
+    return Camera(name=name, width=int(width), height=int(height),
+                  focal_length=frame.focal_length, pixel_size=frame.pixel_size,
+                  principal_point=(round(xp, 9), round(yp, 9)),  # no float dust in the toml
+                  k1=frame.k1, k2=frame.k2, k3=frame.k3, p1=frame.p1, p2=frame.p2)
 
 
 def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float, float],
@@ -123,11 +237,14 @@ def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float,
         Mean terrain height (m); the projection centres fly at terrain_height + H.
     rng : numpy.random.Generator
         Source of the orientation jitter.
+
+    For a windowed size every image gets a window camera centred on the image of the ground
+    point (origin, terrain_height) — the planned nadir of the middle image.
     """
     camera = make_camera(spec, f"synthetic_{size_name}")
     H = gsd * camera.focal_length / camera.pixel_size[0]
-    base = (1.0 - forward_overlap) * spec.width * gsd
-    spacing = (1.0 - side_overlap) * spec.height * gsd
+    base = (1.0 - forward_overlap) * camera.width * gsd
+    spacing = (1.0 - side_overlap) * camera.height * gsd
     images: List[PlannedImage] = []
     n = spec.images_per_strip
     for s in range(spec.strips):
@@ -142,7 +259,27 @@ def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float,
             pos = np.array([x, y, terrain_height + H]) + jitter
             eo = ExteriorOrientation.from_opk(pos, float(omega), float(phi), kappa, "degrees")
             images.append(PlannedImage(f"{s + 1:02d}{i + 1:02d}", s, i, eo))
+    if spec.windowed:
+        centre = np.array([origin[0], origin[1], terrain_height])
+        for im in images:
+            im.window, im.camera = _window(camera, im, centre, spec)
     return FlightPlan(camera, images, gsd, H, base, spacing, terrain_height)
+
+
+def _window(frame: Camera, image: PlannedImage, centre: np.ndarray, spec: SizeSpec
+            ) -> Tuple[Tuple[int, int], Camera]:
+    """Window of ``spec.width`` × ``spec.height`` px of ``frame`` centred on ``centre``."""
+    from ..geometry.projection import world_to_pixel
+
+    col, row = world_to_pixel(centre[None, :], frame, image.eo)
+    # integer offsets keep the window pixels on the frame's pixel grid
+    col0 = int(np.rint(float(col[0]) - (spec.width - 1) / 2.0))
+    row0 = int(np.rint(float(row[0]) - (spec.height - 1) / 2.0))
+    if not (0 <= col0 <= frame.width - spec.width and 0 <= row0 <= frame.height - spec.height):
+        raise GeometryError(f"The window of image {image.name} at ({col0}, {row0}) leaves the "
+                            f"{frame.width} × {frame.height} px frame; use a smaller window.")
+    cam = window_camera(frame, f"{frame.name}_{image.name}", col0, row0, spec.width, spec.height)
+    return (col0, row0), cam
 
 
 def footprint_points(camera: Camera, eo: ExteriorOrientation, height: float,

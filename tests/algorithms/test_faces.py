@@ -199,10 +199,11 @@ def test_stereo_disparity_python_equals_cli(block, tmp_path) -> None:
     assert py["valid_share"] > 0.3
 
 
-def test_match_model_python_equals_cli(block, tmp_path) -> None:
+@pytest.mark.parametrize("method", ["dense", "fbm_lsm"])
+def test_match_model_python_equals_cli(block, tmp_path, method) -> None:
     project = block["py"]["project"]
     model = registry.run("project_info", {"project": project})["models"][0]["name"]
-    params = {"project": project, "model": model, "method": "dense"}
+    params = {"project": project, "model": model, "method": method}
     py = registry.run("match_model", {**params, "output": str(tmp_path / "py")})
     cli = _cli("match_model", {**params, "output": str(tmp_path / "cli")})
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
@@ -211,10 +212,17 @@ def test_match_model_python_equals_cli(block, tmp_path) -> None:
             assert np.array_equal(x.read(), y.read(), equal_nan=True), name
             assert x.transform == y.transform and x.crs == y.crs, name
     reports = [json.loads((tmp_path / f / "report.json").read_text()) for f in ("py", "cli")]
-    for r in reports:
-        r.pop("seconds")  # wall-clock times
-    assert reports[0] == reports[1]
+    assert _timeless(reports[0]) == _timeless(reports[1])
     assert py["metrics"]["coverage_pct"] > 50
+
+
+def _timeless(value):
+    """A report without its wall-clock times (every key ending in 'seconds')."""
+    if isinstance(value, dict):
+        return {k: _timeless(v) for k, v in value.items() if not k.endswith("seconds")}
+    if isinstance(value, list):
+        return [_timeless(v) for v in value]
+    return value
 
 
 def test_dsm_merge_python_equals_cli(block, tmp_path) -> None:
@@ -240,3 +248,82 @@ def test_interpolate_dem_python_equals_cli(block, tmp_path) -> None:
     _same_files(tmp_path / "py", tmp_path / "cli")
     # compartments between breaklines without a point stay empty
     assert py["used"] == py["points"] > 0 and py["coverage"] > 0.5 and py["filled"] > 0
+
+
+def test_filter_evaluate_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    with rasterio.open(q["dtm"]) as src:
+        z, t = src.read(1), src.transform
+    rows, cols = (a.ravel() for a in np.mgrid[3:z.shape[0] - 3:29, 3:z.shape[1] - 3:31])
+    x, y = t.c + (cols + 0.5) * t.a, t.f + (rows + 0.5) * t.e
+    truth = (np.arange(rows.size) % 4 == 0).astype(int)
+    guess = np.where(np.arange(rows.size) % 5 == 0, 1 - truth, truth)
+    ref, lab = tmp_path / "reference.txt", tmp_path / "labels.txt"
+    ref.write_text("".join(f"{a:.3f}\t{b:.3f}\t{c:.3f}\t{k}\n"
+                           for a, b, c, k in zip(x, y, z[rows, cols], truth)))
+    lab.write_text("".join(f"{k}\n" for k in guess))
+    params = {"labels": str(lab), "reference": str(ref), "dtm": q["dtm"],
+              "reference_dtm": q["dsm"]}
+    py = registry.run("filter_evaluate", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("filter_evaluate", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    m = py["metrics"]
+    assert m["n"] == rows.size and m["b"] + m["c"] == int(np.count_nonzero(guess != truth))
+    assert m["dtm"]["mean"] < 0 and m["dtm_at_ground_points"]["rms"] < 1e-3  # DTM − DSM ≤ 0
+
+
+def _dsm_crop(dsm: str, out: Path, half: float = 12.0) -> str:
+    """The central 2·half m square of a DSM as its own GeoTIFF (small inputs run fast)."""
+    from rasterio.windows import from_bounds
+
+    from photodem.algorithms.raster.io import write_raster
+
+    with rasterio.open(dsm) as src:
+        b = src.bounds
+        cx, cy = 0.5 * (b.left + b.right), 0.5 * (b.bottom + b.top)
+        win = from_bounds(cx - half, cy - half, cx + half, cy + half, src.transform)
+        win = win.round_offsets().round_lengths()
+        data = src.read(1, window=win)
+        path = out / "dsm_crop.tif"
+        write_raster(path, data, transform=src.window_transform(win), crs=src.crs)
+    return str(path)
+
+
+def test_refine_object_space_python_equals_cli(block, tmp_path) -> None:
+    dsm = _dsm_crop(_quality_inputs(block)["dsm"], tmp_path)
+    params = {"project": block["py"]["project"], "dsm": dsm, "spacing": 0.6}
+    py = registry.run("refine_object_space", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("refine_object_space", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    for name in ("dsm.tif", "sigma.tif"):
+        with open_image(tmp_path / "py" / name) as x, open_image(tmp_path / "cli" / name) as y:
+            assert np.array_equal(x.read(), y.read(), equal_nan=True), name
+            assert x.transform == y.transform and x.crs == y.crs, name
+    reports = [json.loads((tmp_path / f / "report.json").read_text()) for f in ("py", "cli")]
+    for r in reports:
+        r.pop("seconds")  # wall-clock times
+    assert reports[0] == reports[1]
+    assert py["metrics"]["refined_cells"] > 0.8 * 40 * 40 and py["metrics"]["failures"] == 0
+
+
+def test_filter_lowpass_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"input": q["dsm"], "project": block["py"]["project"], "preset": "urban",
+              "write_iterations": True}
+    py = registry.run("filter_lowpass", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("filter_lowpass", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["mask"] and py["labels"] is None and 0.0 < py["metrics"]["eliminated_share"] < 0.9
+
+
+def test_filter_linear_prediction_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"input": q["dsm"], "project": block["py"]["project"], "preset": "default",
+              "write_levels": True}
+    py = registry.run("filter_linear_prediction", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("filter_linear_prediction", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["mask"] and py["labels"] is None and 0.0 < py["metrics"]["eliminated_share"] < 0.9

@@ -110,6 +110,47 @@ def _epipolar(project: Path) -> Dict[str, Any]:
     return {"left": str(folder / "left.tif"), "right": str(folder / "right.tif")}
 
 
+def _filter_labels(project: Path) -> Dict[str, str]:
+    """Filter labels and reference labels (X Y Z label) on the truth DTM, made once beside it."""
+    import numpy as np
+    import rasterio
+
+    folder = Path(project).parent / "filter_labels"
+    lab, ref = folder / "labels.txt", folder / "reference.txt"
+    if not ref.is_file():
+        folder.mkdir(exist_ok=True)
+        with rasterio.open(_truth(project, "dtm.tif")) as src:
+            z, t = src.read(1), src.transform
+        rows, cols = (a.ravel() for a in np.mgrid[5:z.shape[0] - 5:37, 5:z.shape[1] - 5:41])
+        x, y = t.c + (cols + 0.5) * t.a, t.f + (rows + 0.5) * t.e
+        truth = (np.arange(rows.size) % 3 == 0).astype(int)
+        guess = truth.copy()
+        guess[::7] = 1 - guess[::7]
+        ref.write_text("".join(f"{a:.3f} {b:.3f} {c:.3f} {k}\n"
+                               for a, b, c, k in zip(x, y, z[rows, cols], truth)))
+        lab.write_text("".join(f"{k}\n" for k in guess))
+    return {"labels": str(lab), "reference": str(ref)}
+
+
+def _dsm_crop(project: Path) -> str:
+    """The central 24 m × 24 m of the truth DSM (object-space refinement runs fast on it)."""
+    import rasterio
+    from rasterio.windows import from_bounds
+
+    from photodem.algorithms.raster.io import write_raster
+
+    path = Path(project).parent / "dsm_crop" / "dsm.tif"
+    if not path.is_file():
+        with rasterio.open(_truth(project, "dsm.tif")) as src:
+            b = src.bounds
+            cx, cy = 0.5 * (b.left + b.right), 0.5 * (b.bottom + b.top)
+            win = from_bounds(cx - 12, cy - 12, cx + 12, cy + 12, src.transform)
+            win = win.round_offsets().round_lengths()
+            write_raster(path, src.read(1, window=win), transform=src.window_transform(win),
+                         crs=src.crs)
+    return str(path)
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_models": lambda out, req: {
@@ -153,6 +194,18 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
         "points": _truth(req("project"), "checkpoints.gpkg"), "project": str(req("project")),
         "breaklines": _truth(req("project"), "breaklines.gpkg"), "spacing": 2.0,
         "max_gap": 100.0, "output": str(out / "dem" / "dem.tif")},
+    "filter_evaluate": lambda out, req: {
+        **_filter_labels(req("project")), "dtm": _truth(req("project"), "dtm.tif"),
+        "reference_dtm": _truth(req("project"), "dsm.tif"), "output": str(out / "evaluate")},
+    "filter_lowpass": lambda out, req: {
+        "input": _truth(req("project"), "dsm.tif"), "project": str(req("project")),
+        "preset": "urban", "write_iterations": True, "output": str(out / "lowpass")},
+    "filter_linear_prediction": lambda out, req: {
+        "input": _truth(req("project"), "dsm.tif"), "project": str(req("project")),
+        "preset": "default", "write_levels": True, "output": str(out / "linear_prediction")},
+    "refine_object_space": lambda out, req: {
+        "project": str(req("project")), "dsm": _dsm_crop(req("project")), "spacing": 0.6,
+        "output": str(out / "refined")},
 }
 
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
+from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
 from ...raster.io import GTIFF_PROFILE, atomic_output, open_image
 from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
@@ -154,22 +155,27 @@ class MatchModel(Algorithm):
     group = GROUP
     group_id = GROUP_ID
     help = (
-        "Matches the two images of a stereo model and grids the points to a DSM. dense: "
-        "epipolar resampling, semi-global matching with left–right check, triangulation of "
-        "every valid disparity, median per DSM cell, interpolation of small gaps that does not "
-        "cross breaklines; exclusion areas and boundaries of edits.gpkg are honoured (NaN). "
-        "Writes dsm.tif (float32, NaN = no height), count.tif (points per cell) and report.json "
-        "(points, coverage, valid disparities, timings)."
+        "Matches the two images of a stereo model and grids the points to a DSM. fbm_lsm: "
+        "image pyramids coarse to fine from the start points of edits.gpkg (or the height "
+        "range), Förstner points, feature-based matching with robust consistency and a "
+        "left–right check, least-squares matching at the finest level; failed windows are "
+        "marked and matching goes on around them; groundel reduction (robust plane, σ1, σ2) "
+        "and a finite-element surface that honours breaklines. dense: semi-global matching of "
+        "every pixel of the epipolar pair, median per cell. Exclusion areas and boundaries of "
+        "edits.gpkg are honoured (NaN). Writes dsm.tif, count.tif, report.json and "
+        "report.html; fbm_lsm also sigma.tif and the raw and reduced points."
     )
     parameters = (
         Parameter("project", "project", "Project folder or project.toml"),
         Parameter("model", "model", "Stereo model"),
-        Parameter("method", "enum", "Method", default="dense", options=("dense",),
-                  help="dense: semi-global matching of every pixel on the epipolar pair."),
+        Parameter("method", "enum", "Method", default="fbm_lsm", options=("fbm_lsm", "dense"),
+                  help="fbm_lsm: hierarchical feature-based matching + LSM under the "
+                       "operator's control; dense: semi-global matching of every pixel."),
         Parameter("output", "output_folder", "Output folder", optional=True,
                   help="Default: <project>/products/dsm/<model>/."),
         Parameter("spacing", "number", "DSM spacing [m]", optional=True, minimum=0.0,
-                  unit="m", help="Default: 1 × the model's ground sample distance."),
+                  unit="m", help="Default: 2 × the model's ground sample distance for fbm_lsm, "
+                                 "1 × for dense."),
         Parameter("min_height", "number", "Lowest height [m]", optional=True, unit="m",
                   minimum=-100000.0, maximum=100000.0,
                   help="Lowest terrain/object height searched. Default: terrain height − 0.3 × "
@@ -180,13 +186,46 @@ class MatchModel(Algorithm):
                        "flying height above ground."),
         Parameter("max_gap", "number", "Interpolate gaps up to [m]", optional=True,
                   minimum=0.0, unit="m",
-                  help="Larger gaps stay empty (NaN). Default: 10 × spacing."),
+                  help="Larger gaps stay empty (NaN). Default: 3 × the groundel size for "
+                       "fbm_lsm, 10 × spacing for dense."),
+        Parameter("preset", "enum", "Strategy preset (fbm_lsm)", default=DEFAULT_PRESET,
+                  options=PRESET_NAMES,
+                  help="flat: large windows and groundels, smooth surface; hilly: medium; "
+                       "urban: small windows and groundels, median, sharp edges; forest: lower "
+                       "envelope of the points per groundel. The options below override it."),
+        Parameter("fbm_window", "integer", "Matching window [px] (fbm_lsm)", optional=True,
+                  minimum=8, maximum=128, unit="px",
+                  help="Side of the window of the robust consistency. Default: the preset's."),
+        Parameter("rho_min", "number", "Minimum correlation (fbm_lsm)", optional=True,
+                  minimum=0.0, maximum=1.0,
+                  help="Candidates with a smaller correlation coefficient are dropped. "
+                       "Default: 0.6."),
+        Parameter("lsm", "bool", "Refine by least-squares matching (fbm_lsm)", default=True,
+                  help="LSM at every point of the finest level; points whose LSM fails keep "
+                       "their feature-based value and a flag."),
+        Parameter("groundel", "number", "Groundel size [m] (fbm_lsm)", optional=True,
+                  minimum=0.0, unit="m",
+                  help="Side of the cells of the robust reduction. Default: the preset's "
+                       "multiple of the GSD (flat: 40 × GSD)."),
+        Parameter("reduction", "enum", "Groundel reduction (fbm_lsm)", optional=True,
+                  options=("l1", "median", "lower"),
+                  help="l1: robust tilted plane; median; lower: lower envelope (vegetation). "
+                       "Default: the preset's."),
+        Parameter("points_format", "enum", "Point format (fbm_lsm)", default="gpkg",
+                  options=("gpkg", "las"),
+                  help="GeoPackage, or LAS (needs the Python package laspy)."),
+        Parameter("use_start_points", "bool", "Use start points (fbm_lsm)", default=True,
+                  help="Start from the start points of edits.gpkg; without any, the whole "
+                       "height range is searched at the coarsest level."),
     )
     outputs = (
         Output("dsm", "raster", "DSM"),
         Output("count", "raster", "Points per cell"),
-        Output("points", "file", "Points (not written yet)"),
+        Output("sigma", "raster", "σ of the heights [m]"),
+        Output("points", "file", "Points"),
+        Output("reduced", "file", "Reduced points"),
         Output("report", "file", "Report (JSON)"),
+        Output("report_html", "file", "Report (HTML)"),
         Output("metrics", "json", "Metrics"),
     )
     iterates_over = "model"
@@ -194,19 +233,32 @@ class MatchModel(Algorithm):
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from pathlib import Path
 
-        from ...matching.dense_model import match_model_dense
         from ...project.model import Project
 
         project = Project.load(params["project"])
         model = project.model(params["model"])
         out = Path(params["output"]) if params.get("output") else \
             project.products_dir("dsm") / model.name
-        if params.get("method", "dense") != "dense":
-            raise InputError(f"Unknown matching method '{params['method']}'; use 'dense'.")
-        return match_model_dense(project, model.name, out, spacing=params.get("spacing") or None,
-                                 min_height=params.get("min_height"),
-                                 max_height=params.get("max_height"),
-                                 max_gap=params.get("max_gap"), feedback=feedback)
+        method = params.get("method") or "fbm_lsm"
+        common = {"spacing": params.get("spacing") or None,
+                  "min_height": params.get("min_height"),
+                  "max_height": params.get("max_height"),
+                  "max_gap": params.get("max_gap"), "feedback": feedback}
+        if method == "dense":
+            from ...matching.dense_model import match_model_dense
+
+            return match_model_dense(project, model.name, out, **common)
+        if method != "fbm_lsm":
+            raise InputError(f"Unknown matching method '{method}'; use fbm_lsm or dense.")
+        from ...matching.fbm_model import match_model_fbm_lsm
+
+        extra = {k: params.get(k) for k in ("fbm_window", "rho_min") if params.get(k)}
+        return match_model_fbm_lsm(
+            project, model.name, out, preset=params.get("preset") or DEFAULT_PRESET,
+            groundel=params.get("groundel") or None, reduction=params.get("reduction") or None,
+            points_format=params.get("points_format") or "gpkg",
+            use_start_points=bool(params.get("use_start_points", True)),
+            lsm=bool(params.get("lsm", True)), **extra, **common)
 
 
 ALGORITHMS = [StereoDisparity, MatchModel]

@@ -88,6 +88,14 @@ class InterpolateDem(Algorithm):
         Parameter("max_gap", "number", "Interpolate gaps up to [m]", optional=True,
                   minimum=0.0, unit="m",
                   help="Larger gaps stay empty (NaN). Default: every gap is interpolated."),
+        Parameter("method", "enum", "Interpolation method", default="membrane",
+                  options=("membrane", "fe"),
+                  help="membrane: median per cell, empty cells by membrane interpolation; fe: "
+                       "finite elements fitted to all points with curvature regularisation "
+                       "(smooth between sparse points, breaklines allow kinks)."),
+        Parameter("smoothing", "number", "Smoothing (fe)", default=0.1, minimum=0.0,
+                  help="Weight of the curvature equations relative to a point (fe only): "
+                       "0.01–0.1 interpolates, 1–10 smooths noisy points."),
     )
     outputs = (
         Output("dem", "raster", "DEM"),
@@ -106,8 +114,89 @@ class InterpolateDem(Algorithm):
                               breaklines=params.get("breaklines") or None,
                               exclusions=params.get("exclusions") or None,
                               boundary=params.get("boundary") or None,
-                              max_gap=params.get("max_gap"), feedback=feedback)
+                              max_gap=params.get("max_gap"),
+                              method=params.get("method") or "membrane",
+                              smoothing=(0.1 if params.get("smoothing") is None
+                                         else params["smoothing"]), feedback=feedback)
         return {k: res[k] for k in ("dem", "count", "points", "used", "filled", "coverage")}
 
 
-ALGORITHMS = [DsmMerge, InterpolateDem]
+class RefineObjectSpace(Algorithm):
+    id = "refine_object_space"
+    name = "Refine DSM in object space (multi-image LSM)"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Refines a DSM with all images that see it (2 … N) by least-squares matching in object "
+        "space: per DSM tile, heights on geometry nodes (every facet_px image pixels), object "
+        "grey values on a finer grid and a gain and offset per image are adjusted together "
+        "(Gauss–Newton, conjugate gradients) so that every image shows the same grey values at "
+        "the projection of the surface, with curvature regularisation, coarse to fine over "
+        "image-pyramid levels. The input DSM must be within a few pixels of parallax. Writes "
+        "dsm.tif (refined heights, float32, NaN where not refined), sigma.tif (σ of the height "
+        "per cell from the normal equations, m) and report.json (images and iterations per "
+        "tile, σ0 in grey values, mean/median σ, failures). Exclusion areas and cells outside "
+        "the boundaries of edits.gpkg are NaN."
+    )
+    parameters = (
+        Parameter("project", "project", "Project folder or project.toml"),
+        Parameter("dsm", "raster", "DSM to refine",
+                  help="Float GeoTIFF in the project CRS (e.g. dsm.tif of 'Match stereo model')."),
+        Parameter("output", "output_folder", "Output folder", optional=True,
+                  help="Default: <project>/products/dsm_refined/<DSM name>/."),
+        Parameter("spacing", "number", "DSM spacing [m]", optional=True, minimum=0.0, unit="m",
+                  help="Cell size of the refined DSM. Default: the input DSM's."),
+        Parameter("levels", "integer", "Pyramid levels", default=2, minimum=1, maximum=8,
+                  help="Image-pyramid levels, coarse to fine; each level doubles the pull-in "
+                       "range (≈ 2 px of parallax on the top level)."),
+        Parameter("max_iter", "integer", "Iterations per level", default=8, minimum=1,
+                  maximum=50, help="Gauss–Newton iterations per level at most."),
+        Parameter("regularisation", "number", "Regularisation share", default=1.0,
+                  minimum=0.0, maximum=1000.0,
+                  help="Weight of the curvature regularisation relative to the image data on "
+                       "the height diagonal of the normal equations (0 = none)."),
+        Parameter("regularisation_mode", "enum", "Regularisation", default="curvature",
+                  options=("curvature", "correction"),
+                  help="curvature: smooth surface (thesis); correction: smooth only the "
+                       "change to the input DSM (keeps buildings and edges)."),
+        Parameter("facet_px", "number", "Geometry facet [px]", default=8.0, minimum=1.0,
+                  maximum=64.0, unit="px",
+                  help="Spacing of the height unknowns in image pixels (thesis: 8)."),
+        Parameter("grey_px", "number", "Grey-value facet [px]", default=2.0, minimum=0.5,
+                  maximum=16.0, unit="px",
+                  help="Spacing of the object grey values in image pixels (thesis: 2)."),
+        Parameter("images", "string", "Images", optional=True,
+                  help="Comma-separated image names. Default: every image whose footprint "
+                       "covers a tile."),
+        Parameter("tile", "integer", "Tile size [cells]", default=192, minimum=16,
+                  maximum=4096, unit="cells",
+                  help="Side of the computation windows (plus overlap); bounds the memory."),
+    )
+    outputs = (
+        Output("dsm", "raster", "Refined DSM"),
+        Output("sigma", "raster", "σ of the heights [m]"),
+        Output("report", "file", "Report (JSON)"),
+        Output("metrics", "json", "Metrics"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from pathlib import Path
+
+        from ...matching.object_space import refine_object_space
+        from ...project.model import Project
+
+        project = Project.load(params["project"])
+        dsm = Path(params["dsm"])
+        out = Path(params["output"]) if params.get("output") else \
+            project.products_dir("dsm_refined") / dsm.stem
+        images = [n.strip() for n in (params.get("images") or "").split(",") if n.strip()]
+        return refine_object_space(
+            project, dsm, out, spacing=params.get("spacing") or None,
+            levels=params.get("levels"), max_iter=params.get("max_iter", 8),
+            regularisation=params.get("regularisation", 1.0),
+            regularisation_mode=params.get("regularisation_mode", "curvature"),
+            facet_px=params.get("facet_px", 8.0), grey_px=params.get("grey_px", 2.0),
+            images=images or None, tile=params.get("tile", 192), feedback=feedback)
+
+
+ALGORITHMS = [DsmMerge, InterpolateDem, RefineObjectSpace]

@@ -17,7 +17,8 @@ class SyntheticBlock(Algorithm):
         "Generates a deterministic synthetic aerial block: terrain (gentle, dunes or steep), an "
         "embankment and a ditch with breaklines, buildings, trees and a forest patch, textured "
         "ground with bright check-point discs, frame images in two or more strips (60 % forward, "
-        "30 % side overlap) rendered by ray casting against the true DSM. Writes a complete "
+        "30 % side overlap; aerial: one strip of three windowed film frames) rendered by ray "
+        "casting against the true DSM. Writes a complete "
         "project (project.toml, images, edits.gpkg, in-strip stereo models) and the ground truth "
         "(DTM, DSM, land cover, building footprints, 3-D breaklines, check points) below "
         "truth/. The same seed always gives the same block."
@@ -25,9 +26,12 @@ class SyntheticBlock(Algorithm):
     parameters = (
         Parameter("output", "output_folder", "Output project folder"),
         Parameter("size", "enum", "Block size", default="small",
-                  options=("tiny", "small", "medium", "large"),
+                  options=("tiny", "small", "medium", "large", "aerial"),
                   help="tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: "
-                       "1408×2000 px; large: 2400×3400 px (≈ 8 Mpx)."),
+                       "1408×2000 px; large: 2400×3400 px (≈ 8 Mpx); aerial: three "
+                       "wide-angle film frames in one strip (11500 px, c = 153 mm, B/H 0.6, "
+                       "base 4600 px, H ≈ 1150 m) of which a 1024×1024 px window over the "
+                       "common ground patch is rendered — for height accuracy in ‰ of H."),
         Parameter("terrain", "enum", "Terrain type", default="gentle",
                   options=("gentle", "dunes", "steep"),
                   help="steep: relief > 100 m with slopes of 45° and more (flown 2.5× higher)."),
@@ -51,6 +55,8 @@ class SyntheticBlock(Algorithm):
         Output("models", "number", "Number of stereo models"),
         Output("gsd_m", "number", "Ground sample distance [m]"),
         Output("flying_height_m", "number", "Flying height above mean terrain [m]"),
+        Output("base_px", "number", "Mean model base in pixels B/GSD (σZ/H = σpx/base_px)"),
+        Output("b_h", "number", "Mean base-to-height ratio B/H of the models"),
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:

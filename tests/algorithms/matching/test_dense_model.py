@@ -31,7 +31,7 @@ def block(tmp_path_factory):
 def dsm(block, tmp_path_factory):
     out = tmp_path_factory.mktemp("dense_model_out") / "dsm"
     return registry.run("match_model", {"project": block["project"], "model": MODEL,
-                                        "output": str(out)})
+                                        "method": "dense", "output": str(out)})
 
 
 def _open_stats(block, dsm_path: str, flying_height: float):

@@ -1,0 +1,1054 @@
+r"""DSM → DTM by hierarchical robust linear prediction (Kraus & Pfeifer 1998 style).
+
+Linear prediction (least-squares interpolation with filtering, seed-002-003 A3.9)
+    Heights are split into a deterministic trend and a zero-mean remainder
+    :math:`l = z - t(x, y)`; the remainder is a correlated signal plus white noise,
+    :math:`l = s + n`, with the Gaussian covariance
+
+    .. math:: C(d) = C_0 \exp\bigl(-(d / c)^2\bigr), \qquad
+              \operatorname{Var}(n_i) = \sigma_n^2 / p_i .
+
+    The signal at any point P (observation or not) is predicted as
+
+    .. math:: \hat s(P) = \mathbf c_P^\top (\mathbf C + \mathbf D)^{-1} \mathbf l, \qquad
+              (\mathbf C)_{jk} = C(|P_j P_k|), \ \mathbf D = \operatorname{diag}(\sigma_n^2/p_j),
+
+    and the surface is :math:`t + \hat s`. With :math:`\sigma_n^2 > 0` the support heights are
+    filtered (the surface does not pass through them); with :math:`\sigma_n^2 = 0` it is pure
+    interpolation (exact at the support points). Different weights ``p`` vary the diagonal.
+
+How it is computed on a grid
+    The observations are the DSM cells. Because the Gaussian is separable,
+    :math:`\exp(-(\Delta x^2 + \Delta y^2)/c^2) = \exp(-\Delta x^2/c^2)\exp(-\Delta y^2/c^2)`,
+    the product :math:`\mathbf C \mathbf x` over all cells is two 1-D correlations with the
+    kernel :math:`k(d) = e^{-(d/c)^2}` truncated at :math:`|d| \le 2.5c` (< 0.2 % of C₀). The
+    system :math:`(\mathbf C + \mathbf D)\mathbf x = \mathbf l` over the active cells is solved
+    by Jacobi-preconditioned conjugate gradients (the matrix is never formed), and
+    :math:`\hat{\mathbf s} = \mathbf C \mathbf x` gives the prediction at *every* cell at once:
+    the observations' filtered heights and the heights of eliminated cells and holes.
+    This is exactly :math:`\mathbf c^\top \mathbf C^{-1}\mathbf l` with a compactly supported
+    (truncated) covariance, i.e. every cell's neighbourhood is the disc of radius 2.5 c.
+    :func:`predict_dense` is the textbook dense formula (used by the tests to check this).
+
+Covariance from the data
+    The empirical covariance of ``l`` over the current ground candidates is formed along rows
+    and columns for lags 0…m cells: :math:`V_{zz} = \overline{l^2}`,
+    :math:`\hat C(d) = \overline{l_i l_{i+d}}`. A weighted log-linear fit
+    :math:`\ln \hat C(d) = \ln C_0 - d^2/c^2` over the positive lags ≥ 1 gives ``c`` (clamped to
+    the level's range), then :math:`C_0` by least squares for that ``c``;
+    :math:`\sigma_n^2 = V_{zz} - C_0` (the covariance extrapolated to d → 0 is the signal, the
+    rest of the variance at lag 0 is noise), at least ``min_noise_share``·V_zz. A fixed
+    ``noise_share`` ν overrides it: :math:`C_0 = (1-ν)V_{zz}`, :math:`\sigma_n^2 = ν V_{zz}`.
+
+Robust iterations with an asymmetric weight function
+    With the residual :math:`r = l - \hat s` and the shift ``g``
+
+    .. math:: p(r) = \begin{cases} 1 & r \le g \\
+                     \dfrac{1}{1 + \bigl((r - g)/h\bigr)^{b}} & g < r \le g + w \\
+                     0 & r > g + w \ \text{ or } \ r < g - w_\downarrow \end{cases}
+
+    points below the surface keep their full weight, points above lose it (``h`` = residual
+    above ``g`` at which the weight is ½, ``b`` the steepness, ``w`` the cut-off; the lower
+    cut-off :math:`w_\downarrow` removes deep blunders). The shift is re-estimated from the
+    residual histogram every iteration: :math:`g = -\min(k_g \sigma_-, g_{max})` with
+    :math:`\sigma_- = \sqrt{\overline{r^2}}` over the negative residuals (the ground's
+    spread below a surface that objects still pull up). Cells with ``p = 0`` are eliminated.
+
+Hierarchy (data pyramid)
+    Level 0 is the DSM; level ℓ+1 takes the **lowest** cell of every 2×2 block of level ℓ
+    (moved to the block centre along the local slope, so steep terrain is not biased low), up
+    to the first level whose cell size reaches ``coarse_spacing`` (buildings and small woods
+    shrink away; larger ones are bridged by the robust prediction whose correlation length
+    grows with the cell size). The coarsest level's trend is a robust plane; every finer
+    level's trend is the coarser DTM (bilinear), its ground candidates are the cells within
+    the band :math:`[-b_\downarrow, b_\uparrow + \text{slope}\cdot s_{coarse}/2]` of it, and
+    their starting weights are the weight function of their residuals to it. ``slope`` is the
+    larger of the preset's and the median slope of the coarsest level; at coarse levels the
+    cut-off grows by slope·s/2 and the half-weight residual by slope·s/4.
+
+Operator edits (:class:`~.surface_input.FilterConstraints`)
+    ``remove`` cells are never observations (bridged); ``keep`` cells are no observations
+    either (the terrain around them is predicted without them) and the DTM equals the DSM
+    there; manual ground points (and 3-D
+    breakline heights) are observations with a negligible noise variance (weight → ∞) and the
+    DTM passes exactly through every ground point (set in its cell); **breaklines** split the
+    grid into sides (each line extended to the grid border by its end directions): the
+    covariance between cells of different sides is zero, so no prediction and no trend
+    reaches across a breakline. Ground points are checked against the surface predicted
+    without them (the check the report lists).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from affine import Affine
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..processing.feedback import Feedback, ensure_feedback
+from ..surface.gridding import Grid, line_barrier
+
+Array = NDArray[Any]
+PathLike = Union[str, Path]
+
+#: Relative noise variance given to hard constraints (manual ground points).
+HARD_NOISE = 1e-6
+
+
+@dataclass
+class LPParameters:
+    """Parameters of the robust linear prediction, in operator units (metres).
+
+    Attributes
+    ----------
+    coarse_spacing : float
+        Cell size (m) the pyramid reaches at its coarsest level; about the width of the
+        largest building/wood that should disappear by the lowest-cell reduction (larger
+        ones are bridged by the prediction).
+    iterations : int
+        Robust iterations per level (the finest level uses ``fine_iterations``).
+    fine_iterations : int
+        Robust iterations at levels 0 and 1 (their candidates are already close to ground).
+    half_weight : float
+        ``h`` (m): residual above the shift at which the weight is ½ (``a = 1/h``).
+    exponent : float
+        ``b``: steepness of the weight function.
+    cutoff : float
+        ``w`` (m): residuals more than this above the shift get weight 0 (level 0; coarser
+        levels add ``slope``·cell size / 2).
+    low_cutoff : float
+        ``w↓`` (m): residuals more than this below the shift are blunders (weight 0).
+    shift_factor : float
+        ``k_g``: the shift is ``g = −min(k_g·σ₋, max_shift)``.
+    max_shift : float
+        Largest |g| (m).
+    band_above, band_below : float
+        Candidates at a finer level lie within [−band_below, band_above] (m) of the coarser
+        DTM (band_above grows by ``slope``·coarse cell size / 2).
+    slope : float
+        Least terrain slope allowance (m/m) that widens the cut-off and the band at coarse
+        levels; the median slope of the coarsest level is used where it is larger.
+    noise_share : float or None
+        Fixed noise share ν = σ_n²/V_zz (0 = pure interpolation); None = estimated.
+    min_noise_share : float
+        Smallest estimated noise share (keeps the system well conditioned).
+    max_noise : float
+        Largest estimated noise σ (m); where relief or objects inflate the variance, the
+        share above ``max_noise²`` is signal (else the prediction would smooth metres away).
+    corr_min, corr_max : float
+        Range of the correlation length ``c`` in cells of each level.
+    corr_length : float or None
+        Fixed correlation length (m) at level 0 (coarser levels scale with the cell size);
+        None = estimated.
+    ground_tolerance : float
+        |DSM − DTM| (m) up to which a cell/point is labelled ground.
+    max_gap : float
+        DSM holes wider than this (m) stay NaN in the DTM at the data border; interior holes
+        are always filled. 0 = fill everything.
+    cg_tol : float
+        Relative residual at which the conjugate gradients stop.
+    """
+
+    coarse_spacing: float = 32.0
+    iterations: int = 4
+    fine_iterations: int = 2
+    half_weight: float = 0.5
+    exponent: float = 4.0
+    cutoff: float = 1.5
+    low_cutoff: float = 5.0
+    shift_factor: float = 1.0
+    max_shift: float = 0.5
+    band_above: float = 1.0
+    band_below: float = 5.0
+    slope: float = 0.15
+    noise_share: Optional[float] = None
+    min_noise_share: float = 0.1
+    max_noise: float = 0.3
+    corr_min: float = 1.0
+    corr_max: float = 3.0
+    corr_length: Optional[float] = None
+    ground_tolerance: float = 0.5
+    max_gap: float = 0.0
+    cg_tol: float = 5e-3
+
+    @classmethod
+    def from_dict(cls, values: Dict[str, Any]) -> LPParameters:
+        """Parameters from a dict; None values and unknown keys are ignored."""
+        names = {f.name for f in fields(cls)}
+        return replace(cls(), **{k: v for k, v in values.items() if k in names and v is not None})
+
+
+@dataclass
+class Covariance:
+    """Gaussian covariance model of the trend-removed heights (C(d) = c0·exp(−(d/corr)²))."""
+
+    c0: float
+    noise: float
+    corr: float  # in cells
+    vzz: float
+
+    @property
+    def noise_share(self) -> float:
+        return self.noise / max(self.c0 + self.noise, 1e-30)
+
+
+@dataclass
+class LPResult:
+    """Result of :func:`filter_linear_prediction`.
+
+    Attributes
+    ----------
+    dtm : ndarray float32
+        The DTM (NaN only at wide holes of the data border, see ``max_gap``).
+    ground : ndarray bool
+        Ground cells: |DSM − DTM| ≤ ground_tolerance (keep areas ground, remove areas not).
+    weights : ndarray float32
+        Final weights of level 0 (0 = eliminated, NaN = no observation).
+    iterations : list of dict
+        One row per robust iteration (level, spacing, covariance, shift, eliminated share).
+    disagreeing : list of dict
+        Manual ground points the filter disagrees with (see ``check_ground_points``).
+    levels : list of ndarray
+        DTM of every level (coarse → fine) when ``keep_levels`` was asked for.
+    """
+
+    dtm: Array
+    ground: Array
+    weights: Array
+    iterations: List[Dict[str, Any]]
+    disagreeing: List[Dict[str, Any]]
+    levels: List[Array]
+
+
+# -- closed-form reference ------------------------------------------------------------------------
+def gaussian_covariance(d: Array, c0: float, corr: float) -> Array:
+    """C(d) = c0 · exp(−(d/corr)²)."""
+    return c0 * np.exp(-(np.asarray(d, float) / corr) ** 2)
+
+
+def predict_dense(xy: Array, values: Array, xy_new: Array, c0: float, corr: float,
+                  noise: Union[float, Array] = 0.0) -> Array:
+    r"""Textbook linear prediction :math:`\hat s(P) = \mathbf c_P^\top(\mathbf C+\mathbf D)^{-1} l`.
+
+    Parameters
+    ----------
+    xy : ndarray (n, 2)
+        Support points.
+    values : ndarray (n,)
+        Trend-removed heights ``l``.
+    xy_new : ndarray (m, 2)
+        Prediction points.
+    c0, corr : float
+        Gaussian covariance ``C(d) = c0·exp(−(d/corr)²)``.
+    noise : float or ndarray (n,)
+        Noise variance on the diagonal (0 = pure interpolation).
+
+    Returns
+    -------
+    ndarray (m,)
+    """
+    xy = np.asarray(xy, float)
+    xy_new = np.asarray(xy_new, float)
+    d = np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)
+    cmat = gaussian_covariance(d, c0, corr) + np.diag(np.broadcast_to(noise, len(xy)))
+    cvec = gaussian_covariance(np.linalg.norm(xy_new[:, None, :] - xy[None, :, :], axis=2),
+                               c0, corr)
+    return cvec @ np.linalg.solve(cmat, np.asarray(values, float))
+
+
+# -- covariance operator on a grid ----------------------------------------------------------------
+class _Sides:
+    """Breakline sides of a grid: labels 0…k−1 (k−1 = the breakline cells themselves)."""
+
+    def __init__(self, labels: Array, k: int) -> None:
+        from scipy import ndimage
+
+        self.labels = labels
+        self.k = k
+        self.slices = ndimage.find_objects(labels + 1, max_label=k)
+
+
+def _extended_lines(lines: Sequence[Any], length: float) -> List[Any]:
+    """Each line part's two end segments extended by ``length`` (m) in their directions."""
+    from shapely.geometry import LineString
+
+    out = []
+    for g in lines:
+        for part in getattr(g, "geoms", [g]):
+            c = np.asarray(part.coords, float)[:, :2]
+            if len(c) < 2:
+                continue
+            for a, b in ((c[0], c[1]), (c[-1], c[-2])):
+                u = a - b
+                n = float(np.hypot(*u))
+                if n > 0:
+                    out.append(LineString([tuple(a), tuple(a + u / n * length)]))
+    return out
+
+
+def breakline_sides(lines: Sequence[Any], grid: Grid) -> Tuple[Optional[_Sides], Array, Array]:
+    """Partition of the grid by breaklines and their extensions to the grid border.
+
+    Returns
+    -------
+    (sides or None without lines, barrier mask, barrier heights)
+        Sides are the 4-connected components of the cells no (extended) line touches; cells
+        touched only by an extension join the nearest side; the breakline cells form a class
+        of their own (they correlate along the line, not with either side).
+    """
+    from rasterio.features import rasterize
+    from scipy import ndimage
+
+    lines = [g for g in (lines or []) if g is not None and not g.is_empty]
+    barrier, zline = line_barrier(lines, grid)
+    if not lines or not barrier.any():
+        return None, barrier, zline
+    diag = grid.spacing * math.hypot(grid.width, grid.height)
+    ext = _extended_lines(lines, 2.0 * diag)
+    cut = barrier.copy()
+    if ext:
+        cut |= rasterize([(g, 1) for g in ext], out_shape=grid.shape, transform=grid.transform,
+                         fill=0, all_touched=True, dtype="uint8").astype(bool)
+    labels, n = ndimage.label(~cut)
+    labels = labels.astype(np.int32) - 1  # −1 on cut cells
+    only_ext = cut & ~barrier
+    if only_ext.any() and n > 0:
+        # nearest cell of a side (cut cells are the background of the transform)
+        _, (ir, ic) = ndimage.distance_transform_edt(cut, return_indices=True)
+        labels[only_ext] = labels[ir[only_ext], ic[only_ext]]
+    labels[barrier] = n
+    return _Sides(labels, n + 1), barrier, zline
+
+
+def _kernel(corr: float) -> Array:
+    """1-D Gaussian correlation kernel exp(−(d/corr)²), |d| ≤ 2.5·corr cells."""
+    r = max(1, math.ceil(2.5 * corr))
+    d = np.arange(-r, r + 1, dtype=np.float64)
+    return np.exp(-(d / corr) ** 2).astype(np.float32)
+
+
+def _smooth(x: Array, k: Array) -> Array:
+    from scipy import ndimage
+
+    y = ndimage.correlate1d(x, k, axis=0, mode="constant", output=np.float32)
+    return ndimage.correlate1d(y, k, axis=1, mode="constant", output=np.float32)
+
+
+def covariance_apply(x: Array, c0: float, corr: float, sides: Optional[_Sides] = None) -> Array:
+    r"""Covariance times a grid vector: :math:`(\mathbf C\mathbf x)_i = \sum_j C(d_{ij}) x_j`.
+
+    Cells of different breakline sides do not correlate:
+    :math:`\mathbf C = \sum_k \mathbf M_k \mathbf C_{full} \mathbf M_k`.
+    """
+    k = _kernel(corr)
+    x = np.asarray(x, np.float32)
+    if sides is None:
+        y = _smooth(x, k)
+        y *= np.float32(c0)
+        return y
+    out = np.zeros_like(x)
+    r = len(k) // 2
+    h, w = x.shape
+    for lab, sl in enumerate(sides.slices):
+        if sl is None:
+            continue
+        r0, r1 = max(sl[0].start - r, 0), min(sl[0].stop + r, h)
+        q0, q1 = max(sl[1].start - r, 0), min(sl[1].stop + r, w)
+        m = sides.labels[r0:r1, q0:q1] == lab
+        y = _smooth(np.where(m, x[r0:r1, q0:q1], 0.0).astype(np.float32), k)
+        out[r0:r1, q0:q1] += np.where(m, c0 * y, 0.0).astype(np.float32)
+    return out
+
+
+def _pcg(matvec: Callable[[Array], Array], b: Array, x: Array, minv: Array, tol: float,
+         maxiter: int, feedback: Feedback) -> Tuple[Array, int]:
+    """Jacobi-preconditioned conjugate gradients on grid vectors (float32, float64 dots)."""
+
+    def dot(u: Array, v: Array) -> float:
+        # float64 accumulation without BLAS: the same sum whatever the thread count, so every
+        # face (CLI, QGIS, qgis_process) gives bit-identical results
+        return float(np.einsum("i,i->", u.ravel(), v.ravel(), dtype=np.float64))
+
+    bnorm = math.sqrt(dot(b, b))
+    if bnorm == 0:
+        return np.zeros_like(b), 0
+    r = b - matvec(x)
+    z = minv * r
+    p = z.copy()
+    rz = dot(r, z)
+    it = 0
+    while it < maxiter:
+        it += 1
+        feedback.check()
+        ap = matvec(p)
+        alpha = np.float32(rz / max(dot(p, ap), 1e-300))
+        x += alpha * p  # in place where possible: grids of 16 M cells
+        ap *= alpha
+        r -= ap
+        if math.sqrt(dot(r, r)) <= tol * bnorm:
+            break
+        np.multiply(minv, r, out=z)
+        rz_new = dot(r, z)
+        p *= np.float32(rz_new / max(rz, 1e-300))
+        p += z
+        rz = rz_new
+    return x, it
+
+
+def lp_solve(lz: Array, active: Array, cov: Covariance, noise_scale: Optional[Array] = None,
+             sides: Optional[_Sides] = None, x0: Optional[Array] = None, tol: float = 1e-3,
+             maxiter: int = 300, feedback: Optional[Feedback] = None
+             ) -> Tuple[Array, Array, int]:
+    r"""Grid prediction :math:`\hat{\mathbf s} = \mathbf C(\mathbf C+\mathbf D)^{-1}\mathbf l`.
+
+    Parameters
+    ----------
+    l : ndarray (h, w)
+        Trend-removed heights (any value where not active).
+    active : ndarray of bool
+        Observations.
+    cov : Covariance
+        ``c0``, ``noise`` (σ_n²), ``corr`` (cells).
+    noise_scale : ndarray, optional
+        Per-cell factor of σ_n² on the diagonal (1/p, σ_i²/σ²); default 1.
+    sides : optional
+        Breakline partition (no correlation across).
+    x0 : ndarray, optional
+        Start vector (warm start from the previous robust iteration).
+
+    Returns
+    -------
+    (ŝ at every cell, the solution x = (C+D)⁻¹ l, CG iterations)
+    """
+    feedback = ensure_feedback(feedback)
+    act = np.asarray(active, bool)
+    noise = cov.noise if cov.noise > 0 else HARD_NOISE * cov.c0  # pure interpolation: nugget
+    d = np.zeros(act.shape, np.float32)
+    scale = 1.0 if noise_scale is None else noise_scale
+    d[act] = (noise * np.broadcast_to(scale, act.shape))[act]
+    b = np.where(act, lz, 0.0).astype(np.float32)
+    actf = act.astype(np.float32)
+
+    def matvec(v: Array) -> Array:
+        out = covariance_apply(v, cov.c0, cov.corr, sides)
+        out *= actf
+        out += d * v
+        return out
+
+    # Jacobi: the diagonal is C(0) + D (the kernel's centre is 1)
+    minv = np.where(act, 1.0 / (cov.c0 + d), 0.0).astype(np.float32)
+    x = np.zeros_like(b) if x0 is None else np.where(act, x0, 0.0).astype(np.float32)
+    x, its = _pcg(matvec, b, x, minv, tol, maxiter, feedback)
+    s = covariance_apply(x, cov.c0, cov.corr, sides)
+    if cov.noise <= 0:
+        s = np.where(act, b, s)  # pure interpolation is exact at the support points
+    return s, x, its
+
+
+# -- covariance estimation ------------------------------------------------------------------------
+def empirical_covariance(lz: Array, mask: Array, max_lag: int) -> Tuple[Array, Array]:
+    """Mean products of heights ``d`` cells apart along rows and columns, d = 0…max_lag.
+
+    Returns
+    -------
+    (covariance per lag, number of pairs per lag)
+    """
+    v = np.where(mask, lz, 0.0).astype(np.float64)
+    m = np.asarray(mask, bool)
+    cov = np.zeros(max_lag + 1)
+    cnt = np.zeros(max_lag + 1)
+    cov[0] = float(np.sum(v * v))
+    cnt[0] = float(m.sum())
+    for d in range(1, max_lag + 1):
+        s, n = 0.0, 0.0
+        if v.shape[1] > d:
+            s += float(np.sum(v[:, d:] * v[:, :-d]))
+            n += float(np.count_nonzero(m[:, d:] & m[:, :-d]))
+        if v.shape[0] > d:
+            s += float(np.sum(v[d:] * v[:-d]))
+            n += float(np.count_nonzero(m[d:] & m[:-d]))
+        cov[d], cnt[d] = s, n
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(cnt > 0, cov / np.maximum(cnt, 1), np.nan), cnt
+
+
+def fit_covariance(emp: Array, corr_min: float, corr_max: float,
+                   noise_share: Optional[float] = None, min_noise_share: float = 0.05,
+                   corr: Optional[float] = None, max_noise: Optional[float] = None
+                   ) -> Covariance:
+    r"""Gaussian model from the empirical covariance (see the module notes).
+
+    Parameters
+    ----------
+    emp : ndarray
+        Empirical covariance at lags 0…m (cells); ``emp[0] = V_zz``.
+    corr_min, corr_max : float
+        Range of the correlation length (cells).
+    noise_share : float, optional
+        Fixed ν: C₀ = (1 − ν)·V_zz, σ² = ν·V_zz.
+    corr : float, optional
+        Fixed correlation length (cells).
+    max_noise : float, optional
+        Largest noise σ (m): the estimated noise variance is capped at ``max_noise²`` (where
+        relief or objects inflate V_zz the signal takes the rest), but kept ≥ 10⁻²·C₀.
+    """
+    vzz = float(emp[0]) if np.isfinite(emp[0]) and emp[0] > 0 else 1e-4
+    vzz = max(vzz, 1e-6)
+    d = np.arange(len(emp), dtype=float)
+    use = (d >= 1) & np.isfinite(emp) & (emp > 0.02 * vzz)
+    if corr is None:
+        if use.sum() >= 2:
+            w = emp[use]
+            A = np.column_stack([np.ones(use.sum()), -d[use] ** 2])
+            coef, *_ = np.linalg.lstsq(A * w[:, None], np.log(emp[use]) * w, rcond=None)
+            corr = 1.0 / math.sqrt(coef[1]) if coef[1] > 0 else corr_max
+        elif use.sum() == 1:
+            k = int(d[use][0])
+            ratio = min(float(emp[k]) / vzz, 0.999)
+            corr = k / math.sqrt(-math.log(ratio)) if ratio > 0 else corr_min
+        else:
+            corr = corr_min
+    corr = float(min(max(corr, corr_min), corr_max))
+    if noise_share is not None:
+        nu = float(min(max(noise_share, 0.0), 0.99))
+        return Covariance((1.0 - nu) * vzz, nu * vzz, corr, vzz)
+    kd = np.exp(-(d / corr) ** 2)
+    ok = (d >= 1) & np.isfinite(emp)
+    c0 = float(np.sum(emp[ok] * kd[ok]) / np.sum(kd[ok] ** 2)) if ok.any() else vzz
+    c0 = min(max(c0, 0.05 * vzz), (1.0 - min_noise_share) * vzz)
+    noise = vzz - c0
+    if max_noise is not None and noise > max_noise ** 2:
+        noise = max(max_noise ** 2, 1e-2 * c0)
+        c0 = vzz - noise
+    return Covariance(c0, noise, corr, vzz)
+
+
+# -- robust weights -------------------------------------------------------------------------------
+def asymmetric_weights(r: Array, g: float, half_weight: float, exponent: float, cutoff: float,
+                       low_cutoff: float = np.inf) -> Array:
+    r"""Kraus–Pfeifer weights: 1 below ``g``, :math:`1/(1+((r-g)/h)^b)` above, 0 beyond ``g+w``.
+
+    Residuals more than ``low_cutoff`` below ``g`` get 0 too (blunders).
+    """
+    r = np.asarray(r, np.float64)
+    u = np.maximum(r - g, 0.0) / max(half_weight, 1e-9)
+    with np.errstate(over="ignore", invalid="ignore"):
+        p = 1.0 / (1.0 + u ** exponent)
+    p = np.where(r > g + cutoff, 0.0, p)
+    p = np.where(r < g - low_cutoff, 0.0, p)
+    return np.where(np.isfinite(r), p, 0.0)
+
+
+def residual_shift(r: Array, factor: float, max_shift: float) -> float:
+    r"""Shift ``g = −min(k·σ₋, g_max)`` with σ₋ the RMS of the negative residuals."""
+    neg = r[r < 0]
+    if neg.size == 0:
+        return 0.0
+    return -min(factor * math.sqrt(float(np.mean(neg.astype(np.float64) ** 2))), max_shift)
+
+
+# -- pyramid ---------------------------------------------------------------------------------------
+def _reduce_min(a: Array) -> Array:
+    """Lowest finite value of every 2×2 block (NaN if none)."""
+    h, w = a.shape
+    p = np.full((h + h % 2, w + w % 2), np.nan, np.float32)
+    p[:h, :w] = a
+    return np.fmin(np.fmin(p[0::2, 0::2], p[1::2, 0::2]), np.fmin(p[0::2, 1::2], p[1::2, 1::2]))
+
+
+def _minmod(z: Array, axis: int) -> Array:
+    """Slope per cell along ``axis``: the smaller one-sided difference (0 at a sign change)."""
+    d = np.diff(z, axis=axis)
+    pad = [(0, 0), (0, 0)]
+    pad[axis] = (1, 0)
+    back = np.pad(d, pad, mode="edge")
+    pad[axis] = (0, 1)
+    fwd = np.pad(d, pad, mode="edge")
+    same = np.sign(back) == np.sign(fwd)
+    return np.where(same, np.sign(fwd) * np.minimum(np.abs(back), np.abs(fwd)), 0.0)
+
+
+def _reduce_lowest(a: Array, max_slope: float = 1.5) -> Array:
+    r"""Lowest cell of every 2×2 block, moved to the block centre along the terrain slope.
+
+    On a slope the lowest cell lies at the block's downhill corner, so the plain minimum is
+    biased low by :math:`|\nabla z|\, s/\sqrt 2` per level — a bias that piles up over the
+    levels and cuts slopes. With the gradient ``(g_x, g_y)`` of the minimum grid (central
+    differences limited by *minmod*: the smaller one-sided difference if both have the same
+    sign, else 0, so a building next to the block does not tilt it; clipped to
+    ``max_slope`` per fine cell) and the lowest cell's offset ``(δx, δy)`` (±s/2)
+    from the block centre, the block value is :math:`z_{min} - g_x δx - g_y δy`.
+    """
+    h, w = a.shape
+    p = np.full((h + h % 2, w + w % 2), np.nan, np.float32)
+    p[:h, :w] = a
+    subs = np.stack([p[0::2, 0::2], p[0::2, 1::2], p[1::2, 0::2], p[1::2, 1::2]])
+    zmin = np.fmin(np.fmin(subs[0], subs[1]), np.fmin(subs[2], subs[3]))
+    ok = np.isfinite(zmin)
+    if ok.sum() < 4 or min(zmin.shape) < 3:
+        return zmin
+    k = np.argmin(np.where(np.isfinite(subs), subs, np.inf), axis=0)
+    dcol = np.where(k % 2 == 1, 0.5, -0.5)  # offset in fine cells: +x to the right
+    drow = np.where(k >= 2, 0.5, -0.5)  # rows grow downwards
+    from scipy import ndimage
+
+    _, (ir, ic) = ndimage.distance_transform_edt(~ok, return_indices=True)
+    zf = zmin[ir, ic].astype(np.float64)  # gaps take the nearest value for the gradient
+    gr = np.clip(_minmod(zf, 0) / 2.0, -max_slope, max_slope)  # per fine cell
+    gc = np.clip(_minmod(zf, 1) / 2.0, -max_slope, max_slope)
+    return (zmin - gc * dcol - gr * drow).astype(np.float32)
+
+
+def _up1(a: Array, axis: int, n: int) -> Array:
+    a = np.moveaxis(a, axis, 0)
+    prev = np.concatenate([a[:1], a[:-1]])
+    nxt = np.concatenate([a[1:], a[-1:]])
+    out = np.empty((2 * a.shape[0],) + a.shape[1:], np.float32)
+    out[0::2] = 0.75 * a + 0.25 * prev
+    out[1::2] = 0.75 * a + 0.25 * nxt
+    return np.moveaxis(out[:n], 0, axis)
+
+
+def upsample2(a: Array, shape: Tuple[int, int]) -> Array:
+    """Bilinear ×2 upsampling of a level to the next finer level of ``shape``.
+
+    Coarse cell i covers fine cells 2i, 2i+1, so fine cell 2i lies a quarter coarse cell
+    before coarse centre i: :math:`f_{2i} = ¾a_i + ¼a_{i-1}`, :math:`f_{2i+1} = ¾a_i + ¼a_{i+1}`
+    (edges clamped).
+    """
+    return _up1(_up1(np.asarray(a, np.float32), 0, shape[0]), 1, shape[1])
+
+
+def _upsample_sides(a: Array, shape: Tuple[int, int], sides_c: Optional[_Sides],
+                    sides_f: Optional[_Sides]) -> Array:
+    """Upsampling that takes every fine cell's value only from coarse cells of its side."""
+    from scipy import ndimage
+
+    up = upsample2(a, shape)
+    if sides_c is None or sides_f is None:
+        return up
+    hc, wc = a.shape
+    # side of a coarse cell = side of the fine cell at its upper-left corner (same geometry)
+    rr = np.minimum(np.arange(hc) * 2, shape[0] - 1)
+    cc = np.minimum(np.arange(wc) * 2, shape[1] - 1)
+    lab_c = sides_f.labels[np.ix_(rr, cc)].copy()
+    lab_c[sides_c.labels == sides_c.k - 1] = -1  # coarse breakline cells belong to no side
+    out = up.copy()
+    for lab, sl in enumerate(sides_f.slices[:-1]):
+        if sl is None:
+            continue
+        c0 = max(sl[0].start // 2 - 2, 0), max(sl[1].start // 2 - 2, 0)
+        c1 = min(sl[0].stop // 2 + 2, hc), min(sl[1].stop // 2 + 2, wc)
+        sub_lab = lab_c[c0[0]:c1[0], c0[1]:c1[1]]
+        have = sub_lab == lab
+        if not have.any():
+            continue
+        sub = a[c0[0]:c1[0], c0[1]:c1[1]]
+        if not have.all():  # other sides' cells take the nearest value of this side
+            _, (ir, ic) = ndimage.distance_transform_edt(~have, return_indices=True)
+            sub = sub[ir, ic]
+        f0 = (2 * c0[0], 2 * c0[1])
+        fine = upsample2(sub, (min(2 * c1[0], shape[0]) - f0[0],
+                               min(2 * c1[1], shape[1]) - f0[1]))
+        m = sides_f.labels[f0[0]:f0[0] + fine.shape[0], f0[1]:f0[1] + fine.shape[1]] == lab
+        view = out[f0[0]:f0[0] + fine.shape[0], f0[1]:f0[1] + fine.shape[1]]
+        view[m] = fine[m]
+    return out
+
+
+def _level_grid(grid: Grid, level: int) -> Grid:
+    f = 2 ** level
+    t = grid.transform
+    return Grid(Affine(t.a * f, t.b, t.c, t.d, t.e * f, t.f), -(-grid.width // f),
+                -(-grid.height // f), grid.spacing * f)
+
+
+def pyramid_levels(shape: Tuple[int, int], spacing: float, coarse_spacing: float) -> int:
+    """Number of reductions: the first level whose cell reaches ``coarse_spacing``, keeping
+    at least 8 cells along the shorter side."""
+    n = 0
+    while spacing * 2 ** n < coarse_spacing and min(shape) / 2 ** (n + 1) >= 8:
+        n += 1
+    return n
+
+
+def _robust_plane(z: Array, valid: Array, prm: LPParameters, cutoff: float) -> Array:
+    """Plane trend of the coarsest level, fitted with the asymmetric weights (5 iterations)."""
+    rows, cols = np.nonzero(valid)
+    zz = z[valid].astype(np.float64)
+    if zz.size < 3:
+        return np.full(z.shape, float(np.nanmin(z)) if zz.size else 0.0, np.float32)
+    A = np.column_stack([np.ones(zz.size), cols - cols.mean(), rows - rows.mean()])
+    p = np.ones(zz.size)
+    coef = np.zeros(3)
+    for _ in range(5):
+        sw = np.sqrt(p)
+        coef, *_ = np.linalg.lstsq(A * sw[:, None], zz * sw, rcond=None)
+        r = zz - A @ coef
+        g = residual_shift(r, prm.shift_factor, max(prm.max_shift, cutoff / 2))
+        p = asymmetric_weights(r, g, max(prm.half_weight, cutoff / 4), prm.exponent, cutoff,
+                               prm.low_cutoff)
+        if p.sum() < 3:
+            p = np.ones(zz.size)
+            break
+    rr, cc = np.mgrid[0:z.shape[0], 0:z.shape[1]]
+    return (coef[0] + coef[1] * (cc - cols.mean()) + coef[2] * (rr - rows.mean())
+            ).astype(np.float32)
+
+
+def _cells_of(points: Array, grid: Grid) -> Tuple[Array, Array]:
+    """Flat cell index (−1 outside) and heights of 3-D points on a grid."""
+    pts = np.asarray(points, float).reshape(-1, 3)
+    r, c = grid.cell_of(pts[:, 0], pts[:, 1]) if len(pts) else (np.zeros(0, int),) * 2
+    return np.where(r >= 0, r * grid.width + c, -1), pts[:, 2]
+
+
+def _hard_grid(points: Array, grid: Grid) -> Array:
+    """Mean height of the ground points per cell (NaN elsewhere)."""
+    flat, z = _cells_of(points, grid)
+    out = np.full(grid.width * grid.height, np.nan, np.float32)
+    ok = flat >= 0
+    if ok.any():
+        n = np.bincount(flat[ok], minlength=out.size)
+        s = np.bincount(flat[ok], weights=z[ok], minlength=out.size)
+        out = np.where(n > 0, s / np.maximum(n, 1), np.nan).astype(np.float32)
+    return out.reshape(grid.shape)
+
+
+# -- the filter -----------------------------------------------------------------------------------
+def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters] = None,
+                             constraints: Any = None, sigma: Optional[Array] = None,
+                             feedback: Optional[Feedback] = None,
+                             keep_levels: bool = False) -> LPResult:
+    """Hierarchical robust linear prediction of a DSM grid (see the module notes).
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        DSM, NaN = no data.
+    grid : Grid
+        Its grid (spacing in metres; the transform places edits).
+    params : LPParameters, optional
+    constraints : FilterConstraints, optional
+        keep / remove masks, ground points, breaklines.
+    sigma : ndarray (h, w), optional
+        σ_z per cell: the noise variance of a cell is scaled by (σ_i/median σ)².
+    feedback : Feedback, optional
+    keep_levels : bool
+        Keep every level's DTM in ``LPResult.levels``.
+
+    Raises
+    ------
+    InputError
+        Fewer than 10 usable cells (all NaN or all removed).
+    """
+    from scipy import ndimage
+
+    feedback = ensure_feedback(feedback)
+    prm = params or LPParameters()
+    z0 = np.array(z, dtype=np.float32)
+    z0[~np.isfinite(z0)] = np.nan
+    shape = z0.shape
+    keep = np.zeros(shape, bool)
+    remove = np.zeros(shape, bool)
+    gpts = np.zeros((0, 3))
+    lines: List[Any] = []
+    if constraints is not None:
+        keep = np.asarray(constraints.keep, bool)
+        remove = np.asarray(constraints.remove, bool) & ~keep
+        gpts = np.asarray(constraints.ground_points, float).reshape(-1, 3)
+        lines = list(constraints.breaklines or [])
+    valid0 = np.isfinite(z0)
+    # keep cells are no observations either: the terrain around an embankment is predicted
+    # without it (a 6 m dam would make the Gaussian prediction ring), then the DSM is put back
+    obs0 = np.where(remove | keep, np.nan, z0).astype(np.float32)
+    if np.count_nonzero(np.isfinite(obs0)) + len(gpts) < 10:
+        raise InputError("Fewer than 10 DSM cells are left for the linear prediction (all "
+                         "no data or inside 'remove' exclusion areas); check the input and the "
+                         "exclusion areas.")
+    noise_scale0 = None
+    if sigma is not None:
+        sg = np.asarray(sigma, float)
+        med = np.nanmedian(sg[np.isfinite(sg) & (sg > 0)]) if np.any(sg > 0) else np.nan
+        if np.isfinite(med):
+            noise_scale0 = np.where(np.isfinite(sg) & (sg > 0), (sg / med) ** 2, 1.0
+                                    ).astype(np.float32)
+
+    # pyramid: lowest cell per 2×2 block
+    n_red = pyramid_levels(shape, grid.spacing, prm.coarse_spacing)
+    zs, scales = [obs0], [noise_scale0]
+    for _ in range(n_red):
+        zs.append(_reduce_lowest(zs[-1]))
+        scales.append(_reduce_scale(scales[-1]))
+    rows: List[Dict[str, Any]] = []
+    levels_out: List[Array] = []
+    dtm_c: Optional[Array] = None
+    sides_c: Optional[_Sides] = None
+    weights0 = np.full(shape, np.nan, np.float32)
+    disagreeing: List[Dict[str, Any]] = []
+    total_work = sum(4.0 ** -lv for lv in range(n_red + 1))
+    done = 0.0
+    it_no = 0
+    t_start = time.perf_counter()
+    for lv in range(n_red, -1, -1):
+        fb = feedback.step(100.0 * done / total_work,
+                           100.0 * (done + 4.0 ** -lv) / total_work)
+        done += 4.0 ** -lv
+        g_lv = _level_grid(grid, lv)
+        zl = zs[lv]
+        hard = _hard_grid(gpts, g_lv)
+        is_hard = np.isfinite(hard)
+        sides, _, bz = breakline_sides(lines, g_lv) if lines else (None, None, None)
+        zl = np.where(is_hard, hard, zl).astype(np.float32)
+        soft_line = np.zeros(zl.shape, bool)
+        if bz is not None:
+            soft_line = np.isfinite(bz) & ~is_hard
+            zl = np.where(soft_line, bz, zl).astype(np.float32)
+        valid = np.isfinite(zl)
+        forced = (soft_line | is_hard) & valid
+        if dtm_c is None:
+            slope = max(prm.slope, _terrain_slope(zl, g_lv.spacing))
+        slope_allow = slope * g_lv.spacing / 2.0
+        cutoff = prm.cutoff + (slope_allow if lv > 0 else 0.0)
+        half_w = prm.half_weight + (slope_allow / 2.0 if lv > 0 else 0.0)
+        if dtm_c is None:
+            trend = _robust_plane(zl, valid, prm, prm.cutoff + slope * g_lv.spacing)
+            cand = valid.copy()
+            corr_rng = (prm.corr_min, max(prm.corr_max, 2.0 * prm.corr_max))
+        else:
+            trend = _upsample_sides(dtm_c, zl.shape, sides_c, sides)
+            dz = zl - trend
+            band_up = prm.band_above + slope * g_lv.spacing  # = slope · coarse cell / 2
+            cand = valid & (((dz <= band_up) & (dz >= -prm.band_below)) | forced)
+            corr_rng = (prm.corr_min, prm.corr_max)
+        lz = np.where(valid, zl - trend, 0.0).astype(np.float32)
+        corr_fixed = None if prm.corr_length is None else prm.corr_length / g_lv.spacing
+        max_lag = math.ceil(2 * corr_rng[1]) + 1
+        cov = fit_covariance(empirical_covariance(lz, cand, max_lag)[0], *corr_rng,
+                             noise_share=prm.noise_share, min_noise_share=prm.min_noise_share,
+                             corr=corr_fixed, max_noise=prm.max_noise)
+        p = np.where(cand, 1.0, 0.0).astype(np.float32)
+        if dtm_c is not None:
+            # the coarser DTM is the first surface: its residuals give the starting weights
+            # (one robust iteration for free)
+            g0 = residual_shift(lz[cand & ~forced], prm.shift_factor, prm.max_shift)
+            p = asymmetric_weights(np.where(cand, lz, np.nan), g0, half_w, prm.exponent,
+                                   cutoff, prm.low_cutoff).astype(np.float32)
+            p[forced] = 1.0
+        n_valid = max(int(valid.sum()), 1)
+        n_iter = prm.fine_iterations if lv <= 1 else prm.iterations
+        x = None
+        s = np.zeros(shape, np.float32)
+        g = 0.0
+        for k in range(max(n_iter, 1)):
+            active = p > 0
+            scale = np.where(active, 1.0 / np.maximum(p, 1e-6), 1.0).astype(np.float32)
+            if scales[lv] is not None:
+                scale *= scales[lv]
+            scale[is_hard] = HARD_NOISE * cov.c0 / max(cov.noise, 1e-12)
+            s, x, its = lp_solve(lz, active, cov, scale, sides, x0=x, tol=prm.cg_tol,
+                                 maxiter=300 if lz.size > 10 ** 6 else 2000, feedback=fb)
+            r = np.where(valid, lz - s, np.nan)
+            rc = r[cand & ~forced]
+            g = residual_shift(rc, prm.shift_factor, prm.max_shift)
+            p_new = asymmetric_weights(np.where(cand, r, np.nan), g, half_w,
+                                       prm.exponent, cutoff, prm.low_cutoff).astype(np.float32)
+            p_new[forced] = 1.0
+            if k == 0 and lv == n_red and prm.noise_share is None and prm.corr_length is None:
+                # coarsest level (objects among the candidates): re-estimate the covariance
+                # from the cells that now look like ground
+                cov = fit_covariance(empirical_covariance(lz, p_new > 0.5, max_lag)[0],
+                                     *corr_rng, min_noise_share=prm.min_noise_share,
+                                     max_noise=prm.max_noise)
+            it_no += 1
+            elim = int(np.count_nonzero(valid & (p_new == 0)))
+            rows.append({"iteration": it_no, "level": lv, "spacing_m": float(g_lv.spacing),
+                         "candidates": int(cand.sum()),
+                         "eliminated_share": float(np.count_nonzero(valid & (p_new == 0)
+                                                                    & (p > 0))) / n_valid,
+                         "eliminated_total_share": elim / n_valid,
+                         "shift_m": round(float(g), 4), "c0_m2": round(cov.c0, 5),
+                         "noise_share": round(cov.noise_share, 4),
+                         "corr_length_m": round(cov.corr * g_lv.spacing, 3),
+                         "cg_iterations": its})
+            if k < n_iter - 1:
+                p = p_new
+            fb.progress(100.0 * (k + 1) / max(n_iter, 1))
+        # final surface of the level: prediction with the last weights
+        dtm_l = (trend + s).astype(np.float32)
+        if lv == 0:
+            weights0 = np.where(valid, p, np.nan).astype(np.float32)
+            if is_hard.any():
+                disagreeing = _ground_point_check(lz, trend, p, cov, scales[0], sides, x,
+                                                  is_hard, gpts, grid, prm, fb)
+            dtm_l = np.where(is_hard, hard, dtm_l)
+            dtm_l = np.where(keep & valid0, z0, dtm_l)
+        if keep_levels:
+            levels_out.append(dtm_l)
+        dtm_c, sides_c = dtm_l, sides
+        feedback.info(f"Level {lv} ({g_lv.spacing:g} m, {g_lv.width} × {g_lv.height} cells): "
+                      f"c = {cov.corr * g_lv.spacing:.1f} m, noise share "
+                      f"{cov.noise_share:.2f}, shift {g:+.2f} m, "
+                      f"{100.0 * rows[-1]['eliminated_total_share']:.1f} % eliminated "
+                      f"({time.perf_counter() - t_start:.1f} s).")
+    dtm = np.asarray(dtm_c, np.float32)
+    if prm.max_gap > 0 and not valid0.all():
+        far = ndimage.distance_transform_edt(~(valid0 | remove)) * grid.spacing > prm.max_gap / 2
+        outer = far & _touches_border(~(valid0 | remove))
+        dtm = np.where(outer, np.nan, dtm).astype(np.float32)
+    ground = valid0 & (np.abs(z0 - dtm) <= prm.ground_tolerance) & ~remove
+    ground |= keep & valid0
+    return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
+
+
+def _terrain_slope(z: Array, spacing: float) -> float:
+    """Median gradient magnitude (m/m) of the coarsest level: the slope allowance actually
+    needed (the preset's ``slope`` is the least one), so one default serves steep terrain."""
+    gy, gx = np.gradient(np.asarray(z, np.float64), spacing)
+    g = np.hypot(gx, gy)
+    g = g[np.isfinite(g)]
+    return float(np.median(g)) if g.size else 0.0
+
+
+def _reduce_scale(sc: Optional[Array]) -> Optional[Array]:
+    """Noise scale of a coarse cell: the smallest of its block (the lowest cell is one of them)."""
+    if sc is None:
+        return None
+    return np.nan_to_num(_reduce_min(sc), nan=1.0).astype(np.float32)
+
+
+def _touches_border(mask: Array) -> Array:
+    """Cells of the components of ``mask`` that touch the grid border."""
+    from scipy import ndimage
+
+    lab, n = ndimage.label(mask)
+    if n == 0:
+        return np.zeros(mask.shape, bool)
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    return np.isin(lab, edge[edge > 0])
+
+
+def _ground_point_check(lz: Array, trend: Array, p: Array, cov: Covariance,
+                        scale0: Optional[Array], sides: Optional[_Sides], x: Array,
+                        is_hard: Array, gpts: Array, grid: Grid, prm: LPParameters,
+                        feedback: Feedback) -> List[Dict[str, Any]]:
+    """Ground points against the level-0 surface predicted *without* them."""
+    from .surface_input import check_ground_points
+
+    active = (p > 0) & ~is_hard
+    scale = np.where(active, 1.0 / np.maximum(p, 1e-6), 1.0).astype(np.float32)
+    if scale0 is not None:
+        scale *= scale0
+    s, _, _ = lp_solve(lz, active, cov, scale, sides, x0=np.where(is_hard, 0.0, x),
+                       tol=prm.cg_tol, feedback=feedback)
+    return check_ground_points(trend + s, grid, gpts, prm.ground_tolerance)
+
+
+# -- the algorithm ------------------------------------------------------------------------------
+def _sigma_grid(inp: Any) -> Optional[Array]:
+    """σ_z of the lowest point of every cell (the point the cell's height comes from)."""
+    if inp.sigma is None or inp.points is None or inp.point_cells is None:
+        return None
+    cells = np.asarray(inp.point_cells)
+    ok = (cells >= 0) & np.isfinite(inp.points[:, 2]) & np.isfinite(inp.sigma)
+    if not ok.any():
+        return None
+    idx = np.flatnonzero(ok)
+    order = idx[np.lexsort((inp.points[idx, 2], cells[idx]))]
+    first = np.concatenate([[True], cells[order][1:] != cells[order][:-1]])
+    out = np.full(inp.grid.width * inp.grid.height, np.nan, np.float32)
+    out[cells[order][first]] = inp.sigma[order][first]
+    return out.reshape(inp.grid.shape)
+
+
+def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str = "default",
+                                 project: Optional[PathLike] = None,
+                                 spacing: Optional[float] = None, crs: Any = None,
+                                 overrides: Optional[Dict[str, Any]] = None,
+                                 write_levels: bool = False,
+                                 feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """Read, filter by robust linear prediction, and write the products (the algorithm's run).
+
+    Parameters
+    ----------
+    input : path
+        DSM raster or points (see :func:`~.surface_input.read_filter_input`).
+    output : path
+        Output folder (new or empty), written completely or not at all.
+    preset : str
+        Name in :data:`~.presets.LINEAR_PREDICTION_PRESETS`.
+    project : path, optional
+        Project whose edits are honoured.
+    spacing : float, optional
+        Grid spacing (m) for point input.
+    crs : optional
+        CRS of inputs that carry none.
+    overrides : dict, optional
+        :class:`LPParameters` fields (None = the preset's value).
+    write_levels : bool
+        Also write the DTM of every pyramid level (``level_<k>.tif``, on the input grid).
+
+    Returns
+    -------
+    dict
+        ``dtm``, ``ndsm``, ``mask`` or ``labels``, ``report``, ``metrics``.
+    """
+    from .presets import linear_prediction_preset
+    from .surface_input import read_filter_constraints, read_filter_input, write_filter_outputs
+
+    feedback = ensure_feedback(feedback)
+    values = linear_prediction_preset(preset)
+    values.update({k: v for k, v in (overrides or {}).items() if v is not None})
+    prm = LPParameters.from_dict(values)
+    inp = read_filter_input(input, spacing=spacing, crs=crs, feedback=feedback)
+    cons = read_filter_constraints(project, inp.grid, inp.crs)
+    feedback.progress(5.0)
+    t0 = time.perf_counter()
+    res = filter_linear_prediction(inp.z, inp.grid, prm, cons, sigma=_sigma_grid(inp),
+                                   feedback=feedback.step(5.0, 85.0), keep_levels=write_levels)
+    feedback.info(f"Linear prediction took {time.perf_counter() - t0:.1f} s.")
+    valid = np.isfinite(inp.z)
+    n_valid = int(valid.sum())
+    n_ground = int(np.count_nonzero(res.ground))
+    extra: Dict[str, Array] = {}
+    if write_levels:
+        for k, lvl in enumerate(res.levels):
+            f = 2 ** (len(res.levels) - 1 - k)
+            extra[f"level_{len(res.levels) - 1 - k}"] = np.repeat(
+                np.repeat(lvl, f, axis=0), f, axis=1)[:inp.grid.height, :inp.grid.width]
+    report: Dict[str, Any] = {
+        "algorithm": "filter_linear_prediction",
+        "preset": preset or "default",
+        "parameters": asdict(prm),
+        "cells_valid": n_valid,
+        "cells_ground": n_ground,
+        "eliminated_share": 1.0 - n_ground / max(n_valid, 1),
+        "ground_tolerance_m": prm.ground_tolerance,
+        "iterations": res.iterations,
+        "constraints": {"keep_cells": int(cons.keep.sum()), "remove_cells": int(cons.remove.sum()),
+                        "ground_points": len(cons.ground_points),
+                        "breaklines": len(cons.breaklines)},
+        "ground_points_disagreeing": res.disagreeing,
+        "warnings": [],
+    }
+    if res.disagreeing:
+        msg = (f"{len(res.disagreeing)} manual ground point(s) differ from the filtered surface "
+               f"by more than {prm.ground_tolerance:g} m (listed in the report).")
+        report["warnings"].append(msg)
+        feedback.warning(msg)
+    return write_filter_outputs(output, inp, res.dtm, res.ground, report, extra_rasters=extra,
+                                feedback=feedback.step(85.0, 100.0),
+                                title="DSM → DTM filtering: robust linear prediction",
+                                product="filter_linear_prediction")
+
+
+__all__ = ["Covariance", "LPParameters", "LPResult", "asymmetric_weights", "breakline_sides",
+           "covariance_apply", "empirical_covariance", "filter_linear_prediction",
+           "fit_covariance", "gaussian_covariance", "lp_solve", "predict_dense",
+           "pyramid_levels", "residual_shift", "run_filter_linear_prediction", "upsample2"]

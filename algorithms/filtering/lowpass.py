@@ -1,0 +1,677 @@
+r"""Iterative robust low-pass filtering of a DSM to a DTM (the "Phoenics" method).
+
+After Raguse (2000) §3.3.1 (methods/seed-002-003.md A3.8): a sequence of low-pass filters with a
+shrinking window gives approximate DTMs; each is differenced with the current surface, cells too
+high above it (buildings, vegetation) or too far below it (blunders) are eliminated, and the
+holes are finally filled from the surrounding ground.
+
+Smoothing (normalised convolution of first order)
+    In iteration ``k`` every cell gets the height :math:`T_k` of the least-squares plane through
+    the remaining cells of a square window of side :math:`w_k` centred on it. With weights
+    :math:`p_j \in \{0, 1\}` (1 = remaining cell), local coordinates ``u, v`` and the window
+    means :math:`\bar{\cdot} = \sum p_j \cdot / \sum p_j` (all computed with box filters, so the
+    cost per cell does not depend on the window):
+
+    .. math::
+        C = \begin{pmatrix} \overline{u^2} - \bar u^2 & \overline{uv} - \bar u \bar v \\
+                            \overline{uv} - \bar u \bar v & \overline{v^2} - \bar v^2
+            \end{pmatrix},\quad
+        (b, c)^T = C^{-1} \begin{pmatrix} \overline{uz} - \bar u \bar z \\
+                                          \overline{vz} - \bar v \bar z \end{pmatrix},\quad
+        T = \bar z + b (u_0 - \bar u) + c (v_0 - \bar v)
+
+    A tilted plane is reproduced exactly, also next to holes and at the raster border (a plain
+    mean would be biased there by slope × centroid offset). Where the support is degenerate
+    (:math:`\det C` tiny) the mean :math:`\bar z` is used.
+
+Elimination
+    :math:`D_k = M_{k-1} - T_k` (the *difference model*, written per iteration on request);
+    a cell is eliminated if :math:`D_k > t_k + s \cdot w_k / 4` (object) or
+    :math:`D_k < -d` (blunder), with :math:`t_k` the iteration's threshold, ``s`` the slope
+    allowance (a plane over a window of side ``w`` lies :math:`s\,w/4` below a ridge whose two
+    slopes differ by ``s``) and ``d`` the blunder depth. Eliminated cells stay eliminated.
+
+Hole filling
+    Membrane (Laplace) interpolation :math:`\nabla^2 z = 0` of the eliminated and empty cells
+    with the ground cells as fixed values, solved coarse to fine on a pyramid (block means of
+    the known cells, Jacobi relaxation on every level starting from the coarser solution).
+
+Operator edits
+    ``keep`` areas: never eliminated, not used as support for their neighbours, the DSM is the
+    DTM there (bit for bit). ``remove`` areas: eliminated before the first iteration, bridged by
+    the hole filling. Manual ground points: their cells get the point height, are never
+    eliminated and are fixed values of the hole filling (the DTM passes through them); the
+    report lists the points the filter's own surface (filled without them) disagrees with.
+    Breaklines: the cells on either side of a line are smoothed only with cells of their own
+    side (within the window's reach), and the hole filling does not connect cells across a
+    line, so a step along a breakline keeps its height.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..processing.feedback import Feedback, ensure_feedback
+from ..surface.gridding import Grid
+from .presets import lowpass_preset
+from .surface_input import (
+    FilterConstraints,
+    FilterInput,
+    check_ground_points,
+    read_filter_constraints,
+    read_filter_input,
+    write_filter_outputs,
+)
+
+PathLike = Union[str, Path]
+Array = NDArray[Any]
+
+#: Rows per strip of the box-filter smoothing (bounds the float64 temporaries).
+STRIP_ROWS = 768
+
+#: Side (cells) below which the hole-filling pyramid stops.
+COARSEST = 48
+
+
+# -- smoothing ------------------------------------------------------------------------------------
+def plane_smooth(z: Array, weight: Array, radius: int, min_count: int = 3,
+                 strip_rows: int = STRIP_ROWS) -> Array:
+    """Height of the local least-squares plane over a square window (see the module notes).
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights; cells with weight 0 (or NaN height) are ignored.
+    weight : ndarray of bool (h, w)
+        Support cells.
+    radius : int
+        Half side of the window in cells (side ``2·radius + 1``).
+    min_count : int
+        Fewest support cells a window needs; fewer gives NaN.
+    strip_rows : int
+        Rows processed at once (memory bound: ~12 float64 arrays of ``strip_rows + 2·radius``
+        rows).
+
+    Returns
+    -------
+    ndarray float32 (h, w)
+        The plane heights; the window mean where the plane is undetermined; NaN without support.
+    """
+    from scipy.ndimage import uniform_filter
+
+    z = np.asarray(z)
+    h, w = z.shape
+    size = 2 * int(radius) + 1
+    out = np.full((h, w), np.nan, np.float32)
+    ok_all = np.asarray(weight, bool) & np.isfinite(z)
+    if not ok_all.any():
+        return out
+    # determinant floor relative to a full window's (u and v variances ≈ r(r+1)/3 each)
+    full_var = max(radius * (radius + 1) / 3.0, 0.25)
+    det_floor = 1e-3 * full_var * full_var
+    ucol = np.arange(w, dtype=np.float64) - w / 2.0
+    for r0 in range(0, h, strip_rows):
+        r1 = min(h, r0 + strip_rows)
+        a0, a1 = max(0, r0 - radius), min(h, r1 + radius)
+        ok = ok_all[a0:a1]
+        p = ok.astype(np.float64)
+        if not p.any():
+            continue
+        zmean = float(np.asarray(z[a0:a1][ok], np.float64).mean())
+        # centred heights: better conditioned sums
+        zz = np.where(ok, np.asarray(z[a0:a1], np.float64) - zmean, 0.0)
+        u = np.broadcast_to(ucol, p.shape)
+        v = (np.arange(a1 - a0, dtype=np.float64) - (a1 - a0) / 2.0)[:, None]
+        v = np.broadcast_to(v, p.shape)
+
+        def box(a: Array) -> Array:
+            return uniform_filter(a, size=size, mode="constant", cval=0.0)
+
+        m0 = box(p)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            inv = np.where(m0 > 0, 1.0 / np.where(m0 > 0, m0, 1.0), 0.0)
+            pu, pv = p * u, p * v
+            mu = box(pu) * inv
+            mv = box(pv) * inv
+            mz = box(zz) * inv
+            cuu = box(pu * u) * inv - mu * mu
+            cvv = box(pv * v) * inv - mv * mv
+            cuv = box(pu * v) * inv - mu * mv
+            cuz = box(u * zz) * inv - mu * mz
+            cvz = box(v * zz) * inv - mv * mz
+            det = cuu * cvv - cuv * cuv
+            good = det > det_floor
+            sd = np.where(good, det, 1.0)
+            b = np.where(good, (cvv * cuz - cuv * cvz) / sd, 0.0)
+            c = np.where(good, (cuu * cvz - cuv * cuz) / sd, 0.0)
+            t = mz + b * (u - mu) + c * (v - mv)
+        count = m0 * size * size
+        t = np.where(count >= min_count - 0.5, t, np.nan)
+        out[r0:r1] = (t[r0 - a0:r1 - a0] + zmean).astype(np.float32)
+    return out
+
+
+def _sub_grid(grid: Grid, r0: int, c0: int, h: int, w: int) -> Grid:
+    from affine import Affine
+
+    t = grid.transform
+    return Grid(t * Affine.translation(c0, r0), w, h, grid.spacing)
+
+
+def breakline_sides(lines: Sequence[Any], grid: Grid, reach: float
+                    ) -> List[Tuple[Tuple[int, int, int, int], Array, Array]]:
+    """Per breakline: its window ``(r0, r1, c0, c1)`` and the left/right side masks within it.
+
+    The sides are the single-sided buffers of width ``reach`` (m) — the cells a smoothing
+    window centred on one side could reach on the other.
+    """
+    from ..surface.gridding import polygon_mask
+
+    out = []
+    for line in lines:
+        for part in getattr(line, "geoms", [line]):
+            if part.is_empty or part.length <= 0:
+                continue
+            left = part.buffer(reach, single_sided=True)
+            right = part.buffer(-reach, single_sided=True)
+            xmin, ymin, xmax, ymax = part.buffer(reach).bounds
+            inv = ~grid.transform
+            cs, rs = zip(*(inv * (x, y) for x in (xmin, xmax) for y in (ymin, ymax)))
+            c0, c1 = max(0, math.floor(min(cs))), min(grid.width, math.ceil(max(cs)))
+            r0, r1 = max(0, math.floor(min(rs))), min(grid.height, math.ceil(max(rs)))
+            if c1 <= c0 or r1 <= r0:
+                continue
+            sub = _sub_grid(grid, r0, c0, r1 - r0, c1 - c0)
+            out.append(((r0, r1, c0, c1), polygon_mask([left], sub), polygon_mask([right], sub)))
+    return out
+
+
+def smooth(z: Array, support: Array, radius: int, sides: Sequence[Any] = (),
+           barrier: Optional[Array] = None) -> Array:
+    """:func:`plane_smooth` that does not smooth across breaklines.
+
+    ``sides`` comes from :func:`breakline_sides` (with a reach ≥ the window's half diagonal):
+    a cell on one side of a line gets its plane from support cells on that side only. Barrier
+    cells (on the lines) are never support.
+    """
+    support = np.asarray(support, bool)
+    if barrier is not None:
+        support = support & ~barrier
+    t = plane_smooth(z, support, radius)
+    h, w = z.shape
+    for (r0, r1, c0, c1), left, right in sides:
+        a0, a1 = max(0, r0 - radius), min(h, r1 + radius)
+        b0, b1 = max(0, c0 - radius), min(w, c1 + radius)
+        zs, ss = z[a0:a1, b0:b1], support[a0:a1, b0:b1]
+        for mine, other in ((left & ~right, right), (right & ~left, left)):
+            if not mine.any():
+                continue
+            other_full = np.zeros(zs.shape, bool)
+            other_full[r0 - a0:r1 - a0, c0 - b0:c1 - b0] = other
+            ts = plane_smooth(zs, ss & ~other_full, radius)
+            block = t[r0:r1, c0:c1]
+            block[mine] = ts[r0 - a0:r1 - a0, c0 - b0:c1 - b0][mine]
+    return t
+
+
+# -- hole filling ---------------------------------------------------------------------------------
+def _downsample(values: Array, known: Array, barrier: Array) -> Tuple[Array, Array, Array]:
+    h, w = values.shape
+    hh, ww = (h + 1) // 2, (w + 1) // 2
+    vk = np.zeros((2 * hh, 2 * ww))
+    kk = np.zeros((2 * hh, 2 * ww))
+    bb = np.zeros((2 * hh, 2 * ww), bool)
+    use = known & ~barrier
+    vk[:h, :w] = np.where(use, values, 0.0)
+    kk[:h, :w] = use
+    bb[:h, :w] = barrier
+    s = vk.reshape(hh, 2, ww, 2).sum(axis=(1, 3))
+    n = kk.reshape(hh, 2, ww, 2).sum(axis=(1, 3))
+    b = bb.reshape(hh, 2, ww, 2).any(axis=(1, 3))
+    inside = np.zeros((2 * hh, 2 * ww))
+    inside[:h, :w] = 1.0
+    # only blocks known entirely: a partial block's mean sits off its centre (bias on slopes)
+    kc = (n > 0) & (n >= inside.reshape(hh, 2, ww, 2).sum(axis=(1, 3)))
+    vc = np.where(kc, s / np.maximum(n, 1), np.nan)
+    return vc, kc & ~b, b
+
+
+def _upsample(coarse: Array, shape: Tuple[int, int]) -> Array:
+    """Bilinear 2× upsampling (coarse cell centres at fine 2i + ½), cropped to ``shape``."""
+    out = coarse.astype(np.float32)
+    for axis, n in ((0, shape[0]), (1, shape[1])):
+        m = out.shape[axis]
+        pos = np.clip((np.arange(n) - 0.5) / 2.0, 0.0, m - 1.0)
+        i0 = np.minimum(np.floor(pos).astype(np.int64), max(m - 2, 0))
+        i1 = np.minimum(i0 + 1, m - 1)
+        f = (pos - i0).astype(np.float32)
+        a, b = np.take(out, i0, axis=axis), np.take(out, i1, axis=axis)
+        f = f[:, None] if axis == 0 else f[None, :]
+        out = a * (1.0 - f) + b * f
+    return out
+
+
+def _relax(values: Array, known: Array, barrier: Array, iterations: int) -> Array:
+    r"""Improve the unknown non-barrier cells towards ∇²z = 0 (in place, returned).
+
+    The discrete equations :math:`\sum_{j \in N_4(i)} (z_i - z_j) = 0` over the open
+    4-neighbours form a symmetric positive definite system in the unknown cells; it is solved
+    by conjugate gradients from the current values (at most ``iterations`` steps).
+    """
+    from scipy import sparse
+    from scipy.sparse.linalg import cg
+
+    h, w = values.shape
+    free = ~known & ~barrier
+    idx = np.flatnonzero(free)
+    if idx.size == 0 or iterations <= 0:
+        return values
+    flat = values.reshape(-1)
+    pos = np.full(h * w, -1, np.int64)
+    pos[idx] = np.arange(idx.size)
+    rows, cols = np.divmod(idx, w)
+    open_ = ~barrier.reshape(-1)
+    known_f = known.reshape(-1)
+    diag = np.zeros(idx.size)
+    rhs = np.zeros(idx.size)
+    ai, aj = [], []
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        nr, nc = rows + dr, cols + dc
+        ok = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
+        nb = np.where(ok, np.clip(nr, 0, h - 1) * w + np.clip(nc, 0, w - 1), 0)
+        ok &= open_[nb]
+        diag += ok
+        kn = ok & known_f[nb]
+        rhs += np.where(kn, flat[nb], 0.0)
+        un = ok & (pos[nb] >= 0)
+        ai.append(np.flatnonzero(un))
+        aj.append(pos[nb][un])
+    has = diag > 0
+    diag[~has] = 1.0  # isolated cells keep their start value
+    rhs[~has] = flat[idx][~has]
+    ai_c, aj_c = np.concatenate(ai), np.concatenate(aj)
+    a = sparse.csr_matrix((np.concatenate([diag, -np.ones(ai_c.size)]),
+                           (np.concatenate([np.arange(idx.size), ai_c]),
+                            np.concatenate([np.arange(idx.size), aj_c]))),
+                          shape=(idx.size, idx.size))
+    x0 = flat[idx].astype(np.float64)
+    # solve for the correction: better conditioned right-hand side, same system
+    r0 = rhs - a @ x0
+    sol, _ = cg(a, r0, x0=np.zeros_like(x0), maxiter=int(iterations), atol=1e-7)
+    flat[idx] = (x0 + sol).astype(values.dtype)
+    return values
+
+
+def membrane_fill(values: Array, known: Array, barrier: Optional[Array] = None,
+                  barrier_z: Optional[Array] = None, iterations: int = 40) -> Array:
+    r"""Fill the unknown cells by membrane interpolation :math:`\nabla^2 z = 0`.
+
+    Coarse to fine: the known cells are averaged 2 × 2 down to ~:data:`COARSEST` cells, the
+    coarsest level is filled from the nearest known cell and relaxed, every finer level starts
+    from the coarser solution and is relaxed ``iterations`` times (Jacobi) with the known cells
+    fixed. No neighbour relation crosses a barrier cell; unknown barrier cells get
+    ``barrier_z`` (3-D breaklines) or the nearest filled height.
+
+    Returns
+    -------
+    ndarray float32
+        ``values`` at known cells, the interpolation elsewhere (NaN only without any known cell).
+    """
+    from scipy import ndimage
+
+    values = np.asarray(values, np.float32)
+    known = np.asarray(known, bool) & np.isfinite(values)
+    barrier = np.zeros(values.shape, bool) if barrier is None else np.asarray(barrier, bool)
+    if known.all():
+        return values.copy()
+    if not (known & ~barrier).any():
+        return np.full(values.shape, np.nan, np.float32)
+    levels = [(values, known, barrier)]
+    while max(levels[-1][0].shape) > COARSEST:
+        v, k, b = levels[-1]
+        nxt = _downsample(v, k, b)
+        if not nxt[1].any():  # nothing known at the coarser level: start here
+            break
+        levels.append(nxt)
+    sol: Optional[Array] = None
+    for depth in range(len(levels) - 1, -1, -1):
+        v, k, b = levels[depth]
+        cur = np.where(k, v, np.nan).astype(np.float32)
+        if sol is None:
+            src = k & ~b
+            if not src.any():
+                src = np.isfinite(cur)
+            _, (nr, nc) = ndimage.distance_transform_edt(~src, return_indices=True)
+            cur = np.where(k, cur, cur[nr, nc]).astype(np.float32)
+            n_it = min(4 * max(cur.shape), 200)
+        else:
+            up = _upsample(sol, cur.shape)
+            cur = np.where(k, cur, up).astype(np.float32)
+            # coarser levels are cheap (¼ the cells each): relax them longer
+            n_it = iterations * 2 ** min(depth, 4)
+        cur[~np.isfinite(cur)] = np.nanmean(cur) if np.isfinite(cur).any() else 0.0
+        sol = _relax(cur, k, b, n_it)
+    assert sol is not None
+    out = sol
+    bfree = barrier & ~known
+    if bfree.any():
+        if barrier_z is not None:
+            bz = np.asarray(barrier_z, np.float32)
+            use = bfree & np.isfinite(bz)
+            out[use] = bz[use]
+            bfree &= ~use
+        if bfree.any():
+            src = ~bfree & ~barrier | known
+            _, (nr, nc) = ndimage.distance_transform_edt(~src, return_indices=True)
+            out[bfree] = out[nr[bfree], nc[bfree]]
+    out[known] = values[known]
+    return out.astype(np.float32)
+
+
+# -- the filter -----------------------------------------------------------------------------------
+def lowpass_parameters(preset: str = "default",
+                       overrides: Optional[Dict[str, Any]] = None) -> Dict[str, Any]:
+    """The preset's parameters with the operator's overrides applied.
+
+    Overrides: ``max_window`` (m; all windows scaled in the preset's proportions),
+    ``iterations`` (windows and thresholds resampled geometrically between the first and the
+    last), ``threshold`` (m, last iteration; earlier ones scaled in proportion), ``slope``
+    (%), or any key of the preset tables. ``None`` values are ignored.
+    """
+    par = lowpass_preset(preset)
+    par["preset"] = (preset or "default").strip().lower()
+    ov = {k: v for k, v in (overrides or {}).items() if v is not None}
+    windows = [float(x) for x in ov.pop("windows_m", par["windows_m"])]
+    thresholds = [float(x) for x in ov.pop("thresholds_m", par["thresholds_m"])]
+    if len(windows) != len(thresholds) or not windows:
+        raise InputError("The low-pass schedule needs as many thresholds as windows (≥ 1).")
+    n = ov.pop("iterations", None)
+    if n is not None and int(n) != len(windows):
+        n = int(n)
+        if n < 1:
+            raise InputError("The low-pass filter needs at least one iteration.")
+        f = np.linspace(0.0, 1.0, n) if n > 1 else np.zeros(1)
+        windows = list(windows[0] * (windows[-1] / windows[0]) ** f)
+        thresholds = list(thresholds[0] * (thresholds[-1] / thresholds[0]) ** f)
+    mw = ov.pop("max_window", None)
+    if mw is not None:
+        if not mw > 0:
+            raise InputError("The largest window must be positive.")
+        scale = float(mw) / windows[0]
+        windows = [x * scale for x in windows]
+    thr = ov.pop("threshold", None)
+    if thr is not None:
+        if not thr > 0:
+            raise InputError("The height threshold must be positive.")
+        scale = float(thr) / thresholds[-1]
+        thresholds = [x * scale for x in thresholds]
+    slope = ov.pop("slope", None)
+    if slope is not None:
+        par["slope_pct"] = float(slope)
+    for k, v in ov.items():
+        if k not in par:
+            raise InputError(f"Unknown low-pass parameter '{k}'.")
+        par[k] = v
+    par["windows_m"] = [round(float(x), 3) for x in windows]
+    par["thresholds_m"] = [round(float(x), 3) for x in thresholds]
+    return par
+
+
+def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
+                   constraints: Optional[FilterConstraints] = None, grid: Optional[Grid] = None,
+                   keep_differences: bool = False,
+                   feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """Filter a DSM grid to a DTM with the iterative robust low-pass (see the module notes).
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        DSM, NaN = no data.
+    spacing : float
+        Cell size (m).
+    params : dict
+        :func:`lowpass_parameters`.
+    constraints : FilterConstraints, optional
+        The operator's edits on this grid (``grid`` is then needed for the ground points and
+        breaklines).
+    keep_differences : bool
+        Return the difference model of every iteration.
+
+    Returns
+    -------
+    dict
+        ``dtm`` (float32), ``ground`` (bool: remaining DSM cells, keep areas, ground points),
+        ``iterations`` (per iteration: window, threshold, eliminated counts and shares),
+        ``differences`` (list of float32 grids or empty), ``ground_points_disagreeing``,
+        ``eliminated_share``, ``cells_valid``, ``cells_ground``, ``seconds``.
+    """
+    feedback = ensure_feedback(feedback)
+    start = time.perf_counter()
+    dsm = np.asarray(z, np.float32)
+    shape = dsm.shape
+    if grid is None:
+        from affine import Affine
+
+        grid = Grid(Affine(spacing, 0, 0, 0, -spacing, shape[0] * spacing), shape[1], shape[0],
+                    spacing)
+    cons = constraints if constraints is not None else FilterConstraints.empty(grid)
+    keep = np.asarray(cons.keep, bool)
+    remove = np.asarray(cons.remove, bool)
+    barrier = (np.asarray(cons.barrier, bool) if cons.barrier is not None
+               else np.zeros(shape, bool))
+    valid = np.isfinite(dsm)
+    n_valid = int(valid.sum())
+    if n_valid == 0:
+        raise InputError("The DSM holds no height (every cell is nodata).")
+    # manual ground points: their cells take the point height and are protected
+    gp = np.asarray(cons.ground_points, float).reshape(-1, 3)
+    gp_cells = np.zeros(shape, bool)
+    gp_z = np.full(shape, np.nan, np.float32)
+    if gp.size:
+        r, c = grid.cell_of(gp[:, 0], gp[:, 1])
+        ins = r >= 0
+        gp_cells[r[ins], c[ins]] = True
+        gp_z[r[ins], c[ins]] = gp[ins, 2]
+    # height range: robust quantiles ± margin (gross blunders)
+    margin = float(params.get("height_margin_m", 10.0))
+    zv = dsm[valid]
+    lo, hi = np.quantile(zv, [0.005, 0.995]) if zv.size > 20 else (zv.min(), zv.max())
+    out_of_range = valid & ((dsm < lo - margin) | (dsm > hi + margin)) & ~keep
+    support = valid & ~keep & ~remove & ~out_of_range
+    m = dsm.copy()
+    m[gp_cells] = gp_z[gp_cells]
+    support |= gp_cells
+    rows: List[Dict[str, Any]] = []
+    diffs: List[Array] = []
+    windows = [float(x) for x in params["windows_m"]]
+    thresholds = [float(x) for x in params["thresholds_m"]]
+    down = float(params.get("down_threshold_m", 5.0))
+    slope = float(params.get("slope_pct", 0.0)) / 100.0
+    n_filterable = max(int((valid & ~keep).sum()), 1)
+    pre = int((valid & ~keep & (remove | out_of_range)).sum())
+    rows.append({"iteration": 0, "window_m": 0.0, "threshold_m": float("nan"),
+                 "eliminated": pre, "eliminated_share": pre / n_filterable,
+                 "eliminated_total_share": pre / n_filterable,
+                 "step": "height range and remove areas"})
+    eliminated_total = pre
+    n_steps = len(windows) + 2
+    for k, (wm, tk) in enumerate(zip(windows, thresholds), start=1):
+        feedback.progress(100.0 * (k - 1) / n_steps)
+        radius = max(1, round(wm / spacing / 2.0))
+        sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
+            if cons.breaklines else []
+        t = smooth(m, support, radius, sides, barrier)
+        d = m - t
+        thr = tk + slope * wm / 4.0
+        with np.errstate(invalid="ignore"):
+            elim = support & ~gp_cells & ((d > thr) | (d < -down))
+        # cells without any support in the window keep their height (nothing to compare)
+        elim &= np.isfinite(t)
+        n_el = int(elim.sum())
+        support &= ~elim
+        m[elim] = np.nan
+        eliminated_total += n_el
+        rows.append({"iteration": k, "window_m": wm, "threshold_m": round(thr, 3),
+                     "eliminated": n_el, "eliminated_share": n_el / n_filterable,
+                     "eliminated_total_share": eliminated_total / n_filterable,
+                     "step": "smoothing and elimination"})
+        feedback.info(f"Iteration {k}: window {wm:g} m, threshold {thr:.2f} m, "
+                      f"{n_el} cells eliminated ({100.0 * n_el / n_filterable:.1f} %).")
+        if keep_differences:
+            diffs.append(np.where(valid, dsm - t, np.nan).astype(np.float32))
+        del t, d
+    feedback.progress(100.0 * len(windows) / n_steps)
+    # optional light smoothing of the ground cells ("interpolation with filtering")
+    ground_vals = m.copy()
+    fs = float(params.get("final_smoothing_m", 0.0))
+    if fs > spacing:
+        radius = max(1, round(fs / spacing / 2.0))
+        sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
+            if cons.breaklines else []
+        t = smooth(m, support, radius, sides, barrier)
+        upd = support & ~gp_cells & np.isfinite(t)
+        ground_vals[upd] = t[upd]
+    # known values of the hole filling: ground survivors, keep areas (DSM), ground points
+    known = support.copy()
+    keep_known = keep & valid
+    ground_vals[keep_known] = dsm[keep_known]
+    known |= keep_known
+    # DSM nodata reaching the raster border stays nodata (no extrapolation into nothing)
+    outside = _border_nodata(valid | remove | keep)
+    free_known = known & ~gp_cells
+    disagree: List[Dict[str, Any]] = []
+    tol = float(params.get("ground_tolerance_m", 0.5))
+    if gp.size:
+        free = membrane_fill(ground_vals, free_known, barrier, cons.barrier_z)
+        disagree = check_ground_points(free, grid, gp, tol)
+        del free
+    feedback.progress(100.0 * (len(windows) + 1) / n_steps)
+    dtm = membrane_fill(ground_vals, known, barrier, cons.barrier_z)
+    dtm[keep_known] = dsm[keep_known]
+    dtm[gp_cells] = gp_z[gp_cells]
+    dtm[outside] = np.nan
+    ground = (support | keep_known | gp_cells) & valid
+    n_ground = int(ground.sum())
+    result = {
+        "dtm": dtm,
+        "ground": ground,
+        "iterations": rows,
+        "differences": diffs,
+        "ground_points_disagreeing": disagree,
+        "eliminated_share": eliminated_total / n_filterable,
+        "cells_valid": n_valid,
+        "cells_ground": n_ground,
+        "seconds": time.perf_counter() - start,
+    }
+    return result
+
+
+def _border_nodata(has: Array, reach: int = 3) -> Array:
+    """Empty cells connected to the raster border and more than ``reach`` cells from data.
+
+    They stay NaN in the DTM (no extrapolation into areas without data); the first few cells
+    are filled so that points at the edge of a gridded point cloud still have a DTM height.
+    """
+    from scipy import ndimage
+
+    empty = ~has
+    if not empty.any() or not has.any():
+        return empty
+    lab, n = ndimage.label(empty)
+    if n == 0:
+        return empty
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    edge = edge[edge > 0]
+    far = ndimage.distance_transform_edt(empty) > reach
+    return np.isin(lab, edge) & far
+
+
+def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default",
+                       project: Optional[PathLike] = None, spacing: Optional[float] = None,
+                       crs: Any = None, overrides: Optional[Dict[str, Any]] = None,
+                       write_iterations: bool = False,
+                       feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """``filter_lowpass``: read, filter, write (nothing is written when anything fails).
+
+    Parameters
+    ----------
+    input : path
+        DSM raster or points (see :func:`.surface_input.read_filter_input`).
+    output : path
+        Output folder (new or empty).
+    preset : str
+        Name in :data:`.presets.LOWPASS_PRESETS`.
+    project : path, optional
+        Project whose edits.gpkg is honoured.
+    spacing : float, optional
+        Grid spacing of point input (m).
+    crs : optional
+        CRS of input without one.
+    overrides : dict, optional
+        ``max_window``, ``iterations``, ``threshold``, ``slope`` (see
+        :func:`lowpass_parameters`).
+    write_iterations : bool
+        Also write ``diff_01.tif`` … (the difference model of every iteration).
+
+    Returns
+    -------
+    dict
+        ``dtm``, ``ndsm``, ``mask`` or ``labels``, ``report`` (paths) and ``metrics``.
+    """
+    feedback = ensure_feedback(feedback)
+    params = lowpass_parameters(preset, overrides)
+    inp: FilterInput = read_filter_input(input, spacing=spacing, crs=crs, feedback=feedback)
+    if project is not None and str(project) != "" and inp.crs is None:
+        from ..project.model import Project
+
+        prj_crs = Project.load(project).crs
+        if prj_crs:
+            from .surface_input import to_crs
+
+            inp.crs = to_crs(prj_crs)
+    cons = read_filter_constraints(project, inp.grid, inp.crs)
+    feedback.progress(5.0)
+    res = lowpass_filter(inp.z, inp.grid.spacing, params, cons, inp.grid,
+                         keep_differences=write_iterations, feedback=feedback.step(5.0, 85.0))
+    for b in res["ground_points_disagreeing"]:
+        feedback.warning(f"Manual ground point {b['index']} ({b['x']:.2f}, {b['y']:.2f}, "
+                         f"{b['z']:.2f}): the filter's surface differs by "
+                         f"{'?' if b['dh'] is None else format(b['dh'], '+.2f')} m "
+                         f"({b['status']}); the DTM passes through the point.")
+    report = {
+        "algorithm": "filter_lowpass",
+        "preset": params["preset"],
+        "parameters": {k: v for k, v in params.items() if k != "preset"},
+        "iterations": res["iterations"],
+        "eliminated_share": res["eliminated_share"],
+        "cells_valid": res["cells_valid"],
+        "cells_ground": res["cells_ground"],
+        "ground_tolerance_m": params["ground_tolerance_m"],
+        "grid": {"width": inp.grid.width, "height": inp.grid.height,
+                 "spacing": inp.grid.spacing},
+        "constraints": {"keep_cells": int(cons.keep.sum()),
+                        "remove_cells": int(cons.remove.sum()),
+                        "ground_points": len(cons.ground_points),
+                        "breaklines": len(cons.breaklines)},
+        "ground_points_disagreeing": res["ground_points_disagreeing"],
+        "warnings": [],
+    }
+    extra = {f"diff_{i:02d}": d for i, d in enumerate(res["differences"], start=1)}
+    out = write_filter_outputs(output, inp, res["dtm"], res["ground"], report,
+                               extra_rasters=extra, feedback=feedback.step(85.0, 100.0),
+                               title="DSM → DTM: iterative low-pass filter",
+                               product="filter_lowpass")
+    feedback.info(f"Eliminated {100.0 * res['eliminated_share']:.1f} % of the DSM cells in "
+                  f"{res['seconds']:.1f} s; DTM in {out['dtm']}.")
+    return out
+
+
+__all__ = ["breakline_sides", "lowpass_filter", "lowpass_parameters", "membrane_fill",
+           "plane_smooth", "run_filter_lowpass", "smooth"]

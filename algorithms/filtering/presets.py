@@ -1,0 +1,156 @@
+"""Parameter presets of the DSM → DTM filters, in operator units (metres, per cent).
+
+One ``default`` set serves all terrain types; ``flat``, ``hilly``, ``urban``, ``forest`` and
+``steep`` are tuned variants. Options the operator gives override the preset's values.
+
+Low-pass (:mod:`.lowpass`, the iterative "Phoenics" method, Raguse 2000 §3.3.1):
+
+``windows_m``
+    Side of the square smoothing window of every iteration (m), largest first. The largest
+    window should be 2–3 × the largest building width; objects wider than about half the
+    largest window survive (mark them as ``remove`` exclusion areas).
+``thresholds_m``
+    Height above the smoothed surface (m) beyond which a cell is an object, per iteration.
+``down_threshold_m``
+    Depth below the smoothed surface (m) beyond which a cell is a blunder (matching error).
+``slope_pct``
+    Allowance for breaks of slope (ridges, hill tops, embankment edges in keep areas' vicinity):
+    the threshold of an iteration grows by ``slope_pct/100 · window/4`` — the largest offset a
+    least-squares plane over the window has at a ridge whose slopes differ by ``slope_pct`` %.
+``final_smoothing_m``
+    Window (m) of a last light smoothing of the ground cells ("interpolation with filtering":
+    ground heights are not kept exactly); 0 = off.
+``height_margin_m``
+    Cells more than this below the 0.5 % or above the 99.5 % height quantile of the DSM are
+    blunders before the first iteration.
+``ground_tolerance_m``
+    Points within this of the DTM are labelled ground (point input).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict
+
+from ..errors import InputError
+
+#: Low-pass presets (see the module notes for the meaning of every entry).
+LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
+    "default": {
+        "windows_m": (60.0, 40.0, 20.0, 10.0),
+        "thresholds_m": (2.5, 1.5, 1.0, 0.5),
+        "down_threshold_m": 5.0,
+        "slope_pct": 20.0,
+        "final_smoothing_m": 3.0,
+        "height_margin_m": 10.0,
+        "ground_tolerance_m": 0.5,
+    },
+    "flat": {
+        "windows_m": (60.0, 40.0, 20.0, 10.0),
+        "thresholds_m": (2.0, 1.0, 0.6, 0.3),
+        "down_threshold_m": 3.0,
+        "slope_pct": 5.0,
+        "final_smoothing_m": 3.0,
+        "height_margin_m": 5.0,
+        "ground_tolerance_m": 0.3,
+    },
+    "hilly": {
+        "windows_m": (60.0, 40.0, 20.0, 10.0),
+        "thresholds_m": (3.0, 2.0, 1.0, 0.6),
+        "down_threshold_m": 5.0,
+        "slope_pct": 35.0,
+        "final_smoothing_m": 3.0,
+        "height_margin_m": 15.0,
+        "ground_tolerance_m": 0.6,
+    },
+    "urban": {
+        "windows_m": (100.0, 60.0, 30.0, 15.0, 8.0),
+        "thresholds_m": (2.5, 1.5, 1.0, 0.6, 0.4),
+        "down_threshold_m": 4.0,
+        "slope_pct": 15.0,
+        "final_smoothing_m": 3.0,
+        "height_margin_m": 10.0,
+        "ground_tolerance_m": 0.5,
+    },
+    "forest": {
+        "windows_m": (120.0, 80.0, 40.0, 20.0, 10.0),
+        "thresholds_m": (3.0, 2.0, 1.2, 0.8, 0.5),
+        "down_threshold_m": 6.0,
+        "slope_pct": 25.0,
+        "final_smoothing_m": 5.0,
+        "height_margin_m": 15.0,
+        "ground_tolerance_m": 0.6,
+    },
+    "steep": {
+        "windows_m": (40.0, 25.0, 15.0, 8.0),
+        "thresholds_m": (4.0, 2.5, 1.5, 1.0),
+        "down_threshold_m": 8.0,
+        "slope_pct": 60.0,
+        "final_smoothing_m": 3.0,
+        "height_margin_m": 30.0,
+        "ground_tolerance_m": 1.0,
+    },
+}
+
+#: Linear-prediction presets (:mod:`.linear_prediction`; keys are ``LPParameters`` fields):
+#: ``coarse_spacing`` cell size (m) of the coarsest pyramid level (≈ the largest building or
+#: wood that shrinks away by the lowest-cell reduction; larger ones are bridged);
+#: ``half_weight`` residual (m) above the shift where the weight is ½; ``cutoff`` residual (m)
+#: above the shift beyond which the weight is 0; ``low_cutoff`` depth (m) below the shift that
+#: is a blunder; ``band_above``/``band_below`` (m) ground candidates around the coarser level's
+#: DTM; ``slope`` (m/m) terrain allowance added to the cut-off and the band at coarse levels
+#: (``slope``·cell/2); ``shift_factor``/``max_shift`` shift g = −min(k·σ₋, g_max) (m);
+#: ``iterations``/``fine_iterations`` robust iterations per level (coarse / the two finest);
+#: ``ground_tolerance`` |DSM − DTM| (m) labelled ground.
+LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
+    "default": {"coarse_spacing": 32.0, "half_weight": 0.5, "cutoff": 1.5, "low_cutoff": 5.0,
+                "band_above": 1.0, "band_below": 5.0, "slope": 0.15, "shift_factor": 1.0,
+                "max_shift": 0.5, "iterations": 4, "fine_iterations": 2,
+                "ground_tolerance": 0.5},
+    "flat": {"coarse_spacing": 32.0, "half_weight": 0.2, "cutoff": 0.6, "low_cutoff": 3.0,
+             "band_above": 0.6, "band_below": 3.0, "slope": 0.05, "shift_factor": 1.0,
+             "max_shift": 0.3, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.3},
+    "hilly": {"coarse_spacing": 32.0, "half_weight": 0.4, "cutoff": 1.2, "low_cutoff": 5.0,
+              "band_above": 1.5, "band_below": 5.0, "slope": 0.35, "shift_factor": 1.0,
+              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.6},
+    "urban": {"coarse_spacing": 64.0, "half_weight": 0.3, "cutoff": 0.8, "low_cutoff": 4.0,
+              "band_above": 0.8, "band_below": 4.0, "slope": 0.15, "shift_factor": 1.0,
+              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.5},
+    "forest": {"coarse_spacing": 64.0, "half_weight": 0.3, "cutoff": 1.0, "low_cutoff": 6.0,
+               "band_above": 1.0, "band_below": 6.0, "slope": 0.25, "shift_factor": 1.5,
+               "max_shift": 1.0, "iterations": 5, "fine_iterations": 2,
+               "ground_tolerance": 0.6},
+    "steep": {"coarse_spacing": 16.0, "half_weight": 0.6, "cutoff": 2.0, "low_cutoff": 8.0,
+              "band_above": 2.5, "band_below": 8.0, "slope": 0.6, "shift_factor": 1.0,
+              "max_shift": 1.0, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 1.0},
+}
+
+#: Preset names, in the order the GUIs list them.
+PRESET_NAMES = ("default", "flat", "hilly", "urban", "forest", "steep")
+
+
+def preset(table: Dict[str, Dict[str, Any]], name: str) -> Dict[str, Any]:
+    """A copy of preset ``name`` of ``table``.
+
+    Raises
+    ------
+    InputError
+        For an unknown name (the message lists the known ones).
+    """
+    key = (name or "default").strip().lower()
+    if key not in table:
+        raise InputError(f"Unknown preset '{name}'; use one of {', '.join(table)}.")
+    return dict(table[key])
+
+
+def lowpass_preset(name: str = "default") -> Dict[str, Any]:
+    """A copy of the low-pass preset ``name``."""
+    return preset(LOWPASS_PRESETS, name)
+
+
+def linear_prediction_preset(name: str = "default") -> Dict[str, Any]:
+    """A copy of the linear-prediction preset ``name``."""
+    return preset(LINEAR_PREDICTION_PRESETS, name)
+
+
+__all__ = ["LINEAR_PREDICTION_PRESETS", "LOWPASS_PRESETS", "PRESET_NAMES",
+           "linear_prediction_preset", "lowpass_preset", "preset"]

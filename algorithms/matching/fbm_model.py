@@ -1,0 +1,458 @@
+r"""DSM of one stereo model by hierarchical feature-based matching + LSM (seed-000 §3.3).
+
+1. :func:`.model_setup.prepare_model`: epipolar geometry, height and disparity range,
+   measuring area (stereo overlap ∩ boundaries), exclusion areas, breaklines, DSM grid
+   (default spacing 2 × GSD).
+2. Grey epipolar images of both images; the operator's constraints are carried into the left
+   epipolar image: exclusion areas and the outside of the boundaries become the ``mask`` (not
+   matched), breaklines become ``barriers`` (approximations do not propagate across them), the
+   start points of ``edits.gpkg`` (with heights) become ``seeds``. Without start points the
+   coarsest level searches the whole height range.
+3. :func:`.hierarchy.match_epipolar_fbm_lsm`: image pyramids coarse → fine, Förstner points,
+   candidate matching with robust consistency and a bidirectional check, LSM at the finest
+   level; failed windows are marked, matching goes on around them.
+4. Every raw point is intersected (:meth:`EpipolarPair.disparity_to_world`) with
+   :math:`\sigma_Z = |Z(d + \sigma_d) - Z(d)|`; points outside the measuring area or inside
+   an exclusion area are dropped.
+5. Groundel reduction (:func:`..surface.groundel.reduce_groundels`, cell ``groundel`` m,
+   default 40 GSD ≈ √2 × the FBM window on the ground): robust L1 plane / median / lower
+   envelope per cell, σ1 (raw points), σ2 = F·σ1/√n̄ (reduced points), outlier flags.
+6. The DSM grid from the inlier points (weights 1/σ_Z²) by the finite-element interpolation
+   with curvature regularisation (:func:`..surface.fe_grid.fe_interpolate`), which honours
+   breaklines, exclusion areas (NaN) and boundaries, or by the median per cell + membrane
+   gap filling (``interpolation="membrane"``).
+
+Outputs (staged folder: nothing is left behind on error or cancel): ``dsm.tif``,
+``sigma.tif`` (σ2 of the groundel each cell lies in, m), ``count.tif`` (raw points per cell),
+``points.gpkg`` / ``points.las`` (raw points: σ_Z, σ_d, ρ, flags, level, outlier),
+``reduced.gpkg`` / ``.las`` (one point per groundel), ``report.json`` and ``report.html``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import fields, replace
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.epipolar import SIDES
+from ..processing.feedback import Feedback, ensure_feedback
+from .model_setup import ModelSetup, footprint, prepare_model
+
+PathLike = Union[str, Path]
+
+#: Strategy presets (seed-000 §3.1: empirical parameter sets per terrain type). Keys are
+#: fields of :class:`.hierarchy.FbmLsmOptions` or the surface options of
+#: :func:`match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``).
+PRESETS: Dict[str, Dict[str, Any]] = {
+    # open, gently undulating terrain: large windows and groundels, L1 planes, smooth surface
+    "flat": {"fbm_window": 32, "groundel_gsd": 40.0, "reduction": "l1", "smoothing": 1.0},
+    # hills: smaller windows follow the relief; medium groundels
+    "hilly": {"fbm_window": 24, "groundel_gsd": 24.0, "reduction": "l1", "smoothing": 0.3},
+    # buildings: small windows, tight bidirectional check, small groundels, median, little
+    # smoothing so that roofs and walls stay sharp
+    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "groundel_gsd": 10.0,
+              "reduction": "median", "smoothing": 0.05},
+    # vegetation: the lower envelope of the points of a groundel is taken as the terrain
+    "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
+               "smoothing": 0.3},
+}
+PRESET_NAMES = tuple(PRESETS)
+DEFAULT_PRESET = "flat"
+
+POINT_FORMATS = ("gpkg", "las")
+
+
+def _grey(image: np.ndarray, pair: Any, side: str) -> np.ndarray:
+    """Grey (band mean) epipolar image, float32, NaN outside the original image."""
+    img, valid = pair.resample(image, side)
+    grey = img.astype(np.float32)
+    if grey.ndim == 3:
+        grey = grey.mean(axis=0)
+    grey[~valid] = np.nan
+    return grey
+
+
+def _to_epipolar(setup: ModelSetup, coords: np.ndarray, z: float) -> np.ndarray:
+    """Object (x, y[, z]) vertices → left epipolar (col, row); missing z → ``z``."""
+    c = np.asarray(coords, dtype=float)
+    zz = c[:, 2] if c.shape[1] > 2 else np.full(len(c), z)
+    zz = np.where(np.isfinite(zz), zz, z)
+    col, row = setup.pair.world_to_epipolar(np.column_stack([c[:, 0], c[:, 1], zz]), "left")
+    return np.column_stack([col, row])
+
+
+def _epipolar_shapes(setup: ModelSetup, geoms: List[Any], z: float) -> List[Any]:
+    from shapely.geometry import LineString, Polygon
+
+    out = []
+    for g in geoms:
+        for part in getattr(g, "geoms", [g]):
+            if part.geom_type == "Polygon":
+                ext = _to_epipolar(setup, np.asarray(part.exterior.coords), z)
+                holes = [_to_epipolar(setup, np.asarray(h.coords), z) for h in part.interiors]
+                poly = Polygon(ext, holes)
+                if np.isfinite(ext).all():
+                    out.append(poly.buffer(0))
+            elif part.geom_type == "LineString":
+                xy = _to_epipolar(setup, np.asarray(part.coords), z)
+                if np.isfinite(xy).all() and len(xy) > 1:
+                    out.append(LineString(xy))
+    return out
+
+
+def epipolar_constraints(setup: ModelSetup, shape: Tuple[int, int]
+                         ) -> Tuple[Optional[np.ndarray], Optional[np.ndarray]]:
+    """Mask (exclusions, outside the boundaries) and barriers (breaklines) in the left image.
+
+    Polygons are projected at the model's mid height (the exact test is made in object space
+    after the intersection); breaklines at their own heights.
+    """
+    from affine import Affine
+    from rasterio.features import rasterize
+
+    centre = Affine.translation(-0.5, -0.5)  # pixel centres at integer coordinates
+    mask = None
+    excl = _epipolar_shapes(setup, setup.exclusions, setup.z_mid)
+    if excl:
+        mask = rasterize([(g, 1) for g in excl], out_shape=shape, transform=centre,
+                         dtype="uint8").astype(bool)
+    if setup.boundaries:
+        inside = _epipolar_shapes(setup, setup.boundaries, setup.z_mid)
+        keep = rasterize([(g, 1) for g in inside], out_shape=shape, transform=centre,
+                         dtype="uint8").astype(bool) if inside else np.zeros(shape, bool)
+        mask = ~keep if mask is None else (mask | ~keep)
+    barriers = None
+    lines = _epipolar_shapes(setup, setup.breaklines, setup.z_mid)
+    if lines:
+        barriers = rasterize([(g, 1) for g in lines], out_shape=shape, transform=centre,
+                             all_touched=True, dtype="uint8").astype(bool)
+    return mask, barriers
+
+
+def start_point_seeds(setup: ModelSetup) -> Optional[np.ndarray]:
+    """The operator's start points as seeds ``(col, row, disparity)`` of the left image.
+
+    Raises
+    ------
+    InputError
+        A start point without a height, outside the model or inside an exclusion area.
+    """
+    from ..project.edits import read_layer
+
+    path = Path(setup.project.edits_path)
+    if not path.is_file():
+        return None
+    try:
+        feats = read_layer(path, "start_points")
+    except InputError:
+        return None
+    if not feats:
+        return None
+    from shapely.geometry import Point
+
+    seeds = []
+    for k, (geom, props) in enumerate(feats, start=1):
+        h = props.get("height")
+        if h is None and geom.has_z:
+            h = geom.z
+        if h is None or not np.isfinite(float(h)):
+            raise InputError(f"Start point {k} has no height; enter its terrain height (m) in "
+                             "edits.gpkg (layer start_points, field height).")
+        h = float(h)
+        p = Point(geom.x, geom.y)
+        inside = all(footprint(c, r.eo, h).contains(p)
+                     for c, r in zip(setup.cameras, setup.records))
+        if setup.boundaries:
+            inside = inside and any(b.contains(p) for b in setup.boundaries)
+        if not inside:
+            raise InputError(f"Start point {k} at ({geom.x:.2f}, {geom.y:.2f}) lies outside "
+                             f"model '{setup.model.name}'; move it into the stereo overlap.")
+        if any(e.contains(p) for e in setup.exclusions):
+            raise InputError(f"Start point {k} at ({geom.x:.2f}, {geom.y:.2f}) lies in an "
+                             "exclusion area; move it out or delete it.")
+        world = np.array([[geom.x, geom.y, h]])
+        cl, row = setup.pair.world_to_epipolar(world, "left")
+        cr, _ = setup.pair.world_to_epipolar(world, "right")
+        seeds.append([float(cl[0]), float(row[0]), float(cl[0] - cr[0])])
+    return np.asarray(seeds, dtype=float)
+
+
+def _options(preset: str, overrides: Dict[str, Any]) -> Tuple[Any, Dict[str, Any]]:
+    """Hierarchy options and surface options from a preset and explicit values."""
+    from .hierarchy import FbmLsmOptions
+
+    if preset not in PRESETS:
+        raise InputError(f"Unknown preset '{preset}'; use one of {', '.join(PRESET_NAMES)}.")
+    values = dict(PRESETS[preset])
+    values.update({k: v for k, v in overrides.items() if v is not None})
+    names = {f.name for f in fields(FbmLsmOptions)}
+    surface_keys = ("groundel_gsd", "reduction", "smoothing")
+    unknown = set(values) - names - set(surface_keys)
+    if unknown:
+        raise InputError(f"Unknown matching option(s): {', '.join(sorted(unknown))}.")
+    options = replace(FbmLsmOptions(), **{k: v for k, v in values.items() if k in names})
+    surface = {k: values[k] for k in surface_keys if k in values}
+    return options, surface
+
+
+def _cell_lookup(grid: Any, x: np.ndarray, y: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Flat cell index of points (−1 outside the grid)."""
+    r, c = grid.cell_of(x, y)
+    r = np.asarray(r)
+    c = np.asarray(c)
+    ok = (r >= 0) & (r < grid.height) & (c >= 0) & (c < grid.width)
+    return np.where(ok, r * grid.width + c, -1), ok
+
+
+def _sigma2_on(red: Any, grid: Any) -> np.ndarray:
+    """σ2 = F·σ1_cell/√n of the groundel each DSM cell centre lies in (NaN: no σ)."""
+    g, layers = red.grid()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s2 = red.F * layers["sigma1"] / np.sqrt(layers["n"].astype(np.float32))
+    t = grid.transform
+    xs = t.c + (np.arange(grid.width) + 0.5) * t.a
+    ys = t.f + (np.arange(grid.height) + 0.5) * t.e
+    r, _ = g.cell_of(np.zeros_like(ys) + g.transform.c, ys)
+    _, c = g.cell_of(xs, np.zeros_like(xs) + g.transform.f - 0.5 * g.spacing)
+    out = np.full(grid.shape, np.nan, np.float32)
+    rr, cc = np.meshgrid(r, c, indexing="ij")
+    ok = (rr >= 0) & (cc >= 0)
+    out[ok] = s2[rr[ok], cc[ok]]
+    return out
+
+
+def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
+                        spacing: Optional[float] = None, feedback: Optional[Feedback] = None,
+                        min_height: Optional[float] = None, max_height: Optional[float] = None,
+                        max_gap: Optional[float] = None, preset: str = DEFAULT_PRESET,
+                        groundel: Optional[float] = None, reduction: Optional[str] = None,
+                        smoothing: Optional[float] = None, interpolation: str = "fe",
+                        points_format: str = "gpkg", use_start_points: bool = True,
+                        **options: Any) -> Dict[str, Any]:
+    """DSM of a stereo model by hierarchical FBM + LSM (see the module notes).
+
+    Parameters
+    ----------
+    project : Project or path
+    model : str
+        Stereo model name.
+    output_dir : path
+        Output folder (created, or replaced if PhotoDEM wrote it).
+    spacing : float, optional
+        DSM cell size (m); default 2 × the model's GSD.
+    min_height, max_height : float, optional
+        Height range (m) searched without start points; default terrain height ∓/± 0.3 H.
+    max_gap : float, optional
+        Cells farther than ``max_gap / 2`` (m) from every matched point stay NaN; default
+        (or 0): every cell of the measuring area gets a height, and the report tells the
+        measured share (cells within half a groundel of a point) from the interpolated one.
+    preset : {"flat", "hilly", "urban", "forest"}
+        Strategy preset (:data:`PRESETS`); explicit options win.
+    groundel : float, optional
+        Groundel (reduction cell) side (m); default the preset's ``groundel_gsd`` × GSD.
+    reduction : {"l1", "median", "lower"}, optional
+        Groundel reduction mode; default the preset's.
+    smoothing : float, optional
+        Curvature weight of the FE interpolation; default the preset's.
+    interpolation : {"fe", "membrane"}
+        Finite elements with curvature regularisation, or median per cell + membrane filling.
+    points_format : {"gpkg", "las"}
+        Format of the point outputs (LAS needs laspy).
+    use_start_points : bool
+        Use the start points of ``edits.gpkg`` as seeds.
+    **options
+        Fields of :class:`.hierarchy.FbmLsmOptions` (fbm_window, rho_min, lsm, …).
+
+    Returns
+    -------
+    dict
+        ``{"dsm", "sigma", "count", "points", "reduced", "report", "report_html", "metrics"}``.
+    """
+    from ..raster.io import staged_folder
+    from ..surface.gridding import polygon_mask, write_grid
+    from ..surface.groundel import reduce_groundels
+    from ..surface.point_output import write_points
+    from .hierarchy import match_epipolar_fbm_lsm
+    from .model_report import write_model_report
+
+    feedback = ensure_feedback(feedback)
+    t_start = time.perf_counter()
+    if points_format not in POINT_FORMATS:
+        raise InputError(f"Unknown point format '{points_format}'; use gpkg or las.")
+    if interpolation not in ("fe", "membrane"):
+        raise InputError(f"Unknown interpolation '{interpolation}'; use fe or membrane.")
+    opts, surface = _options(preset, dict(options, groundel_gsd=None, reduction=reduction,
+                                          smoothing=smoothing))
+    setup = prepare_model(project, model, spacing=spacing, spacing_gsd=2.0,
+                          min_height=min_height, max_height=max_height)
+    project, m, pair, grid = setup.project, setup.model, setup.pair, setup.grid
+    cell = float(groundel) if groundel else float(surface["groundel_gsd"]) * setup.gsd
+    if not cell > 0:
+        raise InputError(f"The groundel size must be positive, got {cell}.")
+    max_gap = None if max_gap is None or max_gap <= 0 else float(max_gap)
+    seeds = start_point_seeds(setup) if use_start_points else None
+    feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
+                  f"disparities {setup.min_d}…{setup.max_d} px; "
+                  f"{0 if seeds is None else len(seeds)} start point(s); DSM "
+                  f"{grid.width}×{grid.height} cells at {setup.spacing:.3f} m; groundels "
+                  f"{cell:.2f} m.")
+    timings: Dict[str, float] = {}
+    t0 = time.perf_counter()
+    grey = {}
+    for side, rec in zip(SIDES, setup.records):
+        grey[side] = _grey(project.read_image(rec, colour_only=True), pair, side)
+        feedback.check()
+    mask, barriers = epipolar_constraints(setup, grey["left"].shape)
+    timings["epipolar"] = time.perf_counter() - t0
+    feedback.progress(5.0)
+
+    t0 = time.perf_counter()
+    matches = match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d, setup.max_d,
+                                     seeds=seeds, mask=mask, barriers=barriers, options=opts,
+                                     feedback=feedback.step(5, 70))
+    del grey
+    timings["matching"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    col, row, d = matches.col, matches.row, matches.disparity
+    pts = pair.disparity_to_world(d, col, row)
+    pts_s = pair.disparity_to_world(d + np.maximum(matches.sigma_px, 1e-3), col, row)
+    sigma_z = np.abs(pts_s[:, 2] - pts[:, 2])
+    ok = np.isfinite(pts).all(axis=1)
+    # object-space constraints, exactly: inside the measuring area, outside exclusions
+    allowed = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions,
+                                                                              grid)
+    idx, on_grid = _cell_lookup(grid, pts[:, 0], pts[:, 1])
+    ok &= on_grid
+    ok[ok] = allowed.ravel()[idx[ok]]
+    n_raw_all = len(d)
+    keep = np.nonzero(ok)[0]
+    pts, sigma_z, idx = pts[keep], sigma_z[keep], idx[keep]
+    timings["intersection"] = time.perf_counter() - t0
+    feedback.progress(72.0)
+    if len(pts) < 3:
+        raise InputError(f"Model '{m.name}': matching found {len(pts)} points; check the "
+                         "height range, the start points and the image texture.")
+
+    t0 = time.perf_counter()
+    mode = surface.get("reduction", "l1")
+    red = reduce_groundels(pts[:, 0], pts[:, 1], pts[:, 2], cell,
+                           origin=(grid.transform.c, grid.transform.f), mode=mode)
+    inlier = ~red.outlier
+    timings["reduction"] = time.perf_counter() - t0
+    feedback.progress(78.0)
+
+    t0 = time.perf_counter()
+    from ..surface.gridding import GridAccumulator, finish_grid
+
+    if interpolation == "fe":
+        from ..surface.fe_grid import fe_interpolate
+
+        w = 1.0 / np.maximum(sigma_z[inlier], 1e-3) ** 2
+        z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
+                                   weights=w, smoothing=float(surface.get("smoothing", 1.0)),
+                                   breaklines=setup.breaklines, exclusions=setup.exclusions,
+                                   boundaries=setup.boundaries, max_gap=max_gap,
+                                   feedback=feedback.step(78, 92))
+    else:
+        acc = GridAccumulator(grid)
+        acc.add(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2])
+        zg, n_cell = acc.reduce()
+        z_grid = finish_grid(zg, n_cell, grid, math.inf if max_gap is None else max_gap,
+                             setup.exclusions, setup.boundaries,
+                             setup.breaklines).z
+    z_grid = np.asarray(z_grid, dtype=np.float32)
+    z_grid[~allowed] = np.nan
+    count = np.bincount(idx, minlength=grid.width * grid.height).reshape(grid.shape)
+    sigma_grid = _sigma2_on(red, grid)
+    timings["gridding"] = time.perf_counter() - t0
+    feedback.check()
+
+    n_area = int(allowed.sum())
+    n_have = int((np.isfinite(z_grid) & allowed).sum())
+    coverage = 100.0 * n_have / n_area if n_area else 0.0
+    # measured: within half a groundel of a matched point (the rest is interpolated)
+    from scipy import ndimage
+
+    near = ndimage.distance_transform_edt(count == 0) * grid.spacing <= 0.5 * cell
+    measured = 100.0 * int((near & allowed).sum()) / n_area if n_area else 0.0
+    summary = red.summary()
+    H = setup.flying_height
+    metrics = {
+        "points_matched": n_raw_all,
+        "points_raw": len(pts),
+        "points_reduced": red.cells,
+        "outliers": red.n_outliers,
+        "coverage_pct": coverage,
+        "measured_pct": measured,
+        "sigma1_m": summary.get("sigma1_m"),
+        "sigma2_m": summary.get("sigma2_m"),
+        "sigma2_permille": (1000.0 * summary["sigma2_m"] / H
+                            if summary.get("sigma2_m") is not None else None),
+        "spacing_m": setup.spacing,
+        "groundel_m": cell,
+        "cells": [grid.width, grid.height],
+        "disparity_range_px": [setup.min_d, setup.max_d],
+        "height_range_m": [setup.z_min, setup.z_max],
+        "start_points": 0 if seeds is None else len(seeds),
+        "failed_windows": len(matches.failures),
+        "max_gap_m": max_gap,
+        "base_px": float(pair.base * pair.focal_px / H) if H > 0 else None,
+    }
+    out = Path(output_dir)
+    suffix = "." + points_format
+    with staged_folder(out, replace=True, product="match_model") as tmp:
+        write_grid(tmp / "dsm.tif", z_grid, grid, crs=project.crs)
+        write_grid(tmp / "count.tif", np.minimum(count, 65535).astype(np.uint16), grid,
+                   crs=project.crs, overviews=False)
+        if sigma_grid is not None:
+            write_grid(tmp / "sigma.tif", np.asarray(sigma_grid, np.float32), grid,
+                       crs=project.crs, overviews=False)
+        feedback.progress(94.0)
+        write_points(tmp / f"points{suffix}", pts[:, 0], pts[:, 1], pts[:, 2], {
+            "sigma_z": sigma_z.astype(np.float32),
+            "sigma_px": matches.sigma_px[keep].astype(np.float32),
+            "rho": matches.rho[keep].astype(np.float32),
+            "flags": matches.flags[keep].astype(np.int32),
+            "level": matches.level[keep].astype(np.int32),
+            "outlier": red.outlier.astype(np.int32),
+        }, crs=project.crs)
+        write_points(tmp / f"reduced{suffix}", red.x, red.y, red.z, {
+            "n": red.n.astype(np.int32), "sigma1": red.sigma1.astype(np.float32),
+            "sigma2": (red.F * red.sigma1 / np.sqrt(np.maximum(red.n, 1))).astype(np.float32),
+            "plane": red.plane.astype(np.int32)}, crs=project.crs)
+        feedback.progress(97.0)
+        fails = matches.failures
+        fail_xy = None
+        if len(fails):
+            d_mid = 0.5 * (setup.min_d + setup.max_d)
+            w = pair.disparity_to_world(np.full(len(fails), d_mid), fails[:, 0], fails[:, 1])
+            fail_xy = w[:, :2]
+        timings["total"] = time.perf_counter() - t_start
+        report = {"model": m.name, "method": "fbm_lsm", "images": setup.names,
+                  "crs": project.crs, "flying_height_m": H, "preset": preset,
+                  "metrics": metrics, "levels": matches.stats.get("levels", []),
+                  "reduction": summary,
+                  "matching": {k: v for k, v in matches.stats.items() if k != "levels"},
+                  "options": {f.name: getattr(opts, f.name) for f in fields(opts)},
+                  "seconds": timings}
+        write_model_report(tmp, report, dsm=tmp / "dsm.tif",
+                           sigma=tmp / "sigma.tif" if sigma_grid is not None else None,
+                           count=tmp / "count.tif", failures=fail_xy)
+        feedback.progress(100.0)
+    feedback.info(f"Model {m.name}: {metrics['points_raw']} points, "
+                  f"{metrics['points_reduced']} groundels, coverage {coverage:.1f} %.")
+    return {"dsm": str(out / "dsm.tif"),
+            "sigma": str(out / "sigma.tif") if sigma_grid is not None else None,
+            "count": str(out / "count.tif"), "points": str(out / f"points{suffix}"),
+            "reduced": str(out / f"reduced{suffix}"), "report": str(out / "report.json"),
+            "report_html": str(out / "report.html"), "metrics": metrics}
+
+
+__all__ = ["DEFAULT_PRESET", "PRESETS", "PRESET_NAMES", "epipolar_constraints",
+           "match_model_fbm_lsm", "start_point_seeds"]

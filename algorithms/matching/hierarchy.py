@@ -1,0 +1,735 @@
+r"""Coarse-to-fine control strategy of the feature-based + LSM matcher (seed-000 §3.3).
+
+:func:`match_epipolar_fbm_lsm` matches an epipolar pair (rows correspond, d = col_l − col_r)
+over Gaussian image pyramids. The approximation of every level is a **piecewise-planar
+disparity grid aligned with the image pyramid**: one plane per matching window (window side
+``fbm_window`` px of the level), split into components by breakline pixels
+(:func:`.fbm.window_components`), so that nothing is interpolated or propagated across a
+barrier.
+
+Per level (coarsest first):
+
+1. **Predictions** for each window component, in this order of preference:
+   the previous level's plane of the component under the point (× 2; at the top level an
+   ``approx`` grid from the caller), a seed (operator start point), the planes of already
+   matched neighbouring components (region growing; evaluated at the point), or — at the
+   top level only — the full search range ``[min_d, max_d] / 2^k``.
+2. **Waves** (best-first/breadth-first over the window graph): all components with a
+   prediction are matched together with :func:`.fbm.fbm_level` (bidirectional FBM with robust
+   per-window consistency). A component that fails runs the failure cascade once per level:
+   *enlarge the window* (2 × window side, NCC window + 4), then *reduce the step* (denser
+   Förstner points: w_factor/4, q ≥ 0.5, 3 × 3 non-maximum suppression); if it still fails it
+   stays open and is retried from its matched neighbours' planes whenever more of them
+   succeed (*come back from other sides*). Matching never stops at a failure.
+3. Components still unmatched at the end of the level are **marked** (``failures``) unless they
+   are masked (≥ 90 % no-data/exclusion) or tiny (< ¼ window). Their planes are filled from
+   the neighbours over the component graph (barrier-aware) for the next level; masked
+   components stay empty.
+
+At level 0 the accepted FBM points are optionally refined by epipolar LSM (3 geometric + 2
+radiometric unknowns, :func:`.lsm.lsm_match`); points that do not converge or fail the σ_px /
+ρ thresholds keep their FBM value and get :data:`FLAG_LSM_FAILED`.
+
+Point flags (bits of ``EpipolarMatches.flags``):
+
+=====  ==========================  ============================================================
+bit    name                        meaning
+=====  ==========================  ============================================================
+1      :data:`FLAG_LSM`            disparity and σ from LSM
+2      :data:`FLAG_LSM_FAILED`     LSM tried and rejected (σ, ρ, convergence): FBM value kept
+4      :data:`FLAG_FEATURE_SUBPIXEL`  NCC parabola failed: Förstner feature difference kept
+8      :data:`FLAG_ENLARGED`       window matched in the enlarged-window retry
+16     :data:`FLAG_DENSIFIED`      window matched with denser points (reduced step)
+32     :data:`FLAG_RETRY`          window matched in a later wave from its neighbours'
+                                   predictions (came back from another side)
+=====  ==========================  ============================================================
+
+Only accepted points are returned (bidirectional failures and outliers are counted in
+``stats``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..processing.feedback import ensure_feedback
+from .fbm import (
+    FLAG_FEATURE_SUBPIXEL,
+    FBMResult,
+    Grouping,
+    detect_features,
+    fbm_level,
+    fill_nodata,
+    group_wls,
+    window_components,
+)
+from .interest import InterestPoints
+from .lsm import lsm_match
+from .pyramid import build_pyramid, from_level, levels_for_disparity, to_level
+
+FLAG_LSM = 1
+FLAG_LSM_FAILED = 2
+FLAG_ENLARGED = 8
+FLAG_DENSIFIED = 16
+FLAG_RETRY = 32
+__all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_LSM",
+           "FLAG_LSM_FAILED", "FLAG_RETRY", "EpipolarMatches", "FbmLsmOptions",
+           "match_epipolar_fbm_lsm"]
+
+_NONE, _COARSE, _NEIGHBOURS, _RANGE, _SEED = 0, 1, 2, 3, 4
+
+
+@dataclass
+class FbmLsmOptions:
+    """Parameters of :func:`match_epipolar_fbm_lsm` (px = pixels of the working level).
+
+    Attributes
+    ----------
+    levels : int, optional
+        Pyramid levels incl. level 0; None → :func:`.pyramid.levels_for_disparity` so that the
+        range ``max_d − min_d`` shrinks to ≤ fbm_window/4 px at the top (top ≥ 2 windows).
+    interest_window : int
+        Förstner summation window (seed: 5 × 5; pilot 3 × 5).
+    q_min, w_factor : float
+        Förstner roundness threshold and weight factor × median(w).
+    nms_window : int
+        Non-maximum suppression of the interest points (5 → ≤ 4 % of the pixels).
+    ncc_window : int
+        Window of the candidate correlation ρ (seed ≈ 5 × 5).
+    refine_window : int
+        Window of the NCC parabola for the sub-pixel disparity.
+    rho_min : float
+        Candidates need ρ ≥ rho_min (seed 0.5–0.7).
+    fbm_window : int
+        Matching-window side, px (seed 30–40, ≈ 32).
+    pull_in : float, optional
+        Half width of the candidate search around the prediction, px. None → fbm_window/8
+        (4 px) when predicted from the coarser level, fbm_window/4 (8 px, the FBM convergence
+        range of the seed) when growing from seeds or neighbours.
+    bidir_tol : float
+        Left→right and right→left disparities must agree within this, px.
+    row_tol : float
+        Candidates within ± row_tol rows of the left point, px.
+    min_points : int
+        Accepted points a window needs to count as matched.
+    huber_iterations, redescending_iterations, huber_k, redescending_c, reject_k, sigma_floor :
+        Robust consistency (:func:`.fbm.robust_plane_fit`): 2 × Huber k = 1.5σ, 4 × exp(−(v/2.5σ)²),
+        outliers beyond 3σ, σ ≥ 0.3 px.
+    enlarge, densify : bool
+        Failure cascade steps (enlarge the window; reduce the step = denser points).
+    keep_coarse : bool
+        Also return the points of the coarser levels (in level-0 pixels, ``level`` > 0).
+    lsm : bool
+        Refine the level-0 points by epipolar LSM.
+    lsm_half : int
+        LSM template half size (window = 2·half + 1 = 17 ≈ the seed's 16 × 16).
+    lsm_max_sigma, lsm_min_rho : float
+        LSM acceptance: σ_px ≤ 0.2 px, ρ ≥ 0.7 (seed Tab. 3.9).
+    lsm_max_iter : int
+        Gauss–Newton iteration limit.
+    lsm_pull_in : float
+        LSM may move the disparity at most this far from the FBM value, px.
+    """
+
+    levels: Optional[int] = None
+    interest_window: int = 5
+    q_min: float = 0.6
+    w_factor: float = 1.0
+    nms_window: int = 5
+    ncc_window: int = 7
+    refine_window: int = 9
+    rho_min: float = 0.6
+    fbm_window: int = 32
+    pull_in: Optional[float] = None
+    bidir_tol: float = 1.0
+    row_tol: float = 1.0
+    min_points: int = 3
+    huber_iterations: int = 2
+    redescending_iterations: int = 4
+    huber_k: float = 1.5
+    redescending_c: float = 2.5
+    reject_k: float = 3.0
+    sigma_floor: float = 0.3
+    enlarge: bool = True
+    densify: bool = True
+    keep_coarse: bool = False
+    lsm: bool = True
+    lsm_half: int = 8
+    lsm_max_sigma: float = 0.2
+    lsm_min_rho: float = 0.7
+    lsm_max_iter: int = 20
+    lsm_pull_in: float = 2.0
+
+
+@dataclass
+class EpipolarMatches:
+    """All accepted points of an epipolar pair, in level-0 pixels of the left image.
+
+    Attributes
+    ----------
+    col, row : float64
+        Left epipolar pixel (sub-pixel Förstner position).
+    disparity : float64
+        d = col_left − col_right, px.
+    sigma_px : float32
+        σ of the disparity, px: the LSM shift σ, else σ0 of the point's FBM window.
+    rho : float32
+        Correlation coefficient (LSM after matching, else the NCC peak).
+    flags : uint8
+        ``FLAG_*`` bits (module docstring).
+    level : int8
+        Pyramid level the point was matched at (0 for final points).
+    stats : dict
+        JSON-ready: ``{"levels": {"k": {...}}, "total": {...}}`` with per level features
+        left/right, candidates, windows, masked/failed windows, failure %, accepted points,
+        outliers, bidirectional rejections, cascade recoveries, waves, seconds; LSM tried/failed.
+    failures : (k, 3) float64
+        col, row (left, level-0 px) and level of the window components marked as failed.
+    """
+
+    col: NDArray
+    row: NDArray
+    disparity: NDArray
+    sigma_px: NDArray
+    rho: NDArray
+    flags: NDArray
+    level: NDArray
+    stats: Dict[str, Any] = field(default_factory=dict)
+    failures: NDArray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    def __len__(self) -> int:
+        return int(self.col.size)
+
+
+def _reduce_any(mask: NDArray) -> NDArray:
+    """Boolean 2 × 2 block 'any' (the pyramid's block layout, odd edges repeated)."""
+    m = np.asarray(mask, bool)
+    if m.shape[0] % 2 or m.shape[1] % 2:
+        m = np.pad(m, ((0, m.shape[0] % 2), (0, m.shape[1] % 2)), mode="edge")
+    return m.reshape(m.shape[0] // 2, 2, m.shape[1] // 2, 2).any(axis=(1, 3))
+
+
+def _mask_pyramid(mask: Optional[NDArray], n: int) -> List[Optional[NDArray]]:
+    if mask is None:
+        return [None] * n
+    out = [np.asarray(mask, bool)]
+    for _ in range(n - 1):
+        out.append(_reduce_any(out[-1]))
+    return out
+
+
+def _eval_planes(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
+                 ) -> NDArray:
+    """Disparity of the groups' planes d = p0 + p1·u + p2·v at points (NaN for g < 0)."""
+    out = np.full(np.shape(cols), np.nan)
+    ok = g >= 0
+    if ok.any():
+        gg = g[ok]
+        u, v = grouping.uv(cols[ok], rows[ok], gg)
+        p = plane[gg]
+        out[ok] = p[:, 0] + p[:, 1] * u + p[:, 2] * v
+    return out
+
+
+def _neighbour_prediction(plane: NDArray, grouping: Grouping, matched: NDArray, g: NDArray,
+                          cols: NDArray, rows: NDArray) -> NDArray:
+    """Mean of the matched neighbour components' planes, evaluated at each point."""
+    out = np.full(np.shape(cols), np.nan)
+    e = grouping.edges
+    if e.size == 0 or g.size == 0:
+        return out
+    e = e[matched[e[:, 1]]]
+    if e.size == 0:
+        return out
+    order = np.argsort(e[:, 0], kind="stable")
+    src, dst = e[order, 0], e[order, 1]
+    start = np.searchsorted(src, g, side="left")
+    stop = np.searchsorted(src, g, side="right")
+    cnt = np.where(g >= 0, stop - start, 0)
+    if cnt.sum() == 0:
+        return out
+    pi = np.repeat(np.arange(g.size), cnt)
+    first = np.cumsum(cnt) - cnt
+    nb = dst[start[pi] + (np.arange(pi.size) - first[pi])]
+    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
+    s = np.bincount(pi, val, g.size)
+    has = cnt > 0
+    out[has] = s[has] / cnt[has]
+    return out
+
+
+def _fill_planes(plane: NDArray, grouping: Grouping, matched: NDArray, masked: NDArray
+                 ) -> NDArray:
+    """Planes for unmatched, unmasked components from their neighbours (over the graph).
+
+    Wave by wave, each open component takes the mean of its filled neighbours' planes
+    evaluated at its centre (slopes averaged). The graph has no edges across barriers.
+    """
+    out = plane.copy()
+    have = matched.copy()
+    e = grouping.edges
+    c = grouping.centres
+    ws = grouping.window
+    while e.size:
+        sel = have[e[:, 1]] & ~have[e[:, 0]] & ~masked[e[:, 0]]
+        if not sel.any():
+            break
+        s, d = e[sel, 0], e[sel, 1]
+        u = (c[s, 0] - c[d, 0]) / ws
+        v = (c[s, 1] - c[d, 1]) / ws
+        p0 = out[d, 0] + out[d, 1] * u + out[d, 2] * v
+        n = np.bincount(s, minlength=len(out)).astype(float)
+        new = n > 0
+        acc = np.zeros_like(out)
+        acc[:, 0] = np.bincount(s, p0, len(out))
+        acc[:, 1] = np.bincount(s, out[d, 1], len(out))
+        acc[:, 2] = np.bincount(s, out[d, 2], len(out))
+        out[new] = acc[new] / n[new, None]
+        have |= new
+    out[~have] = np.nan
+    return out
+
+
+class _Collected:
+    """Accepted points of one level, appended wave by wave."""
+
+    def __init__(self) -> None:
+        self.parts: List[Tuple[NDArray, ...]] = []
+
+    def add(self, res: FBMResult, sel: NDArray, flag: int) -> None:
+        if sel.any():
+            self.parts.append((res.col[sel], res.row[sel], res.disparity[sel], res.rho[sel],
+                               res.sigma_px[sel], (res.flags[sel] | flag).astype(np.uint8),
+                               res.group[sel]))
+
+    def arrays(self) -> Tuple[NDArray, ...]:
+        if not self.parts:
+            return (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, np.float32),
+                    np.zeros(0, np.float32), np.zeros(0, np.uint8), np.zeros(0, np.int64))
+        return tuple(np.concatenate(p) for p in zip(*self.parts))
+
+
+def _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx):
+    L = np.asarray(left, dtype=np.float32)
+    R = np.asarray(right, dtype=np.float32)
+    if L.ndim != 2 or R.ndim != 2:
+        raise InputError("left and right must be 2-D grey images; convert colour images first")
+    if L.shape[0] != R.shape[0]:
+        raise InputError(f"epipolar images must have the same number of rows (left {L.shape}, "
+                         f"right {R.shape}); resample both with the same epipolar pair")
+    if not (np.isfinite(min_d) and np.isfinite(max_d)) or max_d < min_d:
+        raise InputError(f"disparity range [{min_d}, {max_d}] is invalid: give min_d ≤ max_d")
+    for name, m in (("mask", mask), ("barriers", barriers)):
+        if m is not None and np.shape(m) != L.shape:
+            raise InputError(f"{name} must have the left image's shape {L.shape}, "
+                             f"not {np.shape(m)}")
+    if seeds is not None:
+        s = np.asarray(seeds, dtype=np.float64)
+        if s.ndim != 2 or s.shape[1] != 3:
+            raise InputError("seeds must be an (n, 3) array of col, row, disparity")
+    if approx is not None:
+        grid, step = approx
+        if np.ndim(grid) != 2 or not step > 0:
+            raise InputError("approx must be (2-D disparity grid, positive step in px)")
+    return L, R
+
+
+def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: float, *,
+                           seeds: Optional[NDArray] = None, mask: Optional[NDArray] = None,
+                           barriers: Optional[NDArray] = None,
+                           approx: Optional[Tuple[NDArray, float]] = None,
+                           options: Optional[FbmLsmOptions] = None,
+                           feedback=None) -> EpipolarMatches:
+    """Hierarchical feature-based matching (+ LSM) of an epipolar pair; all raw points.
+
+    Parameters
+    ----------
+    left, right : (rows, cols) float32
+        Grey epipolar images (rows correspond), NaN = no data. The widths may differ.
+    min_d, max_d : float
+        Disparity range d = col_l − col_r at level 0, px (used at the top level when there are
+        no seeds and for components never reached from them).
+    seeds : (n, 3) array, optional
+        Operator start points: col, row, disparity at level 0.
+    mask : bool array (left shape), optional
+        True = do not match (exclusion areas, outside the boundary): no points there.
+    barriers : bool array (left shape), optional
+        True = breakline pixel: predictions never propagate across (window components).
+    approx : (grid, step), optional
+        Disparity approximation (level-0 px, NaN = unknown); ``grid[i, j]`` holds for the
+        level-0 pixels with row in [i·step, (i+1)·step) and col in [j·step, (j+1)·step).
+        Used at the top level instead of the range.
+    options : FbmLsmOptions, optional
+    feedback : Feedback, optional
+        Progress (per wave and level) and cancellation.
+
+    Returns
+    -------
+    EpipolarMatches
+    """
+    t_start = time.perf_counter()
+    fb = ensure_feedback(feedback)
+    opt = options or FbmLsmOptions()
+    L0, R0 = _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx)
+    Lf, vL = fill_nodata(L0)
+    Rf, vR = fill_nodata(R0)
+    ws = int(opt.fbm_window)
+    if opt.levels is None:
+        n_levels = levels_for_disparity(max_d - min_d, pull_in=ws / 4.0, min_size=2 * ws,
+                                        shape=(min(L0.shape[0], R0.shape[0]),
+                                               min(L0.shape[1], R0.shape[1])))
+    else:
+        n_levels = max(1, int(opt.levels))
+    pl = build_pyramid(Lf, n_levels)
+    pr = build_pyramid(Rf, n_levels)
+    n_levels = min(len(pl), len(pr))
+    vLp = _mask_pyramid(~vL, n_levels)
+    vRp = _mask_pyramid(~vR, n_levels)
+    mp = _mask_pyramid(mask, n_levels)
+    bp = _mask_pyramid(barriers, n_levels)
+    top = n_levels - 1
+    lsm_window = 2 * int(opt.lsm_half) + 1
+    margin = max(opt.ncc_window + 4, opt.refine_window, lsm_window if opt.lsm else 0) // 2 + 1
+    pull_ref = opt.pull_in if opt.pull_in is not None else ws / 8.0
+    pull_grow = opt.pull_in if opt.pull_in is not None else ws / 4.0
+    robust = {"huber_iterations": opt.huber_iterations,
+              "redescending_iterations": opt.redescending_iterations,
+              "huber_k": opt.huber_k, "redescending_c": opt.redescending_c,
+              "reject_k": opt.reject_k, "sigma_floor": opt.sigma_floor}
+    level_kw = {"rho_min": opt.rho_min, "row_tol": opt.row_tol, "bidir_tol": opt.bidir_tol,
+                "min_points": opt.min_points, "robust": robust,
+                "refine_window": opt.refine_window}
+    cost = np.array([4.0 ** -k for k in range(n_levels)])
+    done_cost = 0.0
+    total_cost = float(cost.sum())
+
+    prev: Optional[Tuple[NDArray, Grouping]] = None  # filled planes of the coarser level
+    stats_levels: Dict[str, Any] = {}
+    failures: List[NDArray] = []
+    out_parts: List[Tuple[NDArray, ...]] = []
+    n_seeds_used = 0
+    for k in range(top, -1, -1):
+        t_level = time.perf_counter()
+        scale = 2.0 ** k
+        Lk, Rk = pl[k], pr[k]
+        validL = ~vLp[k] if vLp[k] is not None else None
+        validR = ~vRp[k] if vRp[k] is not None else None
+        excl = None
+        if mp[k] is not None or bp[k] is not None:
+            excl = np.zeros(Lk.shape, bool)
+            for m in (mp[k], bp[k]):
+                if m is not None:
+                    excl |= m
+        grouping = window_components(Lk.shape, ws, bp[k])
+        ng = grouping.n_groups
+        fkw = {"window": opt.interest_window, "q_min": opt.q_min, "w_factor": opt.w_factor,
+               "nms_window": opt.nms_window, "margin": margin}
+        fl = detect_features(Lk, validL, excl, **fkw)
+        fr = detect_features(Rk, validR, None, **fkw)
+        # masked components: ≥ 90 % excluded or without data; tiny ones (< ¼ window usable,
+        # e.g. cut by the image border, where no point can lie) are not failures
+        lab = grouping.labels.ravel()
+        bad_px = np.zeros(Lk.shape, bool)
+        if mp[k] is not None:
+            bad_px |= mp[k]
+        if validL is not None:
+            bad_px |= ~validL
+        n_bad = np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
+        masked = n_bad >= 0.9 * np.maximum(grouping.area, 1)
+        bad_px[:margin + 1, :] = bad_px[-margin - 1:, :] = True
+        bad_px[:, :margin + 1] = bad_px[:, -margin - 1:] = True
+        usable = grouping.area - np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
+        tiny = usable < 0.25 * ws * ws
+
+        # ---- predictions -----------------------------------------------------------------
+        mode = np.zeros(ng, np.int8)
+        seed_d = np.full(ng, np.nan)
+        coarse = None
+        if prev is not None:
+            p_plane, p_group = prev
+
+            def coarse(cols, rows, p_plane=p_plane, p_group=p_group):
+                c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
+                g1 = p_group.of(c1, r1, nearest=True)
+                return 2.0 * _eval_planes(p_plane, p_group, g1, c1, r1)
+
+            mode[:] = _COARSE
+        else:
+            if approx is not None:
+                grid = np.asarray(approx[0], dtype=np.float64)
+                step = float(approx[1])
+
+                def coarse(cols, rows, grid=grid, step=step, k=k, scale=scale):
+                    i = np.floor((from_level(rows, k) + 0.5) / step).astype(np.int64)
+                    j = np.floor((from_level(cols, k) + 0.5) / step).astype(np.int64)
+                    ok = (i >= 0) & (i < grid.shape[0]) & (j >= 0) & (j < grid.shape[1])
+                    out = np.full(np.shape(cols), np.nan)
+                    out[ok] = grid[i[ok], j[ok]] / scale
+                    return out
+
+                mode[:] = _COARSE
+            if seeds is not None:
+                s = np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
+                inside = ((s[:, 0] >= -0.5) & (s[:, 0] < L0.shape[1] - 0.5)
+                          & (s[:, 1] >= -0.5) & (s[:, 1] < L0.shape[0] - 0.5)
+                          & np.isfinite(s).all(axis=1))
+                if not inside.any():
+                    raise InputError(f"none of the {len(s)} start point(s) lies inside the "
+                                     f"left epipolar image ({L0.shape[1]} × {L0.shape[0]} px); "
+                                     "check the start points of this model")
+                if not inside.all():
+                    fb.warning(f"{int((~inside).sum())} start point(s) outside the left "
+                               "epipolar image are ignored")
+                s = s[inside]
+                gs = grouping.of(to_level(s[:, 0], k), to_level(s[:, 1], k), nearest=True)
+                ok = gs >= 0
+                n_seeds_used = int(ok.sum())
+                cnt = np.bincount(gs[ok], minlength=ng)
+                sd = np.bincount(gs[ok], s[ok, 2] / scale, ng)
+                has = cnt > 0
+                seed_d[has] = sd[has] / cnt[has]
+                mode[has] = _SEED
+            elif approx is None:
+                mode[:] = _RANGE
+        mid_k = 0.5 * (min_d + max_d) / scale
+        half_k = 0.5 * (max_d - min_d) / scale + 1.0
+
+        matched = np.zeros(ng, bool)
+        plane = np.full((ng, 3), np.nan)
+        tried_nb = np.full(ng, -1, np.int64)
+        cascaded = np.zeros(ng, bool)
+        todo = (mode != _NONE) & ~masked
+        collected = _Collected()
+        st = {"features_left": int(fl.cols.size), "features_right": int(fr.cols.size),
+              "candidates": 0, "outliers": 0, "bidir_rejected": 0, "windows": int(ng),
+              "windows_masked": int(masked.sum()), "enlarged_recovered": 0,
+              "densified_recovered": 0, "retry_recovered": 0, "waves": 0,
+              "range_fallback": 0}
+        big: Optional[Grouping] = None
+        fallback_done = k != top
+        wave = 0
+        while True:
+            if not todo.any():
+                if fallback_done:
+                    break
+                fallback_done = True
+                # never reached from the seeds/approximation: search the whole range
+                todo = (tried_nb < 0) & ~matched & ~masked
+                mode[todo] = _RANGE
+                st["range_fallback"] = int(todo.sum())
+                if not todo.any():
+                    break
+            todo_now = todo.copy()
+            retry = (mode == _NEIGHBOURS) & (wave > 0)
+
+            def predict(cols, rows, active=None, context=None, todo_now=todo_now, mode=mode,
+                        plane=plane, matched=matched, coarse=coarse, seed_d=seed_d,
+                        grouping=grouping, mid_k=mid_k, half_k=half_k):
+                """(d_pred, pull_in) at left positions of this level; NaN = not matched now.
+
+                ``active`` (per component) replaces the wave's to-do set; ``context``
+                components predict from their own plane (enlarged windows).
+                """
+                g = grouping.of(cols, rows)
+                gg = np.maximum(g, 0)
+                d = np.full(np.shape(cols), np.nan)
+                p = np.full(np.shape(cols), np.nan)
+                act = (g >= 0) & (todo_now if active is None else active)[gg]
+                m = np.where(act, mode[gg], _NONE)
+                sel = m == _COARSE
+                if sel.any() and coarse is not None:
+                    d[sel] = coarse(cols[sel], rows[sel])
+                    p[sel] = pull_ref
+                sel = m == _SEED
+                if sel.any():
+                    d[sel] = seed_d[g[sel]]
+                    p[sel] = pull_grow
+                sel = m == _RANGE
+                if sel.any():
+                    d[sel] = mid_k
+                    p[sel] = half_k
+                sel = m == _NEIGHBOURS
+                if sel.any():
+                    d[sel] = _neighbour_prediction(plane, grouping, matched, g[sel],
+                                                   cols[sel], rows[sel])
+                    p[sel] = pull_grow
+                if context is not None:
+                    own = (g >= 0) & context[gg] & ~act
+                    if own.any():
+                        d[own] = _eval_planes(plane, grouping, g[own], cols[own], rows[own])
+                        p[own] = pull_ref
+                return d, p
+
+            nb_count = np.bincount(grouping.edges[:, 0], matched[grouping.edges[:, 1]],
+                                   ng) if grouping.edges.size else np.zeros(ng)
+            tried_nb[todo_now] = nb_count[todo_now].astype(np.int64)
+            res = fbm_level(Lk, Rk, fl, fr, grouping, predict, ncc_window=opt.ncc_window,
+                            **level_kw)
+            for key in ("candidates", "outliers", "bidir_rejected"):
+                st[key] += res.stats[key]
+            ok = todo_now & (res.n_accepted >= opt.min_points)
+            sel = ok[np.maximum(res.group, 0)] & (res.group >= 0)
+            collected.add(res, sel & ~retry[res.group], 0)
+            collected.add(res, sel & retry[res.group], FLAG_RETRY)
+            st["retry_recovered"] += int((ok & retry).sum())
+            plane[ok] = res.plane[ok]
+            matched |= ok
+            failed = todo_now & ~ok & ~cascaded
+            # ---- failure cascade: enlarge the window, then reduce the step ----------------
+            if failed.any() and opt.enlarge:
+                cascaded |= failed
+                if big is None:
+                    big = window_components(Lk.shape, 2 * ws, bp[k])
+                gl_small = grouping.of(fl.cols, fl.rows)
+                in_failed = (gl_small >= 0) & failed[np.maximum(gl_small, 0)]
+                big_sel = np.zeros(big.n_groups, bool)
+                gb = big.of(fl.cols, fl.rows)
+                big_sel[gb[in_failed & (gb >= 0)]] = True
+                ctx = (gb >= 0) & big_sel[np.maximum(gb, 0)] & (gl_small >= 0)
+                # context: matched components sharing a big window with a failed one
+                context = np.zeros(ng, bool)
+                context[gl_small[ctx]] = True
+                context &= matched
+
+                def predict_big(cols, rows, predict=predict, failed=failed, context=context):
+                    return predict(cols, rows, active=failed, context=context)
+
+                res2 = fbm_level(Lk, Rk, fl, fr, big, predict_big,
+                                 ncc_window=opt.ncc_window + 4, **level_kw)
+                g2 = grouping.of(res2.col, res2.row)
+                keep = (g2 >= 0) & failed[np.maximum(g2, 0)]
+                cnt = np.bincount(g2[keep], minlength=ng)
+                ok2 = failed & (cnt >= opt.min_points)
+                if ok2.any():
+                    keep &= ok2[np.maximum(g2, 0)]
+                    res2.group = g2
+                    collected.add(res2, keep, FLAG_ENLARGED)
+                    plane[ok2] = _points_planes(grouping, res2.col[keep], res2.row[keep],
+                                                res2.disparity[keep], g2[keep])[ok2]
+                    matched |= ok2
+                    st["enlarged_recovered"] += int(ok2.sum())
+                failed &= ~ok2
+            if failed.any() and opt.densify:
+                cascaded |= failed
+                # denser points, detected only in the rows/columns of the failed windows (the
+                # thresholds become local there, as the seed's sub-image thresholds)
+                dkw = dict(fkw, w_factor=opt.w_factor / 4.0, q_min=min(opt.q_min, 0.5),
+                           nms_window=3)
+                wi = grouping.window_index[failed]
+                nwx = -(-Lk.shape[1] // ws)
+                pad = margin + 4
+                r0 = max(int(wi.min() // nwx) * ws - pad, 0)
+                r1 = min(int(wi.max() // nwx + 1) * ws + pad, Lk.shape[0])
+                c0 = max(int((wi % nwx).min()) * ws - pad, 0)
+                c1 = min(int((wi % nwx).max() + 1) * ws + pad, Lk.shape[1])
+                dfl = _detect_crop(Lk, validL, excl, r0, r1, c0, c1, dkw)
+                dfr = _detect_crop(Rk, validR, None, r0, min(r1, Rk.shape[0]), 0, Rk.shape[1],
+                                   dkw)
+                gd = grouping.of(dfl.cols, dfl.rows)
+                sub = (gd >= 0) & failed[np.maximum(gd, 0)]
+                dfl_sub = InterestPoints(*(a[sub] for a in dfl))
+
+                def predict_dense(cols, rows, predict=predict, failed=failed):
+                    return predict(cols, rows, active=failed)
+
+                res3 = fbm_level(Lk, Rk, dfl_sub, dfr, grouping, predict_dense,
+                                 ncc_window=opt.ncc_window, **level_kw)
+                ok3 = failed & (res3.n_accepted >= opt.min_points)
+                if ok3.any():
+                    sel3 = (res3.group >= 0) & ok3[np.maximum(res3.group, 0)]
+                    collected.add(res3, sel3, FLAG_DENSIFIED)
+                    plane[ok3] = res3.plane[ok3]
+                    matched |= ok3
+                    st["densified_recovered"] += int(ok3.sum())
+            # ---- next wave: come back from other sides ----------------------------------
+            nb_count = np.bincount(grouping.edges[:, 0], matched[grouping.edges[:, 1]],
+                                   ng) if grouping.edges.size else np.zeros(ng)
+            todo = ~matched & ~masked & (nb_count > 0) & (nb_count > tried_nb)
+            mode[todo] = _NEIGHBOURS
+            wave += 1
+            fb.progress(100.0 * (done_cost + cost[k] * min(0.9, 0.3 + 0.1 * wave)) / total_cost)
+        st["waves"] = wave
+        # ---- level results ------------------------------------------------------------------
+        col, row, d, rho, sig, flags, _ = collected.arrays()
+        fail = ~matched & ~masked & ~tiny
+        st["failed_windows"] = int(fail.sum())
+        n_eval = int((~masked & ~tiny).sum())
+        st["failure_pct"] = round(100.0 * st["failed_windows"] / max(n_eval, 1), 3)
+        st["accepted"] = int(col.size)
+        if fail.any():
+            c = grouping.centres[fail]
+            failures.append(np.stack([from_level(c[:, 0], k), from_level(c[:, 1], k),
+                                      np.full(len(c), k, float)], 1))
+        prev = (_fill_planes(plane, grouping, matched, masked), grouping)
+        if k == 0 or opt.keep_coarse:
+            out_parts.append((from_level(col, k), from_level(row, k), d * scale,
+                              (sig * scale).astype(np.float32), rho.astype(np.float32),
+                              flags, np.full(col.size, k, np.int8)))
+        st["seconds"] = round(time.perf_counter() - t_level, 3)
+        stats_levels[str(k)] = st
+        done_cost += cost[k]
+        fb.progress(100.0 * done_cost / total_cost * (0.9 if opt.lsm else 1.0))
+        fb.info(f"FBM level {k}: {st['accepted']} points, {st['failed_windows']} failed "
+                f"windows ({st['failure_pct']} %), {st['waves']} waves")
+
+    col, row, disp, sig, rho, flags, level = (np.concatenate(p) for p in zip(*out_parts))
+    total: Dict[str, Any] = {"levels": n_levels, "seeds_used": n_seeds_used,
+                             "lsm_tried": 0, "lsm_failed": 0}
+    if opt.lsm:
+        t_lsm = time.perf_counter()
+        sel = np.flatnonzero(level == 0)
+        if sel.size:
+            res = lsm_match(Lf, Rf, col[sel], row[sel], col[sel] - disp[sel], None,
+                            window=lsm_window, model="epipolar", max_iter=opt.lsm_max_iter,
+                            max_shift=opt.lsm_pull_in, min_corr=opt.lsm_min_rho,
+                            max_sigma=opt.lsm_max_sigma)
+            good = res.valid & np.isfinite(res.cols)
+            gi = sel[good]
+            disp[gi] = col[gi] - res.cols[good]
+            sig[gi] = res.sigma_col[good]
+            rho[gi] = res.corr[good]
+            flags[gi] |= FLAG_LSM
+            flags[sel[~good]] |= FLAG_LSM_FAILED
+            total["lsm_tried"] = int(sel.size)
+            total["lsm_failed"] = int((~good).sum())
+        total["lsm_seconds"] = round(time.perf_counter() - t_lsm, 3)
+        stats_levels["0"]["lsm_tried"] = total["lsm_tried"]
+        stats_levels["0"]["lsm_failed"] = total["lsm_failed"]
+    fb.progress(100.0)
+    fail_arr = np.concatenate(failures) if failures else np.zeros((0, 3))
+    total["points"] = int(col.size)
+    total["failed_windows"] = len(fail_arr)
+    total["failure_pct_level0"] = stats_levels["0"]["failure_pct"]
+    total["seconds"] = round(time.perf_counter() - t_start, 3)
+    return EpipolarMatches(col, row, disp, sig, rho, flags, level,
+                           {"levels": stats_levels, "total": total}, fail_arr)
+
+
+def _detect_crop(img: NDArray, valid: Optional[NDArray], excl: Optional[NDArray], r0: int,
+                 r1: int, c0: int, c1: int, kw: dict) -> InterestPoints:
+    """:func:`.fbm.detect_features` on a crop, in the coordinates of the whole image."""
+    crop = (slice(r0, r1), slice(c0, c1))
+    if r1 - r0 < 8 or c1 - c0 < 8:
+        return InterestPoints(*(np.zeros(0) for _ in range(4)))
+    f = detect_features(img[crop], None if valid is None else valid[crop],
+                        None if excl is None else excl[crop], **kw)
+    return InterestPoints(f.cols + c0, f.rows + r0, f.w, f.q)
+
+
+def _points_planes(grouping: Grouping, col: NDArray, row: NDArray, d: NDArray, g: NDArray
+                   ) -> NDArray:
+    """Absolute plane d = p0 + p1·u + p2·v per group from accepted points (NaN where none)."""
+    ng = grouping.n_groups
+    out = np.full((ng, 3), np.nan)
+    if col.size:
+        u, v = grouping.uv(col, row, g)
+        a = group_wls(u, v, d, np.ones(col.size), g, ng, 1e-3)
+        has = np.bincount(g, minlength=ng) > 0
+        out[has] = a[has]
+    return out

@@ -1,0 +1,205 @@
+r"""What every matcher of a stereo model needs before it matches: geometry, heights, area, grid.
+
+:func:`prepare_model` loads the model's two images' cameras and orientations, builds the
+normal-case :class:`~..geometry.epipolar.EpipolarPair`, derives the height range to search
+(default: terrain height ``Z_t`` ∓/± 0.3 × flying height above ground ``H``) and its disparity
+range, intersects the two footprints (at the lowest and highest height) to the measuring area,
+cuts it to the operator's boundaries, reads exclusion areas and breaklines from ``edits.gpkg``
+(crossing breaklines are refused: the interpolation could not honour both) and lays the DSM
+grid over it. Both ``match_model`` methods (dense and fbm_lsm) start here, so a model whose
+images do not overlap or a wrong height range fails with the same one-line message.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, List, Optional
+
+import numpy as np
+
+from ..errors import GeometryError, InputError
+from ..geometry.epipolar import EpipolarPair
+from ..surface.gridding import Grid
+
+
+@dataclass
+class ModelSetup:
+    """Geometry, heights, measuring area and grid of one stereo model (see module notes)."""
+
+    project: Any
+    model: Any
+    records: List[Any]
+    cameras: List[Any]
+    pair: EpipolarPair
+    z_min: float
+    z_max: float
+    z_mid: float
+    flying_height: float
+    gsd: float
+    spacing: float
+    min_d: int
+    max_d: int
+    overlap: Any
+    extent: Any
+    grid: Grid
+    exclusions: List[Any] = field(default_factory=list)
+    boundaries: List[Any] = field(default_factory=list)
+    breaklines: List[Any] = field(default_factory=list)
+
+    @property
+    def names(self) -> List[str]:
+        return [r.name for r in self.records]
+
+    def measuring_area(self) -> Any:
+        """The stereo overlap at the mid height, inside the boundaries."""
+        from shapely.ops import unary_union
+
+        area = self.overlap
+        if self.boundaries:
+            area = area.intersection(unary_union(self.boundaries))
+        return area
+
+
+def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
+    """Image footprint polygon on the plane Z = ``height``."""
+    from shapely.geometry import Polygon
+
+    from ..geometry.projection import ray_at_height
+
+    c = cam.corners()
+    t = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
+    border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
+    pts = ray_at_height(border[:, 0], border[:, 1], height, cam, eo)
+    ok = np.isfinite(pts).all(axis=1)
+    if ok.sum() < 3:
+        return Polygon()
+    return Polygon(pts[ok, :2]).buffer(0)
+
+
+def check_breaklines(lines: List[Any]) -> None:
+    """Refuse breaklines that cross each other or themselves (seed-000 §2.10).
+
+    Touching at end points is allowed (lines that continue one another).
+
+    Raises
+    ------
+    InputError
+        Naming the two lines (1-based, in the order of the layer) and the crossing point.
+    """
+    from shapely.geometry import Point
+
+    def ends(line: Any) -> List[Any]:
+        return [Point(line.coords[0]), Point(line.coords[-1])]
+
+    for i, a in enumerate(lines):
+        if not a.is_simple:
+            raise InputError(f"Breakline {i + 1} crosses itself; fix it in edits.gpkg "
+                             "(layer breaklines).")
+        for j in range(i + 1, len(lines)):
+            b = lines[j]
+            if not a.intersects(b):
+                continue
+            cut = a.intersection(b)
+            points = list(getattr(cut, "geoms", [cut]))
+            shared = [e for e in ends(a) if any(e.distance(f) < 1e-6 for f in ends(b))]
+            if all(isinstance(p, Point) and any(p.distance(e) < 1e-6 for e in shared)
+                   for p in points):
+                continue  # one line continues the other
+            x, y = cut.representative_point().coords[0][:2]
+            raise InputError(f"Breaklines {i + 1} and {j + 1} cross at ({x:.2f}, {y:.2f}); "
+                             "breaklines must not cross or touch — fix them in edits.gpkg.")
+
+
+def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
+                  spacing_gsd: float = 1.0, min_height: Optional[float] = None,
+                  max_height: Optional[float] = None, disparity_margin: int = 4) -> ModelSetup:
+    """Geometry, heights, area and grid of a stereo model (see the module notes).
+
+    Parameters
+    ----------
+    project : Project or path
+    model : str
+        Stereo model name.
+    spacing : float, optional
+        DSM cell size (m); default ``spacing_gsd`` × the model's GSD.
+    spacing_gsd : float
+        Default spacing in GSDs.
+    min_height, max_height : float, optional
+        Height range (m); default terrain height ∓/± 0.3 H.
+    disparity_margin : int
+        Extra disparities (px) on either side of the range (which is also widened by 10 %
+        for the variation of depth across the image).
+
+    Raises
+    ------
+    InputError, GeometryError
+        Bad height range, spacing, boundaries, crossing breaklines; images that do not overlap.
+    """
+    from shapely.ops import unary_union
+
+    from ..project.edits import read_constraints
+    from ..project.model import Project
+
+    if not isinstance(project, Project):
+        project = Project.load(project)
+    m = project.model(model)
+    recs = [project.image(m.left), project.image(m.right)]
+    cams = [project.camera_of(r) for r in recs]
+    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
+                                          names=(recs[0].name, recs[1].name))
+    mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
+    terrain = project.terrain_height
+    H = m.height_above_ground
+    if terrain is None:
+        terrain = mean_z - (H if np.isfinite(H) else 10.0 * pair.base)
+    if not np.isfinite(H):
+        H = mean_z - float(terrain)
+    z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
+    z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
+    if not z_max > z_min:
+        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
+    if z_max >= mean_z:
+        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
+                         "give a lower max_height.")
+    z_mid = float(np.clip(float(terrain), z_min, z_max))
+    fp = [footprint(c, r.eo, z_mid) for c, r in zip(cams, recs)]
+    overlap = fp[0].intersection(fp[1])
+    if overlap.is_empty or overlap.area <= 0:
+        raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
+                            f"'{m.name}' do not overlap; check the model or the orientations.")
+    gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
+    spacing = float(spacing) if spacing else float(spacing_gsd * gsd)
+    if not spacing > 0:
+        raise InputError(f"The spacing must be positive, got {spacing}.")
+    ring = np.asarray(overlap.convex_hull.exterior.coords)[:, :2]
+    d_lo, d_hi = pair.disparity_range(z_min, z_max, xy=np.vstack([ring, ring.mean(axis=0)]))
+    if not (np.isfinite(d_lo) and np.isfinite(d_hi)):
+        raise GeometryError(f"Model '{m.name}': the height range {z_min:.1f}…{z_max:.1f} m "
+                            "gives no disparity; check min_height/max_height.")
+    widen = 0.1 * (d_hi - d_lo)
+    min_d = math.floor(d_lo - widen) - int(disparity_margin)
+    max_d = math.ceil(d_hi + widen) + int(disparity_margin)
+    excl, bounds, lines = (read_constraints(project.edits_path)
+                           if Path(project.edits_path).is_file() else ([], [], []))
+    check_breaklines(lines)
+    areas = []
+    for z in (z_min, z_mid, z_max):  # narrow (cropped) images may overlap at z_mid only
+        a = footprint(cams[0], recs[0].eo, z).intersection(footprint(cams[1], recs[1].eo, z))
+        if not a.is_empty:
+            areas.append(a)
+    extent = unary_union(areas)
+    if bounds:
+        extent = extent.intersection(unary_union(bounds))
+        if extent.is_empty:
+            raise InputError(f"The boundaries of edits.gpkg do not touch model '{m.name}'.")
+    grid = Grid.from_bounds(*extent.bounds, spacing=spacing)
+    return ModelSetup(project=project, model=m, records=recs, cameras=cams, pair=pair,
+                      z_min=z_min, z_max=z_max, z_mid=z_mid, flying_height=float(H),
+                      gsd=float(gsd), spacing=spacing, min_d=min_d, max_d=max_d,
+                      overlap=overlap, extent=extent, grid=grid, exclusions=excl,
+                      boundaries=bounds, breaklines=lines)
+
+
+__all__ = ["ModelSetup", "check_breaklines", "footprint", "prepare_model"]

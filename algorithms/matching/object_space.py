@@ -1,0 +1,941 @@
+r"""Object-space multi-image least-squares matching on a DSM grid (2.5D "facets stereo vision").
+
+Refines a DSM with every image that sees it (2 … N), after Wrobel's FAST Vision as described by
+Schlüter (1999) — see ``methods/seed-004.md`` §5 (the minimal 2.5D algorithm, variant I).
+
+Model (per computation window)
+    Sample points :math:`p` on a grid of one ground pixel :math:`\Delta s_\ell = GSD\cdot2^\ell`;
+    object grey values :math:`G` on a grid of ``grey_px`` pixels, bilinear; heights as the input
+    DSM plus a bilinear correction on geometry nodes of ``facet_px`` pixels (aligned with the
+    output cells):
+
+    .. math::
+
+       Z_p = Z^{in}_p + \sum_m a_{pm}\,\Delta Z_m, \qquad G_p = \sum_k b_{pk}\,G_k
+
+    With :math:`(c, r)_{pi} = \mathrm{world\_to\_pixel}_i(X_p, Y_p, Z_p)` and the grey value
+    :math:`g_{pi}` of image *i* there (bilinear), the radiometric correspondence
+    :math:`h_{1i}\,g_{pi} + h_{0i} = G_p` is linearised (Gauss–Newton, unit weights):
+
+    .. math::
+
+       \sum_k b_{pk}\,dG_k - k_{pi}\sum_m a_{pm}\,dZ_m - g_{pi}\,dh_{1i} - dh_{0i}
+       = h_{1i}g_{pi} + h_{0i} - G_p + v_{pi},
+       \qquad k_{pi} = h_{1i}\,\nabla g_{pi}\cdot\frac{\partial(c, r)_{pi}}{\partial Z}
+
+    (gradients from central differences of the pyramid level, ∂(c, r)/∂Z by central differences
+    of the collinearity). The radiometric datum is fixed on a reference image
+    (:math:`h_0 = 0, h_1 = 1`); only samples seen by at least two images give equations.
+
+Regularisation (curvature minimisation, seed (7.2-5/6))
+    For every interior geometry node, with node spacing normalised to 1 and heights in metres,
+    pseudo-observations of weight λ:
+    :math:`dZ_{i-1} - 2dZ_i + dZ_{i+1} = -(Z^\circ_{i-1} - 2Z^\circ_i + Z^\circ_{i+1})` along
+    both axes. ``regularisation_mode="curvature"`` uses the surface :math:`Z^\circ = Z^{in} +
+    \Delta Z` (the thesis's curvature minimisation, λ = 1e4 for 8-bit grey values);
+    ``"correction"`` only :math:`\Delta Z` (keeps the shape of the input DSM: buildings, edges).
+
+Solution
+    Normal equations :math:`N = A^TA + \lambda R^TR`, solved by conjugate gradients with the
+    Jacobi (diagonal) preconditioner (seed Tab. 7-3: as fast as SSOR, no fill-in). Increments
+    are clipped to 0.2 geometry spacings and 1 px of parallax. Stop when
+    :math:`\max|dZ| < 0.01\,GSD_\ell H/B` or σ0 changes by less than 0.5 %, at most ``max_iter``
+    iterations per level. Coarse → fine over ``levels`` image-pyramid levels
+    (:func:`.pyramid.build_pyramid` of the image windows), the correction of level ℓ+1
+    prolongated bilinearly as the start of level ℓ.
+
+Precision (seed §2.13, 7.3-11)
+    After the finest level the system is rebuilt **without** regularisation (radiometry kept),
+    factorised once (sparse LU, :func:`scipy.sparse.linalg.splu`); :math:`\sigma_0^2 =
+    (l^Tl - l^TA\hat x)/(n - u)` in grey values and :math:`\sigma_{Z,m} = \sigma_0\sqrt{Q_{mm}}`.
+    :math:`Q_{mm}` is estimated by **probing** (Tang & Saad 2012): the geometry nodes are split
+    into :math:`d \times d` colour classes (nodes ``d`` apart, d = 5); one solve with the sum of
+    the unit vectors of a class gives :math:`Q_{mm} + \sum_j Q_{mj}` over the other class
+    members, which are ≥ 5 nodes away, where the correlations have decayed (seed: 0.2–0.35 for
+    direct neighbours). So 25 solves instead of one per node; the bias is a small
+    overestimate. Output cells get σ interpolated bilinearly from the nodes (the thesis's
+    pragmatic, slightly pessimistic choice).
+
+Windows
+    The output grid is processed in tiles of ``tile`` cells plus ``overlap`` cells on every side
+    (only the tile's core is written). Each window reads only the image windows it needs
+    (:func:`..raster.io.open_image` windows) and uses the images whose footprint covers at least
+    ``min_cover`` of it. Exclusion areas and cells outside the boundaries of ``edits.gpkg`` are
+    NaN. A window whose adjustment diverges is written as NaN and counted as a failure; the run
+    goes on.
+
+Not modelled: occlusions (no z-buffer; fine for open terrain, the 2.5D limit at walls anyway),
+breaklines in the regularisation, robust reweighting (off by default in the thesis as well).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import sparse
+
+from ..errors import GeometryError, InputError
+from ..geometry.projection import world_to_pixel
+from ..processing.feedback import Feedback, ensure_feedback
+from .pyramid import build_pyramid, to_level
+
+PathLike = Union[str, Path]
+Array = NDArray[np.float64]
+
+#: Colour distance (nodes) of the probing estimate of diag(N⁻¹).
+PROBE_DISTANCE = 5
+#: Regularisation modes.
+MODES = ("curvature", "correction")
+
+
+# -- small numerical helpers -------------------------------------------------------------------
+def _dot(a: Array, b: Array) -> float:
+    """Σ a·b by numpy's pairwise summation: bit-identical in every process (BLAS ``ddot``
+    kernels are not, and CG iteration counts would follow)."""
+    return float(np.sum(a * b))
+
+
+def _noblas(eo: Any) -> Any:
+    """A copy of an orientation whose rotation matrix is a strided view.
+
+    numpy's ``matmul`` then uses its own loop instead of ``cblas_dgemm`` for the projection
+    (:func:`..geometry.projection.world_to_camera`). Inside QGIS another CBLAS (GSL's) may be
+    loaded first and sum in another order; the last-bit differences would flip convergence
+    decisions, and the product must be the same in every face (Python, CLI, QGIS).
+    """
+    from ..geometry.orientation import ExteriorOrientation
+
+    rot = np.repeat(np.asarray(eo.rotation, dtype=float), 2, axis=1)[:, ::2]
+    return ExteriorOrientation(np.array(eo.position, dtype=float), rot)
+
+
+def pcg(N: sparse.csr_matrix, b: Array, tol: float = 1e-6, max_iter: int = 2000
+        ) -> Tuple[Array, int]:
+    r"""Conjugate gradients with the Jacobi preconditioner :math:`M = \mathrm{diag}(N)`.
+
+    Stops when :math:`\|b - Nx\| \le \mathrm{tol}\,\|b\|`. Returns ``(x, iterations)``.
+    """
+    d = N.diagonal()
+    minv = np.where(d > 0, 1.0 / np.where(d > 0, d, 1.0), 1.0)
+    x = np.zeros_like(b)
+    r = b.copy()
+    limit = tol * tol * _dot(b, b)
+    if limit == 0.0:
+        return x, 0
+    z = minv * r
+    p = z.copy()
+    rz = _dot(r, z)
+    for it in range(1, max_iter + 1):
+        q = N @ p
+        alpha = rz / _dot(p, q)
+        x += alpha * p
+        r -= alpha * q
+        if _dot(r, r) <= limit:
+            return x, it
+        z = minv * r
+        rz_new = _dot(r, z)
+        p = z + (rz_new / rz) * p
+        rz = rz_new
+    return x, max_iter
+
+
+def _bilinear_index(u: Array, n: int) -> Tuple[Array, Array]:
+    """Lower node index (clipped to n−2) and fraction of fractional grid coordinates ``u``."""
+    i0 = np.clip(np.floor(u).astype(np.intp), 0, max(n - 2, 0))
+    return i0, u - i0
+
+
+def _bilinear_weights(u: Array, v: Array, nx: int, ny: int) -> Tuple[Array, Array]:
+    """Node indices (n, 4) and bilinear weights (n, 4) on an ny × nx node grid (row-major)."""
+    iu, fu = _bilinear_index(u, nx)
+    iv, fv = _bilinear_index(v, ny)
+    iu1 = np.minimum(iu + 1, nx - 1)
+    iv1 = np.minimum(iv + 1, ny - 1)
+    idx = np.stack([iv * nx + iu, iv * nx + iu1, iv1 * nx + iu, iv1 * nx + iu1], axis=1)
+    w = np.stack([(1 - fv) * (1 - fu), (1 - fv) * fu, fv * (1 - fu), fv * fu], axis=1)
+    return idx, w
+
+
+def _sample_stack(stack: NDArray, col: Array, row: Array, margin: float = 1.0
+                  ) -> Tuple[Array, NDArray[np.bool_]]:
+    """Bilinear values of a (bands, h, w) stack at (col, row); valid inside a margin."""
+    _, h, w = stack.shape
+    ok = (col >= margin) & (col <= w - 1 - margin) & (row >= margin) & (row <= h - 1 - margin)
+    c = np.where(ok, col, margin)
+    r = np.where(ok, row, margin)
+    c0, fc = _bilinear_index(c, w)
+    r0, fr = _bilinear_index(r, h)
+    flat = stack.reshape(stack.shape[0], -1)
+    i00 = r0 * w + c0
+    out = ((1 - fr) * ((1 - fc) * flat[:, i00] + fc * flat[:, i00 + 1])
+           + fr * ((1 - fc) * flat[:, i00 + w] + fc * flat[:, i00 + w + 1]))
+    return out, ok
+
+
+def _fill_nearest(z: NDArray) -> NDArray:
+    """NaNs replaced by the nearest finite value (for internal use only)."""
+    from scipy import ndimage
+
+    bad = ~np.isfinite(z)
+    if not bad.any() or bad.all():
+        return np.where(bad, 0.0, z)
+    idx = ndimage.distance_transform_edt(bad, return_distances=False, return_indices=True)
+    return z[tuple(idx)]
+
+
+def _second_difference_rows(ny: int, nx: int) -> sparse.csr_matrix:
+    """Rows of the discrete curvature (7.2-5/6) on an ny × nx node grid: [1, −2, 1] X and Y."""
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    blocks = []
+    for centre, lo, hi in ((idx[:, 1:-1], idx[:, :-2], idx[:, 2:]),
+                           (idx[1:-1, :], idx[:-2, :], idx[2:, :])):
+        c = centre.ravel()
+        if c.size:
+            blocks.append((lo.ravel(), c, hi.ravel()))
+    if not blocks:
+        return sparse.csr_matrix((0, ny * nx))
+    lo = np.concatenate([b[0] for b in blocks])
+    c = np.concatenate([b[1] for b in blocks])
+    hi = np.concatenate([b[2] for b in blocks])
+    n = c.size
+    rows = np.repeat(np.arange(n), 3)
+    cols = np.stack([lo, c, hi], axis=1).ravel()
+    vals = np.tile([1.0, -2.0, 1.0], n)
+    return sparse.csr_matrix((vals, (rows, cols)), shape=(n, ny * nx))
+
+
+# -- image windows -----------------------------------------------------------------------------
+@dataclass
+class _ImageWindow:
+    """Pyramid of one image window: level → (3, h, w) stack of grey, ∂/∂col, ∂/∂row."""
+
+    name: str
+    camera: Any
+    eo: Any
+    col0: int
+    row0: int
+    levels: List[NDArray] = field(default_factory=list)
+
+
+def _read_grey(path: Path, col0: int, row0: int, width: int, height: int) -> NDArray:
+    """Grey (mean of the colour bands) of an image window, float32."""
+    from rasterio.enums import ColorInterp
+    from rasterio.windows import Window
+
+    from ..raster.io import open_image
+
+    with open_image(path) as src:
+        bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
+        bands = (bands or [1])[:3]
+        data = src.read(bands, window=Window(col0, row0, width, height)).astype(np.float32)
+    return data.mean(axis=0)
+
+
+def _stack(level_image: NDArray) -> NDArray:
+    img = np.asarray(level_image, dtype=np.float32)
+    gr, gc = np.gradient(img)
+    return np.stack([img, gc, gr]).astype(np.float32)
+
+
+# -- the adjustment of one window --------------------------------------------------------------
+@dataclass
+class WindowResult:
+    """Result of one computation window (geometry nodes are on the output grid)."""
+
+    dz: Array  # correction per geometry node (ny, nx)
+    sigma: Array  # σ_Z per geometry node (m), NaN where undetermined
+    observed: NDArray[np.bool_]  # nodes with observations of ≥ 2 images
+    sigma0: float  # grey values
+    iterations: List[int]
+    cg_iterations: List[int]
+    images: List[str]
+    ok: bool
+    message: str = ""
+    reg_share: float = float("nan")
+
+
+def adjust_window(z_in: NDArray, valid: NDArray[np.bool_], x_first: float, y_first: float,
+                  spacing: float, stride: int, windows: Sequence[_ImageWindow], gsd: float,
+                  parallax_per_m: float, levels: int, *, max_iter: int = 8,
+                  regularisation: float = 1.0, weight: Optional[float] = None,
+                  mode: str = "curvature", grey_px: float = 2.0,
+                  feedback: Optional[Feedback] = None) -> WindowResult:
+    r"""Object-space least-squares matching of one window (see the module notes).
+
+    Parameters
+    ----------
+    z_in : (rows, cols) array
+        Input heights at the output cell centres of the window (NaN allowed, see ``valid``).
+    valid : (rows, cols) bool
+        Cells that may be refined (finite input, not excluded).
+    x_first, y_first : float
+        World position of the centre of cell (0, 0) of the window.
+    spacing : float
+        Output cell size (m); rows go south (−Y).
+    stride : int
+        Output cells per geometry node on level 0; ``(rows − 1)`` and ``(cols − 1)`` must be
+        multiples of ``stride·2^(levels−1)``.
+    windows : sequence of _ImageWindow
+        Image pyramids (``levels`` levels) with cameras and orientations.
+    gsd : float
+        Ground sample distance of level 0 (m).
+    parallax_per_m : float
+        Pixels of parallax per metre of height for the widest base, B/(H·GSD).
+    levels : int
+    max_iter, regularisation, mode, grey_px
+        See :func:`refine_object_space`.
+    weight : float, optional
+        Fixed λ (``regularisation_weight``); default: from the share ``regularisation``.
+    """
+    feedback = ensure_feedback(feedback)
+    rows, cols = z_in.shape
+    zf = _fill_nearest(np.asarray(z_in, dtype=float))
+    n_img = len(windows)
+    names = [w.name for w in windows]
+    dz_nodes: Optional[Array] = None
+    iters: List[int] = []
+    cg_iters: List[int] = []
+    h0 = np.zeros(n_img)
+    h1 = np.ones(n_img)
+    sigma0 = float("nan")
+    last: Dict[str, Any] = {}
+    reg_share = float("nan")
+    share = float(regularisation)
+    ref = -1
+    first = True
+    for level in range(levels - 1, -1, -1):
+        st = stride * 2 ** level  # output cells per node on this level
+        ny, nx = (rows - 1) // st + 1, (cols - 1) // st + 1
+        if min(ny, nx) < 3:
+            continue
+        if dz_nodes is None:
+            dz = np.zeros((ny, nx))
+        else:  # prolongation: bilinear, node spacing halves
+            from scipy import ndimage
+
+            pr, pc = np.mgrid[0:ny, 0:nx]
+            dz = ndimage.map_coordinates(dz_nodes, [pr / 2.0, pc / 2.0], order=1,
+                                         mode="nearest")
+        gsd_l = gsd * 2 ** level
+        # samples: one per ground pixel of the level, over the hull of the cell centres
+        ext_x = (cols - 1) * spacing
+        ext_y = (rows - 1) * spacing
+        ns_x = max(math.floor(ext_x / gsd_l), 1)
+        ns_y = max(math.floor(ext_y / gsd_l), 1)
+        su = (np.arange(ns_x) + 0.5) * (ext_x / ns_x)  # metres from the first cell centre
+        sv = (np.arange(ns_y) + 0.5) * (ext_y / ns_y)
+        SU, SV = np.meshgrid(su, sv)
+        SU, SV = SU.ravel(), SV.ravel()
+        # input heights and validity at the samples (output cells → bilinear)
+        cu, cv = SU / spacing, SV / spacing
+        zidx, zw = _bilinear_weights(cu, cv, cols, rows)
+        z_s = (zf.ravel()[zidx] * zw).sum(axis=1)
+        v_s = (valid.ravel()[zidx] | (zw == 0)).all(axis=1)
+        gidx, gw = _bilinear_weights(SU / (st * spacing), SV / (st * spacing), nx, ny)
+        # grey grid
+        dgo = grey_px * gsd_l
+        nox = math.ceil(ext_x / dgo) + 1
+        noy = math.ceil(ext_y / dgo) + 1
+        oidx, ow = _bilinear_weights(SU / dgo, SV / dgo, nox, noy)
+        Xs = x_first + SU
+        Ys = y_first - SV
+        delta = max(gsd_l, 0.05)
+        reg = _second_difference_rows(ny, nx)
+        zin_nodes = zf[::st, ::st][:ny, :nx]
+        G: Optional[Array] = None
+        lam = -1.0 if weight is None else float(weight)
+        prev_s0 = float("inf")
+        n_it = 0
+        done = False
+        for it in range(max_iter + 1):
+            feedback.check()
+            zs = z_s + (dz.ravel()[gidx] * gw).sum(axis=1)
+            g_all, k_all = _observe(windows, level, Xs, Ys, zs, v_s, delta)
+            seen = np.isfinite(g_all)
+            use = seen.sum(axis=0) >= 2
+            if use.sum() < 16:
+                return _failed(names, iters, cg_iters, "no samples seen by two images")
+            if ref < 0:  # radiometric datum: the image that sees most samples
+                ref = int(np.argmax(seen[:, use].sum(axis=1)))
+            if G is None:
+                if first:  # start radiometry: mean and spread matched to the reference
+                    g_ref = g_all[ref, use & seen[ref]]
+                    for i in range(n_img):
+                        gi = g_all[i, use & seen[i]]
+                        if i != ref and gi.size >= 16:
+                            h1[i] = float(np.std(g_ref) / max(float(np.std(gi)), 1e-6))
+                            h0[i] = float(np.mean(g_ref) - h1[i] * np.mean(gi))
+                    first = False
+                G = _start_grey(g_all, seen, use, h0, h1, oidx, ow, noy, nox)
+            A, obs, cols_g, rad_cols = _design(g_all, k_all, seen & use[None, :], gidx, gw, oidx,
+                                             ow, G, h0, h1, ref, nx * ny, nox * noy)
+            n_z, n_unk = nx * ny, A.shape[1]
+            s0 = math.sqrt(_dot(obs, obs) / max(obs.size - n_unk, 1))
+            last = {"A": A, "l": obs, "n_z": n_z, "ny": ny, "nx": nx,
+                    "n_rad": 2 * len(rad_cols)}
+            if not np.isfinite(s0) or (it > 0 and s0 > 3.0 * prev_s0):
+                return _failed(names, iters, cg_iters, "the adjustment diverged")
+            if done or it == max_iter or (it > 1 and abs(prev_s0 - s0) < 0.005 * prev_s0):
+                break
+            prev_s0 = s0
+            # normal equations: data + λ·curvature (7.2-5/6)
+            Nd = (A.T @ A).tocsr()
+            b = A.T @ obs
+            R = sparse.hstack([reg, sparse.csr_matrix((reg.shape[0], n_unk - n_z))]).tocsr()
+            RtR = (R.T @ R).tocsr()
+            if lam < 0:  # λ from the share, once per level: fixed within the Gauss-Newton loop
+                d_data = float(Nd.diagonal()[:n_z].mean())
+                d_reg = float(RtR.diagonal()[:n_z].mean())
+                lam = share * d_data / max(d_reg, 1e-30) if d_reg > 0 else 0.0
+            Nr = lam * RtR
+            reg_share = float(Nr.diagonal()[:n_z].mean()
+                              / max(float(Nd.diagonal()[:n_z].mean()), 1e-30))
+            z_node = dz if mode == "correction" else zin_nodes + dz
+            b = b - lam * (R.T @ (reg @ z_node.ravel()))
+            x, k_cg = pcg((Nd + Nr).tocsr(), b)
+            cg_iters.append(k_cg)
+            px_per_m = parallax_per_m / 2 ** level
+            lim = min(0.2 * st * spacing, 1.0 / max(px_per_m, 1e-9))
+            dZ = np.clip(x[:n_z], -lim, lim)
+            dz = dz + dZ.reshape(ny, nx)
+            G = G.copy()
+            G[cols_g >= 0] += x[cols_g[cols_g >= 0]]
+            for i, (j0, j1) in rad_cols.items():
+                h0[i] += x[j0]
+                h1[i] += x[j1]
+            n_it += 1
+            # converged in height: one more linearisation gives the final residuals
+            done = float(np.max(np.abs(dZ))) < 0.01 / max(px_per_m, 1e-9)
+        iters.append(n_it)
+        sigma0 = s0
+        dz_nodes = dz
+    if dz_nodes is None or not last:
+        return _failed(names, iters, cg_iters, "the window is too small for the geometry facets")
+    sigma, sigma0, observed = _precision(last)
+    return WindowResult(dz_nodes, sigma, observed, sigma0, iters, cg_iters, names, True,
+                        reg_share=reg_share)
+
+
+def _failed(names: List[str], iters: List[int], cg_iters: List[int], message: str
+            ) -> WindowResult:
+    return WindowResult(np.zeros((1, 1)), np.full((1, 1), np.nan), np.zeros((1, 1), bool),
+                        float("nan"), iters, cg_iters, names, False, message)
+
+
+def _observe(windows: Sequence[_ImageWindow], level: int, Xs: Array, Ys: Array, zs: Array,
+             valid: NDArray[np.bool_], delta: float) -> Tuple[Array, Array]:
+    r"""Grey values (NaN = not seen) and height coefficients of every sample in every image.
+
+    The coefficient is :math:`\nabla g\cdot\partial(c, r)/\partial Z` in grey values per
+    metre, on pyramid level ``level`` (central differences of ±``delta`` m).
+    """
+    n_img = len(windows)
+    g_all = np.full((n_img, zs.size), np.nan)
+    k_all = np.zeros((n_img, zs.size))
+    scale = 2.0 ** level
+    for i, win in enumerate(windows):
+        pts = np.stack([Xs, Ys, zs], axis=1)
+        c, r = world_to_pixel(pts, win.camera, win.eo)
+        pts[:, 2] += delta
+        cp, rp = world_to_pixel(pts, win.camera, win.eo)
+        pts[:, 2] -= 2 * delta
+        cm, rm = world_to_pixel(pts, win.camera, win.eo)
+        jc = (cp - cm) / (2 * delta) / scale  # level pixels per metre
+        jr = (rp - rm) / (2 * delta) / scale
+        lc = to_level(c - win.col0, level)
+        lr = to_level(r - win.row0, level)
+        vals, ok = _sample_stack(win.levels[level], lc, lr)
+        ok &= valid & np.isfinite(lc) & np.isfinite(lr)
+        g_all[i] = np.where(ok, vals[0], np.nan)
+        k_all[i] = np.where(ok, vals[1] * jc + vals[2] * jr, 0.0)
+    return g_all, k_all
+
+
+def _start_grey(g_all: Array, seen: NDArray[np.bool_], use: NDArray[np.bool_], h0: Array,
+                h1: Array, oidx: NDArray, ow: Array, noy: int, nox: int) -> Array:
+    """Start grey values: the radiometrically adjusted mean of the images, spread to the grey
+    nodes by the bilinear weights (nodes without samples take the nearest value)."""
+    adj = np.where(seen, h1[:, None] * g_all + h0[:, None], 0.0)
+    gmean = adj[:, use].sum(axis=0) / seen[:, use].sum(axis=0)
+    wsum = np.bincount(oidx[use].ravel(), ow[use].ravel(), nox * noy)
+    gsum = np.bincount(oidx[use].ravel(), (ow[use] * gmean[:, None]).ravel(), nox * noy)
+    G = np.where(wsum > 1e-6, gsum / np.maximum(wsum, 1e-12), np.nan)
+    return _fill_nearest(G.reshape(noy, nox)).ravel()
+
+
+def _design(g_all: Array, k_all: Array, mask: NDArray[np.bool_], gidx: NDArray, gw: Array,
+            oidx: NDArray, ow: Array, G: Array, h0: Array, h1: Array, ref: int, n_z: int,
+            n_grey: int):
+    """Sparse design matrix and reduced observations (see the module notes).
+
+    Columns: [dZ (all geometry nodes) | dG (grey nodes with observations) | dh0, dh1 per
+    non-reference image]. Returns ``A, obs, cols_g, rad_cols``.
+    """
+    img_i, samp = np.nonzero(mask)
+    n = img_i.size
+    g = g_all[img_i, samp]
+    k = h1[img_i] * k_all[img_i, samp]
+    ob = oidx[samp]
+    used_g = np.zeros(n_grey, bool)
+    used_g[ob.ravel()] = True
+    cols_g = np.full(n_grey, -1, np.intp)
+    cols_g[used_g] = n_z + np.arange(int(used_g.sum()))
+    n_g = int(used_g.sum())
+    rad_cols: Dict[int, Tuple[int, int]] = {}
+    nxt = n_z + n_g
+    for i in range(g_all.shape[0]):
+        if i != ref:
+            rad_cols[i] = (nxt, nxt + 1)
+            nxt += 2
+    rows = np.arange(n)
+    r_list = [np.repeat(rows, 4), np.repeat(rows, 4)]
+    c_list = [gidx[samp].ravel(), cols_g[ob].ravel()]
+    v_list = [(-k[:, None] * gw[samp]).ravel(), ow[samp].ravel()]
+    not_ref = img_i != ref
+    if not_ref.any():
+        rr = rows[not_ref]
+        c0 = np.array([rad_cols.get(i, (0, 0))[0] for i in range(g_all.shape[0])])
+        r_list += [rr, rr]
+        c_list += [c0[img_i[not_ref]], c0[img_i[not_ref]] + 1]
+        v_list += [-np.ones(rr.size), -g[not_ref]]
+    A = sparse.csr_matrix((np.concatenate(v_list), (np.concatenate(r_list),
+                                                     np.concatenate(c_list))),
+                          shape=(n, nxt))
+    Gp = (G[ob] * ow[samp]).sum(axis=1)
+    obs = h1[img_i] * g + h0[img_i] - Gp
+    return A, obs, cols_g, rad_cols
+
+
+def _precision(last: Dict[str, Any]) -> Tuple[Array, float, NDArray[np.bool_]]:
+    r"""σ0 and σ_Z per geometry node from the unregularised normal equations (probing).
+
+    The few radiometric unknowns couple with every grey value and height, so they are
+    eliminated by a Schur complement instead of entering the sparse LU (they would make its
+    factors dense): with :math:`N = [[B, C], [C^T, D]]`, :math:`Y = B^{-1}C`,
+    :math:`S = D - C^TY`,
+
+    .. math:: (N^{-1})_{mm} = (B^{-1})_{mm} + (Y S^{-1} Y^T)_{mm}, \qquad
+              \hat x_B = B^{-1}(b_B - C\hat x_D),\; \hat x_D = S^{-1}(b_D - Y^Tb_B)
+    """
+    from scipy.sparse.linalg import splu
+
+    A, obs, n_z, ny, nx = last["A"], last["l"], last["n_z"], last["ny"], last["nx"]
+    n_rad = last["n_rad"]
+    N = (A.T @ A).tocsc()
+    d = N.diagonal()
+    dz_diag = d[:n_z]
+    pos = dz_diag[dz_diag > 0]
+    observed = dz_diag > (1e-6 * float(np.median(pos)) if pos.size else np.inf)
+    n_all = N.shape[0]
+    n_b = n_all - n_rad
+    # undetermined unknowns (no observation) are removed; a tiny ridge keeps the LU stable
+    keep = np.flatnonzero(np.concatenate([observed, d[n_z:n_b] > 0]))
+    rad = np.arange(n_b, n_all)
+    B = N[keep][:, keep].tocsc()
+    B = B + sparse.diags(1e-10 * B.diagonal() + 1e-12, format="csc")
+    C = N[keep][:, rad].toarray()
+    D = N[rad][:, rad].toarray()
+    sigma = np.full(n_z, np.nan)
+    try:
+        lu = splu(B)
+    except RuntimeError:  # exactly singular
+        return sigma.reshape(ny, nx), float("nan"), observed.reshape(ny, nx)
+    rhs = A.T @ obs
+    b_b, b_d = rhs[keep], rhs[rad]
+    if n_rad:  # dense products by einsum, not BLAS (see :func:`_noblas`)
+        Y = lu.solve(C)
+        S = D - np.einsum("ij,ik->jk", C, Y)
+        Sinv = np.linalg.pinv(S)
+        x_d = np.einsum("ij,j->i", Sinv, b_d - np.einsum("ij,i->j", Y, b_b))
+        x_b = lu.solve(b_b - np.einsum("ij,j->i", C, x_d))
+    else:
+        x_d = np.zeros(0)
+        x_b = lu.solve(b_b)
+    vtv = _dot(obs, obs) - _dot(b_b, x_b) - _dot(b_d, x_d)
+    n_obs, n_unk = obs.size, keep.size + n_rad
+    sigma0 = math.sqrt(max(vtv, 0.0) / max(n_obs - n_unk, 1))
+    node = np.flatnonzero(observed)  # the observed nodes come first in ``keep``
+    r, c = np.divmod(node, nx)
+    colour = (r % PROBE_DISTANCE) * PROBE_DISTANCE + (c % PROBE_DISTANCE)
+    E = np.zeros((keep.size, PROBE_DISTANCE ** 2))
+    E[np.arange(node.size), colour] = 1.0
+    X = lu.solve(E)
+    q = X[np.arange(node.size), colour]
+    if n_rad:
+        Yz = Y[:node.size]
+        q = q + np.einsum("ij,jk,ik->i", Yz, Sinv, Yz)
+    sigma[node] = sigma0 * np.sqrt(np.maximum(q, 0.0))
+    return sigma.reshape(ny, nx), sigma0, observed.reshape(ny, nx)
+
+
+# -- the driver ------------------------------------------------------------------------------
+def _footprint_cover(cam: Any, eo: Any, X: Array, Y: Array, Z: Array) -> float:
+    """Share of the points (X, Y, Z) that project inside the image."""
+    c, r = world_to_pixel(np.stack([X, Y, Z], axis=-1), cam, eo)
+    ok = (c >= 0) & (c <= cam.width - 1) & (r >= 0) & (r <= cam.height - 1)
+    return float(np.mean(ok)) if ok.size else 0.0
+
+
+def _image_window(cam: Any, eo: Any, X: Array, Y: Array, zlo: float, zhi: float, pad: int
+                  ) -> Optional[Tuple[int, int, int, int]]:
+    """Level-0 pixel window (col0, row0, width, height) that holds the points, clipped."""
+    cs, rs = [], []
+    for z in (zlo, zhi):
+        c, r = world_to_pixel(np.stack([X, Y, np.full_like(X, z)], axis=-1), cam, eo)
+        cs.append(c)
+        rs.append(r)
+    c = np.concatenate(cs)
+    r = np.concatenate(rs)
+    if not (np.isfinite(c).any() and np.isfinite(r).any()):
+        return None
+    c0 = max(math.floor(np.nanmin(c)) - pad, 0)
+    c1 = min(math.ceil(np.nanmax(c)) + pad + 1, cam.width)
+    r0 = max(math.floor(np.nanmin(r)) - pad, 0)
+    r1 = min(math.ceil(np.nanmax(r)) + pad + 1, cam.height)
+    if c1 - c0 < 8 or r1 - r0 < 8:
+        return None
+    return c0, r0, c1 - c0, r1 - r0
+
+
+def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
+                        spacing: Optional[float] = None, levels: Optional[int] = None,
+                        max_iter: int = 8, regularisation: float = 1.0,
+                        regularisation_weight: Optional[float] = None,
+                        regularisation_mode: str = "curvature",
+                        images: Optional[Sequence[str]] = None, tile: int = 192,
+                        overlap: Optional[int] = None, facet_px: float = 8.0,
+                        grey_px: float = 2.0, min_cover: float = 0.1,
+                        feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    r"""Refine a DSM by object-space multi-image least-squares matching (module notes).
+
+    Parameters
+    ----------
+    project : Project or path
+        The project (cameras, oriented images, edits.gpkg).
+    dsm : path
+        The DSM to refine (float, NaN/nodata = no height), in the project CRS.
+    output_dir : path
+        Output folder (created, or replaced if PhotoDEM wrote it); nothing is left on error.
+    spacing : float, optional
+        Cell size of the refined DSM (m); default the DSM's. Geometry nodes lie on every
+        ``stride``-th cell, ``stride = max(1, round(facet_px·GSD / spacing))``.
+    levels : int, optional
+        Image-pyramid levels (coarse → fine); default 2 (the input DSM must be within
+        ≈ 2 px of parallax on the top level, i.e. ≈ 4 px on level 0). More levels only help
+        where the texture survives the reduction.
+    max_iter : int
+        Gauss–Newton iterations per level at most.
+    regularisation : float
+        Share of the curvature regularisation on the height diagonal of the normal equations,
+        mean diag(λRᵀR) / mean diag(AᵀA) (seed-004 §5.5): λ is set from it on the first
+        iteration of every level and window, so it does not depend on the grey-value range,
+        texture or image count. 0 = no regularisation.
+    regularisation_weight : float, optional
+        A fixed λ instead (grey values² per m², node spacing normalised to 1; the thesis used
+        1e4 with 8-bit images).
+    regularisation_mode : {"curvature", "correction"}
+        Penalise the curvature of the surface (thesis) or only of the correction to the DSM.
+    images : sequence of str, optional
+        Image names to use; default every image whose footprint covers ≥ ``min_cover`` of a
+        tile.
+    tile : int
+        Tile side in output cells (plus ``overlap`` on every side).
+    overlap : int, optional
+        Overlap in cells on every side; default 3 geometry facets.
+    facet_px, grey_px : float
+        Geometry and grey facet sizes in image pixels (thesis: 8 and 2).
+    min_cover : float
+        Share of a tile an image must see to be used there.
+    feedback : Feedback, optional
+        Progress and cancellation.
+
+    Returns
+    -------
+    dict
+        ``{"dsm", "sigma", "report", "metrics"}``.
+    """
+    from rasterio.windows import Window
+
+    from ..project.model import Project
+    from ..raster.io import GTIFF_PROFILE, open_image, staged_folder
+    from ..raster.sample import bilinear_grid, world_to_grid
+    from ..surface.gridding import Grid, polygon_mask
+
+    feedback = ensure_feedback(feedback)
+    t_start = time.perf_counter()
+    if regularisation_mode not in MODES:
+        raise InputError(f"Unknown regularisation mode '{regularisation_mode}'; use one of "
+                         f"{', '.join(MODES)}.")
+    if not regularisation >= 0 or (regularisation_weight is not None
+                                    and not regularisation_weight >= 0):
+        raise InputError("The regularisation must not be negative.")
+    if int(max_iter) < 1:
+        raise InputError("max_iter must be at least 1.")
+    if not isinstance(project, Project):
+        project = Project.load(project)
+    dsm = Path(dsm)
+    if not dsm.is_file():
+        raise InputError(f"The DSM '{dsm}' does not exist.")
+    recs = project.images if images is None else [project.image(n) for n in images]
+    if len(recs) < 2:
+        raise InputError("Object-space matching needs at least two images; the project or "
+                         "the 'images' list has fewer.")
+    for rec in recs:
+        p = project.image_path(rec)
+        if not p.is_file():
+            raise InputError(f"Image file '{p}' of image '{rec.name}' does not exist; fix its "
+                             "path in project.toml.")
+    with open_image(dsm) as src:
+        if src.crs is not None and project.crs:
+            from rasterio.crs import CRS
+
+            if CRS.from_user_input(project.crs) != src.crs:
+                raise InputError(f"The DSM '{dsm.name}' is in another CRS than the project; "
+                                 "reproject it to the project CRS first.")
+        t = src.transform
+        if t.b != 0 or t.d != 0 or abs(abs(t.a) - abs(t.e)) > 1e-9 * abs(t.a):
+            raise InputError(f"The DSM '{dsm.name}' must be north-up with square cells.")
+        dsm_spacing = float(abs(t.a))
+        b = src.bounds
+        in_grid = Grid(t, src.width, src.height, dsm_spacing)
+        nodata = src.nodata
+        # a coarse overview of the heights: terrain height and height range
+        step = max(1, max(src.width, src.height) // 256)
+        ov = src.read(1, out_shape=(max(1, src.height // step), max(1, src.width // step)),
+                      masked=True).astype(float).filled(np.nan)
+    if not np.isfinite(ov).any():
+        raise InputError(f"The DSM '{dsm.name}' has no heights.")
+    spacing = dsm_spacing if not spacing else float(spacing)
+    if not spacing > 0:
+        raise InputError(f"The spacing must be positive, got {spacing}.")
+    out_grid = in_grid if spacing == dsm_spacing else Grid.from_bounds(
+        b.left, b.bottom, b.right, b.top, spacing)
+    z_mean = float(np.nanmean(ov))
+    cams = {rec.name: project.camera_of(rec) for rec in recs}
+    heights = np.array([rec.eo.position[2] - z_mean for rec in recs])
+    if not (heights > 0).all():
+        raise GeometryError("Some images are not above the DSM; check the DSM heights and the "
+                            "orientations.")
+    gsd = float(np.median([cams[r.name].gsd(h) for r, h in zip(recs, heights)]))
+    levels = 2 if levels is None else int(levels)
+    if levels < 1:
+        raise InputError("levels must be at least 1.")
+    stride = max(1, round(facet_px * gsd / spacing))
+    unit = stride * 2 ** (levels - 1)  # node lattice of the top level, in cells
+    overlap = int(overlap) if overlap is not None else 3 * stride
+    tile = max(int(tile), unit)
+    excl, bounds, _lines = ([], [], [])
+    if Path(project.edits_path).is_file():
+        from ..project.edits import read_constraints
+
+        excl, bounds, _lines = read_constraints(project.edits_path, project.crs or None)
+    W, H = out_grid.width, out_grid.height
+    tiles = [(r0, c0) for r0 in range(0, H, tile) for c0 in range(0, W, tile)]
+    feedback.info(f"Object-space matching: {len(recs)} images, GSD {gsd:.3f} m, DSM "
+                  f"{W}×{H} cells at {spacing:.3f} m, geometry nodes every {stride} cells, "
+                  f"{levels} levels, {len(tiles)} tiles.")
+    out = Path(output_dir)
+    tile_reports: List[Dict[str, Any]] = []
+    sig_all: List[Array] = []
+    n_refined = 0
+    n_nodes = 0
+    failures = 0
+    with staged_folder(out, replace=True, product="refine_object_space") as tmp:
+        profile = dict(GTIFF_PROFILE)
+        profile.update(width=W, height=H, count=1, dtype="float32", nodata=float("nan"),
+                       predictor=3, transform=out_grid.transform)
+        if project.crs:
+            profile["crs"] = project.crs
+        if W < 256 or H < 256:
+            profile.update(tiled=False)
+            profile.pop("blockxsize")
+            profile.pop("blockysize")
+        with open_image(tmp / "dsm.tif", "w", **profile) as dst_z, \
+                open_image(tmp / "sigma.tif", "w", **profile) as dst_s, \
+                open_image(dsm) as src:
+            for t_i, (r0, c0) in enumerate(tiles):
+                feedback.progress(100.0 * t_i / len(tiles))
+                th, tw = min(tile, H - r0), min(tile, W - c0)
+                # window: core ± overlap, extended so that nodes of every level fit exactly
+                wr0, wc0 = r0 - overlap, c0 - overlap
+                nr = th + 2 * overlap
+                nc = tw + 2 * overlap
+                nr = ((nr - 1 + unit - 1) // unit) * unit + 1
+                nc = ((nc - 1 + unit - 1) // unit) * unit + 1
+                wgrid = Grid(out_grid.transform * out_grid.transform.translation(wc0, wr0),
+                             nc, nr, spacing)
+                x_first, y_first = wgrid.transform * (0.5, 0.5)
+                if out_grid is in_grid:
+                    z_in = src.read(1, window=Window(wc0, wr0, nc, nr), boundless=True,
+                                    fill_value=np.nan, masked=True)
+                    z_in = z_in.astype(float).filled(np.nan)
+                else:
+                    xs = x_first + spacing * np.arange(nc)
+                    ys = y_first - spacing * np.arange(nr)
+                    XX, YY = np.meshgrid(xs, ys)
+                    cc, rr = world_to_grid(src.transform, XX, YY)
+                    ic0 = max(int(np.floor(cc.min())) - 1, 0)
+                    ir0 = max(int(np.floor(rr.min())) - 1, 0)
+                    ic1 = min(int(np.ceil(cc.max())) + 2, src.width)
+                    ir1 = min(int(np.ceil(rr.max())) + 2, src.height)
+                    if ic1 > ic0 and ir1 > ir0:
+                        a = src.read(1, window=Window(ic0, ir0, ic1 - ic0, ir1 - ir0),
+                                     masked=True).astype(float).filled(np.nan)
+                        z_in = bilinear_grid(a, cc - ic0, rr - ir0)
+                    else:
+                        z_in = np.full((nr, nc), np.nan)
+                if nodata is not None and np.isfinite(nodata):
+                    z_in[z_in == nodata] = np.nan
+                valid = np.isfinite(z_in)
+                if excl:
+                    valid &= ~polygon_mask(excl, wgrid)
+                if bounds:
+                    valid &= polygon_mask(bounds, wgrid)
+                core = (slice(overlap, overlap + th), slice(overlap, overlap + tw))
+                z_out = np.full((th, tw), np.nan, np.float32)
+                s_out = np.full((th, tw), np.nan, np.float32)
+                rep: Dict[str, Any] = {"tile": [int(r0), int(c0)], "images": [],
+                                       "iterations": [], "sigma0": None, "failed": False}
+                if valid[core].any():
+                    res = _run_tile(recs, cams, project, z_in, valid, x_first, y_first,
+                                    spacing, stride, gsd, levels, min_cover, max_iter,
+                                    regularisation, regularisation_weight,
+                                    regularisation_mode, grey_px,
+                                    feedback)
+                    rep["images"] = res.images
+                    rep["iterations"] = res.iterations
+                    rep["cg_iterations"] = res.cg_iterations
+                    rep["regularisation_share"] = (round(res.reg_share, 4)
+                                                   if np.isfinite(res.reg_share) else None)
+                    if res.ok:
+                        from scipy import ndimage
+
+                        rr_, cc_ = np.mgrid[0:nr, 0:nc]
+                        coords = [rr_ / stride, cc_ / stride]
+                        dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
+                        sg = ndimage.map_coordinates(np.nan_to_num(res.sigma, nan=1e9),
+                                                     coords, order=1, mode="nearest")
+                        obs = ndimage.map_coordinates(res.observed.astype(float), coords,
+                                                      order=1, mode="nearest")
+                        good = valid & (obs > 0.5) & (sg < 1e8)
+                        zr = np.where(good, z_in + dz, np.nan)
+                        sr = np.where(good, sg, np.nan)
+                        z_out = zr[core].astype(np.float32)
+                        # σ to 0.1 mm: the sparse LU may differ in the last bits between
+                        # processes (BLAS builds), which must not show in the product
+                        s_out = np.round(sr[core], 4).astype(np.float32)
+                        rep["sigma0"] = round(res.sigma0, 4) if np.isfinite(res.sigma0) \
+                            else None
+                        k = np.isfinite(s_out)
+                        n_refined += int(k.sum())
+                        sig_all.append(s_out[k].astype(float))
+                        nodes_core = res.observed[overlap // stride:(overlap + th) // stride,
+                                                  overlap // stride:(overlap + tw) // stride]
+                        n_nodes += int(nodes_core.sum())
+                    else:
+                        failures += 1
+                        rep["failed"] = True
+                        rep["message"] = res.message
+                        feedback.warning(f"Tile at row {r0}, col {c0}: {res.message}; left "
+                                         "empty (NaN).")
+                tile_reports.append(rep)
+                dst_z.write(z_out[None], window=Window(c0, r0, tw, th))
+                dst_s.write(s_out[None], window=Window(c0, r0, tw, th))
+        feedback.check()
+        sig = np.concatenate(sig_all) if sig_all else np.zeros(0)
+        s0s = [r["sigma0"] for r in tile_reports if r.get("sigma0") is not None]
+        seconds = time.perf_counter() - t_start
+        metrics = {
+            "cells": [W, H],
+            "spacing_m": spacing,
+            "gsd_m": gsd,
+            "geometry_stride_cells": stride,
+            "levels": levels,
+            "tiles": len(tiles),
+            "refined_cells": n_refined,
+            "geometry_nodes": n_nodes,
+            "failures": failures,
+            "sigma0_grey_mean": float(np.mean(s0s)) if s0s else None,
+            "sigma0_grey_median": float(np.median(s0s)) if s0s else None,
+            "sigma_z_mean_m": float(sig.mean()) if sig.size else None,
+            "sigma_z_median_m": float(np.median(sig)) if sig.size else None,
+        }
+        report = {"dsm": str(dsm), "crs": project.crs, "metrics": metrics,
+                  "options": {"max_iter": int(max_iter), "regularisation": regularisation,
+                              "regularisation_weight": regularisation_weight,
+                              "regularisation_mode": regularisation_mode,
+                              "facet_px": facet_px, "grey_px": grey_px, "tile": tile,
+                              "overlap": overlap, "min_cover": min_cover,
+                              "sigma": "probing of diag(N⁻¹), colour distance "
+                                       f"{PROBE_DISTANCE} nodes, without regularisation"},
+                  "tiles": tile_reports, "seconds": {"total": seconds}}
+        (tmp / "report.json").write_text(json.dumps(report, indent=1), encoding="utf-8")
+        feedback.progress(100.0)
+    feedback.info(f"Refined {n_refined} cells ({n_nodes} geometry nodes), median σ_Z "
+                  f"{metrics['sigma_z_median_m'] or float('nan'):.3f} m, {failures} failed "
+                  "tiles.")
+    return {"dsm": str(out / "dsm.tif"), "sigma": str(out / "sigma.tif"),
+            "report": str(out / "report.json"), "metrics": metrics}
+
+
+def _run_tile(recs: Sequence[Any], cams: Dict[str, Any], project: Any, z_in: Array,
+              valid: NDArray[np.bool_], x_first: float, y_first: float, spacing: float,
+              stride: int, gsd: float, levels: int, min_cover: float, max_iter: int,
+              regularisation: float, weight: Optional[float], mode: str, grey_px: float,
+              feedback: Feedback
+              ) -> WindowResult:
+    """Choose the images of a window, read their windows and pyramids, adjust."""
+    nr, nc = z_in.shape
+    zf = z_in[valid]
+    zlo, zhi = float(zf.min()), float(zf.max())
+    zm = float(np.median(zf))
+    # footprint test on a coarse lattice of the window's valid cells
+    rr, cc = np.nonzero(valid)
+    sel = np.linspace(0, rr.size - 1, min(rr.size, 400)).astype(int)
+    X = x_first + cc[sel] * spacing
+    Y = y_first - rr[sel] * spacing
+    Z = z_in[rr[sel], cc[sel]]
+    border = np.array([[0, 0], [0, nc - 1], [nr - 1, 0], [nr - 1, nc - 1]], float)
+    BX = x_first + border[:, 1] * spacing
+    BY = y_first - border[:, 0] * spacing
+    lim = 2.0 ** levels * 8.0
+    wins: List[_ImageWindow] = []
+    for rec in recs:
+        cam = cams[rec.name]
+        if _footprint_cover(cam, rec.eo, X, Y, Z) < min_cover:
+            continue
+        box = _image_window(cam, rec.eo, np.concatenate([BX, X]), np.concatenate([BY, Y]),
+                            zlo - 1.0, zhi + 1.0, int(lim))
+        if box is None:
+            continue
+        grey = _read_grey(project.image_path(rec), *box)
+        pyr = build_pyramid(grey, levels)
+        if len(pyr) < levels:
+            continue
+        wins.append(_ImageWindow(rec.name, cam, _noblas(rec.eo), box[0], box[1],
+                                 [_stack(p) for p in pyr]))
+    if len(wins) < 2:
+        return WindowResult(np.zeros((1, 1)), np.full((1, 1), np.nan), np.zeros((1, 1), bool),
+                            float("nan"), [], [], [w.name for w in wins], False,
+                            "fewer than two images see it")
+    # widest base over the used images → parallax per metre of height
+    P = np.array([w.eo.position for w in wins])
+    base = max(float(np.linalg.norm(P[i, :2] - P[j, :2]))
+               for i in range(len(wins)) for j in range(i + 1, len(wins)))
+    h = float(np.mean(P[:, 2]) - zm)
+    parallax_per_m = max(base / h / gsd, 1e-6)
+    return adjust_window(z_in, valid, x_first, y_first, spacing, stride, wins, gsd,
+                         parallax_per_m, levels, max_iter=max_iter,
+                         regularisation=regularisation, weight=weight, mode=mode,
+                         grey_px=grey_px,
+                         feedback=feedback)
+
+
+__all__ = ["MODES", "WindowResult", "adjust_window", "pcg", "refine_object_space"]

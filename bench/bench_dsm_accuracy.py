@@ -1,0 +1,215 @@
+"""DSM accuracy of the matchers in ‰ of the flying height (issue 4 acceptance).
+
+(a) Synthetic ``aerial`` block (wide-angle film geometry rendered as 1024 px windows: base
+    ≈ 4600 px, so σ_Z/H = σ_px / base_px is the same as for a full aerial model), model
+    0101_0102 with one start point:
+    - ``fbm_lsm`` (hierarchical FBM + LSM, groundels, FE surface),
+    - ``dense`` (our SGM) and the peer ``dense`` with OpenCV's plain StereoSGBM in the same run,
+    - ``refine_object_space`` (3 images) started from the dense DSM,
+    each against the true DSM on open textured land cover (classes 1 open, 7 field): RMS, NMAD
+    in m and ‰ H, over all cells and over the measured cells (within half a groundel of a
+    matched point for fbm_lsm). Targets: fbm_lsm ≤ 0.1 ‰, dense ≤ 0.15 ‰, refined ≤ 0.07 ‰.
+(b) Texture direction (seed-000 §6): field furrows parallel vs perpendicular to the epipolar
+    lines (flight direction) → fbm_lsm RMS and point count on the field class.
+(c) NGI pair 0182/0184: fbm_lsm DSM against the 24 m reference ``dem.tif``: RMS, NMAD,
+    coverage.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Dict, Optional
+
+import numpy as np
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "ngi_aerial_block"
+MODEL = "0101_0102"
+OPEN = (1, 7)
+
+
+def _errors(dsm: str, truth: Dict[str, Any], count: Optional[str] = None,
+            radius: float = 0.0, classes=OPEN) -> Dict[str, float]:
+    """DSM − true DSM on the given classes (all cells, and near matched points)."""
+    import rasterio
+    from rasterio.warp import Resampling, reproject
+    from scipy import ndimage
+
+    with rasterio.open(dsm) as src:
+        z, transform, crs = src.read(1), src.transform, src.crs
+    ref = np.full(z.shape, np.nan, np.float32)
+    lc = np.zeros(z.shape, np.float32)
+    for path, arr, how in ((truth["dsm"], ref, Resampling.average),
+                           (truth["landcover"], lc, Resampling.nearest)):
+        with rasterio.open(path) as src:
+            reproject(rasterio.band(src, 1), arr, dst_transform=transform, dst_crs=crs,
+                      resampling=how)
+    sel = np.isin(lc, classes) & np.isfinite(z) & np.isfinite(ref)
+    out = {}
+    masks = {"all": sel}
+    if count:
+        with rasterio.open(count) as src:
+            n = src.read(1)
+        near = ndimage.distance_transform_edt(n == 0) * transform.a <= radius
+        masks["measured"] = sel & near
+    for key, m in masks.items():
+        d = (z - ref)[m].astype(float)
+        out[f"rms_{key}_m"] = float(np.sqrt(np.mean(d**2))) if d.size else float("nan")
+        out[f"nmad_{key}_m"] = (float(1.4826 * np.median(np.abs(d - np.median(d))))
+                                if d.size else float("nan"))
+        out[f"cells_{key}"] = int(d.size)
+    return out
+
+
+def _start_point(project: Path, truth: Dict[str, Any], lo: float, hi: float) -> None:
+    import rasterio
+    from shapely.geometry import Point
+
+    from photodem.algorithms.matching.model_setup import prepare_model
+    from photodem.algorithms.project.edits import add_features
+
+    setup = prepare_model(project, MODEL, min_height=lo, max_height=hi)
+    c = setup.measuring_area().centroid
+    with rasterio.open(truth["dtm"]) as src:
+        h = float(next(src.sample([(c.x, c.y)]))[0])
+    add_features(project / "edits.gpkg", "start_points", [(Point(c.x, c.y), {"height": h})])
+
+
+def _block(tmp: Path, name: str, texture_direction: float = 0.0):
+    import rasterio
+
+    from photodem.algorithms.synthetic.block import generate_block
+
+    block = generate_block(tmp / name, size="aerial", terrain="gentle", seed=1,
+                           texture_direction=texture_direction)
+    truth = {k: str(v) for k, v in block.truth.items()}
+    with rasterio.open(truth["dsm"]) as src:
+        z = src.read(1)
+    lo, hi = float(np.nanmin(z)) - 5.0, float(np.nanmax(z)) + 5.0
+    _start_point(block.project, truth, lo, hi)
+    return block, truth, lo, hi
+
+
+def _row(case: str, res: Dict[str, Any], errs: Dict[str, float], H: float,
+         seconds: float, target: Optional[float]) -> Dict[str, Any]:
+    row = {"case": case, "rms_m": errs["rms_all_m"], "nmad_m": errs["nmad_all_m"],
+           "rms_permille_h": 1000.0 * errs["rms_all_m"] / H}
+    if "rms_measured_m" in errs:
+        row["rms_measured_m"] = errs["rms_measured_m"]
+        row["rms_measured_permille_h"] = 1000.0 * errs["rms_measured_m"] / H
+    row.update(coverage_pct=res["metrics"].get("coverage_pct"),
+               measured_pct=res["metrics"].get("measured_pct"), seconds=seconds,
+               target_permille_h=target)
+    return row
+
+
+def _synthetic(tmp: Path) -> Dict[str, Any]:
+    from photodem.algorithms.matching.dense_model import match_model_dense
+    from photodem.algorithms.matching.fbm_model import match_model_fbm_lsm
+    from photodem.algorithms.matching.object_space import refine_object_space
+
+    block, truth, lo, hi = _block(tmp, "aerial")
+    H = float(block.flying_height)
+    rows = []
+    t0 = time.perf_counter()
+    fbm = match_model_fbm_lsm(block.project, MODEL, tmp / "fbm")
+    dt = time.perf_counter() - t0
+    half = 0.5 * fbm["metrics"]["groundel_m"]
+    rows.append(_row("fbm_lsm (1 start point)", fbm,
+                     _errors(fbm["dsm"], truth, fbm["count"], half), H, dt, 0.1))
+    dense = {}
+    for method in ("sgm", "opencv_sgbm"):
+        t0 = time.perf_counter()
+        dense[method] = match_model_dense(block.project, MODEL, tmp / f"dense_{method}",
+                                          min_height=lo, max_height=hi, method=method)
+        dt = time.perf_counter() - t0
+        rows.append(_row(f"dense {method}", dense[method],
+                         _errors(dense[method]["dsm"], truth), H, dt,
+                         0.15 if method == "sgm" else None))
+    t0 = time.perf_counter()
+    ref = refine_object_space(block.project, dense["sgm"]["dsm"], tmp / "refined")
+    dt = time.perf_counter() - t0
+    ref.setdefault("metrics", {})
+    rows.append(_row("refine_object_space (3 images) from dense sgm", ref,
+                     _errors(ref["dsm"], truth), H, dt, 0.07))
+    ratio = rows[1]["rms_m"] / rows[2]["rms_m"] if rows[2]["rms_m"] else None
+    return {"flying_height_m": H, "gsd_m": block.gsd, "base_px": block.base_px,
+            "rows": rows, "dense_rms_ratio_ours_over_sgbm": ratio}
+
+
+def _texture(tmp: Path) -> Dict[str, Any]:
+    from photodem.algorithms.matching.fbm_model import match_model_fbm_lsm
+
+    rows = []
+    for direction, label in ((0.0, "parallel"), (90.0, "perpendicular")):
+        block, truth, _, _ = _block(tmp, f"tex{int(direction)}", direction)
+        r = match_model_fbm_lsm(block.project, MODEL, tmp / f"tex_fbm{int(direction)}")
+        half = 0.5 * r["metrics"]["groundel_m"]
+        e = _errors(r["dsm"], truth, r["count"], half, classes=(7,))
+        rows.append({"case": f"furrows {label} to the epipolar lines (field class)",
+                     "points": r["metrics"]["points_raw"],
+                     "measured_pct": r["metrics"]["measured_pct"],
+                     "rms_m": e["rms_all_m"], "rms_measured_m": e["rms_measured_m"],
+                     "nmad_measured_m": e["nmad_measured_m"]})
+    return {"rows": rows}
+
+
+def _ngi(tmp: Path) -> Dict[str, Any]:
+    from photodem.algorithms.processing import registry
+    from photodem.algorithms.quality.compare import compare_dems
+
+    proj = tmp / "ngi"
+    registry.run("project_create", {
+        "images": str(DATA / "ngi"), "exterior": str(DATA / "io" / "ngi_xyz_opk.csv"),
+        "interior": str(DATA / "io" / "ngi_int_param.yaml"), "angle_unit": "degrees",
+        "dem": str(DATA / "ngi" / "dem.tif"), "output": str(proj)})
+    info = registry.run("project_info", {"project": str(proj)})
+    model = next((m for m in info["models"]
+                  if {m["left"][-8:-4], m["right"][-8:-4]} & {"0182", "0184"} == {"0182", "0184"}
+                  or ("0182" in m["name"] and "0184" in m["name"])), None)
+    if model is None:
+        return {"skipped": "no model 0182/0184 in the created project"}
+    out = {}
+    for method in ("fbm_lsm", "dense"):
+        t0 = time.perf_counter()
+        r = registry.run("match_model", {"project": str(proj), "model": model["name"],
+                                         "method": method, "min_height": 100.0,
+                                         "max_height": 850.0, "spacing": 24.0,
+                                         "output": str(tmp / f"ngi_{method}")})
+        dt = time.perf_counter() - t0
+        s = compare_dems(r["dsm"], DATA / "ngi" / "dem.tif")["stats"]
+        h = model["height_above_ground_m"]
+        out[method] = {"rms_m": s["rms"], "nmad_m": s["nmad"], "mean_m": s["mean"],
+                       "rms_permille_h": 1000 * s["rms"] / h,
+                       "coverage_pct": r["metrics"]["coverage_pct"],
+                       "measured_pct": r["metrics"].get("measured_pct"), "seconds": dt}
+    out["model"] = model["name"]
+    return out
+
+
+def run() -> dict:
+    with tempfile.TemporaryDirectory(prefix="bench-dsm-") as tmp:
+        tmp = Path(tmp)
+        result: Dict[str, Any] = {"synthetic_aerial": _synthetic(tmp),
+                                  "texture": _texture(tmp)}
+        result["ngi_0182_0184"] = (_ngi(tmp) if DATA.is_dir()
+                                   else {"skipped": f"real data not found at {DATA}"})
+    rows = list(result["synthetic_aerial"]["rows"]) + list(result["texture"]["rows"])
+    ngi = result["ngi_0182_0184"]
+    for method in ("fbm_lsm", "dense"):
+        if method in ngi:
+            rows.append({"case": f"NGI {ngi['model']} {method} vs dem.tif (24 m grid)",
+                         **ngi[method]})
+    result.update(
+        title="DSM accuracy of fbm_lsm, dense and object-space refinement (‰ of H)",
+        rows=rows,
+        notes=["open textured terrain = land-cover classes 1 (open) and 7 (field) of the "
+               "synthetic truth; 'measured' = cells within half a groundel of a matched point "
+               "(fbm_lsm interpolates the rest)",
+               f"aerial block: H = {result['synthetic_aerial']['flying_height_m']:.0f} m, "
+               f"base = {result['synthetic_aerial']['base_px']:.0f} px, so 0.1 ‰ H = "
+               f"{1e-4 * result['synthetic_aerial']['base_px']:.2f} px of parallax",
+               "dense RMS ratio ours / OpenCV StereoSGBM (same pipeline): "
+               f"{result['synthetic_aerial']['dense_rms_ratio_ours_over_sgbm']}"])
+    return result

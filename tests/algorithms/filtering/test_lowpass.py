@@ -1,0 +1,232 @@
+"""Iterative robust low-pass filter (algorithms/filtering/lowpass) against closed forms."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import rasterio
+from affine import Affine
+from shapely.geometry import LineString
+
+from photodem.algorithms.errors import InputError
+from photodem.algorithms.filtering.lowpass import (
+    lowpass_filter,
+    lowpass_parameters,
+    membrane_fill,
+    plane_smooth,
+    run_filter_lowpass,
+)
+from photodem.algorithms.filtering.presets import LOWPASS_PRESETS, PRESET_NAMES
+from photodem.algorithms.filtering.surface_input import FilterConstraints
+from photodem.algorithms.processing import registry
+from photodem.algorithms.raster.io import write_raster
+from photodem.algorithms.surface.gridding import Grid, line_barrier
+
+CRS = "EPSG:25832"
+N = 160
+
+
+def _grid(n: int = N, s: float = 1.0) -> Grid:
+    return Grid(Affine(s, 0, 0, 0, -s, n * s), n, n, s)
+
+
+def _xy(n: int = N):
+    rows, cols = np.mgrid[0:n, 0:n].astype(float)
+    return cols + 0.5, n - rows - 0.5  # cell centres, x east, y north
+
+
+def _plane(n: int = N) -> np.ndarray:
+    x, y = _xy(n)
+    return 100.0 + 0.08 * x - 0.05 * y
+
+
+def test_plane_smooth_reproduces_tilted_plane_next_to_holes_and_border() -> None:
+    z = _plane()
+    support = np.ones(z.shape, bool)
+    support[40:100, 50:120] = False
+    t = plane_smooth(z, support, 12)
+    from scipy.ndimage import uniform_filter
+
+    # wherever a fifth of the window has support (degenerate supports fall back to the mean)
+    ok = uniform_filter(support.astype(float), 25, mode="constant") >= 0.2
+    assert np.isfinite(t[ok]).all() and ok.mean() > 0.8
+    assert np.abs(t[ok] - z[ok]).max() < 1e-3  # a mean would be off by slope × offset here
+
+
+def test_membrane_fill_of_a_plane_hole() -> None:
+    z = _plane().astype(np.float32)
+    known = np.ones(z.shape, bool)
+    known[30:130, 20:110] = False
+    f = membrane_fill(np.where(known, z, np.nan), known)
+    assert np.abs(f - z).max() < 0.02 and (f[known] == z[known]).all()
+
+
+def test_box_building_on_plane_is_removed() -> None:
+    truth = _plane()
+    dsm = truth.copy()
+    dsm[50:70, 60:85] += 9.0  # a 20 m × 25 m building, 9 m high
+    dsm[110:118, 20:30] += 6.0
+    res = lowpass_filter(dsm.astype(np.float32), 1.0, lowpass_parameters())
+    assert np.abs(res["dtm"] - truth).max() < 0.01
+    assert not res["ground"][50:70, 60:85].any() and not res["ground"][110:118, 20:30].any()
+    n_obj = 20 * 25 + 8 * 10
+    assert res["eliminated_share"] == pytest.approx(n_obj / N ** 2, rel=0.1)
+    assert res["iterations"][1]["eliminated"] > 0
+
+
+def test_tilted_plane_stays() -> None:
+    z = (_plane() + 0.3 * _xy()[0]).astype(np.float32)  # 38 % slope in x
+    res = lowpass_filter(z, 1.0, lowpass_parameters())
+    assert res["eliminated_share"] == 0.0 and np.abs(res["dtm"] - z).max() < 1e-3
+
+
+def _embankment_scene():
+    """Gentle plane, a 7 m railway embankment (crest 9 m, slopes 1:1.5) and two houses."""
+    x, y = _xy()
+    truth = 60.0 + 0.01 * x
+    d = np.abs(y - 0.6 * x - 20.0) / np.hypot(1.0, 0.6)  # distance to the embankment axis
+    emb = np.clip(7.0 - np.maximum(d - 4.5, 0.0) / 1.5, 0.0, None)
+    truth = truth + emb
+    dsm = truth.copy()
+    dsm[20:32, 110:124] += 8.0
+    dsm[10:22, 10:22] += 7.0
+    keep = d < 4.5 + 1.5 * 7.0 + 3.0
+    return dsm.astype(np.float32), truth, keep, emb > 0.5
+
+
+def test_embankment_removed_without_keep_area_and_kept_with_it() -> None:
+    dsm, truth, keep, on_emb = _embankment_scene()
+    par = lowpass_parameters("flat")
+    # the known failure of low-pass filters (Raguse 2000, Tab. 6.7): the embankment is
+    # (partly) eliminated and the DTM lies metres below it
+    res = lowpass_filter(dsm, 1.0, par)
+    err = res["dtm"] - truth
+    assert err[on_emb].mean() < -1.5 and err[on_emb].min() < -4.0
+    assert (~res["ground"][on_emb]).mean() > 0.4
+    # with a keep exclusion area the DSM stays the DTM there, bit for bit
+    cons = FilterConstraints.empty(_grid())
+    cons.keep = keep
+    res = lowpass_filter(dsm, 1.0, par, cons, _grid())
+    assert (res["dtm"][keep] == dsm[keep]).all()
+    err = res["dtm"] - truth
+    assert np.abs(err).max() < 0.05
+    assert not res["ground"][20:32, 110:124].any()
+
+
+def test_remove_area_is_bridged() -> None:
+    truth = _plane()
+    dsm = truth.copy()
+    dsm[40:120, 40:120] += 15.0  # an 80 m forest: wider than half the largest window
+    cons = FilterConstraints.empty(_grid())
+    cons.remove = np.zeros(dsm.shape, bool)
+    cons.remove[38:122, 38:122] = True
+    res = lowpass_filter(dsm.astype(np.float32), 1.0, lowpass_parameters(), cons, _grid())
+    assert np.abs(res["dtm"] - truth).max() < 0.05 and not res["ground"][cons.remove].any()
+
+
+def test_manual_ground_points_are_hard_constraints() -> None:
+    grid = _grid()
+    truth = _plane()
+    dsm = truth.copy()
+    dsm[60:90, 60:90] += 10.0
+    cons = FilterConstraints.empty(grid)
+    x, y = _xy()
+    cons.ground_points = np.array([
+        [x[75, 75] + 0.2, y[75, 75] - 0.3, truth[75, 75] - 1.0],  # in the hole, 1 m low
+        [x[10, 10], y[10, 10], truth[10, 10] + 0.05],  # agrees within the tolerance
+    ])
+    res = lowpass_filter(dsm.astype(np.float32), 1.0, lowpass_parameters(), cons, grid)
+    r, c = grid.cell_of(cons.ground_points[:, 0], cons.ground_points[:, 1])
+    assert np.array_equal(res["dtm"][r, c], cons.ground_points[:, 2].astype(np.float32))
+    bad = res["ground_points_disagreeing"]
+    assert [b["index"] for b in bad] == [0] and bad[0]["dh"] == pytest.approx(1.0, abs=0.05)
+    # the surface bends to the point: its neighbours lie between the point and the plane
+    nb = res["dtm"][74:77, 74:77] - truth[74:77, 74:77]
+    assert (nb <= 0.01).all() and (nb >= -1.0).all()
+
+
+def test_breakline_keeps_a_vertical_step() -> None:
+    grid = _grid()
+    x, y = _xy()
+    truth = np.where(x < 80, 50.0, 53.0) + 0.01 * y
+    dsm = truth.copy()
+    dsm[40:60, 60:78] += 8.0  # houses right at the step, both sides
+    dsm[100:115, 82:100] += 8.0
+    cons = FilterConstraints.empty(grid)
+    cons.breaklines = [LineString([(80.0, -5.0, 51.5), (80.0, N + 5.0, 51.5)])]
+    cons.barrier, cons.barrier_z = line_barrier(cons.breaklines, grid)
+    par = lowpass_parameters()
+    plain = lowpass_filter(dsm.astype(np.float32), 1.0, par)
+    res = lowpass_filter(dsm.astype(np.float32), 1.0, par, cons, grid)
+    off = ~cons.barrier
+    assert np.abs(res["dtm"] - truth)[off].max() < 0.01
+    assert np.abs(plain["dtm"] - truth)[off].max() > 0.3  # without it the step is smeared
+
+
+def test_parameters_presets_and_overrides() -> None:
+    assert set(LOWPASS_PRESETS) == set(PRESET_NAMES)
+    for name in PRESET_NAMES:
+        p = lowpass_parameters(name)
+        assert len(p["windows_m"]) == len(p["thresholds_m"]) and p["windows_m"][0] > 0
+    p = lowpass_parameters("default", {"max_window": 90, "threshold": 0.25, "iterations": 3,
+                                       "slope": 0, "final_smoothing_m": 0})
+    assert p["windows_m"][0] == 90 and len(p["windows_m"]) == 3
+    assert p["thresholds_m"][-1] == 0.25 and p["slope_pct"] == 0 and p["final_smoothing_m"] == 0
+    with pytest.raises(InputError, match="Unknown preset"):
+        lowpass_parameters("marsh")
+
+
+def _write_dsm(path, z):
+    write_raster(path, np.asarray(z, np.float32), Affine(1, 0, 1000, 0, -1, 2000 + N), CRS)
+    return str(path)
+
+
+def test_run_raster_writes_products_and_iterations(tmp_path) -> None:
+    dsm = _plane()
+    dsm[50:70, 60:85] += 9.0
+    out = registry.run("filter_lowpass", {"input": _write_dsm(tmp_path / "dsm.tif", dsm),
+                                          "output": str(tmp_path / "out"),
+                                          "write_iterations": True})
+    assert out["labels"] is None and out["mask"].endswith("mask.tif")
+    with rasterio.open(out["mask"]) as src:
+        mask = src.read(1)
+    assert mask[50:70, 60:85].all() and mask.sum() == 20 * 25
+    with rasterio.open(out["ndsm"]) as src:
+        assert src.read(1)[60, 70] == pytest.approx(9.0, abs=0.01)
+    n_it = len(LOWPASS_PRESETS["default"]["windows_m"])
+    assert sorted(p.name for p in (tmp_path / "out").glob("diff_*.tif")) == \
+        [f"diff_{i:02d}.tif" for i in range(1, n_it + 1)]
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["preset"] == "default" and len(rep["iterations"]) == n_it + 1
+
+
+def test_run_points_labels_in_input_order(tmp_path) -> None:
+    rng = np.random.default_rng(3)
+    n = 6000
+    x, y = rng.uniform(0, 80, n), rng.uniform(0, 80, n)
+    z = 20.0 + 0.05 * x + rng.normal(0, 0.03, n)
+    obj = (np.abs(x - 40) < 8) & (np.abs(y - 40) < 8)
+    z = np.where(obj, z + 6.0, z)
+    path = tmp_path / "pts.txt"
+    np.savetxt(path, np.column_stack([x, y, z, obj]), fmt="%.3f", delimiter=",")
+    out = run_filter_lowpass(path, tmp_path / "out", spacing=1.0, crs=CRS)
+    labels = np.loadtxt(out["labels"], dtype=int)
+    assert labels.shape == (n,) and np.mean(labels == obj) > 0.99
+    assert out["mask"] is None
+
+
+def test_bad_input_one_line_error_nothing_written(tmp_path) -> None:
+    nan = _write_dsm(tmp_path / "nan.tif", np.full((N, N), np.nan))
+    with pytest.raises(InputError) as err:
+        registry.run("filter_lowpass", {"input": nan, "output": str(tmp_path / "o1")})
+    assert "\n" not in str(err.value) and not (tmp_path / "o1").exists()
+    few = tmp_path / "few.xyz"
+    few.write_text("1 1 1\n2 2 2\n3 3 3\n")
+    with pytest.raises(InputError):
+        registry.run("filter_lowpass", {"input": str(few), "output": str(tmp_path / "o2")})
+    with pytest.raises(InputError, match="CRS"):
+        registry.run("filter_lowpass", {"input": _write_dsm(tmp_path / "ok.tif", _plane()),
+                                        "output": str(tmp_path / "o3"), "crs": "EPSG:999999"})
+    assert not any(p.name.startswith(("o1", "o2", "o3", ".o")) for p in tmp_path.iterdir())

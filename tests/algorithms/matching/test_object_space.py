@@ -1,0 +1,192 @@
+"""Object-space multi-image LSM: a small rendered scene with a known surface.
+
+The scene: a smooth analytic surface (±1.5 m hills and a 3 % slope) with band-limited texture,
+rendered by the synthetic ray caster (box PSF, per-image gain/offset, vignetting, noise 2 DN)
+into three 240 × 240 px frame images along X (GSD 0.2 m, H = 48 m, bases 12 and 24 m:
+B/H = 0.25 / 0.5). The start DSM is the truth plus a 0.5 m bump and a 0.15 m wave.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rasterio
+from affine import Affine
+from scipy import sparse
+from scipy.sparse.linalg import spsolve
+from shapely.geometry import box
+
+from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.geometry.camera import Camera
+from photodem.algorithms.geometry.orientation import ExteriorOrientation
+from photodem.algorithms.matching.object_space import (
+    _second_difference_rows,
+    pcg,
+    refine_object_space,
+)
+from photodem.algorithms.processing import registry
+from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.project.edits import add_features, create_edits
+from photodem.algorithms.project.model import ImageRecord, Project
+from photodem.algorithms.raster.io import write_raster
+from photodem.algorithms.synthetic.render import Renderer, render_image
+from photodem.algorithms.synthetic.terrain import Grid, band_noise
+
+CRS = "EPSG:25832"
+X0, Y0, ZT = 500000.0, 5500000.0, 100.0
+GSD, NPX = 0.2, 240
+FLY = GSD * NPX  # principal distance = NPX px → H = 48 m
+BASE = 12.0
+
+
+def truth(x, y):
+    u, v = np.asarray(x) - X0, np.asarray(y) - Y0
+    return ZT + 1.5 * np.sin(2 * np.pi * u / 37.0) * np.cos(2 * np.pi * v / 29.0) + 0.03 * u
+
+
+def start_error(u, v):
+    return 0.5 * np.exp(-(u ** 2 + v ** 2) / (2 * 4.0 ** 2)) + 0.15 * np.sin(u / 3.0 + v / 5.0)
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    root = tmp_path_factory.mktemp("object_space") / "project"
+    cell, half = 0.1, 40.0
+    n = int(2 * half / cell)
+    grid = Grid(X0 - half, Y0 + half, cell, n, n)
+    dsm = truth(grid.xs, grid.ys) * np.ones((n, n))
+    rng = np.random.default_rng(1)
+    alb = np.clip(0.45 + 0.14 * band_noise(rng, grid, 1.2) + 0.07 * band_noise(rng, grid, 0.5),
+                  0.05, 0.95).astype(np.float32)
+    renderer = Renderer(grid, dsm, np.stack([alb, alb, alb]), np.zeros((0, 3)), 1.0)
+    cam = Camera("cam", NPX, NPX, focal_length=NPX * 0.01, pixel_size=(0.01, 0.01))
+    (root / "images").mkdir(parents=True)
+    seqs = np.random.SeedSequence(7).spawn(3)
+    recs = []
+    for k, dx in enumerate((-BASE, 0.0, BASE)):
+        eo = ExteriorOrientation.from_opk([X0 + dx, Y0, ZT + FLY], 0.5 * (k - 1), -0.3 * k,
+                                          1.0 * k)
+        img, _ = render_image(renderer, cam, eo, 2, 1 << 18, seqs[k], 0.1)
+        write_raster(root / "images" / f"img{k}.tif", img)
+        recs.append(ImageRecord(f"img{k}", f"images/img{k}.tif", "cam", eo))
+    Project(root=root, name="os", crs=CRS, cameras={"cam": cam}, images=recs,
+            terrain_height=ZT).save()
+    create_edits(root / "edits.gpkg", CRS)
+    # start DSM: 24 m × 24 m at 0.4 m, truth + smooth error
+    spacing, half_dsm = 0.4, 12.0
+    m = int(2 * half_dsm / spacing)
+    t = Affine(spacing, 0, X0 - half_dsm, 0, -spacing, Y0 + half_dsm)
+    cols, rows = np.meshgrid(np.arange(m) + 0.5, np.arange(m) + 0.5)
+    x, y = t * (cols, rows)
+    z_true = truth(x, y)
+    write_raster(root / "start.tif", (z_true + start_error(x - X0, y - Y0)).astype(np.float32),
+                 transform=t, crs=CRS)
+    return {"root": root, "dsm": root / "start.tif", "truth": z_true, "x": x, "y": y}
+
+
+def _errors(scene, path):
+    with rasterio.open(path) as src:
+        z = src.read(1)
+    inner = np.zeros(z.shape, bool)
+    inner[3:-3, 3:-3] = True  # one geometry facet off the border
+    return z - scene["truth"], inner
+
+
+# -- numerics ---------------------------------------------------------------------------------
+def test_pcg_equals_direct_solution() -> None:
+    rng = np.random.default_rng(0)
+    A = sparse.random(400, 120, density=0.05, random_state=3, format="csr") \
+        + sparse.eye(400, 120, format="csr")
+    N = (A.T @ A).tocsr()
+    b = rng.standard_normal(120)
+    x, it = pcg(N, b, tol=1e-12)
+    assert np.allclose(x, spsolve(N.tocsc(), b), atol=1e-8) and 0 < it < 400
+
+
+def test_curvature_rows_vanish_on_planes() -> None:
+    R = _second_difference_rows(5, 7)
+    rr, cc = np.mgrid[0:5, 0:7]
+    assert R.shape == (5 * 5 + 3 * 7, 35)
+    assert np.allclose(R @ (3.0 + 0.2 * rr - 0.7 * cc).ravel(), 0.0)
+    assert np.allclose(R @ (cc ** 2).ravel().astype(float), np.where(
+        np.arange(R.shape[0]) < 25, 2.0, 0.0))
+
+
+# -- the synthetic scene ----------------------------------------------------------------------
+def test_refinement_approaches_truth_with_consistent_sigma(scene, tmp_path) -> None:
+    res = refine_object_space(scene["root"], scene["dsm"], tmp_path / "out")
+    e0, inner = _errors(scene, scene["dsm"])
+    e1, _ = _errors(scene, res["dsm"])
+    with rasterio.open(res["sigma"]) as src:
+        sig = src.read(1)
+        assert src.crs is not None and src.dtypes[0] == "float32"
+    ok = inner & np.isfinite(e1)
+    assert ok.sum() > 0.95 * inner.sum()
+    rms0 = float(np.sqrt(np.mean(e0[ok] ** 2)))
+    rms1 = float(np.sqrt(np.mean(e1[ok] ** 2)))
+    px_per_m = 2 * BASE / FLY / GSD  # parallax of the widest pair per metre of height
+    med_sig = float(np.median(sig[ok]))
+    print(f"RMS before {rms0:.3f} m = {rms0 * px_per_m:.2f} px = {1000 * rms0 / FLY:.2f} ‰ H, "
+          f"after {rms1:.3f} m = {rms1 * px_per_m:.2f} px = {1000 * rms1 / FLY:.2f} ‰ H; "
+          f"median σ_Z {med_sig:.3f} m, σ0 {res['metrics']['sigma0_grey_median']:.2f} GL")
+    # measured: 0.196 → 0.064 m (0.49 → 0.16 px of parallax, 4.1 → 1.3 ‰ H), σ_Z 0.078 m
+    assert rms1 < 0.5 * rms0
+    assert abs(float(np.mean(e1[ok]))) < 0.03
+    assert 0.5 < rms1 / med_sig < 2.0  # predicted σ within ×2 of the empirical error
+    # most errors inside the 2.58 σ band
+    assert np.mean(np.abs(e1[ok]) < 2.58 * sig[ok]) > 0.85
+    m = res["metrics"]
+    assert m["failures"] == 0 and m["refined_cells"] == int(np.isfinite(e1).sum())
+    assert 1.0 < m["sigma0_grey_median"] < 15.0
+    import json
+
+    rep = json.loads(Path(res["report"]).read_text())
+    assert rep["tiles"][0]["images"] == ["img0", "img1", "img2"]
+    assert all(1 <= k <= 8 for k in rep["tiles"][0]["iterations"])
+
+
+def test_three_images_beat_two(scene, tmp_path) -> None:
+    _, inner = _errors(scene, scene["dsm"])
+    out = {}
+    for name, imgs in (("two", ["img0", "img1"]), ("three", None)):
+        res = refine_object_space(scene["root"], scene["dsm"], tmp_path / name, images=imgs)
+        e, _ = _errors(scene, res["dsm"])
+        ok = inner & np.isfinite(e)
+        out[name] = (float(np.sqrt(np.mean(e[ok] ** 2))), res["metrics"]["sigma_z_median_m"])
+    print(f"2 images: RMS {out['two'][0]:.3f} m, σ {out['two'][1]:.3f} m; "
+          f"3 images: RMS {out['three'][0]:.3f} m, σ {out['three'][1]:.3f} m")
+    assert out["three"][0] < out["two"][0]
+    assert out["three"][1] < out["two"][1]
+
+
+def test_exclusion_is_nan_and_cancel_leaves_nothing(scene, tmp_path) -> None:
+    proj = tmp_path / "project"
+    shutil.copytree(scene["root"], proj)
+    add_features(proj / "edits.gpkg", "exclusion_areas",
+                 [(box(X0 - 3, Y0 - 3, X0 + 3, Y0 + 3), {"action": "exclude"})])
+    res = registry.run("refine_object_space", {"project": str(proj),
+                                               "dsm": str(proj / "start.tif")})
+    assert Path(res["dsm"]).parent == proj / "products" / "dsm_refined" / "start"
+    with rasterio.open(res["dsm"]) as src:
+        z = src.read(1)
+    inside = (np.abs(scene["x"] - X0) < 2.9) & (np.abs(scene["y"] - Y0) < 2.9)
+    assert inside.sum() > 150 and np.isnan(z[inside]).all()
+    assert np.isfinite(z[~inside]).mean() > 0.9
+
+    fb = Feedback()
+    fb._on_progress = lambda p: fb.cancel() if p > 20 else None
+    with pytest.raises(Cancelled):
+        refine_object_space(proj, proj / "start.tif", tmp_path / "cancelled", feedback=fb,
+                            tile=20)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["project"]
+
+
+def test_bad_input_is_one_line_error(scene, tmp_path) -> None:
+    with pytest.raises(InputError, match="at least two images"):
+        refine_object_space(scene["root"], scene["dsm"], tmp_path / "o", images=["img1"])
+    with pytest.raises(InputError, match="does not exist"):
+        refine_object_space(scene["root"], tmp_path / "missing.tif", tmp_path / "o")
+    assert not (tmp_path / "o").exists()

@@ -1,0 +1,29 @@
+"""``photodem demo`` runs the whole chain: block → epipolar pairs → DSMs → merge → DTM."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from photodem.algorithms.demo import run_demo
+from photodem.algorithms.errors import PhotodemError
+
+
+def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
+    s = run_demo(tmp_path / "demo", size="tiny")
+    surfaces = s["surfaces"]
+    assert len(surfaces["models"]) == len(s["models"]) >= 2
+    assert all(m["coverage_pct"] > 90 for m in surfaces["models"])
+    assert Path(surfaces["dsm_merged"]).is_file() and Path(surfaces["dtm"]).is_file()
+    dtm = surfaces["dtm_vs_truth"]
+    assert dtm["count"] > 0 and abs(dtm["mean"]) < 1.0
+    text = Path(s["summary"]).read_text(encoding="utf-8")
+    assert "DTM | true DTM" in text and "merged DSM" in text
+
+
+def test_demo_refuses_a_foreign_folder(tmp_path) -> None:
+    (tmp_path / "mine.txt").write_text("operator data", encoding="utf-8")
+    with pytest.raises(PhotodemError, match="not an earlier PhotoDEM demo"):
+        run_demo(tmp_path, size="tiny")
+    assert (tmp_path / "mine.txt").read_text(encoding="utf-8") == "operator data"
