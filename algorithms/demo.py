@@ -10,7 +10,10 @@
    matching + LSM, groundels, finite-element surface); ``dsm_merge`` merges the model DSMs and
    ``dem_compare`` compares the merged DSM with the true DSM;
 6. ``filter_lowpass`` filters the merged DSM to a DTM (honouring the project's edits) and
-   ``dem_compare`` compares it with the true DTM.
+   ``dem_compare`` compares it with the true DTM;
+7. ``mosaic`` rectifies every image as a true ortho on the merged DSM (occlusions filled from the
+   next best image), routes the seamlines around objects (DSM − DTM), balances the images and
+   writes the true-ortho mosaic.
 
 The summary is written as ``summary.json`` and ``summary.md`` into the demo folder.
 """
@@ -203,7 +206,15 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
         return {k: s.get(k) for k in ("count", "mean", "rms", "nmad", "q95")} | {
             "rms_permille_H": 1000.0 * s["rms"] / height, "report": c["report"]}
 
+    feedback.info("True-ortho mosaic …")
+    mosaic = registry.run("mosaic", {
+        "project": str(project.root), "dem": str(out / "dsm_merged.tif"), "true_ortho": True,
+        "dsm": str(out / "dsm_merged.tif"), "dtm": dtm["dtm"],
+        "output": str(out / "mosaic.tif")})
     return {
+        "mosaic": {**{k: mosaic.get(k) for k in ("mosaic", "seamlines", "report", "gsd",
+                                                  "balance")},
+                   "images": len(info["images"])},
         "models": [{"name": r["model"], "points": r["metrics"]["points_raw"],
                     "coverage_pct": r["metrics"]["coverage_pct"],
                     "measured_pct": r["metrics"].get("measured_pct"),
@@ -258,6 +269,10 @@ def _markdown(s: Dict[str, Any]) -> str:
         c = f[key]
         lines.append(f"| {name} | {ref} | {c['mean']:.3f} | {c['rms']:.3f} | "
                      f"{c['nmad']:.3f} | {c['rms_permille_H']:.3f} | `{c['report']}` |")
-    lines += ["", "Truth files: " + ", ".join(f"`{Path(v).name}`" for v in s["truth"].values()),
+    mo = f["mosaic"]
+    lines += ["", f"True-ortho mosaic of {mo.get('images')} images at {mo.get('gsd')} m: "
+              f"`{mo.get('mosaic')}` (seamlines and footprints `{mo.get('seamlines')}`, "
+              f"balancing `{mo.get('report')}`).",
+              "", "Truth files: " + ", ".join(f"`{Path(v).name}`" for v in s["truth"].values()),
               ""]
     return "\n".join(lines)

@@ -380,7 +380,7 @@
         </message>
         <message>
             <source>Project folder or project.toml</source>
-            <extracomment>epipolar_pair.project: description; match_model.project: description; refine_object_space.project: description</extracomment>
+            <extracomment>epipolar_pair.project: description; match_model.project: description; mosaic.project: description; ortho_displacement.project: description; orthorectify.project: description; refine_object_space.project: description</extracomment>
             <translation>Projektordner oder project.toml</translation>
         </message>
         <message>
@@ -390,7 +390,7 @@
         </message>
         <message>
             <source>Output folder</source>
-            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; filter_evaluate.output: description; filter_linear_prediction.output: description; filter_lowpass.output: description; match_model.output: description; point_compare.outp</extracomment>
+            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; filter_evaluate.output: description; filter_linear_prediction.output: description; filter_lowpass.output: description; match_model.output: description; ortho_displacement</extracomment>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
@@ -1025,7 +1025,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1375,7 +1375,7 @@
         </message>
         <message>
             <source>Tile size [cells]</source>
-            <extracomment>refine_object_space.tile: description</extracomment>
+            <extracomment>mosaic.tile: description; refine_object_space.tile: description</extracomment>
             <translation>Kachelgröße [Zellen]</translation>
         </message>
         <message>
@@ -1510,7 +1510,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -1692,6 +1692,456 @@
             <source>Eliminated share, covariance per level, ground-point check</source>
             <extracomment>filter_linear_prediction output metrics</extracomment>
             <translation>Eliminierter Anteil, Kovarianz je Stufe, Prüfung der Bodenpunkte</translation>
+        </message>
+        <message>
+            <source>Orthorectify image</source>
+            <extracomment>orthorectify: name</extracomment>
+            <translation>Bild orthorektifizieren</translation>
+        </message>
+        <message>
+            <source>Orthophotos</source>
+            <extracomment>mosaic: group; ortho_displacement: group; orthorectify: group</extracomment>
+            <translation>Orthofotos</translation>
+        </message>
+        <message>
+            <source>Indirect differential rectification of one image of the project onto a DEM: for every output cell the height comes from the DEM (bilinear), the cell is projected into the image by the collinearity equations (with distortion) and the image is resampled there (nearest, bilinear or cubic), tile by tile. A DTM gives a classical ortho (buildings lean away from the nadir by Δr = h·r/H); a true ortho needs the DSM: cells the camera cannot see because a building or tree hides them are marked occluded (alpha 0, visibility 2) so that a mosaic fills them from another image. Writes a tiled GeoTIFF with overviews (the image bands plus an alpha band) and &lt;name&gt;_visibility.tif (0 outside the image, 1 visible, 2 occluded). A DEM in another CRS is reprojected on the fly (with a warning).</source>
+            <extracomment>orthorectify: help</extracomment>
+            <translation>Indirekte differentielle Entzerrung eines Bildes des Projekts auf ein DGM: Für jede Ausgabezelle kommt die Höhe aus dem DGM (bilinear), die Zelle wird mit den Kollinearitätsgleichungen (mit Verzeichnung) ins Bild projiziert und das Bild dort neu abgetastet (nächster Nachbar, bilinear oder kubisch), Kachel für Kachel. Ein DGM ergibt ein klassisches Orthofoto (Gebäude kippen um Δr = h·r/H vom Nadir weg); ein True-Ortho braucht das DOM: Zellen, die die Kamera nicht sieht, weil ein Gebäude oder Baum sie verdeckt, werden als verdeckt markiert (Alpha 0, Sichtbarkeit 2), damit ein Mosaik sie aus einem anderen Bild füllt. Schreibt ein gekacheltes GeoTIFF mit Übersichten (die Bildkanäle plus ein Alphakanal) und &lt;name&gt;_visibility.tif (0 außerhalb des Bildes, 1 sichtbar, 2 verdeckt). Ein DGM in einem anderen KBS wird während der Verarbeitung umprojiziert (mit einer Warnung).</translation>
+        </message>
+        <message>
+            <source>Image</source>
+            <extracomment>ortho_displacement.image: description; orthorectify.image: description</extracomment>
+            <translation>Bild</translation>
+        </message>
+        <message>
+            <source>DEM (DTM, or DSM for a true ortho)</source>
+            <extracomment>orthorectify.dem: description</extracomment>
+            <translation>DHM (DGM, oder DOM für ein True-Ortho)</translation>
+        </message>
+        <message>
+            <source>Heights of the surface to rectify onto; any CRS (reprojected on the fly).</source>
+            <extracomment>orthorectify.dem: help</extracomment>
+            <translation>Höhen der Fläche, auf die entzerrt wird; beliebiges KBS (wird bei Bedarf umprojiziert).</translation>
+        </message>
+        <message>
+            <source>Orthophoto</source>
+            <extracomment>orthorectify output ortho; orthorectify.output: description</extracomment>
+            <translation>Orthofoto</translation>
+        </message>
+        <message>
+            <source>Default: &lt;project&gt;/products/ortho/&lt;image&gt;.tif.</source>
+            <extracomment>orthorectify.output: help</extracomment>
+            <translation>Standard: &lt;project&gt;/products/ortho/&lt;image&gt;.tif.</translation>
+        </message>
+        <message>
+            <source>Cell size (GSD) [m]</source>
+            <extracomment>mosaic.gsd: description; orthorectify.gsd: description</extracomment>
+            <translation>Zellgröße (Bodenauflösung) [m]</translation>
+        </message>
+        <message>
+            <source>Default: the image's ground sample distance at the DEM's mean height, rounded.</source>
+            <extracomment>orthorectify.gsd: help</extracomment>
+            <translation>Höhen der Fläche, auf die entzerrt wird; beliebiges KBS (wird bei Bedarf umprojiziert).</translation>
+        </message>
+        <message>
+            <source>Resampling</source>
+            <extracomment>orthorectify.resampling: description</extracomment>
+            <translation>Resampling</translation>
+        </message>
+        <message>
+            <source>nearest</source>
+            <extracomment>mosaic.resampling: option; orthorectify.resampling: option</extracomment>
+            <translation>nächster Nachbar</translation>
+        </message>
+        <message>
+            <source>bilinear</source>
+            <extracomment>mosaic.resampling: option; orthorectify.resampling: option</extracomment>
+            <translation>bilinear</translation>
+        </message>
+        <message>
+            <source>cubic</source>
+            <extracomment>mosaic.resampling: option; orthorectify.resampling: option</extracomment>
+            <translation>kubisch</translation>
+        </message>
+        <message>
+            <source>True ortho (occlusion test)</source>
+            <extracomment>orthorectify.true_ortho: description</extracomment>
+            <translation>Resampling</translation>
+        </message>
+        <message>
+            <source>Mask cells hidden from the camera by the DSM; needs the DSM.</source>
+            <extracomment>orthorectify.true_ortho: help</extracomment>
+            <translation>Zellen maskieren, die das DOM vor der Kamera verdeckt; benötigt das DOM.</translation>
+        </message>
+        <message>
+            <source>DSM for the occlusion test</source>
+            <extracomment>orthorectify.dsm: description</extracomment>
+            <translation>DOM für den Verdeckungstest</translation>
+        </message>
+        <message>
+            <source>Needed for a true ortho; the DEM should then be this DSM too.</source>
+            <extracomment>orthorectify.dsm: help</extracomment>
+            <translation>Nötig für ein True-Ortho; als DHM sollte dann ebenfalls dieses DOM dienen.</translation>
+        </message>
+        <message>
+            <source>Extent</source>
+            <extracomment>orthorectify.extent: description</extracomment>
+            <translation>Ausdehnung</translation>
+        </message>
+        <message>
+            <source>xmin,ymin,xmax,ymax in the project CRS. Default: the image footprint on the DEM.</source>
+            <extracomment>orthorectify.extent: help</extracomment>
+            <translation>xmin,ymin,xmax,ymax im Projekt-KBS. Standard: der Bildfußabdruck auf dem DHM.</translation>
+        </message>
+        <message>
+            <source>Visibility (0 outside, 1 visible, 2 occluded)</source>
+            <extracomment>orthorectify output visibility</extracomment>
+            <translation>Sichtbarkeit (0 außerhalb, 1 sichtbar, 2 verdeckt)</translation>
+        </message>
+        <message>
+            <source>Cell size (m)</source>
+            <extracomment>mosaic output gsd; orthorectify output gsd</extracomment>
+            <translation>Zellgröße (m)</translation>
+        </message>
+        <message>
+            <source>Occluded cells (% of the cells inside the image)</source>
+            <extracomment>orthorectify output occluded_pct</extracomment>
+            <translation>Zellen maskieren, die das DOM vor der Kamera verdeckt; benötigt das DOM.</translation>
+        </message>
+        <message>
+            <source>Size [width, height] (cells)</source>
+            <extracomment>mosaic output cells; orthorectify output cells</extracomment>
+            <translation>Größe [Breite, Höhe] (Zellen)</translation>
+        </message>
+        <message>
+            <source>Ortho displacement from DEM errors</source>
+            <extracomment>ortho_displacement: name</extracomment>
+            <translation>Orthofoto-Versatz durch DGM-Fehler</translation>
+        </message>
+        <message>
+            <source>Shows where a DEM error moves an orthophoto. Predicted: for an image of the project and a DEM error e = DEM − reference (a difference raster, or the DEM and the reference DEM) the exact ray geometry gives the displacement d = −e·(X − X0, Y − Y0)/(Z0 − Zref), |d| = ΔR = Δh·R/H (R: distance from the nadir point, H: flying height above the cell); written as displacement.tif (|d|, dx, dy and the signed radial part, m, + away from the nadir). Measured: two orthos of the same area are matched in windows on a grid (NCC search, then least-squares refinement to a fraction of a pixel); shifts.gpkg and shifts.csv hold dx, dy (m and px), NCC and a status per window, summary.json the mean and RMS shift. With both, the predicted shift is added to every window.</source>
+            <extracomment>ortho_displacement: help</extracomment>
+            <translation>Zeigt, wohin ein DGM-Fehler ein Orthofoto verschiebt. Vorhergesagt: für ein Bild des Projekts und einen DGM-Fehler e = DGM − Referenz (ein Differenzraster, oder das DGM und das Referenz-DGM) ergibt die exakte Strahlgeometrie den Versatz d = −e·(X − X0, Y − Y0)/(Z0 − Zref), |d| = ΔR = Δh·R/H (R: Abstand vom Nadirpunkt, H: Flughöhe über der Zelle); geschrieben als displacement.tif (|d|, dx, dy und der vorzeichenbehaftete radiale Anteil, m, + vom Nadir weg). Gemessen: zwei Orthofotos desselben Gebiets werden in Fenstern auf einem Raster zugeordnet (NCC-Suche, dann Kleinste-Quadrate-Verfeinerung auf Bruchteile eines Pixels); shifts.gpkg und shifts.csv enthalten dx, dy (m und px), NCC und einen Status je Fenster, summary.json die mittlere und die RMS-Verschiebung. Mit beidem wird jedem Fenster die vorhergesagte Verschiebung beigefügt.</translation>
+        </message>
+        <message>
+            <source>Needed for the predicted displacement.</source>
+            <extracomment>ortho_displacement.project: help</extracomment>
+            <translation>Nötig für den vorhergesagten Versatz.</translation>
+        </message>
+        <message>
+            <source>The image whose ortho is analysed (predicted displacement).</source>
+            <extracomment>ortho_displacement.image: help</extracomment>
+            <translation>Das Bild, dessen Orthofoto untersucht wird (vorhergesagter Versatz).</translation>
+        </message>
+        <message>
+            <source>DEM error (DEM − reference) [m]</source>
+            <extracomment>ortho_displacement.error: description</extracomment>
+            <translation>DGM-Fehler (DGM − Referenz) [m]</translation>
+        </message>
+        <message>
+            <source>E.g. difference.tif of 'Compare DEM with reference'; its grid is the output grid.</source>
+            <extracomment>ortho_displacement.error: help</extracomment>
+            <translation>Z. B. difference.tif aus „DGM mit Referenz vergleichen“; sein Raster ist das Ausgaberaster.</translation>
+        </message>
+        <message>
+            <source>DEM of the ortho</source>
+            <extracomment>ortho_displacement.dem: description</extracomment>
+            <translation>DGM des Orthofotos</translation>
+        </message>
+        <message>
+            <source>With the reference DEM instead of an error raster: e = DEM − reference on the DEM's grid.</source>
+            <extracomment>ortho_displacement.dem: help</extracomment>
+            <translation>Mit dem Referenz-DGM statt eines Fehlerrasters: e = DGM − Referenz auf dem Raster des DGM.</translation>
+        </message>
+        <message>
+            <source>Reference DEM (true heights)</source>
+            <extracomment>ortho_displacement.reference: description</extracomment>
+            <translation>Referenz-DGM (wahre Höhen)</translation>
+        </message>
+        <message>
+            <source>Terrain height [m]</source>
+            <extracomment>ortho_displacement.terrain_height: description</extracomment>
+            <translation>Geländehöhe [m]</translation>
+        </message>
+        <message>
+            <source>True height for H when only the error raster is given (default: the project's terrain height).</source>
+            <extracomment>ortho_displacement.terrain_height: help</extracomment>
+            <translation>Wahre Höhe für H, wenn nur das Fehlerraster gegeben ist (Standard: die Geländehöhe des Projekts).</translation>
+        </message>
+        <message>
+            <source>Ortho to check</source>
+            <extracomment>ortho_displacement.ortho: description</extracomment>
+            <translation>Zu prüfendes Orthofoto</translation>
+        </message>
+        <message>
+            <source>Measured shift: this ortho is matched against the reference ortho.</source>
+            <extracomment>ortho_displacement.ortho: help</extracomment>
+            <translation>Gemessene Verschiebung: dieses Orthofoto wird dem Referenz-Orthofoto zugeordnet.</translation>
+        </message>
+        <message>
+            <source>Reference ortho</source>
+            <extracomment>ortho_displacement.reference_ortho: description</extracomment>
+            <translation>Referenz-Orthofoto</translation>
+        </message>
+        <message>
+            <source>Its grid defines the windows and the pixel unit (e.g. the ortho on the reference DEM, or a neighbouring ortho).</source>
+            <extracomment>ortho_displacement.reference_ortho: help</extracomment>
+            <translation>Sein Raster bestimmt die Fenster und die Pixeleinheit (z. B. das Orthofoto auf dem Referenz-DGM oder ein benachbartes Orthofoto).</translation>
+        </message>
+        <message>
+            <source>Matching window [px]</source>
+            <extracomment>ortho_displacement.window: description</extracomment>
+            <translation>Zuordnungsfenster [px]</translation>
+        </message>
+        <message>
+            <source>Odd size of the matched windows.</source>
+            <extracomment>ortho_displacement.window: help</extracomment>
+            <translation>Ungerade Größe der zugeordneten Fenster.</translation>
+        </message>
+        <message>
+            <source>Search radius [px]</source>
+            <extracomment>ortho_displacement.radius: description</extracomment>
+            <translation>Suchradius [px]</translation>
+        </message>
+        <message>
+            <source>Largest shift that is searched for.</source>
+            <extracomment>ortho_displacement.radius: help</extracomment>
+            <translation>Größte Verschiebung, nach der gesucht wird.</translation>
+        </message>
+        <message>
+            <source>Window spacing [px]</source>
+            <extracomment>ortho_displacement.spacing: description</extracomment>
+            <translation>Fensterabstand [px]</translation>
+        </message>
+        <message>
+            <source>Default: the window size.</source>
+            <extracomment>ortho_displacement.spacing: help</extracomment>
+            <translation>Standard: die Fenstergröße.</translation>
+        </message>
+        <message>
+            <source>Minimum correlation</source>
+            <extracomment>ortho_displacement.min_ncc: description</extracomment>
+            <translation>Mindestkorrelation</translation>
+        </message>
+        <message>
+            <source>Receives displacement.tif, shifts.gpkg, shifts.csv and summary.json.</source>
+            <extracomment>ortho_displacement.output: help</extracomment>
+            <translation>Erhält displacement.tif, shifts.gpkg, shifts.csv und summary.json.</translation>
+        </message>
+        <message>
+            <source>Predicted displacement (|d|, dx, dy, radial) [m]</source>
+            <extracomment>ortho_displacement output displacement</extracomment>
+            <translation>Vorhergesagter Versatz (|d|, dx, dy, radial) [m]</translation>
+        </message>
+        <message>
+            <source>Statistics of the predicted displacement</source>
+            <extracomment>ortho_displacement output predicted</extracomment>
+            <translation>Statistik des vorhergesagten Versatzes</translation>
+        </message>
+        <message>
+            <source>Measured shifts per window (GeoPackage)</source>
+            <extracomment>ortho_displacement output points</extracomment>
+            <translation>Gemessene Verschiebungen je Fenster (GeoPackage)</translation>
+        </message>
+        <message>
+            <source>Measured shifts per window (CSV)</source>
+            <extracomment>ortho_displacement output csv</extracomment>
+            <translation>Gemessene Verschiebungen je Fenster (CSV)</translation>
+        </message>
+        <message>
+            <source>Statistics of the measured shifts</source>
+            <extracomment>ortho_displacement output measured</extracomment>
+            <translation>Statistik der gemessenen Verschiebungen</translation>
+        </message>
+        <message>
+            <source>Measured against predicted shifts</source>
+            <extracomment>ortho_displacement output comparison</extracomment>
+            <translation>Gemessene gegen vorhergesagte Verschiebungen</translation>
+        </message>
+        <message>
+            <source>Summary (JSON)</source>
+            <extracomment>ortho_displacement output json</extracomment>
+            <translation>Zusammenfassung (JSON)</translation>
+        </message>
+        <message>
+            <source>Orthophoto mosaic</source>
+            <extracomment>mosaic: name</extracomment>
+            <translation>Orthophotomosaik</translation>
+        </message>
+        <message>
+            <source>Mosaics orthos into one tiled GeoTIFF with overviews (colour bands + alpha). Inputs: orthos (PhotoDEM orthos carry their projection centre), or a project and a DEM: then every image is rectified first (a true ortho on the DSM with true_ortho). Seamlines: auto starts from the nadir partition (each cell to the image with the nearest projection centre) and routes every seam along a least-cost path through low image difference and low DSM height above the DTM (give dsm and dtm), so seams do not cut through buildings or trees; nadir keeps the partition; edits takes the 'seamlines' layer of the project's edits.gpkg; or give a vector file: lines cut the area (each part to the image nearest in nadir), polygons with an 'image' attribute take their area from that image (the footprints layer a mosaic writes can be edited and reused). Occluded cells (alpha 0) are filled from the next best image. Balancing: gain and offset per image and band by least squares over all overlaps (gain_offset), plus histogram matching (histogram), or none; feathering blends across seams over the given width. Writes the mosaic, &lt;name&gt;_seamlines.gpkg (footprints: one polygon per source image; seamlines) and &lt;name&gt;_balance.json (gains, offsets, mean difference of the overlaps before and after). Works tile by tile; seams and balancing use a seam grid of at most seam_cells cells a side, so memory does not grow with the mosaic.</source>
+            <extracomment>mosaic: help</extracomment>
+            <translation>Fügt Orthophotos zu einem gekachelten GeoTIFF mit Übersichten zusammen (Farbkanäle + Alpha). Eingaben: Orthophotos (PhotoDEM-Orthophotos tragen ihr Projektionszentrum) oder ein Projekt und ein DGM: dann wird zuerst jedes Bild entzerrt (mit true_ortho ein True-Ortho auf dem DOM). Schnittlinien: auto beginnt mit der Nadir-Aufteilung (jede Zelle zum Bild mit dem nächsten Projektionszentrum) und führt jede Schnittlinie auf einem Weg geringster Kosten durch geringe Bilddifferenz und geringe Höhe des DOM über dem DGM (dsm und dtm angeben), sodass Schnittlinien keine Gebäude oder Bäume zerschneiden; nadir behält die Aufteilung; edits nimmt die Ebene 'seamlines' der edits.gpkg des Projekts; oder eine Vektordatei angeben: Linien zerschneiden die Fläche (jeder Teil zum im Nadir nächsten Bild), Polygone mit einem Attribut 'image' nehmen ihre Fläche aus diesem Bild (die Ebene footprints, die ein Mosaik schreibt, kann bearbeitet und wiederverwendet werden). Verdeckte Zellen (Alpha 0) werden aus dem nächstbesten Bild gefüllt. Ausgleich: Verstärkung und Versatz je Bild und Kanal durch Ausgleichung über alle Überlappungen (gain_offset), zusätzlich Histogrammanpassung (histogram) oder keiner; Überblendung über die angegebene Breite an den Schnittlinien. Schreibt das Mosaik, &lt;Name&gt;_seamlines.gpkg (footprints: ein Polygon je Quellbild; seamlines) und &lt;Name&gt;_balance.json (Verstärkungen, Versätze, mittlere Differenz der Überlappungen vorher und nachher). Arbeitet kachelweise; Schnittlinien und Ausgleich nutzen ein Schnittliniengitter mit höchstens seam_cells Zellen je Seite, sodass der Speicherbedarf nicht mit dem Mosaik wächst.</translation>
+        </message>
+        <message>
+            <source>Needed with 'dem' (rectify every image) and for seamlines=edits.</source>
+            <extracomment>mosaic.project: help</extracomment>
+            <translation>Nötig mit 'dem' (jedes Bild entzerren) und für seamlines=edits.</translation>
+        </message>
+        <message>
+            <source>Orthos</source>
+            <extracomment>mosaic.inputs: description</extracomment>
+            <translation>Orthophotos</translation>
+        </message>
+        <message>
+            <source>Orthos to mosaic (same CRS, bands and data type).</source>
+            <extracomment>mosaic.inputs: help</extracomment>
+            <translation>Zu mosaikierende Orthophotos (gleiches KBS, gleiche Kanäle und gleicher Datentyp).</translation>
+        </message>
+        <message>
+            <source>DEM to rectify the project images on</source>
+            <extracomment>mosaic.dem: description</extracomment>
+            <translation>DGM zur Entzerrung der Projektbilder</translation>
+        </message>
+        <message>
+            <source>Instead of 'inputs': every image of the project is rectified onto it.</source>
+            <extracomment>mosaic.dem: help</extracomment>
+            <translation>Statt 'inputs': jedes Bild des Projekts wird darauf entzerrt.</translation>
+        </message>
+        <message>
+            <source>True orthos (occlusion test)</source>
+            <extracomment>mosaic.true_ortho: description</extracomment>
+            <translation>True-Orthos (Verdeckungstest)</translation>
+        </message>
+        <message>
+            <source>With 'dem': rectify on the DSM with the occlusion test; needs 'dsm'.</source>
+            <extracomment>mosaic.true_ortho: help</extracomment>
+            <translation>Mit 'dem': auf dem DOM mit Verdeckungstest entzerren; benötigt 'dsm'.</translation>
+        </message>
+        <message>
+            <source>Surface for true orthos and, with the DTM, for seams that avoid buildings and trees.</source>
+            <extracomment>mosaic.dsm: help</extracomment>
+            <translation>Oberfläche für True-Orthos und, mit dem DGM, für Schnittlinien, die Gebäude und Bäume meiden.</translation>
+        </message>
+        <message>
+            <source>Terrain for the height above ground (DSM − DTM) of the seam cost. Default with 'dem': the DEM when it is not the DSM.</source>
+            <extracomment>mosaic.dtm: help</extracomment>
+            <translation>Gelände für die Höhe über Grund (DOM − DGM) in den Schnittlinienkosten. Standard mit 'dem': das DGM, wenn es nicht das DOM ist.</translation>
+        </message>
+        <message>
+            <source>Default: the finest input (or the images' GSD when rectifying).</source>
+            <extracomment>mosaic.gsd: help</extracomment>
+            <translation>Standard: die feinste Eingabe (bzw. die Bodenauflösung der Bilder beim Entzerren).</translation>
+        </message>
+        <message>
+            <source>Resampling (rectification)</source>
+            <extracomment>mosaic.resampling: description</extracomment>
+            <translation>Resampling (Entzerrung)</translation>
+        </message>
+        <message>
+            <source>Seamlines</source>
+            <extracomment>mosaic.seamlines: description</extracomment>
+            <translation>Schnittlinien</translation>
+        </message>
+        <message>
+            <source>auto, nadir, edits, or a vector file (lines, or polygons with an 'image' attribute).</source>
+            <extracomment>mosaic.seamlines: help</extracomment>
+            <translation>auto, nadir, edits oder eine Vektordatei (Linien oder Polygone mit einem Attribut 'image').</translation>
+        </message>
+        <message>
+            <source>Radiometric balancing</source>
+            <extracomment>mosaic.balance: description</extracomment>
+            <translation>Radiometrischer Ausgleich</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <extracomment>mosaic.balance: option</extracomment>
+            <translation>keiner</translation>
+        </message>
+        <message>
+            <source>gain_offset</source>
+            <extracomment>mosaic.balance: option</extracomment>
+            <translation>Verstärkung/Versatz</translation>
+        </message>
+        <message>
+            <source>histogram</source>
+            <extracomment>mosaic.balance: option</extracomment>
+            <translation>Histogrammanpassung</translation>
+        </message>
+        <message>
+            <source>Reference image</source>
+            <extracomment>mosaic.reference: description</extracomment>
+            <translation>Referenzbild</translation>
+        </message>
+        <message>
+            <source>Image kept unchanged by the balancing. Default: mean gain 1, mean offset 0.</source>
+            <extracomment>mosaic.reference: help</extracomment>
+            <translation>Bild, das der Ausgleich unverändert lässt. Standard: mittlere Verstärkung 1, mittlerer Versatz 0.</translation>
+        </message>
+        <message>
+            <source>Feather width [m]</source>
+            <extracomment>mosaic.feather: description</extracomment>
+            <translation>Überblendbreite [m]</translation>
+        </message>
+        <message>
+            <source>Blend width across seams. Default: 10 cells; 0 = hard.</source>
+            <extracomment>mosaic.feather: help</extracomment>
+            <translation>Breite der Überblendung über die Schnittlinien. Standard: 10 Zellen; 0 = harter Schnitt.</translation>
+        </message>
+        <message>
+            <source>Seam corridor half-width [m]</source>
+            <extracomment>mosaic.corridor: description</extracomment>
+            <translation>Halbe Breite des Schnittlinienkorridors [m]</translation>
+        </message>
+        <message>
+            <source>How far a seam may leave the nadir boundary. Default: a quarter of the distance between neighbouring projection centres.</source>
+            <extracomment>mosaic.corridor: help</extracomment>
+            <translation>Wie weit eine Schnittlinie von der Nadirgrenze abweichen darf. Standard: ein Viertel des Abstands benachbarter Projektionszentren.</translation>
+        </message>
+        <message>
+            <source>Object height [m]</source>
+            <extracomment>mosaic.min_height: description</extracomment>
+            <translation>Objekthöhe [m]</translation>
+        </message>
+        <message>
+            <source>Cells at least this high above the DTM are avoided by seams.</source>
+            <extracomment>mosaic.min_height: help</extracomment>
+            <translation>Zellen mindestens so hoch über dem DGM meiden die Schnittlinien.</translation>
+        </message>
+        <message>
+            <source>Side of the processing tiles.</source>
+            <extracomment>mosaic.tile: help</extracomment>
+            <translation>Seitenlänge der Verarbeitungskacheln.</translation>
+        </message>
+        <message>
+            <source>Seam grid size [cells]</source>
+            <extracomment>mosaic.seam_cells: description</extracomment>
+            <translation>Größe des Schnittliniengitters [Zellen]</translation>
+        </message>
+        <message>
+            <source>Longest side of the reduced grid for seams and balancing.</source>
+            <extracomment>mosaic.seam_cells: help</extracomment>
+            <translation>Längste Seite des verkleinerten Gitters für Schnittlinien und Ausgleich.</translation>
+        </message>
+        <message>
+            <source>Mosaic</source>
+            <extracomment>mosaic output mosaic; mosaic.output: description</extracomment>
+            <translation>Mosaik</translation>
+        </message>
+        <message>
+            <source>Default: &lt;project&gt;/products/mosaic/mosaic.tif.</source>
+            <extracomment>mosaic.output: help</extracomment>
+            <translation>Standard: &lt;Projekt&gt;/products/mosaic/mosaic.tif.</translation>
+        </message>
+        <message>
+            <source>Footprints and seamlines (GeoPackage)</source>
+            <extracomment>mosaic output seamlines</extracomment>
+            <translation>Bildflächen und Schnittlinien (GeoPackage)</translation>
+        </message>
+        <message>
+            <source>Balancing report (JSON)</source>
+            <extracomment>mosaic output report</extracomment>
+            <translation>Ausgleichsbericht (JSON)</translation>
+        </message>
+        <message>
+            <source>Seam statistics</source>
+            <extracomment>mosaic output seams</extracomment>
+            <translation>Schnittlinienstatistik</translation>
+        </message>
+        <message>
+            <source>Mean difference in the overlaps before/after balancing</source>
+            <extracomment>mosaic output balance</extracomment>
+            <translation>Mittlere Differenz in den Überlappungen vor/nach dem Ausgleich</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

@@ -25,6 +25,7 @@ ALGORITHM_MODULES = (
     "matching",
     "surface",
     "filtering",
+    "ortho",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).

@@ -327,3 +327,48 @@ def test_filter_linear_prediction_python_equals_cli(block, tmp_path) -> None:
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
     _same_files(tmp_path / "py", tmp_path / "cli")
     assert py["mask"] and py["labels"] is None and 0.0 < py["metrics"]["eliminated_share"] < 0.9
+
+
+def test_orthorectify_python_equals_cli(block, tmp_path) -> None:
+    q = _quality_inputs(block)
+    params = {"project": block["py"]["project"], "image": "0102", "dem": q["dsm"],
+              "dsm": q["dsm"], "true_ortho": True, "gsd": 0.3, "resampling": "cubic"}
+    py = registry.run("orthorectify", {**params, "output": str(tmp_path / "py" / "o.tif")})
+    cli = _cli("orthorectify", {**params, "output": str(tmp_path / "cli" / "o.tif")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert 0.0 < py["occluded_pct"] < 20.0 and py["gsd"] == 0.3
+
+
+def test_ortho_displacement_python_equals_cli(block, tmp_path) -> None:
+    from photodem.algorithms.ortho.rectify import orthorectify_image
+
+    q = _quality_inputs(block)
+    project = block["py"]["project"]
+    for image in ("0101", "0102"):
+        orthorectify_image(project, image, q["dtm"], tmp_path / f"{image}.tif", gsd=0.3)
+    params = {"project": project, "image": "0102", "dem": q["dsm"], "reference": q["dtm"],
+              "ortho": str(tmp_path / "0102.tif"), "reference_ortho": str(tmp_path / "0101.tif"),
+              "window": 21, "radius": 6}
+    py = registry.run("ortho_displacement", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("ortho_displacement", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["predicted"]["max_m"] > 1.0 and py["measured"]["matched"] > 10
+
+
+def test_mosaic_python_equals_cli(block, tmp_path) -> None:
+    from photodem.algorithms.ortho.rectify import orthorectify_image
+
+    q = _quality_inputs(block)
+    project = block["py"]["project"]
+    for image in ("0101", "0102"):
+        orthorectify_image(project, image, q["dtm"], tmp_path / f"{image}.tif", gsd=0.3)
+    params = {"inputs": f"{tmp_path / '0101.tif'},{tmp_path / '0102.tif'}", "dsm": q["dsm"],
+              "dtm": q["dtm"], "balance": "gain_offset", "feather": 1.5}
+    py = registry.run("mosaic", {**params, "inputs": params["inputs"].split(","),
+                                 "output": str(tmp_path / "py" / "m.tif")})
+    cli = _cli("mosaic", {**params, "output": str(tmp_path / "cli" / "m.tif")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["balance"]["after"]["mean_difference"] <= 2.0 and py["gsd"] == 0.3

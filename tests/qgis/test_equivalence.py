@@ -151,6 +151,18 @@ def _dsm_crop(project: Path) -> str:
     return str(path)
 
 
+def _ortho_pair(project: Path) -> Dict[str, str]:
+    """Orthos of images 0101 and 0102 on the truth DTM (0.3 m), made once beside the project."""
+    from photodem.algorithms.ortho.rectify import orthorectify_image
+
+    folder = Path(project).parent / "ortho_pair"
+    paths = {"ortho": folder / "0102.tif", "reference_ortho": folder / "0101.tif"}
+    for key, image in (("reference_ortho", "0101"), ("ortho", "0102")):
+        if not paths[key].is_file():
+            orthorectify_image(project, image, _truth(project, "dtm.tif"), paths[key], gsd=0.3)
+    return {k: str(v) for k, v in paths.items()}
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_models": lambda out, req: {
@@ -203,6 +215,19 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "filter_linear_prediction": lambda out, req: {
         "input": _truth(req("project"), "dsm.tif"), "project": str(req("project")),
         "preset": "default", "write_levels": True, "output": str(out / "linear_prediction")},
+    "orthorectify": lambda out, req: {
+        "project": str(req("project")), "image": "0102", "dem": _truth(req("project"), "dsm.tif"),
+        "gsd": 0.3, "resampling": "cubic", "true_ortho": True,
+        "dsm": _truth(req("project"), "dsm.tif"), "output": str(out / "ortho" / "0102.tif")},
+    "ortho_displacement": lambda out, req: {
+        "project": str(req("project")), "image": "0102", "dem": _truth(req("project"), "dsm.tif"),
+        "reference": _truth(req("project"), "dtm.tif"), **_ortho_pair(req("project")),
+        "window": 21, "radius": 6, "output": str(out / "displacement")},
+    "mosaic": lambda out, req: {
+        "inputs": [v for _, v in sorted(_ortho_pair(req("project")).items())],
+        "dsm": _truth(req("project"), "dsm.tif"), "dtm": _truth(req("project"), "dtm.tif"),
+        "seamlines": "auto", "balance": "gain_offset", "feather": 1.5,
+        "output": str(out / "mosaic" / "mosaic.tif")},
     "refine_object_space": lambda out, req: {
         "project": str(req("project")), "dsm": _dsm_crop(req("project")), "spacing": 0.6,
         "output": str(out / "refined")},

@@ -1,0 +1,757 @@
+r"""Orthophoto mosaic: several orthos → one tiled GeoTIFF with overviews, seams, balancing.
+
+Inputs
+    Orthos in the PhotoDEM format (:mod:`.rectify`): colour bands + alpha band (255 valid,
+    0 outside or occluded), tags ``PHOTODEM_IMAGE`` and ``PHOTODEM_CAMERA_X/Y`` (projection
+    centre). Other orthos are accepted too: validity from an alpha band, else the nodata value,
+    else the raster extent; the nadir point is then the raster centre (with a warning). All
+    inputs must have the same CRS, colour band count and data type.
+
+Grid
+    North-up, cell size ``gsd`` (default the finest input), origin on a multiple of the cell
+    size (the rule of :func:`.rectify.orthorectify_image`, so orthos of the same GSD are copied
+    cell for cell; others are resampled bilinearly, alpha by nearest neighbour).
+
+Steps
+    1. *Seam grid*: the mosaic grid reduced by the integer factor
+       :math:`f = \lceil \max(W, H) / \mathrm{seam\_cells} \rceil`; every ortho is
+       block-averaged onto it (colour and alpha, GDAL ``average``), with DSM (block maximum)
+       and DTM (block mean) when given.
+    2. *Balancing* (:mod:`.balance`) from the cells valid in both images of every overlap.
+    3. *Partition* (:mod:`.seamlines`): nadir Voronoi partition, then least-cost seams
+       (``auto``), or the operator's seamlines.
+    4. *Mosaic*, tile by tile (``tile`` × ``tile`` cells plus a halo of half the feather width):
+       the label of each cell is the seam-grid label (or the operator's region, rasterised at
+       full resolution); where that image is not valid (outside, or occluded in a true ortho)
+       the cell is filled from the valid image with the nearest projection centre ("next best
+       image"). Feathering: with :math:`d_k` the signed distance (cells) of a cell to the
+       border of image :math:`k`'s region (positive inside) and :math:`F` the feather width in
+       cells, the weights are :math:`w_k = \mathrm{clip}(\tfrac12 + d_k/F, 0, 1)` times the
+       validity of image :math:`k`, and the value is :math:`\sum_k w_k v_k' / \sum_k w_k` — a
+       linear ramp of width :math:`F` across every seam.
+
+Memory
+    Seam grid: at most ``seam_cells²`` cells, a window per ortho (≈ overlap factor × bands ×
+    4 bytes per cell); mosaic: one tile plus halo per ortho that touches it. Neither grows with
+    the mosaic size beyond the seam grid, whose size is a parameter.
+
+Outputs
+    ``output`` (colour bands + alpha, the inputs' data type, overviews), beside it
+    ``<stem>_seamlines.gpkg`` (layer ``footprints``: one polygon per source image with
+    ``image``, ``ortho``, ``area_m2``; layer ``seamlines``: shared borders) and
+    ``<stem>_balance.json`` (gains/offsets per image and band, mean and mean absolute
+    difference per overlap before/after balancing).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import tempfile
+import time
+from contextlib import ExitStack
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from affine import Affine
+from numpy.typing import NDArray
+from scipy import ndimage
+
+from ..errors import InputError
+from ..processing.feedback import Feedback, ensure_feedback
+from ..raster.io import GTIFF_PROFILE, atomic_output
+from . import balance as bal
+from . import seamlines as sl
+
+PathLike = Union[str, Path]
+Array = NDArray[Any]
+
+#: Seamline sources besides a vector file.
+SEAMLINE_MODES = ("auto", "nadir", "edits")
+
+
+@dataclass
+class OrthoInfo:
+    """What the mosaic needs to know about one input ortho."""
+
+    path: Path
+    name: str
+    crs: Any
+    transform: Affine
+    width: int
+    height: int
+    colour: List[int]
+    alpha: Optional[int]
+    nodata: Optional[float]
+    dtype: str
+    centre: Tuple[float, float]
+    centre_from_tags: bool
+    colorinterp: List[Any]
+
+    @property
+    def gsd(self) -> float:
+        return min(abs(self.transform.a), abs(self.transform.e))
+
+    @property
+    def bounds(self) -> Tuple[float, float, float, float]:
+        t = self.transform
+        xs = (t.c, t.c + t.a * self.width)
+        ys = (t.f, t.f + t.e * self.height)
+        return min(xs), min(ys), max(xs), max(ys)
+
+
+def read_ortho_info(path: PathLike) -> OrthoInfo:
+    """Open an ortho and describe it (see the module notes on accepted inputs).
+
+    Raises
+    ------
+    InputError
+        Missing or unreadable file, rotated raster.
+    """
+    import rasterio
+    from rasterio.enums import ColorInterp
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"Ortho '{path}' does not exist.")
+    try:
+        with rasterio.open(path) as src:
+            tags = src.tags()
+            interp = list(src.colorinterp)
+            alpha = [i + 1 for i, c in enumerate(interp) if c == ColorInterp.alpha]
+            if not alpha and "PHOTODEM_IMAGE" in tags and src.count >= 2:
+                alpha = [src.count]  # the shared format: the last band is alpha
+            colour = [b for b in range(1, src.count + 1) if b not in alpha]
+            t = src.transform
+            if abs(t.b) > 0 or abs(t.d) > 0:
+                raise InputError(f"'{path.name}' is a rotated raster; warp it north-up first.")
+            b = src.bounds
+            try:
+                centre = (float(tags["PHOTODEM_CAMERA_X"]), float(tags["PHOTODEM_CAMERA_Y"]))
+                from_tags = True
+            except (KeyError, ValueError):
+                centre = (0.5 * (b.left + b.right), 0.5 * (b.bottom + b.top))
+                from_tags = False
+            return OrthoInfo(path, tags.get("PHOTODEM_IMAGE") or path.stem, src.crs, t,
+                             src.width, src.height, colour, alpha[0] if alpha else None,
+                             src.nodata, src.dtypes[colour[0] - 1] if colour else src.dtypes[0],
+                             centre, from_tags, [interp[i - 1] for i in colour])
+    except rasterio.errors.RasterioIOError as exc:
+        raise InputError(f"Cannot read the ortho '{path.name}': {exc}") from exc
+
+
+def check_inputs(infos: Sequence[OrthoInfo]) -> None:
+    """One-line errors for inputs that cannot be mosaicked together."""
+    if not infos:
+        raise InputError("No orthos given; give at least one ortho (or a project and a DEM).")
+    names = [i.name for i in infos]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError(f"The image {', '.join(dup)} occurs in more than one input ortho; "
+                         "give each image once.")
+    counts = {len(i.colour) for i in infos}
+    if len(counts) > 1:
+        detail = ", ".join(f"{i.path.name}: {len(i.colour)}" for i in infos)
+        raise InputError(f"The orthos have different band counts ({detail}); mosaic only "
+                         "orthos with the same bands (e.g. all RGB or all grey).")
+    dtypes = {i.dtype for i in infos}
+    if len(dtypes) > 1:
+        detail = ", ".join(f"{i.path.name}: {i.dtype}" for i in infos)
+        raise InputError(f"The orthos have different data types ({detail}); convert them to "
+                         "one type first.")
+    crss = {str(i.crs) if i.crs else "" for i in infos}
+    if len(crss) > 1:
+        raise InputError("The orthos are in different CRSs; rectify (or warp) them all into "
+                         "the project CRS first.")
+
+
+def mosaic_grid(infos: Sequence[OrthoInfo], gsd: Optional[float] = None
+                ) -> Tuple[Affine, int, int, float]:
+    """Transform, width, height and cell size of the mosaic grid (see the module notes)."""
+    s = float(gsd) if gsd else min(i.gsd for i in infos)
+    if not s > 0:
+        raise InputError(f"The mosaic cell size must be positive, got {gsd}.")
+    xmin = min(i.bounds[0] for i in infos)
+    ymin = min(i.bounds[1] for i in infos)
+    xmax = max(i.bounds[2] for i in infos)
+    ymax = max(i.bounds[3] for i in infos)
+    x0 = round(math.floor(xmin / s + 1e-9) * s, 6)
+    y0 = round(math.ceil(ymax / s - 1e-9) * s, 6)
+    width = max(math.ceil((xmax - x0) / s - 1e-9), 1)
+    height = max(math.ceil((y0 - ymin) / s - 1e-9), 1)
+    if width * height > 2 ** 36:
+        raise InputError(f"The mosaic would have {width} × {height} cells; give a larger GSD.")
+    return Affine(s, 0.0, x0, 0.0, -s, y0), width, height, s
+
+
+def _aligned(info: OrthoInfo, transform: Affine) -> Optional[Tuple[int, int]]:
+    """(row, col) of the ortho's first cell on a grid, if it lies on it without resampling."""
+    t, s = info.transform, transform.a
+    if t.e > 0 or abs(t.a - s) > 1e-9 * s or abs(-t.e - s) > 1e-9 * s:
+        return None
+    col, row = (t.c - transform.c) / s, (transform.f - t.f) / s
+    if abs(col - round(col)) > 1e-6 or abs(row - round(row)) > 1e-6:
+        return None
+    return round(row), round(col)
+
+
+def _window_of(info: OrthoInfo, transform: Affine, width: int, height: int
+               ) -> Optional[Tuple[int, int, int, int]]:
+    """Rows/cols ``(r0, r1, c0, c1)`` of a grid that the ortho's extent touches."""
+    s = transform.a
+    b = info.bounds
+    c0 = max(math.floor((b[0] - transform.c) / s + 1e-9), 0)
+    c1 = min(math.ceil((b[2] - transform.c) / s - 1e-9), width)
+    r0 = max(math.floor((transform.f - b[3]) / s + 1e-9), 0)
+    r1 = min(math.ceil((transform.f - b[1]) / s - 1e-9), height)
+    if r1 <= r0 or c1 <= c0:
+        return None
+    return r0, r1, c0, c1
+
+
+def _read_on_grid(src: Any, info: OrthoInfo, transform: Affine, r0: int, r1: int, c0: int,
+                  c1: int, resampling: str) -> Tuple[Array, Array]:
+    """Colour (b, h, w) float32 and validity (h, w) float32 in [0, 1] of one grid window.
+
+    ``resampling`` is ``"full"`` (the mosaic grid: copied when aligned, else bilinear colour
+    and nearest alpha) or ``"average"`` (block averages on a coarser grid).
+    """
+    import rasterio
+    from rasterio.enums import Resampling
+    from rasterio.warp import reproject
+    from rasterio.windows import Window
+
+    h, w = r1 - r0, c1 - c0
+    colour = np.full((len(info.colour), h, w), np.nan, np.float32)
+    valid = np.zeros((h, w), np.float32)
+    off = _aligned(info, transform) if resampling == "full" else None
+    if off is not None:
+        ar, ac = off
+        a0, a1 = max(r0, ar), min(r1, ar + info.height)
+        b0, b1 = max(c0, ac), min(c1, ac + info.width)
+        if a1 <= a0 or b1 <= b0:
+            return colour, valid
+        win = Window(b0 - ac, a0 - ar, b1 - b0, a1 - a0)
+        sl_ = (slice(a0 - r0, a1 - r0), slice(b0 - c0, b1 - c0))
+        data = src.read(info.colour, window=win)
+        colour[:, sl_[0], sl_[1]] = data
+        if info.alpha is not None:
+            valid[sl_] = src.read(info.alpha, window=win) > 0
+        elif info.nodata is not None:
+            valid[sl_] = np.all(data != info.nodata, axis=0)
+        else:
+            valid[sl_] = 1.0
+        return colour, valid
+    win_tr = transform * Affine.translation(c0, r0)
+    avg = resampling == "average"
+    for k, band in enumerate(info.colour):
+        reproject(source=rasterio.band(src, band), destination=colour[k],
+                  src_transform=info.transform, src_crs=info.crs, dst_transform=win_tr,
+                  dst_crs=info.crs, src_nodata=info.nodata, dst_nodata=np.nan,
+                  init_dest_nodata=True,
+                  resampling=Resampling.average if avg else Resampling.bilinear)
+    if info.alpha is not None:
+        a = np.full((h, w), np.nan, np.float32)
+        reproject(source=rasterio.band(src, info.alpha), destination=a,
+                  src_transform=info.transform, src_crs=info.crs, dst_transform=win_tr,
+                  dst_crs=info.crs, src_nodata=None, dst_nodata=np.nan, init_dest_nodata=True,
+                  resampling=Resampling.average if avg else Resampling.nearest)
+        a = np.nan_to_num(a, nan=0.0)
+        valid = (a / 255.0 if avg else (a > 0)).astype(np.float32)
+    else:
+        valid = np.all(np.isfinite(colour), axis=0).astype(np.float32)
+    valid[~np.all(np.isfinite(colour), axis=0)] = 0.0
+    return colour, valid
+
+
+def _coverage(info: OrthoInfo, transform: Affine, r0: int, r1: int, c0: int, c1: int,
+              frac: Array) -> Array:
+    """1 where a seam-grid cell is inside the image footprint (visible or occluded).
+
+    From ``<stem>_visibility.tif`` (0 outside, 1 visible, 2 occluded; block minimum > 0);
+    without it the valid fraction ``frac``.
+    """
+    import rasterio
+    from rasterio.enums import Resampling
+    from rasterio.warp import reproject
+
+    vis = info.path.with_name(f"{info.path.stem}_visibility.tif")
+    if not vis.is_file():
+        return frac
+    out = np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+    with rasterio.open(vis) as src:
+        reproject(source=rasterio.band(src, 1), destination=out, src_transform=src.transform,
+                  src_crs=src.crs or info.crs, dst_transform=transform * Affine.translation(c0, r0),
+                  dst_crs=info.crs or src.crs, src_nodata=None, dst_nodata=np.nan,
+                  init_dest_nodata=True, resampling=Resampling.min)
+    return np.maximum(np.where(np.nan_to_num(out, nan=0.0) > 0, 1.0, 0.0), frac
+                      ).astype(np.float32)
+
+
+def _read_height(path: PathLike, transform: Affine, shape: Tuple[int, int], crs: Any,
+                 how: str) -> Array:
+    """A DSM/DTM block-aggregated (``max`` or ``average``) onto the seam grid, NaN = none."""
+    import rasterio
+    from rasterio.enums import Resampling
+    from rasterio.warp import reproject
+
+    out = np.full(shape, np.nan, np.float32)
+    try:
+        with rasterio.open(path) as src:
+            reproject(source=rasterio.band(src, 1), destination=out,
+                      src_transform=src.transform, src_crs=src.crs or crs,
+                      dst_transform=transform, dst_crs=crs or src.crs,
+                      src_nodata=src.nodata if src.nodata is not None else np.nan,
+                      dst_nodata=np.nan, init_dest_nodata=True,
+                      resampling=Resampling.max if how == "max" else Resampling.average)
+    except rasterio.errors.RasterioIOError as exc:
+        raise InputError(f"Cannot read the surface '{Path(path).name}': {exc}") from exc
+    out[~np.isfinite(out)] = np.nan
+    return out
+
+
+def _dtype_range(dtype: str) -> Tuple[float, float]:
+    dt = np.dtype(dtype)
+    if np.issubdtype(dt, np.integer):
+        info = np.iinfo(dt)
+        return float(info.min), float(info.max)
+    return -np.inf, np.inf
+
+
+def _signed_distance(mask: Array) -> Array:
+    """Distance (cells) to the region border: +½, +1½ … inside, −½, −1½ … outside."""
+    inside = ndimage.distance_transform_edt(mask)
+    outside = ndimage.distance_transform_edt(~mask)
+    return np.where(mask, inside - 0.5, 0.5 - outside)
+
+
+def _blend(values: List[Array], valid: List[Array], labels: Array, ids: List[int],
+           feather: float) -> Tuple[Array, Array]:
+    """Feathered mosaic of one tile (see the module notes); returns (bands, alpha mask)."""
+    nb = values[0].shape[0]
+    h, w = labels.shape
+    present = [k for k, i in enumerate(ids) if (labels == i).any()]
+    if feather < 1.0 or len(present) <= 1:
+        out = np.zeros((nb, h, w), np.float32)
+        for k in present:
+            m = labels == ids[k]
+            out[:, m] = values[k][:, m]
+        return out, labels >= 0
+    num = np.zeros((nb, h, w), np.float32)
+    den = np.zeros((h, w), np.float32)
+    for k, i in enumerate(ids):
+        mask = labels == i
+        d = _signed_distance(mask)
+        wk = np.clip(0.5 + d / feather, 0.0, 1.0).astype(np.float32) * (valid[k] > 0)
+        if not wk.any():
+            continue
+        num += wk * np.nan_to_num(values[k], nan=0.0)
+        den += wk
+    out = num / np.maximum(den, 1e-12)
+    return out, labels >= 0
+
+
+def _seam_sources(seamlines: str, project: Any) -> Optional[Path]:
+    """The vector file of the operator's seamlines, or None for automatic seams."""
+    text = (seamlines or "auto").strip()
+    if text.lower() in ("auto", "nadir"):
+        return None
+    if text.lower() == "edits":
+        if project is None:
+            raise InputError("seamlines=edits needs the project (its edits.gpkg has the "
+                             "'seamlines' layer); give 'project' or a seamline file.")
+        return Path(project.edits_path)
+    return Path(text)
+
+
+def mosaic_orthos(
+    inputs: Sequence[PathLike],
+    output: PathLike,
+    *,
+    gsd: Optional[float] = None,
+    seamlines: str = "auto",
+    balance: str = "gain_offset",
+    feather: Optional[float] = None,
+    reference: Optional[str] = None,
+    dsm: Optional[PathLike] = None,
+    dtm: Optional[PathLike] = None,
+    corridor: Optional[float] = None,
+    min_height: float = 2.0,
+    project: Any = None,
+    tile: int = 1024,
+    seam_cells: int = 1024,
+    feedback: Optional[Feedback] = None,
+) -> Dict[str, Any]:
+    """Mosaic orthos into one raster with seamlines and radiometric balancing.
+
+    Parameters
+    ----------
+    inputs : sequence of paths
+        Orthos (see the module notes).
+    output : path
+        Mosaic GeoTIFF; ``<stem>_seamlines.gpkg`` and ``<stem>_balance.json`` go beside it.
+    gsd : float, optional
+        Cell size (m); default the finest input.
+    seamlines : str
+        ``"auto"`` (nadir partition + least-cost seams), ``"nadir"`` (nadir partition only),
+        ``"edits"`` (the project's ``edits.gpkg`` layer ``seamlines``) or a vector file
+        (:func:`.seamlines.read_operator_seamlines`).
+    balance : {"none", "gain_offset", "histogram"}
+    feather : float, optional
+        Width of the blend across seams (m); default 10 cells, 0 = hard seams.
+    reference : str, optional
+        Image kept radiometrically unchanged; default mean gain 1 and mean offset 0.
+    dsm, dtm : path, optional
+        Surface and terrain: with both, seams avoid cells with DSM − DTM ≥ ``min_height``.
+    corridor : float, optional
+        Half-width of the seam search corridor (m); default a quarter of the median distance
+        between neighbouring projection centres.
+    min_height : float
+        Height above terrain (m) from which an object is avoided.
+    project : Project, optional
+        Needed for ``seamlines="edits"``.
+    tile : int
+        Side of the mosaic tiles (cells); bounds the memory.
+    seam_cells : int
+        Longest side of the seam grid (cells); bounds the memory of seams and balancing.
+    feedback : Feedback, optional
+
+    Returns
+    -------
+    dict
+        ``mosaic, seamlines, report`` (paths), ``gsd``, ``cells`` [w, h], ``images``,
+        ``seam_factor``, ``seams`` (routing statistics), ``balance`` (before/after summary),
+        ``filled_pct`` (% of mosaic cells filled from another than their partition image),
+        ``seconds``.
+    """
+    import rasterio
+    from rasterio.enums import ColorInterp, Resampling
+    from rasterio.windows import Window
+
+    fb = ensure_feedback(feedback)
+    start = time.perf_counter()
+    if balance not in bal.BALANCE_MODES:
+        raise InputError(f"Balancing '{balance}' is not one of {', '.join(bal.BALANCE_MODES)}.")
+    infos = [read_ortho_info(p) for p in inputs]
+    check_inputs(infos)
+    for i in infos:
+        if not i.centre_from_tags:
+            fb.warning(f"{i.path.name} has no PHOTODEM_CAMERA_X/Y tags; its nadir point is "
+                       "taken as the raster centre.")
+    names = [i.name for i in infos]
+    crs = infos[0].crs
+    transform, W, H, s = mosaic_grid(infos, gsd)
+    out = Path(output)
+    paths = sibling_paths(out)
+    ref_index = None
+    if reference:
+        if reference not in names:
+            raise InputError(f"The reference image '{reference}' is not one of the inputs "
+                             f"({', '.join(names)}).")
+        ref_index = names.index(reference)
+    seam_file = _seam_sources(seamlines, project)
+    feather_m = 10.0 * s if feather is None else float(feather)
+    feather_px = feather_m / s
+
+    # 1. seam grid ------------------------------------------------------------------------
+    f = max(1, math.ceil(max(W, H) / max(int(seam_cells), 16)))
+    cs = f * s
+    ctr = Affine(cs, 0.0, transform.c, 0.0, -cs, transform.f)
+    CW, CH = math.ceil(W / f), math.ceil(H / f)
+    fb.info(f"Mosaic of {len(infos)} orthos: {W} × {H} cells of {s:g} m, seam grid "
+            f"{CW} × {CH} (factor {f}).")
+    samples: List[bal.BalanceImage] = []
+    fracs: List[Array] = []
+    covers: List[Array] = []
+    with ExitStack() as stack:
+        srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
+        for k, (info, src) in enumerate(zip(infos, srcs)):
+            fb.step(0, 15).progress(100.0 * k / len(infos))
+            win = _window_of(info, ctr, CW, CH)
+            if win is None:
+                samples.append(bal.BalanceImage(0, 0, np.zeros((len(info.colour), 0, 0),
+                                                               np.float32),
+                                                np.zeros((0, 0), bool)))
+                fracs.append(np.zeros((0, 0), np.float32))
+                covers.append(np.zeros((0, 0), np.float32))
+                continue
+            r0, r1, c0, c1 = win
+            colour, frac = _read_on_grid(src, info, ctr, r0, r1, c0, c1, "average")
+            full = frac >= 1.0 - 1e-6
+            colour[:, ~full] = np.nan
+            samples.append(bal.BalanceImage(r0, c0, colour, full))
+            fracs.append(frac)
+            covers.append(_coverage(info, ctr, r0, r1, c0, c1, frac))
+
+        # 2. balancing ----------------------------------------------------------------------
+        gains, offsets, luts, report = bal.balance_images(samples, balance, ref_index, names)
+        fb.info(f"Balancing ({balance}): mean overlap difference "
+                f"{report['before']['mean_difference']} → {report['after']['mean_difference']} "
+                f"DN, mean |difference| {report['before']['mean_abs_difference']} → "
+                f"{report['after']['mean_abs_difference']} DN.")
+
+        # 3. partition ----------------------------------------------------------------------
+        seam_imgs = []
+        for k, smp in enumerate(samples):
+            frac = fracs[k]
+            grey = np.nan_to_num(apply_mean(smp.bands, gains[k], offsets[k], luts[k]), nan=0.0)
+            seam_imgs.append(sl.SeamImage(names[k], infos[k].centre, smp.row, smp.col,
+                                          frac, grey, covers[k]))
+        # the partition is built on the image footprints; occluded cells are filled later
+        labels = sl.nadir_labels((CH, CW), ctr, seam_imgs, geometric=True)
+        next_best = sl.nadir_labels((CH, CW), ctr, seam_imgs)
+        hag = None
+        margin = math.ceil(0.5 * feather_m / cs) + 1
+        if dsm is not None and dtm is not None:
+            hag = sl.object_height(_read_height(dsm, ctr, (CH, CW), crs, "max"),
+                                   _read_height(dtm, ctr, (CH, CW), crs, "average"))
+        seam_stats: Dict[str, Any] = {"mode": "auto" if seam_file is None else "operator"}
+        regions: List[Tuple[Any, int]] = []
+        if seam_file is not None:
+            layers = ("seamlines",) if seamlines.strip().lower() == "edits" else None
+            assigned, cuts = sl.read_operator_seamlines(seam_file, crs, names, layers)
+            if cuts:
+                regions.extend(sl.cut_regions(cuts, _bounds(transform, W, H), labels, ctr,
+                                              len(infos)))
+            regions.extend(assigned)  # assigned polygons win over cut regions
+            op = sl.rasterize_regions(regions, (CH, CW), ctr)
+            labels = np.where(op >= 0, op, labels).astype(np.int32)
+            seam_stats.update(regions=len(regions), assigned=len(assigned), cut_lines=len(cuts))
+        elif seamlines.strip().lower() == "auto" and len(infos) > 1:
+            cor_m = sl.default_corridor([i.centre for i in infos]) if corridor is None \
+                else float(corridor)
+            cor = max(round(cor_m / cs), 2)
+            labels, st = sl.route_seams(labels, seam_imgs, hag, corridor=cor,
+                                        min_height=min_height, margin=margin,
+                                        feedback=fb.step(15, 30))
+            seam_stats.update(st, corridor_m=round(cor * cs, 3))
+        else:
+            seam_stats["mode"] = "nadir"
+        partition = labels  # footprint polygons: the seams, without occlusion fills
+        labels = sl.fill_invalid(labels, seam_imgs, next_best)
+        del seam_imgs, samples, fracs, covers, next_best
+
+        # 4. mosaic, tile by tile -------------------------------------------------------------
+        dtype = infos[0].dtype
+        lo, hi = _dtype_range(dtype)
+        nb = len(infos[0].colour)
+        halo = math.ceil(feather_px / 2.0) + 1 if feather_px >= 1.0 else 0
+        img_wins = [_window_of(i, transform, W, H) for i in infos]
+        prof = dict(GTIFF_PROFILE)
+        prof.update(width=W, height=H, count=nb + 1, dtype=dtype, transform=transform,
+                    nodata=None)
+        if crs:
+            prof["crs"] = crs
+        if W < 256 or H < 256:
+            prof.update(tiled=False)
+            prof.pop("blockxsize")
+            prof.pop("blockysize")
+        tile = max(int(tile), 64)
+        tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]
+        filled = 0
+        covered = 0
+        tfb = fb.step(30, 95)
+        with atomic_output(out) as tmp, rasterio.open(tmp, "w", **prof) as dst:
+            for t_idx, (r0, c0) in enumerate(tiles):
+                tfb.progress(100.0 * t_idx / len(tiles))
+                r1, c1 = min(r0 + tile, H), min(c0 + tile, W)
+                R0, R1 = max(r0 - halo, 0), min(r1 + halo, H)
+                C0, C1 = max(c0 - halo, 0), min(c1 + halo, W)
+                lab = labels[np.arange(R0, R1)[:, None] // f, np.arange(C0, C1)[None, :] // f]
+                if regions:
+                    op = sl.rasterize_regions(regions, (R1 - R0, C1 - C0),
+                                              transform * Affine.translation(C0, R0))
+                    lab = np.where(op >= 0, op, lab)
+                ids, vals, valids = [], [], []
+                for k, (info, src) in enumerate(zip(infos, srcs)):
+                    wk = img_wins[k]
+                    if wk is None or wk[1] <= R0 or wk[0] >= R1 or wk[3] <= C0 or wk[2] >= C1:
+                        continue
+                    colour, valid = _read_on_grid(src, info, transform, R0, R1, C0, C1, "full")
+                    if not valid.any():
+                        continue
+                    ids.append(k)
+                    vals.append(bal.apply_balance(colour, gains[k], offsets[k], luts[k]))
+                    valids.append(valid > 0)
+                final = _final_labels(lab, ids, valids, infos, transform, R0, R1, C0, C1)
+                inner = (slice(r0 - R0, r1 - R0), slice(c0 - C0, c1 - C0))
+                filled += int(((final != lab) & (final >= 0))[inner].sum())
+                covered += int((final >= 0)[inner].sum())
+                if ids:
+                    data, alpha = _blend(vals, valids, final, ids, feather_px)
+                else:
+                    data = np.zeros((nb, R1 - R0, C1 - C0), np.float32)
+                    alpha = np.zeros((R1 - R0, C1 - C0), bool)
+                data = data[:, inner[0], inner[1]]
+                alpha = alpha[inner]
+                if np.issubdtype(np.dtype(dtype), np.integer):
+                    data = np.clip(np.rint(data), lo, hi)
+                data = np.where(alpha[None], data, 0).astype(dtype)
+                a = np.where(alpha, _alpha_value(dtype), 0).astype(dtype)
+                win = Window(c0, r0, c1 - c0, r1 - r0)
+                dst.write(data, indexes=list(range(1, nb + 1)), window=win)
+                dst.write(a, nb + 1, window=win)
+            dst.colorinterp = [*infos[0].colorinterp, ColorInterp.alpha]
+            dst.update_tags(PHOTODEM_MOSAIC="1", PHOTODEM_IMAGES=",".join(names),
+                            PHOTODEM_GSD=f"{s:g}", PHOTODEM_SEAMLINES=seam_stats["mode"],
+                            PHOTODEM_BALANCE=balance)
+            fb.progress(95.0)
+            factors, fac = [], 2
+            while max(W, H) / fac >= 256:
+                factors.append(fac)
+                fac *= 2
+            if factors:
+                dst.build_overviews(factors, Resampling.average)
+                dst.update_tags(ns="rio_overview", resampling="average")
+
+    # 5. footprints / seamlines and the report -------------------------------------------------
+    polys = sl.partition_polygons(partition, ctr, len(infos))
+    if regions:  # operator regions exactly, the rest from the seam grid
+        from shapely.ops import unary_union
+
+        op_union = unary_union([g for g, _ in regions])
+        area = _box(transform, W, H)
+        polys = [None if p is None else p.difference(op_union) for p in polys]
+        for k in range(len(infos)):
+            mine = [g for g, kk in regions if kk == k]
+            if mine:
+                part = unary_union(mine).intersection(area)
+                polys[k] = part if polys[k] is None else polys[k].union(part)
+        polys = [None if p is None or p.is_empty else p for p in polys]
+    lines = sl.seam_lines(polys)
+    sl.write_seamlines(paths["seamlines"], polys, names, [i.path.name for i in infos], lines,
+                       crs)
+    report["seams"] = seam_stats
+    report["seam_factor"] = f
+    report["filled_pct"] = round(100.0 * filled / max(covered, 1), 3)
+    with atomic_output(paths["report"]) as tmp:
+        tmp.write_text(json.dumps(report, indent=2), encoding="utf-8")
+    return {"mosaic": str(out), "seamlines": str(paths["seamlines"]),
+            "report": str(paths["report"]), "gsd": s, "cells": [W, H], "images": names,
+            "seam_factor": f, "seams": seam_stats,
+            "balance": {"before": report["before"], "after": report["after"]},
+            "filled_pct": report["filled_pct"],
+            "seconds": round(time.perf_counter() - start, 2)}
+
+
+def apply_mean(bands: Array, gain: Array, offset: Array,
+               lut: Optional[Tuple[Array, Array]]) -> Array:
+    """Grey value: the mean of the balanced bands (b, h, w) → (h, w)."""
+    if bands.size == 0:
+        return np.zeros(bands.shape[1:], np.float32)
+    return bal.apply_balance(bands, gain, offset, lut).mean(axis=0)
+
+
+def _alpha_value(dtype: str) -> float:
+    dt = np.dtype(dtype)
+    return 255.0 if dt == np.uint8 or not np.issubdtype(dt, np.integer) else \
+        float(min(np.iinfo(dt).max, 65535))
+
+
+def _final_labels(lab: Array, ids: List[int], valids: List[Array], infos: Sequence[OrthoInfo],
+                  transform: Affine, R0: int, R1: int, C0: int, C1: int) -> Array:
+    """Partition label where that image is valid, else the valid image nearest in nadir."""
+    h, w = lab.shape
+    best = np.full((h, w), np.inf)
+    final = np.full((h, w), -1, np.int32)
+    x, y = sl.cell_centres(transform, np.arange(R0, R1), np.arange(C0, C1))
+    for k, valid in zip(ids, valids):
+        cx, cy = infos[k].centre
+        d2 = (x - cx) ** 2 + (y - cy) ** 2
+        score = np.where(valid, np.where(lab == k, -1.0, d2), np.inf)
+        better = score < best
+        best[better] = score[better]
+        final[better] = k
+    return final
+
+
+def _bounds(transform: Affine, W: int, H: int) -> Tuple[float, float, float, float]:
+    return (transform.c, transform.f + transform.e * H, transform.c + transform.a * W,
+            transform.f)
+
+
+def _box(transform: Affine, W: int, H: int) -> Any:
+    from shapely.geometry import box
+
+    return box(*_bounds(transform, W, H))
+
+
+def sibling_paths(output: PathLike) -> Dict[str, Path]:
+    """Files a mosaic writes: the mosaic, ``<stem>_seamlines.gpkg``, ``<stem>_balance.json``."""
+    out = Path(output)
+    return {"mosaic": out, "seamlines": out.with_name(f"{out.stem}_seamlines.gpkg"),
+            "report": out.with_name(f"{out.stem}_balance.json")}
+
+
+def mosaic_project(
+    project: Any,
+    dem: PathLike,
+    output: PathLike,
+    *,
+    images: Optional[Sequence[str]] = None,
+    gsd: Optional[float] = None,
+    resampling: str = "bilinear",
+    dsm: Optional[PathLike] = None,
+    true_ortho: bool = False,
+    dtm: Optional[PathLike] = None,
+    feedback: Optional[Feedback] = None,
+    **mosaic_options: Any,
+) -> Dict[str, Any]:
+    """Rectify every (or the given) project image onto ``dem`` and mosaic the orthos.
+
+    The orthos go to a scratch folder beside ``output`` that is removed afterwards. With
+    ``true_ortho`` the images are rectified on ``dsm`` with the occlusion test, and occluded
+    cells are filled from other images. Seams avoid objects when a DSM and a DTM are known:
+    ``dsm`` and ``dtm`` (default: ``dem`` when it is not the DSM).
+
+    Returns
+    -------
+    dict
+        :func:`mosaic_orthos`'s result plus ``orthos`` (per image: gsd, occluded_pct).
+    """
+    from ..project.model import Project
+    from .rectify import orthorectify_image
+
+    fb = ensure_feedback(feedback)
+    proj = project if isinstance(project, Project) else Project.load(project)
+    if true_ortho and not dsm:
+        raise InputError("A true-ortho mosaic needs a DSM: set 'dsm' or switch true_ortho off.")
+    names = list(images) if images else [im.name for im in proj.images]
+    if not names:
+        raise InputError("The project has no images to rectify.")
+    surface = dsm if true_ortho else dem
+    if dtm is None and dsm is not None and Path(dem).resolve() != Path(dsm).resolve():
+        dtm = dem
+    out = Path(output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=f".{out.stem}.orthos.", dir=str(out.parent)))
+    try:
+        orthos, info = [], {}
+        for k, name in enumerate(names):
+            step = fb.step(40.0 * k / len(names), 40.0 * (k + 1) / len(names))
+            path = scratch / f"{Path(name).stem}.tif"
+            res = orthorectify_image(proj, name, surface, path, gsd=gsd, resampling=resampling,
+                                     dsm=dsm if true_ortho else None, feedback=step)
+            orthos.append(path)
+            info[name] = {"gsd": res.get("gsd"), "occluded_pct": res.get("occluded_pct")}
+        result = mosaic_orthos(orthos, out, gsd=gsd, dsm=dsm, dtm=dtm, project=proj,
+                               feedback=fb.step(40, 100), **mosaic_options)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    result["orthos"] = info
+    return result
+
+
+__all__ = [
+    "SEAMLINE_MODES",
+    "OrthoInfo",
+    "check_inputs",
+    "mosaic_grid",
+    "mosaic_orthos",
+    "mosaic_project",
+    "read_ortho_info",
+    "sibling_paths",
+]
