@@ -147,7 +147,13 @@ class LPParameters:
         Fixed correlation length (m) at level 0 (coarser levels scale with the cell size);
         None = estimated.
     ground_tolerance : float
-        |DSM − DTM| (m) up to which a cell/point is labelled ground.
+        |DSM − DTM| (m) up to which a cell/point is labelled ground on flat terrain.
+    ground_slope_factor : float
+        ``k``: the ground tolerance grows by ``k``·|∇DTM|·cell size on slopes (see
+        :func:`~.surface_input.point_labels`).
+    low_outlier : float
+        Depth (m) below the second lowest neighbour (5 × 5 cells) beyond which a cell is a low
+        blunder before the pyramid is built (:func:`~.surface_input.low_outliers`); 0 = off.
     max_gap : float
         DSM holes wider than this (m) stay NaN in the DTM at the data border; interior holes
         are always filled. 0 = fill everything.
@@ -164,7 +170,7 @@ class LPParameters:
     low_cutoff: float = 5.0
     shift_factor: float = 1.0
     max_shift: float = 0.5
-    band_above: float = 1.0
+    band_above: float = 2.0
     band_below: float = 5.0
     slope: float = 0.15
     noise_share: Optional[float] = None
@@ -174,6 +180,8 @@ class LPParameters:
     corr_max: float = 3.0
     corr_length: Optional[float] = None
     ground_tolerance: float = 0.5
+    ground_slope_factor: float = 1.25
+    low_outlier: float = 1.5
     max_gap: float = 0.0
     cg_tol: float = 5e-3
 
@@ -207,7 +215,8 @@ class LPResult:
     dtm : ndarray float32
         The DTM (NaN only at wide holes of the data border, see ``max_gap``).
     ground : ndarray bool
-        Ground cells: |DSM − DTM| ≤ ground_tolerance (keep areas ground, remove areas not).
+        Ground cells: |DSM − DTM| ≤ ground_tolerance + ground_slope_factor·|∇DTM|·cell (keep
+        areas ground, remove areas not).
     weights : ndarray float32
         Final weights of level 0 (0 = eliminated, NaN = no observation).
     iterations : list of dict
@@ -537,7 +546,7 @@ def asymmetric_weights(r: Array, g: float, half_weight: float, exponent: float, 
     Residuals more than ``low_cutoff`` below ``g`` get 0 too (blunders).
     """
     r = np.asarray(r, np.float64)
-    u = np.maximum(r - g, 0.0) / max(half_weight, 1e-9)
+    u = np.maximum(r - g, 0.0) / np.maximum(half_weight, 1e-9)
     with np.errstate(over="ignore", invalid="ignore"):
         p = 1.0 / (1.0 + u ** exponent)
     p = np.where(r > g + cutoff, 0.0, p)
@@ -768,6 +777,12 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
     # keep cells are no observations either: the terrain around an embankment is predicted
     # without it (a 6 m dam would make the Gaussian prediction ring), then the DSM is put back
     obs0 = np.where(remove | keep, np.nan, z0).astype(np.float32)
+    if prm.low_outlier > 0:
+        # isolated low blunders would pull the lowest-cell pyramid (and with it every level's
+        # candidate band) down by metres: cut them before the reduction
+        from .surface_input import low_outliers
+
+        obs0[low_outliers(obs0, prm.low_outlier)] = np.nan
     if np.count_nonzero(np.isfinite(obs0)) + len(gpts) < 10:
         raise InputError("Fewer than 10 DSM cells are left for the linear prediction (all "
                          "no data or inside 'remove' exclusion areas); check the input and the "
@@ -814,7 +829,12 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         forced = (soft_line | is_hard) & valid
         if dtm_c is None:
             slope = max(prm.slope, _terrain_slope(zl, g_lv.spacing))
-        slope_allow = slope * g_lv.spacing / 2.0
+        if dtm_c is None:
+            slope_f: Any = slope
+        else:
+            slope_f = np.maximum(slope, _local_slope(
+                _upsample_sides(dtm_c, zl.shape, sides_c, sides), g_lv.spacing))
+        slope_allow = slope_f * g_lv.spacing / 2.0
         cutoff = prm.cutoff + (slope_allow if lv > 0 else 0.0)
         half_w = prm.half_weight + (slope_allow / 2.0 if lv > 0 else 0.0)
         if dtm_c is None:
@@ -824,7 +844,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         else:
             trend = _upsample_sides(dtm_c, zl.shape, sides_c, sides)
             dz = zl - trend
-            band_up = prm.band_above + slope * g_lv.spacing  # = slope · coarse cell / 2
+            band_up = prm.band_above + slope_f * g_lv.spacing  # = slope · coarse cell / 2
             cand = valid & (((dz <= band_up) & (dz >= -prm.band_below)) | forced)
             corr_rng = (prm.corr_min, prm.corr_max)
         lz = np.where(valid, zl - trend, 0.0).astype(np.float32)
@@ -902,7 +922,12 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         far = ndimage.distance_transform_edt(~(valid0 | remove)) * grid.spacing > prm.max_gap / 2
         outer = far & _touches_border(~(valid0 | remove))
         dtm = np.where(outer, np.nan, dtm).astype(np.float32)
-    ground = valid0 & (np.abs(z0 - dtm) <= prm.ground_tolerance) & ~remove
+    from .surface_input import dtm_slope
+
+    tol = prm.ground_tolerance + prm.ground_slope_factor * grid.spacing * np.nan_to_num(
+        dtm_slope(dtm, grid.spacing))
+    with np.errstate(invalid="ignore"):
+        ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove
     ground |= keep & valid0
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
 
@@ -914,6 +939,13 @@ def _terrain_slope(z: Array, spacing: float) -> float:
     g = np.hypot(gx, gy)
     g = g[np.isfinite(g)]
     return float(np.median(g)) if g.size else 0.0
+
+
+def _local_slope(z: Array, spacing: float) -> Array:
+    """Gradient magnitude (m/m) per cell of a surface (central differences)."""
+    gy, gx = np.gradient(np.asarray(z, np.float64), spacing)
+    g = np.hypot(gx, gy)
+    return np.where(np.isfinite(g), g, 0.0)
 
 
 def _reduce_scale(sc: Optional[Array]) -> Optional[Array]:
@@ -1030,6 +1062,7 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
         "cells_ground": n_ground,
         "eliminated_share": 1.0 - n_ground / max(n_valid, 1),
         "ground_tolerance_m": prm.ground_tolerance,
+        "ground_slope_factor": prm.ground_slope_factor,
         "iterations": res.iterations,
         "constraints": {"keep_cells": int(cons.keep.sum()), "remove_cells": int(cons.remove.sum()),
                         "ground_points": len(cons.ground_points),

@@ -27,9 +27,12 @@ Smoothing (normalised convolution of first order)
 Elimination
     :math:`D_k = M_{k-1} - T_k` (the *difference model*, written per iteration on request);
     a cell is eliminated if :math:`D_k > t_k + s \cdot w_k / 4` (object) or
-    :math:`D_k < -d` (blunder), with :math:`t_k` the iteration's threshold, ``s`` the slope
-    allowance (a plane over a window of side ``w`` lies :math:`s\,w/4` below a ridge whose two
-    slopes differ by ``s``) and ``d`` the blunder depth. Eliminated cells stay eliminated.
+    :math:`D_k < -(d + s \cdot w_k / 4)` (blunder), with :math:`t_k` the iteration's threshold,
+    ``s`` the slope allowance (a plane over a window of side ``w`` lies :math:`s\,w/4` below a
+    ridge whose two slopes differ by ``s``, and as far above a valley or the terrace below a
+    wall) and ``d`` the blunder depth. Eliminated cells stay eliminated. Before the first
+    iteration, isolated pits (``low_outlier_m`` below their second lowest neighbour,
+    :func:`.surface_input.low_outliers`) are eliminated by a local, slope-invariant test.
 
 Hole filling
     Membrane (Laplace) interpolation :math:`\nabla^2 z = 0` of the eliminated and empty cells
@@ -65,6 +68,7 @@ from .surface_input import (
     FilterConstraints,
     FilterInput,
     check_ground_points,
+    low_outliers,
     read_filter_constraints,
     read_filter_input,
     write_filter_outputs,
@@ -484,6 +488,11 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
     zv = dsm[valid]
     lo, hi = np.quantile(zv, [0.005, 0.995]) if zv.size > 20 else (zv.min(), zv.max())
     out_of_range = valid & ((dsm < lo - margin) | (dsm > hi + margin)) & ~keep
+    # isolated low blunders (a local, slope-invariant test: the iterations' planes cannot tell
+    # a pit from the foot of a slope)
+    low_depth = float(params.get("low_outlier_m", 0.0) or 0.0)
+    if low_depth > 0:
+        out_of_range |= low_outliers(np.where(keep | remove, np.nan, dsm), low_depth) & valid
     support = valid & ~keep & ~remove & ~out_of_range
     m = dsm.copy()
     m[gp_cells] = gp_z[gp_cells]
@@ -499,7 +508,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
     rows.append({"iteration": 0, "window_m": 0.0, "threshold_m": float("nan"),
                  "eliminated": pre, "eliminated_share": pre / n_filterable,
                  "eliminated_total_share": pre / n_filterable,
-                 "step": "height range and remove areas"})
+                 "step": "height range, low outliers and remove areas"})
     eliminated_total = pre
     n_steps = len(windows) + 2
     for k, (wm, tk) in enumerate(zip(windows, thresholds), start=1):
@@ -510,8 +519,11 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         t = smooth(m, support, radius, sides, barrier)
         d = m - t
         thr = tk + slope * wm / 4.0
+        # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
+        # it lies s·w/4 below a ridge: the blunder depth grows alike
+        thr_down = down + slope * wm / 4.0
         with np.errstate(invalid="ignore"):
-            elim = support & ~gp_cells & ((d > thr) | (d < -down))
+            elim = support & ~gp_cells & ((d > thr) | (d < -thr_down))
         # cells without any support in the window keep their height (nothing to compare)
         elim &= np.isfinite(t)
         n_el = int(elim.sum())
@@ -654,6 +666,7 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
         "cells_valid": res["cells_valid"],
         "cells_ground": res["cells_ground"],
         "ground_tolerance_m": params["ground_tolerance_m"],
+        "ground_slope_factor": params.get("ground_slope_factor", 0.0),
         "grid": {"width": inp.grid.width, "height": inp.grid.height,
                  "spacing": inp.grid.spacing},
         "constraints": {"keep_cells": int(cons.keep.sum()),

@@ -12,7 +12,12 @@ Low-pass (:mod:`.lowpass`, the iterative "Phoenics" method, Raguse 2000 §3.3.1)
 ``thresholds_m``
     Height above the smoothed surface (m) beyond which a cell is an object, per iteration.
 ``down_threshold_m``
-    Depth below the smoothed surface (m) beyond which a cell is a blunder (matching error).
+    Depth below the smoothed surface (m) beyond which a cell is a blunder (matching error); it
+    grows by the same slope allowance as the height threshold (a plane lies above a valley
+    as it lies below a ridge). Isolated pits are caught earlier by ``low_outlier_m``.
+``low_outlier_m``
+    Depth (m) below the second lowest neighbour (5 × 5 cells) beyond which a cell is a low
+    blunder before the first iteration (slope-invariant net cut from below); 0 = off.
 ``slope_pct``
     Allowance for breaks of slope (ridges, hill tops, embankment edges in keep areas' vicinity):
     the threshold of an iteration grows by ``slope_pct/100 · window/4`` — the largest offset a
@@ -24,7 +29,10 @@ Low-pass (:mod:`.lowpass`, the iterative "Phoenics" method, Raguse 2000 §3.3.1)
     Cells more than this below the 0.5 % or above the 99.5 % height quantile of the DSM are
     blunders before the first iteration.
 ``ground_tolerance_m``
-    Points within this of the DTM are labelled ground (point input).
+    Points within this of the DTM are labelled ground (point input) on flat terrain.
+``ground_slope_factor``
+    The tolerance grows by this factor × local DTM slope × grid spacing (SMRF-style elevation
+    threshold; the DTM misses slope × spacing between its nodes on steep terrain).
 """
 
 from __future__ import annotations
@@ -38,11 +46,13 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
     "default": {
         "windows_m": (60.0, 40.0, 20.0, 10.0),
         "thresholds_m": (2.5, 1.5, 1.0, 0.5),
-        "down_threshold_m": 5.0,
+        "down_threshold_m": 8.0,
         "slope_pct": 20.0,
         "final_smoothing_m": 3.0,
         "height_margin_m": 10.0,
         "ground_tolerance_m": 0.5,
+        "low_outlier_m": 1.5,
+        "ground_slope_factor": 1.25,
     },
     "flat": {
         "windows_m": (60.0, 40.0, 20.0, 10.0),
@@ -52,6 +62,8 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "final_smoothing_m": 3.0,
         "height_margin_m": 5.0,
         "ground_tolerance_m": 0.3,
+        "low_outlier_m": 1.0,
+        "ground_slope_factor": 1.0,
     },
     "hilly": {
         "windows_m": (60.0, 40.0, 20.0, 10.0),
@@ -61,6 +73,8 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "final_smoothing_m": 3.0,
         "height_margin_m": 15.0,
         "ground_tolerance_m": 0.6,
+        "low_outlier_m": 1.5,
+        "ground_slope_factor": 1.25,
     },
     "urban": {
         "windows_m": (100.0, 60.0, 30.0, 15.0, 8.0),
@@ -70,6 +84,8 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "final_smoothing_m": 3.0,
         "height_margin_m": 10.0,
         "ground_tolerance_m": 0.5,
+        "low_outlier_m": 1.5,
+        "ground_slope_factor": 1.25,
     },
     "forest": {
         "windows_m": (120.0, 80.0, 40.0, 20.0, 10.0),
@@ -79,6 +95,8 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "final_smoothing_m": 5.0,
         "height_margin_m": 15.0,
         "ground_tolerance_m": 0.6,
+        "low_outlier_m": 2.0,
+        "ground_slope_factor": 1.25,
     },
     "steep": {
         "windows_m": (40.0, 25.0, 15.0, 8.0),
@@ -88,6 +106,8 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "final_smoothing_m": 3.0,
         "height_margin_m": 30.0,
         "ground_tolerance_m": 1.0,
+        "low_outlier_m": 2.0,
+        "ground_slope_factor": 1.5,
     },
 }
 
@@ -100,28 +120,37 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
 #: DTM; ``slope`` (m/m) terrain allowance added to the cut-off and the band at coarse levels
 #: (``slope``·cell/2); ``shift_factor``/``max_shift`` shift g = −min(k·σ₋, g_max) (m);
 #: ``iterations``/``fine_iterations`` robust iterations per level (coarse / the two finest);
-#: ``ground_tolerance`` |DSM − DTM| (m) labelled ground.
+#: ``ground_tolerance`` |DSM − DTM| (m) labelled ground, widened by ``ground_slope_factor``·slope·
+#: cell on slopes; ``low_outlier`` depth (m) of a low blunder below its second lowest neighbour.
+#: ``band_above`` 2 m in the default: on steep slopes the coarse levels lie metres below the
+#: ground; the fine levels' own robust weights then reject objects within the band.
 LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
     "default": {"coarse_spacing": 32.0, "half_weight": 0.5, "cutoff": 1.5, "low_cutoff": 5.0,
-                "band_above": 1.0, "band_below": 5.0, "slope": 0.15, "shift_factor": 1.0,
+                "band_above": 2.0, "band_below": 5.0, "slope": 0.15, "shift_factor": 1.0,
                 "max_shift": 0.5, "iterations": 4, "fine_iterations": 2,
-                "ground_tolerance": 0.5},
+                "ground_tolerance": 0.5,
+               "low_outlier": 1.5, "ground_slope_factor": 1.25},
     "flat": {"coarse_spacing": 32.0, "half_weight": 0.2, "cutoff": 0.6, "low_cutoff": 3.0,
              "band_above": 0.6, "band_below": 3.0, "slope": 0.05, "shift_factor": 1.0,
-             "max_shift": 0.3, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.3},
+             "max_shift": 0.3, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.3,
+            "low_outlier": 1.0, "ground_slope_factor": 1.0},
     "hilly": {"coarse_spacing": 32.0, "half_weight": 0.4, "cutoff": 1.2, "low_cutoff": 5.0,
               "band_above": 1.5, "band_below": 5.0, "slope": 0.35, "shift_factor": 1.0,
-              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.6},
+              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.6,
+             "low_outlier": 1.5, "ground_slope_factor": 1.25},
     "urban": {"coarse_spacing": 64.0, "half_weight": 0.3, "cutoff": 0.8, "low_cutoff": 4.0,
               "band_above": 0.8, "band_below": 4.0, "slope": 0.15, "shift_factor": 1.0,
-              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.5},
+              "max_shift": 0.5, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 0.5,
+             "low_outlier": 1.5, "ground_slope_factor": 1.25},
     "forest": {"coarse_spacing": 64.0, "half_weight": 0.3, "cutoff": 1.0, "low_cutoff": 6.0,
                "band_above": 1.0, "band_below": 6.0, "slope": 0.25, "shift_factor": 1.5,
                "max_shift": 1.0, "iterations": 5, "fine_iterations": 2,
-               "ground_tolerance": 0.6},
+               "ground_tolerance": 0.6,
+              "low_outlier": 2.0, "ground_slope_factor": 1.25},
     "steep": {"coarse_spacing": 16.0, "half_weight": 0.6, "cutoff": 2.0, "low_cutoff": 8.0,
               "band_above": 2.5, "band_below": 8.0, "slope": 0.6, "shift_factor": 1.0,
-              "max_shift": 1.0, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 1.0},
+              "max_shift": 1.0, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 1.0,
+             "low_outlier": 2.0, "ground_slope_factor": 1.5},
 }
 
 #: Preset names, in the order the GUIs list them.

@@ -7,6 +7,10 @@ Input (:func:`read_filter_input`)
     cell — a DSM for filtering whose cells prefer the ground — and every point keeps the flat
     index of its cell, so the filter's result can be given back point by point.
 
+Low outliers (:func:`low_outliers`)
+    Pits of one or two cells deeper than a threshold below their second lowest neighbour —
+    a slope-invariant "net cut" from below, shared by both filters before they start.
+
 Constraints (:func:`read_filter_constraints`)
     From the project's ``edits.gpkg``: exclusion areas with action ``keep`` (the DSM stays the
     DTM there: embankments, dams), ``remove``/``exclude`` (no ground there: bridged), manual
@@ -17,9 +21,10 @@ Outputs (:func:`write_filter_outputs`)
     In one staged folder (complete or not at all): ``dtm.tif``, ``ndsm.tif`` (DSM − DTM),
     ``mask.tif`` (raster input: uint8 1 = object, 0 = ground, 255 = no data) or ``labels.txt``
     (point input: one label per input point in input order, 0 = ground, 1 = object; a point is
-    ground if :math:`|z - z_{DTM}(x, y)| \le t` with ``t = report["ground_tolerance_m"]`` and
-    :math:`z_{DTM}` bilinear), ``report.json`` and ``report.html``, and extra rasters such as the
-    difference model of every iteration.
+    ground if :math:`|z - z_{DTM}(x, y)| \le t + k\,|\nabla z_{DTM}|\,s` with
+    ``t = report["ground_tolerance_m"]``, ``k = report["ground_slope_factor"]`` (default 0), ``s``
+    the spacing and :math:`z_{DTM}` bilinear, see :func:`point_labels`), ``report.json`` and
+    ``report.html``, and extra rasters such as the difference model of every iteration.
 """
 
 from __future__ import annotations
@@ -486,17 +491,107 @@ def check_ground_points(dtm: Array, grid: Grid, ground_points: Array,
     return out
 
 
-def point_labels(inp: FilterInput, dtm: Array, tol: float) -> Array:
-    """0 = ground, 1 = object per input point: ground if |z − DTM(x, y)| ≤ ``tol`` (bilinear).
+def dtm_slope(dtm: Array, spacing: float) -> Array:
+    r"""Gradient magnitude :math:`|\nabla z|` (m/m) of a grid by central differences.
 
-    Points without a DTM height are objects.
+    NaN cells give NaN (and so do their neighbours' one-sided differences: no slope is
+    invented at data borders; :func:`point_labels` then uses no slope allowance).
+    """
+    z = np.asarray(dtm, np.float64)
+    if min(z.shape) < 2:
+        return np.zeros(z.shape)
+    gy, gx = np.gradient(z, float(spacing))
+    return np.hypot(gx, gy)
+
+
+def point_labels(inp: FilterInput, dtm: Array, tol: float, slope_factor: float = 0.0) -> Array:
+    r"""0 = ground, 1 = object per input point, against the DTM (bilinear).
+
+    A point is ground if
+
+    .. math:: |z - z_{DTM}(x, y)| \le t + k \cdot |\nabla z_{DTM}(x, y)| \cdot s
+
+    with ``t = tol``, ``k = slope_factor`` and ``s`` the grid spacing: a DTM at cell
+    resolution misses the heights between its nodes by up to about slope × spacing on steep
+    terrain (break lines, lowest-point gridding, the ±½ cell position of the node), so the
+    tolerance grows with the local slope as in SMRF's elevation threshold (Pingel et al.
+    2013: ``t + k·slope`` at 1 m cells). ``k = 0`` gives the plain tolerance. Points without
+    a DTM height are objects.
     """
     pts = inp.points
     if pts is None:
         raise ValueError("point labels need point input")
     zd = sample_bilinear(dtm, inp.grid, pts[:, 0], pts[:, 1])
-    ground = np.isfinite(zd) & np.isfinite(pts[:, 2]) & (np.abs(pts[:, 2] - zd) <= tol)
+    limit = np.full(len(pts), float(tol))
+    if slope_factor > 0:
+        g = sample_bilinear(dtm_slope(dtm, inp.grid.spacing), inp.grid, pts[:, 0], pts[:, 1])
+        limit += float(slope_factor) * np.where(np.isfinite(g), g, 0.0) * inp.grid.spacing
+    with np.errstate(invalid="ignore"):
+        ground = np.isfinite(zd) & np.isfinite(pts[:, 2]) & (np.abs(pts[:, 2] - zd) <= limit)
     return np.where(ground, 0, 1).astype(np.uint8)
+
+
+def low_outliers(z: Array, depth: float, radius: int = 2, passes: int = 2) -> Array:
+    r"""Isolated low blunders of a DSM grid (multipath, mismatches): a "net cut" from below.
+
+    A cell is a low outlier if it lies more than ``depth`` below the **second lowest** of its
+    valid neighbours in the :math:`(2r+1)^2` window (the centre excluded):
+
+    .. math:: z_c < z_{(2)}(N_r(c)) - d .
+
+    On any plane — however steep — several neighbours of a cell lie below it (the window is
+    symmetric), so :math:`z_{(2)} \le z_c` and nothing is flagged; at the foot of a wall or
+    in a valley the lower side supplies such neighbours as well. Only cells with valid
+    neighbours on all four sides (above, below, left, right of the centre row/column) are
+    judged, so the lowest cell at the border of a steep grid or hole is no pit. Taking the
+    second lowest tolerates a second blunder next to the first. The test is repeated
+    ``passes`` times (a removed blunder may have hidden its neighbour).
+
+    Returns
+    -------
+    ndarray of bool
+        True at low outliers.
+    """
+    zz = np.asarray(z, np.float32)
+    out = np.zeros(zz.shape, bool)
+    if not depth > 0 or zz.size == 0:
+        return out
+    r = int(radius)
+    h, w = zz.shape
+    cur = np.where(np.isfinite(zz), zz, np.inf).astype(np.float32)
+    for _ in range(max(int(passes), 1)):
+        pad = np.pad(cur, r, mode="constant", constant_values=np.inf)
+        up = np.zeros((h, w), bool)
+        down = np.zeros((h, w), bool)
+        left = np.zeros((h, w), bool)
+        right = np.zeros((h, w), bool)
+        # lowest and second lowest neighbour by a running pair of minima (elementwise, so
+        # the same bits on every platform; no sort per cell)
+        m1 = np.full((h, w), np.inf, np.float32)
+        m2 = np.full((h, w), np.inf, np.float32)
+        for dr in range(-r, r + 1):
+            for dc in range(-r, r + 1):
+                if dr == 0 and dc == 0:
+                    continue
+                v = pad[r + dr:r + dr + h, r + dc:r + dc + w]
+                ok = np.isfinite(v)
+                if dr < 0:
+                    up |= ok
+                elif dr > 0:
+                    down |= ok
+                if dc < 0:
+                    left |= ok
+                elif dc > 0:
+                    right |= ok
+                np.minimum(m2, np.maximum(m1, v), out=m2)
+                np.minimum(m1, v, out=m1)
+        new = (np.isfinite(cur) & np.isfinite(m2) & up & down & left & right
+               & (cur < m2 - np.float32(depth)))
+        if not new.any():
+            break
+        out |= new
+        cur[new] = np.inf
+    return out
 
 
 # -- outputs ------------------------------------------------------------------------------------
@@ -618,13 +713,14 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
     dtm = np.asarray(dtm, np.float32)
     ground = np.asarray(ground, bool)
     tol = float(report.get("ground_tolerance_m") or DEFAULT_GROUND_TOLERANCE)
+    slope_factor = float(report.get("ground_slope_factor") or 0.0)
     report = dict(report)
     report.setdefault("ground_tolerance_m", tol)
     report.setdefault("input", inp.path)
     report.setdefault("source", inp.source)
     labels = None
     if inp.source == "points" and inp.points is not None:
-        labels = point_labels(inp, dtm, tol)
+        labels = point_labels(inp, dtm, tol, slope_factor)
         report["points"] = len(labels)
         report["points_ground"] = int(np.count_nonzero(labels == 0))
         report["points_object"] = int(np.count_nonzero(labels == 1))
@@ -662,6 +758,6 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
 
 
 __all__ = ["DEFAULT_GROUND_TOLERANCE", "MIN_POINTS", "FilterConstraints", "FilterInput",
-           "check_ground_points", "grid_lowest", "nice_spacing", "point_labels",
-           "read_filter_constraints", "read_filter_input", "sample_bilinear", "to_crs",
-           "write_filter_outputs"]
+           "check_ground_points", "dtm_slope", "grid_lowest", "low_outliers", "nice_spacing",
+           "point_labels", "read_filter_constraints", "read_filter_input", "sample_bilinear",
+           "to_crs", "write_filter_outputs"]

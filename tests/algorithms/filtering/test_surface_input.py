@@ -177,3 +177,45 @@ def test_empty_constraints_shape() -> None:
     grid = Grid(Affine(1, 0, 0, 0, -1, 4), 5, 4, 1.0)
     c = FilterConstraints.empty(grid)
     assert c.keep.shape == c.remove.shape == c.barrier.shape == (4, 5)
+
+
+def test_low_outliers_net_cut_is_slope_invariant() -> None:
+    from photodem.algorithms.filtering.surface_input import low_outliers
+
+    rows, cols = np.mgrid[0:60, 0:60].astype(float)
+    steep = 100.0 + 1.0 * cols + 0.7 * rows  # 122 % slope: nothing is a pit
+    assert not low_outliers(steep, 0.5).any()
+    # a 4 m retaining wall across the slope: the foot of the wall is no pit either
+    wall = steep + np.where(rows >= 30, 4.0, 0.0)
+    assert not low_outliers(wall, 0.5).any()
+    z = steep.copy()
+    # on a 122 % slope the window's lowest neighbours lie 3.4 m below the centre: the test
+    # sees blunders deeper than that plus the depth (on flat ground: deeper than the depth)
+    z[10, 10] -= 8.0  # single blunder
+    z[40, 40] -= 9.0  # a pair of blunders
+    z[40, 41] -= 8.0
+    z[20, 50] -= 1.0  # shallower than the depth: stays
+    z[5, 30] = np.nan
+    got = low_outliers(z, 1.5)
+    assert set(zip(*np.nonzero(got))) == {(10, 10), (40, 40), (40, 41)}
+    flat = np.full((30, 30), 5.0)
+    flat[15, 15] -= 2.0
+    flat[0, 0] -= 2.0  # a border cell has no neighbours above/left: not judged
+    assert set(zip(*np.nonzero(low_outliers(flat, 1.5)))) == {(15, 15)}
+
+
+def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
+    from photodem.algorithms.filtering.surface_input import FilterInput, dtm_slope, point_labels
+
+    g = Grid(Affine(1.0, 0, 0.0, 0, -1.0, 40.0), 40, 40, 1.0)
+    _, cols = np.mgrid[0:40, 0:40].astype(float)
+    dtm = (10.0 + 0.8 * cols).astype(np.float32)  # 80 % slope along x
+    assert np.allclose(dtm_slope(dtm, 1.0), 0.8)
+    x = np.array([20.5, 20.5, 20.5, 20.5])
+    y = np.array([20.5, 20.5, 20.5, 20.5])
+    zd = 10.0 + 0.8 * 20.0
+    # tolerance 0.5 m, + 1.25 · 0.8 · 1 m = 1.5 m with the slope allowance
+    z = zd + np.array([0.4, 1.2, -1.4, 1.6])
+    inp = FilterInput(dtm, g, None, points=np.column_stack([x, y, z]), source="points")
+    assert point_labels(inp, dtm, 0.5).tolist() == [0, 1, 1, 1]
+    assert point_labels(inp, dtm, 0.5, 1.25).tolist() == [0, 0, 0, 1]
