@@ -80,6 +80,7 @@ Operator edits (:class:`~.surface_input.FilterConstraints`)
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import asdict, dataclass, fields, replace
@@ -99,6 +100,10 @@ PathLike = Union[str, Path]
 
 #: Relative noise variance given to hard constraints (manual ground points).
 HARD_NOISE = 1e-6
+
+#: Overlap of tiles (large grids, :mod:`.tiles`) in coarsest-level cells (``coarse_spacing``):
+#: the finer levels' predictions reach a few correlation lengths, the coarse levels further.
+TILE_OVERLAP_COARSE = 8.0
 
 
 @dataclass
@@ -335,17 +340,66 @@ def breakline_sides(lines: Sequence[Any], grid: Grid) -> Tuple[Optional[_Sides],
     return _Sides(labels, n + 1), barrier, zline
 
 
-def _kernel(corr: float) -> Array:
-    """1-D Gaussian correlation kernel exp(−(d/corr)²), |d| ≤ 2.5·corr cells."""
+#: Largest negative eigenvalue (relative to C₀) the truncated covariance may have: a fifth of
+#: the smallest noise variance :func:`fit_covariance` gives (10⁻²·C₀).
+MAX_NEGATIVITY = 2e-3
+
+
+@functools.lru_cache(maxsize=64)
+def _kernel_radius(corr: float) -> int:
+    r"""Truncation radius (cells) of the 1-D kernel: ⌈2.5·corr⌉, longer where needed.
+
+    A truncated Gaussian is not positive definite: its spectrum
+    :math:`K(f) = \sum_{|d| \le r} e^{-(d/c)^2} \cos 2\pi f d` has negative side lobes of
+    about :math:`e^{-(r/c)^2}`, and the separable 2-D operator has the eigenvalues
+    :math:`C_0 K(f_x) K(f_y)`, as low as :math:`C_0 K_{min} K(0)`. With c = 6 cells and
+    r = 2.5c that is −1.8 % of C₀ — more than a small noise variance, so C + D is indefinite
+    and the conjugate gradients diverge (the float overflow at the coarsest level of large
+    DSMs). The radius grows until :math:`-K_{min} K(0) \le` :data:`MAX_NEGATIVITY`.
+    """
     r = max(1, math.ceil(2.5 * corr))
+    f = np.linspace(0.0, 0.5, 1025)
+    while True:
+        d = np.arange(-r, r + 1, dtype=np.float64)
+        k = np.exp(-(d / corr) ** 2)
+        spec = (np.cos(2.0 * np.pi * f[:, None] * d[None, :]) * k).sum(axis=1)  # no BLAS
+        if -float(spec.min()) * float(k.sum()) <= MAX_NEGATIVITY or r > 6 * corr:
+            return r
+        r += 1
+
+
+def _kernel(corr: float) -> Array:
+    """1-D Gaussian correlation kernel exp(−(d/corr)²), |d| ≤ :func:`_kernel_radius` cells."""
+    r = _kernel_radius(float(corr))
     d = np.arange(-r, r + 1, dtype=np.float64)
     return np.exp(-(d / corr) ** 2).astype(np.float32)
 
 
+#: Cells per strip of the column pass of :func:`_smooth` (≈ 4 MB of float32: cache-sized).
+STRIP_CELLS = 2 ** 20
+
+
 def _smooth(x: Array, k: Array) -> Array:
+    """Separable correlation with ``k`` along columns, then rows (zero outside the grid).
+
+    The column pass runs on strips of rows (with ``len(k)//2`` halo rows): a whole-grid pass
+    along axis 0 strides through memory and is ~2.5 × slower; every output cell is the same
+    sum of the same products in the same order, so the strips give bit-identical values.
+    """
     from scipy import ndimage
 
-    y = ndimage.correlate1d(x, k, axis=0, mode="constant", output=np.float32)
+    h, w = x.shape
+    r = len(k) // 2
+    rows = max(32, STRIP_CELLS // max(w, 1))
+    if h <= rows + 2 * r:
+        y = ndimage.correlate1d(x, k, axis=0, mode="constant", output=np.float32)
+    else:
+        y = np.empty((h, w), np.float32)
+        for r0 in range(0, h, rows):
+            r1 = min(h, r0 + rows)
+            a0, a1 = max(0, r0 - r), min(h, r1 + r)
+            part = ndimage.correlate1d(x[a0:a1], k, axis=0, mode="constant", output=np.float32)
+            y[r0:r1] = part[r0 - a0:r1 - a0]
     return ndimage.correlate1d(y, k, axis=1, mode="constant", output=np.float32)
 
 
@@ -734,7 +788,8 @@ def _hard_grid(points: Array, grid: Grid) -> Array:
 def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters] = None,
                              constraints: Any = None, sigma: Optional[Array] = None,
                              feedback: Optional[Feedback] = None,
-                             keep_levels: bool = False) -> LPResult:
+                             keep_levels: bool = False,
+                             max_cells: Optional[int] = None) -> LPResult:
     """Hierarchical robust linear prediction of a DSM grid (see the module notes).
 
     Parameters
@@ -750,7 +805,11 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         σ_z per cell: the noise variance of a cell is scaled by (σ_i/median σ)².
     feedback : Feedback, optional
     keep_levels : bool
-        Keep every level's DTM in ``LPResult.levels``.
+        Keep every level's DTM in ``LPResult.levels`` (not for tiled grids).
+    max_cells : int, optional
+        Grids with more cells are filtered in overlapping tiles (:mod:`.tiles`, default
+        :data:`.tiles.MAX_CELLS`) with an overlap of :data:`TILE_OVERLAP_COARSE` coarse cells;
+        ``weights`` is then NaN and ``iterations`` are the first tile's.
 
     Raises
     ------
@@ -759,8 +818,27 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
     """
     from scipy import ndimage
 
+    from .tiles import MAX_CELLS, filter_in_tiles
+
     feedback = ensure_feedback(feedback)
     prm = params or LPParameters()
+    limit = MAX_CELLS if max_cells is None else int(max_cells)
+    if z.shape[0] * z.shape[1] > limit:
+        overlap = math.ceil(TILE_OVERLAP_COARSE * prm.coarse_spacing / grid.spacing)
+        tile_sigma = None if sigma is None else np.asarray(sigma)
+
+        def run_tile(zt: Array, gt: Grid, ct: Any, fb: Feedback) -> Dict[str, Any]:
+            r0, c0 = _offset(grid, gt)
+            st = None if tile_sigma is None else tile_sigma[r0:r0 + gt.height, c0:c0 + gt.width]
+            res = filter_linear_prediction(zt, gt, prm, ct, st, fb, False, max_cells=zt.size)
+            return {"dtm": res.dtm, "ground": res.ground, "iterations": res.iterations,
+                    "ground_points_disagreeing": res.disagreeing}
+
+        tiled = filter_in_tiles(run_tile, z, grid, constraints, overlap, limit, feedback)
+        feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
+        return LPResult(tiled["dtm"], tiled["ground"], np.full(z.shape, np.nan, np.float32),
+                        tiled["first"].get("iterations", []),
+                        tiled["ground_points_disagreeing"], [])
     z0 = np.array(z, dtype=np.float32)
     z0[~np.isfinite(z0)] = np.nan
     shape = z0.shape
@@ -930,6 +1008,12 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove
     ground |= keep & valid0
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
+
+
+def _offset(grid: Grid, sub: Grid) -> Tuple[int, int]:
+    """(row, col) of a sub-grid's first cell in ``grid``."""
+    t, u = grid.transform, sub.transform
+    return round((u.f - t.f) / t.e), round((u.c - t.c) / t.a)
 
 
 def _terrain_slope(z: Array, spacing: float) -> float:

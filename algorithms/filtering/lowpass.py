@@ -83,6 +83,11 @@ STRIP_ROWS = 768
 #: Side (cells) below which the hole-filling pyramid stops.
 COARSEST = 48
 
+#: Overlap of tiles (large grids, :mod:`.tiles`) in units of the largest window: the
+#: iterations compound (a cell eliminated in iteration 1 changes iteration 2's planes) and the
+#: hole filling reaches across eliminated buildings.
+TILE_OVERLAP_WINDOWS = 2.0
+
 
 # -- smoothing ------------------------------------------------------------------------------------
 def plane_smooth(z: Array, weight: Array, radius: int, min_count: int = 3,
@@ -431,7 +436,8 @@ def lowpass_parameters(preset: str = "default",
 def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
                    constraints: Optional[FilterConstraints] = None, grid: Optional[Grid] = None,
                    keep_differences: bool = False,
-                   feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+                   feedback: Optional[Feedback] = None,
+                   max_cells: Optional[int] = None) -> Dict[str, Any]:
     """Filter a DSM grid to a DTM with the iterative robust low-pass (see the module notes).
 
     Parameters
@@ -446,7 +452,11 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         The operator's edits on this grid (``grid`` is then needed for the ground points and
         breaklines).
     keep_differences : bool
-        Return the difference model of every iteration.
+        Return the difference model of every iteration (not for tiled grids).
+    max_cells : int, optional
+        Grids with more cells are filtered in overlapping tiles (:mod:`.tiles`; default
+        :data:`.tiles.MAX_CELLS`); the overlap is :data:`TILE_OVERLAP_WINDOWS` × the largest
+        window.
 
     Returns
     -------
@@ -456,15 +466,47 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         ``differences`` (list of float32 grids or empty), ``ground_points_disagreeing``,
         ``eliminated_share``, ``cells_valid``, ``cells_ground``, ``seconds``.
     """
+    from .tiles import MAX_CELLS, filter_in_tiles
+
     feedback = ensure_feedback(feedback)
     start = time.perf_counter()
-    dsm = np.asarray(z, np.float32)
-    shape = dsm.shape
+    shape = tuple(np.shape(z))
     if grid is None:
         from affine import Affine
 
         grid = Grid(Affine(spacing, 0, 0, 0, -spacing, shape[0] * spacing), shape[1], shape[0],
                     spacing)
+    limit = MAX_CELLS if max_cells is None else int(max_cells)
+    if shape[0] * shape[1] > limit:
+        overlap = math.ceil(TILE_OVERLAP_WINDOWS * max(params["windows_m"]) / spacing)
+
+        zall = np.asarray(z)
+        if not np.isfinite(zall).any():
+            raise InputError("The DSM holds no height (every cell is nodata).")
+        # the blunder range of the whole DSM, not of each tile (same test everywhere)
+        tile_params = dict(params, height_range=_height_range(zall[np.isfinite(zall)]))
+
+        def run_tile(zt: Array, gt: Grid, ct: Optional[FilterConstraints],
+                     fb: Feedback) -> Dict[str, Any]:
+            return lowpass_filter(zt, spacing, tile_params, ct, gt, False, fb,
+                                  max_cells=zt.size)
+
+        tiled = filter_in_tiles(run_tile, z, grid, constraints, overlap, limit, feedback)
+        first = tiled["first"]
+        valid = np.isfinite(z)
+        n_valid = int(valid.sum())
+        keep = (np.zeros(shape, bool) if constraints is None
+                else np.asarray(constraints.keep, bool))
+        n_filterable = max(int((valid & ~keep).sum()), 1)
+        elim = int((valid & ~keep & ~tiled["ground"]).sum())
+        feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
+        return {"dtm": tiled["dtm"], "ground": tiled["ground"],
+                "iterations": first.get("iterations", []), "differences": [],
+                "ground_points_disagreeing": tiled["ground_points_disagreeing"],
+                "eliminated_share": elim / n_filterable, "cells_valid": n_valid,
+                "cells_ground": int(tiled["ground"].sum()), "tiles": tiled["tiles"],
+                "tile_overlap_cells": overlap, "seconds": time.perf_counter() - start}
+    dsm = np.asarray(z, np.float32)
     cons = constraints if constraints is not None else FilterConstraints.empty(grid)
     keep = np.asarray(cons.keep, bool)
     remove = np.asarray(cons.remove, bool)
@@ -485,8 +527,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         gp_z[r[ins], c[ins]] = gp[ins, 2]
     # height range: robust quantiles ± margin (gross blunders)
     margin = float(params.get("height_margin_m", 10.0))
-    zv = dsm[valid]
-    lo, hi = np.quantile(zv, [0.005, 0.995]) if zv.size > 20 else (zv.min(), zv.max())
+    lo, hi = params.get("height_range") or _height_range(dsm[valid])
     out_of_range = valid & ((dsm < lo - margin) | (dsm > hi + margin)) & ~keep
     # isolated low blunders (a local, slope-invariant test: the iterations' planes cannot tell
     # a pit from the foot of a slope)
@@ -583,6 +624,15 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         "seconds": time.perf_counter() - start,
     }
     return result
+
+
+def _height_range(zv: Array) -> Tuple[float, float]:
+    """0.5 % and 99.5 % height quantiles of the valid DSM heights (min/max for ≤ 20)."""
+    if zv.size > 20:
+        lo, hi = np.quantile(zv, [0.005, 0.995])
+    else:
+        lo, hi = zv.min(), zv.max()
+    return float(lo), float(hi)
 
 
 def _border_nodata(has: Array, reach: int = 3) -> Array:
