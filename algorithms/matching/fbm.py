@@ -42,8 +42,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
-from .interest import InterestPoints, forstner
-from .ncc import ncc_epipolar
+from .interest import InterestPoints, forstner, forstner_measures
+from .ncc import ncc_epipolar, ncc_surface
 
 #: the NCC parabola failed; the disparity is the difference of the Förstner sub-pixel features
 FLAG_FEATURE_SUBPIXEL = 4
@@ -71,9 +71,49 @@ def fill_nodata(image: NDArray) -> Tuple[NDArray, NDArray]:
     return img[tuple(idx)], valid
 
 
+def local_weight_threshold(w: NDArray, usable: Optional[NDArray], cell: int, w_factor: float,
+                           floor: float) -> NDArray:
+    r"""Förstner weight threshold per sub-image (seed §2.3 item 5), as a per-pixel map.
+
+    The image is split into ``cell`` × ``cell`` sub-images; each gets
+    :math:`t = f\cdot\max(\operatorname{median}_{cell}(w), \text{floor}\cdot
+    \operatorname{median}_{image}(w))` over its usable pixels with w > 0. A global median
+    threshold leaves areas of weak texture (fields, shadowed slopes) without points when the
+    image also holds strong texture; the floor keeps pure noise in uniform areas out.
+    Sub-images without usable pixels take the global threshold.
+    """
+    h, wd = w.shape
+    ok = w > 0
+    if usable is not None:
+        ok &= usable
+    vals = np.where(ok, w, np.nan).astype(np.float64)
+    glob = float(np.median(vals[ok])) if ok.any() else np.inf
+    ny, nx = -(-h // cell), -(-wd // cell)
+    pad = np.full((ny * cell, nx * cell), np.nan)
+    pad[:h, :wd] = vals
+    blocks = pad.reshape(ny, cell, nx, cell).transpose(0, 2, 1, 3).reshape(ny, nx, -1)
+    have = np.isfinite(blocks).any(axis=2)
+    med = np.full((ny, nx), glob)
+    if have.any():
+        med[have] = _nanmedian_rows(blocks[have])
+    thr = w_factor * np.maximum(med, floor * glob)
+    return np.repeat(np.repeat(thr, cell, 0), cell, 1)[:h, :wd]
+
+
+def _nanmedian_rows(a: NDArray) -> NDArray:
+    """Median of the finite values of each row (every row has at least one)."""
+    s = np.sort(a, axis=1)  # NaN sorts last
+    n = np.isfinite(a).sum(axis=1)
+    r = np.arange(a.shape[0])
+    lo = s[r, (n - 1) // 2]
+    hi = s[r, n // 2]
+    return 0.5 * (lo + hi)
+
+
 def detect_features(image: NDArray, valid: Optional[NDArray] = None, exclude: Optional[NDArray]
                     = None, *, window: int = 5, q_min: float = 0.6, w_factor: float = 1.0,
-                    nms_window: int = 5, margin: int = 5) -> InterestPoints:
+                    nms_window: int = 5, margin: int = 5, local_cell: Optional[int] = None,
+                    local_floor: float = 0.0625) -> InterestPoints:
     """Förstner points of a (finite) image, without points near nodata or in excluded pixels.
 
     Parameters
@@ -87,12 +127,33 @@ def detect_features(image: NDArray, valid: Optional[NDArray] = None, exclude: Op
         Förstner parameters (:func:`.interest.forstner`).
     margin : int
         Half size of the largest window that will be cut around a point (NCC, LSM).
+    local_cell : int, optional
+        Sub-image side (px) for local weight thresholds (:func:`local_weight_threshold`);
+        None: one threshold ``w_factor · median(w)`` for the whole image.
+    local_floor : float
+        With ``local_cell``: a sub-image's median counts at least ``local_floor`` × the
+        image's median.
     """
-    pts = forstner(image, window=window, q_min=q_min, w_factor=w_factor, nms_window=nms_window,
-                   border=margin + 1)
+    if local_cell:
+        w_map, _, _ = forstner_measures(image, window)
+        usable = None
+        if valid is not None or exclude is not None:
+            usable = np.ones(image.shape, bool)
+            if valid is not None:
+                usable &= valid
+            if exclude is not None:
+                usable &= ~exclude
+        thr = local_weight_threshold(w_map, usable, int(local_cell), w_factor, local_floor)
+        pts = forstner(image, window=window, q_min=q_min, w_factor=0.0, nms_window=nms_window,
+                       border=margin + 1)
+    else:
+        pts = forstner(image, window=window, q_min=q_min, w_factor=w_factor,
+                       nms_window=nms_window, border=margin + 1)
     keep = np.ones(pts.cols.size, bool)
     ci = np.rint(pts.cols).astype(np.int64)
     ri = np.rint(pts.rows).astype(np.int64)
+    if local_cell:
+        keep &= pts.w > thr[ri, ci]
     if valid is not None and not np.all(valid):
         near_bad = ndimage.maximum_filter(~valid, size=2 * margin + 1, mode="constant",
                                           cval=True)
@@ -167,6 +228,90 @@ def candidate_pairs(ca: NDArray, ra: NDArray, cb: NDArray, rb: NDArray, d_lo: ND
     ib = np.concatenate(ib_parts)
     keep = np.abs(rb[ib] - ra[ia]) <= row_tol
     return ia[keep], ib[keep]
+
+
+def correlation_candidates(img_a: NDArray, img_b: NDArray, ca: NDArray, ra: NDArray,
+                           d_lo: NDArray, d_hi: NDArray, *, window: int = 7,
+                           rho_min: float = 0.6, max_peaks: int = 3, chunk: int = 4096
+                           ) -> Tuple[NDArray, NDArray, NDArray]:
+    r"""Candidates of a points from the NCC profile along the same row of image b.
+
+    For every a point the correlation coefficient ρ(k) of the ``window`` × ``window``
+    template at the rounded point with the b window at column ``round(ca) − k`` is evaluated
+    for all integer disparities :math:`k \in [\lceil d_{lo} \rceil, \lfloor d_{hi} \rfloor]`
+    (:func:`.ncc.ncc_surface`, float32 sums without BLAS). Every *local maximum* of the profile
+    with :math:`\rho \ge \rho_{min}` (at most ``max_peaks``, the highest first, none on the
+    ends of the range) is a candidate; its disparity is refined by the parabola through the
+    maximum and its two neighbours, :math:`\delta = (\rho_- - \rho_+) / (2(\rho_- - 2\rho_0 +
+    \rho_+))`. Unlike feature-to-feature candidates these do not need the same interest point
+    to be detected in both images (on real images with perspective and radiometric
+    differences only about half of them are).
+
+    Returns
+    -------
+    ia : (m,) int64 index of the a point; d : (m,) float64 sub-pixel disparity ca − cb;
+    rho : (m,) float64 peak correlation.
+    """
+    ca = np.asarray(ca, float)
+    ra = np.asarray(ra, float)
+    ok = np.isfinite(d_lo) & np.isfinite(d_hi)
+    k0 = np.ceil(np.where(ok, d_lo, 0.0)).astype(np.int64)
+    k1 = np.floor(np.where(ok, d_hi, -1.0)).astype(np.int64)
+    nd = k1 - k0 + 1
+    idx = np.flatnonzero(ok & (nd >= 3))
+    empty = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+    if idx.size == 0:
+        return empty
+    # sort by range width so that a chunk's profiles have similar lengths (bounded waste)
+    idx = idx[np.argsort(nd[idx], kind="stable")]
+    h = window // 2
+    hb, wb = img_b.shape
+    ci = np.rint(ca).astype(np.int64)
+    ri = np.rint(ra).astype(np.int64)
+    parts = []
+    for s0 in range(0, idx.size, chunk):
+        sel = idx[s0:s0 + chunk]
+        n = sel.size
+        m = int(nd[sel].max())
+        rr = np.clip(ri[sel, None] + np.arange(-h, h + 1), 0, img_a.shape[0] - 1)
+        cc = np.clip(ci[sel, None] + np.arange(-h, h + 1), 0, img_a.shape[1] - 1)
+        tpl = img_a[rr[:, :, None], cc[:, None, :]]
+        start = ci[sel] - k1[sel]  # b column of offset 0 (disparity k1)
+        rb = np.clip(ri[sel, None] + np.arange(-h, h + 1), 0, hb - 1)
+        cb = np.clip(start[:, None] - h + np.arange(m + 2 * h), 0, wb - 1)
+        srch = img_b[rb[:, :, None], cb[:, None, :]]
+        prof = ncc_surface(tpl, srch)[:, 0, :].astype(np.float64)  # (n, m)
+        col_b = start[:, None] + np.arange(m)
+        bad = ((col_b - h < 0) | (col_b + h > wb - 1) | (np.arange(m)[None, :] >= nd[sel, None])
+               | ((ri[sel] - h < 0) | (ri[sel] + h > hb - 1))[:, None])
+        prof = np.where(bad | ~np.isfinite(prof), -2.0, prof)
+        left_n = np.concatenate([np.full((n, 1), np.inf), prof[:, :-1]], 1)
+        right_n = np.concatenate([prof[:, 1:], np.full((n, 1), np.inf)], 1)
+        peak = (prof >= left_n) & (prof > right_n) & (prof >= rho_min)
+        pi, pj = np.nonzero(peak)
+        if pi.size == 0:
+            continue
+        rho = prof[pi, pj]
+        # the highest ``max_peaks`` maxima of each point
+        order = np.lexsort((-rho, pi))
+        pi, pj, rho = pi[order], pj[order], rho[order]
+        first = np.r_[0, np.flatnonzero(np.diff(pi)) + 1]
+        rank = np.arange(pi.size) - np.repeat(first, np.diff(np.r_[first, pi.size]))
+        keep = rank < max_peaks
+        pi, pj, rho = pi[keep], pj[keep], rho[keep]
+        cm, cp = prof[pi, pj - 1], prof[pi, pj + 1]
+        den = cm - 2.0 * rho + cp
+        with np.errstate(invalid="ignore", divide="ignore"):
+            delta = np.where(den < 0, 0.5 * (cm - cp) / np.where(den < 0, den, -1.0), 0.0)
+        delta = np.clip(delta, -0.5, 0.5)
+        # template cut at the rounded point: the fractional part carries over (shift model)
+        d = (k1[sel][pi] - pj - delta) + 0.0
+        parts.append((sel[pi], d, rho))
+    if not parts:
+        return empty
+    ia, d, rho = (np.concatenate(p) for p in zip(*parts))
+    order = np.argsort(ia, kind="stable")
+    return ia[order], d[order], rho[order]
 
 
 def group_weighted_median(x: NDArray, w: NDArray, g: NDArray, n_groups: int) -> NDArray:
@@ -451,15 +596,22 @@ class OneWay(NamedTuple):
     n_outliers: NDArray  # per group
 
 
-def match_oneway(img_a: NDArray, img_b: NDArray, fa: InterestPoints, fb: InterestPoints,
-                 d_pred: NDArray, pull_in: NDArray, group: NDArray, u: NDArray, v: NDArray,
-                 n_groups: int, *, ncc_window: int = 7, rho_min: float = 0.6,
-                 row_tol: float = 1.0, rho_cap: float = 0.99, **robust) -> OneWay:
+def match_oneway(img_a: NDArray, img_b: NDArray, fa: InterestPoints,
+                 fb: Optional[InterestPoints], d_pred: NDArray, pull_in: NDArray, group: NDArray,
+                 u: NDArray, v: NDArray, n_groups: int, *, ncc_window: int = 7,
+                 rho_min: float = 0.6, row_tol: float = 1.0, rho_cap: float = 0.99,
+                 candidates: str = "features", max_peaks: int = 3, **robust) -> OneWay:
     """Candidates, weights, robust consistency and one-to-one for the a points of one level.
 
     ``d_pred`` / ``pull_in`` / ``group`` / ``u`` / ``v`` are per a point (NaN or −1: skip);
     the disparity is ``col_a − col_b`` in the a image's convention. ``robust`` goes to
     :func:`robust_plane_fit`.
+
+    ``candidates="features"``: the b interest points ``fb`` within the row tolerance and the
+    disparity interval (the seed's FBM); ``match`` holds b point indices.
+    ``candidates="correlation"``: the local maxima of the NCC profile along the row of b
+    (:func:`correlation_candidates`, ``fb`` unused); ``match`` holds the b pixel
+    ``row · width + col`` (used for the one-to-one rule).
     """
     na = fa.cols.size
     match = np.full(na, -1, np.int64)
@@ -468,32 +620,51 @@ def match_oneway(img_a: NDArray, img_b: NDArray, fa: InterestPoints, fb: Interes
     n_cand = np.zeros(n_groups, np.int64)
     n_out = np.zeros(n_groups, np.int64)
     active = np.isfinite(d_pred) & (group >= 0)
-    ia, ib = candidate_pairs(fa.cols, fa.rows, fb.cols, fb.rows,
-                             np.where(active, d_pred - pull_in, np.nan),
-                             np.where(active, d_pred + pull_in, np.nan), row_tol)
-    if ia.size == 0:
-        return OneWay(match, disp, rho_out, np.where(active, group, -1), None, n_cand, n_out)
-    # window vectors only for the points that take part
-    ua, inv_a = np.unique(ia, return_inverse=True)
-    ub, inv_b = np.unique(ib, return_inverse=True)
-    za, sa = window_vectors(img_a, fa.cols[ua], fa.rows[ua], ncc_window)
-    zb, sb = window_vectors(img_b, fb.cols[ub], fb.rows[ub], ncc_window)
-    rho = np.empty(ia.size, np.float32)
-    step = 1 << 17
-    for s0 in range(0, ia.size, step):  # bounded memory for the pair gathers
-        sl = slice(s0, s0 + step)
-        rho[sl] = np.einsum("ij,ij->i", za[inv_a[sl]], zb[inv_b[sl]])
-    keep = rho >= rho_min
-    ia, ib, rho = ia[keep], ib[keep], rho[keep].astype(np.float64)
-    inv_a, inv_b = inv_a[keep], inv_b[keep]
-    if ia.size == 0:
-        return OneWay(match, disp, rho_out, np.where(active, group, -1), None, n_cand, n_out)
+    d_lo = np.where(active, d_pred - pull_in, np.nan)
+    d_hi = np.where(active, d_pred + pull_in, np.nan)
+    if candidates == "correlation":
+        ia, d, rho = correlation_candidates(img_a, img_b, fa.cols, fa.rows, d_lo, d_hi,
+                                            window=ncc_window, rho_min=rho_min,
+                                            max_peaks=max_peaks)
+        if ia.size == 0:
+            return OneWay(match, disp, rho_out, np.where(active, group, -1), None, n_cand,
+                          n_out)
+        cb = fa.cols[ia] - d
+        ib = np.rint(fa.rows[ia]).astype(np.int64) * img_b.shape[1] + np.rint(cb).astype(
+            np.int64)
+        _, sa = window_vectors(img_a, fa.cols[ia], fa.rows[ia], ncc_window)
+        _, sb = window_vectors(img_b, cb, fa.rows[ia], ncc_window)
+        # the b position is no interest point: its tr Q is taken equal to the a point's
+        tq = (1.0 / np.maximum(fa.w[ia].astype(float), 1e-30)) ** 2
+    elif candidates == "features":
+        ia, ib = candidate_pairs(fa.cols, fa.rows, fb.cols, fb.rows, d_lo, d_hi, row_tol)
+        if ia.size == 0:
+            return OneWay(match, disp, rho_out, np.where(active, group, -1), None, n_cand,
+                          n_out)
+        # window vectors only for the points that take part
+        ua, inv_a = np.unique(ia, return_inverse=True)
+        ub, inv_b = np.unique(ib, return_inverse=True)
+        za, sa = window_vectors(img_a, fa.cols[ua], fa.rows[ua], ncc_window)
+        zb, sb = window_vectors(img_b, fb.cols[ub], fb.rows[ub], ncc_window)
+        rho = np.empty(ia.size, np.float32)
+        step = 1 << 17
+        for s0 in range(0, ia.size, step):  # bounded memory for the pair gathers
+            sl = slice(s0, s0 + step)
+            rho[sl] = np.einsum("ij,ij->i", za[inv_a[sl]], zb[inv_b[sl]])
+        keep = rho >= rho_min
+        ia, ib, rho = ia[keep], ib[keep], rho[keep].astype(np.float64)
+        sa, sb = sa[inv_a[keep]], sb[inv_b[keep]]
+        if ia.size == 0:
+            return OneWay(match, disp, rho_out, np.where(active, group, -1), None, n_cand,
+                          n_out)
+        tq = 1.0 / np.maximum(fa.w[ia].astype(float), 1e-30) * (
+            1.0 / np.maximum(fb.w[ib].astype(float), 1e-30))
+        d = fa.cols[ia] - fb.cols[ib]
+    else:
+        raise ValueError(f"candidates must be 'features' or 'correlation', not {candidates!r}")
     rc = np.minimum(rho, rho_cap)  # ρ → 1 would give an infinite weight
-    tq = 1.0 / np.maximum(fa.w[ia].astype(float), 1e-30) * (
-        1.0 / np.maximum(fb.w[ib].astype(float), 1e-30))
-    wij = 0.5 * rc / (1 - rc) / np.maximum(sa[inv_a] * sb[inv_b], 1e-12) / np.sqrt(tq)
+    wij = 0.5 * rc / (1 - rc) / np.maximum(sa * sb, 1e-12) / np.sqrt(tq)
     wij /= np.median(wij)  # scale-free weights (grey values and w cancel out)
-    d = fa.cols[ia] - fb.cols[ib]
     g = group[ia]
     fit = robust_plane_fit(u[ia], v[ia], d - d_pred[ia], wij, g, n_groups, **robust)
     n_cand = np.bincount(g, minlength=n_groups)
@@ -541,7 +712,8 @@ def fbm_level(left: NDArray, right: NDArray, fl: InterestPoints, fr: InterestPoi
               grouping: Grouping, predict: Predictor, *, ncc_window: int = 7,
               refine_window: int = 9, rho_min: float = 0.6, row_tol: float = 1.0,
               bidir_tol: Optional[float] = 1.0, min_points: int = 3,
-              robust: Optional[dict] = None) -> FBMResult:
+              robust: Optional[dict] = None, candidates: str = "features",
+              max_peaks: int = 3) -> FBMResult:
     """Bidirectional FBM of given features on one level (see the module docstring).
 
     Parameters
@@ -556,6 +728,12 @@ def fbm_level(left: NDArray, right: NDArray, fl: InterestPoints, fr: InterestPoi
     rho_min, row_tol, bidir_tol, min_points : thresholds (ρ, rows px, px, points per window);
         ``bidir_tol=None`` (or inf) switches the bidirectional check off
     robust : keyword arguments of :func:`robust_plane_fit`
+    candidates : ``"features"`` (right interest points, the seed's FBM) or ``"correlation"``
+        (local maxima of the NCC profile along the right row, :func:`correlation_candidates`;
+        interest points in the left image only, as the best ISPRS approach, seed §3.4). With
+        correlation candidates the right→left pass starts from the matched right positions
+        and searches the left row over the same interval (``fr`` is then unused).
+    max_peaks : correlation candidates per point (the highest local maxima)
     """
     robust = robust or {}
     ng = grouping.n_groups
@@ -564,24 +742,35 @@ def fbm_level(left: NDArray, right: NDArray, fl: InterestPoints, fr: InterestPoi
     dl, pl = predict(fl.cols, fl.rows)
     dl = np.where(gl >= 0, dl, np.nan)
     ul, vl = grouping.uv(fl.cols, fl.rows, np.maximum(gl, 0))
-    lr = match_oneway(left, right, fl, fr, dl, pl, gl, ul, vl, ng, ncc_window=ncc_window,
-                      rho_min=rho_min, row_tol=row_tol, **robust)
-    # right → left: prediction and group at the predicted left position (two passes)
-    d0, _ = predict(fr.cols, fr.rows)
-    d0 = np.where(np.isfinite(d0), d0, np.nanmedian(dl) if np.isfinite(dl).any() else 0.0)
-    d1, _ = predict(fr.cols + d0, fr.rows)
-    d1 = np.where(np.isfinite(d1), d1, d0)
-    d2, p2 = predict(fr.cols + d1, fr.rows)
-    gr = grouping.of(fr.cols + d1, fr.rows)
-    d2 = np.where(gr >= 0, d2, np.nan)
-    ur, vr = grouping.uv(fr.cols + d1, fr.rows, np.maximum(gr, 0))
-    # in the right image's convention the disparity is col_r − col_l = −d
-    rl = match_oneway(right, left, fr, fl, -d2, p2, gr, ur, vr, ng, ncc_window=ncc_window,
-                      rho_min=rho_min, row_tol=row_tol, **robust)
+    mkw = dict(ncc_window=ncc_window, rho_min=rho_min, row_tol=row_tol,
+               candidates=candidates, max_peaks=max_peaks, **robust)
+    lr = match_oneway(left, right, fl, fr, dl, pl, gl, ul, vl, ng, **mkw)
     j = lr.match
     have = j >= 0
     back = np.full(j.size, np.nan)
-    back[have] = -rl.disparity[j[have]]
+    if candidates == "correlation":
+        # right → left from the matched right positions, same interval and window as the
+        # left point (in the right image's convention the disparity is col_r − col_l = −d)
+        hv = np.flatnonzero(have)
+        fr_m = InterestPoints(fl.cols[hv] - lr.disparity[hv], fl.rows[hv], fl.w[hv],
+                              fl.q[hv])
+        rl = match_oneway(right, left, fr_m, None, -dl[hv], pl[hv], gl[hv], ul[hv], vl[hv],
+                          ng, **mkw)
+        back[hv] = -rl.disparity
+        d2 = np.where(have, dl, np.nan)
+    else:
+        # right → left: prediction and group at the predicted left position (two passes)
+        d0, _ = predict(fr.cols, fr.rows)
+        d0 = np.where(np.isfinite(d0), d0,
+                      np.nanmedian(dl) if np.isfinite(dl).any() else 0.0)
+        d1, _ = predict(fr.cols + d0, fr.rows)
+        d1 = np.where(np.isfinite(d1), d1, d0)
+        d2, p2 = predict(fr.cols + d1, fr.rows)
+        gr = grouping.of(fr.cols + d1, fr.rows)
+        d2 = np.where(gr >= 0, d2, np.nan)
+        ur, vr = grouping.uv(fr.cols + d1, fr.rows, np.maximum(gr, 0))
+        rl = match_oneway(right, left, fr, fl, -d2, p2, gr, ur, vr, ng, **mkw)
+        back[have] = -rl.disparity[j[have]]
     if bidir_tol is None or not np.isfinite(bidir_tol):  # check switched off
         agree = have
     else:

@@ -200,6 +200,27 @@ def _options(preset: str, overrides: Dict[str, Any]) -> Tuple[Any, Dict[str, Any
     return options, surface
 
 
+def _inside_any(polygons: List[Any], x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Points strictly inside any of the (multi)polygons (holes honoured), vectorised."""
+    from matplotlib.path import Path as MplPath
+
+    out = np.zeros(len(x), bool)
+    xy = np.column_stack([x, y])
+    for g in polygons:
+        for part in getattr(g, "geoms", [g]):
+            if part.geom_type != "Polygon" or part.is_empty:
+                continue
+            x0, y0, x1, y1 = part.bounds
+            cand = np.flatnonzero((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1) & ~out)
+            if cand.size == 0:
+                continue
+            inside = MplPath(np.asarray(part.exterior.coords)[:, :2]).contains_points(xy[cand])
+            for hole in part.interiors:
+                inside &= ~MplPath(np.asarray(hole.coords)[:, :2]).contains_points(xy[cand])
+            out[cand[inside]] = True
+    return out
+
+
 def _cell_lookup(grid: Any, x: np.ndarray, y: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """Flat cell index of points (−1 outside the grid)."""
     r, c = grid.cell_of(x, y)
@@ -330,6 +351,8 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     idx, on_grid = _cell_lookup(grid, pts[:, 0], pts[:, 1])
     ok &= on_grid
     ok[ok] = allowed.ravel()[idx[ok]]
+    # exactly: a point inside an exclusion area is dropped even where the cell centre is not
+    ok[ok] = ~_inside_any(setup.exclusions, pts[ok, 0], pts[ok, 1])
     n_raw_all = len(d)
     keep = np.nonzero(ok)[0]
     pts, sigma_z, idx = pts[keep], sigma_z[keep], idx[keep]
@@ -353,7 +376,13 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     if interpolation == "fe":
         from ..surface.fe_grid import fe_interpolate
 
-        w = 1.0 / np.maximum(sigma_z[inlier], 1e-3) ** 2
+        # a point's weight: its matching σ_Z and the scatter of the points about the local
+        # surface (σ1 of the groundels: texture, roughness, objects), which σ_Z of LSM
+        # (often a few cm) does not contain — else a few over-confident points bend the plate
+        # into ripples between them
+        s1 = red.summary().get("sigma1_m")
+        s1 = float(s1) if s1 is not None and math.isfinite(s1) else 0.0
+        w = 1.0 / (np.maximum(sigma_z[inlier], 1e-3) ** 2 + s1 * s1)
         z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                                    weights=w, smoothing=float(surface.get("smoothing", 1.0)),
                                    breaklines=setup.breaklines, exclusions=setup.exclusions,

@@ -7,13 +7,28 @@ disparity grid aligned with the image pyramid**: one plane per matching window (
 (:func:`.fbm.window_components`), so that nothing is interpolated or propagated across a
 barrier.
 
+Pyramid depth: enough levels that the disparity range shrinks to ≤ fbm_window/4 px at the
+top, but the top level must still hold one whole matching window (plus the margins where no
+point can lie) across the **stereo overlap** (left columns whose range [min_d, max_d] reaches
+right-image data), and the image's shorter side ≥ 2 windows — else fewer levels.
+
 Per level (coarsest first):
 
+0. **Features** in the left image only where the search range can reach right-image data
+   (no overlap = masked, not failed), Förstner weight thresholds **per sub-image**
+   (2 × fbm_window; seed §2.3: strong and weak texture in one image both get points).
+   **Candidates** (default ``candidates="correlation"``): the best local maximum of the 7 × 7
+   NCC profile along the right row within the pull-in of each left point (interest operator in
+   one image, as the best ISPRS approach, seed §3.4) — on real imagery only about half of the
+   Förstner points are detected again in the other image, which starved the feature-to-feature
+   candidates (``candidates="features"``, the seed's FBM, still available).
 1. **Predictions** for each window component, in this order of preference:
    the previous level's plane of the component under the point (× 2; at the top level an
    ``approx`` grid from the caller), a seed (operator start point), the planes of already
-   matched neighbouring components (region growing; evaluated at the point), or — at the
-   top level only — the full search range ``[min_d, max_d] / 2^k``.
+   matched neighbouring components (region growing; evaluated at the point), or the full
+   search range ``[min_d, max_d] / 2^k`` — at the top level, and at any level for components
+   the coarser level could not predict (so that a failed coarse level never yields zero
+   points silently).
 2. **Waves** (best-first/breadth-first over the window graph): all components with a
    prediction are matched together with :func:`.fbm.fbm_level` (bidirectional FBM with robust
    per-window consistency). A component that fails runs the failure cascade once per level:
@@ -21,14 +36,26 @@ Per level (coarsest first):
    Förstner points: w_factor/4, q ≥ 0.5, 3 × 3 non-maximum suppression); if it still fails it
    stays open and is retried from its matched neighbours' planes whenever more of them
    succeed (*come back from other sides*). Matching never stops at a failure.
-3. Components still unmatched at the end of the level are **marked** (``failures``) unless they
-   are masked (≥ 90 % no-data/exclusion) or tiny (< ¼ window). Their planes are filled from
-   the neighbours over the component graph (barrier-aware) for the next level; masked
-   components stay empty.
+   When no component is left, **neighbour consistency**: a matched component whose plane
+   differs at its centre from the median of ≥ 3 matched neighbours' planes by more than
+   max(neighbour_tol, pull-in/2) px loses its points and is redone once from its neighbours
+   (a wrong coarse prediction must not propagate down the pyramid).
+3. Components still unmatched at the end of the level are **marked** (``failures``) unless
+   they are masked (≥ 90 % no-data/exclusion/no overlap) or tiny (< ½ window usable). Their
+   planes are filled from the neighbours over the component graph (barrier-aware) for the
+   next level (masked ones too, as predictions only).
 
-At level 0 the accepted FBM points are optionally refined by epipolar LSM (3 geometric + 2
-radiometric unknowns, :func:`.lsm.lsm_match`); points that do not converge or fail the σ_px /
-ρ thresholds keep their FBM value and get :data:`FLAG_LSM_FAILED`.
+At level 0 the accepted FBM points are refined by epipolar LSM (3 geometric + 2 radiometric
+unknowns, :func:`.lsm.lsm_match`); points that do not converge or fail the σ_px / ρ
+thresholds are **rejected** (seed §2.12; on the NGI pairs every FBM point off by > 2 px was
+among them) unless ``lsm_reject=False`` (then they keep their FBM value with
+:data:`FLAG_LSM_FAILED`). Then **grid densification** (``grid_step``, default 4 px): every
+grid node of a component with a plane (matched, or filled from matched neighbours) is
+searched by NCC around the plane (± the pull-in: a per-point refinement, the plane need not
+fit rough terrain), refined by LSM and kept only if LSM accepts it and the right→left NCC
+search returns to it (:data:`FLAG_GRID`); seed §3.1 "good points in regularly densified
+sub-images". This gives the 24 m DSM of mountainous terrain ~5 % of the pixels as points
+instead of ~0.3 %.
 
 Point flags (bits of ``EpipolarMatches.flags``):
 
@@ -42,6 +69,7 @@ bit    name                        meaning
 16     :data:`FLAG_DENSIFIED`      window matched with denser points (reduced step)
 32     :data:`FLAG_RETRY`          window matched in a later wave from its neighbours'
                                    predictions (came back from another side)
+64     :data:`FLAG_GRID`           grid densification point (LSM)
 =====  ==========================  ============================================================
 
 Only accepted points are returned (bidirectional failures and outliers are counted in
@@ -56,6 +84,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from ..errors import InputError
 from ..processing.feedback import ensure_feedback
@@ -66,11 +95,13 @@ from .fbm import (
     detect_features,
     fbm_level,
     fill_nodata,
+    group_weighted_median,
     group_wls,
     window_components,
 )
 from .interest import InterestPoints
 from .lsm import lsm_match
+from .ncc import ncc_epipolar
 from .pyramid import build_pyramid, from_level, levels_for_disparity, to_level
 
 FLAG_LSM = 1
@@ -78,7 +109,8 @@ FLAG_LSM_FAILED = 2
 FLAG_ENLARGED = 8
 FLAG_DENSIFIED = 16
 FLAG_RETRY = 32
-__all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_LSM",
+FLAG_GRID = 64
+__all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_GRID", "FLAG_LSM",
            "FLAG_LSM_FAILED", "FLAG_RETRY", "EpipolarMatches", "FbmLsmOptions",
            "match_epipolar_fbm_lsm"]
 
@@ -100,18 +132,35 @@ class FbmLsmOptions:
         Förstner roundness threshold and weight factor × median(w).
     nms_window : int
         Non-maximum suppression of the interest points (5 → ≤ 4 % of the pixels).
+    local_cell : int, optional
+        Sub-images (px of each level) with their own Förstner weight threshold
+        ``w_factor × median(w)`` (seed §2.3: homogeneous point distribution on images with
+        strong texture differences); None → 2 × fbm_window; 0 → one global threshold.
+    local_floor : float
+        A sub-image's median counts at least this share of the image's median (keeps noise in
+        uniform areas out).
     ncc_window : int
         Window of the candidate correlation ρ (seed ≈ 5 × 5).
     refine_window : int
         Window of the NCC parabola for the sub-pixel disparity.
     rho_min : float
         Candidates need ρ ≥ rho_min (seed 0.5–0.7).
+    candidates : {"correlation", "features"}
+        Candidate source (:func:`.fbm.fbm_level`): local maxima of the NCC profile along the
+        right epipolar row for every left Förstner point (default: no need for the same point
+        to be detected in both images, which on real images holds for only about half of
+        them), or the right Förstner points (the seed's pure FBM).
+    max_peaks : int
+        Correlation candidates per point (the highest local NCC maxima). 1 (default): in
+        weak texture the lower maxima of 7 × 7 windows are dense enough that a few of them
+        agree on a false plane by chance; the best peak of each point rarely does.
     fbm_window : int
         Matching-window side, px (seed 30–40, ≈ 32).
     pull_in : float, optional
         Half width of the candidate search around the prediction, px. None → fbm_window/8
         (4 px) when predicted from the coarser level, fbm_window/4 (8 px, the FBM convergence
-        range of the seed) when growing from seeds or neighbours.
+        range of the seed) when growing from seeds or neighbours; with correlation candidates
+        at least 4 and 8 px (small windows on steep terrain).
     bidir_tol : float
         Left→right and right→left disparities must agree within this, px.
     row_tol : float
@@ -135,6 +184,20 @@ class FbmLsmOptions:
         Gauss–Newton iteration limit.
     lsm_pull_in : float
         LSM may move the disparity at most this far from the FBM value, px.
+    lsm_reject : bool
+        Drop level-0 points whose LSM fails (seed §2.12: reject by σ_px / ρ / convergence);
+        False keeps their FBM value with :data:`FLAG_LSM_FAILED`.
+    neighbour_tol : float
+        A matched window component whose plane differs from the median of its (≥ 3) matched
+        neighbours' planes by more than max(neighbour_tol, pull-in/2) px at its centre is
+        redone once from its neighbours (0 = off).
+    grid_step : int
+        With ``lsm``: densification on a regular grid of this step (level-0 px; 0 = off).
+        Every grid node of a matched window component is predicted from the component's FBM
+        plane, refined per point by an NCC search within ± the FBM pull-in (so the plane
+        need not fit rough terrain) and then by LSM; only nodes passing the LSM thresholds
+        are kept (:data:`FLAG_GRID`). Seed §3.1: "good points in regularly densified
+        sub-images" (Hannah) and "match many points, then select the locally best".
     """
 
     levels: Optional[int] = None
@@ -142,9 +205,13 @@ class FbmLsmOptions:
     q_min: float = 0.6
     w_factor: float = 1.0
     nms_window: int = 5
+    local_cell: Optional[int] = None
+    local_floor: float = 0.0625
     ncc_window: int = 7
     refine_window: int = 9
     rho_min: float = 0.6
+    candidates: str = "correlation"
+    max_peaks: int = 1
     fbm_window: int = 32
     pull_in: Optional[float] = None
     bidir_tol: float = 1.0
@@ -165,6 +232,9 @@ class FbmLsmOptions:
     lsm_min_rho: float = 0.7
     lsm_max_iter: int = 20
     lsm_pull_in: float = 2.0
+    lsm_reject: bool = True
+    neighbour_tol: float = 2.0
+    grid_step: int = 4
 
 
 @dataclass
@@ -308,6 +378,10 @@ class _Collected:
                                res.sigma_px[sel], (res.flags[sel] | flag).astype(np.uint8),
                                res.group[sel]))
 
+    def drop_groups(self, drop: NDArray) -> None:
+        """Remove the points of the components marked in ``drop``."""
+        self.parts = [tuple(a[~drop[p[6]]] for a in p) for p in self.parts]
+
     def arrays(self) -> Tuple[NDArray, ...]:
         if not self.parts:
             return (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, np.float32),
@@ -380,10 +454,18 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     Lf, vL = fill_nodata(L0)
     Rf, vR = fill_nodata(R0)
     ws = int(opt.fbm_window)
+    lsm_window = 2 * int(opt.lsm_half) + 1
+    margin_coarse = max(opt.ncc_window + 4, opt.refine_window) // 2 + 1
+    margin0 = max(margin_coarse, lsm_window // 2 + 1 if opt.lsm else 0)
     if opt.levels is None:
         n_levels = levels_for_disparity(max_d - min_d, pull_in=ws / 4.0, min_size=2 * ws,
                                         shape=(min(L0.shape[0], R0.shape[0]),
                                                min(L0.shape[1], R0.shape[1])))
+        # the top level must hold at least one whole matching window (plus the margins where
+        # no point can lie) across the stereo overlap, else nothing can be matched there
+        overlap0 = _overlap_width(vL, vR, min_d, max_d)
+        while n_levels > 1 and overlap0 / 2.0 ** (n_levels - 1) < ws + 2 * margin_coarse:
+            n_levels -= 1
     else:
         n_levels = max(1, int(opt.levels))
     pl = build_pyramid(Lf, n_levels)
@@ -394,22 +476,27 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     mp = _mask_pyramid(mask, n_levels)
     bp = _mask_pyramid(barriers, n_levels)
     top = n_levels - 1
-    lsm_window = 2 * int(opt.lsm_half) + 1
-    margin = max(opt.ncc_window + 4, opt.refine_window, lsm_window if opt.lsm else 0) // 2 + 1
-    pull_ref = opt.pull_in if opt.pull_in is not None else ws / 8.0
-    pull_grow = opt.pull_in if opt.pull_in is not None else ws / 4.0
+    # the coarser level's plane is off by its relief curvature, not by a share of the window:
+    # small windows keep ≥ 4 px (8 px when growing) with correlation candidates, whose search
+    # is not bound to the FBM convergence range of a window
+    floor = 4.0 if opt.candidates == "correlation" else 0.0
+    pull_ref = opt.pull_in if opt.pull_in is not None else max(ws / 8.0, floor)
+    pull_grow = opt.pull_in if opt.pull_in is not None else max(ws / 4.0, 2.0 * floor)
     robust = {"huber_iterations": opt.huber_iterations,
               "redescending_iterations": opt.redescending_iterations,
               "huber_k": opt.huber_k, "redescending_c": opt.redescending_c,
               "reject_k": opt.reject_k, "sigma_floor": opt.sigma_floor}
     level_kw = {"rho_min": opt.rho_min, "row_tol": opt.row_tol, "bidir_tol": opt.bidir_tol,
                 "min_points": opt.min_points, "robust": robust,
-                "refine_window": opt.refine_window}
+                "refine_window": opt.refine_window, "candidates": opt.candidates,
+                "max_peaks": int(opt.max_peaks)}
+    use_right_features = opt.candidates == "features"
     cost = np.array([4.0 ** -k for k in range(n_levels)])
     done_cost = 0.0
     total_cost = float(cost.sum())
 
     prev: Optional[Tuple[NDArray, Grouping]] = None  # filled planes of the coarser level
+    prev_matched = np.zeros((0, 3))
     stats_levels: Dict[str, Any] = {}
     failures: List[NDArray] = []
     out_parts: List[Tuple[NDArray, ...]] = []
@@ -420,19 +507,35 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
         Lk, Rk = pl[k], pr[k]
         validL = ~vLp[k] if vLp[k] is not None else None
         validR = ~vRp[k] if vRp[k] is not None else None
+        margin = margin0 if k == 0 else margin_coarse
+        # left pixels whose search range [min_d, max_d] never reaches right-image data: no
+        # stereo overlap, so nothing to match (not a failure)
+        no_overlap = ~_overlap_mask(validR, Rk.shape, Lk.shape, min_d / scale - 1.0,
+                                    max_d / scale + 1.0, margin)
+        pm = prev_matched[np.isfinite(prev_matched[:, 0])]
+        if pm.size:
+            # sharper: the disparities the coarser level measured (its planes at their window
+            # corners, ± the growing pull-in) instead of the a-priori range. Not per pixel: a
+            # wrong coarse window must stay open for the neighbour check, not be masked
+            corners = (pm[:, :1] + pm[:, 1:2] * np.array([-0.5, 0.5, -0.5, 0.5])
+                       + pm[:, 2:3] * np.array([-0.5, -0.5, 0.5, 0.5]))
+            lo_all = max(2.0 * float(corners.min()) - pull_grow, min_d / scale) - 1.0
+            hi_all = min(2.0 * float(corners.max()) + pull_grow, max_d / scale) + 1.0
+            no_overlap |= ~_overlap_mask(validR, Rk.shape, Lk.shape, lo_all, hi_all, margin)
         excl = None
-        if mp[k] is not None or bp[k] is not None:
-            excl = np.zeros(Lk.shape, bool)
-            for m in (mp[k], bp[k]):
-                if m is not None:
-                    excl |= m
+        for m in (mp[k], bp[k], no_overlap if no_overlap.any() else None):
+            if m is not None:
+                excl = m.copy() if excl is None else (excl | m)
         grouping = window_components(Lk.shape, ws, bp[k])
         ng = grouping.n_groups
         fkw = {"window": opt.interest_window, "q_min": opt.q_min, "w_factor": opt.w_factor,
-               "nms_window": opt.nms_window, "margin": margin}
+               "nms_window": opt.nms_window, "margin": margin,
+               "local_cell": 2 * ws if opt.local_cell is None else int(opt.local_cell),
+               "local_floor": opt.local_floor}
         fl = detect_features(Lk, validL, excl, **fkw)
-        fr = detect_features(Rk, validR, None, **fkw)
-        # masked components: ≥ 90 % excluded or without data; tiny ones (< ¼ window usable,
+        fr = (detect_features(Rk, validR, None, **fkw) if use_right_features
+              else _no_points())
+        # masked components: ≥ 90 % excluded or without data; tiny ones (< ½ window usable,
         # e.g. cut by the image border, where no point can lie) are not failures
         lab = grouping.labels.ravel()
         bad_px = np.zeros(Lk.shape, bool)
@@ -440,12 +543,13 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
             bad_px |= mp[k]
         if validL is not None:
             bad_px |= ~validL
+        bad_px |= no_overlap
         n_bad = np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
         masked = n_bad >= 0.9 * np.maximum(grouping.area, 1)
         bad_px[:margin + 1, :] = bad_px[-margin - 1:, :] = True
         bad_px[:, :margin + 1] = bad_px[:, -margin - 1:] = True
         usable = grouping.area - np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
-        tiny = usable < 0.25 * ws * ws
+        tiny = usable < 0.5 * ws * ws
 
         # ---- predictions -----------------------------------------------------------------
         mode = np.zeros(ng, np.int8)
@@ -460,6 +564,11 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
                 return 2.0 * _eval_planes(p_plane, p_group, g1, c1, r1)
 
             mode[:] = _COARSE
+            # components the coarser level could not predict (nothing matched within reach
+            # there, e.g. a failed top level) search the whole range: never zero points
+            # silently
+            no_pred = ~np.isfinite(coarse(grouping.centres[:, 0], grouping.centres[:, 1]))
+            mode[no_pred] = _RANGE
         else:
             if approx is not None:
                 grid = np.asarray(approx[0], dtype=np.float64)
@@ -514,7 +623,23 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
         big: Optional[Grouping] = None
         fallback_done = k != top
         wave = 0
+        suspect_done = np.zeros(ng, bool)
         while True:
+            if not todo.any() and opt.neighbour_tol and opt.neighbour_tol > 0:
+                # consistency between windows: a component whose plane disagrees with the
+                # median of (≥ 3) matched neighbours is redone from its neighbours, once
+                sus = _suspect_components(plane, grouping, matched & ~suspect_done,
+                                          matched, max(float(opt.neighbour_tol),
+                                                       pull_ref / 2.0))
+                if sus.any():
+                    suspect_done |= sus
+                    matched &= ~sus
+                    plane[sus] = np.nan
+                    collected.drop_groups(sus)
+                    mode[sus] = _NEIGHBOURS
+                    tried_nb[sus] = -1
+                    todo = sus
+                    st["suspect_redone"] = st.get("suspect_redone", 0) + int(sus.sum())
             if not todo.any():
                 if fallback_done:
                     break
@@ -629,8 +754,8 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
                 c0 = max(int((wi % nwx).min()) * ws - pad, 0)
                 c1 = min(int((wi % nwx).max() + 1) * ws + pad, Lk.shape[1])
                 dfl = _detect_crop(Lk, validL, excl, r0, r1, c0, c1, dkw)
-                dfr = _detect_crop(Rk, validR, None, r0, min(r1, Rk.shape[0]), 0, Rk.shape[1],
-                                   dkw)
+                dfr = (_detect_crop(Rk, validR, None, r0, min(r1, Rk.shape[0]), 0,
+                                    Rk.shape[1], dkw) if use_right_features else _no_points())
                 gd = grouping.of(dfl.cols, dfl.rows)
                 sub = (gd >= 0) & failed[np.maximum(gd, 0)]
                 dfl_sub = InterestPoints(*(a[sub] for a in dfl))
@@ -666,7 +791,10 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
             c = grouping.centres[fail]
             failures.append(np.stack([from_level(c[:, 0], k), from_level(c[:, 1], k),
                                       np.full(len(c), k, float)], 1))
-        prev = (_fill_planes(plane, grouping, matched, masked), grouping)
+        # predictions for the next level everywhere (also into masked components, which
+        # only sharpens the overlap there; nothing is matched in them)
+        prev = (_fill_planes(plane, grouping, matched, np.zeros(ng, bool)), grouping)
+        prev_matched = np.where(matched[:, None], plane, np.nan)  # measured planes only
         if k == 0 or opt.keep_coarse:
             out_parts.append((from_level(col, k), from_level(row, k), d * scale,
                               (sig * scale).astype(np.float32), rho.astype(np.float32),
@@ -680,7 +808,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
 
     col, row, disp, sig, rho, flags, level = (np.concatenate(p) for p in zip(*out_parts))
     total: Dict[str, Any] = {"levels": n_levels, "seeds_used": n_seeds_used,
-                             "lsm_tried": 0, "lsm_failed": 0}
+                             "lsm_tried": 0, "lsm_failed": 0, "lsm_rejected": 0}
     if opt.lsm:
         t_lsm = time.perf_counter()
         sel = np.flatnonzero(level == 0)
@@ -698,9 +826,33 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
             flags[sel[~good]] |= FLAG_LSM_FAILED
             total["lsm_tried"] = int(sel.size)
             total["lsm_failed"] = int((~good).sum())
+            if opt.lsm_reject and (~good).any():
+                # seed §2.12: reject by the LSM thresholds — on real images nearly every gross
+                # FBM error (> 2 px) is among these points
+                keep = np.ones(col.size, bool)
+                keep[sel[~good]] = False
+                col, row, disp, sig, rho, flags, level = (
+                    a[keep] for a in (col, row, disp, sig, rho, flags, level))
+                total["lsm_rejected"] = int((~keep).sum())
         total["lsm_seconds"] = round(time.perf_counter() - t_lsm, 3)
         stats_levels["0"]["lsm_tried"] = total["lsm_tried"]
+        if opt.grid_step and opt.grid_step > 0:
+            t_grid = time.perf_counter()
+            fb.check()
+            # failed components are predicted from their neighbours' planes (wider search)
+            g_plane = _fill_planes(plane, grouping, matched, masked)
+            g_pull = np.where(matched, pull_ref, pull_grow)
+            g_parts, g_stats = _grid_points(Lf, Rf, grouping, g_plane, g_pull, excl, validL,
+                                            margin, int(opt.grid_step), opt, lsm_window)
+            if g_parts is not None:
+                col, row, disp, sig, rho, flags, level = (
+                    np.concatenate([a, b]) for a, b in zip(
+                        (col, row, disp, sig, rho, flags, level), g_parts))
+            g_stats["seconds"] = round(time.perf_counter() - t_grid, 3)
+            total["grid"] = g_stats
+            stats_levels["0"]["grid_points"] = g_stats["accepted"]
         stats_levels["0"]["lsm_failed"] = total["lsm_failed"]
+        stats_levels["0"]["lsm_rejected"] = total.get("lsm_rejected", 0)
     fb.progress(100.0)
     fail_arr = np.concatenate(failures) if failures else np.zeros((0, 3))
     total["points"] = int(col.size)
@@ -711,12 +863,158 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
                            {"levels": stats_levels, "total": total}, fail_arr)
 
 
+def _suspect_components(plane: NDArray, grouping: Grouping, test: NDArray, matched: NDArray,
+                        tol: float) -> NDArray:
+    """Components (of ``test``) whose plane disagrees with their matched neighbours.
+
+    At the component's centre, the planes of its matched neighbours (over the barrier-free
+    graph) are evaluated; with at least 3 of them, the component is suspect when its own
+    plane differs from their median by more than ``tol`` px. A single wrong window (a
+    consistent but false set of correlation peaks, e.g. from a wrong coarse prediction)
+    is thus caught by the majority around it; real relief changes smoothly across windows.
+    """
+    ng = grouping.n_groups
+    out = np.zeros(ng, bool)
+    e = grouping.edges
+    if e.size == 0:
+        return out
+    e = e[test[e[:, 0]] & matched[e[:, 1]]]
+    if e.size == 0:
+        return out
+    c = grouping.centres
+    s, d = e[:, 0], e[:, 1]
+    u, v = grouping.uv(c[s, 0], c[s, 1], d)
+    val = plane[d, 0] + plane[d, 1] * u + plane[d, 2] * v
+    cnt = np.bincount(s, minlength=ng)
+    med = group_weighted_median(val, np.ones(val.size), s, ng)
+    own = plane[:, 0]  # the plane at its own centre (u = v = 0)
+    out = (cnt >= 3) & test & np.isfinite(med) & (np.abs(own - med) > tol)
+    return out
+
+
+def _overlap_width(valid_left: NDArray, valid_right: NDArray, min_d: float, max_d: float
+                   ) -> float:
+    """Width (level-0 px) of the left columns whose search range reaches right-image data.
+
+    A left column c overlaps when some right column c − d, d ∈ [min_d, max_d], holds data in
+    any row: c ∈ [c_r,min + min_d, c_r,max + max_d] ∩ the left columns with data.
+    """
+    cl = np.flatnonzero(valid_left.any(axis=0))
+    cr = np.flatnonzero(valid_right.any(axis=0))
+    if cl.size == 0 or cr.size == 0:
+        return 0.0
+    lo = max(float(cl[0]), cr[0] + min_d)
+    hi = min(float(cl[-1]), cr[-1] + max_d)
+    return max(hi - lo + 1.0, 0.0)
+
+
+def _overlap_mask(valid_right: Optional[NDArray], right_shape: Tuple[int, int],
+                  left_shape: Tuple[int, int], lo: float, hi: float, margin: int) -> NDArray:
+    """Left pixels (r, c) with right data at (r, c − d) for some d ∈ [lo, hi] (level px).
+
+    The right image's data (eroded by ``margin`` so that a correlation window fits) is summed
+    cumulatively along the rows; a left pixel overlaps when the sum over the columns
+    [c − hi, c − lo] is positive. Rows beyond the right image have no overlap.
+    """
+    h, w = left_shape
+    hr, wr = right_shape
+    vr = np.ones((hr, wr), bool) if valid_right is None else np.asarray(valid_right, bool)
+    vr = vr.copy()
+    m = int(margin)
+    if m > 0:
+        vr[:, :m] = vr[:, wr - m:] = False
+        vr[:m, :] = vr[hr - m:, :] = False
+        if valid_right is not None and not np.all(valid_right):
+            vr &= ~ndimage.maximum_filter(~np.asarray(valid_right, bool), size=2 * m + 1,
+                                          mode="constant", cval=True)
+    rows = min(h, hr)
+    cs = np.zeros((rows, wr + 1), np.int64)
+    cs[:, 1:] = np.cumsum(vr[:rows], axis=1)
+    c = np.arange(w, dtype=np.float64)
+    a = np.clip(np.ceil(c - hi), 0, wr).astype(np.int64)  # first right column (incl.)
+    b = np.clip(np.floor(c - lo) + 1, 0, wr).astype(np.int64)  # last right column + 1
+    out = np.zeros((h, w), bool)
+    out[:rows] = (cs[:, b] - cs[:, a]) > 0
+    return out
+
+
+def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
+                 pull: NDArray, excl: Optional[NDArray], valid: Optional[NDArray],
+                 margin: int, step: int, opt: FbmLsmOptions, lsm_window: int
+                 ) -> Tuple[Optional[Tuple[NDArray, ...]], Dict[str, Any]]:
+    """Level-0 grid densification (see ``FbmLsmOptions.grid_step``).
+
+    Nodes ``(step/2 + i·step)`` of components with a plane (NaN rows: none), away from
+    no-data, exclusions, barriers and the image border; prediction = the component's plane;
+    NCC search (``refine_window``) within ± ``pull[component]`` px, peak ρ ≥ ``rho_min`` and
+    ambiguity ≤ 0.9; then epipolar LSM, kept only when valid (σ_px, ρ, convergence).
+    """
+    h, w = Lf.shape
+    st: Dict[str, Any] = {"nodes": 0, "ncc_ok": 0, "accepted": 0}
+    ok_px = np.ones((h, w), bool)
+    if excl is not None:
+        ok_px &= ~excl
+    if valid is not None and not np.all(valid):
+        ok_px &= ~ndimage.maximum_filter(~valid, size=2 * margin + 1, mode="constant",
+                                         cval=True)
+    ok_px[:margin + 1, :] = ok_px[h - margin - 1:, :] = False
+    ok_px[:, :margin + 1] = ok_px[:, w - margin - 1:] = False
+    r0 = step // 2
+    rr, cc = np.mgrid[r0:h:step, r0:w:step]
+    rr, cc = rr.ravel(), cc.ravel()
+    sel = ok_px[rr, cc]
+    rr, cc = rr[sel].astype(float), cc[sel].astype(float)
+    g = grouping.of(cc, rr)
+    d = _eval_planes(plane, grouping, g, cc, rr)
+    sel = np.isfinite(d)
+    rr, cc, d, p = rr[sel], cc[sel], d[sel], pull[g[sel]]
+    st["nodes"] = int(rr.size)
+    if rr.size == 0:
+        return None, st
+    res = ncc_epipolar(Lf, Rf, cc, rr, np.floor(d - p), np.ceil(d + p),
+                       window=opt.refine_window, min_ncc=opt.rho_min, max_ratio=0.9)
+    good_ncc = res.valid & np.isfinite(res.cols)
+    st["ncc_ok"] = int(good_ncc.sum())
+    rr, cc, cr = rr[good_ncc], cc[good_ncc], res.cols[good_ncc]
+    if rr.size == 0:
+        return None, st
+    lsm = lsm_match(Lf, Rf, cc, rr, cr, None, window=lsm_window, model="epipolar",
+                    max_iter=opt.lsm_max_iter, max_shift=opt.lsm_pull_in,
+                    min_corr=opt.lsm_min_rho, max_sigma=opt.lsm_max_sigma)
+    good = lsm.valid & np.isfinite(lsm.cols)
+    st["lsm_ok"] = int(good.sum())
+    if good.any() and opt.bidir_tol is not None and np.isfinite(opt.bidir_tol):
+        # right → left over the same interval: occlusions and repetitive texture give a
+        # different best match back (the bidirectional check of the FBM points, seed §2.8)
+        gi = np.flatnonzero(good)
+        dd = cc[gi] - lsm.cols[gi]
+        pg = p[good_ncc][gi]
+        back = ncc_epipolar(Rf, Lf, lsm.cols[gi], rr[gi], np.floor(-dd - pg),
+                            np.ceil(-dd + pg), window=opt.refine_window,
+                            min_ncc=opt.rho_min, max_ratio=1.0)
+        agree = back.valid & (np.abs(-back.disparity - dd) <= opt.bidir_tol)
+        good[gi[~agree]] = False
+    st["accepted"] = int(good.sum())
+    if not good.any():
+        return None, st
+    n = int(good.sum())
+    parts = (cc[good], rr[good], cc[good] - lsm.cols[good],
+             lsm.sigma_col[good].astype(np.float32), lsm.corr[good].astype(np.float32),
+             np.full(n, FLAG_GRID | FLAG_LSM, np.uint8), np.zeros(n, np.int8))
+    return parts, st
+
+
+def _no_points() -> InterestPoints:
+    return InterestPoints(np.zeros(0), np.zeros(0), np.zeros(0, np.float32),
+                          np.zeros(0, np.float32))
+
+
 def _detect_crop(img: NDArray, valid: Optional[NDArray], excl: Optional[NDArray], r0: int,
                  r1: int, c0: int, c1: int, kw: dict) -> InterestPoints:
     """:func:`.fbm.detect_features` on a crop, in the coordinates of the whole image."""
     crop = (slice(r0, r1), slice(c0, c1))
     if r1 - r0 < 8 or c1 - c0 < 8:
-        return InterestPoints(*(np.zeros(0) for _ in range(4)))
+        return _no_points()
     f = detect_features(img[crop], None if valid is None else valid[crop],
                         None if excl is None else excl[crop], **kw)
     return InterestPoints(f.cols + c0, f.rows + r0, f.w, f.q)

@@ -8,6 +8,8 @@ from scipy import ndimage
 
 from photodem.algorithms.matching.fbm import (
     candidate_pairs,
+    correlation_candidates,
+    detect_features,
     fbm_match,
     group_weighted_median,
     one_to_one,
@@ -170,3 +172,58 @@ def test_mask_and_nodata_single_level(textured):
     ci, ri = np.rint(res.col).astype(int), np.rint(res.row).astype(int)
     assert not mask[ri, ci].any()
     assert res.col.min() > 20
+
+
+def test_correlation_candidates_find_a_known_shift():
+    """Constant shift 7.3 px: the best NCC maximum of every point is at 7.3 ± 0.15 px."""
+    rng = np.random.default_rng(5)
+    t = ndimage.gaussian_filter(rng.standard_normal((120, 300)), 1.5)
+    tex = 100 + 30 * t / t.std()
+    yy, xx = np.mgrid[0:120, 0:260].astype(float)
+    right = ndimage.map_coordinates(tex, [yy, xx + 7.3], order=3)
+    left = tex[:, :260]
+    ca, ra = rng.uniform(30, 230, 200), rng.integers(10, 110, 200).astype(float)
+    lo = np.full(200, 2.0)
+    hi = np.full(200, 14.0)
+    hi[::10] = np.nan  # no prediction: no candidates
+    ia, d, rho = correlation_candidates(left.astype(np.float32), right.astype(np.float32), ca,
+                                        ra, lo, hi, window=7, rho_min=0.6, max_peaks=1)
+    assert not np.isin(np.arange(0, 200, 10), ia).any()
+    assert ia.size >= 175 and np.unique(ia).size == ia.size
+    # fractional point positions carry over: d refers to the sub-pixel point itself
+    assert np.median(np.abs(d - 7.3)) < 0.1 and np.abs(d - 7.3).max() < 0.5
+    assert (rho >= 0.6).all()
+    # several maxima per point, the best first; none on the ends of the range
+    ia3, d3, _ = correlation_candidates(left.astype(np.float32), right.astype(np.float32), ca,
+                                        ra, lo, hi, window=7, rho_min=0.0, max_peaks=3)
+    assert np.bincount(ia3).max() <= 3 and ia3.size > ia.size
+    assert ((d3 > 2.0) & (d3 < 14.0)).all()
+
+
+def test_correlation_candidates_match_accurately(textured):
+    left, right, truth = textured
+    res = fbm_match(left, right, 0.0, 20.0, candidates="correlation")
+    e = res.disparity - truth(res.col, res.row)
+    feat = fbm_match(left, right, 0.0, 20.0)
+    assert res.col.size > 1.2 * feat.col.size  # no need for the same point in both images
+    assert np.median(np.abs(e)) <= 0.2
+    assert np.mean(np.abs(e) <= 1.0) >= 0.98
+
+
+def test_local_thresholds_give_points_in_weak_texture():
+    """Half the image with 10 × weaker texture: a global median threshold leaves it almost
+    empty, sub-image thresholds do not; a uniform (noise-free) area never gets points."""
+    rng = np.random.default_rng(2)
+    t = ndimage.gaussian_filter(rng.standard_normal((256, 256)), 1.5)
+    img = 100 + 30 * t / t.std()
+    img[:, 128:] = 100 + 3 * t[:, 128:] / t.std()
+    img[96:160, 160:224] = 100.0
+    glob = detect_features(img, window=5, margin=5)
+    loc = detect_features(img, window=5, margin=5, local_cell=64)
+    weak_g = np.sum(glob.cols > 130)
+    weak_l = np.sum(loc.cols > 130)
+    strong_g, strong_l = np.sum(glob.cols < 126), np.sum(loc.cols < 126)
+    assert weak_g < 0.1 * strong_g
+    assert weak_l > 0.35 * strong_l  # the uniform square takes 1/8 of the weak half
+    flat = (loc.cols > 166) & (loc.cols < 218) & (loc.rows > 102) & (loc.rows < 154)
+    assert not flat.any()

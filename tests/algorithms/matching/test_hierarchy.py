@@ -9,10 +9,13 @@ import pytest
 from scipy import ndimage
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.matching.fbm import window_components
 from photodem.algorithms.matching.hierarchy import (
+    FLAG_GRID,
     FLAG_LSM,
     FLAG_LSM_FAILED,
     FbmLsmOptions,
+    _suspect_components,
     match_epipolar_fbm_lsm,
 )
 from photodem.algorithms.processing.feedback import Feedback
@@ -78,7 +81,9 @@ def test_fbm_accuracy_and_lsm_refinement(pair):
     assert np.median(np.abs(e)) <= 0.3
     assert np.mean(np.abs(e) <= 1.0) >= 0.95
     assert (fbm.level == 0).all() and not (fbm.flags & (FLAG_LSM | FLAG_LSM_FAILED)).any()
-    m = match_epipolar_fbm_lsm(left, right, 0.0, 40.0)
+    # the FBM points only (no grid densification): LSM refines the same points
+    m = match_epipolar_fbm_lsm(left, right, 0.0, 40.0, options=FbmLsmOptions(grid_step=0,
+                                                                             lsm_reject=False))
     el = m.disparity - truth(m.col, m.row)
     lsm = (m.flags & FLAG_LSM) > 0
     assert lsm.mean() > 0.95
@@ -226,3 +231,72 @@ def test_progress_and_approx_grid(pair):
     e = m.disparity - truth(m.col, m.row)
     assert np.mean(np.abs(e) <= 1.0) >= 0.98
     assert _window_coverage(m, left.shape) >= 0.98
+
+
+def test_grid_densification_and_lsm_rejection(pair):
+    """Default: FBM points + LSM-checked grid nodes every 4 px; failed LSM points dropped."""
+    left, right, truth = pair
+    m = match_epipolar_fbm_lsm(left, right, 0.0, 40.0)
+    e = m.disparity - truth(m.col, m.row)
+    grid = (m.flags & FLAG_GRID) > 0
+    assert len(m) > 0.04 * left.size and grid.sum() > 0.8 * len(m)
+    assert np.sqrt(np.mean(e[grid] ** 2)) <= 0.1
+    assert np.mean(np.abs(e) <= 1.0) >= 0.999
+    assert not (m.flags & FLAG_LSM_FAILED).any() and (m.flags & FLAG_LSM).all()
+    tot = m.stats["total"]
+    assert tot["lsm_rejected"] == tot["lsm_failed"]
+    assert tot["grid"]["accepted"] == grid.sum() and tot["points"] == len(m)
+    json.dumps(m.stats)
+
+
+def _narrow_overlap(shift=380, w=480, h=320, seed=8):
+    """Right image = left shifted by ``shift`` px: only w − shift columns overlap."""
+    tex = _texture(h, w + shift + 20, seed)
+    rng = np.random.default_rng(seed)
+    left = tex[:, :w] + rng.normal(0, 2.0, (h, w))
+    right = 0.9 * tex[:, shift:shift + w] + 10 + rng.normal(0, 2.0, (h, w))
+    return left.astype(np.float32), right.astype(np.float32)
+
+
+@pytest.mark.parametrize("window", [16, 24, 32, 48])
+def test_narrow_overlap_never_zero_points(window):
+    """A 100 px overlap strip: the pyramid keeps a whole window across the overlap at the top,
+    windows without overlap are masked (not failures), every window size gives points."""
+    shift = 380
+    left, right = _narrow_overlap(shift)
+    m = match_epipolar_fbm_lsm(left, right, shift - 40.0, shift + 40.0,
+                               options=FbmLsmOptions(fbm_window=window))
+    assert len(m) > 0.03 * left.shape[0] * (left.shape[1] - shift)
+    assert np.mean(np.abs(m.disparity - shift) <= 0.5) >= 0.99
+    assert m.col.min() >= shift - 41  # nothing where the range cannot reach the right image
+    assert m.stats["levels"]["0"]["failure_pct"] <= 10.0
+    top = m.stats["levels"][str(m.stats["total"]["levels"] - 1)]
+    assert top["accepted"] > 0
+
+
+def test_failed_coarse_level_falls_back_to_the_range():
+    """Top level without texture (a blurred copy → no features there): the level below
+    searches the whole range instead of returning nothing."""
+    left, right, _ = _pair()
+    opt = FbmLsmOptions(levels=3, lsm=False, grid_step=0, densify=False, enlarge=False,
+                        rho_min=0.999)  # nothing passes on the top level ...
+    m = match_epipolar_fbm_lsm(left, right, 0.0, 40.0, options=opt)
+    assert len(m) == 0 or m.stats["levels"]["2"]["accepted"] == 0
+    # ... while with the normal threshold on the lower levels the range fallback matches
+    opt = FbmLsmOptions(levels=3, lsm=False, grid_step=0)
+    m = match_epipolar_fbm_lsm(left, right, 0.0, 40.0, options=opt)
+    assert len(m) > 0.008 * left.size
+
+
+def test_suspect_components_majority_of_neighbours():
+    grp = window_components((160, 160), 32)
+    plane = np.zeros((grp.n_groups, 3))
+    plane[:, 0] = 10.0 + 0.05 * grp.centres[:, 0]  # a tilted plane (disparity per window)
+    plane[:, 1] = 0.05 * 32  # its slope in window units
+    plane[12, 0] += 5.0  # the centre window is wrong by 5 px
+    matched = np.ones(grp.n_groups, bool)
+    sus = _suspect_components(plane, grp, matched, matched, 2.0)
+    assert sus.tolist() == [k == 12 for k in range(grp.n_groups)]
+    # a corner window with only 2 matched neighbours is never judged
+    plane[0, 0] += 5.0
+    assert not _suspect_components(plane, grp, matched, matched, 2.0)[0]
