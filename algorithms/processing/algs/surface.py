@@ -149,13 +149,13 @@ class RefineObjectSpace(Algorithm):
         Parameter("levels", "integer", "Pyramid levels", default=2, minimum=1, maximum=8,
                   help="Image-pyramid levels, coarse to fine; each level doubles the pull-in "
                        "range (≈ 2 px of parallax on the top level)."),
-        Parameter("max_iter", "integer", "Iterations per level", default=8, minimum=1,
+        Parameter("max_iter", "integer", "Iterations per level", default=8, minimum=0,
                   maximum=50, help="Gauss–Newton iterations per level at most."),
         Parameter("regularisation", "number", "Regularisation share", default=1.0,
                   minimum=0.0, maximum=1000.0,
                   help="Weight of the curvature regularisation relative to the image data on "
                        "the height diagonal of the normal equations (0 = none)."),
-        Parameter("regularisation_mode", "enum", "Regularisation", default="curvature",
+        Parameter("regularisation_mode", "enum", "Regularisation", default="correction",
                   options=("curvature", "correction"),
                   help="curvature: smooth surface (thesis); correction: smooth only the "
                        "change to the input DSM (keeps buildings and edges)."),
@@ -194,7 +194,7 @@ class RefineObjectSpace(Algorithm):
             project, dsm, out, spacing=params.get("spacing") or None,
             levels=params.get("levels"), max_iter=params.get("max_iter", 8),
             regularisation=params.get("regularisation", 1.0),
-            regularisation_mode=params.get("regularisation_mode", "curvature"),
+            regularisation_mode=params.get("regularisation_mode", "correction"),
             facet_px=params.get("facet_px", 8.0), grey_px=params.get("grey_px", 2.0),
             images=images or None, tile=params.get("tile", 192), feedback=feedback)
 

@@ -23,7 +23,10 @@ from photodem.algorithms.errors import Cancelled, InputError
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.matching.object_space import (
+    _ImageWindow,
+    _screen,
     _second_difference_rows,
+    _visibility,
     pcg,
     refine_object_space,
 )
@@ -115,6 +118,46 @@ def test_curvature_rows_vanish_on_planes() -> None:
         np.arange(R.shape[0]) < 25, 2.0, 0.0))
 
 
+def test_visibility_box_shadow_closed_form() -> None:
+    """A 4 m box on flat ground, seen from far away at t = 0.5 m horizontal per m of rise
+    (towards +X): the ground within 4·0.5 = 2 m west of the box is hidden, the rest visible;
+    the one-cell walls are grazing for a nadir view."""
+    n, sp = 60, 0.5
+    surf = np.zeros((n, n))
+    surf[20:40, 20:40] = 4.0
+    x_first, y_first = 0.25, 29.75  # cell (0, 0) centre
+    rr, cc = np.mgrid[0:n, 0:n]
+    X = (x_first + cc * sp).ravel().astype(float)
+    Y = (y_first - rr * sp).ravel().astype(float)
+    Z = surf.ravel()
+    far = ExteriorOrientation.from_opk([15.0 + 5000.0, 15.0, 10000.0], 0, 0, 0)
+    nadir = ExteriorOrientation.from_opk([15.0, 15.0, 10000.0], 0, 0, 0)
+    wins = [_ImageWindow("far", None, far, 0, 0), _ImageWindow("nadir", None, nadir, 0, 0)]
+    vis = _visibility(wins, X, Y, Z, surf, x_first, y_first, sp).reshape(2, n, n)
+    west_wall = x_first + 20 * sp - 0.5 * sp  # X of the box's west face
+    d = west_wall - (x_first + cc * sp)  # horizontal distance to the face (west of it > 0)
+    rows_box = (rr >= 22) & (rr < 38)
+    hidden = rows_box & (d > 0.5) & (d < 1.6)
+    seen = rows_box & (d > 2.4) & (d < 8.0)
+    assert not vis[0][hidden].any()
+    assert vis[0][seen].all() and vis[1][hidden | seen].all()
+    assert vis[0][25:35, 23:37].all() and vis[1][25:35, 23:37].all()  # the roof
+    assert not vis[1][rows_box & (cc == 19)].any()  # the wall ramp: grazing
+
+
+def test_screen_flags_a_disturbed_image() -> None:
+    rng = np.random.default_rng(4)
+    n = 4000
+    G = 100 + 30 * rng.standard_normal(n)
+    h0, h1 = np.array([0.0, 5.0, -3.0]), np.array([1.0, 0.8, 1.25])
+    g = (G[None, :] - h0[:, None]) / h1[:, None] + rng.standard_normal((3, n))
+    g[2, 123] += 60.0  # a "car" in one image
+    g[1, 77:80] = np.nan  # not seen
+    seen = np.isfinite(g)
+    rej = _screen(g, np.zeros((3, n)), seen, h0, h1, np.zeros(n), 4.0)
+    assert rej[123] and rej.sum() <= 1 + 0.002 * n
+
+
 # -- the synthetic scene ----------------------------------------------------------------------
 def test_refinement_approaches_truth_with_consistent_sigma(scene, tmp_path) -> None:
     res = refine_object_space(scene["root"], scene["dsm"], tmp_path / "out")
@@ -190,3 +233,48 @@ def test_bad_input_is_one_line_error(scene, tmp_path) -> None:
     with pytest.raises(InputError, match="does not exist"):
         refine_object_space(scene["root"], tmp_path / "missing.tif", tmp_path / "o")
     assert not (tmp_path / "o").exists()
+
+
+def test_no_iteration_reproduces_the_input(scene, tmp_path) -> None:
+    res = refine_object_space(scene["root"], scene["dsm"], tmp_path / "o", max_iter=0)
+    with rasterio.open(scene["dsm"]) as a, rasterio.open(res["dsm"]) as b:
+        z0, z1 = a.read(1), b.read(1)
+    ok = np.isfinite(z1)
+    assert ok.mean() > 0.9 and np.array_equal(z0[ok], z1[ok])
+
+
+def test_window_cameras_give_the_same_surface(scene, tmp_path) -> None:
+    """Images cut to windows of their frames (principal point far from the window centre, as
+    the synthetic aerial block renders them) must refine the same surface as the full frames."""
+    from photodem.algorithms.geometry.camera import Camera as Cam
+
+    proj = Project.load(scene["root"])
+    root = tmp_path / "win"
+    (root / "images").mkdir(parents=True)
+    cams, recs = {}, []
+    for k, rec in enumerate(proj.images):
+        cam = proj.camera_of(rec)
+        # windows that hold the DSM and its overlap in every image, at even offsets (the
+        # pyramid lattice); 100 px off-centre at most
+        c0, r0, w, h = (100, 40, 140, 160) if k == 0 else (40, 36, 160, 164) if k == 1 \
+            else (0, 40, 140, 160)
+        with rasterio.open(proj.image_path(rec)) as src:
+            img = src.read(window=((r0, r0 + h), (c0, c0 + w)))
+        write_raster(root / "images" / f"{rec.name}.tif", img)
+        px, py = cam.pixel_size
+        pp = (cam.principal_point[0] - (c0 + (w - 1) / 2 - (cam.width - 1) / 2) * px,
+              cam.principal_point[1] + (r0 + (h - 1) / 2 - (cam.height - 1) / 2) * py)
+        cams[f"w{k}"] = Cam(f"w{k}", w, h, focal_length=cam.focal_length,
+                            pixel_size=cam.pixel_size, principal_point=pp)
+        recs.append(ImageRecord(rec.name, f"images/{rec.name}.tif", f"w{k}", rec.eo))
+    Project(root=root, name="win", crs=CRS, cameras=cams, images=recs,
+            terrain_height=ZT).save()
+    full = refine_object_space(scene["root"], scene["dsm"], tmp_path / "full")
+    win = refine_object_space(root, scene["dsm"], tmp_path / "window")
+    e_full, inner = _errors(scene, full["dsm"])
+    e_win, _ = _errors(scene, win["dsm"])
+    ok = inner & np.isfinite(e_full) & np.isfinite(e_win)
+    rms = [float(np.sqrt(np.mean(e[ok] ** 2))) for e in (e_full, e_win)]
+    diff = float(np.sqrt(np.mean((e_full[ok] - e_win[ok]) ** 2)))
+    print(f"full frames RMS {rms[0]:.3f} m, windows {rms[1]:.3f} m, difference {diff:.4f} m")
+    assert ok.sum() > 0.9 * inner.sum() and abs(rms[1] - rms[0]) < 0.002 and diff < 0.005
