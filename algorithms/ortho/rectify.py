@@ -45,7 +45,7 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 from affine import Affine
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..geometry.camera import Camera
@@ -76,13 +76,35 @@ def _cv2() -> Any:
 
 
 # -- rasters in the project CRS ---------------------------------------------------------------
+def same_horizontal_crs(a: Any, b: Any) -> bool:
+    """True when two CRSs have the same horizontal part (compound CRSs reduced to it).
+
+    A DEM in "projected + vertical" (compound) CRS whose projected part is the project CRS
+    needs no reprojection: the heights are used as they are (their datum is the operator's
+    choice, as for any DEM).
+    """
+    try:
+        import pyproj
+
+        pa, pb = pyproj.CRS.from_wkt(a.to_wkt()), pyproj.CRS.from_wkt(b.to_wkt())
+    except Exception:  # an unparsable CRS is never "the same"
+        return False
+
+    def horizontal(c: Any) -> Any:
+        return c.sub_crs_list[0] if c.is_compound and c.sub_crs_list else c
+
+    return bool(horizontal(pa).equals(horizontal(pb), ignore_axis_order=True))
+
+
 @contextlib.contextmanager
 def open_surface(path: PathLike, crs: str, feedback: Optional[Feedback] = None,
                  what: str = "DEM") -> Iterator[Any]:
     """Open a DEM/DSM so that it reads in the project CRS.
 
     A raster in another CRS is reprojected on the fly (GDAL warped VRT, bilinear) with a
-    warning; one without a CRS is taken to be in the project CRS (also with a warning).
+    warning; a compound CRS whose horizontal part is the project CRS (e.g. "UTM + EGM2008
+    height") is read directly (:func:`same_horizontal_crs`); one without a CRS is taken to be
+    in the project CRS (also with a warning).
 
     Raises
     ------
@@ -109,7 +131,9 @@ def open_surface(path: PathLike, crs: str, feedback: Optional[Feedback] = None,
                 feedback.warning(f"The {what} '{path.name}' has no CRS; it is taken to be in "
                                  "the project CRS.")
             yield src
-        elif src.crs == target:
+        elif src.crs == target or same_horizontal_crs(src.crs, target):
+            # a compound CRS (e.g. "UTM + EGM2008 height") over the project's horizontal CRS
+            # is the same grid: read it directly (no warp, no resampling of the heights)
             yield src
         else:
             feedback.warning(
@@ -191,21 +215,57 @@ def _lerp(a: Array, b: Array, f: Array) -> Array:
 
 
 # -- geometry --------------------------------------------------------------------------------
-def project_grid(camera: Camera, eo: ExteriorOrientation, xs: Array, ys: Array, z: Array
-                 ) -> Tuple[Array, Array]:
-    """Pixel (col, row) of the grid points (xs[j], ys[i], z[i, j]); NaN behind the camera.
+def _image_mm(camera: Camera, eo: ExteriorOrientation, x: ArrayLike, y: ArrayLike,
+              z: ArrayLike) -> Tuple[Array, Array]:
+    r"""Undistorted image coordinates (mm) of world points: :math:`p = R^T (X - C)`,
+    :math:`x = -c\,p_x/p_z`, :math:`y = -c\,p_y/p_z`; NaN behind the camera (:math:`p_z \ge 0`).
 
-    :math:`p = R^T (X - C)` is evaluated term by term (no BLAS: bit-identical results in
-    every environment), using that X − C varies only along columns and Y − C only along rows.
+    Term by term on separate contiguous arrays (no BLAS: bit-identical in every environment).
     """
     R, C = eo.rotation, eo.position
-    dx = (xs - C[0])[None, :]
-    dy = (ys - C[1])[:, None]
-    dz = z - C[2]
-    p = np.empty(z.shape + (3,))
-    for k in range(3):
-        p[..., k] = (R[0, k] * dx + R[1, k] * dy) + R[2, k] * dz
-    return camera.camera_to_pixel(p)
+    dx = np.asarray(x, dtype=float) - C[0]
+    dy = np.asarray(y, dtype=float) - C[1]
+    dz = np.asarray(z, dtype=float) - C[2]
+    # in place where possible: these passes over the tile are memory-bound
+    shape = np.broadcast_shapes(dx.shape, dy.shape, dz.shape)
+    tmp = np.empty(shape)
+    p = []
+    for k in range(3):  # p_k = (R0k·dx + R1k·dy) + R2k·dz
+        pk = np.empty(shape)
+        np.add(R[0, k] * dx, R[1, k] * dy, out=pk)
+        np.multiply(dz, R[2, k], out=tmp)
+        pk += tmp
+        p.append(pk)
+    px, py, pz = p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        np.divide(-camera.focal_length, pz, out=pz)  # pz → the scale −c/p_z
+    pz[~(pz > 0)] = np.nan  # behind the camera (p_z ≥ 0 gives a scale ≤ 0) or NaN
+    px *= pz
+    py *= pz
+    return px, py
+
+
+def project_points(camera: Camera, eo: ExteriorOrientation, x: ArrayLike, y: ArrayLike,
+                   z: ArrayLike) -> Tuple[Array, Array]:
+    """Pixel (col, row) of world points (broadcastable arrays), exactly; NaN behind the camera.
+
+    :func:`_image_mm`, then the camera's distortion and pixel transformation (the formula of
+    :meth:`Camera.camera_to_pixel`).
+    """
+    u, v = _image_mm(camera, eo, x, y, z)
+    if camera.has_distortion:
+        u, v = camera.distort(u, v)
+    return camera.image_to_pixel(u, v)
+
+
+def project_grid(camera: Camera, eo: ExteriorOrientation, xs: Array, ys: Array, z: Array
+                 ) -> Tuple[Array, Array]:
+    """Pixel (col, row) of the grid points (xs[j], ys[i], z[i, j]) for every cell, exactly.
+
+    X − C varies only along columns and Y − C only along rows (see :func:`project_points`).
+    """
+    return project_points(camera, eo, np.asarray(xs, float)[None, :],
+                          np.asarray(ys, float)[:, None], z)
 
 
 def _rays(camera: Camera, eo: ExteriorOrientation, n: int = 24) -> Tuple[Array, Array]:
@@ -387,6 +447,8 @@ def _profile(width: int, height: int, count: int, dtype: str, transform: Affine,
                    nodata=None)
     if crs:
         profile["crs"] = crs
+    # horizontal differencing + fast deflate: smaller and faster to write than plain deflate
+    profile.update(predictor=3 if np.issubdtype(np.dtype(dtype), np.floating) else 2, zlevel=1)
     if width < 256 or height < 256:  # tiles must not exceed tiny rasters
         profile.update(tiled=False)
         profile.pop("blockxsize")
@@ -537,10 +599,9 @@ def orthorectify_image(
         for k, (r0, c0) in enumerate(tiles):
             feedback.progress(95.0 * k / len(tiles))
             th, tw = min(tile, height - r0), min(tile, width - c0)
-            xs = transform.c + (c0 + np.arange(tw) + 0.5) * gsd
-            ys = transform.f - (r0 + np.arange(th) + 0.5) * gsd
             bands, vis = _rectify_tile(cv2, interpolation, source, camera, eo, dem_ds,
-                                       dsm_ds, zmax_dsm, xs, ys, gsd, alpha_value)
+                                       dsm_ds, zmax_dsm, transform, (r0, c0, th, tw),
+                                       alpha_value)
             win = Window(c0, r0, tw, th)
             dst.write(bands, window=win)
             vdst.write(vis[None], window=win)
@@ -572,16 +633,20 @@ def orthorectify_image(
 
 def _rectify_tile(cv2: Any, interpolation: int, source: _ImageSource, camera: Camera,
                   eo: ExteriorOrientation, dem_ds: Any, dsm_ds: Any, zmax_dsm: Optional[float],
-                  xs: Array, ys: Array, gsd: float, alpha_value: int
+                  transform: Affine, cells: Tuple[int, int, int, int], alpha_value: int
                   ) -> Tuple[NDArray[Any], NDArray[np.uint8]]:
-    """One tile: heights, image positions, resampled bands + alpha, visibility codes.
+    """One tile (``cells`` = first row, first col, rows, cols of the output grid): heights,
+    image positions, resampled bands + alpha, visibility codes.
 
     Heights and image positions are computed on the tile plus a ring of one cell, so that the
-    occlusion clean-up (a 2 × 2 opening) sees the same neighbours as in one piece.
+    occlusion clean-up (a 2 × 2 opening) sees the same neighbours as in one piece; cell
+    centres come from their global indices, so every cell gets the same values whatever the
+    tiling.
     """
-    th, tw = ys.size, xs.size
-    xe = np.concatenate([[xs[0] - gsd], xs, [xs[-1] + gsd]])
-    ye = np.concatenate([[ys[0] + gsd], ys, [ys[-1] - gsd]])
+    r0, c0, th, tw = cells
+    gsd = transform.a
+    xe = transform.c + (np.arange(c0 - 1, c0 + tw + 1) + 0.5) * gsd
+    ye = transform.f - (np.arange(r0 - 1, r0 + th + 1) + 0.5) * gsd
     bounds = (float(xe[0] - gsd), float(ye[-1] - gsd), float(xe[-1] + gsd), float(ye[0] + gsd))
     got = read_surface(dem_ds, bounds)
     if got is None:
@@ -610,16 +675,19 @@ def _rectify_tile(cv2: Any, interpolation: int, source: _ImageSource, camera: Ca
     wc1 = min(math.ceil(cv.max()) + 3, camera.width)
     wr1 = min(math.ceil(rv.max()) + 3, camera.height)
     data, mask = source.read(wc0, wr0, wc1, wr1)
-    mapx = np.where(valid, col - wc0, -1.0).astype(np.float32)
-    mapy = np.where(valid, row - wr0, -1.0).astype(np.float32)
+    # float32 maps (OpenCV's fast path); cells outside the image are cleared below
+    mapx = (col - wc0).astype(np.float32)
+    mapy = (row - wr0).astype(np.float32)
+    mapx[~valid] = -1.0
+    mapy[~valid] = -1.0
     res = _remap(cv2, data, mapx, mapy, interpolation)
     if mask is not None:  # cells on masked image pixels (nearest) are outside the image
         m = cv2.remap(mask, mapx, mapy, cv2.INTER_NEAREST, borderMode=cv2.BORDER_REPLICATE)
         vis[(m == 0) & valid] = OUTSIDE
-    good = vis == VISIBLE
+    bad = vis != VISIBLE
+    res[bad] = 0
     out[:n_bands] = np.moveaxis(res, -1, 0)
-    out[:n_bands, ~good] = 0
-    out[n_bands] = np.where(good, alpha_value, 0).astype(source.dtype)
+    out[n_bands][~bad] = alpha_value
     return out, vis
 
 
@@ -682,7 +750,9 @@ __all__ = [
     "open_surface",
     "orthorectify_image",
     "project_grid",
+    "project_points",
     "read_surface",
+    "same_horizontal_crs",
     "surface_heights",
     "visibility_path",
 ]

@@ -30,6 +30,13 @@ Seam routing (``auto``)
     to the side of the path they are connected to. Boundaries are routed one after the other on
     the current partition, twice, so a boundary moved by one seam is routed again.
 
+    What routing cannot avoid (a corridor without a way around, ends that are not two clear
+    pieces) is settled object by object (:func:`keep_objects_whole`): every connected object
+    (DSM − DTM ≥ :math:`h_{\min}`, dilated by the feather margin) that a seam still splits
+    goes entirely to one image — one whose footprint holds all of it, with the fewest
+    occluded cells — so the seam runs along the object's dilated outline. Seams therefore
+    cross buildings and trees only where no single image covers the object.
+
 Operator seamlines
     A vector file (GeoPackage, Shapefile, GeoJSON; every layer is read) or the ``seamlines``
     layer of the project's ``edits.gpkg``:
@@ -289,6 +296,61 @@ def _route_pair(labels: Array, i: int, j: int, images: Sequence[SeamImage],
     return routed, kept
 
 
+def keep_objects_whole(labels: Array, images: Sequence[SeamImage], objects: Array
+                       ) -> Tuple[Array, Dict[str, int]]:
+    """Give every object that the partition splits to one image, so no seam crosses it.
+
+    ``objects`` marks the cells to keep whole (DSM − DTM ≥ min_height, dilated by the
+    feather margin). Each 8-connected object that holds cells of more than one image goes
+    entirely to one image: among the images whose footprint holds *all* its cells the one
+    with the most valid (visible) cells, then the one that already holds most of it. The
+    new seam then
+    runs along the object's dilated outline, off the object. Cells without an image (−1)
+    stay so.
+
+    Returns
+    -------
+    labels : ndarray (H, W) int32
+        The partition with whole objects (a new array).
+    stats : dict
+        ``objects`` (all), ``objects_moved`` (split ones given to one image),
+        ``objects_not_covered`` (split ones that no image's footprint covers completely:
+        cells outside the chosen image are filled from another one).
+    """
+    labels = labels.copy()
+    comp, n = ndimage.label(objects, _EIGHT)
+    stats = {"objects": int(n), "objects_moved": 0, "objects_not_covered": 0}
+    if n == 0:
+        return labels, stats
+    K = len(images)
+    held = (comp > 0) & (labels >= 0)
+    counts = np.bincount(comp[held].astype(np.int64) * K + labels[held],
+                         minlength=(n + 1) * K).reshape(n + 1, K)
+    split = (counts > 0).sum(axis=1) > 1
+    if not split.any():
+        return labels, stats
+    size = np.bincount(comp[held], minlength=n + 1)
+    valid = np.zeros((n + 1, K), np.int64)
+    inside = np.zeros((n + 1, K), np.int64)
+    for k, im in enumerate(images):
+        h, w = im.shape
+        c = comp[im.row:im.row + h, im.col:im.col + w]
+        valid[:, k] = np.bincount(c[(c > 0) & (im.frac >= 1.0)], minlength=n + 1)
+        cover = im.frac if im.cover is None else im.cover
+        inside[:, k] = np.bincount(c[(c > 0) & (cover >= 1.0)], minlength=n + 1)
+    full = inside >= size[:, None]
+    # inside the image completely first, then the fewest occluded cells to fill from other
+    # images, then the image that already holds most of the object
+    big = size.max() + 1
+    score = full * (4 * big * big) + valid * big + counts
+    choice = np.argmax(score, axis=1).astype(np.int32)
+    move = split[comp] & held
+    labels[move] = choice[comp[move]]
+    stats["objects_moved"] = int(split.sum())
+    stats["objects_not_covered"] = int((split & ~full[np.arange(n + 1), choice]).sum())
+    return labels, stats
+
+
 def route_seams(labels: Array, images: Sequence[SeamImage], hag: Optional[Array] = None,
                 corridor: int = 20, min_height: float = 2.0, margin: int = 1,
                 passes: int = 2, feedback: Any = None) -> Tuple[Array, Dict[str, Any]]:
@@ -341,6 +403,11 @@ def route_seams(labels: Array, images: Sequence[SeamImage], hag: Optional[Array]
                 stats["routed"] += routed
                 stats["kept"] += kept
     if hag is not None:
+        stats["seam_cells_on_objects_routed"] = int((boundary_cells(labels)
+                                                     & (hag >= min_height)).sum())
+        # what routing could not avoid: objects split by a seam go whole to one image
+        labels, snap = keep_objects_whole(labels, images, cost_height >= min_height)
+        stats.update(snap)
         stats["seam_cells_on_objects_after"] = int((boundary_cells(labels)
                                                     & (hag >= min_height)).sum())
     return labels, stats
@@ -568,6 +635,7 @@ __all__ = [
     "cut_regions",
     "default_corridor",
     "fill_invalid",
+    "keep_objects_whole",
     "nadir_labels",
     "object_height",
     "partition_polygons",

@@ -280,6 +280,31 @@ def test_dem_in_another_crs_is_reprojected_with_a_warning(city, tmp_path) -> Non
     assert np.array_equal(a, b)  # the DTM is flat: the same heights, the same ortho
 
 
+def test_dem_in_a_compound_crs_is_read_directly(city, tmp_path) -> None:
+    """A DEM in "project CRS + vertical datum" needs no reprojection (no warp, no warning)."""
+    import rasterio.crs
+
+    from photodem.algorithms.ortho.rectify import open_surface, same_horizontal_crs
+
+    compound = rasterio.crs.CRS.from_user_input("EPSG:25832+5783")  # ETRS89 / UTM 32N + DHHN2016
+    assert same_horizontal_crs(compound, rasterio.crs.CRS.from_user_input(CRS))
+    assert not same_horizontal_crs(compound, rasterio.crs.CRS.from_user_input("EPSG:25833"))
+    root = city["root"]
+    with rasterio.open(root / "dtm.tif") as src:
+        data, T = src.read(1), src.transform
+    write_raster(tmp_path / "compound.tif", data, T, compound)
+    fb = Feedback()
+    with open_surface(tmp_path / "compound.tif", CRS, fb) as ds:
+        assert type(ds).__name__ != "WarpedVRT"
+    assert not fb.warnings
+    ext = (X0 - 20.0, Y0 - 20.0, X0 + 20.0, Y0 + 20.0)
+    a = orthorectify_image(root, "c1", tmp_path / "compound.tif", tmp_path / "a.tif", gsd=0.25,
+                           extent=ext)
+    b = orthorectify_image(root, "c1", root / "dtm.tif", tmp_path / "b.tif", gsd=0.25,
+                           extent=ext)
+    assert np.array_equal(_read(a["ortho"])[0], _read(b["ortho"])[0])
+
+
 # -- the tiny synthetic block: check-point discs -----------------------------------------------
 @pytest.fixture(scope="module")
 def block(tmp_path_factory) -> Path:

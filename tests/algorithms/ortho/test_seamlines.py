@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from affine import Affine
 from shapely.geometry import LineString, box
 
@@ -79,3 +80,55 @@ def test_operator_lines_cut_regions_and_polygons() -> None:
     assert polys[0].equals(box(0, 0, 60, 100)) and polys[1].equals(box(60, 0, 160, 100))
     (i, j, line), = seam_lines(polys)
     assert (i, j) == (0, 1) and line.length == 100.0
+
+
+def test_split_objects_go_whole_to_one_image() -> None:
+    from photodem.algorithms.ortho.seamlines import keep_objects_whole
+
+    images = _images()
+    labels = nadir_labels((100, 160), TR, images)
+    objects = np.zeros((100, 160), bool)
+    objects[30:60, 72:95] = True  # straddles the bisector x = 80, mostly in B
+    objects[5:10, 10:20] = True  # inside A only: untouched
+    out, stats = keep_objects_whole(labels, images, objects)
+    assert stats == {"objects": 2, "objects_moved": 1, "objects_not_covered": 0}
+    assert (out[30:60, 72:95] == 1).all()  # the image holding most of it
+    assert (out[5:10, 10:20] == 0).all()
+    assert (out[~objects] == labels[~objects]).all()
+    # the seam runs along the object's outline: its inner cells touch one image only
+    from scipy import ndimage
+
+    assert not (boundary_cells(out) & ndimage.binary_erosion(objects)).any()
+
+
+def test_auto_seamlines_cross_no_building_of_a_true_ortho_mosaic(tmp_path) -> None:
+    """Acceptance (issue 6): automatic seamlines (vector output) cross no truth building
+    footprint of a synthetic block (true-ortho mosaic with DSM and DTM); trees are avoided
+    where possible."""
+    fiona = pytest.importorskip("fiona")
+    pytest.importorskip("cv2")
+    from shapely.geometry import shape
+    from shapely.ops import unary_union
+
+    from photodem.algorithms.ortho.mosaic import mosaic_project
+    from photodem.algorithms.synthetic.block import generate_block
+
+    block = tmp_path / "block"
+    generate_block(block, size="tiny", terrain="gentle", seed=1)
+    truth = block / "truth"
+    with fiona.open(truth / "buildings.gpkg") as src:
+        buildings = [shape(f["geometry"]) for f in src]
+    crossed = {}
+    for mode in ("nadir", "auto"):
+        res = mosaic_project(block, truth / "dsm.tif", tmp_path / mode / "m.tif",
+                             dsm=truth / "dsm.tif", true_ortho=True, dtm=truth / "dtm.tif",
+                             seamlines=mode)
+        with fiona.open(res["seamlines"], layer="seamlines") as src:
+            seams = unary_union([shape(f["geometry"]) for f in src])
+        assert seams.length > 0
+        crossed[mode] = sum(seams.intersection(b).length > 0 for b in buildings)
+        if mode == "auto":
+            stats = res["seams"]
+    assert crossed["nadir"] > 0  # the test scene has buildings on the nadir seams
+    assert crossed["auto"] == 0
+    assert stats["seam_cells_on_objects_after"] == 0
