@@ -390,7 +390,7 @@
         </message>
         <message>
             <source>Output folder</source>
-            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; filter_evaluate.output: description; filter_linear_prediction.output: description; filter_lowpass.output: description; match_model.output: description; ortho_displacement</extracomment>
+            <extracomment>dem_compare.output: description; dem_profile.output: description; epipolar_pair output folder; epipolar_pair.output: description; filter_evaluate.output: description; filter_linear_prediction.output: description; filter_lowpass.output: description; georeference_polygons.output: description; match_mo</extracomment>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
@@ -2142,6 +2142,171 @@
             <source>Mean difference in the overlaps before/after balancing</source>
             <extracomment>mosaic output balance</extracomment>
             <translation>Mittlere Differenz in den Überlappungen vor/nach dem Ausgleich</translation>
+        </message>
+        <message>
+            <source>Georeference image against polygons</source>
+            <extracomment>georeference_polygons: name</extracomment>
+            <translation>Bild an Polygonen georeferenzieren</translation>
+        </message>
+        <message>
+            <source>Georeferencing</source>
+            <extracomment>georeference_polygons: group</extracomment>
+            <translation>Georeferenzierung</translation>
+        </message>
+        <message>
+            <source>Finds the georeference of an image without approximate values (position, scale, rotation and mirroring unknown) by matching area objects: the image is segmented by region growing at several thresholds, its regions and the reference polygons (one class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are described by affine-invariant moment features, corresponding objects are found by a consistency search, verified, refined by ICP, and control points on their outlines give the final transform (affine, projective or 2nd-order polynomial). Writes a QGIS Georeferencer .points file, the control points as GeoPackage, the image resampled into the map CRS, a copy with the control points embedded and a report (overlay, residuals, RMSE in px and m). Too few matching objects give a failure message with the counts of every stage, not a wrong result.</source>
+            <extracomment>georeference_polygons: help</extracomment>
+            <translation>Bestimmt die Georeferenz eines Bildes ohne Näherungswerte (Position, Maßstab, Drehung und Spiegelung unbekannt) durch Zuordnung von Flächenobjekten: Das Bild wird mit mehreren Schwellen durch Bereichswachstum segmentiert, seine Regionen und die Referenzpolygone (eine Klasse eines Vektorlayers, aneinandergrenzende Polygone verschmolzen — oder ein segmentiertes Orthophoto) werden durch affin-invariante Momentmerkmale beschrieben, zugehörige Objekte durch eine Konsistenzsuche gefunden, verifiziert und mit ICP verfeinert; Passpunkte auf ihren Konturen ergeben die endgültige Transformation (affin, projektiv oder Polynom 2. Grades). Schreibt eine .points-Datei des QGIS-Georeferenzierers, die Passpunkte als GeoPackage, das in das Karten-KBS umgebildete Bild, eine Kopie mit eingebetteten Passpunkten und einen Bericht (Überlagerung, Residuen, RMSE in px und m). Zu wenige zugeordnete Objekte ergeben eine Fehlermeldung mit den Anzahlen jeder Stufe, kein falsches Ergebnis.</translation>
+        </message>
+        <message>
+            <source>Image to georeference</source>
+            <extracomment>georeference_polygons.image: description</extracomment>
+            <translation>Zu georeferenzierendes Bild</translation>
+        </message>
+        <message>
+            <source>Any band count (default: the mean of the bands); its own georeference, if any, is ignored.</source>
+            <extracomment>georeference_polygons.image: help</extracomment>
+            <translation>Beliebige Kanalzahl (Standard: Mittel der Kanäle); eine eigene Georeferenz des Bildes wird nicht verwendet.</translation>
+        </message>
+        <message>
+            <source>Reference (polygon layer or orthophoto)</source>
+            <extracomment>georeference_polygons.reference: description</extracomment>
+            <translation>Referenz (Polygonlayer oder Orthophoto)</translation>
+        </message>
+        <message>
+            <source>A polygon layer in any CRS (matched in its projected CRS, or the UTM zone of its centre), or a georeferenced raster segmented like the image.</source>
+            <extracomment>georeference_polygons.reference: help</extracomment>
+            <translation>Ein Polygonlayer in beliebigem KBS (zugeordnet in seinem projizierten KBS oder in der UTM-Zone seiner Mitte) oder ein georeferenziertes Raster, das wie das Bild segmentiert wird.</translation>
+        </message>
+        <message>
+            <source>Class attribute</source>
+            <extracomment>georeference_polygons.class_field: description</extracomment>
+            <translation>Klassenattribut</translation>
+        </message>
+        <message>
+            <source>Attribute selecting the polygons to match (e.g. landuse); empty = all polygons.</source>
+            <extracomment>georeference_polygons.class_field: help</extracomment>
+            <translation>Attribut, das die zuzuordnenden Polygone auswählt (z. B. landuse); leer = alle Polygone.</translation>
+        </message>
+        <message>
+            <source>Class value</source>
+            <extracomment>georeference_polygons.class_value: description</extracomment>
+            <translation>Klassenwert</translation>
+        </message>
+        <message>
+            <source>Value of the class attribute (e.g. forest).</source>
+            <extracomment>georeference_polygons.class_value: help</extracomment>
+            <translation>Wert des Klassenattributs (z. B. forest).</translation>
+        </message>
+        <message>
+            <source>Transform</source>
+            <extracomment>georeference_polygons.transform: description</extracomment>
+            <translation>Transformation</translation>
+        </message>
+        <message>
+            <source>affine</source>
+            <extracomment>georeference_polygons.transform: option</extracomment>
+            <translation>affin</translation>
+        </message>
+        <message>
+            <source>projective</source>
+            <extracomment>georeference_polygons.transform: option</extracomment>
+            <translation>projektiv</translation>
+        </message>
+        <message>
+            <source>poly2</source>
+            <extracomment>georeference_polygons.transform: option</extracomment>
+            <translation>Polynom 2. Grades</translation>
+        </message>
+        <message>
+            <source>Segmentation thresholds [DN]</source>
+            <extracomment>georeference_polygons.thresholds: description</extracomment>
+            <translation>Segmentierungsschwellen [GW]</translation>
+        </message>
+        <message>
+            <source>Region-growing thresholds in grey values of 8-bit data (other data are stretched to 0–255 first), small = over-segmentation.</source>
+            <extracomment>georeference_polygons.thresholds: help</extracomment>
+            <translation>Schwellen des Bereichswachstums in Grauwerten von 8-Bit-Daten (andere Daten werden zuerst auf 0–255 gestreckt); klein = Übersegmentierung.</translation>
+        </message>
+        <message>
+            <source>Pyramid level (−1 = auto)</source>
+            <extracomment>georeference_polygons.pyramid_level: description</extracomment>
+            <translation>Pyramidenstufe (−1 = automatisch)</translation>
+        </message>
+        <message>
+            <source>Segment this pyramid level (factor 2 each); auto: the first level with at most 4 Mpx.</source>
+            <extracomment>georeference_polygons.pyramid_level: help</extracomment>
+            <translation>Diese Pyramidenstufe segmentieren (Faktor 2 je Stufe); automatisch: die erste Stufe mit höchstens 4 Mpx.</translation>
+        </message>
+        <message>
+            <source>Invariant tolerance [%]</source>
+            <extracomment>georeference_polygons.relative_difference: description</extracomment>
+            <translation>Toleranz der Invarianten [%]</translation>
+        </message>
+        <message>
+            <source>Relative difference allowed for each of the six invariants.</source>
+            <extracomment>georeference_polygons.relative_difference: help</extracomment>
+            <translation>Zulässige relative Differenz für jede der sechs Invarianten.</translation>
+        </message>
+        <message>
+            <source>Search depth [pairs]</source>
+            <extracomment>georeference_polygons.max_depth: description</extracomment>
+            <translation>Suchtiefe [Paare]</translation>
+        </message>
+        <message>
+            <source>Control point tolerance σ_NP [px]</source>
+            <extracomment>georeference_polygons.sigma_np: description</extracomment>
+            <translation>Passpunkttoleranz σ_NP [px]</translation>
+        </message>
+        <message>
+            <source>Control points are accepted (best first) while the RMS of their outline distances stays below this.</source>
+            <extracomment>georeference_polygons.sigma_np: help</extracomment>
+            <translation>Passpunkte werden (beste zuerst) übernommen, solange der RMS ihrer Konturabstände darunter bleibt.</translation>
+        </message>
+        <message>
+            <source>Transform (kind, 3 × 3 matrix image col/row → map)</source>
+            <extracomment>georeference_polygons output transform</extracomment>
+            <translation>Transformation (Art, 3 × 3-Matrix Bildspalte/-zeile → Karte)</translation>
+        </message>
+        <message>
+            <source>RMSE of the control points (px)</source>
+            <extracomment>georeference_polygons output rmse_px</extracomment>
+            <translation>RMSE der Passpunkte (px)</translation>
+        </message>
+        <message>
+            <source>RMSE of the control points (map units)</source>
+            <extracomment>georeference_polygons output rmse_m</extracomment>
+            <translation>RMSE der Passpunkte (Karteneinheiten)</translation>
+        </message>
+        <message>
+            <source>Control points (QGIS .points)</source>
+            <extracomment>georeference_polygons output gcps</extracomment>
+            <translation>Passpunkte (QGIS .points)</translation>
+        </message>
+        <message>
+            <source>Control points (GeoPackage)</source>
+            <extracomment>georeference_polygons output gcps_gpkg</extracomment>
+            <translation>Passpunkte (GeoPackage)</translation>
+        </message>
+        <message>
+            <source>Georeferenced image</source>
+            <extracomment>georeference_polygons output image</extracomment>
+            <translation>Georeferenziertes Bild</translation>
+        </message>
+        <message>
+            <source>Report (JSON; HTML beside it)</source>
+            <extracomment>georeference_polygons output report</extracomment>
+            <translation>Bericht (JSON; HTML daneben)</translation>
+        </message>
+        <message>
+            <source>Verified object pairs</source>
+            <extracomment>georeference_polygons output n_pairs</extracomment>
+            <translation>Verifizierte Objektpaare</translation>
+        </message>
+        <message>
+            <source>Control points used</source>
+            <extracomment>georeference_polygons output n_gcps</extracomment>
+            <translation>Verwendete Passpunkte</translation>
         </message>
         <message>
             <source>PhotoDEM toolbox</source>

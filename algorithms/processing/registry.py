@@ -26,6 +26,7 @@ ALGORITHM_MODULES = (
     "surface",
     "filtering",
     "ortho",
+    "georef",
 )
 
 #: Comma-separated importable modules with further ``ALGORITHMS`` (site extensions, tests).

@@ -372,3 +372,17 @@ def test_mosaic_python_equals_cli(block, tmp_path) -> None:
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
     _same_files(tmp_path / "py", tmp_path / "cli")
     assert py["balance"]["after"]["mean_difference"] <= 2.0 and py["gsd"] == 0.3
+
+
+def test_georeference_polygons_python_equals_cli(tmp_path) -> None:
+    from photodem.algorithms.synthetic.polygon_scene import georef_case
+
+    case = georef_case(tmp_path / "case", seed=5, width=700, height=700)
+    params = {"image": case["image"], "reference": case["reference"], "class_field": "class",
+              "class_value": "forest", "transform": "affine"}
+    params.pop("class_field"), params.pop("class_value")  # all classes: more objects
+    py = registry.run("georeference_polygons", {**params, "output": str(tmp_path / "py")})
+    cli = _cli("georeference_polygons", {**params, "output": str(tmp_path / "cli")})
+    assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
+    _same_files(tmp_path / "py", tmp_path / "cli")
+    assert py["n_pairs"] >= 3 and py["rmse_px"] < 1.0

@@ -163,6 +163,16 @@ def _ortho_pair(project: Path) -> Dict[str, str]:
     return {k: str(v) for k, v in paths.items()}
 
 
+def _georef_case(project: Path) -> Dict[str, str]:
+    """A synthetic image of a polygon map (unknown georeference), made once beside the project."""
+    from photodem.algorithms.synthetic.polygon_scene import georef_case
+
+    folder = Path(project).parent / "georef_case"
+    if not (folder / "image.tif").is_file():
+        georef_case(folder, seed=5, width=600, height=600)
+    return {"image": str(folder / "image.tif"), "reference": str(folder / "map.gpkg")}
+
+
 # Inputs per algorithm; ``out`` is the run's own output folder.
 CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
     "stereo_models": lambda out, req: {
@@ -228,6 +238,9 @@ CASES: Dict[str, Callable[..., Dict[str, Any]]] = {
         "dsm": _truth(req("project"), "dsm.tif"), "dtm": _truth(req("project"), "dtm.tif"),
         "seamlines": "auto", "balance": "gain_offset", "feather": 1.5,
         "output": str(out / "mosaic" / "mosaic.tif")},
+    "georeference_polygons": lambda out, req: {
+        **_georef_case(req("project")), "transform": "affine", "thresholds": "5,6,7,8",
+        "output": str(out / "georef")},
     "refine_object_space": lambda out, req: {
         "project": str(req("project")), "dsm": _dsm_crop(req("project")), "spacing": 0.6,
         "output": str(out / "refined")},

@@ -1,0 +1,316 @@
+"""Outputs of the polygon georeferencing: control points, the georeferenced image, the report.
+
+- ``<name>.points``: the QGIS Georeferencer's control point file. Its source coordinates are
+  those of a raster without georeference as QGIS shows it: x = column of the pixel corner grid
+  (the left edge of the image is 0), y = −row (the top edge is 0, rows downwards negative).
+  Our pixel centres are at integers, so sourceX = col + 0.5, sourceY = −(row + 0.5).
+- ``gcps.gpkg``: the control points in the map CRS with image coordinates and residuals.
+- ``<name>_georef.tif``: the image resampled into the map CRS by the fitted transform (all
+  bands, bilinear, alpha band; tiled with overviews), written tile by tile.
+- ``<name>_gcps.tif``: a copy of the image with the control points embedded (GDAL GCPs), for
+  GDAL/QGIS tools that warp by themselves.
+- ``report.json`` and ``report.html`` with ``overlay.png``: matched polygons over the image,
+  the residual table, RMSE in pixels and metres, pairs, warnings.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Union
+
+import numpy as np
+
+from ..processing.feedback import Feedback
+from .correspondence import apply
+from .fit import points_summary
+
+PathLike = Union[str, Path]
+
+
+def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
+    """The QGIS Georeferencer ``.points`` file (see the module notes for the convention)."""
+    fit = result["fit"]
+    rows = points_summary(fit)
+    lines = [f"#CRS: {result['crs'].to_wkt()}",
+             "mapX,mapY,sourceX,sourceY,enable,dX,dY,residual"]
+    for g, r in zip(result["gcps"], rows):
+        px = fit.pixel_size
+        lines.append(f"{g.map[0]:.6f},{g.map[1]:.6f},{g.image[0] + 0.5:.6f},"
+                     f"{-(g.image[1] + 0.5):.6f},{1 if r['used'] else 0},"
+                     f"{r['dx_map'] / px:.6f},{r['dy_map'] / px:.6f},{r['residual_px']:.6f}")
+    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return Path(path)
+
+
+def write_gcps_gpkg(path: PathLike, result: Dict[str, Any]) -> Path:
+    """Control points as a point layer in the map CRS."""
+    import fiona
+
+    fit = result["fit"]
+    schema = {"geometry": "Point",
+              "properties": {"id": "int", "image_col": "float", "image_row": "float",
+                             "residual_m": "float", "residual_px": "float", "loo_m": "float",
+                             "enabled": "int", "pair": "int"}}
+    with fiona.open(path, "w", driver="GPKG", layer="gcps", crs_wkt=result["crs"].to_wkt(),
+                    schema=schema) as dst:
+        for k, (g, r) in enumerate(zip(result["gcps"], points_summary(fit))):
+            loo = r["loo_map"]
+            dst.write({"geometry": {"type": "Point", "coordinates": g.map},
+                       "properties": {"id": k, "image_col": g.image[0], "image_row": g.image[1],
+                                      "residual_m": r["residual_map"],
+                                      "residual_px": r["residual_px"],
+                                      "loo_m": None if not np.isfinite(loo) else loo,
+                                      "enabled": int(r["used"]), "pair": g.pair}})
+    return Path(path)
+
+
+def _inverse_points(result: Dict[str, Any], xy: np.ndarray) -> np.ndarray:
+    """Map → image for the fitted transform (poly2: Newton steps on the forward model)."""
+    fit = result["fit"]
+    if fit.matrix is not None:
+        return apply(np.linalg.inv(fit.matrix), xy)
+    return result["inverse_fit"].forward(xy)  # poly2: its own map → image fit
+
+
+def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
+                        gsd: Optional[float] = None, tile: int = 512,
+                        feedback: Optional[Feedback] = None) -> Path:
+    """The image resampled into the map CRS (bilinear, alpha band), tile by tile."""
+    import rasterio
+    from rasterio.transform import Affine
+    from rasterio.windows import Window
+    from scipy import ndimage
+
+    from ..raster.io import GTIFF_PROFILE, atomic_output, open_image
+
+    fb = feedback or Feedback()
+    fit = result["fit"]
+    with open_image(image) as src:
+        W, H, count, dtype = src.width, src.height, src.count, src.dtypes[0]
+        corners = np.array([[-0.5, -0.5], [W - 0.5, -0.5], [-0.5, H - 0.5], [W - 0.5, H - 0.5]])
+        mc = fit.forward(corners)
+        px = gsd or fit.pixel_size
+        x0, y1 = np.floor(mc.min(axis=0) / px) * px
+        x1, y0 = np.ceil(mc.max(axis=0) / px) * px
+        x0, x1 = float(min(x0, x1)), float(max(x0, x1))
+        ylo, yhi = float(min(y0, y1)), float(max(y0, y1))
+        cols, rows = round((x1 - x0) / px), round((yhi - ylo) / px)
+        transform = Affine(px, 0, x0, 0, -px, yhi)
+        profile = dict(GTIFF_PROFILE)
+        profile.update(driver="GTiff", width=cols, height=rows, count=count + 1, dtype=dtype,
+                       transform=transform, crs=result["crs"].to_wkt(), nodata=None)
+        if cols < 256 or rows < 256:
+            profile.update(tiled=False)
+            profile.pop("blockxsize", None)
+            profile.pop("blockysize", None)
+        amax = 255 if dtype == "uint8" else np.iinfo(dtype).max if np.issubdtype(
+            np.dtype(dtype), np.integer) else 1.0
+        with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+            n_tiles = ((rows + tile - 1) // tile) * ((cols + tile - 1) // tile)
+            done = 0
+            for r0 in range(0, rows, tile):
+                for c0 in range(0, cols, tile):
+                    fb.check()
+                    th, tw = min(tile, rows - r0), min(tile, cols - c0)
+                    cc, rr = np.meshgrid(c0 + np.arange(tw) + 0.5, r0 + np.arange(th) + 0.5)
+                    xy = np.column_stack([x0 + cc.ravel() * px, yhi - rr.ravel() * px])
+                    ij = _inverse_points(result, xy)
+                    ci, ri = ij[:, 0], ij[:, 1]
+                    inside = (ci >= -0.5) & (ci <= W - 0.5) & (ri >= -0.5) & (ri <= H - 0.5)
+                    out = np.zeros((count + 1, th * tw), dtype=dtype)
+                    if inside.any():
+                        # the source window this tile needs (never the whole image)
+                        wc0 = max(int(np.floor(ci[inside].min())) - 1, 0)
+                        wr0 = max(int(np.floor(ri[inside].min())) - 1, 0)
+                        wc1 = min(int(np.ceil(ci[inside].max())) + 2, W)
+                        wr1 = min(int(np.ceil(ri[inside].max())) + 2, H)
+                        data = src.read(window=Window(wc0, wr0, wc1 - wc0, wr1 - wr0))
+                        coords = np.vstack([ri[inside] - wr0, ci[inside] - wc0])
+                        for b in range(count):
+                            v = ndimage.map_coordinates(data[b].astype(np.float64), coords,
+                                                        order=1, mode="nearest")
+                            if np.issubdtype(np.dtype(dtype), np.integer):
+                                v = np.round(v)
+                            out[b, inside] = v.astype(dtype)
+                        out[count, inside] = amax
+                    dst.write(out.reshape(count + 1, th, tw), window=Window(c0, r0, tw, th))
+                    done += 1
+                    fb.progress(100.0 * done / n_tiles)
+            factors = [f for f in (2, 4, 8, 16, 32) if max(rows, cols) / f >= 256]
+            if factors:
+                dst.build_overviews(factors, rasterio.enums.Resampling.average)
+            dst.colorinterp = [*dst.colorinterp[:count],
+                               rasterio.enums.ColorInterp.alpha]
+    return Path(path)
+
+
+def write_with_gcps(path: PathLike, image: PathLike, result: Dict[str, Any]) -> Path:
+    """A copy of the image with the used control points embedded as GDAL GCPs."""
+    import rasterio
+    from rasterio.control import GroundControlPoint
+
+    from ..raster.io import atomic_output, open_image
+
+    fit = result["fit"]
+    gcps = [GroundControlPoint(row=g.image[1] + 0.5, col=g.image[0] + 0.5, x=g.map[0],
+                               y=g.map[1], id=str(k))
+            for k, (g, u) in enumerate(zip(result["gcps"], fit.used)) if u]
+    with open_image(image) as src:
+        profile = src.profile.copy()
+        profile.pop("transform", None)
+        profile.pop("crs", None)
+        profile.update(driver="GTiff")
+        with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+            for _, window in src.block_windows(1):
+                dst.write(src.read(window=window), window=window)
+            dst.gcps = (gcps, result["crs"].to_wkt())
+    return Path(path)
+
+
+def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
+    """Matched image polygons (green) and reference polygons taken into the image (red)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    grey = result["grey"]
+    fi, fr = result["img_features"], result["ref_features"]
+    H, W = grey.shape
+    fig, ax = plt.subplots(figsize=(8, 8 * H / max(W, 1)))
+    ax.imshow(grey, cmap="gray", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
+    for h in result["pairs"]:
+        a = fi[h.i].obj.ring
+        b = _inverse_points(result, fr[h.j].obj.ring)
+        for ring, colour in ((a, "lime"), (b, "red")):
+            p = np.vstack([ring, ring[:1]])
+            ax.plot(p[:, 0], p[:, 1], "-", color=colour, lw=0.8)
+    g = np.array([p.image for p in result["gcps"]]) if result["gcps"] else np.zeros((0, 2))
+    if len(g):
+        ax.plot(g[:, 0], g[:, 1], "+", color="yellow", ms=4)
+    ax.set_xlim(-0.5, W - 0.5)
+    ax.set_ylim(H - 0.5, -0.5)
+    ax.set_title("matched objects: image (green), reference (red); control points (+)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return Path(path)
+
+
+def report_dict(result: Dict[str, Any]) -> Dict[str, Any]:
+    """Everything an operator checks, JSON-ready."""
+    fit = result["fit"]
+    fi, fr = result["img_features"], result["ref_features"]
+    return {
+        "transform": transform_json(result),
+        "rmse_px": fit.rmse_px, "rmse_m": fit.rmse_map, "sigma0_m": fit.sigma0,
+        "pixel_size_m": fit.pixel_size, "counts": result["counts"],
+        "pairs": [{"image_object": fi[h.i].obj.id, "reference_object": fr[h.j].obj.id,
+                   "run": fi[h.i].obj.run, "threshold": fi[h.i].obj.threshold,
+                   "q": h.q, "d4_alternative": h.alternative,
+                   "reference_features": fr[h.j].obj.attributes.get("features")}
+                  for h in result["pairs"]],
+        "icp": result["icp"],
+        "gcps": [{"image": list(g.image), "map": list(g.map), **r}
+                 for g, r in zip(result["gcps"], points_summary(fit))],
+        "segmentation": result["segmentation"], "reference": result["reference"],
+        "reference_kind": result["reference_kind"], "image": result["image_info"],
+        "parameters": result["parameters"], "warnings": result["warnings"],
+        "extensions": ["smoothing before segmentation" if result["parameters"]["smooth"]
+                       else None,
+                       "merging of similar adjacent regions" if result["parameters"]["merge"]
+                       else None,
+                       "D4 alternatives for ambiguous standard positions",
+                       "least-squares re-estimate of the global affine after verification",
+                       "joint ICP of all verified outlines with outline offset",
+                       "control points along outlines" if result["parameters"]["gcp_mode"]
+                       == "outline" else None],
+    }
+
+
+def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
+    """The final transform: kind, 3 × 3 matrix (image col/row → map) or poly2 coefficients."""
+    fit = result["fit"]
+    out: Dict[str, Any] = {"kind": fit.kind, "crs": result["crs"].to_string()}
+    if fit.matrix is not None:
+        out["matrix"] = [[float(v) for v in row] for row in fit.matrix]
+    else:
+        Ns, Nd, coef = fit.poly
+        out["poly2"] = {"normalise_image": Ns.tolist(), "normalise_map": Nd.tolist(),
+                        "x": coef[0].tolist(), "y": coef[1].tolist(),
+                        "terms": ["1", "x", "y", "x²", "xy", "y²"]}
+    return out
+
+
+def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, Path]:
+    """report.json, report.html and overlay.png in ``folder``."""
+    from ..processing.spec import json_ready
+
+    rep = report_dict(result)
+    rep["extensions"] = [e for e in rep["extensions"] if e]
+    (folder / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
+                                        encoding="utf-8")
+    overlay_png(folder / "overlay.png", result)
+    rows = "".join(
+        f"<tr><td>{k}</td><td>{g['image'][0]:.2f}</td><td>{g['image'][1]:.2f}</td>"
+        f"<td>{g['map'][0]:.2f}</td><td>{g['map'][1]:.2f}</td><td>{g['residual_px']:.3f}</td>"
+        f"<td>{g['residual_map']:.3f}</td><td>{g['loo_map']:.3f}</td>"
+        f"<td>{'yes' if g['used'] else 'no'}</td></tr>"
+        for k, g in enumerate(rep["gcps"]))
+    warn = "".join(f"<li>{html.escape(w)}</li>" for w in rep["warnings"]) or "<li>none</li>"
+    c = rep["counts"]
+    page = f"""<!doctype html><html><head><meta charset="utf-8">
+<title>Georeferencing {html.escape(name)}</title>
+<style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 8px;text-align:right}}
+table{{border-collapse:collapse}}tr:nth-child(even){{background:#eee}}</style></head><body>
+<h1>Georeferencing of {html.escape(name)}</h1>
+<p>Transform: <b>{rep['transform']['kind']}</b> into {html.escape(rep['transform']['crs'])}.
+RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
+{rep['pixel_size_m']:.3f} m); {c.get('gcps')} control points from {c.get('verified_pairs')}
+verified object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} image and
+{c.get('reference_objects')} reference objects).</p>
+<h2>Warnings</h2><ul>{warn}</ul>
+<img src="overlay.png" style="max-width:100%">
+<h2>Control points</h2>
+<table><tr><th>#</th><th>col</th><th>row</th><th>X</th><th>Y</th><th>residual px</th>
+<th>residual m</th><th>leave-one-out m</th><th>used</th></tr>{rows}</table>
+</body></html>"""
+    (folder / "report.html").write_text(page, encoding="utf-8")
+    return {"report": folder / "report.json", "html": folder / "report.html",
+            "overlay": folder / "overlay.png"}
+
+
+def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],
+                  feedback: Optional[Feedback] = None, replace: bool = False
+                  ) -> Dict[str, Any]:
+    """All products into the folder ``output`` (staged: nothing half-written is left)."""
+    from ..raster.io import staged_folder
+
+    name = Path(image).stem
+    out = Path(output)
+    with staged_folder(out, replace=replace, product="georeference_polygons") as tmp:
+        write_points_file(tmp / f"{name}.points", result)
+        write_gcps_gpkg(tmp / "gcps.gpkg", result)
+        write_georeferenced(tmp / f"{name}_georef.tif", image, result, feedback=feedback)
+        write_with_gcps(tmp / f"{name}_gcps.tif", image, result)
+        write_report(tmp, result, name)
+    return {"folder": str(out), "points": str(out / f"{name}.points"),
+            "gcps": str(out / "gcps.gpkg"), "image": str(out / f"{name}_georef.tif"),
+            "image_gcps": str(out / f"{name}_gcps.tif"), "report": str(out / "report.json"),
+            "html": str(out / "report.html")}
+
+
+def summary(result: Dict[str, Any], paths: Dict[str, Any]) -> Dict[str, Any]:
+    """The algorithm's JSON result."""
+    fit = result["fit"]
+    return {"transform": transform_json(result), "rmse_px": float(fit.rmse_px),
+            "rmse_m": float(fit.rmse_map), "gcps": paths["points"],
+            "gcps_gpkg": paths["gcps"], "image": paths["image"], "report": paths["report"],
+            "n_pairs": int(result["counts"]["verified_pairs"]),
+            "n_gcps": int(result["counts"]["gcps"])}
+
+
+def points_list(result: Dict[str, Any]) -> List[Dict[str, Any]]:
+    return report_dict(result)["gcps"]

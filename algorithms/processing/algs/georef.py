@@ -1,0 +1,106 @@
+"""Algorithm declarations: automatic georeferencing against GIS polygons."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Dict
+
+from ..feedback import Feedback, StepFeedback
+from ..spec import Algorithm, Output, Parameter
+
+GROUP = "Georeferencing"
+GROUP_ID = "georef"
+
+
+class GeoreferencePolygons(Algorithm):
+    id = "georeference_polygons"
+    name = "Georeference image against polygons"
+    group = GROUP
+    group_id = GROUP_ID
+    help = (
+        "Finds the georeference of an image without approximate values (position, scale, "
+        "rotation and mirroring unknown) by matching area objects: the image is segmented by "
+        "region growing at several thresholds, its regions and the reference polygons (one "
+        "class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are "
+        "described by affine-invariant moment features, corresponding objects are found by a "
+        "consistency search, verified, refined by ICP, and control points on their outlines "
+        "give the final transform (affine, projective or 2nd-order polynomial). Writes a QGIS "
+        "Georeferencer .points file, the control points as GeoPackage, the image resampled into "
+        "the map CRS, a copy with the control points embedded and a report (overlay, "
+        "residuals, RMSE in px and m). Too few matching objects give a failure message with "
+        "the counts of every stage, not a wrong result."
+    )
+    parameters = (
+        Parameter("image", "raster", "Image to georeference",
+                  help="Any band count (default: the mean of the bands); its own georeference, "
+                       "if any, is ignored."),
+        Parameter("reference", "file", "Reference (polygon layer or orthophoto)",
+                  extensions=(".gpkg", ".shp", ".geojson", ".json", ".tif", ".tiff"),
+                  help="A polygon layer in any CRS (matched in its projected CRS, or the UTM "
+                       "zone of its centre), or a georeferenced raster segmented like the "
+                       "image."),
+        Parameter("class_field", "string", "Class attribute", optional=True,
+                  help="Attribute selecting the polygons to match (e.g. landuse); empty = all "
+                       "polygons."),
+        Parameter("class_value", "string", "Class value", optional=True,
+                  help="Value of the class attribute (e.g. forest)."),
+        Parameter("transform", "enum", "Transform", default="affine",
+                  options=("affine", "projective", "poly2")),
+        Parameter("output", "output_folder", "Output folder"),
+        Parameter("thresholds", "string", "Segmentation thresholds [DN]", default="5,6,7,8",
+                  help="Region-growing thresholds in grey values of 8-bit data (other data are "
+                       "stretched to 0–255 first), small = over-segmentation."),
+        Parameter("pyramid_level", "integer", "Pyramid level (−1 = auto)", default=-1,
+                  minimum=-1, maximum=4,
+                  help="Segment this pyramid level (factor 2 each); auto: the first level "
+                       "with at most 4 Mpx."),
+        Parameter("relative_difference", "number", "Invariant tolerance [%]", default=3.0,
+                  minimum=0.1, maximum=20.0, unit="%",
+                  help="Relative difference allowed for each of the six invariants."),
+        Parameter("max_depth", "integer", "Search depth [pairs]", default=6, minimum=2,
+                  maximum=20),
+        Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
+                  minimum=0.1, maximum=50.0, unit="px",
+                  help="Control points are accepted (best first) while the RMS of their "
+                       "outline distances stays below this."),
+    )
+    outputs = (
+        Output("transform", "json", "Transform (kind, 3 × 3 matrix image col/row → map)"),
+        Output("rmse_px", "number", "RMSE of the control points (px)"),
+        Output("rmse_m", "number", "RMSE of the control points (map units)"),
+        Output("gcps", "file", "Control points (QGIS .points)"),
+        Output("gcps_gpkg", "vector", "Control points (GeoPackage)"),
+        Output("image", "raster", "Georeferenced image"),
+        Output("report", "file", "Report (JSON; HTML beside it)"),
+        Output("n_pairs", "number", "Verified object pairs"),
+        Output("n_gcps", "number", "Control points used"),
+    )
+
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
+        from ...errors import InputError
+        from ...georef.pipeline import georeference
+        from ...georef.products import summary, write_outputs
+        from ...raster.io import PRODUCT_MARKER
+
+        level = params.get("pyramid_level", -1)
+        output = Path(params["output"])
+        # refuse an operator's own folder before the work, not after it
+        if output.is_file() or (output.is_dir() and any(output.iterdir())
+                                and not (output / PRODUCT_MARKER).is_file()):
+            raise InputError(f"The output folder '{output}' holds files PhotoDEM did not "
+                             "write; choose an empty or new folder.")
+        result = georeference(
+            params["image"], params["reference"], params.get("class_field") or None,
+            params.get("class_value") or None, params.get("transform") or "affine",
+            thresholds=params.get("thresholds") or None,
+            pyramid_level="auto" if level is None or int(level) < 0 else int(level),
+            rd=float(params.get("relative_difference", 3.0)) / 100.0,
+            max_depth=int(params.get("max_depth", 6)),
+            sigma_np_px=float(params.get("sigma_np", 2.0)),
+            feedback=StepFeedback(feedback, 0, 80))
+        paths = write_outputs(output, params["image"], result,
+                              feedback=StepFeedback(feedback, 80, 100), replace=True)
+        return summary(result, paths)
+
+
+ALGORITHMS = [GeoreferencePolygons]

@@ -1,0 +1,124 @@
+"""The whole chain on synthetic scenes, its outputs and its failure messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import fiona
+import numpy as np
+import pytest
+import rasterio
+from shapely.geometry import Polygon, shape
+
+from photodem.algorithms.errors import GeometryError, InputError
+from photodem.algorithms.georef.fit import corner_error
+from photodem.algorithms.georef.pipeline import georeference
+from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
+from photodem.algorithms.processing import registry
+from photodem.algorithms.synthetic.polygon_scene import (
+    georef_case,
+    make_scene,
+    ortho_case,
+    write_scene,
+)
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    return georef_case(tmp_path_factory.mktemp("georef") / "case", seed=5)
+
+
+def test_synthetic_case_recovered_to_half_a_pixel(case) -> None:
+    res = georeference(case["image"], case["reference"])
+    err = corner_error(res["fit"], case["truth"], case["width"], case["height"])
+    assert err.max() <= 0.5
+    assert res["counts"]["verified_pairs"] >= 6 and res["counts"]["gcps"] >= 50
+    assert res["fit"].rmse_px < 0.5
+
+
+def test_image_against_orthophoto(tmp_path) -> None:
+    c = ortho_case(tmp_path, seed=1, size_px=600)
+    res = georeference(c["image"], c["reference"])
+    assert corner_error(res["fit"], c["truth"], c["width"], c["height"]).max() <= 1.0
+
+
+def test_outputs_of_the_algorithm(case, tmp_path) -> None:
+    out = tmp_path / "out"
+    res = registry.run("georeference_polygons", {
+        "image": case["image"], "reference": case["reference"], "output": str(out)})
+    assert res["n_pairs"] >= 6 and res["rmse_px"] < 0.5
+    T = np.array(res["transform"]["matrix"])
+    assert corner_error(T, case["truth"], case["width"], case["height"]).max() <= 0.5
+    # the .points file: QGIS georeferencer columns, source y negative (pixel corner grid)
+    lines = Path(res["gcps"]).read_text().splitlines()
+    assert lines[0].startswith("#CRS: ") and lines[1].startswith("mapX,mapY,sourceX,sourceY")
+    mx, my, sx, sy = (float(v) for v in lines[2].split(",")[:4])
+    col, row = sx - 0.5, -sy - 0.5
+    p = T @ np.array([col, row, 1.0])
+    assert np.hypot(p[0] - mx, p[1] - my) < 2.0 * abs(np.linalg.det(T[:2, :2])) ** 0.5
+    with fiona.open(res["gcps_gpkg"]) as src:
+        assert len(src) == len(lines) - 2
+    # the georeferenced image: forests (dark) inside the forest polygons
+    with rasterio.open(res["image"]) as src, fiona.open(case["reference"]) as ref:
+        assert src.crs.to_epsg() == 32632 and src.count == 2
+        for feat in ref:
+            if feat["properties"]["class"] != "forest":
+                continue
+            c = shape(feat["geometry"]).representative_point()
+            v, a = next(src.sample([(c.x, c.y)]))
+            if a:
+                assert v < 90
+    for key in ("report",):
+        assert Path(res[key]).is_file()
+    assert (out / "report.html").is_file() and (out / "overlay.png").is_file()
+    with rasterio.open(out / "image_gcps.tif") as src:
+        gcps, crs = src.gcps
+        assert len(gcps) >= 50 and crs is not None
+
+
+def test_bad_inputs_write_nothing(case, tmp_path) -> None:
+    out = tmp_path / "never"
+    with pytest.raises(InputError, match="no attribute 'landuse'"):
+        registry.run("georeference_polygons", {
+            "image": case["image"], "reference": case["reference"], "class_field": "landuse",
+            "class_value": "forest", "output": str(out)})
+    with pytest.raises(InputError, match="No polygons with class = desert"):
+        registry.run("georeference_polygons", {
+            "image": case["image"], "reference": case["reference"], "class_field": "class",
+            "class_value": "desert", "output": str(out)})
+    # a map of another area: no common objects → the failure report, not a wrong answer
+    other = write_scene(make_scene(99), tmp_path / "other.gpkg")
+    with pytest.raises(GeometryError, match="Georeferencing failed"):
+        registry.run("georeference_polygons", {
+            "image": case["image"], "reference": str(other), "output": str(out)})
+    assert not out.exists()
+
+
+def test_reference_dissolves_split_polygons_and_reprojects(tmp_path) -> None:
+    scene = make_scene(3, split_share=1.0)
+    path = write_scene(scene, tmp_path / "map.gpkg")
+    objs, _crs, info = reference_objects_from_vector(path, "class", "forest")
+    assert info["selected"] > len(objs)  # split parts were merged
+    forests = [p for p, c in zip(scene.polygons, scene.classes) if c == "forest"]
+    from shapely.ops import unary_union
+
+    truth = list(getattr(unary_union(forests), "geoms", []))
+    for g in truth:
+        best = max(Polygon(o.ring).intersection(g).area / Polygon(o.ring).union(g).area
+                   for o in objs)
+        assert best > 0.999
+    # the same layer in geographic coordinates is matched in UTM 32N again
+    import pyproj
+    from shapely.geometry import mapping
+
+    from photodem.algorithms.georef.reference_layer import _transform_polygon
+
+    tr_obj = pyproj.Transformer.from_crs("EPSG:32632", "EPSG:4326", always_xy=True)
+    ll = tmp_path / "ll.geojson"
+    schema = {"geometry": "Polygon", "properties": {"class": "str"}}
+    with fiona.open(ll, "w", driver="GeoJSON", crs="EPSG:4326", schema=schema) as dst:
+        for p, c in zip(scene.polygons, scene.classes):
+            dst.write({"geometry": mapping(_transform_polygon(p, tr_obj)),
+                       "properties": {"class": c}})
+    objs2, crs2, _ = reference_objects_from_vector(ll, "class", "forest")
+    assert crs2.to_epsg() == 32632 and len(objs2) == len(objs)
