@@ -161,8 +161,10 @@ def run_demo(output: Union[str, Path], size: str = "small", seed: int = 1, worke
         models.append({**m, "epipolar": str(folder), "checkpoints": check})
         feedback.progress(92 + 8 * (k + 1) / max(len(info["models"]), 1))
     surfaces = _surfaces(project, info, block, out, feedback)
+    georef = _georef(out, seed, feedback)
     summary = {
         "surfaces": surfaces,
+        "georef": georef,
         "project": str(project_dir),
         "images": len(info["images"]),
         "gsd_m": block.get("gsd_m"),
@@ -225,6 +227,24 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
     }
 
 
+def _georef(out: Path, seed: int, feedback: Feedback) -> Dict[str, Any]:
+    """Georeference a synthetic scene (a polygon map and an image of it under an unknown
+    affine map, mirrored or not) and compare the result with the truth."""
+    from .georef.fit import corner_error
+    from .synthetic.polygon_scene import georef_case
+
+    feedback.info("Georeferencing an image against polygons …")
+    case = georef_case(out / "georef_scene", seed=seed + 4)
+    res = registry.run("georeference_polygons", {
+        "image": case["image"], "reference": case["reference"],
+        "output": str(out / "georef")})
+    err = corner_error(np.array(res["transform"]["matrix"]), case["truth"], case["width"],
+                       case["height"])
+    return {"pairs": res["n_pairs"], "gcps": res["n_gcps"], "rmse_px": res["rmse_px"],
+            "corner_error_px": float(err.max()), "report": res["report"],
+            "image": res["image"]}
+
+
 def _markdown(s: Dict[str, Any]) -> str:
     lines = [
         "# PhotoDEM demo",
@@ -273,6 +293,10 @@ def _markdown(s: Dict[str, Any]) -> str:
     lines += ["", f"True-ortho mosaic of {mo.get('images')} images at {mo.get('gsd')} m: "
               f"`{mo.get('mosaic')}` (seamlines and footprints `{mo.get('seamlines')}`, "
               f"balancing `{mo.get('report')}`).",
+              "", f"Georeferencing against polygons: {s['georef']['pairs']} object pairs, "
+              f"{s['georef']['gcps']} control points, RMSE {s['georef']['rmse_px']:.2f} px, "
+              f"largest error at the image corners against the truth "
+              f"{s['georef']['corner_error_px']:.2f} px (report `{s['georef']['report']}`).",
               "", "Truth files: " + ", ".join(f"`{Path(v).name}`" for v in s["truth"].values()),
               ""]
     return "\n".join(lines)

@@ -34,6 +34,7 @@ class PolygonScene:
     classes: List[str]
     extent: Tuple[float, float, float, float]
     crs: str = CRS
+    groups: Optional[List[int]] = None  # parts of one object (a split forest) share a group
 
 
 def _blob(rng: np.random.Generator, centre: Tuple[float, float], radius: float,
@@ -58,6 +59,7 @@ def make_scene(seed: int = 0, size: float = 3000.0, n_forest: int = 14, n_field:
     x0, y0 = ORIGIN
     polys: List[Any] = []
     classes: List[str] = []
+    groups: List[int] = []
     occupied: List[Any] = []
     plan = ["forest"] * n_forest + ["field"] * n_field + ["lake"] * n_lake
     for cls in plan:
@@ -90,11 +92,13 @@ def make_scene(seed: int = 0, size: float = 3000.0, n_forest: int = 14, n_field:
                 for part in getattr(parts, "geoms", [parts]):
                     polys.append(part)
                     classes.append(cls)
+                    groups.append(len(occupied))
             else:
                 polys.append(p)
                 classes.append(cls)
+                groups.append(len(occupied))
             break
-    return PolygonScene(polys, classes, (x0, y0, x0 + size, y0 + size))
+    return PolygonScene(polys, classes, (x0, y0, x0 + size, y0 + size), groups=groups)
 
 
 def write_scene(scene: PolygonScene, path: PathLike) -> Path:
@@ -154,13 +158,19 @@ def render(scene: PolygonScene, T_img_to_map: NDArray[np.float64], width: int, h
     e, f = Tinv[0, 2] + 0.5, Tinv[1, 2] + 0.5
     ss = supersample
     values = np.full(len(scene.polygons), GREY["background"])
+    groups = scene.groups or list(range(len(scene.polygons)))
+    by_group: Dict[int, float] = {}
     for k, cls in enumerate(scene.classes):
+        if groups[k] in by_group:  # the parts of one split forest look the same
+            values[k] = by_group[groups[k]]
+            continue
         if cls == "field":
             values[k] = rng.uniform(140, 200)
         elif cls == "forest":
             values[k] = GREY["forest"] + rng.uniform(-8, 8)
         else:
             values[k] = GREY["lake"] + rng.uniform(-5, 5)
+        by_group[groups[k]] = values[k]
     shapes = [(affine_transform(p, [a * ss, b * ss, c * ss, d * ss, e * ss, f * ss]), v)
               for p, v in zip(scene.polygons, values)]
     big = features.rasterize(shapes, out_shape=(height * ss, width * ss),
@@ -194,8 +204,8 @@ def georef_case(folder: PathLike, seed: int = 0, width: int = 1000, height: int 
     scene = make_scene(seed if scene_seed is None else scene_seed, **scene_options)
     rng = np.random.default_rng(seed)
     size = scene.extent[2] - scene.extent[0]
-    gsd = size / (1.1 * max(width, height))  # the map covers the image at scale 1
-    T = random_affine(rng, gsd, width, height, scene.extent, scale_range=(0.5, 1.0))
+    gsd = size / (1.1 * max(width, height))  # scale 1: the map just covers the image
+    T = random_affine(rng, gsd, width, height, scene.extent, scale_range=(0.5, 2.0))
     img = render(scene, T, width, height, seed=seed, noise=noise)
     ref = write_scene(scene, folder / "map.gpkg")
     image = write_image(folder / "image.tif", img)

@@ -1,4 +1,5 @@
-"""``photodem demo`` runs the whole chain: block → epipolar pairs → DSMs → merge → DTM."""
+"""``photodem demo`` runs the whole chain: block → epipolar pairs → DSMs → merge → DTM → true
+ortho mosaic, and georeferences an image against polygons."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
     assert dtm["count"] > 0 and abs(dtm["mean"]) < 1.0
     text = Path(s["summary"]).read_text(encoding="utf-8")
     assert "DTM | true DTM" in text and "merged DSM" in text
+    assert s["georef"]["corner_error_px"] < 1.0 and "Georeferencing against polygons" in text
 
 
 def test_demo_refuses_a_foreign_folder(tmp_path) -> None:
