@@ -122,3 +122,20 @@ def test_reference_dissolves_split_polygons_and_reprojects(tmp_path) -> None:
                        "properties": {"class": c}})
     objs2, crs2, _ = reference_objects_from_vector(ll, "class", "forest")
     assert crs2.to_epsg() == 32632 and len(objs2) == len(objs)
+
+
+@pytest.mark.parametrize("kind", ["projective", "poly2"])
+def test_other_transforms_write_an_aligned_image(case, tmp_path, kind) -> None:
+    res = registry.run("georeference_polygons", {
+        "image": case["image"], "reference": case["reference"], "transform": kind,
+        "output": str(tmp_path / kind)})
+    assert res["transform"]["kind"] == kind and res["rmse_px"] < 0.5
+    dark = []
+    with rasterio.open(res["image"]) as src, fiona.open(case["reference"]) as ref:
+        for feat in ref:
+            if feat["properties"]["class"] in ("forest", "lake"):
+                c = shape(feat["geometry"]).representative_point()
+                v, a = next(src.sample([(c.x, c.y)]))
+                if a:
+                    dark.append(v < 90)
+    assert dark and all(dark)
