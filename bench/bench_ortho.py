@@ -91,8 +91,13 @@ def _ngi(tmp: Path) -> Dict[str, Any]:
     dem = DATA / "ngi" / "dem.tif"
     # the common GSD: PhotoDEM's default (image GSD at the DEM's mean height) of the first frame
     gsd = float(orthorectify_image(project, names[0], dem, tmp / "probe.tif")["gsd"])
-    ours, t_ours = _best(lambda: _ours(project, names, dem, tmp / "ours", gsd))
-    theirs, t_theirs = _best(lambda: _theirs(names, dem, tmp / "orthority", gsd))
+    # alternating runs, best of five each: both see the same state of the machine
+    t_ours = t_theirs = np.inf
+    for _ in range(5):
+        ours, t = _best(lambda: _ours(project, names, dem, tmp / "ours", gsd), repeat=1)
+        t_ours = min(t_ours, t)
+        theirs, t = _best(lambda: _theirs(names, dem, tmp / "orthority", gsd), repeat=1)
+        t_theirs = min(t_theirs, t)
     rows: List[Dict[str, Any]] = []
     for name in names:
         s = measure_shift(theirs[name], ours[name], window=31, radius=4).summary()
@@ -377,8 +382,8 @@ def run() -> dict:
     notes += [
         "mean_shift_px: length of the mean shift vector over the matched 31 px windows "
         "(NCC + least-squares, pixels of our ortho); goal vs orthority ≤ 0.25 px.",
-        "speedup_ours = orthority time / our time for all four frames (best of 3, same "
-        "process, both bilinear); goal ≥ 1.5.",
+        "speedup_ours = orthority time / our time for all four frames (best of 5, "
+        "alternating, same process, both bilinear); goal ≥ 1.5.",
         "NGI overlaps: shifts between our orthos of neighbouring frames include the effect of "
         "the 24 m DEM's errors (ΔR = Δh·R/H, R up to ≈ 2.5 km at H ≈ 4.9 km).",
         "Check-point discs: brightness-weighted centroid of the disc blob; RMSE of the 2-D "

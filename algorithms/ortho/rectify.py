@@ -39,7 +39,11 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
+import threading
 import time
+from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
@@ -449,6 +453,8 @@ def _profile(width: int, height: int, count: int, dtype: str, transform: Affine,
         profile["crs"] = crs
     # horizontal differencing + fast deflate: smaller and faster to write than plain deflate
     profile.update(predictor=3 if np.issubdtype(np.dtype(dtype), np.floating) else 2, zlevel=1)
+    # blocks are compressed on all cores while the next tile is computed
+    profile.update(num_threads="all_cpus")
     if width < 256 or height < 256:  # tiles must not exceed tiny rasters
         profile.update(tiled=False)
         profile.pop("blockxsize")
@@ -462,6 +468,37 @@ def _overview_factors(width: int, height: int) -> List[int]:
         factors.append(f)
         f *= 2
     return factors
+
+
+class _SerialReads:
+    """A rasterio dataset whose reads are serialised: tiles are computed in threads, and one
+    GDAL handle must not be read from two threads at once."""
+
+    def __init__(self, ds: Any) -> None:
+        self._ds = ds
+        self._lock = threading.Lock()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._ds, name)
+
+    def read(self, *args: Any, **kwargs: Any) -> Any:
+        with self._lock:
+            return self._ds.read(*args, **kwargs)
+
+    def read_masks(self, *args: Any, **kwargs: Any) -> Any:
+        with self._lock:
+            return self._ds.read_masks(*args, **kwargs)
+
+
+def _tiles(width: int, height: int, tile: int, workers: int
+           ) -> List[Tuple[int, int, int, int]]:
+    """(first row, first col, rows, cols) of the processing tiles: squares of at most ``tile``
+    cells, small enough that every worker gets about two tiles, in multiples of the 256-cell
+    GeoTIFF block (whole blocks are compressed as soon as they are complete)."""
+    share = math.sqrt(width * height / (2.0 * workers))
+    tile = min(tile, max(256, 256 * math.ceil(share / 256)))
+    return [(r0, c0, min(tile, height - r0), min(tile, width - c0))
+            for r0 in range(0, height, tile) for c0 in range(0, width, tile)]
 
 
 def orthorectify_image(
@@ -542,19 +579,21 @@ def orthorectify_image(
                      "cubic": cv2.INTER_CUBIC}[resampling]
 
     with contextlib.ExitStack() as stack:
-        dem_ds = stack.enter_context(open_surface(dem, project.crs, feedback, "DEM"))
+        dem_ds = _SerialReads(stack.enter_context(open_surface(dem, project.crs, feedback,
+                                                               "DEM")))
         dsm_ds = None
         if dsm is not None:
             if Path(dsm).resolve() != Path(dem).resolve():
                 feedback.warning("The true ortho rectifies onto the DEM and tests visibility "
                                  "against a different DSM: cells below roofs and trees of the "
                                  "DSM count as occluded. Use the DSM as DEM for a true ortho.")
-            dsm_ds = stack.enter_context(open_surface(dsm, project.crs, feedback, "DSM"))
+            dsm_ds = _SerialReads(stack.enter_context(open_surface(dsm, project.crs, feedback,
+                                                                   "DSM")))
         src = stack.enter_context(open_image(image_path))
         if (src.width, src.height) != (camera.width, camera.height):
             raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
                              f"'{camera.name}' is {camera.width}×{camera.height} px.")
-        source = _ImageSource(src)
+        source = _ImageSource(_SerialReads(src))
 
         box, mean_z, _ = image_footprint(camera, eo, dem_ds, rec.name, "DEM")
         if extent is not None:
@@ -592,20 +631,39 @@ def orthorectify_image(
         dst = stack.enter_context(open_image(ortho_tmp, "w", **profile))
         vdst = stack.enter_context(open_image(vis_tmp, "w", **vprofile))
 
-        tiles = [(r0, c0) for r0 in range(0, height, tile) for c0 in range(0, width, tile)]
+        workers = os.cpu_count() or 1
+        tiles = _tiles(width, height, tile, workers)
         counts = np.zeros(3, dtype=np.int64)
         from rasterio.windows import Window
 
-        for k, (r0, c0) in enumerate(tiles):
-            feedback.progress(95.0 * k / len(tiles))
-            th, tw = min(tile, height - r0), min(tile, width - c0)
-            bands, vis = _rectify_tile(cv2, interpolation, source, camera, eo, dem_ds,
-                                       dsm_ds, zmax_dsm, transform, (r0, c0, th, tw),
-                                       alpha_value)
-            win = Window(c0, r0, tw, th)
-            dst.write(bands, window=win)
-            vdst.write(vis[None], window=win)
-            counts += np.bincount(vis.ravel(), minlength=3)[:3]
+        def rectify(cells: Tuple[int, int, int, int]) -> Tuple[NDArray[Any], NDArray[np.uint8]]:
+            return _rectify_tile(cv2, interpolation, source, camera, eo, dem_ds, dsm_ds,
+                                 zmax_dsm, transform, cells, alpha_value)
+
+        # tiles are computed on all cores (numpy and OpenCV release the GIL) and written here
+        # in order; at most one tile per worker waits, which bounds the memory
+        workers = max(1, min(workers, len(tiles)))
+        pool = ThreadPoolExecutor(workers)
+        try:
+            todo = iter(tiles)
+            running: deque[Tuple[Tuple[int, int, int, int], Future[Any]]] = deque()
+            for cells in todo:
+                running.append((cells, pool.submit(rectify, cells)))
+                if len(running) > workers:
+                    break
+            for k in range(len(tiles)):
+                feedback.progress(95.0 * k / len(tiles))
+                (r0, c0, th, tw), future = running.popleft()
+                bands, vis = future.result()
+                nxt = next(todo, None)
+                if nxt is not None:
+                    running.append((nxt, pool.submit(rectify, nxt)))
+                win = Window(c0, r0, tw, th)
+                dst.write(bands, window=win)
+                vdst.write(vis[None], window=win)
+                counts += np.bincount(vis.ravel(), minlength=3)[:3]
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
         feedback.progress(96.0)
         _finish(dst, vdst, source, rec.name, eo, dem, dsm, width, height, gsd)
         if counts[VISIBLE] == 0:
@@ -737,9 +795,12 @@ def _finish(dst: Any, vdst: Any, source: _ImageSource, name: str, eo: ExteriorOr
     vdst.update_tags(PHOTODEM_IMAGE=name, PHOTODEM_VISIBILITY="0 outside, 1 visible, 2 occluded")
     factors = _overview_factors(width, height)
     if factors:
-        dst.build_overviews(factors, Resampling.average)
-        dst.update_tags(ns="rio_overview", resampling="average")
-        vdst.build_overviews(factors, Resampling.nearest)
+        import rasterio
+
+        with rasterio.Env(GDAL_NUM_THREADS="ALL_CPUS"):  # flushing compresses on all cores
+            dst.build_overviews(factors, Resampling.average)
+            dst.update_tags(ns="rio_overview", resampling="average")
+            vdst.build_overviews(factors, Resampling.nearest)
 
 
 __all__ = [
