@@ -1064,8 +1064,12 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
             "failures": failures,
             "sigma0_grey_mean": float(np.mean(s0s)) if s0s else None,
             "sigma0_grey_median": float(np.median(s0s)) if s0s else None,
-            "sigma_z_mean_m": float(sig.mean()) if sig.size else None,
+            # no mean: nodes on texture-free ground have σ of kilometres (no regularisation
+            # in the σ), which would swamp it; the share of such nodes is reported instead
             "sigma_z_median_m": float(np.median(sig)) if sig.size else None,
+            "sigma_z_p95_m": float(np.percentile(sig, 95)) if sig.size else None,
+            "nodes_sigma_over_1m_pct": (round(100.0 * float(np.mean(sig > 1.0)), 3)
+                                        if sig.size else None),
         }
         report = {"dsm": str(dsm), "crs": project.crs, "metrics": metrics,
                   "options": {"max_iter": int(max_iter), "regularisation": regularisation,
