@@ -95,11 +95,14 @@ def make_albedo(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndar
     w = -X * np.sin(theta) + Y * np.cos(theta)
     furrow = (0.78 + 0.22 * np.sin(2.0 * np.pi * w / period)).astype(np.float32)
     del w
-    _paint(albedo, ptype == 1, colours["furrowed"], furrow)
+    # band-limited noise under the furrows and crop rows as well (seed-000 §7: "band-limited
+    # noise plus field patches"): soil clods and gaps; a pure sinusoid would be ambiguous
+    # by whole periods across the furrows, which real fields are not
+    _paint(albedo, ptype == 1, colours["furrowed"], furrow * (1.0 + 0.10 * fine))
     del furrow
     c, s = np.cos(obj.parcel_angle), np.sin(obj.parcel_angle)
     rows_ = (0.85 + 0.15 * np.sin(2.0 * np.pi * (X * c + Y * s) / 3.0)).astype(np.float32)
-    _paint(albedo, ptype == 2, colours["crop"], rows_)
+    _paint(albedo, ptype == 2, colours["crop"], rows_ * (1.0 + 0.10 * fine))
     del rows_
     _paint(albedo, ptype == 3, colours["bare"], 1.0 + 0.15 * fine)
     del ptype
