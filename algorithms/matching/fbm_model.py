@@ -200,6 +200,36 @@ def _options(preset: str, overrides: Dict[str, Any]) -> Tuple[Any, Dict[str, Any
     return options, surface
 
 
+def _on_surface(pair: Any, col: np.ndarray, row: np.ndarray, min_d: float, max_d: float,
+                z_grid: np.ndarray, grid: Any, steps: int = 128) -> np.ndarray:
+    """Ground position (n, 2) of left epipolar pixels: where their ray meets the DSM.
+
+    Failed windows have no disparity; their rays are sampled over the disparity range and
+    the first crossing of the DSM (nearest cell) is taken, so the report's failure map shows
+    them where they are, not where the middle of a range of hundreds of metres would put them.
+    Rays that do not meet the DSM keep the middle of the range.
+    """
+    d = np.linspace(min_d, max_d, steps)
+    w = pair.disparity_to_world(np.broadcast_to(d, (col.size, steps)),
+                                np.repeat(col[:, None], steps, 1),
+                                np.repeat(row[:, None], steps, 1))
+    r, c = grid.cell_of(w[..., 0], w[..., 1])
+    inside = r >= 0
+    surf = np.full(r.shape, np.nan)
+    surf[inside] = z_grid[r[inside], c[inside]]
+    above = w[..., 2] - surf  # grows with the disparity (the ray point rises)
+    cross = (above[:, :-1] < 0) & (above[:, 1:] >= 0)
+    k = np.where(cross.any(1), cross.argmax(1), -1)
+    out = w[:, steps // 2, :2].copy()
+    hit = k >= 0
+    if hit.any():
+        i = np.flatnonzero(hit)
+        a0, a1 = above[i, k[hit]], above[i, k[hit] + 1]
+        t = (-a0 / (a1 - a0))[:, None]
+        out[hit] = (1 - t) * w[i, k[hit], :2] + t * w[i, k[hit] + 1, :2]
+    return out
+
+
 def _inside_any(polygons: List[Any], x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Points strictly inside any of the (multi)polygons (holes honoured), vectorised."""
     from matplotlib.path import Path as MplPath
@@ -459,9 +489,8 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         fails = matches.failures
         fail_xy = None
         if len(fails):
-            d_mid = 0.5 * (setup.min_d + setup.max_d)
-            w = pair.disparity_to_world(np.full(len(fails), d_mid), fails[:, 0], fails[:, 1])
-            fail_xy = w[:, :2]
+            fail_xy = _on_surface(pair, fails[:, 0], fails[:, 1], setup.min_d, setup.max_d,
+                                  z_grid, grid)
         timings["total"] = time.perf_counter() - t_start
         report = {"model": m.name, "method": "fbm_lsm", "images": setup.names,
                   "crs": project.crs, "flying_height_m": H, "preset": preset,
