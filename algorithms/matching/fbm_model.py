@@ -462,6 +462,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         "failed_windows": len(matches.failures),
         "max_gap_m": max_gap,
         "base_px": float(pair.base * pair.focal_px / H) if H > 0 else None,
+        "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
     }
     out = Path(output_dir)
     suffix = "." + points_format

@@ -307,6 +307,33 @@ def _eval_planes(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, 
     return out
 
 
+def _plane_range(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
+                 ) -> Tuple[NDArray, NDArray]:
+    """Lowest and highest disparity of a group's own plane and its neighbours' planes at
+    each point (NaN for g < 0): where they disagree (a roof beside the ground) the point's
+    disparity is not known better than that."""
+    lo = _eval_planes(plane, grouping, g, cols, rows)
+    hi = lo.copy()
+    e = grouping.edges
+    if e.size == 0 or g.size == 0:
+        return lo, hi
+    order = np.argsort(e[:, 0], kind="stable")
+    src, dst = e[order, 0], e[order, 1]
+    start = np.searchsorted(src, g, side="left")
+    stop = np.searchsorted(src, g, side="right")
+    cnt = np.where(g >= 0, stop - start, 0)
+    if cnt.sum() == 0:
+        return lo, hi
+    pi = np.repeat(np.arange(g.size), cnt)
+    first = np.cumsum(cnt) - cnt
+    nb = dst[start[pi] + (np.arange(pi.size) - first[pi])]
+    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
+    ok = np.isfinite(val)
+    np.fmin.at(lo, pi[ok], val[ok])
+    np.fmax.at(hi, pi[ok], val[ok])
+    return lo, hi
+
+
 def _neighbour_prediction(plane: NDArray, grouping: Grouping, matched: NDArray, g: NDArray,
                           cols: NDArray, rows: NDArray) -> NDArray:
     """Mean of the matched neighbour components' planes, evaluated at each point."""
@@ -555,6 +582,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
         mode = np.zeros(ng, np.int8)
         seed_d = np.full(ng, np.nan)
         coarse = None
+        coarse_range = None
         if prev is not None:
             p_plane, p_group = prev
 
@@ -562,6 +590,12 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
                 c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
                 g1 = p_group.of(c1, r1, nearest=True)
                 return 2.0 * _eval_planes(p_plane, p_group, g1, c1, r1)
+
+            def coarse_range(cols, rows, p_plane=p_plane, p_group=p_group):
+                c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
+                g1 = p_group.of(c1, r1, nearest=True)
+                lo, hi = _plane_range(p_plane, p_group, g1, c1, r1)
+                return 2.0 * lo, 2.0 * hi
 
             mode[:] = _COARSE
             # components the coarser level could not predict (nothing matched within reach
@@ -655,6 +689,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
 
             def predict(cols, rows, active=None, context=None, todo_now=todo_now, mode=mode,
                         plane=plane, matched=matched, coarse=coarse, seed_d=seed_d,
+                        coarse_range=coarse_range,
                         grouping=grouping, mid_k=mid_k, half_k=half_k):
                 """(d_pred, pull_in) at left positions of this level; NaN = not matched now.
 
@@ -669,8 +704,15 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
                 m = np.where(act, mode[gg], _NONE)
                 sel = m == _COARSE
                 if sel.any() and coarse is not None:
-                    d[sel] = coarse(cols[sel], rows[sel])
-                    p[sel] = pull_ref
+                    if coarse_range is not None:
+                        # between disagreeing coarse planes (e.g. a window's roof plane
+                        # extrapolated over ground) search their whole span, up to 4 pull-ins
+                        lo, hi = coarse_range(cols[sel], rows[sel])
+                        d[sel] = 0.5 * (lo + hi)
+                        p[sel] = pull_ref + np.minimum(0.5 * (hi - lo), 3.0 * pull_ref)
+                    else:
+                        d[sel] = coarse(cols[sel], rows[sel])
+                        p[sel] = pull_ref
                 sel = m == _SEED
                 if sel.any():
                     d[sel] = seed_d[g[sel]]
