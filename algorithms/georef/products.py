@@ -83,7 +83,7 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
     from rasterio.windows import Window
     from scipy import ndimage
 
-    from ..raster.io import GTIFF_PROFILE, atomic_output, open_image
+    from ..raster.io import GTIFF_PROFILE, atomic_output, open_image, overview_factors
 
     fb = feedback or Feedback()
     fit = result["fit"]
@@ -138,7 +138,7 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
                     dst.write(out.reshape(count + 1, th, tw), window=Window(c0, r0, tw, th))
                     done += 1
                     fb.progress(100.0 * done / n_tiles)
-            factors = [f for f in (2, 4, 8, 16, 32) if max(rows, cols) / f >= 256]
+            factors = overview_factors(cols, rows)
             if factors:
                 dst.build_overviews(factors, rasterio.enums.Resampling.average)
             dst.colorinterp = [*dst.colorinterp[:count],

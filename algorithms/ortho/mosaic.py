@@ -62,7 +62,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output
+from ..raster.io import GTIFF_PROFILE, atomic_output, overview_factors
 from . import balance as bal
 from . import seamlines as sl
 
@@ -599,10 +599,7 @@ def mosaic_orthos(
                             PHOTODEM_GSD=f"{s:g}", PHOTODEM_SEAMLINES=seam_stats["mode"],
                             PHOTODEM_BALANCE=balance)
             fb.progress(95.0)
-            factors, fac = [], 2
-            while max(W, H) / fac >= 256:
-                factors.append(fac)
-                fac *= 2
+            factors = overview_factors(W, H)
             if factors:
                 dst.build_overviews(factors, Resampling.average)
                 dst.update_tags(ns="rio_overview", resampling="average")

@@ -38,6 +38,7 @@ the tile size (plus the image window and DEM window a tile needs), not by the ou
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import threading
@@ -56,7 +57,7 @@ from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
-from ..raster.io import GTIFF_PROFILE, atomic_output, open_image
+from ..raster.io import GTIFF_PROFILE, atomic_output, open_image, overview_factors
 from .visibility import march_margin, occluded
 
 PathLike = Union[str, Path]
@@ -88,9 +89,19 @@ def same_horizontal_crs(a: Any, b: Any) -> bool:
     choice, as for any DEM).
     """
     try:
+        wkt_a, wkt_b = a.to_wkt(), b.to_wkt()
+    except Exception:  # an unparsable CRS is never "the same"
+        return False
+    return _same_horizontal_wkt(wkt_a, wkt_b)
+
+
+@functools.lru_cache(maxsize=64)
+def _same_horizontal_wkt(wkt_a: str, wkt_b: str) -> bool:
+    # cached: pyproj's parsing costs milliseconds, and every ortho of a block asks again
+    try:
         import pyproj
 
-        pa, pb = pyproj.CRS.from_wkt(a.to_wkt()), pyproj.CRS.from_wkt(b.to_wkt())
+        pa, pb = pyproj.CRS.from_wkt(wkt_a), pyproj.CRS.from_wkt(wkt_b)
     except Exception:  # an unparsable CRS is never "the same"
         return False
 
@@ -462,14 +473,6 @@ def _profile(width: int, height: int, count: int, dtype: str, transform: Affine,
     return profile
 
 
-def _overview_factors(width: int, height: int) -> List[int]:
-    factors, f = [], 2
-    while max(width, height) / f >= 256:
-        factors.append(f)
-        f *= 2
-    return factors
-
-
 class _SerialReads:
     """A rasterio dataset whose reads are serialised: tiles are computed in threads, and one
     GDAL handle must not be read from two threads at once."""
@@ -793,14 +796,15 @@ def _finish(dst: Any, vdst: Any, source: _ImageSource, name: str, eo: ExteriorOr
                     PHOTODEM_DSM=str(Path(dsm).resolve()) if dsm else "",
                     PHOTODEM_TRUE_ORTHO="1" if dsm else "0", PHOTODEM_GSD=f"{gsd:g}")
     vdst.update_tags(PHOTODEM_IMAGE=name, PHOTODEM_VISIBILITY="0 outside, 1 visible, 2 occluded")
-    factors = _overview_factors(width, height)
+    factors = overview_factors(width, height)
     if factors:
         import rasterio
 
         with rasterio.Env(GDAL_NUM_THREADS="ALL_CPUS"):  # flushing compresses on all cores
             dst.build_overviews(factors, Resampling.average)
             dst.update_tags(ns="rio_overview", resampling="average")
-            vdst.build_overviews(factors, Resampling.nearest)
+            if dsm:  # a classical ortho's visibility repeats its alpha band: no overviews
+                vdst.build_overviews(factors, Resampling.nearest)
 
 
 __all__ = [

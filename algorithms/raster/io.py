@@ -14,7 +14,7 @@ import shutil
 import uuid
 import warnings
 from pathlib import Path
-from typing import Any, Dict, Iterator, Optional, Union
+from typing import Any, Dict, Iterator, List, Optional, Union
 
 import numpy as np
 import rasterio
@@ -174,11 +174,17 @@ def write_raster(
     with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
         dst.write(arr)
         if overviews:
-            factors = []
-            f = 2
-            while max(width, height) / f >= 256:
-                factors.append(f)
-                f *= 2
+            factors = overview_factors(width, height)
             if factors:
                 dst.build_overviews(factors, Resampling.average)
     return Path(path)
+
+
+def overview_factors(width: int, height: int) -> List[int]:
+    """Internal overview factors 2, 4, 8, … of a raster, down to about 256 cells on the
+    longer side (a level smaller than one 256-cell block is not worth reading)."""
+    factors, f = [], 2
+    while max(width, height) / f >= 256:
+        factors.append(f)
+        f *= 2
+    return factors

@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output
+from ..raster.io import GTIFF_PROFILE, atomic_output, overview_factors
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -250,10 +250,7 @@ def _profile(width: int, height: int, dtype: str, transform: Affine, crs: Any,
 
 
 def _overviews(dst: Any, width: int, height: int, resampling: Any) -> None:
-    factors, f = [], 2
-    while max(width, height) / f >= 256:
-        factors.append(f)
-        f *= 2
+    factors = overview_factors(width, height)
     if factors:
         dst.build_overviews(factors, resampling)
 

@@ -30,7 +30,11 @@ from photodem.algorithms.processing import registry  # noqa: E402
 from photodem.algorithms.processing.feedback import Feedback  # noqa: E402
 from photodem.algorithms.project.model import ImageRecord, Project  # noqa: E402
 from photodem.algorithms.quality.targets import target_centroids  # noqa: E402
-from photodem.algorithms.raster.io import open_image, write_raster  # noqa: E402
+from photodem.algorithms.raster.io import (  # noqa: E402
+    open_image,
+    overview_factors,
+    write_raster,
+)
 from photodem.algorithms.raster.sample import bilinear  # noqa: E402
 from photodem.algorithms.synthetic.block import generate_block  # noqa: E402
 from photodem.algorithms.synthetic.render import Renderer, render_image  # noqa: E402
@@ -151,6 +155,10 @@ def test_true_ortho_roofs_on_footprints_and_occlusion(city, tmp_path) -> None:
     assert iou_occ >= 0.9, iou_occ
     assert (bands[3][occ] == 0).all() and (bands[:3, occ] == 0).all()
     assert ((vis == 1) == (bands[3] == 255)).all()
+    # both rasters carry overviews for display (the occlusions are worth looking at)
+    for path in (res["ortho"], res["visibility"]):
+        with rasterio.open(path) as src:
+            assert src.overviews(1) == overview_factors(src.width, src.height) != []
 
 
 def test_classical_ortho_shows_building_lean(city, tmp_path) -> None:
@@ -158,6 +166,9 @@ def test_classical_ortho_shows_building_lean(city, tmp_path) -> None:
     root = city["root"]
     res = orthorectify_image(root, "c1", root / "dtm.tif", tmp_path / "dtm.tif", gsd=0.2)
     bands, T, tags = _read(res["ortho"])
+    # a classical ortho's visibility repeats its alpha band: written without overviews
+    with rasterio.open(res["ortho"]) as a, rasterio.open(res["visibility"]) as v:
+        assert a.overviews(1) and not v.overviews(1)
     assert tags["PHOTODEM_TRUE_ORTHO"] == "0" and res["occluded_pct"] == 0.0
     gx, gy = _cells(T, bands.shape[1:])
     red = _red(bands)
