@@ -1,4 +1,4 @@
-r"""Orthophoto mosaic: several orthos → one tiled GeoTIFF with overviews, seams, balancing.
+r"""Orthophoto mosaic: several orthos → one Cloud-Optimised GeoTIFF, seams, balancing.
 
 Inputs
     Orthos in the PhotoDEM format (:mod:`.rectify`): colour bands + alpha band (255 valid,
@@ -62,7 +62,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output, overview_factors
+from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, overview_factors
 from . import balance as bal
 from . import seamlines as sl
 
@@ -554,7 +554,9 @@ def mosaic_orthos(
         filled = 0
         covered = 0
         tfb = fb.step(30, 95)
-        with atomic_output(out) as tmp, rasterio.open(tmp, "w", **prof) as dst:
+        # a Cloud-Optimised GeoTIFF: the mosaic is the block's deliverable
+        with cog_output(out, prof) as (tmp, scratch_prof), \
+                rasterio.open(tmp, "w", **scratch_prof) as dst:
             for t_idx, (r0, c0) in enumerate(tiles):
                 tfb.progress(100.0 * t_idx / len(tiles))
                 r1, c1 = min(r0 + tile, H), min(c0 + tile, W)

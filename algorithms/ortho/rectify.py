@@ -57,7 +57,7 @@ from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
-from ..raster.io import GTIFF_PROFILE, atomic_output, open_image, overview_factors
+from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, open_image, overview_factors
 from .visibility import march_margin, occluded
 
 PathLike = Union[str, Path]
@@ -629,7 +629,8 @@ def orthorectify_image(
         alpha_value = 255
         profile = _profile(width, height, n_bands + 1, dtype, transform, project.crs)
         vprofile = _profile(width, height, 1, "uint8", transform, project.crs)
-        ortho_tmp = stack.enter_context(atomic_output(output))
+        # a Cloud-Optimised GeoTIFF, through an uncompressed scratch file (see cog_output)
+        ortho_tmp, profile = stack.enter_context(cog_output(output, profile))
         vis_tmp = stack.enter_context(atomic_output(vis_path))
         dst = stack.enter_context(open_image(ortho_tmp, "w", **profile))
         vdst = stack.enter_context(open_image(vis_tmp, "w", **vprofile))

@@ -14,7 +14,7 @@ import shutil
 import uuid
 import warnings
 from pathlib import Path
-from typing import Any, Dict, Iterator, List, Optional, Union
+from typing import Any, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 import rasterio
@@ -58,6 +58,41 @@ def atomic_output(path: PathLike) -> Iterator[Path]:
         for leftover in (tmp, Path(str(tmp) + ".aux.xml"), Path(str(tmp) + ".ovr")):
             if leftover.exists():
                 leftover.unlink()
+
+
+#: Creation options that carry over from a product's profile to its Cloud-Optimised copy.
+_COG_OPTIONS = ("tiled", "blockxsize", "blockysize", "compress", "predictor", "zlevel",
+                "interleave", "BIGTIFF", "num_threads")
+
+
+@contextlib.contextmanager
+def cog_output(path: PathLike, profile: Dict[str, Any]
+               ) -> Iterator[Tuple[Path, Dict[str, Any]]]:
+    """Yield a scratch path and the profile to write it with; on success the scratch file
+    (with the internal overviews built into it) becomes a Cloud-Optimised GeoTIFF at ``path``,
+    atomically like :func:`atomic_output`, with the creation options of ``profile``.
+
+    GDAL can put overviews before the full-resolution data (the COG layout) only when it copies
+    a finished file, so products written tile by tile go through a scratch file. It is written
+    uncompressed: the overviews are then built without decoding blocks, and the only
+    compression is the copy's. The scratch file is always removed.
+    """
+    creation = {k: v for k, v in profile.items() if k in _COG_OPTIONS}
+    scratch_profile = {k: v for k, v in profile.items()
+                       if k not in ("compress", "predictor", "zlevel", "num_threads")}
+    scratch_profile["compress"] = "none"
+    with atomic_output(path) as final:
+        scratch = final.with_name(f"{final.stem}.scratch{final.suffix}")
+        try:
+            yield scratch, scratch_profile
+            from rasterio.shutil import copy
+
+            copy(str(scratch), str(final), driver="GTiff", copy_src_overviews=True, **creation)
+        finally:
+            for leftover in (scratch, Path(str(scratch) + ".aux.xml"),
+                             Path(str(scratch) + ".ovr")):
+                if leftover.exists():
+                    leftover.unlink()
 
 
 #: Marker file in every folder a PhotoDEM algorithm wrote; only such folders are ever replaced.

@@ -25,8 +25,9 @@ class Orthorectify(Algorithm):
         "(nearest, bilinear or cubic), tile by tile. A DTM gives a classical ortho (buildings "
         "lean away from the nadir by Δr = h·r/H); a true ortho needs the DSM: cells the camera "
         "cannot see because a building or tree hides them are marked occluded (alpha 0, "
-        "visibility 2) so that a mosaic fills them from another image. Writes a tiled GeoTIFF "
-        "with overviews (the image bands plus an alpha band) and <name>_visibility.tif (0 "
+        "visibility 2) so that a mosaic fills them from another image. Writes a Cloud-Optimised "
+        "GeoTIFF (COG) with overviews (the image bands plus an alpha band) and "
+        "<name>_visibility.tif (0 "
         "outside the image, 1 visible, 2 occluded). A DEM in another CRS is reprojected on the "
         "fly (with a warning)."
     )
@@ -208,7 +209,8 @@ class Mosaic(Algorithm):
     group = GROUP
     group_id = GROUP_ID
     help = (
-        "Mosaics orthos into one tiled GeoTIFF with overviews (colour bands + alpha). Inputs: "
+        "Mosaics orthos into one Cloud-Optimised GeoTIFF (COG) with overviews (colour bands + "
+        "alpha). Inputs: "
         "orthos (PhotoDEM orthos carry their projection centre), or a project and a DEM: then "
         "every image is rectified first (a true ortho on the DSM with true_ortho). Seamlines: "
         "auto starts from the nadir partition (each cell to the image with the nearest "

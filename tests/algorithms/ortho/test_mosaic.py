@@ -126,6 +126,11 @@ def test_auto_seams_avoid_the_building(tmp_path: Path) -> None:
     assert res["seams"]["seam_cells_on_objects_after"] == 0
     data, alpha = read_mosaic(out)
     assert (alpha == 255).all()
+    import rasterio
+
+    with rasterio.open(out) as ds:  # the deliverable is a Cloud-Optimised GeoTIFF
+        assert ds.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
     src = source_map(data[0], T, 50)
     assert (src >= 0).all()
     from rasterio.features import rasterize

@@ -155,10 +155,13 @@ def test_true_ortho_roofs_on_footprints_and_occlusion(city, tmp_path) -> None:
     assert iou_occ >= 0.9, iou_occ
     assert (bands[3][occ] == 0).all() and (bands[:3, occ] == 0).all()
     assert ((vis == 1) == (bands[3] == 255)).all()
-    # both rasters carry overviews for display (the occlusions are worth looking at)
+    # both rasters carry overviews for display (the occlusions are worth looking at); the
+    # ortho is a Cloud-Optimised GeoTIFF
     for path in (res["ortho"], res["visibility"]):
         with rasterio.open(path) as src:
             assert src.overviews(1) == overview_factors(src.width, src.height) != []
+    with rasterio.open(res["ortho"]) as src:
+        assert src.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"
 
 
 def test_classical_ortho_shows_building_lean(city, tmp_path) -> None:
