@@ -3,7 +3,8 @@
 Every product is written to a temporary name beside its target and renamed when complete
 (:func:`atomic_output`, :func:`staged_folder`), so a failed or cancelled run leaves nothing and an
 existing product is replaced only by a complete one. GeoTIFFs are tiled and compressed; final
-products can be Cloud-Optimised (overviews, :func:`write_raster` with ``overviews=True``).
+products are Cloud-Optimised (overviews first, :func:`cog_output`; :func:`write_raster` with
+``overviews=True``).
 """
 
 from __future__ import annotations
@@ -184,7 +185,8 @@ def write_raster(
     """Write a 2-D (rows, cols) or 3-D (bands, rows, cols) array as a tiled GeoTIFF, atomically.
 
     Without ``transform`` the raster lives in image space (pixel coordinates). Float rasters
-    default to ``nodata = NaN``. ``overviews=True`` adds internal overviews
+    default to ``nodata = NaN``. ``overviews=True`` writes a Cloud-Optimised GeoTIFF with
+    internal overviews
     (factors 2, 4, 8, … down to ~256 px) for display.
     """
     arr = np.asarray(data)
@@ -206,12 +208,15 @@ def write_raster(
         profile.pop("blockxsize")
         profile.pop("blockysize")
     profile.update(options)
-    with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
+    if not overviews:
+        with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
+            dst.write(arr)
+        return Path(path)
+    with cog_output(path, profile) as (tmp, scratch), open_image(tmp, "w", **scratch) as dst:
         dst.write(arr)
-        if overviews:
-            factors = overview_factors(width, height)
-            if factors:
-                dst.build_overviews(factors, Resampling.average)
+        factors = overview_factors(width, height)
+        if factors:
+            dst.build_overviews(factors, Resampling.average)
     return Path(path)
 
 

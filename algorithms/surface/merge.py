@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output, overview_factors
+from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, overview_factors
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -345,14 +345,15 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
                                    or ss.height != i.height):
                 raise InputError(f"The σ raster '{i.sigma_path}' does not have the grid of "
                                  f"'{i.path.name}'; give σ on the DSM's grid.")
-        tmp_dsm = stack.enter_context(atomic_output(out_paths["dsm"]))
-        tmp_cnt = stack.enter_context(atomic_output(out_paths["count"]))
+        tmp_dsm, dsm_profile = stack.enter_context(cog_output(
+            out_paths["dsm"], _profile(width, height, "float32", transform, crs_out,
+                                       float("nan"))))
+        tmp_cnt, cnt_profile = stack.enter_context(cog_output(
+            out_paths["count"], _profile(width, height, "uint16", transform, crs_out, None)))
         tmp_json = stack.enter_context(atomic_output(out_paths["report"]))
         tmp_csv = stack.enter_context(atomic_output(out_paths["csv"]))
-        with rasterio.open(tmp_dsm, "w", **_profile(width, height, "float32", transform,
-                                                     crs_out, float("nan"))) as dst, \
-                rasterio.open(tmp_cnt, "w", **_profile(width, height, "uint16", transform,
-                                                       crs_out, None)) as cnt_dst:
+        with rasterio.open(tmp_dsm, "w", **dsm_profile) as dst, \
+                rasterio.open(tmp_cnt, "w", **cnt_profile) as cnt_dst:
             k = 0
             for tr in range(n_tr):
                 for tc in range(n_tc):

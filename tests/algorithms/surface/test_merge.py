@@ -51,7 +51,10 @@ def test_two_planes_with_offset_give_exact_seam_stats(tmp_path) -> None:
         assert (src.width, src.height) == (90, 50)
         assert src.transform == Affine(1, 0, 1000, 0, -1, 2000)
         assert src.crs.to_epsg() == 25832 and src.dtypes[0] == "float32"
+        assert src.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"  # a final product
         z = src.read(1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "a.tif", "b.tif", "m.tif", "m_count.tif", "m_seams.csv", "m_seams.json"]
     ov = z[10:40, 30:60]  # overlap: mean of a and a + 0.5
     cols, rows = np.meshgrid(np.arange(30, 60), np.arange(10, 40))
     truth = 100.0 + 0.25 * (cols + 0.5) + 0.5 * (-(rows + 0.5)) + 0.25
