@@ -7,7 +7,11 @@ holes are finally filled from the surrounding ground.
 
 Smoothing (normalised convolution of first order)
     In iteration ``k`` every cell gets the height :math:`T_k` of the least-squares plane through
-    the remaining cells of a square window of side :math:`w_k` centred on it. With weights
+    the remaining cells of a square window of side :math:`w_k` centred on it that are not more
+    than the iteration's threshold above the grey opening of the remaining cells with the same
+    window (:func:`plane_support`): objects narrower than the window no longer pull the plane
+    up — a building on a hillside, whose roof is flush with the slope above it, was otherwise
+    a terrace to the plane and survived. With weights
     :math:`p_j \in \{0, 1\}` (1 = remaining cell), local coordinates ``u, v`` and the window
     means :math:`\bar{\cdot} = \sum p_j \cdot / \sum p_j` (all computed with box filters, so the
     cost per cell does not depend on the window):
@@ -68,6 +72,7 @@ from .surface_input import (
     FilterConstraints,
     FilterInput,
     check_ground_points,
+    grey_opening,
     low_outliers,
     read_filter_constraints,
     read_filter_input,
@@ -165,6 +170,36 @@ def plane_smooth(z: Array, weight: Array, radius: int, min_count: int = 3,
         t = np.where(count >= min_count - 0.5, t, np.nan)
         out[r0:r1] = (t[r0 - a0:r1 - a0] + zmean).astype(np.float32)
     return out
+
+
+def plane_support(z: Array, support: Array, radius: int, threshold: float) -> Array:
+    """Support cells of an iteration's planes: at most ``threshold`` above the grey opening.
+
+    The opening of the support heights with the window of the planes (side ``2·radius + 1``)
+    is their lower envelope without the objects narrower than the window; it keeps slopes and
+    terraces exactly (:func:`~.surface_input.grey_opening`). Cells more than the iteration's
+    threshold above it are objects for the plane fit — so an object cannot lift the plane by
+    which it is judged — but they are eliminated only by the usual test against the plane.
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Current heights.
+    support : ndarray of bool
+        Remaining cells.
+    radius : int
+        Half side of the window (cells).
+    threshold : float
+        Height (m) above the opening beyond which a cell does not support the planes.
+
+    Returns
+    -------
+    ndarray of bool
+        The support cells of the plane fit (a subset of ``support``).
+    """
+    opened = grey_opening(np.where(support, z, np.nan), 2 * int(radius) + 1)
+    with np.errstate(invalid="ignore"):
+        return support & ~(np.asarray(z) - opened > threshold)
 
 
 def _sub_grid(grid: Grid, r0: int, c0: int, h: int, w: int) -> Grid:
@@ -557,9 +592,11 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         radius = max(1, round(wm / spacing / 2.0))
         sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
             if cons.breaklines else []
-        t = smooth(m, support, radius, sides, barrier)
-        d = m - t
         thr = tk + slope * wm / 4.0
+        # manual ground points always support the planes
+        fit = plane_support(m, support, radius, thr) | (support & gp_cells)
+        t = smooth(m, fit, radius, sides, barrier)
+        d = m - t
         # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
         # it lies s·w/4 below a ridge: the blunder depth grows alike
         thr_down = down + slope * wm / 4.0
@@ -737,4 +774,4 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
 
 
 __all__ = ["breakline_sides", "lowpass_filter", "lowpass_parameters", "membrane_fill",
-           "plane_smooth", "run_filter_lowpass", "smooth"]
+           "plane_smooth", "plane_support", "run_filter_lowpass", "smooth"]

@@ -594,6 +594,46 @@ def low_outliers(z: Array, depth: float, radius: int = 2, passes: int = 2) -> Ar
     return out
 
 
+def grey_opening(z: Array, size: int) -> Array:
+    r"""Grey-value opening (erosion, then dilation) of a grid with a square window.
+
+    .. math:: (z \circ B)(c) = \max_{c' \in B(c)} \min_{c'' \in B(c')} z(c'')
+
+    with :math:`B` the ``size`` × ``size`` window. The opening removes every peak narrower
+    than the window (buildings, trees) and keeps any surface that is monotone along every
+    line through the window exactly — a tilted plane, a slope, a terrace — so, unlike the
+    plain minimum, it is not biased low on slopes; only ridges and hill tops narrower than the
+    window are cut (by about their slope × half the window), and an object on a slope leaves
+    a shelf at the ground height of its uphill edge. Beyond the border the grid is
+    continued by point reflection (:math:`z(-k) = 2 z(0) - z(k)`), which continues a slope
+    (a flat continuation would cut the uphill border strip by slope × half the window). NaN
+    cells are ignored as support and stay NaN.
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights, NaN = no data.
+    size : int
+        Side of the window in cells (odd).
+
+    Returns
+    -------
+    ndarray float32 (h, w)
+    """
+    from scipy import ndimage
+
+    zz = np.asarray(z, np.float32)
+    h, w = zz.shape
+    r = min(int(size) // 2, h - 1, w - 1)
+    ext = np.pad(zz, r, mode="reflect", reflect_type="odd") if r > 0 else zz
+    ok = np.isfinite(ext)
+    ero = ndimage.minimum_filter(np.where(ok, ext, np.inf), size=int(size), mode="nearest")
+    # windows without data have no erosion: they must not win the dilation
+    ero[~np.isfinite(ero)] = -np.inf
+    out = ndimage.maximum_filter(ero, size=int(size), mode="nearest")[r:r + h, r:r + w]
+    return np.where(np.isfinite(zz) & np.isfinite(out), out, np.nan).astype(np.float32)
+
+
 # -- outputs ------------------------------------------------------------------------------------
 def _iteration_figure(rows: Sequence[Dict[str, Any]]) -> Any:
     from ..quality.report import new_figure
@@ -758,6 +798,6 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
 
 
 __all__ = ["DEFAULT_GROUND_TOLERANCE", "MIN_POINTS", "FilterConstraints", "FilterInput",
-           "check_ground_points", "dtm_slope", "grid_lowest", "low_outliers", "nice_spacing",
-           "point_labels", "read_filter_constraints", "read_filter_input", "sample_bilinear",
-           "to_crs", "write_filter_outputs"]
+           "check_ground_points", "dtm_slope", "grey_opening", "grid_lowest", "low_outliers",
+           "nice_spacing", "point_labels", "read_filter_constraints", "read_filter_input",
+           "sample_bilinear", "to_crs", "write_filter_outputs"]

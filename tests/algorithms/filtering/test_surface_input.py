@@ -204,6 +204,26 @@ def test_low_outliers_net_cut_is_slope_invariant() -> None:
     assert set(zip(*np.nonzero(low_outliers(flat, 1.5)))) == {(15, 15)}
 
 
+def test_grey_opening_keeps_slopes_and_removes_narrow_objects() -> None:
+    from photodem.algorithms.filtering.surface_input import grey_opening
+
+    rows, cols = np.mgrid[0:50, 0:70].astype(float)
+    slope = 100.0 + 0.8 * cols - 0.5 * rows + 3.0 * (cols > 35)  # with a 3 m wall
+    z = slope.copy()
+    z[3, 3] = np.nan
+    got = grey_opening(z, 9)
+    # slopes and the wall exactly, up to the raster border (point reflection)
+    assert np.nanmax(np.abs(got - slope)) < 1e-3 and np.isnan(got[3, 3])
+    flat = 50.0 + 0.02 * cols
+    z = flat.copy()
+    z[10:18, 20:27] += 6.0  # 7 cells wide: narrower than 9, removed
+    z[30:45, 45:62] += 6.0  # 15 cells: wider than 9, stays (its uphill rim as low as that)
+    got = grey_opening(z, 9)
+    # on a slope the object leaves a shelf at the ground height of its uphill edge
+    assert np.abs(got[10:18, 20:27] - flat[10:18, 20:27]).max() <= 0.02 * 8 + 1e-3
+    assert np.abs(got[30:45, 45:62] - z[30:45, 45:62]).max() <= 0.02 * 8 + 1e-3
+
+
 def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
     from photodem.algorithms.filtering.surface_input import FilterInput, dtm_slope, point_labels
 
