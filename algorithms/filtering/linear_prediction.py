@@ -1093,17 +1093,16 @@ def _ground_point_check(lz: Array, trend: Array, p: Array, cov: Covariance,
 # -- the algorithm ------------------------------------------------------------------------------
 def _sigma_grid(inp: Any) -> Optional[Array]:
     """σ_z of the lowest point of every cell (the point the cell's height comes from)."""
+    from .surface_input import lowest_points
+
     if inp.sigma is None or inp.points is None or inp.point_cells is None:
         return None
-    cells = np.asarray(inp.point_cells)
-    ok = (cells >= 0) & np.isfinite(inp.points[:, 2]) & np.isfinite(inp.sigma)
-    if not ok.any():
+    low = lowest_points(inp)
+    low = low[np.isfinite(inp.sigma[low])]
+    if low.size == 0:
         return None
-    idx = np.flatnonzero(ok)
-    order = idx[np.lexsort((inp.points[idx, 2], cells[idx]))]
-    first = np.concatenate([[True], cells[order][1:] != cells[order][:-1]])
     out = np.full(inp.grid.width * inp.grid.height, np.nan, np.float32)
-    out[cells[order][first]] = inp.sigma[order][first]
+    out[inp.point_cells[low]] = inp.sigma[low]
     return out.reshape(inp.grid.shape)
 
 

@@ -345,6 +345,7 @@ def test_isprs_samp11_default_parameters(tmp_path) -> None:
     np.savetxt(path, data[:, :3], fmt="%.2f")
     out = run_filter_lowpass(path, tmp_path / "out")
     t1, _, kappa = kappa_pct(data[:, 3], np.loadtxt(out["labels"]).astype(int))
-    # measured 82.0 % (Type I 8.1 %, Type II 9.7 %); with planes over all remaining cells and
-    # no protection of the cells on the opening 77.8 % (9.3 %, 12.9 %)
-    assert kappa > 80.0 and t1 < 10.0
+    # measured 82.5 % (Type I 7.0 %, Type II 10.7 %); with planes over all remaining cells, no
+    # protection of the cells on the opening and labels from the DTM alone 77.8 % (9.3 %,
+    # 12.9 %)
+    assert kappa > 80.0 and t1 < 9.0

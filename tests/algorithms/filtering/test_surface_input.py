@@ -13,9 +13,11 @@ from shapely.geometry import LineString, Point, Polygon
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.filtering.surface_input import (
     FilterConstraints,
+    FilterInput,
     check_ground_points,
     grid_lowest,
     nice_spacing,
+    point_labels,
     read_filter_constraints,
     read_filter_input,
     sample_bilinear,
@@ -147,7 +149,7 @@ def test_write_outputs_points_and_raster(tmp_path) -> None:
     np.savetxt(path, np.column_stack([xs.ravel(), ys.ravel(), zs.ravel()]))
     inp = read_filter_input(path, spacing=1.0, crs=CRS)
     dtm = np.full(inp.grid.shape, 5.0, np.float32)
-    out = write_filter_outputs(tmp_path / "out", inp, dtm, np.isfinite(inp.z),
+    out = write_filter_outputs(tmp_path / "out", inp, dtm, np.isfinite(inp.z) & (inp.z < 8.0),
                                {"ground_tolerance_m": 0.5, "iterations": [
                                    {"iteration": 1, "eliminated_share": 0.01}]})
     labels = np.loadtxt(out["labels"], dtype=int)
@@ -225,7 +227,7 @@ def test_grey_opening_keeps_slopes_and_removes_narrow_objects() -> None:
 
 
 def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
-    from photodem.algorithms.filtering.surface_input import FilterInput, dtm_slope, point_labels
+    from photodem.algorithms.filtering.surface_input import dtm_slope
 
     g = Grid(Affine(1.0, 0, 0.0, 0, -1.0, 40.0), 40, 40, 1.0)
     _, cols = np.mgrid[0:40, 0:40].astype(float)
@@ -239,3 +241,18 @@ def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
     inp = FilterInput(dtm, g, None, points=np.column_stack([x, y, z]), source="points")
     assert point_labels(inp, dtm, 0.5).tolist() == [0, 1, 1, 1]
     assert point_labels(inp, dtm, 0.5, 1.25).tolist() == [0, 0, 0, 1]
+
+
+def test_lowest_point_of_a_ground_cell_is_ground() -> None:
+    from photodem.algorithms.filtering.surface_input import lowest_points
+
+    # two cells: a ground cell whose lowest point lies 2 m above a DTM that passes beside it
+    # (smoothed over a bank), with a bush point above it; an object cell
+    xyz = np.array([[0.5, 0.5, 12.0], [0.6, 0.4, 14.0], [1.5, 0.5, 20.0], [1.4, 0.6, 20.0]])
+    zg, grid, cells = grid_lowest(xyz, 1.0)
+    inp = FilterInput(zg, grid, None, points=xyz, point_cells=cells, source="points")
+    assert sorted(lowest_points(inp).tolist()) == [0, 2]  # ties: the first point
+    dtm = np.full(grid.shape, 10.0, np.float32)
+    ground = np.array([[True, False]])
+    assert point_labels(inp, dtm, 0.5).tolist() == [1, 1, 1, 1]
+    assert point_labels(inp, dtm, 0.5, ground=ground).tolist() == [0, 1, 1, 1]
