@@ -53,6 +53,10 @@ Robust iterations with an asymmetric weight function
     residual histogram every iteration: :math:`g = -\min(k_g \sigma_-, g_{max})` with
     :math:`\sigma_- = \sqrt{\overline{r^2}}` over the negative residuals (the ground's
     spread below a surface that objects still pull up). Cells with ``p = 0`` are eliminated.
+    Below the coarsest level, candidates within ``h`` of the grey opening with a
+    ``coarse_spacing`` window keep :math:`p = 1`: the opening removes the objects the pyramid
+    removes but keeps slopes, terraces and the upper edges of banks, where the smooth
+    prediction passes far below the terrain and the weight function alone would reject it.
 
 Hierarchy (data pyramid)
     Level 0 is the DSM; level ℓ+1 takes the mean of the **two lowest** cells of every 2×2
@@ -956,13 +960,17 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
                              noise_share=prm.noise_share, min_noise_share=prm.min_noise_share,
                              corr=corr_fixed, max_noise=prm.max_noise)
         p = np.where(cand, 1.0, 0.0).astype(np.float32)
+        # full weight where terrain is certain: hard constraints, and (below the coarsest
+        # level) the candidates on the opening (:func:`_on_terrain`)
+        sure = forced | (_on_terrain(zl, cand, prm, g_lv.spacing) if dtm_c is not None
+                         else np.zeros(zl.shape, bool))
         if dtm_c is not None:
             # the coarser DTM is the first surface: its residuals give the starting weights
             # (one robust iteration for free)
             g0 = residual_shift(lz[cand & ~forced], prm.shift_factor, prm.max_shift)
             p = asymmetric_weights(np.where(cand, lz, np.nan), g0, half_w, prm.exponent,
                                    cutoff, prm.low_cutoff).astype(np.float32)
-            p[forced] = 1.0
+            p[sure] = 1.0
         n_valid = max(int(valid.sum()), 1)
         n_iter = prm.fine_iterations if lv <= 1 else prm.iterations
         x = None
@@ -981,7 +989,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
             g = residual_shift(rc, prm.shift_factor, prm.max_shift)
             p_new = asymmetric_weights(np.where(cand, r, np.nan), g, half_w,
                                        prm.exponent, cutoff, prm.low_cutoff).astype(np.float32)
-            p_new[forced] = 1.0
+            p_new[sure] = 1.0
             if k == 0 and lv == n_red and prm.noise_share is None and prm.corr_length is None:
                 # coarsest level (objects among the candidates): re-estimate the covariance
                 # from the cells that now look like ground
@@ -1032,6 +1040,22 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove
     ground |= keep & valid0
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
+
+
+def _on_terrain(z: Array, cand: Array, prm: LPParameters, spacing: float) -> Array:
+    """Candidates within ``half_weight`` of the grey opening with a ``coarse_spacing`` window.
+
+    The opening removes the objects the pyramid is meant to remove (narrower than
+    ``coarse_spacing``) and keeps slopes, terraces and the upper edges of banks exactly
+    (:func:`~.surface_input.grey_opening`); a cell on it is terrain, however far the smooth
+    prediction passes below it at a break of slope — the weight function alone would reject
+    it there.
+    """
+    from .surface_input import grey_opening
+
+    size = max(3, round(prm.coarse_spacing / spacing) | 1)
+    with np.errstate(invalid="ignore"):
+        return cand & (z - grey_opening(z, size) <= prm.half_weight)
 
 
 def _offset(grid: Grid, sub: Grid) -> Tuple[int, int]:
