@@ -53,18 +53,27 @@ Robust iterations with an asymmetric weight function
     residual histogram every iteration: :math:`g = -\min(k_g \sigma_-, g_{max})` with
     :math:`\sigma_- = \sqrt{\overline{r^2}}` over the negative residuals (the ground's
     spread below a surface that objects still pull up). Cells with ``p = 0`` are eliminated.
+    Below the coarsest level, candidates within ``h`` of the grey opening with a
+    ``coarse_spacing`` window keep :math:`p = 1`: the opening removes the objects the pyramid
+    removes but keeps slopes, terraces and the upper edges of banks, where the smooth
+    prediction passes far below the terrain and the weight function alone would reject it.
 
 Hierarchy (data pyramid)
-    Level 0 is the DSM; level ℓ+1 takes the **lowest** cell of every 2×2 block of level ℓ
-    (moved to the block centre along the local slope, so steep terrain is not biased low), up
+    Level 0 is the DSM; level ℓ+1 takes the mean of the **two lowest** cells of every 2×2
+    block of level ℓ (moved to the block centre along the local slope, so steep terrain is
+    not biased low; the single lowest cell is the lowest noise value and, on terraced slopes,
+    the lower terrace — a bias that piles up over the levels), up
     to the first level whose cell size reaches ``coarse_spacing`` (buildings and small woods
     shrink away; larger ones are bridged by the robust prediction whose correlation length
     grows with the cell size). The coarsest level's trend is a robust plane; every finer
     level's trend is the coarser DTM (bilinear), its ground candidates are the cells within
     the band :math:`[-b_\downarrow, b_\uparrow + \text{slope}\cdot s_{coarse}/2]` of it, and
     their starting weights are the weight function of their residuals to it. ``slope`` is the
-    larger of the preset's and the median slope of the coarsest level; at coarse levels the
-    cut-off grows by slope·s/2 and the half-weight residual by slope·s/4.
+    larger of the preset's and the median slope of the coarsest level, and at finer levels
+    the local slope of the coarser DTM where it is larger; at every level the cut-off grows
+    by slope·s/2 and the half-weight residual by slope·s/4 (a cell's height stands for
+    terrain up to half a cell away: on a slope its residual to a smooth surface spreads by
+    about slope·s/2, at the finest level too).
 
 Operator edits (:class:`~.surface_input.FilterConstraints`)
     ``remove`` cells are never observations (bridged); ``keep`` cells are no observations
@@ -125,8 +134,8 @@ class LPParameters:
     exponent : float
         ``b``: steepness of the weight function.
     cutoff : float
-        ``w`` (m): residuals more than this above the shift get weight 0 (level 0; coarser
-        levels add ``slope``·cell size / 2).
+        ``w`` (m): residuals more than this above the shift get weight 0 on flat terrain;
+        every level adds ``slope``·cell size / 2 (``half_weight`` half of that).
     low_cutoff : float
         ``w↓`` (m): residuals more than this below the shift are blunders (weight 0).
     shift_factor : float
@@ -137,8 +146,9 @@ class LPParameters:
         Candidates at a finer level lie within [−band_below, band_above] (m) of the coarser
         DTM (band_above grows by ``slope``·coarse cell size / 2).
     slope : float
-        Least terrain slope allowance (m/m) that widens the cut-off and the band at coarse
-        levels; the median slope of the coarsest level is used where it is larger.
+        Least terrain slope allowance (m/m) that widens the cut-off and the band at every
+        level; the median slope of the coarsest level (at finer levels the local slope of
+        the coarser DTM) is used where it is larger.
     noise_share : float or None
         Fixed noise share ν = σ_n²/V_zz (0 = pure interpolation); None = estimated.
     min_noise_share : float
@@ -625,47 +635,65 @@ def _reduce_min(a: Array) -> Array:
     return np.fmin(np.fmin(p[0::2, 0::2], p[1::2, 0::2]), np.fmin(p[0::2, 1::2], p[1::2, 1::2]))
 
 
-def _minmod(z: Array, axis: int) -> Array:
-    """Slope per cell along ``axis``: the smaller one-sided difference (0 at a sign change)."""
+def _limited_slope(z: Array, axis: int) -> Array:
+    """Slope per cell along ``axis`` by the monotonised central (MC) limiter.
+
+    The central difference where both one-sided differences agree in sign, but at most twice
+    the smaller of them (0 at a sign change): exact on a plane, while a building or a wall
+    next to the cell cannot tilt it by more than twice the terrain's own slope.
+    """
     d = np.diff(z, axis=axis)
     pad = [(0, 0), (0, 0)]
     pad[axis] = (1, 0)
     back = np.pad(d, pad, mode="edge")
     pad[axis] = (0, 1)
     fwd = np.pad(d, pad, mode="edge")
-    same = np.sign(back) == np.sign(fwd)
-    return np.where(same, np.sign(fwd) * np.minimum(np.abs(back), np.abs(fwd)), 0.0)
+    mag = np.minimum(np.minimum(2.0 * np.abs(back), 2.0 * np.abs(fwd)), 0.5 * np.abs(back + fwd))
+    return np.where(np.sign(back) == np.sign(fwd), np.sign(fwd) * mag, 0.0)
 
 
 def _reduce_lowest(a: Array, max_slope: float = 1.5) -> Array:
-    r"""Lowest cell of every 2×2 block, moved to the block centre along the terrain slope.
+    r"""Mean of the two lowest cells of every 2×2 block, moved to the block centre along the slope.
 
-    On a slope the lowest cell lies at the block's downhill corner, so the plain minimum is
-    biased low by :math:`|\nabla z|\, s/\sqrt 2` per level — a bias that piles up over the
-    levels and cuts slopes. With the gradient ``(g_x, g_y)`` of the minimum grid (central
-    differences limited by *minmod*: the smaller one-sided difference if both have the same
-    sign, else 0, so a building next to the block does not tilt it; clipped to
-    ``max_slope`` per fine cell) and the lowest cell's offset ``(δx, δy)`` (±s/2)
-    from the block centre, the block value is :math:`z_{min} - g_x δx - g_y δy`.
+    The lowest cells keep the ground and drop objects: a building edge or corner covers at
+    most two cells of a block, so objects shrink by about a fine cell per side and level.
+    Two rather than the single lowest cell, because the minimum of four is the lowest noise
+    or roughness value (−1.03 σ for Gaussian noise, −0.66 σ for the mean of the two lowest)
+    and, on terraced slopes, the lower terrace; the bias piles up over the levels (metres at
+    16 m cells on 50 % slopes: the finer levels' candidate band then cuts the slope). On a
+    slope the lowest cells lie on the block's downhill side: with the gradient
+    ``(g_x, g_y)`` of the level (:func:`_limited_slope` per cell, averaged over the block,
+    clipped to ``max_slope``) and the mean offset ``(δx, δy)`` of the two cells from the
+    block centre (±½ fine cell each), the block value is :math:`\bar z_2 - g_x δx - g_y δy`.
     """
+    from scipy import ndimage
+
     h, w = a.shape
     p = np.full((h + h % 2, w + w % 2), np.nan, np.float32)
     p[:h, :w] = a
     subs = np.stack([p[0::2, 0::2], p[0::2, 1::2], p[1::2, 0::2], p[1::2, 1::2]])
-    zmin = np.fmin(np.fmin(subs[0], subs[1]), np.fmin(subs[2], subs[3]))
-    ok = np.isfinite(zmin)
-    if ok.sum() < 4 or min(zmin.shape) < 3:
-        return zmin
-    k = np.argmin(np.where(np.isfinite(subs), subs, np.inf), axis=0)
-    dcol = np.where(k % 2 == 1, 0.5, -0.5)  # offset in fine cells: +x to the right
-    drow = np.where(k >= 2, 0.5, -0.5)  # rows grow downwards
-    from scipy import ndimage
-
+    order = np.argsort(np.where(np.isfinite(subs), subs, np.inf), axis=0, kind="stable")
+    v0 = np.take_along_axis(subs, order[:1], axis=0)[0]
+    v1 = np.take_along_axis(subs, order[1:2], axis=0)[0]
+    two = np.isfinite(v1)  # blocks with a single cell take that cell
+    i1 = np.where(two, order[1], order[0])
+    out = np.where(two, 0.5 * (v0 + v1), v0)
+    ok = np.isfinite(a)
+    if ok.sum() < 4 or min(a.shape) < 3:
+        return out.astype(np.float32)
+    dcol = np.array([-0.5, 0.5, -0.5, 0.5])  # offset in fine cells: +x to the right
+    drow = np.array([-0.5, -0.5, 0.5, 0.5])  # rows grow downwards
     _, (ir, ic) = ndimage.distance_transform_edt(~ok, return_indices=True)
-    zf = zmin[ir, ic].astype(np.float64)  # gaps take the nearest value for the gradient
-    gr = np.clip(_minmod(zf, 0) / 2.0, -max_slope, max_slope)  # per fine cell
-    gc = np.clip(_minmod(zf, 1) / 2.0, -max_slope, max_slope)
-    return (zmin - gc * dcol - gr * drow).astype(np.float32)
+    zf = np.asarray(a, np.float64)[ir, ic]  # gaps take the nearest value for the gradient
+    hh, ww = p.shape[0] // 2, p.shape[1] // 2
+    grads = []
+    for axis in (0, 1):
+        g = np.pad(_limited_slope(zf, axis), ((0, h % 2), (0, w % 2)), mode="edge")
+        grads.append(np.clip(g.reshape(hh, 2, ww, 2).mean(axis=(1, 3)), -max_slope, max_slope))
+    gr, gc = grads
+    dc = 0.5 * (dcol[order[0]] + dcol[i1])
+    dr = 0.5 * (drow[order[0]] + drow[i1])
+    return (out - gc * dc - gr * dr).astype(np.float32)
 
 
 def _up1(a: Array, axis: int, n: int) -> Array:
@@ -913,8 +941,8 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
             slope_f = np.maximum(slope, _local_slope(
                 _upsample_sides(dtm_c, zl.shape, sides_c, sides), g_lv.spacing))
         slope_allow = slope_f * g_lv.spacing / 2.0
-        cutoff = prm.cutoff + (slope_allow if lv > 0 else 0.0)
-        half_w = prm.half_weight + (slope_allow / 2.0 if lv > 0 else 0.0)
+        cutoff = prm.cutoff + slope_allow
+        half_w = prm.half_weight + slope_allow / 2.0
         if dtm_c is None:
             trend = _robust_plane(zl, valid, prm, prm.cutoff + slope * g_lv.spacing)
             cand = valid.copy()
@@ -932,13 +960,17 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
                              noise_share=prm.noise_share, min_noise_share=prm.min_noise_share,
                              corr=corr_fixed, max_noise=prm.max_noise)
         p = np.where(cand, 1.0, 0.0).astype(np.float32)
+        # full weight where terrain is certain: hard constraints, and (below the coarsest
+        # level) the candidates on the opening (:func:`_on_terrain`)
+        sure = forced | (_on_terrain(zl, cand, prm, g_lv.spacing) if dtm_c is not None
+                         else np.zeros(zl.shape, bool))
         if dtm_c is not None:
             # the coarser DTM is the first surface: its residuals give the starting weights
             # (one robust iteration for free)
             g0 = residual_shift(lz[cand & ~forced], prm.shift_factor, prm.max_shift)
             p = asymmetric_weights(np.where(cand, lz, np.nan), g0, half_w, prm.exponent,
                                    cutoff, prm.low_cutoff).astype(np.float32)
-            p[forced] = 1.0
+            p[sure] = 1.0
         n_valid = max(int(valid.sum()), 1)
         n_iter = prm.fine_iterations if lv <= 1 else prm.iterations
         x = None
@@ -957,7 +989,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
             g = residual_shift(rc, prm.shift_factor, prm.max_shift)
             p_new = asymmetric_weights(np.where(cand, r, np.nan), g, half_w,
                                        prm.exponent, cutoff, prm.low_cutoff).astype(np.float32)
-            p_new[forced] = 1.0
+            p_new[sure] = 1.0
             if k == 0 and lv == n_red and prm.noise_share is None and prm.corr_length is None:
                 # coarsest level (objects among the candidates): re-estimate the covariance
                 # from the cells that now look like ground
@@ -1008,6 +1040,22 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
         ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove
     ground |= keep & valid0
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
+
+
+def _on_terrain(z: Array, cand: Array, prm: LPParameters, spacing: float) -> Array:
+    """Candidates within ``half_weight`` of the grey opening with a ``coarse_spacing`` window.
+
+    The opening removes the objects the pyramid is meant to remove (narrower than
+    ``coarse_spacing``) and keeps slopes, terraces and the upper edges of banks exactly
+    (:func:`~.surface_input.grey_opening`); a cell on it is terrain, however far the smooth
+    prediction passes below it at a break of slope — the weight function alone would reject
+    it there.
+    """
+    from .surface_input import grey_opening
+
+    size = max(3, round(prm.coarse_spacing / spacing) | 1)
+    with np.errstate(invalid="ignore"):
+        return cand & (z - grey_opening(z, size) <= prm.half_weight)
 
 
 def _offset(grid: Grid, sub: Grid) -> Tuple[int, int]:
@@ -1069,17 +1117,16 @@ def _ground_point_check(lz: Array, trend: Array, p: Array, cov: Covariance,
 # -- the algorithm ------------------------------------------------------------------------------
 def _sigma_grid(inp: Any) -> Optional[Array]:
     """σ_z of the lowest point of every cell (the point the cell's height comes from)."""
+    from .surface_input import lowest_points
+
     if inp.sigma is None or inp.points is None or inp.point_cells is None:
         return None
-    cells = np.asarray(inp.point_cells)
-    ok = (cells >= 0) & np.isfinite(inp.points[:, 2]) & np.isfinite(inp.sigma)
-    if not ok.any():
+    low = lowest_points(inp)
+    low = low[np.isfinite(inp.sigma[low])]
+    if low.size == 0:
         return None
-    idx = np.flatnonzero(ok)
-    order = idx[np.lexsort((inp.points[idx, 2], cells[idx]))]
-    first = np.concatenate([[True], cells[order][1:] != cells[order][:-1]])
     out = np.full(inp.grid.width * inp.grid.height, np.nan, np.float32)
-    out[cells[order][first]] = inp.sigma[order][first]
+    out[inp.point_cells[low]] = inp.sigma[low]
     return out.reshape(inp.grid.shape)
 
 

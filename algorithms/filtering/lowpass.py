@@ -7,7 +7,11 @@ holes are finally filled from the surrounding ground.
 
 Smoothing (normalised convolution of first order)
     In iteration ``k`` every cell gets the height :math:`T_k` of the least-squares plane through
-    the remaining cells of a square window of side :math:`w_k` centred on it. With weights
+    the remaining cells of a square window of side :math:`w_k` centred on it that are not more
+    than the iteration's threshold above the grey opening :math:`O_k` of the remaining cells
+    with the same window (:func:`height_above_opening`): objects narrower than the window no
+    longer pull the plane up — a building on a hillside, whose roof is flush with the slope
+    above it, was otherwise a terrace to the plane and survived. With weights
     :math:`p_j \in \{0, 1\}` (1 = remaining cell), local coordinates ``u, v`` and the window
     means :math:`\bar{\cdot} = \sum p_j \cdot / \sum p_j` (all computed with box filters, so the
     cost per cell does not depend on the window):
@@ -30,7 +34,10 @@ Elimination
     :math:`D_k < -(d + s \cdot w_k / 4)` (blunder), with :math:`t_k` the iteration's threshold,
     ``s`` the slope allowance (a plane over a window of side ``w`` lies :math:`s\,w/4` below a
     ridge whose two slopes differ by ``s``, and as far above a valley or the terrace below a
-    wall) and ``d`` the blunder depth. Eliminated cells stay eliminated. Before the first
+    wall) and ``d`` the blunder depth. Cells within :math:`t_k` of the opening
+    (:math:`M_{k-1} - O_k \le t_k`) are not objects: the opening keeps slopes, terraces and the
+    upper edges of banks exactly, where the plane misses a break of slope by far more than
+    ``s·w/4``. Eliminated cells stay eliminated. Before the first
     iteration, isolated pits (``low_outlier_m`` below their second lowest neighbour,
     :func:`.surface_input.low_outliers`) are eliminated by a local, slope-invariant test.
 
@@ -68,6 +75,7 @@ from .surface_input import (
     FilterConstraints,
     FilterInput,
     check_ground_points,
+    grey_opening,
     low_outliers,
     read_filter_constraints,
     read_filter_input,
@@ -165,6 +173,18 @@ def plane_smooth(z: Array, weight: Array, radius: int, min_count: int = 3,
         t = np.where(count >= min_count - 0.5, t, np.nan)
         out[r0:r1] = (t[r0 - a0:r1 - a0] + zmean).astype(np.float32)
     return out
+
+
+def height_above_opening(z: Array, support: Array, radius: int) -> Array:
+    """Height of every support cell above the grey opening of the support cells.
+
+    The opening with the window of the planes (side ``2·radius + 1``,
+    :func:`~.surface_input.grey_opening`) is the lower envelope of the support without the
+    objects narrower than the window; it keeps slopes, terraces and the upper edges of banks
+    exactly. NaN outside the support.
+    """
+    zs = np.where(support, z, np.nan)
+    return (zs - grey_opening(zs, 2 * int(radius) + 1)).astype(np.float32)
 
 
 def _sub_grid(grid: Grid, r0: int, c0: int, h: int, w: int) -> Grid:
@@ -557,14 +577,22 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         radius = max(1, round(wm / spacing / 2.0))
         sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
             if cons.breaklines else []
-        t = smooth(m, support, radius, sides, barrier)
-        d = m - t
         thr = tk + slope * wm / 4.0
+        above = height_above_opening(m, support, radius)
+        with np.errstate(invalid="ignore"):
+            # objects (cells far above the opening) do not support the planes that judge
+            # them; manual ground points always do
+            fit = support & ~(above > thr) | (support & gp_cells)
+            # cells on the opening lie on terrain it keeps: the plane's error at a break of
+            # slope (the upper edge of a bank) is no reason to eliminate them
+            on_terrain = above <= tk
+        t = smooth(m, fit, radius, sides, barrier)
+        d = m - t
         # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
         # it lies s·w/4 below a ridge: the blunder depth grows alike
         thr_down = down + slope * wm / 4.0
         with np.errstate(invalid="ignore"):
-            elim = support & ~gp_cells & ((d > thr) | (d < -thr_down))
+            elim = support & ~gp_cells & (((d > thr) & ~on_terrain) | (d < -thr_down))
         # cells without any support in the window keep their height (nothing to compare)
         elim &= np.isfinite(t)
         n_el = int(elim.sum())
@@ -736,5 +764,5 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
     return out
 
 
-__all__ = ["breakline_sides", "lowpass_filter", "lowpass_parameters", "membrane_fill",
-           "plane_smooth", "run_filter_lowpass", "smooth"]
+__all__ = ["breakline_sides", "height_above_opening", "lowpass_filter", "lowpass_parameters",
+           "membrane_fill", "plane_smooth", "run_filter_lowpass", "smooth"]

@@ -113,16 +113,16 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
 
 #: Linear-prediction presets (:mod:`.linear_prediction`; keys are ``LPParameters`` fields):
 #: ``coarse_spacing`` cell size (m) of the coarsest pyramid level (≈ the largest building or
-#: wood that shrinks away by the lowest-cell reduction; larger ones are bridged);
+#: wood that shrinks away by the two-lowest-cells reduction; larger ones are bridged);
 #: ``half_weight`` residual (m) above the shift where the weight is ½; ``cutoff`` residual (m)
 #: above the shift beyond which the weight is 0; ``low_cutoff`` depth (m) below the shift that
 #: is a blunder; ``band_above``/``band_below`` (m) ground candidates around the coarser level's
-#: DTM; ``slope`` (m/m) terrain allowance added to the cut-off and the band at coarse levels
+#: DTM; ``slope`` (m/m) terrain allowance added to the cut-off and the band at every level
 #: (``slope``·cell/2); ``shift_factor``/``max_shift`` shift g = −min(k·σ₋, g_max) (m);
 #: ``iterations``/``fine_iterations`` robust iterations per level (coarse / the two finest);
 #: ``ground_tolerance`` |DSM − DTM| (m) labelled ground, widened by ``ground_slope_factor``·slope·
 #: cell on slopes; ``low_outlier`` depth (m) of a low blunder below its second lowest neighbour.
-#: ``band_above`` 2 m in the default: on steep slopes the coarse levels lie metres below the
+#: ``band_above`` 2 m in the default: on steep slopes the coarse levels may lie below the
 #: ground; the fine levels' own robust weights then reject objects within the band.
 LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
     "default": {"coarse_spacing": 32.0, "half_weight": 0.5, "cutoff": 1.5, "low_cutoff": 5.0,

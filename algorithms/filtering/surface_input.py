@@ -23,7 +23,8 @@ Outputs (:func:`write_filter_outputs`)
     (point input: one label per input point in input order, 0 = ground, 1 = object; a point is
     ground if :math:`|z - z_{DTM}(x, y)| \le t + k\,|\nabla z_{DTM}|\,s` with
     ``t = report["ground_tolerance_m"]``, ``k = report["ground_slope_factor"]`` (default 0), ``s``
-    the spacing and :math:`z_{DTM}` bilinear, see :func:`point_labels`), ``report.json`` and
+    the spacing and :math:`z_{DTM}` bilinear, or if it is the lowest point of a cell the filter
+    kept as ground, see :func:`point_labels`), ``report.json`` and
     ``report.html``, and extra rasters such as the difference model of every iteration.
 """
 
@@ -504,7 +505,26 @@ def dtm_slope(dtm: Array, spacing: float) -> Array:
     return np.hypot(gx, gy)
 
 
-def point_labels(inp: FilterInput, dtm: Array, tol: float, slope_factor: float = 0.0) -> Array:
+def lowest_points(inp: FilterInput) -> Array:
+    """Index of the lowest point of every non-empty cell (the point whose height the grid
+    holds, :func:`grid_lowest`), in cell order; ties go to the first point in input order.
+
+    Returns
+    -------
+    ndarray int64
+        Point indices, one per non-empty cell (empty for raster input).
+    """
+    if inp.points is None or inp.point_cells is None:
+        return np.zeros(0, np.int64)
+    cells = np.asarray(inp.point_cells)
+    idx = np.flatnonzero((cells >= 0) & np.isfinite(inp.points[:, 2]))
+    order = idx[np.lexsort((idx, inp.points[idx, 2], cells[idx]))]
+    first = np.concatenate([[True], cells[order][1:] != cells[order][:-1]])
+    return order[first]
+
+
+def point_labels(inp: FilterInput, dtm: Array, tol: float, slope_factor: float = 0.0,
+                 ground: Optional[Array] = None) -> Array:
     r"""0 = ground, 1 = object per input point, against the DTM (bilinear).
 
     A point is ground if
@@ -516,7 +536,10 @@ def point_labels(inp: FilterInput, dtm: Array, tol: float, slope_factor: float =
     terrain (break lines, lowest-point gridding, the ±½ cell position of the node), so the
     tolerance grows with the local slope as in SMRF's elevation threshold (Pingel et al.
     2013: ``t + k·slope`` at 1 m cells). ``k = 0`` gives the plain tolerance. Points without
-    a DTM height are objects.
+    a DTM height are objects. With the filter's ``ground`` mask, the lowest point of every
+    ground cell is ground too: its height is the cell's, which the filter kept as terrain
+    (the DTM may pass beside it where it smooths or interpolates across a break of slope),
+    so the labels agree with the mask a raster input gets.
     """
     pts = inp.points
     if pts is None:
@@ -527,8 +550,11 @@ def point_labels(inp: FilterInput, dtm: Array, tol: float, slope_factor: float =
         g = sample_bilinear(dtm_slope(dtm, inp.grid.spacing), inp.grid, pts[:, 0], pts[:, 1])
         limit += float(slope_factor) * np.where(np.isfinite(g), g, 0.0) * inp.grid.spacing
     with np.errstate(invalid="ignore"):
-        ground = np.isfinite(zd) & np.isfinite(pts[:, 2]) & (np.abs(pts[:, 2] - zd) <= limit)
-    return np.where(ground, 0, 1).astype(np.uint8)
+        is_ground = np.isfinite(zd) & np.isfinite(pts[:, 2]) & (np.abs(pts[:, 2] - zd) <= limit)
+    if ground is not None:
+        low = lowest_points(inp)
+        is_ground[low] |= np.asarray(ground, bool).ravel()[inp.point_cells[low]]
+    return np.where(is_ground, 0, 1).astype(np.uint8)
 
 
 def low_outliers(z: Array, depth: float, radius: int = 2, passes: int = 2) -> Array:
@@ -592,6 +618,46 @@ def low_outliers(z: Array, depth: float, radius: int = 2, passes: int = 2) -> Ar
         out |= new
         cur[new] = np.inf
     return out
+
+
+def grey_opening(z: Array, size: int) -> Array:
+    r"""Grey-value opening (erosion, then dilation) of a grid with a square window.
+
+    .. math:: (z \circ B)(c) = \max_{c' \in B(c)} \min_{c'' \in B(c')} z(c'')
+
+    with :math:`B` the ``size`` × ``size`` window. The opening removes every peak narrower
+    than the window (buildings, trees) and keeps any surface that is monotone along every
+    line through the window exactly — a tilted plane, a slope, a terrace — so, unlike the
+    plain minimum, it is not biased low on slopes; only ridges and hill tops narrower than the
+    window are cut (by about their slope × half the window), and an object on a slope leaves
+    a shelf at the ground height of its uphill edge. Beyond the border the grid is
+    continued by point reflection (:math:`z(-k) = 2 z(0) - z(k)`), which continues a slope
+    (a flat continuation would cut the uphill border strip by slope × half the window). NaN
+    cells are ignored as support and stay NaN.
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights, NaN = no data.
+    size : int
+        Side of the window in cells (odd).
+
+    Returns
+    -------
+    ndarray float32 (h, w)
+    """
+    from scipy import ndimage
+
+    zz = np.asarray(z, np.float32)
+    h, w = zz.shape
+    r = min(int(size) // 2, h - 1, w - 1)
+    ext = np.pad(zz, r, mode="reflect", reflect_type="odd") if r > 0 else zz
+    ok = np.isfinite(ext)
+    ero = ndimage.minimum_filter(np.where(ok, ext, np.inf), size=int(size), mode="nearest")
+    # windows without data have no erosion: they must not win the dilation
+    ero[~np.isfinite(ero)] = -np.inf
+    out = ndimage.maximum_filter(ero, size=int(size), mode="nearest")[r:r + h, r:r + w]
+    return np.where(np.isfinite(zz) & np.isfinite(out), out, np.nan).astype(np.float32)
 
 
 # -- outputs ------------------------------------------------------------------------------------
@@ -720,7 +786,7 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
     report.setdefault("source", inp.source)
     labels = None
     if inp.source == "points" and inp.points is not None:
-        labels = point_labels(inp, dtm, tol, slope_factor)
+        labels = point_labels(inp, dtm, tol, slope_factor, ground)
         report["points"] = len(labels)
         report["points_ground"] = int(np.count_nonzero(labels == 0))
         report["points_object"] = int(np.count_nonzero(labels == 1))
@@ -758,6 +824,6 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
 
 
 __all__ = ["DEFAULT_GROUND_TOLERANCE", "MIN_POINTS", "FilterConstraints", "FilterInput",
-           "check_ground_points", "dtm_slope", "grid_lowest", "low_outliers", "nice_spacing",
-           "point_labels", "read_filter_constraints", "read_filter_input", "sample_bilinear",
-           "to_crs", "write_filter_outputs"]
+           "check_ground_points", "dtm_slope", "grey_opening", "grid_lowest", "low_outliers",
+           "lowest_points", "nice_spacing", "point_labels", "read_filter_constraints",
+           "read_filter_input", "sample_bilinear", "to_crs", "write_filter_outputs"]

@@ -13,9 +13,11 @@ from shapely.geometry import LineString, Point, Polygon
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.filtering.surface_input import (
     FilterConstraints,
+    FilterInput,
     check_ground_points,
     grid_lowest,
     nice_spacing,
+    point_labels,
     read_filter_constraints,
     read_filter_input,
     sample_bilinear,
@@ -147,7 +149,7 @@ def test_write_outputs_points_and_raster(tmp_path) -> None:
     np.savetxt(path, np.column_stack([xs.ravel(), ys.ravel(), zs.ravel()]))
     inp = read_filter_input(path, spacing=1.0, crs=CRS)
     dtm = np.full(inp.grid.shape, 5.0, np.float32)
-    out = write_filter_outputs(tmp_path / "out", inp, dtm, np.isfinite(inp.z),
+    out = write_filter_outputs(tmp_path / "out", inp, dtm, np.isfinite(inp.z) & (inp.z < 8.0),
                                {"ground_tolerance_m": 0.5, "iterations": [
                                    {"iteration": 1, "eliminated_share": 0.01}]})
     labels = np.loadtxt(out["labels"], dtype=int)
@@ -204,8 +206,28 @@ def test_low_outliers_net_cut_is_slope_invariant() -> None:
     assert set(zip(*np.nonzero(low_outliers(flat, 1.5)))) == {(15, 15)}
 
 
+def test_grey_opening_keeps_slopes_and_removes_narrow_objects() -> None:
+    from photodem.algorithms.filtering.surface_input import grey_opening
+
+    rows, cols = np.mgrid[0:50, 0:70].astype(float)
+    slope = 100.0 + 0.8 * cols - 0.5 * rows + 3.0 * (cols > 35)  # with a 3 m wall
+    z = slope.copy()
+    z[3, 3] = np.nan
+    got = grey_opening(z, 9)
+    # slopes and the wall exactly, up to the raster border (point reflection)
+    assert np.nanmax(np.abs(got - slope)) < 1e-3 and np.isnan(got[3, 3])
+    flat = 50.0 + 0.02 * cols
+    z = flat.copy()
+    z[10:18, 20:27] += 6.0  # 7 cells wide: narrower than 9, removed
+    z[30:45, 45:62] += 6.0  # 15 cells: wider than 9, stays (its uphill rim as low as that)
+    got = grey_opening(z, 9)
+    # on a slope the object leaves a shelf at the ground height of its uphill edge
+    assert np.abs(got[10:18, 20:27] - flat[10:18, 20:27]).max() <= 0.02 * 8 + 1e-3
+    assert np.abs(got[30:45, 45:62] - z[30:45, 45:62]).max() <= 0.02 * 8 + 1e-3
+
+
 def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
-    from photodem.algorithms.filtering.surface_input import FilterInput, dtm_slope, point_labels
+    from photodem.algorithms.filtering.surface_input import dtm_slope
 
     g = Grid(Affine(1.0, 0, 0.0, 0, -1.0, 40.0), 40, 40, 1.0)
     _, cols = np.mgrid[0:40, 0:40].astype(float)
@@ -219,3 +241,18 @@ def test_point_labels_tolerance_grows_with_slope(tmp_path) -> None:
     inp = FilterInput(dtm, g, None, points=np.column_stack([x, y, z]), source="points")
     assert point_labels(inp, dtm, 0.5).tolist() == [0, 1, 1, 1]
     assert point_labels(inp, dtm, 0.5, 1.25).tolist() == [0, 0, 0, 1]
+
+
+def test_lowest_point_of_a_ground_cell_is_ground() -> None:
+    from photodem.algorithms.filtering.surface_input import lowest_points
+
+    # two cells: a ground cell whose lowest point lies 2 m above a DTM that passes beside it
+    # (smoothed over a bank), with a bush point above it; an object cell
+    xyz = np.array([[0.5, 0.5, 12.0], [0.6, 0.4, 14.0], [1.5, 0.5, 20.0], [1.4, 0.6, 20.0]])
+    zg, grid, cells = grid_lowest(xyz, 1.0)
+    inp = FilterInput(zg, grid, None, points=xyz, point_cells=cells, source="points")
+    assert sorted(lowest_points(inp).tolist()) == [0, 2]  # ties: the first point
+    dtm = np.full(grid.shape, 10.0, np.float32)
+    ground = np.array([[True, False]])
+    assert point_labels(inp, dtm, 0.5).tolist() == [1, 1, 1, 1]
+    assert point_labels(inp, dtm, 0.5, ground=ground).tolist() == [0, 1, 1, 1]
