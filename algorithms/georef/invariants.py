@@ -145,6 +145,11 @@ def algebraic_invariants(m: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 # -- standard position ---------------------------------------------------------------------------
+#: Share of the full shear step taken per iteration. The full steps (α = −m13/m04,
+#: β = −m31/m40) can cycle without converging for irregular outlines (6 of 86 RGI glacier
+#: polygons); shorter steps have the same fixed points and converge for all of them.
+SHEAR_STEP = 0.7
+
 _D4: List[NDArray[np.float64]] = []
 for _mirror in (False, True):
     for _k in range(4):
@@ -186,23 +191,42 @@ def standard_positions(moments: Sequence[NDArray[np.float64]], tol: float = 1e-1
         return _standard_positions(moments, tol, max_iter, ambiguity)
 
 
+def whitening(m: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Symmetric C^(-1/2) of the second-order moments C = [[m20, m11], [m11, m02]].
+
+    The object mapped by it has m20 = m02 (= 1 for unit area) and m11 = 0; NaN for a
+    degenerate (zero-area or collinear) object.
+    """
+    C = np.array([[m[2, 0], m[1, 1]], [m[1, 1], m[0, 2]]], float)
+    if not np.all(np.isfinite(C)):
+        return np.full((2, 2), np.nan)
+    w, V = np.linalg.eigh(C)
+    if not w[0] > 0:
+        return np.full((2, 2), np.nan)
+    return (V / np.sqrt(w)) @ V.T
+
+
 def _standard_positions(moments: Sequence[NDArray[np.float64]], tol: float, max_iter: int,
                         ambiguity: float) -> List[StandardPosition]:
     n = len(moments)
-    m4 = np.array([[mm[p, 4 - p] for p in range(5)] for mm in moments], float)  # m40…m04
-    A = np.tile(np.eye(2), (n, 1, 1))
+    # start from the frame whitened by the second-order moments (same conditions; on the
+    # 86 RGI glacier outlines a median of 32 instead of 70 iterations, at most 433)
+    A = np.array([whitening(mm) for mm in moments]).reshape(n, 2, 2)
+    m4 = np.array([[t[p, 4 - p] for p in range(5)]
+                   for t in (transform_moments(mm, a, (4,)) for mm, a in zip(moments, A))],
+                  float)  # m40…m04
     done = np.zeros(n, bool)
     iters = np.zeros(n, int)
     for it in range(max_iter):
         # X-shear x' = x + α y with α = −m13/m04: m'_{p,4−p} = Σ_k C(p,k) α^(p−k) m_{k,4−k}
-        alpha = np.where(done, 0.0, -m4[:, 3] / m4[:, 4])
+        alpha = np.where(done, 0.0, -SHEAR_STEP * m4[:, 3] / m4[:, 4])
         new = np.zeros_like(m4)
         for p in range(5):
             for k in range(p + 1):
                 new[:, p] += comb(p, k) * alpha ** (p - k) * m4[:, k]
         m4 = new
         # Y-shear y' = β x + y with β = −m31/m40: m'_{p,q} = Σ_l C(q,l) β^(q−l) m_{4−l,l}
-        beta = np.where(done, 0.0, -m4[:, 1] / m4[:, 0])
+        beta = np.where(done, 0.0, -SHEAR_STEP * m4[:, 1] / m4[:, 0])
         new = np.zeros_like(m4)
         for p in range(5):
             q = 4 - p
@@ -227,15 +251,17 @@ def _standard_positions(moments: Sequence[NDArray[np.float64]], tol: float, max_
     out = []
     for i, mm in enumerate(moments):
         Ai = A[i]
-        if not done[i] or not np.all(np.isfinite(Ai)):
+        SA = np.full((2, 2), np.nan)
+        if done[i] and np.all(np.isfinite(Ai)):
+            m2 = transform_moments(mm, Ai, (2,))
+            g = (m2[0, 2] / m2[2, 0] ** 3) ** 0.125
+            d = (m2[2, 0] / m2[0, 2] ** 3) ** 0.125
+            SA = np.diag([g, d]) @ Ai
+        if not (np.all(np.isfinite(SA)) and abs(np.linalg.det(SA)) > 0):
             out.append(StandardPosition(matrix=np.full((2, 2), np.nan), ambiguous=True,
                                         iterations=int(iters[i]), converged=False,
                                         base=np.full((2, 2), np.nan)))
             continue
-        m2 = transform_moments(mm, Ai, (2,))
-        g = (m2[0, 2] / m2[2, 0] ** 3) ** 0.125
-        d = (m2[2, 0] / m2[0, 2] ** 3) ** 0.125
-        SA = np.diag([g, d]) @ Ai
         m3 = transform_moments(mm, SA, (3,))
         chosen, amb = SA, True
         for D in _D4:

@@ -88,6 +88,23 @@ def test_pair_transform_recovers_the_affine() -> None:
     assert ok >= 12  # most shapes are not ambiguous at all
 
 
+def test_standard_position_of_an_elongated_outline() -> None:
+    # full shear steps cycle for this hexagon (and for 6 of 86 RGI glacier outlines)
+    ring = np.array([[-1.932, 0.194], [-4.705, -0.148], [-1.355, -0.921], [-0.562, -0.973],
+                     [0.409, -0.302], [4.863, -0.375]])
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        L = random_affine(rng)
+        t = rng.uniform(-1e4, 1e4, 2)
+        fa, fb = object_features([PolygonObject(0, orient_ring(ring), IMAGE),
+                                  PolygonObject(1, orient_ring(ring @ L.T + t), REFERENCE)])
+        assert np.all(np.isfinite(fa.normaliser)) and np.all(np.isfinite(fb.normaliser))
+        cands = [pair_transform(fa, fb)]
+        if fa.ambiguous or fb.ambiguous:
+            cands += [pair_transform(fa, fb, N) for N in d4_alternatives(fa)]
+        assert any(np.allclose(C[:2, :2], L, atol=1e-4 * np.abs(L).max()) for C in cands)
+
+
 def test_mbr_matches_brute_force() -> None:
     b = blob(7) @ np.array([[3.0, 0.4], [0.0, 1.0]]).T
     centre, axes, half = min_bounding_rectangle(b)
