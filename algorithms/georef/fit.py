@@ -195,12 +195,17 @@ def corner_error(matrix_or_fit: Any, truth: NDArray[np.float64], width: int, hei
 
 
 def points_summary(fit: TransformFit) -> List[Dict[str, float]]:
-    """Per point: residuals (map, px), leave-one-out, used flag."""
+    """Per point: residuals (map, px), leave-one-out, used flag.
+
+    Rounded to 1e-4 map units and 1e-5 px: a residual is the difference of two map coordinates
+    (10⁵–10⁶ m in a projected CRS), so digits below about 1e-9 m are round-off and differ
+    between builds of the numerical libraries.
+    """
     res = fit.extras["all_residuals_map"]
     out = []
     for k, (r, u) in enumerate(zip(res, fit.used)):
         d = float(np.hypot(*r))
-        out.append({"dx_map": float(r[0]), "dy_map": float(r[1]), "residual_map": d,
-                    "residual_px": d / fit.pixel_size,
-                    "loo_map": float(fit.loo_map[k]), "used": bool(u)})
+        out.append({"dx_map": round(float(r[0]), 4), "dy_map": round(float(r[1]), 4),
+                    "residual_map": round(d, 4), "residual_px": round(d / fit.pixel_size, 5),
+                    "loo_map": round(float(fit.loo_map[k]), 4), "used": bool(u)})
     return out
