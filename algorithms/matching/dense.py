@@ -36,6 +36,14 @@ Method (``method="sgm"``)
 Tiling: the image is processed in tiles of the left image with an overlap margin (SGM paths need
 context); only the tile cores are kept. The cost volume of one tile (``w·h·D``) is bounded by
 ``max_memory_mb``; the volume of the whole image never exists.
+
+Coarse to fine: a wide search range (more than ``coarse_above`` disparities — a large-format
+model over hilly terrain spans hundreds of pixels of parallax) makes every tile's cost volume
+deep and, within the memory budget, its core small, while SGBM's frame still carries the whole
+range. So the pair is first matched at a reduced scale (block means over ``f × f`` pixels,
+``f`` the smallest power of 2 that brings the range to at most 64 disparities), and each tile
+then searches only the range its coarse disparities span, widened by ``2f + 8`` px. A tile
+without coarse disparities takes the range of a growing neighbourhood, finally the full range.
 """
 
 from __future__ import annotations
@@ -51,6 +59,10 @@ from ..processing.feedback import Feedback, ensure_feedback
 
 #: Matching methods; the first is the default.
 METHODS = ("sgm", "opencv_sgbm")
+#: Search ranges wider than this many disparities are narrowed per tile by a coarse pass.
+COARSE_ABOVE = 128
+#: Disparities of the coarse pass at most.
+COARSE_DISPARITIES = 64
 
 Array = NDArray[Any]
 #: A grey image source: ``source(row0, row1, col0, col1)`` → float32 block, NaN = masked.
@@ -188,6 +200,7 @@ def iter_disparity_tiles(
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
+    coarse_above: int = COARSE_ABOVE,
     feedback: Optional[Feedback] = None,
 ) -> Iterator[Tuple[int, int, Array]]:
     """Disparity of the left image tile by tile: yields ``(row0, col0, block)``.
@@ -228,6 +241,9 @@ def iter_disparity_tiles(
         Side of the tile core (px).
     margin : int
         Overlap of the tiles (px of context on each side, discarded afterwards).
+    coarse_above : int
+        A search range of more disparities than this is narrowed per tile by a coarse pass (see
+        the module docstring); 0 = never.
     feedback : Feedback, optional
         Progress per tile; cancelling raises :class:`~photodem.algorithms.errors.Cancelled`.
     """
@@ -250,37 +266,139 @@ def iter_disparity_tiles(
     mode = cv2.STEREO_SGBM_MODE_HH if ours else cv2.STEREO_SGBM_MODE_SGBM
     sp_range = int(speckle_range) * (16 if ours else 1)  # on 1/16-px values inside SGBM
     # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the plain mode
-    matcher = _sgbm(cv2, min_d, num_d, block, p1, p2, uniqueness,
-                    0 if ours else speckle_window, sp_range if not ours else 0, mode)
     h, w = left_shape  # the right source pads with NaN outside its own right_shape
-    side = int(tile_size) if tile_size else tile_size_for(max_memory_mb, min_d, max_d, margin)
+
+    def match(r0: int, r1: int, c0: int, c1: int, lo: int, hi: int) -> Array:
+        """Disparities of the tile core rows r0:r1, cols c0:c1 searched in lo..hi."""
+        R0, R1 = r0 - margin, r1 + margin
+        C0, C1 = c0 - margin, c1 + margin
+        lcore = left(r0, r1, c0, c1)
+        if not np.isfinite(lcore).any():  # nothing to match (outside the image, masked)
+            return np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+        n_d = _num_disparities(lo, hi)
+        # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the
+        # plain mode
+        matcher = _sgbm(cv2, lo, n_d, block, p1, p2, uniqueness,
+                        0 if ours else speckle_window, sp_range if not ours else 0, mode)
+        # common frame: left pixel u ↔ right pixel u − d; start so that SGBM's dead lead
+        # columns (numDisparities + block) and the largest disparity lie left of the content
+        f0 = C0 - max(hi, 0) - (n_d + block)
+        f1 = max(C1, C1 - lo) + 1
+        lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
+        lg[:, C0 - f0:C1 - f0] = left(R0, R1, C0, C1)
+        rg = right(R0, R1, f0, f1)
+        disp = _match_frame(cv2, matcher, lg, rg, lo, hi, n_d, ours, block, lr_max_diff,
+                            normalise_window, speckle_window, int(speckle_range),
+                            fill_max_width, int(edge_erosion), float(range_guard))
+        return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
+
+    coarse = None
+    factor = 1
+    if coarse_above > 0 and num_d > coarse_above:
+        while num_d / factor > COARSE_DISPARITIES:
+            factor *= 2
+        options = {"method": method, "block_size": block, "p1": p1, "p2": p2,
+                   "uniqueness": uniqueness, "lr_max_diff": lr_max_diff,
+                   "normalise_window": normalise_window, "speckle_window": speckle_window,
+                   "speckle_range": speckle_range, "max_memory_mb": max_memory_mb,
+                   "margin": margin}
+        coarse = _coarse_disparity(left, right, left_shape, right_shape, min_d, max_d, factor,
+                                   options, feedback)
+    slack = 2 * factor + 8
+
+    def search_range(r0: int, r1: int, c0: int, c1: int) -> Tuple[int, int]:
+        if coarse is None:
+            return min_d, max_d
+        return _range_from_coarse(coarse, factor, (r0, r1, c0, c1), margin, (min_d, max_d),
+                                  slack)
+
+    if tile_size:
+        side = int(tile_size)
+    else:  # sized for a typical narrowed range; a tile whose range is wider is split below
+        typical = num_d if coarse is None else min(num_d, COARSE_DISPARITIES + 2 * slack)
+        side = tile_size_for(max_memory_mb, 0, typical - 1, margin)
     ty, tx = max(1, math.ceil(h / side)), max(1, math.ceil(w / side))
     th, tw = math.ceil(h / ty), math.ceil(w / tx)
     n_tiles, done = ty * tx, 0
-    lead = num_d + block  # left columns SGBM leaves without disparity
     for iy in range(ty):
         for ix in range(tx):
             feedback.progress(100.0 * done / n_tiles)
             r0, r1 = iy * th, min(h, (iy + 1) * th)
             c0, c1 = ix * tw, min(w, (ix + 1) * tw)
-            R0, R1 = r0 - margin, r1 + margin
-            C0, C1 = c0 - margin, c1 + margin
-            # common frame: left pixel u ↔ right pixel u − d; start so that SGBM's dead lead
-            # columns and the largest disparity lie left of the left content
-            f0 = C0 - max(max_d, 0) - lead
-            f1 = max(C1, C1 - min_d) + 1
-            lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
-            lg[:, C0 - f0:C1 - f0] = left(R0, R1, C0, C1)
-            rg = right(R0, R1, f0, f1)
-            disp = _match_frame(cv2, matcher, lg, rg, min_d, max_d, num_d, ours, block,
-                                lr_max_diff, normalise_window, speckle_window,
-                                int(speckle_range), fill_max_width, int(edge_erosion),
-                                float(range_guard))
-            # back to the tile core
-            core = disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]
+            lo, hi = search_range(r0, r1, c0, c1)
+            sub = side if tile_size else tile_size_for(max_memory_mb, lo, hi, margin)
+            if sub >= max(r1 - r0, c1 - c0):
+                yield r0, c0, match(r0, r1, c0, c1, lo, hi)
+            else:  # too deep a range for the budget: smaller parts, each with its own range
+                for s0 in range(r0, r1, sub):
+                    for t0 in range(c0, c1, sub):
+                        s1, t1 = min(s0 + sub, r1), min(t0 + sub, c1)
+                        yield s0, t0, match(s0, s1, t0, t1, *search_range(s0, s1, t0, t1))
             done += 1
-            yield r0, c0, core
     feedback.progress(100.0)
+
+
+def block_mean_source(source: GreySource, shape: Tuple[int, int], factor: int,
+                      max_pixels: int = 4_000_000) -> Array:
+    """The image of a grey source reduced by block means over ``factor × factor`` pixels.
+
+    NaN-aware: a block with at least one valid pixel gets the mean of its valid pixels, an
+    empty block NaN. Read in strips of about ``max_pixels`` pixels, so that the full image is
+    never in memory.
+    """
+    h, w = shape
+    hc, wc = -(-h // factor), -(-w // factor)
+    out = np.full((hc, wc), np.nan, np.float32)
+    rows = max(1, max_pixels // max(wc * factor * factor, 1)) * factor
+    for r0 in range(0, hc * factor, rows):
+        r1 = min(r0 + rows, hc * factor)
+        blk = source(r0, r1, 0, wc * factor).reshape((r1 - r0) // factor, factor, wc, factor)
+        ok = np.isfinite(blk)
+        n = ok.sum(axis=(1, 3))
+        total = np.where(ok, blk, 0.0).sum(axis=(1, 3), dtype=np.float64)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[r0 // factor:r1 // factor] = np.where(n > 0, total / n, np.nan)
+    return out
+
+
+def _coarse_disparity(left: GreySource, right: GreySource, left_shape: Tuple[int, int],
+                      right_shape: Tuple[int, int], min_d: int, max_d: int, factor: int,
+                      options: dict, feedback: Feedback) -> Array:
+    """Disparities (full-resolution px) of the pair reduced by ``factor``; NaN = none."""
+    cl, cr = (block_mean_source(src, shape, factor)
+              for src, shape in ((left, left_shape), (right, right_shape)))
+    src_l, shape_l = array_source(cl)
+    src_r, shape_r = array_source(cr)
+    out = np.full(shape_l, np.nan, np.float32)
+    # block means of both images over the same pixel blocks: d_coarse = d / factor exactly
+    for r0, c0, blk in iter_disparity_tiles(
+            src_l, src_r, shape_l, shape_r, math.floor(min_d / factor) - 1,
+            math.ceil(max_d / factor) + 1, coarse_above=0, **options):
+        out[r0:r0 + blk.shape[0], c0:c0 + blk.shape[1]] = blk
+        feedback.check()
+    return out * np.float32(factor)
+
+
+def _range_from_coarse(coarse: Array, factor: int, core: Tuple[int, int, int, int],
+                       margin: int, full: Tuple[int, int], slack: int) -> Tuple[int, int]:
+    """Search range of a tile (``core`` = rows r0:r1, cols c0:c1) from the coarse disparities
+    over it and its margin, widened by ``slack`` and clipped to the ``full`` range; where there
+    are none, over a neighbourhood grown ×2 up to 4 times, then the full range."""
+    r0, r1, c0, c1 = core
+    hc, wc = coarse.shape
+    half = max(r1 - r0, c1 - c0) / 2.0
+    for grow in (1.0, 2.0, 4.0, 8.0, 16.0):
+        pad = half * (grow - 1.0) + margin
+        a0, a1 = max(int((r0 - pad) // factor), 0), min(math.ceil((r1 + pad) / factor), hc)
+        b0, b1 = max(int((c0 - pad) // factor), 0), min(math.ceil((c1 + pad) / factor), wc)
+        vals = coarse[a0:a1, b0:b1]
+        vals = vals[np.isfinite(vals)]
+        if vals.size:
+            lo = max(full[0], math.floor(float(vals.min())) - slack)
+            hi = min(full[1], math.ceil(float(vals.max())) + slack)
+            if hi > lo:
+                return lo, hi
+    return full
 
 
 def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d: int,

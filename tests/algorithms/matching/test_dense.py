@@ -21,16 +21,16 @@ from photodem.algorithms.raster.io import open_image, write_raster
 H, W = 150, 240
 
 
-def _pair(shift: float = 0.0, seed: int = 1) -> Dict[str, np.ndarray]:
+def _pair(shift: float = 0.0, seed: int = 1, extra: int = 0) -> Dict[str, np.ndarray]:
     """Left/right grey images and the true left disparity (NaN where occluded).
 
     The disparity is defined on the right image, ``d_R = 9 + 3·sin(2πy/H)·cos(πx/W) + 6·[x > W/2]
     + shift``; the right image is ``T(x + d_R, y)`` of a texture ``T`` (the left image), with a
     gain of 1.3, an offset of −25 and noise σ = 2. The left truth follows by inverting
-    ``x_l = x_r + d_R(x_r)`` along each row.
+    ``x_l = x_r + d_R(x_r)`` along each row. ``extra`` widens the texture for large shifts.
     """
     rng = np.random.default_rng(seed)
-    base = ndimage.gaussian_filter(rng.normal(size=(H, W + 80)), 1.2)
+    base = ndimage.gaussian_filter(rng.normal(size=(H, W + 80 + extra)), 1.2)
     base = 120.0 + 45.0 * base / base.std()
     yy, xr = np.mgrid[0:H, 0:W].astype(float)
     d_r = 9.0 + 3.0 * np.sin(2 * np.pi * yy / H) * np.cos(np.pi * xr / W) + 6.0 * (xr > W / 2)
@@ -72,6 +72,48 @@ def test_known_disparity_field(pair) -> None:
     rms, valid = _score(disp, pair["truth"])
     assert rms < 0.3, rms
     assert valid >= 0.95, valid
+
+
+def test_wide_search_range_is_narrowed_by_a_coarse_pass(monkeypatch) -> None:
+    """Disparities 169–181 px searched in 100–400: the coarse pass (factor 8) narrows every
+    tile's range, and the result is as accurate as the full-range search."""
+    from photodem.algorithms.matching import dense
+
+    p = _pair(shift=160.0, seed=3, extra=200)
+    depths = []
+    real = dense._sgbm
+
+    def spy(cv2, min_d, num_d, *args):
+        depths.append(num_d)
+        return real(cv2, min_d, num_d, *args)
+
+    monkeypatch.setattr(dense, "_sgbm", spy)
+    disp = sgm_disparity(p["left"], p["right"], 100, 400)
+    rms, valid = _score(disp, p["truth"])
+    assert rms < 0.3 and valid >= 0.95, (rms, valid)
+    assert depths[0] <= dense.COARSE_DISPARITIES  # the coarse pass
+    assert max(depths[1:]) <= 64, depths  # 12 px of disparities + 2 × (2·8 + 8) px of slack
+    depths.clear()
+    full = sgm_disparity(p["left"], p["right"], 100, 400, coarse_above=0)
+    assert set(depths) == {304}  # every tile searches the whole range
+    rms_full, valid_full = _score(full, p["truth"])
+    assert rms <= rms_full + 0.05 and valid >= valid_full - 0.01, (rms_full, valid_full)
+
+
+def test_block_mean_source_ignores_masked_pixels() -> None:
+    from photodem.algorithms.matching.dense import array_source, block_mean_source
+
+    img = np.arange(48, dtype=np.float32).reshape(6, 8)
+    img[0, 0] = np.nan
+    img[4:6, 6:8] = np.nan
+    src, shape = array_source(img)
+    out = block_mean_source(src, shape, 2, max_pixels=16)  # strips of 4 rows
+    assert out.shape == (3, 4)
+    assert out[0, 0] == pytest.approx((1 + 8 + 9) / 3)
+    assert out[1, 2] == pytest.approx(img[2:4, 4:6].mean())
+    assert np.isnan(out[2, 3])
+    odd, _ = array_source(np.ones((5, 7), np.float32))
+    assert np.array_equal(block_mean_source(odd, (5, 7), 4), np.ones((2, 2), np.float32))
 
 
 def test_negative_disparities() -> None:
