@@ -672,13 +672,15 @@ def ground_bumps(z: Array, support: Array, surface: Array, spacing: float, tol: 
     With :math:`o(\cdot)` the grey opening (:func:`grey_opening`) over the support cells with
     a ``window_m`` window and :math:`T` the filter's smooth surface, a cell is a bump if
 
-    .. math:: z - o(z) > t + k \cdot |\nabla T| \cdot s + \bigl(T - o(T)\bigr)
+    .. math:: z - o(z) > t + k \cdot |\nabla T| \cdot s + \bigl(T - o(T)\bigr) + m
 
     (``t`` = ``tol``, ``k`` = ``slope_factor``, ``s`` the spacing: the tolerance a ground
     point gets, :func:`point_labels`). The opening reproduces planes, slopes and terraces, so
     ground stands at most its cell's share of the slope above it (lowest-point gridding); it
     cuts ridges and hill tops, by as much as it cuts the same shape in the surface, which the
-    last term allows for. What stands out are objects narrower than the window that the
+    fourth term allows for; ``m`` is the median of :math:`z - o(z) - (T - o(T))` over the
+    support (≥ 0): noise lifts every cell above the opening, by about σ in a matched DSM, and
+    that typical lift is no object. What stands out are objects narrower than the window that the
     filters' larger windows and smooth surfaces accept as ground because they are low:
     bushes, cars, low vegetation, the edge cells of buildings. Objects wider than the window
     are the filters' business.
@@ -710,8 +712,14 @@ def ground_bumps(z: Array, support: Array, surface: Array, spacing: float, tol: 
     cut = np.nan_to_num(ts - grey_opening(ts, size))
     slope = np.nan_to_num(dtm_slope(surface, spacing))
     allowance = float(tol) + float(slope_factor) * slope * spacing + cut
+    lift = zs - grey_opening(zs, size)
+    # noise lifts ground above its own opening (by about σ for a matched DSM): the typical
+    # lift is no bump
+    typical = (lift - cut)[support & np.isfinite(lift)]
+    if typical.size:
+        allowance += max(float(np.median(typical)), 0.0)
     with np.errstate(invalid="ignore"):
-        return support & (zs - grey_opening(zs, size) > allowance)
+        return support & (lift > allowance)
 
 
 # -- outputs ------------------------------------------------------------------------------------

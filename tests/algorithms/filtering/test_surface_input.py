@@ -285,3 +285,16 @@ def test_ground_bumps_flag_narrow_low_objects_not_slopes_ridges_or_terraces() ->
     fine[20:24, 20:24] += 1.6
     got = ground_bumps(fine, np.ones(fine.shape, bool), fine_surface, 0.5, 0.5, 1.25)
     assert got[20:24, 20:24].all() and got.sum() == 16
+
+
+def test_ground_bumps_allow_for_the_noise_of_a_matched_dsm() -> None:
+    from photodem.algorithms.filtering.surface_input import ground_bumps
+
+    rng = np.random.default_rng(5)
+    surface = np.full((200, 200), 50.0)
+    z = surface + rng.normal(0.0, 0.15, surface.shape)  # σ = half the tolerance
+    z[100:103, 100:103] += 1.0
+    got = ground_bumps(z, np.ones(z.shape, bool), surface, 0.5, 0.3, 1.0)
+    # noise lifts every cell above the opening (by ≈ 1.8 σ with 11 × 11 cells): without the
+    # typical lift almost half of the cells would go, a bias of the DTM; with it, the 2 σ tail
+    assert got[100:103, 100:103].all() and got.mean() < 0.04
