@@ -57,6 +57,10 @@ Robust iterations with an asymmetric weight function
     ``coarse_spacing`` window keep :math:`p = 1`: the opening removes the objects the pyramid
     removes but keeps slopes, terraces and the upper edges of banks, where the smooth
     prediction passes far below the terrain and the weight function alone would reject it.
+    At level 0, after the first prediction, candidates more than the ground tolerance above
+    the opening of the candidates with a 5 m window (plus what that opening cuts from the
+    prediction) get :math:`p = 0` and are not ground (:func:`~.surface_input.ground_bumps`:
+    low objects narrower than that, which the weight function only half rejects).
 
 Hierarchy (data pyramid)
     Level 0 is the DSM; level ℓ+1 takes the mean of the **two lowest** cells of every 2×2
@@ -971,6 +975,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
             p = asymmetric_weights(np.where(cand, lz, np.nan), g0, half_w, prm.exponent,
                                    cutoff, prm.low_cutoff).astype(np.float32)
             p[sure] = 1.0
+        bumps = np.zeros(zl.shape, bool)
         n_valid = max(int(valid.sum()), 1)
         n_iter = prm.fine_iterations if lv <= 1 else prm.iterations
         x = None
@@ -990,6 +995,11 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
             p_new = asymmetric_weights(np.where(cand, r, np.nan), g, half_w,
                                        prm.exponent, cutoff, prm.low_cutoff).astype(np.float32)
             p_new[sure] = 1.0
+            if lv == 0 and k == 0:
+                # low objects narrower than a few metres get no weight: the weight function
+                # only halves it below h + slope allowance, and they lift the surface
+                bumps = _bumps(zl, cand & ~forced & (p_new > 0), trend + s, prm, g_lv.spacing)
+            p_new[bumps] = 0.0
             if k == 0 and lv == n_red and prm.noise_share is None and prm.corr_length is None:
                 # coarsest level (objects among the candidates): re-estimate the covariance
                 # from the cells that now look like ground
@@ -1037,7 +1047,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
     tol = prm.ground_tolerance + prm.ground_slope_factor * grid.spacing * np.nan_to_num(
         dtm_slope(dtm, grid.spacing))
     with np.errstate(invalid="ignore"):
-        ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove
+        ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove & ~bumps
     ground |= keep & valid0
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
 
@@ -1056,6 +1066,16 @@ def _on_terrain(z: Array, cand: Array, prm: LPParameters, spacing: float) -> Arr
     size = max(3, round(prm.coarse_spacing / spacing) | 1)
     with np.errstate(invalid="ignore"):
         return cand & (z - grey_opening(z, size) <= prm.half_weight)
+
+
+def _bumps(z: Array, cand: Array, surface: Array, prm: LPParameters, spacing: float) -> Array:
+    """Candidates more than the ground tolerance above their neighbourhood's lower envelope
+    (:func:`~.surface_input.ground_bumps` with ``ground_tolerance`` and
+    ``ground_slope_factor``)."""
+    from .surface_input import ground_bumps
+
+    return ground_bumps(z, cand, surface, spacing, prm.ground_tolerance,
+                        prm.ground_slope_factor)
 
 
 def _offset(grid: Grid, sub: Grid) -> Tuple[int, int]:

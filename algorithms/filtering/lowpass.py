@@ -37,7 +37,11 @@ Elimination
     wall) and ``d`` the blunder depth. Cells within :math:`t_k` of the opening
     (:math:`M_{k-1} - O_k \le t_k`) are not objects: the opening keeps slopes, terraces and the
     upper edges of banks exactly, where the plane misses a break of slope by far more than
-    ``s·w/4``. Eliminated cells stay eliminated. Before the first
+    ``s·w/4``. Eliminated cells stay eliminated. After the last iteration, cells more than the
+    label tolerance above the opening of the remaining cells with a 5 m window (plus what that
+    opening cuts from the last iteration's planes) are eliminated
+    (:func:`.surface_input.ground_bumps`: low objects narrower than that, which the planes
+    hardly notice). Before the first
     iteration, isolated pits (``low_outlier_m`` below their second lowest neighbour,
     :func:`.surface_input.low_outliers`) are eliminated by a local, slope-invariant test.
 
@@ -76,6 +80,7 @@ from .surface_input import (
     FilterInput,
     check_ground_points,
     grey_opening,
+    ground_bumps,
     low_outliers,
     read_filter_constraints,
     read_filter_input,
@@ -484,7 +489,8 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         ``dtm`` (float32), ``ground`` (bool: remaining DSM cells, keep areas, ground points),
         ``iterations`` (per iteration: window, threshold, eliminated counts and shares),
         ``differences`` (list of float32 grids or empty), ``ground_points_disagreeing``,
-        ``eliminated_share``, ``cells_valid``, ``cells_ground``, ``seconds``.
+        ``eliminated_share``, ``cells_valid``, ``cells_ground``, ``cells_bumps`` (cells
+        eliminated by :func:`.surface_input.ground_bumps`; untiled grids), ``seconds``.
     """
     from .tiles import MAX_CELLS, filter_in_tiles
 
@@ -572,6 +578,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
                  "step": "height range, low outliers and remove areas"})
     eliminated_total = pre
     n_steps = len(windows) + 2
+    last_plane = m  # the smooth surface of the last iteration (judges the bumps)
     for k, (wm, tk) in enumerate(zip(windows, thresholds), start=1):
         feedback.progress(100.0 * (k - 1) / n_steps)
         radius = max(1, round(wm / spacing / 2.0))
@@ -587,6 +594,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
             # slope (the upper edge of a bank) is no reason to eliminate them
             on_terrain = above <= tk
         t = smooth(m, fit, radius, sides, barrier)
+        last_plane = t
         d = m - t
         # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
         # it lies s·w/4 below a ridge: the blunder depth grows alike
@@ -607,7 +615,18 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
                       f"{n_el} cells eliminated ({100.0 * n_el / n_filterable:.1f} %).")
         if keep_differences:
             diffs.append(np.where(valid, dsm - t, np.nan).astype(np.float32))
-        del t, d
+        del d
+    # low objects narrower than a few metres pass the windows' planes (they lift them little):
+    # at the label resolution a ground cell is within the label tolerance of its neighbourhood
+    bumps = ground_bumps(m, support & ~gp_cells, last_plane, spacing,
+                         float(params.get("ground_tolerance_m", 0.5)),
+                         float(params.get("ground_slope_factor", 0.0)))
+    n_bumps = int(bumps.sum())
+    support &= ~bumps
+    m[bumps] = np.nan
+    eliminated_total += n_bumps
+    feedback.info(f"{n_bumps} cells stand above their neighbourhood by more than the ground "
+                  "tolerance (low objects): eliminated.")
     feedback.progress(100.0 * len(windows) / n_steps)
     # optional light smoothing of the ground cells ("interpolation with filtering")
     ground_vals = m.copy()
@@ -649,6 +668,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         "eliminated_share": eliminated_total / n_filterable,
         "cells_valid": n_valid,
         "cells_ground": n_ground,
+        "cells_bumps": n_bumps,
         "seconds": time.perf_counter() - start,
     }
     return result

@@ -660,6 +660,68 @@ def grey_opening(z: Array, size: int) -> Array:
     return np.where(np.isfinite(zz) & np.isfinite(out), out, np.nan).astype(np.float32)
 
 
+#: Window (m) of :func:`ground_bumps`: low objects narrower than this (bushes, cars, hedges,
+#: low vegetation) stand out of the lower envelope of their neighbourhood.
+BUMP_WINDOW_M = 5.0
+
+
+def ground_bumps(z: Array, support: Array, surface: Array, spacing: float, tol: float,
+                 slope_factor: float = 0.0, window_m: float = BUMP_WINDOW_M) -> Array:
+    r"""Support cells that stand out of their neighbourhood by more than the label tolerance.
+
+    With :math:`o(\cdot)` the grey opening (:func:`grey_opening`) over the support cells with
+    a ``window_m`` window and :math:`T` the filter's smooth surface, a cell is a bump if
+
+    .. math:: z - o(z) > t + k \cdot |\nabla T| \cdot s + \bigl(T - o(T)\bigr) + m
+
+    (``t`` = ``tol``, ``k`` = ``slope_factor``, ``s`` the spacing: the tolerance a ground
+    point gets, :func:`point_labels`). The opening reproduces planes, slopes and terraces, so
+    ground stands at most its cell's share of the slope above it (lowest-point gridding); it
+    cuts ridges and hill tops, by as much as it cuts the same shape in the surface, which the
+    fourth term allows for; ``m`` is the median of :math:`z - o(z) - (T - o(T))` over the
+    support (≥ 0): noise lifts every cell above the opening, by about σ in a matched DSM, and
+    that typical lift is no object. What stands out are objects narrower than the window that the
+    filters' larger windows and smooth surfaces accept as ground because they are low:
+    bushes, cars, low vegetation, the edge cells of buildings. Objects wider than the window
+    are the filters' business.
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights (NaN = no data).
+    support : ndarray of bool (h, w)
+        The cells judged (the ground so far); the others are no support of the openings.
+    surface : ndarray (h, w)
+        The filter's smooth terrain surface so far (NaN where it has none: no allowance for
+        the cut there).
+    spacing : float
+        Cell size (m).
+    tol, slope_factor : float
+        Label tolerance (m) and its slope factor.
+    window_m : float
+        Side of the window (m); at least 3 cells.
+
+    Returns
+    -------
+    ndarray of bool
+        True at bumps (a subset of ``support``).
+    """
+    size = max(3, round(float(window_m) / float(spacing)) | 1)
+    zs = np.where(support, np.asarray(z, np.float32), np.nan)
+    ts = np.where(support, np.asarray(surface, np.float32), np.nan)
+    cut = np.nan_to_num(ts - grey_opening(ts, size))
+    slope = np.nan_to_num(dtm_slope(surface, spacing))
+    allowance = float(tol) + float(slope_factor) * slope * spacing + cut
+    lift = zs - grey_opening(zs, size)
+    # noise lifts ground above its own opening (by about σ for a matched DSM): the typical
+    # lift is no bump
+    typical = (lift - cut)[support & np.isfinite(lift)]
+    if typical.size:
+        allowance += max(float(np.median(typical)), 0.0)
+    with np.errstate(invalid="ignore"):
+        return support & (lift > allowance)
+
+
 # -- outputs ------------------------------------------------------------------------------------
 def _iteration_figure(rows: Sequence[Dict[str, Any]]) -> Any:
     from ..quality.report import new_figure
@@ -823,7 +885,8 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
     return out
 
 
-__all__ = ["DEFAULT_GROUND_TOLERANCE", "MIN_POINTS", "FilterConstraints", "FilterInput",
-           "check_ground_points", "dtm_slope", "grey_opening", "grid_lowest", "low_outliers",
-           "lowest_points", "nice_spacing", "point_labels", "read_filter_constraints",
-           "read_filter_input", "sample_bilinear", "to_crs", "write_filter_outputs"]
+__all__ = ["BUMP_WINDOW_M", "DEFAULT_GROUND_TOLERANCE", "MIN_POINTS", "FilterConstraints",
+           "FilterInput", "check_ground_points", "dtm_slope", "grey_opening", "grid_lowest",
+           "ground_bumps", "low_outliers", "lowest_points", "nice_spacing", "point_labels",
+           "read_filter_constraints", "read_filter_input", "sample_bilinear", "to_crs",
+           "write_filter_outputs"]

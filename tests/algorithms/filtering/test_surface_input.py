@@ -256,3 +256,45 @@ def test_lowest_point_of_a_ground_cell_is_ground() -> None:
     ground = np.array([[True, False]])
     assert point_labels(inp, dtm, 0.5).tolist() == [1, 1, 1, 1]
     assert point_labels(inp, dtm, 0.5, ground=ground).tolist() == [0, 1, 1, 1]
+
+
+def test_ground_bumps_flag_narrow_low_objects_not_slopes_ridges_or_terraces() -> None:
+    from photodem.algorithms.filtering.surface_input import ground_bumps
+
+    rows, cols = np.mgrid[0:60, 0:80].astype(float)
+    rng = np.random.default_rng(3)
+    # 60 % slopes up to a sharp ridge and a 2 m terrace step: the terrain (and the surface)
+    surface = 100.0 + 0.6 * cols - 1.2 * np.maximum(cols - 60, 0) + 2.0 * (rows > 30)
+    z = surface + rng.normal(0.0, 0.05, cols.shape)
+    # tolerance 0.5 m + 1.25 · 0.6 · 1 m = 1.25 m on the slope
+    z[10:12, 10:12] += 1.6  # a bush 2 m wide
+    z[40, 20] += 1.4  # a single low object cell
+    z[45:60, 30:50] += 1.6  # a platform wider than the 5 m window: not a bump
+    support = np.ones(z.shape, bool)
+    support[5, 5] = False  # not judged, no support
+    got = ground_bumps(z, support, surface, 1.0, 0.5, 1.25)
+    assert got[10:12, 10:12].all() and got[40, 20]
+    assert got.sum() == 5  # nothing on the slopes, the ridge, the terrace step, the platform
+    # the opening cuts the ridge (by slope × half the window): allowed for by the surface's cut
+    flat = ground_bumps(z, support, np.full(z.shape, np.nan), 1.0, 0.5, 1.25)
+    assert flat[:, 58:63].any()
+    # the window is in metres: at 0.5 m cells the bush is 4 cells wide and still a bump
+    x = np.mgrid[0:120, 0:160][1] * 0.5
+    fine_surface = 100.0 + 0.3 * x
+    fine = fine_surface + rng.normal(0.0, 0.05, x.shape)
+    fine[20:24, 20:24] += 1.6
+    got = ground_bumps(fine, np.ones(fine.shape, bool), fine_surface, 0.5, 0.5, 1.25)
+    assert got[20:24, 20:24].all() and got.sum() == 16
+
+
+def test_ground_bumps_allow_for_the_noise_of_a_matched_dsm() -> None:
+    from photodem.algorithms.filtering.surface_input import ground_bumps
+
+    rng = np.random.default_rng(5)
+    surface = np.full((200, 200), 50.0)
+    z = surface + rng.normal(0.0, 0.15, surface.shape)  # σ = half the tolerance
+    z[100:103, 100:103] += 1.0
+    got = ground_bumps(z, np.ones(z.shape, bool), surface, 0.5, 0.3, 1.0)
+    # noise lifts every cell above the opening (by ≈ 1.8 σ with 11 × 11 cells): without the
+    # typical lift almost half of the cells would go, a bias of the DTM; with it, the 2 σ tail
+    assert got[100:103, 100:103].all() and got.mean() < 0.04
