@@ -119,8 +119,10 @@ def georeference(image: PathLike, reference: PathLike, class_field: Optional[str
     except GeometryError as exc:
         if search == "objects" or ref_kind == "raster":
             raise
-        fb.info(f"{exc} — trying the area-based search.")
-        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, str(exc))
+        # the reason and counts only: the advice at the end is repeated by the area stage
+        why = str(exc).replace("Georeferencing failed: ", "").split(". Check that")[0]
+        fb.info(f"Object stage: {why} — trying the area-based search.")
+        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, why)
 
 
 def _object_stage(grey: np.ndarray, img_info: Dict[str, Any], reference: PathLike,
