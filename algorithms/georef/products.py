@@ -193,7 +193,9 @@ def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
         ax.plot(g[:, 0], g[:, 1], "+", color="yellow", ms=4)
     ax.set_xlim(-0.5, W - 0.5)
     ax.set_ylim(H - 0.5, -0.5)
-    ax.set_title("matched objects: image (green), reference (red); control points (+)")
+    ax.set_title("reference polygons through the area-based transform (red); control points "
+                 "(+)" if result.get("stage") == "area" else
+                 "matched objects: image (green), reference (red); control points (+)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
