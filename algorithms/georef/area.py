@@ -9,12 +9,12 @@ approximate values:
 1. **Features** on both sides: the gradient magnitude of the Gaussian-smoothed image and of
    the filled polygon mask (both then respond at the outlines; brightness levels and
    contrast do not matter).
-2. **Rotation and scale** by Fourier–Mellin: magnitude spectra (windowed, high-pass) are
-   translation-invariant; in log-polar coordinates a rotation and a scale become a shift, found
-   by phase correlation. Several peaks, each with its 180° twin, for the image and for its
-   mirror image, are candidates.
-3. **Translation** of each candidate by masked normalised cross-correlation (FFT), which also
-   ranks the candidates.
+2. **Rotation and scale** by Fourier–Mellin: magnitude spectra (radial window, log
+   magnitude, middle frequencies) are translation-invariant; in log-polar coordinates a
+   rotation and a scale become a shift, found by phase correlation. Several peaks, each with
+   its 180° twin, for the image and for its mirror image, are candidates.
+3. **Translation** of each candidate by masked normalised cross-correlation (FFT) with the
+   polygons rendered in the image frame; its peak also ranks the candidates.
 4. **Refinement**: ECC (``cv2.findTransformECC``, affine) of the image feature against the
    polygons rendered in the image geometry, coarse to fine, re-rendering after each step.
 
@@ -134,7 +134,7 @@ def _window(shape: Tuple[int, int]) -> Array:
     return np.where(r < 1.0, 0.5 * (1.0 + np.cos(np.pi * np.minimum(r, 1.0))), 0.0)
 
 
-def log_polar_spectrum(a: Array, n: int, angles: int = 360, radii: int = 256) -> Array:
+def log_polar_spectrum(a: Array, n: int, angles: int = 720, radii: int = 512) -> Array:
     """Log-polar resampled log-magnitude spectrum of ``a`` (zero-padded to n × n).
 
     Rows are angles over 0–360° (the spectrum is point-symmetric, so half would do; the full
@@ -209,7 +209,7 @@ def rotation_scale_candidates(img: Array, ref: Array, n: int, count: int = PEAKS
     out = []
     for drow, dcol, h in correlation_peaks(li, lr, count):
         angle = 2 * math.pi * drow / angles
-        scale = math.exp(-dcol * base)  # image frequencies lower ⇔ the image is enlarged...
+        scale = math.exp(-dcol * base)  # the image's spectrum is the reference's shrunk by 1/s
         out.append((angle, scale, h))
     return out
 
