@@ -2154,9 +2154,9 @@
             <translation>Georeferenzierung</translation>
         </message>
         <message>
-            <source>Finds the georeference of an image without approximate values (position, scale, rotation and mirroring unknown) by matching area objects: the image is segmented by region growing at several thresholds, its regions and the reference polygons (one class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are described by affine-invariant moment features, corresponding objects are found by a consistency search, verified, refined by ICP, and control points on their outlines give the final transform (affine, projective or 2nd-order polynomial). Writes a QGIS Georeferencer .points file, the control points as GeoPackage, the image resampled into the map CRS, a copy with the control points embedded and a report (overlay, residuals, RMSE in px and m). Too few matching objects give a failure message with the counts of every stage, not a wrong result.</source>
+            <source>Finds the georeference of an image without approximate values (position, scale, rotation and mirroring unknown) by matching area objects: the image is segmented by region growing at several thresholds, its regions and the reference polygons (one class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are described by affine-invariant moment features, corresponding objects are found by a consistency search, verified, refined by ICP, and control points on their outlines give the final transform (affine, projective or 2nd-order polynomial). When no objects match (objects not homogeneous in the image), an area-based search compares the whole image with the rasterised polygons instead. Writes a QGIS Georeferencer .points file, the control points as GeoPackage, the image resampled into the map CRS, a copy with the control points embedded and a report (overlay, residuals, RMSE in px and m). Too few matching objects give a failure message with the counts of every stage, not a wrong result.</source>
             <extracomment>georeference_polygons: help</extracomment>
-            <translation>Bestimmt die Georeferenz eines Bildes ohne Näherungswerte (Position, Maßstab, Drehung und Spiegelung unbekannt) durch Zuordnung von Flächenobjekten: Das Bild wird mit mehreren Schwellen durch Bereichswachstum segmentiert, seine Regionen und die Referenzpolygone (eine Klasse eines Vektorlayers, aneinandergrenzende Polygone verschmolzen — oder ein segmentiertes Orthophoto) werden durch affin-invariante Momentmerkmale beschrieben, zugehörige Objekte durch eine Konsistenzsuche gefunden, verifiziert und mit ICP verfeinert; Passpunkte auf ihren Konturen ergeben die endgültige Transformation (affin, projektiv oder Polynom 2. Grades). Schreibt eine .points-Datei des QGIS-Georeferenzierers, die Passpunkte als GeoPackage, das in das Karten-KBS umgebildete Bild, eine Kopie mit eingebetteten Passpunkten und einen Bericht (Überlagerung, Residuen, RMSE in px und m). Zu wenige zugeordnete Objekte ergeben eine Fehlermeldung mit den Anzahlen jeder Stufe, kein falsches Ergebnis.</translation>
+            <translation>Bestimmt die Georeferenz eines Bildes ohne Näherungswerte (Position, Maßstab, Drehung und Spiegelung unbekannt) durch Zuordnung von Flächenobjekten: Das Bild wird mit mehreren Schwellen durch Bereichswachstum segmentiert, seine Regionen und die Referenzpolygone (eine Klasse eines Vektorlayers, aneinandergrenzende Polygone verschmolzen — oder ein segmentiertes Orthophoto) werden durch affin-invariante Momentmerkmale beschrieben, zugehörige Objekte durch eine Konsistenzsuche gefunden, verifiziert und mit ICP verfeinert; Passpunkte auf ihren Konturen ergeben die endgültige Transformation (affin, projektiv oder Polynom 2. Grades). Passen keine Objekte zusammen (Objekte im Bild nicht homogen), vergleicht stattdessen eine flächenbasierte Suche das ganze Bild mit den gerasterten Polygonen. Schreibt eine .points-Datei des QGIS-Georeferenzierers, die Passpunkte als GeoPackage, das in das Karten-KBS umgebildete Bild, eine Kopie mit eingebetteten Passpunkten und einen Bericht (Überlagerung, Residuen, RMSE in px und m). Zu wenige zugeordnete Objekte ergeben eine Fehlermeldung mit den Anzahlen jeder Stufe, kein falsches Ergebnis.</translation>
         </message>
         <message>
             <source>Image to georeference</source>
@@ -2252,6 +2252,31 @@
             <source>Search depth [pairs]</source>
             <extracomment>georeference_polygons.max_depth: description</extracomment>
             <translation>Suchtiefe [Paare]</translation>
+        </message>
+        <message>
+            <source>Search</source>
+            <extracomment>georeference_polygons.search: description</extracomment>
+            <translation>Suche</translation>
+        </message>
+        <message>
+            <source>objects: match image regions to the polygons as objects; area: compare the whole image with the rasterised polygons (rotation and scale by Fourier–Mellin, shift by correlation, refined by ECC) — for objects that are not homogeneous in the image; auto: objects, and the area-based search when they give no result. Polygon layers only.</source>
+            <extracomment>georeference_polygons.search: help</extracomment>
+            <translation>objects: Bildregionen als Objekte den Polygonen zuordnen; area: das ganze Bild mit den gerasterten Polygonen vergleichen (Drehung und Maßstab nach Fourier–Mellin, Verschiebung durch Korrelation, Verfeinerung mit ECC) — für Objekte, die im Bild nicht homogen sind; auto: Objekte, und die flächenbasierte Suche, wenn sie kein Ergebnis liefern. Nur für Polygonlayer.</translation>
+        </message>
+        <message>
+            <source>auto</source>
+            <extracomment>georeference_polygons.search: option</extracomment>
+            <translation>automatisch</translation>
+        </message>
+        <message>
+            <source>objects</source>
+            <extracomment>georeference_polygons.search: option</extracomment>
+            <translation>Objekte</translation>
+        </message>
+        <message>
+            <source>area</source>
+            <extracomment>georeference_polygons.search: option</extracomment>
+            <translation>Fläche</translation>
         </message>
         <message>
             <source>Control point tolerance σ_NP [px]</source>

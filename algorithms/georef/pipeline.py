@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import GeometryError, InputError
 from ..processing.feedback import Feedback, StepFeedback
+from .area import area_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform
 from .invariants import object_features
@@ -39,6 +40,11 @@ PathLike = Union[str, Path]
 
 #: Fewest verified pairs for a result (fewer: the failure report, not a wrong answer).
 MIN_PAIRS = 3
+#: Search modes: object-based, area-based, or objects with the area-based fallback.
+SEARCH_MODES = ("auto", "objects", "area")
+#: Smallest ECC correlation of an area-based result (below: the failure report). Correct
+#: synthetic results reach 0.6–0.85, wrong candidates stay below 0.17.
+MIN_ECC = 0.25
 
 
 def parse_thresholds(text: Union[str, Sequence[float], None]) -> List[float]:
@@ -65,9 +71,16 @@ def georeference(image: PathLike, reference: PathLike, class_field: Optional[str
                  max_depth: int = 6, min_overlap: float = 0.7, verify_overlap: float = 0.5,
                  alpha_min: float = 30.0, sigma_np_px: float = 2.0, max_gcps: int = 500,
                  smooth: float = 1.0, merge: bool = True, band: Optional[int] = None,
-                 gcp_mode: str = "outline",
+                 gcp_mode: str = "outline", search: str = "auto",
                  feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Georeference ``image`` against ``reference``; returns the result (no files written).
+
+    Parameters
+    ----------
+    search : {"auto", "objects", "area"}
+        ``objects``: the object-based chain only; ``area``: the area-based global search only
+        (:mod:`.area`, polygon layers only); ``auto``: objects, and the area-based search
+        when the objects give no result.
 
     Raises
     ------
@@ -81,12 +94,48 @@ def georeference(image: PathLike, reference: PathLike, class_field: Optional[str
     thr = parse_thresholds(thresholds)
     if transform not in ("affine", "projective", "poly2"):
         raise InputError(f"Unknown transform '{transform}'; use affine, projective or poly2.")
+    if search not in SEARCH_MODES:
+        raise InputError(f"Unknown search '{search}'; use {', '.join(SEARCH_MODES)}.")
     grey, img_info = load_image(image, band)
     ref_kind = "raster" if is_raster(reference) else "vector"
+    if ref_kind == "raster" and search == "area":
+        raise InputError("The area-based search needs a polygon layer as reference, not a "
+                         "raster; use search = objects or auto.")
     if ref_kind == "vector":  # first: a bad layer or class fails before any work
         ref_objs, crs, ref_info = reference_objects_from_vector(
             reference, class_field, class_value, feedback=fb)
     fb.progress(5)
+    params = {"thresholds": thr, "rd": rd, "max_depth": max_depth, "min_overlap": min_overlap,
+              "verify_overlap": verify_overlap, "alpha_min": alpha_min,
+              "sigma_np_px": sigma_np_px, "max_gcps": max_gcps, "transform": transform,
+              "smooth": smooth, "merge": merge, "gcp_mode": gcp_mode,
+              "class_field": class_field, "class_value": class_value, "search": search}
+    if search == "area":
+        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, None)
+    try:
+        return _object_stage(grey, img_info, reference, ref_kind,
+                             (ref_objs, crs, ref_info) if ref_kind == "vector" else None,
+                             pyramid_level, params, fb, t0)
+    except GeometryError as exc:
+        if search == "objects" or ref_kind == "raster":
+            raise
+        # the reason and counts only: the advice at the end is repeated by the area stage
+        why = str(exc).replace("Georeferencing failed: ", "").split(". Check that")[0]
+        fb.info(f"Object stage: {why} — trying the area-based search.")
+        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, why)
+
+
+def _object_stage(grey: np.ndarray, img_info: Dict[str, Any], reference: PathLike,
+                  ref_kind: str, ref: Optional[tuple], pyramid_level: Union[int, str],
+                  params: Dict[str, Any], fb: Feedback, t0: float) -> Dict[str, Any]:
+    """The object-based chain (seed-001): segmentation to the final fit."""
+    thr, rd, max_depth = params["thresholds"], params["rd"], params["max_depth"]
+    min_overlap, verify_overlap = params["min_overlap"], params["verify_overlap"]
+    alpha_min, sigma_np_px = params["alpha_min"], params["sigma_np_px"]
+    max_gcps, transform, smooth = params["max_gcps"], params["transform"], params["smooth"]
+    merge, gcp_mode = params["merge"], params["gcp_mode"]
+    if ref is not None:
+        ref_objs, crs, ref_info = ref
     img_objs, seg = image_objects(grey, thr, pyramid_level=pyramid_level, smooth=smooth,
                                   merge=merge, feedback=StepFeedback(fb, 5, 20))
     if ref_kind == "raster":  # segmented like the image
@@ -184,14 +233,55 @@ def georeference(image: PathLike, reference: PathLike, class_field: Optional[str
             "pairs": ver.pairs, "img_features": fi, "ref_features": fr, "crs": crs,
             "counts": counts, "icp": icp_stats, "segmentation": seg, "reference": ref_info,
             "reference_kind": ref_kind, "image_info": img_info, "grey": grey,
-            "warnings": warnings, "seconds": time.perf_counter() - t0,
-            "parameters": {"thresholds": thr, "pyramid_level": level, "rd": rd,
-                           "max_depth": max_depth, "min_overlap": min_overlap,
-                           "verify_overlap": verify_overlap, "alpha_min": alpha_min,
-                           "sigma_np_px": sigma_np_px, "max_gcps": max_gcps,
-                           "transform": transform, "smooth": smooth, "merge": merge,
-                           "gcp_mode": gcp_mode, "class_field": class_field,
-                           "class_value": class_value}}
+            "warnings": warnings, "seconds": time.perf_counter() - t0, "stage": "objects",
+            "parameters": {**params, "pyramid_level": level}}
+
+
+def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[Any],
+                crs: Any, ref_info: Dict[str, Any], params: Dict[str, Any], fb: Feedback,
+                t0: float, object_failure: Optional[str]) -> Dict[str, Any]:
+    """The area-based global search (:mod:`.area`) and the same result layout as the object
+    chain; its control points are a grid of image points through the refined affine."""
+    fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
+    fb.progress(40)
+    res = area_search(grey, [o.ring for o in ref_objs])
+    fb.progress(75)
+    counts: Dict[str, Any] = {"reference_objects": len(ref_objs),
+                              "area_candidates": len(res.candidates),
+                              "area_ncc": round(res.ncc, 4), "area_ecc": round(res.ecc, 4),
+                              "verified_pairs": 0}
+    if res.ecc < MIN_ECC:
+        why = (f"the area-based search found no alignment (ECC correlation {res.ecc:.2f} < "
+               f"{MIN_ECC:g})")
+        if object_failure:
+            why += f"; before it, the object stage: {object_failure}"
+        _fail(counts, why)
+    gcps = grid_control_points(res.transform, np.isfinite(grey))
+    transform = params["transform"]
+    img_xy = np.array([g.image for g in gcps])
+    map_xy = np.array([g.map for g in gcps])
+    fit = fit_transform(img_xy, map_xy, transform)
+    inverse_fit = (fit_transform(map_xy, img_xy, "poly2", robust=False)
+                   if transform == "poly2" else None)
+    counts["gcps"] = int(fit.used.sum())
+    counts["gcps_sharp"] = 0
+    warnings = [f"Control points from the area-based search (grid through the ECC affine, "
+                f"correlation {res.ecc:.2f}): their residuals do not measure the accuracy."]
+    if object_failure:
+        warnings.append(f"The object stage found no result: {object_failure}")
+    for w in warnings:
+        fb.warning(w)
+    fb.progress(85)
+    return {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps, "global": res.transform,
+            "joint": res.transform, "search": res.transform, "pairs": [],
+            "img_features": [], "ref_features": [], "crs": crs, "counts": counts, "icp": [],
+            "segmentation": {}, "reference": ref_info, "reference_kind": "vector",
+            "image_info": img_info, "grey": grey, "warnings": warnings,
+            "seconds": time.perf_counter() - t0, "stage": "area",
+            "area": {"ncc": res.ncc, "ecc": res.ecc, "mirrored": res.mirrored,
+                     "candidates": res.candidates},
+            "reference_rings": [o.ring for o in ref_objs],
+            "parameters": {**params, "pyramid_level": None}}
 
 
 def _fail(counts: Dict[str, Any], why: str) -> None:

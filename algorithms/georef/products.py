@@ -181,18 +181,21 @@ def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
     H, W = grey.shape
     fig, ax = plt.subplots(figsize=(8, 8 * H / max(W, 1)))
     ax.imshow(grey, cmap="gray", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
-    for h in result["pairs"]:
-        a = fi[h.i].obj.ring
-        b = _inverse_points(result, fr[h.j].obj.ring)
-        for ring, colour in ((a, "lime"), (b, "red")):
-            p = np.vstack([ring, ring[:1]])
-            ax.plot(p[:, 0], p[:, 1], "-", color=colour, lw=0.8)
+    outlines = [(fi[h.i].obj.ring, "lime") for h in result["pairs"]]
+    outlines += [(_inverse_points(result, fr[h.j].obj.ring), "red") for h in result["pairs"]]
+    # the area-based stage matched the whole map: all reference outlines
+    outlines += [(_inverse_points(result, r), "red") for r in result.get("reference_rings", [])]
+    for ring, colour in outlines:
+        p = np.vstack([ring, ring[:1]])
+        ax.plot(p[:, 0], p[:, 1], "-", color=colour, lw=0.8)
     g = np.array([p.image for p in result["gcps"]]) if result["gcps"] else np.zeros((0, 2))
     if len(g):
         ax.plot(g[:, 0], g[:, 1], "+", color="yellow", ms=4)
     ax.set_xlim(-0.5, W - 0.5)
     ax.set_ylim(H - 0.5, -0.5)
-    ax.set_title("matched objects: image (green), reference (red); control points (+)")
+    ax.set_title("reference polygons through the area-based transform (red); control points "
+                 "(+)" if result.get("stage") == "area" else
+                 "matched objects: image (green), reference (red); control points (+)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -218,7 +221,10 @@ def report_dict(result: Dict[str, Any]) -> Dict[str, Any]:
         "segmentation": result["segmentation"], "reference": result["reference"],
         "reference_kind": result["reference_kind"], "image": result["image_info"],
         "parameters": result["parameters"], "warnings": result["warnings"],
-        "extensions": ["smoothing before segmentation" if result["parameters"]["smooth"]
+        "stage": result.get("stage", "objects"),
+        "area_search": result.get("area"),
+        "extensions": ["area-based global search" if result.get("stage") == "area" else None,
+                       "smoothing before segmentation" if result["parameters"]["smooth"]
                        else None,
                        "merging of similar adjacent regions" if result["parameters"]["merge"]
                        else None,
@@ -261,6 +267,14 @@ def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, P
         for k, g in enumerate(rep["gcps"]))
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in rep["warnings"]) or "<li>none</li>"
     c = rep["counts"]
+    if rep["stage"] == "area":
+        source = (f"{c.get('gcps')} control points on a grid through the affine of the "
+                  f"area-based search (ECC correlation {c.get('area_ecc')}; "
+                  f"{c.get('reference_objects')} reference objects)")
+    else:
+        source = (f"{c.get('gcps')} control points from {c.get('verified_pairs')} verified "
+                  f"object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} "
+                  f"image and {c.get('reference_objects')} reference objects)")
     page = f"""<!doctype html><html><head><meta charset="utf-8">
 <title>Georeferencing {html.escape(name)}</title>
 <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 8px;text-align:right}}
@@ -268,9 +282,7 @@ table{{border-collapse:collapse}}tr:nth-child(even){{background:#eee}}</style></
 <h1>Georeferencing of {html.escape(name)}</h1>
 <p>Transform: <b>{rep['transform']['kind']}</b> into {html.escape(rep['transform']['crs'])}.
 RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
-{rep['pixel_size_m']:.3f} m); {c.get('gcps')} control points from {c.get('verified_pairs')}
-verified object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} image and
-{c.get('reference_objects')} reference objects).</p>
+{rep['pixel_size_m']:.3f} m); {source}.</p>
 <h2>Warnings</h2><ul>{warn}</ul>
 <img src="overlay.png" style="max-width:100%">
 <h2>Control points</h2>

@@ -195,18 +195,22 @@ def write_image(path: PathLike, img: NDArray[Any], transform: Any = None, crs: A
 
 
 def georef_case(folder: PathLike, seed: int = 0, width: int = 1000, height: int = 1000,
-                scene_seed: Optional[int] = None, noise: float = 2.0,
+                scene_seed: Optional[int] = None, noise: float = 2.0, texture: float = 1.0,
+                scale_range: Tuple[float, float] = (0.5, 2.0), shear: float = 0.15,
                 **scene_options: Any) -> Dict[str, Any]:
     """One synthetic case: map GeoPackage, image, truth transform (image → map, 3 × 3).
 
-    ``scene_options`` go to :func:`make_scene` (e.g. more polygons)."""
+    ``texture``: standard deviation (DN) of the smooth texture inside every object (large:
+    objects that are not homogeneous, as for the area-based search). ``scene_options`` go to
+    :func:`make_scene` (e.g. more polygons)."""
     folder = Path(folder)
     scene = make_scene(seed if scene_seed is None else scene_seed, **scene_options)
     rng = np.random.default_rng(seed)
     size = scene.extent[2] - scene.extent[0]
     gsd = size / (1.1 * max(width, height))  # scale 1: the map just covers the image
-    T = random_affine(rng, gsd, width, height, scene.extent, scale_range=(0.5, 2.0))
-    img = render(scene, T, width, height, seed=seed, noise=noise)
+    T = random_affine(rng, gsd, width, height, scene.extent, scale_range=scale_range,
+                      shear=shear)
+    img = render(scene, T, width, height, seed=seed, noise=noise, texture=texture)
     ref = write_scene(scene, folder / "map.gpkg")
     image = write_image(folder / "image.tif", img)
     return {"reference": str(ref), "image": str(image), "truth": T, "width": width,

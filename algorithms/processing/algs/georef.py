@@ -24,7 +24,9 @@ class GeoreferencePolygons(Algorithm):
         "class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are "
         "described by affine-invariant moment features, corresponding objects are found by a "
         "consistency search, verified, refined by ICP, and control points on their outlines "
-        "give the final transform (affine, projective or 2nd-order polynomial). Writes a QGIS "
+        "give the final transform (affine, projective or 2nd-order polynomial). When no "
+        "objects match (objects not homogeneous in the image), an area-based search compares "
+        "the whole image with the rasterised polygons instead. Writes a QGIS "
         "Georeferencer .points file, the control points as GeoPackage, the image resampled into "
         "the map CRS, a copy with the control points embedded and a report (overlay, "
         "residuals, RMSE in px and m). Too few matching objects give a failure message with "
@@ -59,6 +61,13 @@ class GeoreferencePolygons(Algorithm):
                   help="Relative difference allowed for each of the six invariants."),
         Parameter("max_depth", "integer", "Search depth [pairs]", default=6, minimum=2,
                   maximum=20),
+        Parameter("search", "enum", "Search", default="auto",
+                  options=("auto", "objects", "area"),
+                  help="objects: match image regions to the polygons as objects; area: "
+                       "compare the whole image with the rasterised polygons (rotation and "
+                       "scale by Fourier–Mellin, shift by correlation, refined by ECC) — for "
+                       "objects that are not homogeneous in the image; auto: objects, and the "
+                       "area-based search when they give no result. Polygon layers only."),
         Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
                   minimum=0.1, maximum=50.0, unit="px",
                   help="Control points are accepted (best first) while the RMS of their "
@@ -97,6 +106,7 @@ class GeoreferencePolygons(Algorithm):
             rd=float(params.get("relative_difference", 3.0)) / 100.0,
             max_depth=int(params.get("max_depth", 6)),
             sigma_np_px=float(params.get("sigma_np", 2.0)),
+            search=params.get("search") or "auto",
             feedback=StepFeedback(feedback, 0, 80))
         paths = write_outputs(output, params["image"], result,
                               feedback=StepFeedback(feedback, 80, 100), replace=True)
