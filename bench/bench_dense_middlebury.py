@@ -40,9 +40,9 @@ def _load():
 
 
 def _rss_mb() -> float:
-    import resource
+    from . import peak_mb
 
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
+    return peak_mb()
 
 
 def _worker(name: str) -> dict:

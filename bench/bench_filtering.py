@@ -21,7 +21,7 @@
     low-pass lowers it partly, ``flat`` and linear prediction by metres).
 (c) Speed: a synthetic 4000 × 4000 DSM (1 m; terrain, ~3000 buildings, forest patches, noise)
     filtered by each filter in a child process: seconds and peak resident memory
-    (``ru_maxrss`` of the child, so the peak is the filter's). Targets ≤ 60 s, ≤ 4 GB.
+    (VmHWM of the child, so the peak is the filter's). Targets ≤ 60 s, ≤ 4 GB.
 
 Filters that are not registered yet are reported as missing rows, not as errors.
 """
@@ -38,6 +38,8 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 import numpy as np
+
+from . import PEAK_MB_SOURCE
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("PHOTODEM_SHARED_DATA", ROOT.parent / "shared" / "data"))
@@ -320,14 +322,14 @@ def _synthetic(tmp: Path, have: set) -> Dict[str, Any]:
 
 # -- (c) speed and memory -------------------------------------------------------------------------
 
-CHILD = r"""
-import json, resource, sys, time
+CHILD = PEAK_MB_SOURCE + r"""
+import json, sys, time
 from photodem.algorithms.processing import registry
 t = time.perf_counter()
 res = registry.run(sys.argv[1], {"input": sys.argv[2], "output": sys.argv[3],
                                  "preset": "default"})
 dt = time.perf_counter() - t
-rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+rss = peak_mb()
 print(json.dumps({"time_s": dt, "peak_mb": rss}))
 """
 
@@ -384,7 +386,7 @@ def _speed(tmp: Path, have: set) -> Dict[str, Any]:
                      "peak_mb": round(m["peak_mb"]),
                      "meets_speed": m["time_s"] <= SPEED_TARGETS["seconds"]
                      and m["peak_mb"] <= SPEED_TARGETS["peak_mb"]})
-    notes = [f"speed: one child process per filter (peak = its ru_maxrss incl. Python, numpy, "
+    notes = [f"speed: one child process per filter (peak = its VmHWM incl. Python, numpy, "
              f"GDAL); {os.cpu_count()} CPU(s); targets ≤ {SPEED_TARGETS['seconds']:.0f} s, "
              f"≤ {SPEED_TARGETS['peak_mb'] / 1024:.0f} GB"]
     return {"rows": rows, "notes": notes}

@@ -2,8 +2,8 @@
 
 The ``large`` block (2 strips × 4 images of 2400 × 3400 px, GSD 0.12 m) is generated once;
 model 0101_0102 is then matched by ``match_model`` with each method in its own child process,
-so that the peak memory (``ru_maxrss`` of the child: Python, numpy, GDAL and OpenCV included)
-is the matcher's own. Throughput = left epipolar image pixels / wall time of the whole
+so that the peak memory (VmHWM of the child: Python, numpy, GDAL and OpenCV included) is
+the matcher's own. Throughput = left epipolar image pixels / wall time of the whole
 algorithm (epipolar resampling, matching, gridding, outputs).
 """
 
@@ -18,14 +18,16 @@ import time
 from pathlib import Path
 from typing import Any, Dict
 
-CHILD = r"""
-import json, resource, sys, time
+from . import PEAK_MB_SOURCE
+
+CHILD = PEAK_MB_SOURCE + r"""
+import json, sys, time
 from photodem.algorithms.processing import registry
 t = time.perf_counter()
 res = registry.run("match_model", {"project": sys.argv[1], "model": sys.argv[2],
                                    "method": sys.argv[3], "output": sys.argv[4]})
 dt = time.perf_counter() - t
-rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+rss = peak_mb()
 print(json.dumps({"time_s": dt, "peak_mb": rss, "metrics": res.get("metrics", {})}))
 """
 
@@ -70,5 +72,5 @@ def run() -> dict:
     return {"title": "Matching a large synthetic model: time, throughput, peak memory",
             "rows": rows,
             "notes": [f"block generation (8 images, truth grids): {t_gen:.0f} s, not counted",
-                      "peak_mb = ru_maxrss of the child process running match_model "
+                      "peak_mb = VmHWM of the child process running match_model "
                       "(includes Python, numpy, GDAL, OpenCV); 2 CPU cores"]}

@@ -27,6 +27,8 @@ from typing import Any, Dict, List
 
 import numpy as np
 
+from . import PEAK_MB_SOURCE
+
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "ngi_aerial_block"
 
 
@@ -303,13 +305,13 @@ def _synthetic_mosaic(project: Path, tmp: Path) -> List[Dict[str, Any]]:
 
 
 # -- memory ----------------------------------------------------------------------------------
-CHILD = r"""
-import json, resource, sys, time
+CHILD = PEAK_MB_SOURCE + r"""
+import json, sys, time
 from photodem.algorithms.processing import registry
 t = time.perf_counter()
 res = registry.run("mosaic", {"inputs": sys.argv[1].split(","), "output": sys.argv[2]})
 dt = time.perf_counter() - t
-rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+rss = peak_mb()
 print(json.dumps({"time_s": dt, "peak_mb": rss}))
 """
 

@@ -2,7 +2,7 @@
 
 A reference (smooth terrain, float32, tiled GeoTIFF written by windows) and a DEM (the same plus
 a tilt, noise and blunders) of N × N cells are compared in a child process, so that its peak
-resident memory (``ru_maxrss``) is the comparison's alone. 4000 × 4000 runs always; 10000 × 10000
+resident memory (VmHWM) is the comparison's alone. 4000 × 4000 runs always; 10000 × 10000
 only with ``PHOTODEM_BENCH_LARGE=1`` (about 0.8 GB of temporary files), else it is estimated.
 """
 
@@ -17,14 +17,16 @@ from pathlib import Path
 
 import numpy as np
 
-CHILD = r"""
-import json, resource, sys, time
+from . import PEAK_MB_SOURCE
+
+CHILD = PEAK_MB_SOURCE + r"""
+import json, sys, time
 from photodem.algorithms.quality.compare import compare_dems
 t = time.perf_counter()
 out = compare_dems(sys.argv[1], sys.argv[2], difference_path=sys.argv[3],
                    coregister=sys.argv[4] == "1")
 dt = time.perf_counter() - t
-rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+rss = peak_mb()
 print(json.dumps({"time_s": dt, "peak_mb": rss, "count": out["stats"]["count"],
                   "mean": out["stats"]["mean"], "nmad": out["stats"]["nmad"],
                   "exact": out["precision"]["exact"], "shift": out["shift"]}))
@@ -74,7 +76,7 @@ def run() -> dict:
     rows = [_measure(4000)]
     notes = [
         "compare_dems with default window_size=1024 and memory_budget=512 MiB, difference raster "
-        "written; peak = ru_maxrss of the child process (includes Python, numpy, GDAL caches).",
+        "written; peak = VmHWM of the child process (includes Python, numpy, GDAL caches).",
         "Values kept for exact quantiles: 8 bytes × cells × 3 (overall, per class, per slope); "
         "above the budget the 0.5 mm sparse histograms take over, so memory no longer grows "
         "with the raster size.",
