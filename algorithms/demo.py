@@ -194,9 +194,9 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
         "dem": merged["dsm"],
         "reference": block["truth_dsm"], "classes": block["truth_landcover"],
         "flying_height": height, "output": str(out / "compare_dsm")})
-    n_forest = _forest_exclusions(project, block["truth_landcover"])
-    feedback.info(f"Filtering the merged DSM to a DTM ({n_forest} forest exclusion area(s) "
-                  "drawn as an operator would) …")
+    n_areas = _operator_exclusions(project, block["truth_landcover"])
+    feedback.info(f"Filtering the merged DSM to a DTM ({n_areas} exclusion area(s), forest and "
+                  "embankment, drawn as an operator would) …")
     dtm = registry.run("filter_lowpass", {"input": str(out / "dsm_merged.tif"),
                                           "output": str(out / "dtm"),
                                           "project": str(project.root)})
@@ -229,12 +229,13 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
     }
 
 
-def _forest_exclusions(project: Project, landcover: str, min_area: float = 400.0) -> int:
-    """Add the closed forest as a ``remove`` exclusion area to the project's edits.
+def _operator_exclusions(project: Project, landcover: str, min_area: float = 400.0) -> int:
+    """Add the exclusion areas an operator draws before filtering to the project's edits.
 
-    What an operator draws before filtering: no filter bridges a forest of tens of metres by
-    itself (seed-002-003 A3.8: exclusion areas are part of the method). Drawn here from the
-    truth land cover (single trees dropped by an opening).
+    The closed forest as ``remove`` (no filter bridges a forest of tens of metres by itself)
+    and the embankment as ``keep`` (a dam is terrain that every filter takes for an object;
+    seed-002-003 A3.8: exclusion areas are part of the method). Drawn here from the truth land
+    cover (single trees dropped by an opening).
     """
     import rasterio
     from rasterio.features import shapes
@@ -242,21 +243,24 @@ def _forest_exclusions(project: Project, landcover: str, min_area: float = 400.0
     from shapely.geometry import shape
 
     from .project.edits import add_features
-    from .synthetic.objects import TREE
+    from .synthetic.objects import EMBANKMENT, TREE
 
     with rasterio.open(landcover) as src:
         lc = src.read(1)
         transform = src.transform
-    forest = ndimage.binary_opening(lc == TREE, iterations=3)
-    # the matched DSM rounds the forest edge off over a few metres: a margin of 5 m
-    geoms = [shape(g).buffer(5.0).simplify(0.5)
-             for g, v in shapes(forest.astype(np.uint8), mask=forest, transform=transform)
-             if v == 1 and shape(g).area >= min_area]
-    if geoms:
-        add_features(project.edits_path, "exclusion_areas",
-                     [(g, {"action": "remove", "note": "forest (demo: drawn from land cover)"})
-                      for g in geoms])
-    return len(geoms)
+    # the matched DSM rounds the forest edge off over a few metres: a margin of 5 m; the
+    # embankment's toe gets 1 m
+    kinds = ((ndimage.binary_opening(lc == TREE, iterations=3), 5.0, "remove",
+              "forest (demo: drawn from land cover)"),
+             (lc == EMBANKMENT, 1.0, "keep", "embankment (demo: drawn from land cover)"))
+    features = []
+    for mask, margin, action, note in kinds:
+        features += [(shape(g).buffer(margin).simplify(0.5), {"action": action, "note": note})
+                     for g, v in shapes(mask.astype(np.uint8), mask=mask, transform=transform)
+                     if v == 1 and shape(g).area >= min_area]
+    if features:
+        add_features(project.edits_path, "exclusion_areas", features)
+    return len(features)
 
 
 def _georef(out: Path, seed: int, feedback: Feedback) -> Dict[str, Any]:

@@ -644,7 +644,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
     ground_vals[keep_known] = dsm[keep_known]
     known |= keep_known
     # DSM nodata reaching the raster border stays nodata (no extrapolation into nothing)
-    outside = _border_nodata(valid | remove | keep)
+    outside = _border_nodata(valid)  # also where an exclusion area reaches beyond the data
     free_known = known & ~gp_cells
     disagree: List[Dict[str, Any]] = []
     tol = float(params.get("ground_tolerance_m", 0.5))

@@ -152,6 +152,12 @@ def test_embankment_removed_without_keep_area_and_kept_with_it() -> None:
     err = res["dtm"] - truth
     assert np.abs(err).max() < 0.05
     assert not res["ground"][20:32, 110:124].any()
+    # an exclusion area drawn beyond the DSM's edge does not extend the DTM into nothing
+    cut = dsm.copy()
+    cut[:, 100:] = np.nan
+    res = lowpass_filter(cut, 1.0, par, cons, _grid())
+    assert np.isnan(res["dtm"][:, 104:]).all()
+    assert (res["dtm"][:, :100][keep[:, :100]] == dsm[:, :100][keep[:, :100]]).all()
 
 
 def test_remove_area_is_bridged() -> None:
