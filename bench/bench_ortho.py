@@ -52,8 +52,10 @@ def _ngi_project(folder: Path) -> Path:
 def _ours(project: Path, names: List[str], dem: Path, folder: Path, gsd: float
           ) -> Dict[str, Path]:
     from photodem.algorithms.ortho.rectify import orthorectify_image
+    from photodem.algorithms.project.model import Project
 
     out = {}
+    project = Project.load(project)  # once, as orthority's cameras below
     for name in names:
         out[name] = folder / f"{name}.tif"
         orthorectify_image(project, name, dem, out[name], gsd=gsd, resampling="bilinear")
