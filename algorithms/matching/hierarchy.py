@@ -307,6 +307,22 @@ def _eval_planes(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, 
     return out
 
 
+def _point_neighbours(edges: NDArray, g: NDArray) -> Tuple[NDArray, NDArray, NDArray]:
+    """Every point's neighbour groups along ``edges`` (group → group).
+
+    Returns ``(point, neighbour, count)``: one (point index, neighbour group) pair per edge
+    leaving the point's group ``g`` (none for ``g < 0``), and the number of pairs per point.
+    """
+    order = np.argsort(edges[:, 0], kind="stable")
+    src, dst = edges[order, 0], edges[order, 1]
+    start = np.searchsorted(src, g, side="left")
+    stop = np.searchsorted(src, g, side="right")
+    cnt = np.where(g >= 0, stop - start, 0)
+    pi = np.repeat(np.arange(g.size), cnt)
+    first = np.cumsum(cnt) - cnt
+    return pi, dst[start[pi] + (np.arange(pi.size) - first[pi])], cnt
+
+
 def _plane_range(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
                  ) -> Tuple[NDArray, NDArray]:
     """Lowest and highest disparity of a group's own plane and its neighbours' planes at
@@ -317,16 +333,9 @@ def _plane_range(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, 
     e = grouping.edges
     if e.size == 0 or g.size == 0:
         return lo, hi
-    order = np.argsort(e[:, 0], kind="stable")
-    src, dst = e[order, 0], e[order, 1]
-    start = np.searchsorted(src, g, side="left")
-    stop = np.searchsorted(src, g, side="right")
-    cnt = np.where(g >= 0, stop - start, 0)
+    pi, nb, cnt = _point_neighbours(e, g)
     if cnt.sum() == 0:
         return lo, hi
-    pi = np.repeat(np.arange(g.size), cnt)
-    first = np.cumsum(cnt) - cnt
-    nb = dst[start[pi] + (np.arange(pi.size) - first[pi])]
     val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
     ok = np.isfinite(val)
     np.fmin.at(lo, pi[ok], val[ok])
@@ -344,16 +353,9 @@ def _neighbour_prediction(plane: NDArray, grouping: Grouping, matched: NDArray, 
     e = e[matched[e[:, 1]]]
     if e.size == 0:
         return out
-    order = np.argsort(e[:, 0], kind="stable")
-    src, dst = e[order, 0], e[order, 1]
-    start = np.searchsorted(src, g, side="left")
-    stop = np.searchsorted(src, g, side="right")
-    cnt = np.where(g >= 0, stop - start, 0)
+    pi, nb, cnt = _point_neighbours(e, g)
     if cnt.sum() == 0:
         return out
-    pi = np.repeat(np.arange(g.size), cnt)
-    first = np.cumsum(cnt) - cnt
-    nb = dst[start[pi] + (np.arange(pi.size) - first[pi])]
     val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
     s = np.bincount(pi, val, g.size)
     has = cnt > 0
