@@ -272,8 +272,9 @@ def iter_disparity_tiles(
         """Disparities of the tile core rows r0:r1, cols c0:c1 searched in lo..hi."""
         R0, R1 = r0 - margin, r1 + margin
         C0, C1 = c0 - margin, c1 + margin
-        lcore = left(r0, r1, c0, c1)
-        if not np.isfinite(lcore).any():  # nothing to match (outside the image, masked)
+        lwin = left(R0, R1, C0, C1)
+        if not np.isfinite(lwin[margin:margin + r1 - r0, margin:margin + c1 - c0]).any():
+            # nothing to match in the core (outside the image, masked)
             return np.full((r1 - r0, c1 - c0), np.nan, np.float32)
         n_d = _num_disparities(lo, hi)
         # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the
@@ -285,7 +286,7 @@ def iter_disparity_tiles(
         f0 = C0 - max(hi, 0) - (n_d + block)
         f1 = max(C1, C1 - lo) + 1
         lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
-        lg[:, C0 - f0:C1 - f0] = left(R0, R1, C0, C1)
+        lg[:, C0 - f0:C1 - f0] = lwin
         rg = right(R0, R1, f0, f1)
         disp = _match_frame(cv2, matcher, lg, rg, lo, hi, n_d, ours, block, lr_max_diff,
                             normalise_window, speckle_window, int(speckle_range),

@@ -56,9 +56,14 @@ def atomic_output(path: PathLike) -> Iterator[Path]:
         yield tmp
         os.replace(tmp, path)
     finally:
-        for leftover in (tmp, Path(str(tmp) + ".aux.xml"), Path(str(tmp) + ".ovr")):
-            if leftover.exists():
-                leftover.unlink()
+        _remove_with_sidecars(tmp)
+
+
+def _remove_with_sidecars(path: Path) -> None:
+    """Delete a raster file and the sidecars GDAL may have put beside it."""
+    for leftover in (path, Path(str(path) + ".aux.xml"), Path(str(path) + ".ovr")):
+        if leftover.exists():
+            leftover.unlink()
 
 
 #: Creation options that carry over from a product's profile to its Cloud-Optimised copy.
@@ -90,10 +95,7 @@ def cog_output(path: PathLike, profile: Dict[str, Any]
 
             copy(str(scratch), str(final), driver="GTiff", copy_src_overviews=True, **creation)
         finally:
-            for leftover in (scratch, Path(str(scratch) + ".aux.xml"),
-                             Path(str(scratch) + ".ovr")):
-                if leftover.exists():
-                    leftover.unlink()
+            _remove_with_sidecars(scratch)
 
 
 #: Marker file in every folder a PhotoDEM algorithm wrote; only such folders are ever replaced.
