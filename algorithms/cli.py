@@ -327,7 +327,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps(plan.to_dict(), indent=2, default=str))
         else:
-            state = batch_mod._read_state(plan.project) if args.resume else {}
+            state = batch_mod._read_state(plan.state_home) if args.resume else {}
             print(f"project: {plan.project}\nrun folder: {plan.run_dir}\n"
                   f"workers: {plan.workers}")
             for t in plan.tasks:

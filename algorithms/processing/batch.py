@@ -14,14 +14,28 @@ A batch file is TOML::
     [steps.params]
     output = "{project}/products/{step}/{model}"
 
+    [[steps]]                        # a list of image files (no project needed for these)
+    algorithm = "georeference_polygons"
+    files = ["scenes/*.tif", "extra/LE7_0412.tif"]   # glob patterns or paths
+    [steps.params]
+    reference = "maps/forest.gpkg"
+    output = "{run}/{step}/{file}"
+
 Semantics (kept simple on purpose):
 
 - **Tasks.** A step whose algorithm declares ``iterates_over`` (the name of its ``model`` or
   ``image`` parameter) becomes one task per chosen model/image, with that parameter set; other
   steps are one task. A ``project`` parameter that the step does not set gets the batch project.
+- **File lists.** When ``iterates_over`` names a raster or file parameter, the step's ``files``
+  (glob patterns or paths, relative to the batch file, sorted) give one task per file. Their
+  names (``{file}``, the file name without suffix) must be unique. A batch of such steps needs
+  no project: its run folder is then ``runs/<timestamp>/`` and its resume state
+  ``.photodem/batch-state.json`` beside the batch file.
+- **Paths.** Relative paths in path parameters (inputs and outputs) are relative to the
+  batch file's folder, like the paths in ``[batch]``.
 - **Placeholders** in parameter strings: ``{project}`` (project folder), ``{run}`` (run folder),
-  ``{step}`` (step name), ``{model}`` / ``{image}`` (the task's item). Other braces stay as they
-  are.
+  ``{step}`` (step name), ``{model}`` / ``{image}`` / ``{file}`` (the task's item). Other braces
+  stay as they are.
 - **Order.** Steps run one after the other; the tasks of one step run in parallel on ``workers``
   processes (``spawn`` context; ``workers = 1`` runs them in this process). Every task calls
   :func:`.registry.run`, so its result is the same as from Python, the CLI or QGIS.
@@ -63,6 +77,7 @@ from ..errors import Cancelled, InputError, PhotodemError
 from ..project import toml_io
 from . import registry
 from .feedback import Feedback, ensure_feedback
+from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
@@ -70,9 +85,11 @@ STATE_FILE = Path(".photodem") / "batch-state.json"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
 _FILE_OUTPUT_KINDS = ("file", "folder", "raster", "vector")
-_PLACEHOLDER = re.compile(r"\{(project|run|step|model|image)\}")
+_PLACEHOLDER = re.compile(r"\{(project|run|step|model|image|file)\}")
 _BATCH_KEYS = {"project", "workers", "output"}
-_STEP_KEYS = {"algorithm", "name", "models", "images", "params"}
+_STEP_KEYS = {"algorithm", "name", "models", "images", "files", "params"}
+#: Parameter kinds whose values are files: a step over them iterates over ``files``.
+_FILE_ITEM_KINDS = ("raster", "file")
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -85,15 +102,22 @@ class Task:
     index: int
     step: str
     algorithm: str
-    item: Optional[str]  # the model or image name of an iterating step
-    item_kind: Optional[str]  # "model" or "image"
+    item: Optional[str]  # the model or image name (or the file path) of an iterating step
+    item_kind: Optional[str]  # "model", "image" or "file"
     params: Dict[str, Any]  # raw values, placeholders substituted
     log: Path
 
     @property
+    def name(self) -> Optional[str]:
+        """The item's name: a model or image name, or a file's name without suffix."""
+        if self.item is None or self.item_kind != "file":
+            return self.item
+        return Path(self.item).stem
+
+    @property
     def key(self) -> str:
         """Identity of the task across runs: ``step`` or ``step/item``."""
-        return self.step if self.item is None else f"{self.step}/{self.item}"
+        return self.step if self.item is None else f"{self.step}/{self.name}"
 
     @property
     def params_hash(self) -> str:
@@ -106,17 +130,23 @@ class Task:
 class BatchPlan:
     """A parsed batch file: the project, the run folder, the steps and their tasks."""
 
-    project: Path
+    project: Optional[Path]  # None: a batch over files only
     run_dir: Path
     workers: int
     steps: List[str]
     tasks: List[Task] = field(default_factory=list)
     file: Optional[Path] = None
+    state_root: Optional[Path] = None  # holds .photodem/batch-state.json; default: project
+
+    @property
+    def state_home(self) -> Path:
+        """The folder of the resume state: the project, or the batch file's folder."""
+        return Path(self.state_root or self.project or ".")
 
     def to_dict(self) -> Dict[str, Any]:
         return {
             "file": str(self.file) if self.file else None,
-            "project": str(self.project),
+            "project": str(self.project) if self.project else None,
             "run": str(self.run_dir),
             "workers": self.workers,
             "steps": list(self.steps),
@@ -163,11 +193,13 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
                          "expected [batch] and [[steps]].")
     head = dict(config.get("batch", {}))
     _check_keys(head, _BATCH_KEYS, "[batch]")
-    if "project" not in head:
-        raise InputError("Batch file: [batch] needs project = \"<project folder>\".")
-    project_dir = (Path(base_dir) / Path(str(head["project"])).expanduser()).resolve()
-    project = Project.load(project_dir)
-    project_dir = project.root.resolve()
+    project: Any = None
+    project_dir: Optional[Path] = None
+    if "project" in head:
+        project_dir = (Path(base_dir) / Path(str(head["project"])).expanduser()).resolve()
+        project = Project.load(project_dir)
+        project_dir = project.root.resolve()
+    home = project_dir or Path(base_dir).resolve()
     try:
         workers = int(head.get("workers", 1))
     except (TypeError, ValueError):
@@ -177,21 +209,23 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
                          "number ≥ 1.")
     if run_dir is None:
         if head.get("output"):
-            text = _PLACEHOLDER.sub(lambda m: str(project_dir) if m.group(1) == "project"
-                                    else m.group(0), str(head["output"]))
+            text = _substitute(str(head["output"]),
+                               {"project": str(project_dir)} if project_dir else {},
+                               "[batch] output", keep_others=True)
             run_dir = Path(base_dir) / Path(text).expanduser()
         else:
-            run_dir = _timestamped(project_dir / "runs", now)
+            run_dir = _timestamped(home / "runs", now)
     run = Path(run_dir).resolve()
 
     steps = config.get("steps", [])
     if not isinstance(steps, list) or not steps:
         raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
-    plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[])
+    plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
+                     state_root=home)
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, dict):
             raise InputError(f"Batch file: step {number} is not a table.")
-        _plan_step(plan, project, step, number)
+        _plan_step(plan, project, step, number, Path(base_dir))
     return plan
 
 
@@ -210,7 +244,8 @@ def _timestamped(parent: Path, now: Optional[_dt.datetime]) -> Path:
     return candidate
 
 
-def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int) -> None:
+def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
+               base_dir: Path) -> None:
     _check_keys(step, _STEP_KEYS, f"step {number}")
     if "algorithm" not in step:
         raise InputError(f"Batch file: step {number} needs algorithm = \"id\".")
@@ -228,23 +263,34 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int)
     params = dict(params)
     for p in alg.parameters:  # the batch project unless the step names another one
         if p.kind == "project" and p.name not in params:
-            params[p.name] = "{project}"
+            if project is None and p.required:
+                raise InputError(f"Batch file: step '{name}' ({alg.id}) needs a project; set "
+                                 "project = \"<project folder>\" in [batch].")
+            if project is not None:
+                params[p.name] = "{project}"
 
     iterate = alg.iterates_over
     item_kind: Optional[str] = None
     if iterate is not None:
         item_kind = alg.parameter(iterate).kind
-        if item_kind not in ("model", "image"):
-            raise InputError(f"{alg.id}: iterates_over names '{iterate}', which is neither a "
-                             "model nor an image parameter.")
-    for key in ("models", "images"):
+        if item_kind in _FILE_ITEM_KINDS:
+            item_kind = "file"
+        elif item_kind not in ("model", "image"):
+            raise InputError(f"{alg.id}: iterates_over names '{iterate}', which is not a "
+                             "model, image, raster or file parameter.")
+    for key in ("models", "images", "files"):
         if key in step and (item_kind is None or key != item_kind + "s"):
             raise InputError(
                 f"Batch file: step '{name}' sets {key}, but {alg.id} "
                 + ("does not iterate." if item_kind is None else f"iterates over {item_kind}s.")
             )
     items: List[Optional[str]] = [None]
-    if item_kind is not None and iterate not in params:
+    if item_kind == "file" and iterate not in params:
+        items = _step_files(step.get("files"), base_dir, name, iterate)  # type: ignore[arg-type]
+    elif item_kind is not None and iterate not in params:
+        if project is None:
+            raise InputError(f"Batch file: step '{name}' runs over the project's "
+                             f"{item_kind}s; set project = \"<project folder>\" in [batch].")
         available = ([m.name for m in project.models] if item_kind == "model"
                      else [i.name for i in project.images])
         chosen = step.get(item_kind + "s", "all")
@@ -265,33 +311,94 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int)
             raise InputError(f"Batch file: step '{name}': the project has no {item_kind}s.")
 
     for item in items:
-        values = {"project": str(plan.project), "run": str(plan.run_dir), "step": name}
+        values = {"run": str(plan.run_dir), "step": name}
+        if plan.project is not None:
+            values["project"] = str(plan.project)
         if item is not None:
-            values[item_kind] = item  # type: ignore[index]
-        task_params = {k: _substitute(v, values, name) for k, v in params.items()}
+            values[item_kind] = Path(item).stem if item_kind == "file" else item  # type: ignore
+        task_params = {k: _anchored(alg, k, _substitute(v, values, name), base_dir)
+                       for k, v in params.items()}
         if item is not None:
             task_params[iterate] = item  # type: ignore[index]
-        log = plan.run_dir / (f"{name}.log" if item is None else f"{name}/{_safe(item)}.log")
-        plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
-                               item_kind=item_kind, params=task_params, log=log))
+        task = Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
+                    item_kind=item_kind, params=task_params, log=plan.run_dir)
+        task.log = plan.run_dir / (f"{name}.log" if item is None
+                                   else f"{name}/{_safe(str(task.name))}.log")
+        plan.tasks.append(task)
+
+
+def _anchored(alg: Any, name: str, value: Any, base_dir: Path) -> Any:
+    """A relative path of a path parameter, taken relative to the batch file's folder."""
+    try:
+        kind = alg.parameter(name).kind
+    except KeyError:  # an unknown parameter: the algorithm's own check reports it
+        return value
+    if kind not in (*INPUT_PATH_KINDS, *OUTPUT_KINDS, "multiple_rasters"):
+        return value
+    if isinstance(value, list):
+        return [_anchored(alg, name, v, base_dir) for v in value]
+    if not isinstance(value, str) or not value or Path(value).expanduser().is_absolute():
+        return value
+    return str(base_dir.resolve() / Path(value).expanduser())
+
+
+def _step_files(spec: Union[str, List[Any], None], base_dir: Path, step: str,
+                parameter: str) -> List[str]:
+    """The files of a step: glob patterns or paths relative to the batch file, sorted."""
+    if spec is None:
+        raise InputError(f"Batch file: step '{step}' needs files = [\"<pattern or path>\", …] "
+                         f"(the values of its parameter '{parameter}').")
+    patterns = [spec] if isinstance(spec, str) else spec
+    if not isinstance(patterns, list) or not patterns:
+        raise InputError(f"Batch file: step '{step}': files must be a pattern or a list of "
+                         "patterns/paths.")
+    found: List[Path] = []
+    for pattern in patterns:
+        text = str(Path(str(pattern)).expanduser())
+        path = Path(text) if Path(text).is_absolute() else base_dir / text
+        if any(c in text for c in "*?["):
+            anchor = Path(path.anchor) if path.is_absolute() else Path(".")
+            matches = sorted(p for p in anchor.glob(str(path.relative_to(anchor)))
+                             if p.is_file())
+            if not matches:
+                raise InputError(f"Batch file: step '{step}': no file matches '{pattern}'.")
+            found += matches
+        elif path.is_file():
+            found.append(path)
+        else:
+            raise InputError(f"Batch file: step '{step}': file '{pattern}' does not exist.")
+    files = list(dict.fromkeys(p.resolve() for p in found))  # once each, in order
+    stems: Dict[str, Path] = {}
+    for f in files:
+        if f.stem in stems:
+            raise InputError(f"Batch file: step '{step}': '{stems[f.stem]}' and '{f}' have the "
+                             "same name; {file} must name one file (rename one).")
+        stems[f.stem] = f
+    return [str(f) for f in files]
 
 
 def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
 
 
-def _substitute(value: Any, values: Dict[str, str], step: str) -> Any:
+def _substitute(value: Any, values: Dict[str, str], step: str, keep_others: bool = False
+                ) -> Any:
     if isinstance(value, list):
-        return [_substitute(v, values, step) for v in value]
+        return [_substitute(v, values, step, keep_others) for v in value]
     if not isinstance(value, str):
         return value
 
     def repl(match: re.Match) -> str:
         key = match.group(1)
-        if key not in values:
-            raise InputError(f"Batch file: step '{step}' uses {{{key}}}, but it does not run "
-                             f"per {key}.")
-        return values[key]
+        if key in values:
+            return values[key]
+        if keep_others:
+            return match.group(0)
+        if key == "project":
+            raise InputError(f"Batch file: step '{step}' uses {{project}}, but the batch has "
+                             "no project (set project = \"…\" in [batch]).")
+        raise InputError(f"Batch file: step '{step}' uses {{{key}}}, but it does not run "
+                         f"per {key}.")
 
     return _PLACEHOLDER.sub(repl, value)
 
@@ -483,7 +590,7 @@ def run_batch(
     plan.run_dir.mkdir(parents=True, exist_ok=True)
     started = _dt.datetime.now().isoformat(timespec="seconds")
     t0 = time.perf_counter()
-    state = _read_state(plan.project) if resume else {}
+    state = _read_state(plan.state_home) if resume else {}
     records: List[Dict[str, Any]] = [
         {"step": t.step, "algorithm": t.algorithm, "item": t.item, "status": "cancelled",
          "outputs": {}, "duration_s": 0.0, "error": None, "log": str(t.log),
@@ -507,11 +614,11 @@ def run_batch(
             progress.set(task.index, 100.0)
         label = task.key
         if record["status"] == "done":
-            state_all = _read_state(plan.project)
+            state_all = _read_state(plan.state_home)
             state_all[task.key] = {"hash": task.params_hash, "algorithm": task.algorithm,
                                    "outputs": record["outputs"], "run": str(plan.run_dir),
                                    "finished": _dt.datetime.now().isoformat(timespec="seconds")}
-            _write_state(plan.project, state_all)
+            _write_state(plan.state_home, state_all)
             log(f"{label}: done in {record['duration_s']:.1f} s")
         elif record["status"] == "failed":
             log(f"{label}: FAILED: {record['error']}", warning=True)
@@ -532,7 +639,7 @@ def run_batch(
                 if task.item is not None and blocker is not None:
                     finish(task, {"status": "failed", "duration_s": 0.0, "outputs": {},
                                   "error": f"not run because step '{blocker}' failed for "
-                                           f"{task.item_kind} '{task.item}'"})
+                                           f"{task.item_kind} '{task.name}'"})
                     continue
                 outputs = _resumable(task, state) if resume else None
                 if outputs is not None:
@@ -565,7 +672,7 @@ def run_batch(
             status = "done"
         summary = {
             "file": str(plan.file) if plan.file else None,
-            "project": str(plan.project),
+            "project": str(plan.project) if plan.project else None,
             "run": str(plan.run_dir),
             "status": status,
             "started": started,
@@ -678,7 +785,7 @@ def batch_template(project: PathLike) -> str:
     """
     lines = [
         "# PhotoDEM batch file: run with  photodem batch THIS_FILE.toml",
-        "# Placeholders in parameter values: {project} {run} {step} {model} {image}",
+        "# Placeholders in parameter values: {project} {run} {step} {model} {image} {file}",
         "",
         "[batch]",
         f"project = {_toml_string(str(project))}",

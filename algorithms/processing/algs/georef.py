@@ -17,6 +17,7 @@ class GeoreferencePolygons(Algorithm):
     name = "Georeference image against polygons"
     group = GROUP
     group_id = GROUP_ID
+    iterates_over = "image"  # batch files: one task per image file (files = [...])
     help = (
         "Finds the georeference of an image without approximate values (position, scale, "
         "rotation and mirroring unknown) by matching area objects: the image is segmented by "

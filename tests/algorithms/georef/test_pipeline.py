@@ -139,3 +139,36 @@ def test_other_transforms_write_an_aligned_image(case, tmp_path, kind) -> None:
                 if a:
                     dark.append(v < 90)
     assert dark and all(dark)
+
+
+def test_batch_over_image_files_flags_failures_and_goes_on(case, tmp_path) -> None:
+    """``photodem batch`` over a list of images against one reference (no project)."""
+    import json
+    import shutil
+
+    from photodem.algorithms.cli import main
+
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    shutil.copy(case["image"], scenes / "a_scene.tif")
+    with rasterio.open(case["image"]) as src:  # a blank image: nothing to match
+        profile = src.profile
+    with rasterio.open(scenes / "blank.tif", "w", **profile) as dst:
+        dst.write(np.full((profile["count"], profile["height"], profile["width"]), 120,
+                          np.uint8))
+    batch_file = tmp_path / "georef.toml"
+    batch_file.write_text(
+        '[batch]\nworkers = 1\noutput = "runs/one"\n\n[[steps]]\n'
+        'algorithm = "georeference_polygons"\nname = "georef"\nfiles = "scenes/*.tif"\n'
+        f'[steps.params]\nreference = "{case["reference"]}"\nsearch = "objects"\n'
+        'output = "products/{file}"\n', encoding="utf-8")
+    assert main(["batch", str(batch_file)]) == 1  # one image failed: exit 1, the other ran
+    summary = json.loads((tmp_path / "runs" / "one" / "summary.json").read_text())
+    status = {Path(t["item"]).stem: t for t in summary["tasks"]}
+    assert status["a_scene"]["status"] == "done"
+    assert status["blank"]["status"] == "failed"
+    assert "Georeferencing failed" in status["blank"]["error"]
+    assert (tmp_path / "products" / "a_scene" / "a_scene.points").is_file()
+    assert not (tmp_path / "products" / "blank").exists()
+    report = json.loads((tmp_path / "products" / "a_scene" / "report.json").read_text())
+    assert report["rmse_px"] < 0.5

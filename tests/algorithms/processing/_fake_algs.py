@@ -125,7 +125,31 @@ class Chatty(Algorithm):
                            "input": params["input"]}}
 
 
-ALGORITHMS = [SleepWrite, FailOn, Crash, Chatty]
+class FileSize(Algorithm):
+    """Runs over image files: writes the file's size; fails on files named ``bad*``."""
+
+    id = "fake_file_size"
+    name = "Fake: file size"
+    group = "Testing"
+    group_id = "testing"
+    help = "Writes the size of `image`; an InputError for files whose name starts with bad."
+    iterates_over = "image"
+    parameters = (
+        Parameter("image", "raster", "Image"),
+        Parameter("output", "output_file", "Output"),
+    )
+    outputs = (Output("output", "file", "The file"),)
+
+    def run(self, params, feedback):
+        image = Path(params["image"])
+        if image.name.startswith("bad"):
+            raise InputError(f"{image.name} is not an image")
+        with atomic_output(params["output"]) as tmp:
+            Path(tmp).write_text(str(image.stat().st_size))
+        return {"output": params["output"]}
+
+
+ALGORITHMS = [SleepWrite, FailOn, Crash, Chatty, FileSize]
 
 
 def install(monkeypatch) -> None:

@@ -174,3 +174,78 @@ def test_template_is_a_valid_batch_file(fake_algs, project_dir):
     assert config["steps"]
     for step in config["steps"]:
         assert step["algorithm"]
+
+
+# -- batches over image files (no project) -------------------------------------------------------
+def _scenes(root):
+    (root / "scenes").mkdir(parents=True)
+    for name in ("s2", "s1", "bad3"):
+        (root / "scenes" / f"{name}.tif").write_bytes(b"x" * len(name))
+    (root / "other").mkdir()
+    (root / "other" / "s9.tif").write_bytes(b"y")
+    return root
+
+
+def _file_step(files, **params):
+    return {"algorithm": "fake_file_size", "name": "size", "files": files,
+            "params": {"output": "{run}/{step}/{file}.txt", **params}}
+
+
+def test_plan_over_files_without_a_project(fake_algs, tmp_path):
+    root = _scenes(tmp_path / "b")
+    config = {"batch": {"workers": 1},
+              "steps": [_file_step(["scenes/s*.tif", "other/s9.tif", "scenes/s1.tif"])]}
+    plan = batch.plan_batch(config, base_dir=root)
+    assert plan.project is None
+    assert plan.run_dir.parent == root.resolve() / "runs"  # beside the batch file
+    assert plan.state_home == root.resolve()
+    # sorted per pattern, each file once, {file} = the name without suffix
+    assert [t.name for t in plan.tasks] == ["s1", "s2", "s9"]
+    t = plan.tasks[0]
+    assert t.params["image"] == str((root / "scenes" / "s1.tif").resolve())
+    assert t.params["output"] == f"{plan.run_dir}/size/s1.txt"
+    assert t.key == "size/s1" and t.log == plan.run_dir / "size" / "s1.log"
+    assert batch.plan_batch({"steps": [_file_step("scenes/*.tif")]}, base_dir=root
+                            ).to_dict()["project"] is None
+
+
+@pytest.mark.parametrize(("step", "message"), [
+    (_file_step(None), "needs files"),
+    (_file_step("nothing/*.tif"), "no file matches"),
+    (_file_step(["scenes/missing.tif"]), "does not exist"),
+    (_file_step(["scenes/s1.tif", "other/s1.tif"]), "does not exist"),
+    (_file_step("scenes/*.tif", output="{project}/x/{file}"), "has no project"),
+    (_file_step("scenes/*.tif", output="{model}"), "does not run per model"),
+    ({"algorithm": "fake_sleep_write", "models": "all"}, "needs a project"),
+    ({"algorithm": "fake_file_size", "models": "all"}, "iterates over files"),
+    ({"algorithm": "fake_crash", "files": "scenes/*.tif"}, "does not iterate"),
+])
+def test_file_batch_errors_are_operator_errors(fake_algs, tmp_path, step, message):
+    root = _scenes(tmp_path / "b")
+    with pytest.raises(InputError, match=message):
+        batch.plan_batch({"steps": [step]}, base_dir=root)
+
+
+def test_file_names_must_be_unique(fake_algs, tmp_path):
+    root = _scenes(tmp_path / "b")
+    (root / "other" / "s1.tif").write_bytes(b"z")
+    with pytest.raises(InputError, match="same name"):
+        batch.plan_batch({"steps": [_file_step(["scenes/s1.tif", "other/s1.tif"])]},
+                         base_dir=root)
+
+
+def test_file_batch_runs_past_a_failure_and_resumes(fake_algs, tmp_path):
+    root = _scenes(tmp_path / "b")
+    file = root / "batch.toml"
+    file.write_text('[batch]\nworkers = 1\noutput = "runs/one"\n[[steps]]\n'
+                    'algorithm = "fake_file_size"\nname = "size"\nfiles = "scenes/*.tif"\n'
+                    '[steps.params]\noutput = "out/{step}/{file}.txt"\n')
+    summary = batch.run_batch(batch.load_batch(file))
+    assert summary["status"] == "failed" and summary["project"] is None
+    status = {r["item"].rsplit("/", 1)[-1]: r["status"] for r in summary["tasks"]}
+    assert status == {"bad3.tif": "failed", "s1.tif": "done", "s2.tif": "done"}
+    assert (root / "out" / "size" / "s2.txt").read_text() == "2"
+    assert not (root / "out" / "size" / "bad3.txt").exists()
+    assert (root / ".photodem" / "batch-state.json").is_file()
+    again = batch.run_batch(batch.load_batch(file, run_dir=root / "runs" / "two"))
+    assert again["counts"]["skipped"] == 2 and again["counts"]["failed"] == 1
