@@ -1470,7 +1470,7 @@
         </message>
         <message>
             <source>Iterations</source>
-            <extracomment>filter_lowpass.iterations: description</extracomment>
+            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:40</extracomment>
             <translation>Iterationen</translation>
         </message>
         <message>
@@ -2335,78 +2335,103 @@
         </message>
         <message>
             <source>PhotoDEM toolbox</source>
-            <extracomment>plugin/app/main_window.py:37</extracomment>
+            <extracomment>plugin/app/main_window.py:38</extracomment>
             <translation>PhotoDEM-Werkzeugkasten</translation>
         </message>
         <message>
             <source>Search algorithms …</source>
-            <extracomment>plugin/app/main_window.py:44</extracomment>
+            <extracomment>plugin/app/main_window.py:46</extracomment>
             <translation>Algorithmen suchen …</translation>
         </message>
         <message>
             <source>Choose an algorithm on the left.</source>
-            <extracomment>plugin/app/main_window.py:98</extracomment>
+            <extracomment>plugin/app/main_window.py:100</extracomment>
             <translation>Links einen Algorithmus wählen.</translation>
         </message>
         <message>
             <source>&amp;File</source>
-            <extracomment>plugin/app/main_window.py:108</extracomment>
+            <extracomment>plugin/app/main_window.py:110</extracomment>
             <translation>&amp;Datei</translation>
         </message>
         <message>
             <source>&amp;Quit</source>
-            <extracomment>plugin/app/main_window.py:109</extracomment>
+            <extracomment>plugin/app/main_window.py:111</extracomment>
             <translation>&amp;Beenden</translation>
         </message>
         <message>
+            <source>&amp;Tools</source>
+            <extracomment>plugin/app/main_window.py:114</extracomment>
+            <translation>&amp;Werkzeuge</translation>
+        </message>
+        <message>
+            <source>Review georeferencing…</source>
+            <extracomment>plugin/app/main_window.py:115; plugin/qgis/plugin.py:105</extracomment>
+            <translation>Georeferenzierung prüfen…</translation>
+        </message>
+        <message>
+            <source>Check and edit the control points of a georeferencing result</source>
+            <extracomment>plugin/app/main_window.py:116; plugin/qgis/plugin.py:107</extracomment>
+            <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
+        </message>
+        <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:112</extracomment>
+            <extracomment>plugin/app/main_window.py:119</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:113</extracomment>
+            <extracomment>plugin/app/main_window.py:120</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:203</extracomment>
+            <extracomment>plugin/app/main_window.py:210</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:203</extracomment>
+            <extracomment>plugin/app/main_window.py:210</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:204</extracomment>
+            <extracomment>plugin/app/main_window.py:211</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:218</extracomment>
+            <extracomment>plugin/app/main_window.py:252</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:219</extracomment>
+            <extracomment>plugin/app/main_window.py:253</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:123</extracomment>
+            <extracomment>plugin/app/main_window.py:130</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:208</extracomment>
+            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:237; plugin/widgets/georef_review.py:396; plugin/widgets/georef_review.py:401</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
+            <source>Output folder of a georeferencing</source>
+            <extracomment>plugin/app/main_window.py:230; plugin/qgis/plugin.py:123</extracomment>
+            <translation>Ausgabeordner einer Georeferenzierung</translation>
+        </message>
+        <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:196; plugin/widgets/run_panel.py:101</extracomment>
+            <extracomment>plugin/app/main_window.py:203; plugin/widgets/run_panel.py:101</extracomment>
             <translation>{0} läuft …</translation>
+        </message>
+        <message>
+            <source>Tools → Review georeferencing checks and edits its control points.</source>
+            <extracomment>plugin/app/main_window.py:219</extracomment>
+            <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
             <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
@@ -2427,6 +2452,246 @@
             <source>PhotoDEM aerial photogrammetry</source>
             <extracomment>plugin/qgis/provider.py:34</extracomment>
             <translation>PhotoDEM Luftbildphotogrammetrie</translation>
+        </message>
+        <message>
+            <source>Use</source>
+            <extracomment>plugin/widgets/georef_review.py:31</extracomment>
+            <translation>Verwenden</translation>
+        </message>
+        <message>
+            <source>Role</source>
+            <extracomment>plugin/widgets/georef_review.py:31</extracomment>
+            <translation>Rolle</translation>
+        </message>
+        <message>
+            <source>Pair</source>
+            <extracomment>plugin/widgets/georef_review.py:31</extracomment>
+            <translation>Paar</translation>
+        </message>
+        <message>
+            <source>Column</source>
+            <extracomment>plugin/widgets/georef_review.py:31</extracomment>
+            <translation>Spalte</translation>
+        </message>
+        <message>
+            <source>Row</source>
+            <extracomment>plugin/widgets/georef_review.py:31</extracomment>
+            <translation>Zeile</translation>
+        </message>
+        <message>
+            <source>dX [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:32</extracomment>
+            <translation>dX [px]</translation>
+        </message>
+        <message>
+            <source>dY [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:32</extracomment>
+            <translation>dY [px]</translation>
+        </message>
+        <message>
+            <source>Residual [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:32</extracomment>
+            <translation>Restfehler [px]</translation>
+        </message>
+        <message>
+            <source>Residual [m]</source>
+            <extracomment>plugin/widgets/georef_review.py:32</extracomment>
+            <translation>Restfehler [m]</translation>
+        </message>
+        <message>
+            <source>Leave-one-out [m]</source>
+            <extracomment>plugin/widgets/georef_review.py:33</extracomment>
+            <translation>Ohne diesen Punkt [m]</translation>
+        </message>
+        <message>
+            <source>Reject</source>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <translation>Verwerfen</translation>
+        </message>
+        <message>
+            <source>Image object</source>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <translation>Bildobjekt</translation>
+        </message>
+        <message>
+            <source>Reference object</source>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <translation>Referenzobjekt</translation>
+        </message>
+        <message>
+            <source>Segmentation run</source>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <translation>Segmentierungslauf</translation>
+        </message>
+        <message>
+            <source>Threshold [DN]</source>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <translation>Schwellwert [GW]</translation>
+        </message>
+        <message>
+            <source>Overlap</source>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <translation>Überlappung</translation>
+        </message>
+        <message>
+            <source>ICP RMS [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <translation>ICP-RMS [px]</translation>
+        </message>
+        <message>
+            <source>Converged</source>
+            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
+            <translation>Konvergiert</translation>
+        </message>
+        <message>
+            <source>Add control point</source>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
+            <translation>Passpunkt hinzufügen</translation>
+        </message>
+        <message>
+            <source>Drop outliers (&gt; 3 σ0)</source>
+            <extracomment>plugin/widgets/georef_review.py:115</extracomment>
+            <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
+        </message>
+        <message>
+            <source>Control points</source>
+            <extracomment>plugin/widgets/georef_review.py:139</extracomment>
+            <translation>Passpunkte</translation>
+        </message>
+        <message>
+            <source>Object pairs</source>
+            <extracomment>plugin/widgets/georef_review.py:140</extracomment>
+            <translation>Objektpaare</translation>
+        </message>
+        <message>
+            <source>Add control point…</source>
+            <extracomment>plugin/widgets/georef_review.py:147</extracomment>
+            <translation>Passpunkt hinzufügen…</translation>
+        </message>
+        <message>
+            <source>Switch off largest residual</source>
+            <extracomment>plugin/widgets/georef_review.py:148</extracomment>
+            <translation>Größten Restfehler abschalten</translation>
+        </message>
+        <message>
+            <source>Save</source>
+            <extracomment>plugin/widgets/georef_review.py:149</extracomment>
+            <translation>Speichern</translation>
+        </message>
+        <message>
+            <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
+            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
+            <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
+        </message>
+        <message>
+            <source>Close</source>
+            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
+            <translation>Schließen</translation>
+        </message>
+        <message>
+            <source>Writing the georeferenced image …</source>
+            <extracomment>plugin/widgets/georef_review.py:372</extracomment>
+            <translation>Georeferenziertes Bild wird geschrieben …</translation>
+        </message>
+        <message>
+            <source>Cancel</source>
+            <extracomment>plugin/widgets/georef_review.py:373; plugin/widgets/run_panel.py:42</extracomment>
+            <translation>Abbrechen</translation>
+        </message>
+        <message>
+            <source>yes</source>
+            <extracomment>plugin/widgets/georef_review.py:430</extracomment>
+            <translation>ja</translation>
+        </message>
+        <message>
+            <source>no</source>
+            <extracomment>plugin/widgets/georef_review.py:430</extracomment>
+            <translation>nein</translation>
+        </message>
+        <message>
+            <source>control point</source>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <translation>Passpunkt</translation>
+        </message>
+        <message>
+            <source>outlier (dropped)</source>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <translation>Ausreißer (entfernt)</translation>
+        </message>
+        <message>
+            <source>check point (off)</source>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <translation>Kontrollpunkt (aus)</translation>
+        </message>
+        <message>
+            <source>pair rejected</source>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <translation>Paar verworfen</translation>
+        </message>
+        <message>
+            <source>Image column [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:57</extracomment>
+            <translation>Bildspalte [px]</translation>
+        </message>
+        <message>
+            <source>Image row [px]</source>
+            <extracomment>plugin/widgets/georef_review.py:58</extracomment>
+            <translation>Bildzeile [px]</translation>
+        </message>
+        <message>
+            <source>Map X</source>
+            <extracomment>plugin/widgets/georef_review.py:59</extracomment>
+            <translation>Karte X</translation>
+        </message>
+        <message>
+            <source>Map Y</source>
+            <extracomment>plugin/widgets/georef_review.py:60</extracomment>
+            <translation>Karte Y</translation>
+        </message>
+        <message>
+            <source>Transform:</source>
+            <extracomment>plugin/widgets/georef_review.py:121</extracomment>
+            <translation>Transformation:</translation>
+        </message>
+        <message>
+            <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
+            <extracomment>plugin/widgets/georef_review.py:312</extracomment>
+            <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
+        </message>
+        <message>
+            <source>Discard the changes that are not saved?</source>
+            <extracomment>plugin/widgets/georef_review.py:401</extracomment>
+            <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
+        </message>
+        <message>
+            <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
+            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
+            <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
+        </message>
+        <message>
+            <source>Review georeferencing — {0}</source>
+            <extracomment>plugin/widgets/georef_review.py:107</extracomment>
+            <translation>Georeferenzierung prüfen — {0}</translation>
+        </message>
+        <message>
+            <source>manual</source>
+            <extracomment>plugin/widgets/georef_review.py:303</extracomment>
+            <translation>manuell</translation>
+        </message>
+        <message>
+            <source>; {0} check points: RMSE {1:.3f} m</source>
+            <extracomment>plugin/widgets/georef_review.py:316</extracomment>
+            <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
+        </message>
+        <message>
+            <source>not saved</source>
+            <extracomment>plugin/widgets/georef_review.py:318</extracomment>
+            <translation>nicht gespeichert</translation>
+        </message>
+        <message>
+            <source>Residuals (×{0:.0f})</source>
+            <extracomment>plugin/widgets/georef_review.py:345</extracomment>
+            <translation>Restfehler (×{0:.0f})</translation>
         </message>
         <message>
             <source>Browse</source>
@@ -2517,11 +2782,6 @@
             <source>Run</source>
             <extracomment>plugin/widgets/run_panel.py:39</extracomment>
             <translation>Ausführen</translation>
-        </message>
-        <message>
-            <source>Cancel</source>
-            <extracomment>plugin/widgets/run_panel.py:42</extracomment>
-            <translation>Abbrechen</translation>
         </message>
         <message>
             <source>The log of the run appears here.</source>

@@ -132,7 +132,8 @@ def _fit_once(img: NDArray[np.float64], mp: NDArray[np.float64], kind: str) -> T
 
 def fit_transform(image_xy: NDArray[np.float64], map_xy: NDArray[np.float64],
                   kind: str = "affine", robust: bool = True, k: float = 3.0,
-                  max_drop: float = 0.2) -> TransformFit:
+                  max_drop: float = 0.2, enabled: Optional[NDArray[np.bool_]] = None
+                  ) -> TransformFit:
     """Fit the image → map transform to control points.
 
     Parameters
@@ -141,11 +142,15 @@ def fit_transform(image_xy: NDArray[np.float64], map_xy: NDArray[np.float64],
     robust : bool
         Drop the largest residual while it exceeds ``k·σ0`` (at most ``max_drop`` of the
         points).
+    enabled : array of bool, optional
+        The points that may take part (default: all). The others are check points: they get
+        residuals (in ``extras["all_residuals_map"]``) but do not influence the fit.
     """
     img = np.asarray(image_xy, float)
     mp = np.asarray(map_xy, float)
     n = len(img)
-    used = np.ones(n, bool)
+    used = np.ones(n, bool) if enabled is None else np.asarray(enabled, bool).copy()
+    n_enabled = int(used.sum())
     npar = {"affine": 6, "projective": 8, "poly2": 12}.get(kind, 6)
     while True:
         fit = _fit_once(img[used], mp[used], kind)
@@ -153,7 +158,7 @@ def fit_transform(image_xy: NDArray[np.float64], map_xy: NDArray[np.float64],
         dist = np.hypot(res[:, 0], res[:, 1])
         dof = max(2 * int(used.sum()) - npar, 1)
         sigma0 = float(np.sqrt(np.sum(dist[used] ** 2) / dof))
-        if not robust or (~used).sum() + 1 > max_drop * n:
+        if not robust or n_enabled - int(used.sum()) + 1 > max_drop * n_enabled:
             break
         worst = int(np.argmax(np.where(used, dist, -1.0)))
         if dist[worst] <= k * sigma0 or used.sum() - 1 < MIN_POINTS[kind] + 2:

@@ -216,7 +216,8 @@ def report_dict(result: Dict[str, Any]) -> Dict[str, Any]:
                    "reference_features": fr[h.j].obj.attributes.get("features")}
                   for h in result["pairs"]],
         "icp": result["icp"],
-        "gcps": [{"image": list(g.image), "map": list(g.map), **r}
+        "gcps": [{"image": list(g.image), "map": list(g.map), "pair": g.pair,
+                  "sharp": bool(g.sharp), **r}
                  for g, r in zip(result["gcps"], points_summary(fit))],
         "segmentation": result["segmentation"], "reference": result["reference"],
         "reference_kind": result["reference_kind"], "image": result["image_info"],
@@ -250,8 +251,52 @@ def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
+def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int) -> Path:
+    """Control points over the image frame with their residual vectors (exaggerated): points
+    in the fit blue, the others (outliers, check points) orange; the convex hull of the
+    points in the fit dashed — where the transform is interpolated, not extrapolated."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fit = result["fit"]
+    xy = np.array([g.image for g in result["gcps"]], float).reshape(-1, 2)
+    mp = np.array([g.map for g in result["gcps"]], float).reshape(-1, 2)
+    res = _inverse_points(result, mp) - xy  # measured map point taken into the image
+    fig, ax = plt.subplots(figsize=(7, 7 * height / max(width, 1)))
+    ax.add_patch(plt.Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
+    longest = float(np.hypot(*res.T).max()) if len(res) else 0.0
+    scale = 0.1 * np.hypot(width, height) / longest if longest > 0 else 1.0
+    step = 10.0 ** np.floor(np.log10(scale))  # a round factor: 1, 2 or 5 × 10^k
+    scale = step * max(f for f in (1, 2, 5) if f * step <= scale)
+    for used, colour in ((fit.used, "tab:blue"), (~fit.used, "tab:orange")):
+        if used.any():
+            ax.quiver(xy[used, 0], xy[used, 1], res[used, 0] * scale, res[used, 1] * scale,
+                      color=colour, angles="xy", scale_units="xy", scale=1, width=0.003)
+            ax.plot(xy[used, 0], xy[used, 1], ".", color=colour, ms=3)
+    if fit.used.sum() >= 3:
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            hull = ConvexHull(xy[fit.used])
+            ring = xy[fit.used][np.append(hull.vertices, hull.vertices[0])]
+            ax.plot(ring[:, 0], ring[:, 1], "--", color="tab:blue", lw=0.8)
+        except QhullError:  # collinear points: no hull to draw
+            pass
+    ax.set_xlim(-0.05 * width, 1.05 * width)
+    ax.set_ylim(1.05 * height, -0.05 * height)
+    ax.set_aspect("equal")
+    ax.set_title(f"residuals ×{scale:.0f}; RMSE {fit.rmse_px:.2f} px, "
+                 f"{int(fit.used.sum())} of {len(xy)} points in the fit")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return Path(path)
+
+
 def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, Path]:
-    """report.json, report.html and overlay.png in ``folder``."""
+    """report.json, report.html, overlay.png and residuals.png in ``folder``."""
     from ..processing.spec import json_ready
 
     rep = report_dict(result)
@@ -259,12 +304,33 @@ def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, P
     (folder / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
                                         encoding="utf-8")
     overlay_png(folder / "overlay.png", result)
+    info = result["image_info"]
+    residual_png(folder / "residuals.png", result, info["width"], info["height"])
+    (folder / "report.html").write_text(report_html(rep, name), encoding="utf-8")
+    return {"report": folder / "report.json", "html": folder / "report.html",
+            "overlay": folder / "overlay.png"}
+
+
+def report_html(rep: Dict[str, Any], name: str) -> str:
+    """The HTML report of a report dict (automatic or reviewed)."""
     rows = "".join(
         f"<tr><td>{k}</td><td>{g['image'][0]:.2f}</td><td>{g['image'][1]:.2f}</td>"
         f"<td>{g['map'][0]:.2f}</td><td>{g['map'][1]:.2f}</td><td>{g['residual_px']:.3f}</td>"
         f"<td>{g['residual_map']:.3f}</td><td>{g['loo_map']:.3f}</td>"
         f"<td>{'yes' if g['used'] else 'no'}</td></tr>"
         for k, g in enumerate(rep["gcps"]))
+    review = rep.get("review")
+    if review:
+        check = (f"{review['check_points']} check points, RMSE {review['check_rmse_m']} m"
+                 if review.get("check_points") else "no check points")
+        reviewed = (f"<p>Reviewed by the operator: transform {review['transform']}, outlier "
+                    f"removal {'on' if review['drop_outliers'] else 'off'}, "
+                    f"{len(review['switched_off'])} points switched off, "
+                    f"{len(review['manual'])} added by hand, rejected pairs "
+                    f"{review['rejected_pairs'] or 'none'}; {check}. The automatic result is "
+                    "in report_auto.json.</p>")
+    else:
+        reviewed = ""
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in rep["warnings"]) or "<li>none</li>"
     c = rep["counts"]
     if rep["stage"] == "area":
@@ -282,16 +348,15 @@ table{{border-collapse:collapse}}tr:nth-child(even){{background:#eee}}</style></
 <h1>Georeferencing of {html.escape(name)}</h1>
 <p>Transform: <b>{rep['transform']['kind']}</b> into {html.escape(rep['transform']['crs'])}.
 RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
-{rep['pixel_size_m']:.3f} m); {source}.</p>
+{rep['pixel_size_m']:.3f} m); {source}.</p>{reviewed}
 <h2>Warnings</h2><ul>{warn}</ul>
 <img src="overlay.png" style="max-width:100%">
+<h2>Residuals</h2><img src="residuals.png" style="max-width:100%">
 <h2>Control points</h2>
 <table><tr><th>#</th><th>col</th><th>row</th><th>X</th><th>Y</th><th>residual px</th>
 <th>residual m</th><th>leave-one-out m</th><th>used</th></tr>{rows}</table>
 </body></html>"""
-    (folder / "report.html").write_text(page, encoding="utf-8")
-    return {"report": folder / "report.json", "html": folder / "report.html",
-            "overlay": folder / "overlay.png"}
+    return page
 
 
 def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],

@@ -7,6 +7,7 @@ CLI) without any GUI code.
 from __future__ import annotations
 
 import html
+from pathlib import Path
 from typing import Dict, Optional
 
 from ...algorithms.processing import registry
@@ -37,6 +38,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.setWindowTitle(tr("PhotoDEM toolbox"))
         self.resize(1100, 720)
         self.form: Optional[ParameterForm] = None
+        self.last_georef = ""  # output folder of the last georeferencing run
         self.algorithm: Optional[Algorithm] = None
 
         # left: filter + algorithm tree
@@ -109,6 +111,11 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         quit_action = file_menu.addAction(tr("&Quit"))
         quit_action.setShortcut(QtGui.QKeySequence.Quit)
         quit_action.triggered.connect(self.close)
+        tools_menu = self.menuBar().addMenu(tr("&Tools"))
+        self.review_action = tools_menu.addAction(tr("Review georeferencing…"))
+        self.review_action.setToolTip(tr("Check and edit the control points of a "
+                                         "georeferencing result"))
+        self.review_action.triggered.connect(lambda _checked=False: self.open_georef_review())
         help_menu = self.menuBar().addMenu(tr("&Help"))
         about = help_menu.addAction(tr("&About PhotoDEM"))
         about.triggered.connect(self._about)
@@ -206,6 +213,33 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.statusBar().showMessage(text)
         if status == "failed" and self.message_boxes:
             QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(payload))
+        if (status == "done" and self.run_panel.algorithm_id == "georeference_polygons"
+                and isinstance(payload, dict) and payload.get("report")):
+            self.last_georef = str(Path(payload["report"]).parent)
+            self.statusBar().showMessage(text + " " + tr("Tools → Review georeferencing checks "
+                                                         "and edits its control points."))
+
+    def open_georef_review(self, folder: Optional[str] = None) -> Optional[QtWidgets.QDialog]:
+        """Open the review dialog of a georeferencing output folder (asks for it unless
+        given; the last result of this session is offered first)."""
+        from ...algorithms.errors import PhotodemError
+        from ..widgets.georef_review import GeorefReviewDialog
+
+        if not folder:
+            folder = QtWidgets.QFileDialog.getExistingDirectory(
+                self, tr("Output folder of a georeferencing"), self.last_georef or "")
+            if not folder:
+                return None
+        try:
+            dialog = GeorefReviewDialog(folder, self, message_boxes=self.message_boxes)
+        except PhotodemError as exc:
+            if self.message_boxes:
+                QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(exc))
+            self.statusBar().showMessage(str(exc))
+            return None
+        dialog.setAttribute(QtCore.Qt.WA_DeleteOnClose)
+        dialog.show()
+        return dialog
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
         if self.run_panel.is_running():

@@ -104,6 +104,7 @@ def test_desktop_init_gui_and_unload(qgis_app, plugin):
         added = [c for c in iface.calls if c[0] == "addPluginToRasterMenu"]
         names = {c[2] for c in added}
         assert {f"photodem_{i}" for i in core_registry.algorithms()} <= names
+        assert "photodemGeorefReview" in names
         assert ("addToolBarIcon", "photodemShowToolbox") in iface.calls
         assert all(c[1] == "&PhotoDEM" for c in added)
         iface.calls.clear()
@@ -176,3 +177,23 @@ def test_missing_dependencies_give_one_clear_message(qgis_app, plugin, monkeypat
     assert "rasterio, skimage" in messages[0] and "python3-rasterio python3-skimage" in messages[0]
     broken.unload()
     assert _registry().providerById("photodem") is plugin.provider  # the session's is untouched
+
+
+def test_georef_review_opens_inside_qgis(qgis_app, plugin, tmp_path):
+    """The review dialog on a real result, with QGIS's Qt (desktop plugin, fake iface)."""
+    import photodem
+    from photodem.algorithms.processing import registry as core_registry
+    from photodem.algorithms.synthetic.polygon_scene import georef_case
+
+    case = georef_case(tmp_path / "case", seed=5)
+    out = tmp_path / "georef"
+    core_registry.run("georeference_polygons", {
+        "image": case["image"], "reference": case["reference"], "output": str(out)})
+    desktop = photodem.classFactory(FakeIface())
+    dialog = desktop.open_georef_review(str(out))
+    assert dialog is not None and dialog.point_table.rowCount() >= 50
+    dialog.set_point_enabled(0, False)
+    assert dialog.rows[0]["role"] == "check"
+    assert dialog.save() and (out / "report_auto.json").is_file()
+    dialog.message_boxes = False
+    dialog.close()

@@ -1,0 +1,435 @@
+"""Review dialog of a polygon georeferencing: control points, object pairs, residual map.
+
+The operator switches control points off (they become check points), rejects object pairs,
+adds control points by hand, chooses the transform and the outlier removal, and sees the
+residuals and RMSE update at once; *Save* writes the folder's products again
+(:func:`~photodem.algorithms.georef.review.save_review`). The same dialog serves the
+standalone toolbox and QGIS.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+
+from ...algorithms.errors import Cancelled, PhotodemError
+from ...algorithms.georef.fit import KINDS
+from ...algorithms.georef.review import Review, load_review, save_review
+from ...algorithms.processing.feedback import Feedback
+from ..i18n import tr
+from ..qt import QtCore, QtWidgets, pyqtSignal
+
+#: Colours of the point roles on the residual map.
+ROLE_COLOURS = {"control": "tab:blue", "outlier": "tab:orange", "check": "tab:green",
+                "rejected": "tab:red"}
+
+
+def point_columns() -> List[str]:
+    """Headers of the control point table (the first column holds the Use check box)."""
+    return [tr("Use"), "#", tr("Role"), tr("Pair"), tr("Column"), tr("Row"), "X", "Y",
+            tr("dX [px]"), tr("dY [px]"), tr("Residual [px]"), tr("Residual [m]"),
+            tr("Leave-one-out [m]")]
+
+
+def pair_columns() -> List[str]:
+    """Headers of the object pair table (the first column holds the Reject check box)."""
+    return [tr("Reject"), "#", tr("Image object"), tr("Reference object"),
+            tr("Segmentation run"), tr("Threshold [DN]"), "Q", tr("Overlap"), tr("ICP RMS [px]"),
+            tr("Iterations"), tr("Converged")]
+
+
+def role_text(role: str) -> str:
+    """The operator's word for a point role."""
+    return {"control": tr("control point"), "outlier": tr("outlier (dropped)"),
+            "check": tr("check point (off)"), "rejected": tr("pair rejected")}.get(role, role)
+
+
+class AddPointDialog(QtWidgets.QDialog):
+    """Asks for a manual control point: image column/row and map X/Y."""
+
+    def __init__(self, crs_hint: str, parent: Optional[QtWidgets.QWidget] = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle(tr("Add control point"))
+        form = QtWidgets.QFormLayout(self)
+        self.fields: List[QtWidgets.QDoubleSpinBox] = []
+        for label, lo, hi, decimals in ((tr("Image column [px]"), -1e6, 1e6, 2),
+                                        (tr("Image row [px]"), -1e6, 1e6, 2),
+                                        (tr("Map X"), -1e9, 1e9, 3),
+                                        (tr("Map Y"), -1e9, 1e9, 3)):
+            box = QtWidgets.QDoubleSpinBox(self)
+            box.setRange(lo, hi)
+            box.setDecimals(decimals)
+            form.addRow(label, box)
+            self.fields.append(box)
+        hint = QtWidgets.QLabel(tr("Map coordinates in {0}; pixel centres at whole numbers, "
+                                   "the top-left pixel is (0, 0).").format(crs_hint))
+        hint.setWordWrap(True)
+        form.addRow(hint)
+        buttons = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.Ok | QtWidgets.QDialogButtonBox.Cancel, parent=self)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def values(self) -> List[float]:
+        return [f.value() for f in self.fields]
+
+
+class GeorefReviewDialog(QtWidgets.QDialog):
+    """Review and edit a georeferencing result folder.
+
+    Parameters
+    ----------
+    folder : path
+        Output folder of ``georeference_polygons``.
+    message_boxes : bool
+        Ask before discarding changes and show save errors in message boxes (tests switch
+        it off).
+
+    Raises
+    ------
+    PhotodemError
+        The folder holds no georeferencing result.
+    """
+
+    saved = pyqtSignal(dict)  # the paths written by Save
+
+    def __init__(self, folder: Any, parent: Optional[QtWidgets.QWidget] = None,
+                 message_boxes: bool = True) -> None:
+        super().__init__(parent)
+        self.review: Review = load_review(folder)
+        self.message_boxes = message_boxes
+        self.dirty = False
+        self.rows: List[Dict[str, Any]] = []
+        self.fit: Any = None
+        self.setWindowTitle(tr("Review georeferencing — {0}").format(self.review.name))
+        self.resize(1250, 760)
+
+        # top: transform, outlier removal, summary
+        self.kind_combo = QtWidgets.QComboBox(self)
+        for kind in KINDS:
+            self.kind_combo.addItem(tr(kind), kind)
+        self.kind_combo.setCurrentIndex(KINDS.index(self.review.kind))
+        self.outlier_box = QtWidgets.QCheckBox(tr("Drop outliers (> 3 σ0)"), self)
+        self.outlier_box.setChecked(self.review.drop_outliers)
+        self.summary = QtWidgets.QLabel(self)
+        self.summary.setTextFormat(QtCore.Qt.RichText)
+        self.summary.setWordWrap(True)
+        top = QtWidgets.QHBoxLayout()
+        top.addWidget(QtWidgets.QLabel(tr("Transform:"), self))
+        top.addWidget(self.kind_combo)
+        top.addWidget(self.outlier_box)
+        top.addStretch(1)
+
+        # middle: residual map | tables
+        from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
+        from matplotlib.figure import Figure
+
+        self.figure = Figure(figsize=(6, 6))
+        self.canvas = FigureCanvasQTAgg(self.figure)
+        self.canvas.setMinimumWidth(380)
+        self.axes = self.figure.add_subplot(111)
+        self.thumb, self.thumb_factor = _thumbnail(self.review.folder
+                                                   / f"{self.review.name}_gcps.tif")
+        self.point_table = self._table(point_columns())
+        self.pair_table = self._table(pair_columns())
+        self.tabs = QtWidgets.QTabWidget(self)
+        self.tabs.addTab(self.point_table, tr("Control points"))
+        self.tabs.addTab(self.pair_table, tr("Object pairs"))
+        splitter = QtWidgets.QSplitter(QtCore.Qt.Horizontal, self)
+        splitter.addWidget(self.canvas)
+        splitter.addWidget(self.tabs)
+        splitter.setSizes([480, 770])
+
+        # bottom: actions
+        self.add_button = QtWidgets.QPushButton(tr("Add control point…"), self)
+        self.worst_button = QtWidgets.QPushButton(tr("Switch off largest residual"), self)
+        self.save_button = QtWidgets.QPushButton(tr("Save"), self)
+        self.save_button.setToolTip(tr("Write the control points, the georeferenced image and "
+                                       "the report again (the automatic result is kept as "
+                                       "report_auto.json)."))
+        self.close_button = QtWidgets.QPushButton(tr("Close"), self)
+        buttons = QtWidgets.QHBoxLayout()
+        for b in (self.add_button, self.worst_button):
+            buttons.addWidget(b)
+        buttons.addStretch(1)
+        buttons.addWidget(self.save_button)
+        buttons.addWidget(self.close_button)
+
+        layout = QtWidgets.QVBoxLayout(self)
+        layout.addLayout(top)
+        layout.addWidget(self.summary)
+        layout.addWidget(splitter, 1)
+        layout.addLayout(buttons)
+
+        self._fill_pairs()
+        self._fill_points()
+        self.refresh()
+        for table in (self.point_table, self.pair_table):
+            table.resizeColumnsToContents()
+        self.kind_combo.currentIndexChanged.connect(self._on_kind)
+        self.outlier_box.toggled.connect(self._on_outliers)
+        self.point_table.itemChanged.connect(self._on_point_item)
+        self.pair_table.itemChanged.connect(self._on_pair_item)
+        self.point_table.itemSelectionChanged.connect(self._draw)
+        self.add_button.clicked.connect(self.add_point)
+        self.worst_button.clicked.connect(self.switch_off_worst)
+        self.save_button.clicked.connect(self.save)
+        self.close_button.clicked.connect(self.close)
+        self.canvas.mpl_connect("button_press_event", self._on_click)
+
+    # -- building --------------------------------------------------------------------------------
+    def _table(self, columns: List[str]) -> QtWidgets.QTableWidget:
+        table = QtWidgets.QTableWidget(0, len(columns), self)
+        table.setHorizontalHeaderLabels(columns)
+        table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectRows)
+        table.setEditTriggers(QtWidgets.QAbstractItemView.NoEditTriggers)
+        table.verticalHeader().setVisible(False)
+        # widths are set once after filling: ResizeToContents would measure every column
+        # again for each of the thousands of cells a refresh changes
+        table.horizontalHeader().setSectionResizeMode(QtWidgets.QHeaderView.Interactive)
+        return table
+
+    @staticmethod
+    def _check_item(checked: bool) -> QtWidgets.QTableWidgetItem:
+        item = QtWidgets.QTableWidgetItem()
+        item.setFlags(QtCore.Qt.ItemIsUserCheckable | QtCore.Qt.ItemIsEnabled
+                      | QtCore.Qt.ItemIsSelectable)
+        item.setCheckState(QtCore.Qt.Checked if checked else QtCore.Qt.Unchecked)
+        return item
+
+    def _fill_pairs(self) -> None:
+        table = self.pair_table
+        table.blockSignals(True)
+        table.setRowCount(len(self.review.pairs))
+        for r, pair in enumerate(self.review.pairs):
+            table.setItem(r, 0, self._check_item(pair["pair"] in self.review.rejected_pairs))
+            values = (pair["pair"], pair.get("image_object"), pair.get("reference_object"),
+                      pair.get("run"), pair.get("threshold"), pair.get("q"),
+                      pair.get("overlap"), pair.get("icp_rms_px"), pair.get("iterations"),
+                      pair.get("converged"))
+            for c, v in enumerate(values, start=1):
+                table.setItem(r, c, QtWidgets.QTableWidgetItem(_fmt(v)))
+        table.blockSignals(False)
+
+    def _fill_points(self) -> None:
+        """(Re)build the point rows: the Use check boxes and fixed columns."""
+        table = self.point_table
+        table.blockSignals(True)
+        table.setRowCount(len(self.review.points))
+        for r, p in enumerate(self.review.points):
+            table.setItem(r, 0, self._check_item(p.enabled))
+            for c in range(1, table.columnCount()):
+                table.setItem(r, c, QtWidgets.QTableWidgetItem(""))
+        table.blockSignals(False)
+
+    # -- state changes ---------------------------------------------------------------------------
+    def _changed(self) -> None:
+        self.dirty = True
+        self.refresh()
+
+    def _on_kind(self, index: int) -> None:
+        self.review.kind = self.kind_combo.itemData(index)
+        self._changed()
+
+    def _on_outliers(self, checked: bool) -> None:
+        self.review.drop_outliers = bool(checked)
+        self._changed()
+
+    def _on_point_item(self, item: QtWidgets.QTableWidgetItem) -> None:
+        if item.column() == 0:
+            self.review.points[item.row()].enabled = item.checkState() == QtCore.Qt.Checked
+            self._changed()
+
+    def _on_pair_item(self, item: QtWidgets.QTableWidgetItem) -> None:
+        if item.column() == 0:
+            pair = self.review.pairs[item.row()]["pair"]
+            self.review.set_pair_rejected(pair, item.checkState() == QtCore.Qt.Checked)
+            self._changed()
+
+    def set_point_enabled(self, index: int, enabled: bool) -> None:
+        """Switch a control point on or off (as its check box does)."""
+        self.point_table.item(index, 0).setCheckState(
+            QtCore.Qt.Checked if enabled else QtCore.Qt.Unchecked)
+
+    def set_pair_rejected(self, row: int, rejected: bool) -> None:
+        """Reject an object pair or take it back (as its check box does)."""
+        self.pair_table.item(row, 0).setCheckState(
+            QtCore.Qt.Checked if rejected else QtCore.Qt.Unchecked)
+
+    def add_point(self, values: Optional[List[float]] = None) -> None:
+        """Add a manual control point (asks for it unless ``values`` are given)."""
+        if not values:
+            dialog = AddPointDialog(self.review.report.get("transform", {}).get("crs", ""),
+                                    self)
+            if dialog.exec_() != QtWidgets.QDialog.Accepted:
+                return
+            values = dialog.values()
+        try:
+            self.review.add_point(values[:2], values[2:])
+        except PhotodemError as exc:
+            self._error(str(exc))
+            return
+        self._fill_points()
+        self._changed()
+        self.point_table.selectRow(len(self.review.points) - 1)
+
+    def switch_off_worst(self) -> None:
+        """Switch off the control point with the largest residual."""
+        candidates = [r for r in self.rows if r["role"] == "control"]
+        if candidates:
+            worst = max(candidates, key=lambda r: r["residual_px"])
+            self.set_point_enabled(worst["id"], False)
+
+    # -- display ---------------------------------------------------------------------------------
+    def refresh(self) -> None:
+        """Fit, fill the residual columns and the summary, redraw the map."""
+        try:
+            self.fit = self.review.fit()
+        except PhotodemError as exc:
+            self.fit, self.rows = None, []
+            self.summary.setText(f"<span style='color:#c0392b'>{exc}</span>")
+            self.save_button.setEnabled(False)
+            self._draw()
+            return
+        self.rows = self.review.table(self.fit)
+        table = self.point_table
+        table.blockSignals(True)
+        table.setUpdatesEnabled(False)
+        for r, row in enumerate(self.rows):
+            values = (row["id"], role_text(row["role"]),
+                      tr("manual") if row["manual"] else row["pair"], row["col"], row["row"],
+                      row["x"], row["y"], row["dx_px"], row["dy_px"], row["residual_px"],
+                      row["residual_map"], row["loo_map"])
+            for c, v in enumerate(values, start=1):
+                table.item(r, c).setText(_fmt(v))
+        table.setUpdatesEnabled(True)
+        table.blockSignals(False)
+        fit = self.fit
+        check, n_check = self.review.check_rmse(fit)
+        text = tr("RMSE <b>{0:.3f} px</b> = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in "
+                  "the fit").format(fit.rmse_px, fit.rmse_map, fit.sigma0, int(fit.used.sum()),
+                                    len(self.rows))
+        if n_check:
+            text += tr("; {0} check points: RMSE {1:.3f} m").format(n_check, check)
+        if self.dirty:
+            text += " — <i>" + tr("not saved") + "</i>"
+        self.summary.setText(text)
+        self.save_button.setEnabled(True)
+        self._draw()
+
+    def _draw(self) -> None:
+        ax = self.axes
+        ax.clear()
+        if self.thumb is not None:
+            f = self.thumb_factor
+            h, w = self.thumb.shape
+            ax.imshow(self.thumb, cmap="gray", extent=(-0.5, w * f - 0.5, h * f - 0.5, -0.5))
+        xy = self.review.image_xy()
+        if self.rows and len(xy):
+            res = np.array([[r["dcol"], r["drow"]] for r in self.rows])
+            longest = float(np.hypot(*res.T).max()) or 1.0
+            span = float(np.ptp(xy, axis=0).max()) or 1.0
+            k = 0.08 * span / longest
+            for role, colour in ROLE_COLOURS.items():
+                sel = np.array([r["role"] == role for r in self.rows])
+                if sel.any():
+                    ax.quiver(xy[sel, 0], xy[sel, 1], res[sel, 0] * k, res[sel, 1] * k,
+                              color=colour, angles="xy", scale_units="xy", scale=1,
+                              width=0.003)
+                    ax.plot(xy[sel, 0], xy[sel, 1], ".", color=colour, ms=3,
+                            label=role_text(role))
+            ax.legend(loc="lower right", fontsize=7)
+            ax.set_title(tr("Residuals (×{0:.0f})").format(k), fontsize=9)
+        elif len(xy):
+            ax.plot(xy[:, 0], xy[:, 1], ".", color="0.5", ms=3)
+        selected = sorted({i.row() for i in self.point_table.selectedIndexes()})
+        if selected and len(xy):
+            ax.plot(xy[selected, 0], xy[selected, 1], "o", mfc="none", mec="yellow", ms=9)
+        ax.set_aspect("equal")
+        if self.thumb is not None:
+            h, w = self.thumb.shape
+            ax.set_xlim(-0.5, w * self.thumb_factor - 0.5)
+            ax.set_ylim(h * self.thumb_factor - 0.5, -0.5)
+        self.canvas.draw_idle()
+
+    def _on_click(self, event: Any) -> None:
+        """Select the control point nearest to a click on the map."""
+        if event.inaxes is not self.axes or event.xdata is None:
+            return
+        xy = self.review.image_xy()
+        if not len(xy):
+            return
+        k = int(np.argmin(np.hypot(xy[:, 0] - event.xdata, xy[:, 1] - event.ydata)))
+        self.tabs.setCurrentWidget(self.point_table)
+        self.point_table.selectRow(k)
+
+    # -- saving ----------------------------------------------------------------------------------
+    def save(self) -> bool:
+        """Write the products again; True on success."""
+        progress = QtWidgets.QProgressDialog(tr("Writing the georeferenced image …"),
+                                             tr("Cancel"), 0, 100, self)
+        progress.setWindowModality(QtCore.Qt.WindowModal)
+        progress.setMinimumDuration(500)
+        feedback = Feedback(on_progress=lambda pct: (progress.setValue(int(pct)),
+                                                     QtWidgets.QApplication.processEvents()))
+        progress.canceled.connect(feedback.cancel)
+        try:
+            paths = save_review(self.review, feedback=feedback)
+        except Cancelled:
+            return False
+        except PhotodemError as exc:
+            self._error(str(exc))
+            return False
+        finally:
+            progress.close()
+        self.dirty = False
+        self.refresh()
+        self.saved.emit(paths)
+        return True
+
+    def _error(self, text: str) -> None:
+        self.summary.setText(f"<span style='color:#c0392b'>{text}</span>")
+        if self.message_boxes:
+            QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), text)
+
+    def closeEvent(self, event: Any) -> None:
+        if self.dirty and self.message_boxes:
+            answer = QtWidgets.QMessageBox.question(
+                self, tr("PhotoDEM"), tr("Discard the changes that are not saved?"),
+                QtWidgets.QMessageBox.Discard | QtWidgets.QMessageBox.Cancel)
+            if answer != QtWidgets.QMessageBox.Discard:
+                event.ignore()
+                return
+        super().closeEvent(event)
+
+
+def _thumbnail(path: Path, max_side: int = 800) -> tuple:
+    """The image's band mean at most ``max_side`` pixels wide/high, and its reduction
+    factor (``None, 1`` when it cannot be read: the map then shows the points only)."""
+    try:
+        import rasterio
+
+        from ...algorithms.raster.io import open_image
+
+        with open_image(path) as src:
+            f = max(1, int(np.ceil(max(src.width, src.height) / max_side)))
+            shape = (src.count, max(1, src.height // f), max(1, src.width // f))
+            data = src.read(out_shape=shape, resampling=rasterio.enums.Resampling.average)
+        return data.astype(np.float32).mean(axis=0), src.width / shape[2]
+    except Exception:  # a missing or unreadable copy: the review works without the picture
+        return None, 1
+
+
+def _fmt(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return tr("yes") if value else tr("no")
+    if isinstance(value, float):
+        if not np.isfinite(value):
+            return "–"
+        return f"{value:.3f}" if abs(value) < 1e5 else f"{value:.2f}"
+    return str(value)
