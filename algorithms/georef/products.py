@@ -83,7 +83,7 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
     from rasterio.windows import Window
     from scipy import ndimage
 
-    from ..raster.io import GTIFF_PROFILE, atomic_output, open_image, overview_factors
+    from ..raster.io import atomic_output, gtiff_profile, open_image, overview_factors
 
     fb = feedback or Feedback()
     fit = result["fit"]
@@ -98,13 +98,8 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
         ylo, yhi = float(min(y0, y1)), float(max(y0, y1))
         cols, rows = round((x1 - x0) / px), round((yhi - ylo) / px)
         transform = Affine(px, 0, x0, 0, -px, yhi)
-        profile = dict(GTIFF_PROFILE)
-        profile.update(driver="GTiff", width=cols, height=rows, count=count + 1, dtype=dtype,
-                       transform=transform, crs=result["crs"].to_wkt(), nodata=None)
-        if cols < 256 or rows < 256:
-            profile.update(tiled=False)
-            profile.pop("blockxsize", None)
-            profile.pop("blockysize", None)
+        profile = gtiff_profile(cols, rows, count + 1, dtype, result["crs"].to_wkt(),
+                                transform=transform, nodata=None)
         amax = 255 if dtype == "uint8" else np.iinfo(dtype).max if np.issubdtype(
             np.dtype(dtype), np.integer) else 1.0
         with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:

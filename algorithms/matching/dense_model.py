@@ -56,16 +56,10 @@ def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
     """Grey (band mean) epipolar image as float32, NaN outside the original image."""
     from rasterio.windows import Window
 
-    from ..raster.io import GTIFF_PROFILE, open_image
+    from ..raster.io import gtiff_profile, open_image
 
     w, h = pair.sizes[SIDES.index(side)]
-    profile = dict(GTIFF_PROFILE)
-    profile.update(width=w, height=h, count=1, dtype="float32", nodata=float("nan"),
-                   compress="none")
-    if w < 256 or h < 256:
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
+    profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), compress="none")
     chunk = max(1, _BLOCK_PIXELS // max(w, 1))
     with open_image(path, "w", **profile) as dst:
         for r0, block, valid, _, _ in pair.iter_resample(image, side, chunk):

@@ -862,7 +862,7 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     from rasterio.windows import Window
 
     from ..project.model import Project
-    from ..raster.io import GTIFF_PROFILE, open_image, staged_folder
+    from ..raster.io import gtiff_profile, open_image, staged_folder
     from ..raster.sample import bilinear_grid, world_to_grid
     from ..surface.gridding import Grid, polygon_mask
 
@@ -946,15 +946,8 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     n_nodes = 0
     failures = 0
     with staged_folder(out, replace=True, product="refine_object_space") as tmp:
-        profile = dict(GTIFF_PROFILE)
-        profile.update(width=W, height=H, count=1, dtype="float32", nodata=float("nan"),
-                       predictor=3, transform=out_grid.transform)
-        if project.crs:
-            profile["crs"] = project.crs
-        if W < 256 or H < 256:
-            profile.update(tiled=False)
-            profile.pop("blockxsize")
-            profile.pop("blockysize")
+        profile = gtiff_profile(W, H, 1, "float32", project.crs or None, nodata=float("nan"),
+                                predictor=3, transform=out_grid.transform)
         with open_image(tmp / "dsm.tif", "w", **profile) as dst_z, \
                 open_image(tmp / "sigma.tif", "w", **profile) as dst_s, \
                 open_image(dsm) as src:

@@ -208,7 +208,7 @@ def predict_displacement(project: Any, image: str, output: PathLike, *,
     import rasterio
 
     from ..project.model import Project
-    from ..raster.io import GTIFF_PROFILE, atomic_output
+    from ..raster.io import atomic_output, gtiff_profile
 
     feedback = ensure_feedback(feedback)
     start = time.perf_counter()
@@ -229,13 +229,8 @@ def predict_displacement(project: Any, image: str, output: PathLike, *,
         if z_const is None:
             raise InputError("The flying height above the ground needs the true heights: give "
                              "the reference DEM, the DEM, or a terrain height.")
-    profile = dict(GTIFF_PROFILE)
-    profile.update(count=len(DISPLACEMENT_BANDS), width=width, height=height, dtype="float32",
-                   nodata=float("nan"), transform=transform, crs=crs, predictor=3)
-    if width < 256 or height < 256:
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
+    profile = gtiff_profile(width, height, len(DISPLACEMENT_BANDS), "float32", nodata=float("nan"),
+                            transform=transform, crs=crs, predictor=3)
     warned: Dict[str, bool] = {}
     # running sums for the statistics (float64, exact enough) and a histogram for p95
     n = 0

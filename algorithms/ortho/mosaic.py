@@ -62,7 +62,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, overview_factors
+from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
 from . import balance as bal
 from . import seamlines as sl
 
@@ -540,15 +540,8 @@ def mosaic_orthos(
         nb = len(infos[0].colour)
         halo = math.ceil(feather_px / 2.0) + 1 if feather_px >= 1.0 else 0
         img_wins = [_window_of(i, transform, W, H) for i in infos]
-        prof = dict(GTIFF_PROFILE)
-        prof.update(width=W, height=H, count=nb + 1, dtype=dtype, transform=transform,
-                    nodata=None)
-        if crs:
-            prof["crs"] = crs
-        if W < 256 or H < 256:
-            prof.update(tiled=False)
-            prof.pop("blockxsize")
-            prof.pop("blockysize")
+        prof = gtiff_profile(W, H, nb + 1, dtype, crs or None, transform=transform,
+                             nodata=None)
         tile = max(int(tile), 64)
         tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]
         filled = 0

@@ -57,7 +57,7 @@ from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
-from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, open_image, overview_factors
+from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
 from .visibility import march_margin, occluded
 
 PathLike = Union[str, Path]
@@ -457,20 +457,11 @@ def visibility_path(ortho: PathLike) -> Path:
 
 def _profile(width: int, height: int, count: int, dtype: str, transform: Affine, crs: str
              ) -> Dict[str, Any]:
-    profile = dict(GTIFF_PROFILE)
-    profile.update(width=width, height=height, count=count, dtype=dtype, transform=transform,
-                   nodata=None)
-    if crs:
-        profile["crs"] = crs
-    # horizontal differencing + fast deflate: smaller and faster to write than plain deflate
-    profile.update(predictor=3 if np.issubdtype(np.dtype(dtype), np.floating) else 2, zlevel=1)
+    # horizontal differencing + fast deflate: smaller and faster to write than plain deflate;
     # blocks are compressed on all cores while the next tile is computed
-    profile.update(num_threads="all_cpus")
-    if width < 256 or height < 256:  # tiles must not exceed tiny rasters
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
-    return profile
+    return gtiff_profile(width, height, count, dtype, crs or None, transform=transform,
+                         nodata=None, zlevel=1, num_threads="all_cpus",
+                         predictor=3 if np.issubdtype(np.dtype(dtype), np.floating) else 2)
 
 
 class _SerialReads:

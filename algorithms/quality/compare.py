@@ -37,7 +37,7 @@ from rasterio.windows import Window
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output
+from ..raster.io import atomic_output, gtiff_profile
 from .coregister import nuth_kaab
 from .stats import SLOPE_LABELS, DifferenceAccumulator, _label_key, slope_class_index
 
@@ -374,13 +374,8 @@ def compare_dems(
         out_ds = None
         if difference_path is not None:
             tmp = stack.enter_context(atomic_output(difference_path))
-            profile = dict(GTIFF_PROFILE)
-            profile.update(count=1, width=width, height=height, dtype="float32",
-                           nodata=float("nan"), crs=ref.crs, transform=grid, predictor=3)
-            if width < 256 or height < 256:
-                profile.update(tiled=False)
-                profile.pop("blockxsize")
-                profile.pop("blockysize")
+            profile = gtiff_profile(width, height, 1, "float32", ref.crs, nodata=float("nan"),
+                                    transform=grid, predictor=3)
             out_ds = stack.enter_context(rasterio.open(tmp, "w", **profile))
 
         step = max(16, int(window_size))

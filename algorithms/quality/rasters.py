@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output
+from ..raster.io import atomic_output, gtiff_profile
 
 PathLike = Union[str, Path]
 
@@ -191,20 +191,9 @@ def shade(p: NDArray[Any], q: NDArray[Any], azimuth: float = 315.0,
 
 # -- window by window ---------------------------------------------------------------------------
 def _profile(src: Any, dtype: str, nodata: float) -> Dict[str, Any]:
-    profile = dict(GTIFF_PROFILE)
-    profile.update(width=src.width, height=src.height, count=1, dtype=dtype, nodata=nodata,
-                   transform=src.transform)
-    if src.crs is not None:
-        profile["crs"] = src.crs
-    if dtype.startswith("float"):
-        profile["predictor"] = 3
-    else:
-        profile["predictor"] = 2
-    if src.width < 256 or src.height < 256:
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
-    return profile
+    return gtiff_profile(src.width, src.height, 1, dtype, src.crs, nodata=nodata,
+                         transform=src.transform,
+                         predictor=3 if dtype.startswith("float") else 2)
 
 
 def _cell_metres(src: Any, row0: int, rows: int) -> Tuple[Union[float, NDArray[Any]], float]:

@@ -37,6 +37,27 @@ GTIFF_PROFILE: Dict[str, Any] = {
 }
 
 
+def gtiff_profile(width: int, height: int, count: int = 1, dtype: str = "float32",
+                  crs: Any = None, **options: Any) -> Dict[str, Any]:
+    """The creation profile of a ``height × width`` GeoTIFF of the project.
+
+    :data:`GTIFF_PROFILE` (deflate, 256² tiles) with the size, band count and data type;
+    ``crs`` only when one is given (image-space rasters have none); every other profile key
+    or creation option (``transform``, ``nodata``, ``predictor`` …) as given. A raster smaller
+    than one tile in either direction is written in strips: its tiles would be mostly padding.
+    """
+    profile = dict(GTIFF_PROFILE)
+    profile.update(width=int(width), height=int(height), count=int(count), dtype=dtype,
+                   **options)
+    if crs is not None and crs != "":
+        profile["crs"] = crs
+    if width < GTIFF_PROFILE["blockxsize"] or height < GTIFF_PROFILE["blockysize"]:
+        profile.update(tiled=False)
+        profile.pop("blockxsize")
+        profile.pop("blockysize")
+    return profile
+
+
 def _temp_sibling(path: Path) -> Path:
     return path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.partial")
 
@@ -197,18 +218,11 @@ def write_raster(
     count, height, width = arr.shape
     if nodata is None and np.issubdtype(arr.dtype, np.floating):
         nodata = float("nan")
-    profile = dict(GTIFF_PROFILE)
-    profile.update(count=count, height=height, width=width, dtype=arr.dtype.name, nodata=nodata)
+    profile = gtiff_profile(width, height, count, arr.dtype.name, crs, nodata=nodata)
     if transform is not None:
         profile["transform"] = transform
-    if crs is not None and crs != "":
-        profile["crs"] = crs
     if np.issubdtype(arr.dtype, np.floating):
         profile["predictor"] = 3
-    if width < 256 or height < 256:  # tiles must not exceed tiny rasters
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
     profile.update(options)
     if not overviews:
         with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:

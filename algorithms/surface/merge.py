@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import GTIFF_PROFILE, atomic_output, cog_output, overview_factors
+from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -235,17 +235,9 @@ def _combine(stack: Array, mode: str, sigma: Optional[Array]) -> Array:
 
 def _profile(width: int, height: int, dtype: str, transform: Affine, crs: Any,
              nodata: Optional[float]) -> Dict[str, Any]:
-    prof = dict(GTIFF_PROFILE)
-    prof.update(width=width, height=height, count=1, dtype=dtype, nodata=nodata,
-                transform=transform)
-    if crs is not None:
-        prof["crs"] = crs
+    prof = gtiff_profile(width, height, 1, dtype, crs, nodata=nodata, transform=transform)
     if dtype.startswith("float"):
         prof["predictor"] = 3
-    if width < 256 or height < 256:
-        prof.update(tiled=False)
-        prof.pop("blockxsize")
-        prof.pop("blockysize")
     return prof
 
 

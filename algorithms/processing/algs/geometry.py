@@ -10,23 +10,13 @@ import numpy as np
 
 from ...geometry.epipolar import SIDES, EpipolarPair
 from ...project.model import Project
-from ...raster.io import GTIFF_PROFILE, open_image, staged_folder
+from ...raster.io import gtiff_profile, open_image, staged_folder
 from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, json_ready
 
 #: Pixels per resampled row block (per band): bounds the memory of the resampling.
 _BLOCK_PIXELS = 1_000_000
 
-
-def _profile(width: int, height: int, count: int, dtype: str, **extra: Any) -> Dict[str, Any]:
-    """GeoTIFF profile of the shared GTIFF_PROFILE, untiled when the raster is small."""
-    profile = dict(GTIFF_PROFILE)
-    profile.update(width=width, height=height, count=count, dtype=dtype, **extra)
-    if width < 256 or height < 256:
-        profile.update(tiled=False)
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
-    return profile
 
 
 def _y_parallax_check(pair: EpipolarPair, height: float, n: int = 15) -> float:
@@ -59,8 +49,9 @@ def _write_side(pair: EpipolarPair, side: str, img: np.ndarray, folder: Path,
     chunk = max(1, _BLOCK_PIXELS // max(w, 1))
     bands = img.shape[0]
     photometric = "RGB" if bands == 3 else "MINISBLACK"
-    img_profile = _profile(w, h, bands + 1, img.dtype.name, photometric=photometric, alpha="YES")
-    map_profile = _profile(w, h, 2, "float32", nodata=float("nan"), predictor=3)
+    img_profile = gtiff_profile(w, h, bands + 1, img.dtype.name, photometric=photometric,
+                                alpha="YES")
+    map_profile = gtiff_profile(w, h, 2, "float32", nodata=float("nan"), predictor=3)
     alpha_max = np.iinfo(img.dtype).max if np.issubdtype(img.dtype, np.integer) else 1.0
     # epipolar images live in image space: no geotransform, on purpose
     with open_image(folder / f"{side}.tif", "w", **img_profile) as dst, \

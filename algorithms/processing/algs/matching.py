@@ -10,7 +10,7 @@ import numpy as np
 from ...errors import InputError
 from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
 from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
-from ...raster.io import GTIFF_PROFILE, atomic_output, open_image
+from ...raster.io import atomic_output, gtiff_profile, open_image
 from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
@@ -110,13 +110,7 @@ class StereoDisparity(Algorithm):
             left, shape_l = _grey_source(src_l)
             right, shape_r = _grey_source(src_r)
             h, w = shape_l
-            profile = dict(GTIFF_PROFILE)
-            profile.update(width=w, height=h, count=1, dtype="float32", nodata=float("nan"),
-                           predictor=3)
-            if w < 256 or h < 256:
-                profile.update(tiled=False)
-                profile.pop("blockxsize")
-                profile.pop("blockysize")
+            profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), predictor=3)
             if src_l.crs is not None:  # keep a georeference if the left image has one
                 profile.update(crs=src_l.crs, transform=src_l.transform)
             n_valid, d_min, d_max = 0, math.inf, -math.inf

@@ -70,3 +70,16 @@ def test_cog_output_leaves_nothing_on_failure(tmp_path: Path) -> None:
         raise RuntimeError("cancelled")
     assert [p.name for p in tmp_path.iterdir()] == ["out.tif"]
     assert target.read_bytes() == b"earlier result"
+
+
+def test_gtiff_profile_tiles_large_rasters_only() -> None:
+    from photodem.algorithms.raster.io import gtiff_profile
+
+    big = gtiff_profile(300, 400, 2, "uint16", "EPSG:25832", nodata=0, predictor=2)
+    assert big["tiled"] and big["blockxsize"] == 256 and big["crs"] == "EPSG:25832"
+    assert (big["width"], big["height"], big["count"], big["dtype"]) == (300, 400, 2, "uint16")
+    assert big["nodata"] == 0 and big["predictor"] == 2 and big["compress"] == "deflate"
+    small = gtiff_profile(300, 255)
+    assert not small["tiled"] and "blockxsize" not in small and "crs" not in small
+    assert small["dtype"] == "float32" and small["count"] == 1
+    assert "crs" not in gtiff_profile(300, 300, crs="")  # image space: no CRS
