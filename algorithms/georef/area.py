@@ -18,6 +18,19 @@ approximate values:
 4. **Refinement**: ECC (``cv2.findTransformECC``, affine) of the image feature against the
    polygons rendered in the image geometry, coarse to fine, re-rendering after each step.
 
+When ECC does not confirm the result (the glacier mask of the Everest scene: its outline
+does not pin the image), a second search uses the *individual* polygons' outlines — the
+boundaries between touching polygons follow ridges and illumination edges in the image:
+
+5. **Boundary-orientation search** (:func:`orientation_search`): for every rotation (both
+   handednesses) and scale of a grid, the image's doubled-angle gradient field, averaged
+   into the cells of a raster over the reference, is correlated (FFT, all shifts) with the
+   outlines' doubled-angle normals; placements rank by the cosine over its chance level.
+6. **Refinement** (:func:`refine_orientation`): the best placements are refined (affine,
+   Powell) to maximise the agreement of image gradients with the outline normals along the
+   outlines, coarse to fine; the chosen one must score high and stand clearly ahead of the
+   best other placement (:func:`boundary_search`).
+
 The result is an image → map affine; control points are a grid of image points mapped
 through it (:func:`grid_control_points`).
 """
@@ -412,3 +425,430 @@ def grid_control_points(T: Array, valid: NDArray[np.bool_], count: int = 10
                 out.append(ControlPoint(image=(float(c), float(r)), map=(float(m[0]),
                                         float(m[1])), residual=0.0, pair=-1, sharp=False))
     return out
+
+
+# --- boundary orientation: the individual polygons' outlines against image edge directions ---
+#
+# Where the polygons tile the terrain (glaciers meeting at ice divides, parcels, stands), the
+# boundaries *between* adjacent polygons follow visible edges — ridges, illumination changes —
+# that the dissolved mask does not contain. The cue is the direction of those edges, not
+# brightness or edge strength: the image gradient at a boundary is parallel to the boundary's
+# normal whether the polygon is brighter or darker. Directions are compared as doubled angles
+# (e^{2iφ}: polarity-free), so the score of a placement is a complex correlation (FFT) of the
+# rendered boundary normals with the image's doubled-angle gradient field.
+
+#: Cells along the longer side of the reference extent for the boundary-orientation search.
+ORIENT_CELLS = 128
+#: Image diagonal over the reference extent's diagonal: the scales searched (the image must
+#: show a good part of the reference area; no other assumption on the scale).
+EXTENT_RATIO = (0.3, 1.0)
+#: Rotation and log-scale step × the image's half-diagonal (cells): the image corners move by
+#: at most about half this many cells between neighbouring candidates.
+ORIENT_STEP = 3.0
+#: Fewest image half-diagonal cells (coarser candidates are not searched).
+MIN_RADIUS_CELLS = 12.0
+
+
+def boundary_samples(rings: Sequence[Array], spacing: float
+                     ) -> Tuple[Array, Array, Array]:
+    """Points along polygon outlines every ~``spacing`` map units.
+
+    Returns
+    -------
+    points : (n, 2) array
+        Segment midpoints of the subdivided outlines.
+    angles : (n,) array
+        Direction of the outline at each point (radians, map frame).
+    weights : (n,) array
+        Outline length each point stands for.
+    """
+    pts, ang, wts = [], [], []
+    for r in rings:
+        r = np.asarray(r, float)[:, :2]
+        d = np.diff(r, axis=0)
+        L = np.hypot(d[:, 0], d[:, 1])
+        ok = L > 0
+        if not ok.any():
+            continue
+        r0, d, L = r[:-1][ok], d[ok], L[ok]
+        n = np.maximum(1, np.ceil(L / spacing)).astype(int)
+        seg = np.repeat(np.arange(len(d)), n)
+        k = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        t = (k + 0.5) / n[seg]
+        pts.append(r0[seg] + t[:, None] * d[seg])
+        ang.append(np.arctan2(d[seg, 1], d[seg, 0]))
+        wts.append((L / n)[seg])
+    if not pts:
+        return np.zeros((0, 2)), np.zeros(0), np.zeros(0)
+    return np.vstack(pts), np.concatenate(ang), np.concatenate(wts)
+
+
+def _directions(T: Array, pts: Array, angles: Array) -> Array:
+    """Angles of directions ``angles`` at ``pts`` after the affine part of ``T``."""
+    d = np.c_[np.cos(angles), np.sin(angles)] @ T[:2, :2].T
+    return np.arctan2(d[:, 1], d[:, 0])
+
+
+def boundary_orientation_raster(rings: Sequence[Array], to_cell: Array, shape: Tuple[int, int],
+                                sigma: float = 0.7) -> NDArray[np.complex128]:
+    """Doubled-angle normals of the outlines rendered in a raster (complex, weighted by length).
+
+    Each outline point adds (length) · e^{2iψ}, ψ the outline's normal in the raster frame,
+    bilinearly into the four nearest cells; the raster is then Gaussian-smoothed (``sigma``
+    cells), which tolerates the search's steps. Opposite normals give the same value.
+    """
+    from scipy import ndimage
+
+    c = abs(np.linalg.det(to_cell[:2, :2])) ** -0.5  # map units per cell
+    pts, ang, wts = boundary_samples(rings, c / 4)
+    out = np.zeros(shape, complex)
+    if not len(pts):
+        return out
+    q = apply(to_cell, pts)
+    psi = _directions(to_cell, pts, ang) + math.pi / 2
+    val = wts / c * np.exp(2j * psi)
+    j0, i0 = np.floor(q[:, 0]).astype(int), np.floor(q[:, 1]).astype(int)
+    fx, fy = q[:, 0] - j0, q[:, 1] - i0
+    for di, dj, w in ((0, 0, (1 - fy) * (1 - fx)), (0, 1, (1 - fy) * fx), (1, 0, fy * (1 - fx)),
+                      (1, 1, fy * fx)):
+        ii, jj = i0 + di, j0 + dj
+        ok = (ii >= 0) & (ii < shape[0]) & (jj >= 0) & (jj < shape[1])
+        np.add.at(out, (ii[ok], jj[ok]), w[ok] * val[ok])
+    if sigma > 0:
+        out = ndimage.gaussian_filter(out.real, sigma) + 1j * ndimage.gaussian_filter(out.imag,
+                                                                                      sigma)
+    return out
+
+
+def gradient_orientation(a: Array, valid: Optional[NDArray[np.bool_]] = None,
+                         sigma: float = 0.0) -> NDArray[np.complex128]:
+    """Doubled-angle gradient field |g| e^{2iφ} of ``a`` (φ the gradient direction, x = column,
+    y = row), after an optional Gaussian of ``sigma`` px; zero within two pixels of no data."""
+    from scipy import ndimage
+
+    a = np.asarray(a, float)
+    if valid is None:
+        valid = np.isfinite(a)
+    fill = float(np.mean(a[valid])) if valid.any() else 0.0
+    g = np.where(valid, a, fill)
+    if sigma > 0:
+        g = ndimage.gaussian_filter(g, sigma)
+    gy, gx = np.gradient(g)
+    z = (gx + 1j * gy) ** 2 / (np.hypot(gx, gy) + 1e-12)
+    core = valid if valid.all() else ndimage.binary_erosion(valid, iterations=2)
+    return np.where(core, z, 0.0)
+
+
+def orientation_score(z: NDArray[np.complex128], T: Array, pts: Array, angles: Array,
+                      weights: Array) -> float:
+    """Weighted mean of cos 2Δ over the outline points inside the image.
+
+    Δ is the angle between the image gradient (``z`` from :func:`gradient_orientation`,
+    interpolated bilinearly) and the outline normal mapped into the image by ``T⁻¹`` (``T``:
+    image pixel → map); the weights are outline length × gradient magnitude. 1: every edge
+    runs along the outlines; 0: no relation.
+    """
+    num, den, _ = _orientation_terms(z, T, pts, angles, weights)
+    return num / den if den > 0 else 0.0
+
+
+def _orientation_terms(z: NDArray[np.complex128], T: Array, pts: Array, angles: Array,
+                       weights: Array) -> Tuple[float, float, float]:
+    """Σ w·|g|·cos 2Δ, Σ w·|g| and Σ w over the outline points inside the image."""
+    from scipy import ndimage
+
+    Ti = np.linalg.inv(T)
+    q = apply(Ti, pts)
+    rows, cols = z.shape
+    ok = (q[:, 0] >= 0) & (q[:, 0] <= cols - 1) & (q[:, 1] >= 0) & (q[:, 1] <= rows - 1)
+    if not ok.any():
+        return 0.0, 0.0, 0.0
+    coords = [q[ok, 1], q[ok, 0]]
+    zr = ndimage.map_coordinates(z.real, coords, order=1)
+    zi = ndimage.map_coordinates(z.imag, coords, order=1)
+    psi = _directions(Ti, pts[ok], angles[ok]) + math.pi / 2
+    w = weights[ok]
+    num = float(np.sum((zr * np.cos(2 * psi) + zi * np.sin(2 * psi)) * w))
+    return num, float(np.sum(np.hypot(zr, zi) * w)), float(np.sum(w))
+
+
+@dataclass
+class OrientationCandidate:
+    """A placement of the image in the reference cell raster and its score."""
+
+    transform: Array  # 3 × 3 image pixel → map
+    score: float  # cosine of the doubled-angle fields at the search resolution
+    angle_deg: float
+    scale: float  # cells per image pixel
+    mirrored: bool
+    cells: float = 0.0  # image cells that carry a gradient (the sample of the cosine)
+
+    @property
+    def z(self) -> float:
+        """The cosine in units of its chance level, ≈ 1/√cells: placements of a small image
+        (few cells) reach high cosines by chance, so placements rank by ``score · √cells``."""
+        return self.score * math.sqrt(self.cells)
+
+
+def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIENT_CELLS,
+                       extent_ratio: Tuple[float, float] = EXTENT_RATIO,
+                       step: float = ORIENT_STEP, keep: int = 5, smooth: float = 1.0
+                       ) -> List[OrientationCandidate]:
+    """Brute-force similarity search of the image against the outlines' directions.
+
+    Every rotation (both handednesses) and scale on a grid whose steps move the image corners
+    by about ``step``/2 cells; for each, the image's doubled-angle gradient field (computed
+    at full resolution, σ = 1 px, then averaged over half a cell and warped into the
+    reference cell raster, its angles turned with the image) is correlated (FFT, all shifts)
+    with the rendered outline normals (:func:`boundary_orientation_raster`), normalised as a
+    cosine (the outline energy under the image and the image's field energy). Averaging the
+    fine field keeps the direction of sharp ridges that a gradient of the coarse image loses
+    (Everest at 315 m cells: the truth ranked 602nd and worse for two small-scale cases with
+    coarse gradients, first with the averaged field). Placements rank by the cosine times
+    √(cells of the image): a small image reaches high cosines by chance. Shifts where the
+    image covers less than a quarter of the best-covered shift's outline energy are not
+    scored (a few chance outlines at the reference's edge would be noise).
+
+    Parameters
+    ----------
+    grey : (rows, cols) array
+        Image, NaN = no data.
+    boundaries : sequence of (n, 2) arrays
+        Outlines of the individual (not dissolved) polygons, map coordinates.
+    extent_ratio : (low, high)
+        Scales searched: the image's diagonal is ``low``–``high`` times the reference
+        extent's diagonal.
+
+    Returns
+    -------
+    list of OrientationCandidate
+        The best ``keep`` placements, best first, at least ~3 cells apart or at different
+        rotations/scales.
+    """
+    import cv2
+    from scipy import fft as sfft
+    from scipy import ndimage
+
+    if not len(boundaries):
+        return []
+    to_cell, shape = search_grid(boundaries, cells)
+    pad = 4
+    to_cell = translation(pad, pad) @ to_cell
+    shape = (shape[0] + 2 * pad, shape[1] + 2 * pad)
+    normals = boundary_orientation_raster(boundaries, to_cell, shape, smooth)
+    rows, cols = grey.shape
+    valid0 = np.isfinite(grey)
+    z0 = gradient_orientation(grey, valid0, 1.0)
+    half_img = 0.5 * math.hypot(rows, cols)
+    half_ref = 0.5 * math.hypot(*shape)
+    q_lo = max(extent_ratio[0] * half_ref, MIN_RADIUS_CELLS) / half_img
+    q_hi = extent_ratio[1] * half_ref / half_img
+    big = math.ceil(2 * q_hi * half_img) + 4
+    FS = (sfft.next_fast_len(shape[0] + big), sfft.next_fast_len(shape[1] + big))
+    FO = sfft.fft2(normals.astype(np.complex64), FS)
+    FE = sfft.rfft2(np.abs(normals).astype(np.float32) ** 2, FS)
+    corners = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [cols - 1.0, rows - 1.0],
+                        [0.0, rows - 1.0]])
+    found: List[OrientationCandidate] = []
+    q = q_lo
+    while q <= q_hi * (1 + 1e-9) or not found:
+        r = q * half_img
+        # the fine field averaged over a cell (Gaussian of half a cell before the warp)
+        zf = [(ndimage.gaussian_filter(p, 0.5 / q) if q < 1 else p).astype(np.float32)
+              for p in (z0.real, z0.imag)]
+        n_rot = max(8, math.ceil(2 * math.pi * r / step))
+        for mirrored in (False, True):
+            F = np.diag([-1.0, 1.0, 1.0]) if mirrored else np.eye(3)
+            for k in range(n_rot):
+                a = 2 * math.pi * k / n_rot
+                A = similarity(a, q) @ F
+                c = apply(A, corners)
+                o = -c.min(axis=0) + 2
+                size = np.ceil(c.max(axis=0) - c.min(axis=0) + 4).astype(int)
+                M = (translation(*o) @ A)[:2].astype(np.float32)
+                dsize = (int(size[0]), int(size[1]))
+                vm = cv2.warpAffine(valid0.astype(np.float32), M, dsize,
+                                    flags=cv2.INTER_LINEAR) > 0.999
+                wr, wi = (cv2.warpAffine(p, M, dsize, flags=cv2.INTER_LINEAR) for p in zf)
+                # the field turns with the image: mirrored φ → π − φ, rotated φ → φ + a
+                z = (wr - 1j * wi if mirrored else wr + 1j * wi) * np.exp(2j * a)
+                z = np.where(cv2.erode(vm.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0,
+                             z, 0).astype(np.complex64)
+                zz = float(np.sum(np.abs(z) ** 2))
+                if zz <= 0:
+                    continue
+                core = (z != 0).astype(np.float32)
+                num = sfft.ifft2(FO * np.conj(sfft.fft2(z, FS))).real
+                energy = sfft.irfft2(FE * np.conj(sfft.rfft2(core, FS)), FS)
+                floor = 0.25 * float(energy.max())
+                if floor <= 0:
+                    continue
+                score = np.where(energy > floor, num / np.sqrt(np.maximum(energy, floor) * zz),
+                                 -1.0)
+                i, j = np.unravel_index(int(np.argmax(score)), score.shape)
+                di = i if i < FS[0] // 2 else i - FS[0]
+                dj = j if j < FS[1] // 2 else j - FS[1]
+                S = translation(dj, di) @ translation(*o) @ A  # image pixel → cell
+                found.append(OrientationCandidate(np.linalg.inv(to_cell) @ S,
+                                                  float(score[i, j]), math.degrees(a), q,
+                                                  mirrored, float(core.sum())))
+        q *= 1 + step / r
+    found.sort(key=lambda c: -c.z)
+    out: List[OrientationCandidate] = []
+    centre = np.array([[(cols - 1) / 2, (rows - 1) / 2]])
+    cell = abs(np.linalg.det(to_cell[:2, :2])) ** -0.5
+    for cand in found:
+        p = apply(cand.transform, centre)[0]
+        if any(np.hypot(*(apply(o.transform, centre)[0] - p)) < 3 * cell
+               and o.mirrored == cand.mirrored for o in out):
+            continue
+        out.append(cand)
+        if len(out) >= keep:
+            break
+    return out
+
+
+def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
+                       sigmas: Sequence[float] = (8.0, 4.0, 2.0, 1.0), spacing: float = 1.0,
+                       objective: str = "cosine", model: str = "affine"
+                       ) -> Tuple[Array, float]:
+    """Affine refinement of image → map ``T`` along the outlines' directions.
+
+    ``objective`` "cosine" maximises :func:`orientation_score`; "strength" maximises
+    Σ w·|g|·cos 2Δ / (Σ w · mean |g| of the image), the aligned edge strength *under* the
+    outlines (closer on clean synthetic edges: 0.22 against 0.32 px; farther on Everest:
+    0.8–1.3 against 0.6–0.8 px, where the outlines and the edges differ locally). Coarse to
+    fine (Gaussian ``sigmas`` in image pixels); the parameters are the displacements (pixels)
+    of three image corners, optimised by Powell's method (to 0.01 px at σ ≤ 2 px, 0.1 px
+    above). The outline points are ``spacing`` image pixels apart.
+
+    Returns
+    -------
+    T : (3, 3) array
+    score : float
+        :func:`orientation_score` at the finest level.
+    """
+    from scipy import optimize
+
+    rows, cols = grey.shape
+    valid = np.isfinite(grey)
+    px = math.sqrt(abs(np.linalg.det(T[:2, :2])))
+    pts, ang, wts = boundary_samples(boundaries, px * spacing)
+    ctrl = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0]])
+    Ac = np.c_[ctrl, np.ones(3)]
+    z = np.zeros(grey.shape, complex)
+    for sg in sigmas:
+        z = gradient_orientation(grey, valid, sg)
+        mean_g = float(np.mean(np.abs(z[z != 0]))) if np.any(z != 0) else 1.0
+
+        def moves(x: Array) -> Array:
+            return (_corner_moves(Ac, ctrl, x) if model == "affine" else
+                    _similarity_moves(x, cols, rows))
+
+        def cost(x: Array, z: Array = z, T: Array = T, mean_g: float = mean_g) -> float:
+            num, den, wsum = _orientation_terms(z, T @ np.linalg.inv(moves(x)), pts, ang, wts)
+            if objective == "cosine":
+                return -num / den if den > 0 else 0.0
+            return -num / (wsum * mean_g) if wsum > 0 else 0.0
+
+        r = optimize.minimize(cost, np.zeros(6 if model == "affine" else 4), method="Powell",
+                              options={"xtol": 0.01 if sg <= 2 else 0.1, "ftol": 1e-7})
+        T = T @ np.linalg.inv(moves(r.x))
+    return T, orientation_score(z, T, pts, ang, wts)
+
+
+def _similarity_moves(x: Array, cols: int, rows: int) -> Array:
+    """Shift (x[0], x[1]) px, rotation and scale about the image centre, the latter two as
+    the displacement (px) they cause at the image's half-diagonal."""
+    rad = 0.5 * math.hypot(cols, rows)
+    c = np.array([(cols - 1) / 2, (rows - 1) / 2])
+    S = similarity(x[2] / rad, 1.0 + x[3] / rad)
+    S[:2, 2] = c - S[:2, :2] @ c + x[:2]
+    return S
+
+
+def _corner_moves(Ac: Array, ctrl: Array, x: Array) -> Array:
+    """The affine that moves the three image points ``ctrl`` by ``x`` (pixels, flattened)."""
+    M = np.linalg.solve(Ac, ctrl + x.reshape(3, 2)).T
+    return np.vstack([M, [0.0, 0.0, 1.0]])
+
+
+#: Search placements refined at the coarse levels before the best is refined to full size.
+SCREEN = 6
+#: Orientation score an affine refinement must add to a similarity's to be kept (Everest,
+#: a similarity scene: the affine adds 0.000–0.004 and moves the corners 0.5–1 px).
+AFFINE_GAIN = 0.01
+
+
+@dataclass
+class BoundaryResult:
+    """The boundary-orientation estimate and how it was found."""
+
+    transform: Array  # 3 × 3 image (col, row; centres at integers) → map
+    score: float  # orientation score after the full refinement (σ = 1 px)
+    screen: float  # its score after the coarse refinement (σ = 4 px)
+    runner_up: float  # best coarse-refined score of a placement elsewhere (> 3 cells away)
+    search_score: float  # cosine of the chosen placement at the search resolution
+    mirrored: bool
+    candidates: List[Dict[str, float]] = field(default_factory=list)
+
+    @property
+    def gap(self) -> float:
+        """How far the chosen placement stands out: screen − runner-up."""
+        return self.screen - self.runner_up
+
+
+def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIENT_CELLS,
+                    screen: int = SCREEN) -> BoundaryResult:
+    """Image → map affine from the image's edge directions and the individual outlines.
+
+    :func:`orientation_search` proposes the ``screen`` best placements; each is refined at
+    the coarse levels (similarity, σ = 8 and 4 px, outline points every 2 px) — at the search
+    resolution the right placement is often only just ahead or behind, refined it stands
+    out — and the best is refined to σ = 1 px (similarity; then affine, kept if it raises
+    the score by ``AFFINE_GAIN``); placements that ended within three search cells of it
+    (at an image corner) are refined too, and the best final score wins. The runner-up is
+    the best coarse-refined placement farther away: the gap between the two says whether
+    the choice is unique (a fit to unrelated outlines reaches similar scores at several
+    places).
+    """
+    cands = orientation_search(grey, boundaries, cells, keep=screen)
+    if not cands:
+        return BoundaryResult(np.eye(3), 0.0, 0.0, 0.0, 0.0, False)
+    rows, cols = grey.shape
+    corners = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0],
+                        [cols - 1.0, rows - 1.0]])
+    screened = []
+    for c in cands:
+        T, sc = refine_orientation(grey, boundaries, c.transform, sigmas=(8.0, 4.0),
+                                   spacing=2.0, model="similarity")
+        screened.append((sc, T, c))
+    screened.sort(key=lambda t: -t[0])
+    sc0, T0, best = screened[0]
+    # placements within three search cells of the best are the same one (local optima of
+    # the coarse refinement): each is refined in full, the best final score wins; the
+    # runner-up is the best placement elsewhere
+    near = 3.0 / best.scale
+    basin: List[Array] = []
+    others: List[float] = []
+    for s, T, _ in screened:
+        if np.abs(apply(np.linalg.inv(T0) @ T, corners) - corners).max() <= near:
+            basin.append(T)
+        else:
+            others.append(s)
+    finals = []
+    for Tb in basin:
+        T, score = refine_orientation(grey, boundaries, Tb, sigmas=(2.0, 1.0),
+                                      model="similarity")
+        finals.append((score, T))
+    score, T = max(finals, key=lambda t: t[0])
+    # an affine only where it explains clearly more than a similarity: its two extra
+    # parameters otherwise fit local differences between outlines and edges
+    Ta, score_a = refine_orientation(grey, boundaries, T, sigmas=(1.0,))
+    if score_a >= score + AFFINE_GAIN:
+        T, score = Ta, score_a
+    info = [{"angle_deg": round(c.angle_deg, 2), "scale": round(c.scale, 5),
+             "mirrored": c.mirrored, "search": round(c.score, 4), "refined": round(s, 4)}
+            for s, _, c in screened]
+    return BoundaryResult(T, score, sc0, max(others, default=0.0), best.score, best.mirrored,
+                          info)

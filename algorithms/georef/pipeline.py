@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import GeometryError, InputError
 from ..processing.feedback import Feedback, StepFeedback
-from .area import area_search, grid_control_points
+from .area import area_search, boundary_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform
 from .invariants import object_features
@@ -45,6 +45,13 @@ SEARCH_MODES = ("auto", "objects", "area")
 #: Smallest ECC correlation of an area-based result (below: the failure report). Correct
 #: synthetic results reach 0.6–0.85, wrong candidates stay below 0.17.
 MIN_ECC = 0.25
+#: Boundary-orientation search (docs/decisions.md): smallest score (weighted mean cos 2Δ
+#: after the refinement) and smallest gap between the chosen placement and the best other
+#: one after the coarse refinement. Everest, right placements: 0.62–0.77, gaps ≥ 0.10.
+#: Wrong ones: Everest against random tilings of the RGI extent ≤ 0.46 (gaps 0.01–0.12);
+#: synthetic tilings against unrelated tilings 0.58–0.72, but with gaps ≤ 0.06.
+MIN_ORIENTATION = 0.55
+MIN_GAP = 0.08
 
 
 def parse_thresholds(text: Union[str, Sequence[float], None]) -> List[float]:
@@ -245,18 +252,40 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
     fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
     fb.progress(40)
     res = area_search(grey, [o.ring for o in ref_objs])
-    fb.progress(75)
+    fb.progress(60)
     counts: Dict[str, Any] = {"reference_objects": len(ref_objs),
                               "area_candidates": len(res.candidates),
                               "area_ncc": round(res.ncc, 4), "area_ecc": round(res.ecc, 4),
                               "verified_pairs": 0}
+    area_info: Dict[str, Any] = {"method": "ecc", "ncc": res.ncc, "ecc": res.ecc,
+                                 "mirrored": res.mirrored, "candidates": res.candidates}
+    T = res.transform
     if res.ecc < MIN_ECC:
-        why = (f"the area-based search found no alignment (ECC correlation {res.ecc:.2f} < "
-               f"{MIN_ECC:g})")
-        if object_failure:
-            why += f"; before it, the object stage: {object_failure}"
-        _fail(counts, why)
-    gcps = grid_control_points(res.transform, np.isfinite(grey))
+        # the individual polygons' outlines against the image's edge directions
+        fb.info(f"ECC correlation {res.ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
+                "(individual outlines against edge directions).")
+        outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
+        bres = boundary_search(grey, outlines)
+        counts.update(boundary_outlines=len(outlines),
+                      boundary_score=round(bres.score, 4),
+                      boundary_screen=round(bres.screen, 4),
+                      boundary_runner_up=round(bres.runner_up, 4))
+        if bres.score < MIN_ORIENTATION or bres.gap < MIN_GAP:
+            why = (f"the area-based search found no alignment (ECC correlation {res.ecc:.2f} "
+                   f"< {MIN_ECC:g}; boundary-orientation score {bres.score:.2f}, needs "
+                   f"≥ {MIN_ORIENTATION:g}, ahead of the next placement by {bres.gap:.2f}, "
+                   f"needs ≥ {MIN_GAP:g})")
+            if object_failure:
+                why += f"; before it, the object stage: {object_failure}"
+            _fail(counts, why)
+        T = bres.transform
+        area_info = {"method": "boundary orientation", "score": bres.score,
+                     "screen": bres.screen, "search_score": bres.search_score,
+                     "runner_up": bres.runner_up,
+                     "mirrored": bres.mirrored, "candidates": bres.candidates,
+                     "ecc_before": res.ecc}
+    fb.progress(75)
+    gcps = grid_control_points(T, np.isfinite(grey))
     transform = params["transform"]
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
@@ -265,21 +294,22 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
                    if transform == "poly2" else None)
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = 0
-    warnings = [f"Control points from the area-based search (grid through the ECC affine, "
-                f"correlation {res.ecc:.2f}): their residuals do not measure the accuracy."]
+    how = (f"ECC affine, correlation {res.ecc:.2f}" if area_info["method"] == "ecc" else
+           f"boundary-orientation affine, score {area_info['score']:.2f}")
+    warnings = [f"Control points from the area-based search (grid through the {how}): "
+                "their residuals do not measure the accuracy."]
     if object_failure:
         warnings.append(f"The object stage found no result: {object_failure}")
     for w in warnings:
         fb.warning(w)
     fb.progress(85)
-    return {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps, "global": res.transform,
-            "joint": res.transform, "search": res.transform, "pairs": [],
+    return {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps, "global": T,
+            "joint": T, "search": T, "pairs": [],
             "img_features": [], "ref_features": [], "crs": crs, "counts": counts, "icp": [],
             "segmentation": {}, "reference": ref_info, "reference_kind": "vector",
             "image_info": img_info, "grey": grey, "warnings": warnings,
             "seconds": time.perf_counter() - t0, "stage": "area",
-            "area": {"ncc": res.ncc, "ecc": res.ecc, "mirrored": res.mirrored,
-                     "candidates": res.candidates},
+            "area": area_info,
             "reference_rings": [o.ring for o in ref_objs],
             "parameters": {**params, "pyramid_level": None}}
 

@@ -329,9 +329,11 @@ def report_html(rep: Dict[str, Any], name: str) -> str:
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in rep["warnings"]) or "<li>none</li>"
     c = rep["counts"]
     if rep["stage"] == "area":
+        how = (f"boundary-orientation score {c.get('boundary_score')}"
+               if (rep.get("area_search") or {}).get("method") == "boundary orientation"
+               else f"ECC correlation {c.get('area_ecc')}")
         source = (f"{c.get('gcps')} control points on a grid through the affine of the "
-                  f"area-based search (ECC correlation {c.get('area_ecc')}; "
-                  f"{c.get('reference_objects')} reference objects)")
+                  f"area-based search ({how}; {c.get('reference_objects')} reference objects)")
     else:
         source = (f"{c.get('gcps')} control points from {c.get('verified_pairs')} verified "
                   f"object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} "

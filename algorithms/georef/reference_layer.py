@@ -101,7 +101,9 @@ def reference_objects_from_vector(path: PathLike, class_field: Optional[str] = N
     Returns
     -------
     objects : list of PolygonObject
-        Outer rings in the matching CRS, ids in a stable order (by source feature id).
+        Outer rings in the matching CRS, ids in a stable order (by source feature id);
+        ``attributes["features"]``: the source features dissolved into it,
+        ``attributes["outlines"]``: their rings (outer and holes) before the dissolve.
     crs : pyproj.CRS
     info : dict
         Feature counts (read, selected, after dissolve).
@@ -171,15 +173,30 @@ def reference_objects_from_vector(path: PathLike, class_field: Optional[str] = N
     objects = []
     for k, p in enumerate(parts):
         ring = orient_ring(np.asarray(p.exterior.coords)[:, :2])
-        members = [ids[i] for i, g in enumerate(geoms) if g.intersects(p)]
+        inside = [i for i, g in enumerate(geoms) if g.intersects(p)]
         objects.append(PolygonObject(id=k, ring=ring, source=REFERENCE,
-                                     attributes={"features": members}))
+                                     attributes={"features": [ids[i] for i in inside],
+                                                 "outlines": _outlines(geoms[i]
+                                                                       for i in inside)}))
     info = {"features_read": n_read, "selected": len(geoms), "objects": len(objects),
             "snap": eps, "crs": target.to_string()}
     if feedback:
         feedback.info(f"Reference: {len(geoms)} of {n_read} polygons selected, {len(objects)} "
                       f"objects after dissolving touching ones (matching CRS {target.name}).")
     return objects, target, info
+
+
+def _outlines(geoms: Any) -> List[np.ndarray]:
+    """All rings (outer and holes) of the individual polygons before the dissolve: the
+    boundaries between touching polygons, which the dissolved objects no longer have."""
+    out = []
+    for g in geoms:
+        for p in getattr(g, "geoms", [g]):
+            if p.geom_type != "Polygon" or p.is_empty:
+                continue
+            out.append(np.asarray(p.exterior.coords)[:, :2])
+            out += [np.asarray(r.coords)[:, :2] for r in p.interiors]
+    return out
 
 
 def reference_objects_from_raster(path: PathLike, thresholds: Sequence[float],

@@ -97,9 +97,9 @@ def test_area_search_rejects_unrelated_map(tmp_path, plain):
 
 
 def test_everest_area_search_never_wrong():
-    """Landsat 7 B4 against the RGI glacier outlines, unperturbed: the global search does not
-    find this scene yet (see docs/decisions.md); it must fail with the message, not return a
-    wrong georeference."""
+    """Landsat 7 B4 against the RGI glacier outlines, unperturbed: Fourier–Mellin + ECC does
+    not find this scene, the boundary-orientation search does (docs/decisions.md); whatever
+    the search, a result must be within 1 px, else the run fails with the message."""
     import rasterio
 
     folder = shared_data("everest_landsat_rgi")
