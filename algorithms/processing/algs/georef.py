@@ -27,7 +27,8 @@ class GeoreferencePolygons(Algorithm):
         "consistency search, verified, refined by ICP, and control points on their outlines "
         "give the final transform (affine, projective or 2nd-order polynomial). When no "
         "objects match (objects not homogeneous in the image), an area-based search compares "
-        "the whole image with the rasterised polygons instead. Writes a QGIS "
+        "the whole image with the rasterised polygons, or the polygons' individual outlines "
+        "with the image's edge directions, instead. Writes a QGIS "
         "Georeferencer .points file, the control points as GeoPackage, the image resampled into "
         "the map CRS, a copy with the control points embedded and a report (overlay, "
         "residuals, RMSE in px and m). Too few matching objects give a failure message with "
@@ -66,9 +67,11 @@ class GeoreferencePolygons(Algorithm):
                   options=("auto", "objects", "area"),
                   help="objects: match image regions to the polygons as objects; area: "
                        "compare the whole image with the rasterised polygons (rotation and "
-                       "scale by Fourier–Mellin, shift by correlation, refined by ECC) — for "
-                       "objects that are not homogeneous in the image; auto: objects, and the "
-                       "area-based search when they give no result. Polygon layers only."),
+                       "scale by Fourier–Mellin, shift by correlation, refined by ECC), and "
+                       "when that fails the polygons' individual outlines with the image's "
+                       "edge directions — for objects that are not homogeneous in the image, "
+                       "such as glaciers; auto: objects, and the area-based search when they "
+                       "give no result. Polygon layers only."),
         Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
                   minimum=0.1, maximum=50.0, unit="px",
                   help="Control points are accepted (best first) while the RMS of their "

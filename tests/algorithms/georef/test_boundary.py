@@ -128,8 +128,13 @@ def test_search_and_refinement_recover_a_mirrored_rotated_tiling(tiling) -> None
     best = cands[0]
     assert best.mirrored and np.linalg.det(T[:2, :2]) > 0
     assert corner_error(best.transform, T, SIZE, SIZE).max() < 12  # ~ one search cell
-    refined, score = area.refine_orientation(img, rings, best.transform)
+    # the pipeline refines as a similarity first (0.16 / 0.25 px with PyPI's / Debian's
+    # SciPy); the affine, kept only when it scores better, ends 0.36 / 0.59 px off here
+    refined, score = area.refine_orientation(img, rings, best.transform, model="similarity")
     assert corner_error(refined, T, SIZE, SIZE).max() < 0.5
+    assert score > 0.8
+    refined, score = area.refine_orientation(img, rings, best.transform)
+    assert corner_error(refined, T, SIZE, SIZE).max() < 0.75
     assert score > 0.8
 
 
