@@ -151,7 +151,7 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
     import rasterio
     from scipy import ndimage
 
-    from photodem.algorithms.georef.fit import corner_error
+    from photodem.algorithms.georef.fit import centre_matrix, corner_error
     from photodem.algorithms.synthetic.polygon_scene import write_image
 
     image = DATA / f"LE71400412000304SGS00_{bands}.tif"
@@ -162,8 +162,7 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
         a = src.read().astype(np.float64)
         t = src.transform
         W, H = src.width, src.height
-    T0 = np.array([[t.a, t.b, t.c + 0.5 * (t.a + t.b)], [t.d, t.e, t.f + 0.5 * (t.d + t.e)],
-                   [0, 0, 1.0]])
+    T0 = centre_matrix(t)
     rng = np.random.default_rng(20)
     errs, fails, times, stages, scores = [], [], [], [], []
     for k in range(n):
@@ -230,6 +229,8 @@ def _orb_affine(image: str, ortho: str) -> Any:
     import cv2
     import rasterio
 
+    from photodem.algorithms.georef.fit import centre_matrix
+
     with rasterio.open(ortho) as src:
         o = src.read(1)
         t = src.transform
@@ -249,8 +250,7 @@ def _orb_affine(image: str, ortho: str) -> Any:
     if A is None:
         return None
     M = np.vstack([A, [0, 0, 1.0]])  # OpenCV keypoints: pixel centres at integers
-    G = np.array([[t.a, t.b, t.c + 0.5 * (t.a + t.b)], [t.d, t.e, t.f + 0.5 * (t.d + t.e)],
-                  [0, 0, 1.0]])
+    G = centre_matrix(t)
     return G @ M
 
 

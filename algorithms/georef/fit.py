@@ -183,6 +183,14 @@ def fit_transform(image_xy: NDArray[np.float64], map_xy: NDArray[np.float64],
     return fit
 
 
+def centre_matrix(transform: Any) -> NDArray[np.float64]:
+    """3 × 3 image → map matrix of a raster's geotransform (a rasterio ``Affine``), with the
+    project's pixel convention: pixel centres at integer (col, row)."""
+    t = transform
+    return np.array([[t.a, t.b, t.c + 0.5 * (t.a + t.b)], [t.d, t.e, t.f + 0.5 * (t.d + t.e)],
+                     [0.0, 0.0, 1.0]])
+
+
 def corner_error(matrix_or_fit: Any, truth: NDArray[np.float64], width: int, height: int
                  ) -> NDArray[np.float64]:
     """Distance (image pixels) between the image corners mapped by the recovered and by the

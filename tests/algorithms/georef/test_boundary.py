@@ -15,7 +15,7 @@ from shapely.geometry import MultiPoint, Polygon, box, mapping
 
 from photodem.algorithms.errors import GeometryError
 from photodem.algorithms.georef import area
-from photodem.algorithms.georef.fit import corner_error
+from photodem.algorithms.georef.fit import centre_matrix, corner_error
 from photodem.algorithms.georef.pipeline import georeference
 from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
 from photodem.algorithms.synthetic.polygon_scene import write_image
@@ -180,8 +180,7 @@ def test_everest_rgb_recovered_by_the_boundary_search() -> None:
     image = folder / "LE71400412000304SGS00_RGB.tif"
     with rasterio.open(image) as src:
         t, W, H = src.transform, src.width, src.height
-    truth = np.array([[t.a, t.b, t.c + 0.5 * (t.a + t.b)], [t.d, t.e, t.f + 0.5 * (t.d + t.e)],
-                      [0, 0, 1.0]])
+    truth = centre_matrix(t)
     res = georeference(image, folder / "15_rgi60_glacier_outlines.gpkg", search="area")
     assert res["area"]["method"] == "boundary orientation"
     assert corner_error(res["fit"], truth, W, H).max() <= 1.0
