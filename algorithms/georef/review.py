@@ -136,8 +136,9 @@ class Review:
         return rows
 
     def check_rmse(self, fit: TransformFit) -> Tuple[float, int]:
-        """RMSE (map units) and count of the points not in the fit (check points)."""
-        res = fit.extras["all_residuals_map"][~fit.used]
+        """RMSE (map units) and count of the check points: the points the operator took out
+        (switched off, or of a rejected pair) — not the outliers the robust step dropped."""
+        res = fit.extras["all_residuals_map"][~self.active()]
         if not len(res):
             return float("nan"), 0
         return float(np.sqrt(np.mean(np.sum(res * res, axis=1)))), len(res)
@@ -190,6 +191,7 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
     """
     import pyproj
 
+    from ..processing.spec import json_ready
     from ..raster.io import staged_folder
     from .products import (
         report_html,
@@ -243,8 +245,6 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
         write_with_gcps(tmp / f"{name}_gcps.tif", source, result)
         residual_png(tmp / "residuals.png", result, rep["image"]["width"],
                      rep["image"]["height"])
-        from ..processing.spec import json_ready
-
         (tmp / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
                                          encoding="utf-8")
         (tmp / "report.html").write_text(report_html(rep, name), encoding="utf-8")

@@ -314,17 +314,16 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         values = {"run": str(plan.run_dir), "step": name}
         if plan.project is not None:
             values["project"] = str(plan.project)
-        if item is not None:
-            values[item_kind] = Path(item).stem if item_kind == "file" else item  # type: ignore
+        label = Path(item).stem if item is not None and item_kind == "file" else item
+        if label is not None:
+            values[item_kind] = label  # type: ignore[index]
         task_params = {k: _anchored(alg, k, _substitute(v, values, name), base_dir)
                        for k, v in params.items()}
         if item is not None:
             task_params[iterate] = item  # type: ignore[index]
-        task = Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
-                    item_kind=item_kind, params=task_params, log=plan.run_dir)
-        task.log = plan.run_dir / (f"{name}.log" if item is None
-                                   else f"{name}/{_safe(str(task.name))}.log")
-        plan.tasks.append(task)
+        log = plan.run_dir / (f"{name}.log" if label is None else f"{name}/{_safe(label)}.log")
+        plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
+                               item_kind=item_kind, params=task_params, log=log))
 
 
 def _anchored(alg: Any, name: str, value: Any, base_dir: Path) -> Any:
