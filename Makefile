@@ -55,7 +55,7 @@ gui: venv
 
 # Peers are installed in the bench environment only.
 VENV_BENCH := .venv-bench
-BENCH_PEERS := orthority opencv-python-headless xdem cloth-simulation-filter
+BENCH_PEERS := orthority opencv-python-headless xdem cloth-simulation-filter pysmrf
 $(VENV_BENCH)/.installed: pyproject.toml
 	$(PY) -m venv $(VENV_BENCH)
 	$(VENV_BENCH)/bin/pip install -q --upgrade pip
