@@ -132,6 +132,17 @@ def _smrf_labels(xyz: np.ndarray, params: Dict[str, Any]) -> np.ndarray:
     return np.where(res.is_ground, 0, 1).astype(np.int8)
 
 
+def _peer_row(name: str, labels: np.ndarray, seconds: float, tmp: Path,
+              kappas: Dict[str, float]) -> Dict[str, Any]:
+    """Evaluate a peer's labels on samp11 like our own (``filter_evaluate``); record its kappa."""
+    key = f"peer_{len(kappas)}"
+    f = tmp / f"{key}.txt"
+    f.write_text("".join(f"{int(v)}\n" for v in labels))
+    m = _evaluate(str(f), SAMP11, tmp / f"ev_{key}")
+    kappas[name] = m["kappa_pct"]
+    return _class_row(name, m, seconds)
+
+
 def _isprs(tmp: Path, have: set) -> Dict[str, Any]:
     if not SAMP11.is_file():
         return {"skipped": f"ISPRS data not found at {SAMP11}"}
@@ -177,27 +188,17 @@ def _isprs(tmp: Path, have: set) -> Dict[str, Any]:
                           ("CSF documented steep-slope setting (rigidness 1)", 1)):
             t0 = time.perf_counter()
             lab = _csf_labels(xyz, rig)
-            dt = time.perf_counter() - t0
-            f = tmp / f"csf_{rig}.txt"
-            f.write_text("".join(f"{int(v)}\n" for v in lab))
-            m = _evaluate(str(f), SAMP11, tmp / f"ev_csf_{rig}")
-            kappas[name] = m["kappa_pct"]
-            rows.append(_class_row(name, m, dt))
+            rows.append(_peer_row(name, lab, time.perf_counter() - t0, tmp, kappas))
     try:
         import pysmrf  # noqa: F401
     except ImportError:
         rows.append({"part": "a", "case": "SMRF", "status": "not installed (pip install "
                      "pysmrf into .venv-bench)"})
     else:
-        for i, (name, params) in enumerate(SMRF_RUNS.items()):
+        for name, params in SMRF_RUNS.items():
             t0 = time.perf_counter()
             lab = _smrf_labels(xyz, params)
-            dt = time.perf_counter() - t0
-            f = tmp / f"smrf_{i}.txt"
-            f.write_text("".join(f"{int(v)}\n" for v in lab))
-            m = _evaluate(str(f), SAMP11, tmp / f"ev_smrf_{i}")
-            kappas[name] = m["kappa_pct"]
-            rows.append(_class_row(name, m, dt))
+            rows.append(_peer_row(name, lab, time.perf_counter() - t0, tmp, kappas))
     rows.append({"part": "a", "case": "SMRF, one parameter set, mean of 15 samples (published)",
                  "kappa_pct": SMRF_KAPPA_PCT})
     csf_keys = [k for k in kappas if k.startswith(("CSF", "SMRF"))]
