@@ -18,7 +18,7 @@ from __future__ import annotations
 import html
 import json
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -29,6 +29,18 @@ from .fit import points_summary
 PathLike = Union[str, Path]
 
 
+def points_source(col: Any, row: Any) -> Tuple[Any, Any]:
+    """Image column/row (pixel centres at integers) → sourceX/sourceY of a ``.points`` file
+    (pixel corners at 0, rows negative; see the module notes). Scalars or arrays."""
+    return col + 0.5, -(row + 0.5)
+
+
+def image_from_points_source(x: Any, y: Any) -> Tuple[Any, Any]:
+    """sourceX/sourceY of a ``.points`` file → image column/row: the inverse of
+    :func:`points_source`."""
+    return x - 0.5, -y - 0.5
+
+
 def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
     """The QGIS Georeferencer ``.points`` file (see the module notes for the convention)."""
     fit = result["fit"]
@@ -37,8 +49,8 @@ def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
              "mapX,mapY,sourceX,sourceY,enable,dX,dY,residual"]
     for g, r in zip(result["gcps"], rows):
         px = fit.pixel_size
-        lines.append(f"{g.map[0]:.6f},{g.map[1]:.6f},{g.image[0] + 0.5:.6f},"
-                     f"{-(g.image[1] + 0.5):.6f},{1 if r['used'] else 0},"
+        sx, sy = points_source(*g.image)
+        lines.append(f"{g.map[0]:.6f},{g.map[1]:.6f},{sx:.6f},{sy:.6f},{1 if r['used'] else 0},"
                      f"{r['dx_map'] / px:.6f},{r['dy_map'] / px:.6f},{r['residual_px']:.6f}")
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
     return Path(path)
@@ -323,7 +335,7 @@ def report_html(rep: Dict[str, Any], name: str) -> str:
                     f"{len(review['switched_off'])} points switched off, "
                     f"{len(review['manual'])} added by hand, rejected pairs "
                     f"{review['rejected_pairs'] or 'none'}; {check}. The automatic result is "
-                    "in report_auto.json.</p>")
+                    "in report_auto.json.</p>" + _independent_html(review))
     else:
         reviewed = ""
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in rep["warnings"]) or "<li>none</li>"
@@ -354,6 +366,25 @@ RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
 <th>residual m</th><th>leave-one-out m</th><th>used</th></tr>{rows}</table>
 </body></html>"""
     return page
+
+
+def _independent_html(review: Dict[str, Any]) -> str:
+    """The independent check points of a review section (none: an empty string)."""
+    check = review.get("independent_check")
+    if not check or not check.get("count"):
+        return ""
+    rows = "".join(
+        f"<tr><td>{html.escape(str(p['id']))}</td><td>{p['image'][0]:.2f}</td>"
+        f"<td>{p['image'][1]:.2f}</td><td>{p['map'][0]:.2f}</td><td>{p['map'][1]:.2f}</td>"
+        f"<td>{p['residual_px']:.3f}</td><td>{p['residual_map']:.3f}</td></tr>"
+        for p in check["points"])
+    notes = "".join(f"<li>{html.escape(w)}</li>" for w in check.get("warnings", []))
+    return (f"<h2>Independent check points</h2><p>{check['count']} points from "
+            f"{html.escape(str(check.get('file')))}, not used in the fit: RMSE "
+            f"<b>{check['rmse_px']:.3f} px</b> = {check['rmse_m']:.3f} m.</p>"
+            + (f"<ul>{notes}</ul>" if notes else "")
+            + "<table><tr><th>id</th><th>col</th><th>row</th><th>X</th><th>Y</th>"
+            f"<th>residual px</th><th>residual m</th></tr>{rows}</table>")
 
 
 def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],

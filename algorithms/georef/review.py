@@ -7,6 +7,13 @@ and those of rejected object pairs, become check points: they keep their residua
 new transform but do not influence it. Saving rewrites the folder's products (``.points``,
 ``gcps.gpkg``, the georeferenced image, the image with GCPs, the report); the automatic
 result is kept as ``report_auto.json`` the first time, so nothing of it is lost.
+
+Independent check points (surveyed, or read from a reference map) come from a text file
+(:func:`read_check_points`). They never take part in the fit; the review reports their
+residuals and RMSE separately from the check points the operator took out of the fit, and
+saving keeps them (with the file's path) in the report's review section, so a later review
+session sees them again. Points outside the image are skipped with a warning, not refused: a
+file surveyed for a whole map sheet may cover more than one image.
 """
 
 from __future__ import annotations
@@ -21,11 +28,26 @@ import numpy as np
 
 from ..errors import InputError
 from ..processing.feedback import Feedback
+from ..quality.points import COLUMN_NAMES, field_separator, find_column, parse_number, split_fields
 from .fit import KINDS, MIN_POINTS, TransformFit, fit_transform, points_summary
+from .products import image_from_points_source
 
 PathLike = Union[str, Path]
 #: Pair index of a control point the operator added by hand.
 MANUAL = -1
+
+#: Header names (lower case) of a check-point file's columns. ``col``/``row``: this project's
+#: image convention (pixel centres at integers, rows downwards); ``corner``: pixel corners at 0
+#: as in QGIS ``.points`` files (line negative) or GDAL (line positive).
+CHECK_COLUMNS: Dict[str, Tuple[str, ...]] = {
+    "col": ("col", "column", "image_col", "image_column", "img_col", "spalte"),
+    "row": ("row", "image_row", "img_row", "zeile"),
+    "corner_col": ("sourcex", "pixelx", "pixel", "source_x", "pixel_x"),
+    "corner_row": ("sourcey", "pixely", "line", "source_y", "pixel_y"),
+    "x": ("mapx", "map_x", *COLUMN_NAMES["x"]),
+    "y": ("mapy", "map_y", *COLUMN_NAMES["y"]),
+    "id": COLUMN_NAMES["id"],
+}
 
 
 @dataclass
@@ -44,6 +66,16 @@ class ReviewPoint:
 
 
 @dataclass
+class CheckPoint:
+    """An independent check point: image (col, row; pixel centres at integers) → map (x, y).
+    Never part of the fit."""
+
+    id: str
+    image: Tuple[float, float]
+    map: Tuple[float, float]
+
+
+@dataclass
 class Review:
     """The editable state of a georeferencing result."""
 
@@ -56,6 +88,9 @@ class Review:
     rejected_pairs: Set[int] = field(default_factory=set)
     pairs: List[Dict[str, Any]] = field(default_factory=list)  # report rows + ICP figures
     report: Dict[str, Any] = field(default_factory=dict)
+    check_points: List[CheckPoint] = field(default_factory=list)  # independent, from a file
+    check_file: Optional[str] = None
+    check_warnings: List[str] = field(default_factory=list)  # of the import (skipped points)
 
     def active(self) -> np.ndarray:
         """Points that may take part in the fit: switched on, pair not rejected."""
@@ -113,12 +148,7 @@ class Review:
         (switched off), ``rejected`` (its object pair is rejected).
         """
         fit = fit or self.fit()
-        img = self.image_xy()
-        # the residual in the image (for drawing): map residual through the local inverse
-        # of the transform (finite differences: the same for every kind of transform)
-        J = np.stack([fit.forward(img + [0.5, 0]) - fit.forward(img - [0.5, 0]),
-                      fit.forward(img + [0, 0.5]) - fit.forward(img - [0, 0.5])], axis=-1)
-        d_img = np.linalg.solve(J, fit.extras["all_residuals_map"][..., None])[..., 0]
+        d_img = _image_residuals(fit, self.image_xy(), fit.extras["all_residuals_map"])
         rows = []
         for k, (p, r) in enumerate(zip(self.points, points_summary(fit))):
             if p.pair in self.rejected_pairs:
@@ -142,6 +172,214 @@ class Review:
         if not len(res):
             return float("nan"), 0
         return float(np.sqrt(np.mean(np.sum(res * res, axis=1)))), len(res)
+
+    def import_check_points(self, path: PathLike) -> List[str]:
+        """Read independent check points from a file (:func:`read_check_points`); they
+        replace those imported before. Returns the warnings (points skipped).
+
+        Raises
+        ------
+        InputError
+            The file cannot be read or holds no usable check point.
+        """
+        image = self.report.get("image", {})
+        points, warnings = read_check_points(path, image.get("width"), image.get("height"),
+                                             self.crs_wkt)
+        self.check_points = points
+        self.check_file = str(Path(path).resolve())
+        self.check_warnings = warnings
+        return warnings
+
+    def independent_check(self, fit: TransformFit) -> Dict[str, Any]:
+        """Residuals of the independent check points under ``fit``.
+
+        Returns
+        -------
+        dict
+            ``count``; ``rmse_m`` and ``rmse_px`` (NaN without points); ``points``: per point
+            id, col, row, x, y, residuals (fitted − measured) in map units and pixels as in
+            :func:`~.fit.points_summary`, and ``dcol``/``drow`` (the residual in the image,
+            for drawing).
+        """
+        img = np.array([p.image for p in self.check_points], float).reshape(-1, 2)
+        mp = np.array([p.map for p in self.check_points], float).reshape(-1, 2)
+        if not len(img):
+            return {"count": 0, "rmse_m": float("nan"), "rmse_px": float("nan"), "points": []}
+        res = fit.forward(img) - mp
+        d_img = _image_residuals(fit, img, res)
+        dist = np.hypot(res[:, 0], res[:, 1])
+        rmse = float(np.sqrt(np.mean(dist * dist)))
+        points = [{"id": p.id, "col": p.image[0], "row": p.image[1], "x": p.map[0],
+                   "y": p.map[1], "dx_map": round(float(r[0]), 4),
+                   "dy_map": round(float(r[1]), 4), "residual_map": round(float(d), 4),
+                   "residual_px": round(float(d) / fit.pixel_size, 5),
+                   "dcol": float(di[0]), "drow": float(di[1])}
+                  for p, r, d, di in zip(self.check_points, res, dist, d_img)]
+        return {"count": len(points), "rmse_m": rmse, "rmse_px": rmse / fit.pixel_size,
+                "points": points}
+
+
+def _image_residuals(fit: TransformFit, img: np.ndarray, res_map: np.ndarray) -> np.ndarray:
+    """Map residuals at image points taken into the image (for drawing): through the local
+    inverse of the transform (finite differences: the same for every kind of transform)."""
+    J = np.stack([fit.forward(img + [0.5, 0]) - fit.forward(img - [0.5, 0]),
+                  fit.forward(img + [0, 0.5]) - fit.forward(img - [0, 0.5])], axis=-1)
+    return np.linalg.solve(J, res_map[..., None])[..., 0]
+
+
+# -- independent check points from a file -------------------------------------------------------
+def read_check_points(path: PathLike, width: Optional[int] = None,
+                      height: Optional[int] = None, crs_wkt: Optional[str] = None
+                      ) -> Tuple[List[CheckPoint], List[str]]:
+    """Independent check points from a CSV/TXT file with a header.
+
+    The separator is a comma, semicolon, tab or whitespace (with a semicolon or tab, a decimal
+    comma is read as a point); ``#`` starts a comment. The
+    columns are found by name (:data:`CHECK_COLUMNS`): image ``col,row`` (pixel centres at
+    integers, rows downwards) or ``pixel,line`` / ``sourceX,sourceY`` / ``pixelX,pixelY``
+    (pixel corners at 0, as in a QGIS Georeferencer ``.points`` file — there the line is
+    negative; all lines ≥ 0 are taken as GDAL's downward lines); map ``x,y`` (or ``mapX,mapY``,
+    ``easting,northing`` …); an optional ``id``. Other columns (a ``.points`` file's
+    ``enable``, residuals) are ignored: every row is a check point.
+
+    Parameters
+    ----------
+    width, height : int, optional
+        The image size: points outside the image are skipped with a warning.
+    crs_wkt : str, optional
+        The result's CRS: a ``#CRS:`` line (``.points`` file) must name the same CRS.
+
+    Returns
+    -------
+    points, warnings
+
+    Raises
+    ------
+    InputError
+        A missing file, no header, missing columns, a non-numeric value, no rows, another
+        CRS, or no point inside the image.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"The check-point file '{path}' does not exist.")
+    crs_line, lines = _check_lines(path)
+    if not lines:
+        raise InputError(f"The check-point file '{path.name}' holds no check points.")
+    sep = field_separator(lines[0][1])
+    header = split_fields(lines[0][1], sep)
+    columns, corner = _check_columns(path.name, header)
+    ids, values = _check_values(path.name, lines[1:], sep, header, columns)
+    if not ids:
+        raise InputError(f"The check-point file '{path.name}' has a header but no check "
+                         "points.")
+    col, row, x, y = values.T
+    if corner:
+        col, row = _corner_to_image(path.name, col, row)
+    if crs_line and crs_wkt:
+        _check_crs(path.name, crs_line, crs_wkt)
+    points = [CheckPoint(i, (float(c), float(r)), (float(u), float(v)))
+              for i, c, r, u, v in zip(ids, col, row, x, y)]
+    return _inside_image(path.name, points, width, height)
+
+
+def _check_lines(path: Path) -> Tuple[Optional[str], List[Tuple[int, str]]]:
+    """A ``#CRS:`` comment (QGIS ``.points``) and the numbered lines without comments."""
+    crs_line, lines = None, []
+    text = path.read_text(encoding="utf-8-sig", errors="replace")
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if raw.startswith("#CRS:"):
+            crs_line = raw.removeprefix("#CRS:").strip()
+        stripped = raw.split("#", 1)[0].strip()
+        if stripped:
+            lines.append((number, stripped))
+    return crs_line, lines
+
+
+def _check_columns(name: str, header: Sequence[str]) -> Tuple[List[Optional[int]], bool]:
+    """Indices of id, col, row, x, y in the header, and whether col/row are corner-based."""
+    if all(parse_number(t) is not None for t in header if t):
+        raise InputError(f"'{name}' has no header line; the first line must name the columns, "
+                         "e.g. col,row,x,y or pixel,line,mapX,mapY.")
+    find = {key: find_column(header, names) for key, names in CHECK_COLUMNS.items()}
+    corner = find["col"] is None or find["row"] is None
+    col, row = (find["corner_col"], find["corner_row"]) if corner else (find["col"], find["row"])
+    missing = [label for label, idx in (("image column", col), ("image row", row),
+                                        ("map x", find["x"]), ("map y", find["y"]))
+               if idx is None]
+    if missing:
+        raise InputError(f"The header of '{name}' lacks {', '.join(missing)} (found: "
+                         f"{', '.join(header)}); name the columns col,row,x,y or "
+                         "pixel,line,mapX,mapY.")
+    return [find["id"], col, row, find["x"], find["y"]], corner
+
+
+def _check_values(name: str, lines: Sequence[Tuple[int, str]], sep: Optional[str],
+                  header: Sequence[str], columns: Sequence[Optional[int]]
+                  ) -> Tuple[List[str], np.ndarray]:
+    """Ids and (col, row, x, y) of the data lines; a bad value names its line and column."""
+    cid, *idx = columns
+    # a semicolon or tab file may come from a spreadsheet with decimal commas (German locale)
+    comma = sep in (";", "\t")
+    ids: List[str] = []
+    values: List[List[float]] = []
+    for number, text in lines:
+        tokens = split_fields(text, sep)
+        row: List[float] = []
+        for c in idx:
+            token = tokens[c] if c < len(tokens) else ""
+            value = parse_number(token.replace(",", ".") if comma else token)
+            if value is None:
+                raise InputError(f"'{name}' line {number}: {header[c]} '{token}' is not a "
+                                 "number.")
+            row.append(value)
+        ids.append(tokens[cid] if cid is not None and cid < len(tokens) and tokens[cid]
+                   else str(number))
+        values.append(row)
+    return ids, np.array(values, float).reshape(-1, 4)
+
+
+def _corner_to_image(name: str, col: np.ndarray, row: np.ndarray
+                     ) -> Tuple[np.ndarray, np.ndarray]:
+    """Corner-based pixel/line → image col/row: QGIS's negative lines through the
+    ``.points`` convention, GDAL's positive lines as their negatives."""
+    if (row > 0).any() and (row < 0).any():
+        raise InputError(f"'{name}': the line column mixes positive and negative values; "
+                         "a QGIS .points file has negative lines, a GDAL list positive ones.")
+    return image_from_points_source(col, row if (row <= 0).all() else -row)
+
+
+def _check_crs(name: str, crs_line: str, crs_wkt: str) -> None:
+    """A ``.points`` file's CRS must be the result's (no reprojection of check points)."""
+    import pyproj
+
+    try:
+        same = pyproj.CRS.from_user_input(crs_line).equals(pyproj.CRS.from_wkt(crs_wkt),
+                                                           ignore_axis_order=True)
+    except pyproj.exceptions.CRSError:
+        return  # an unreadable CRS comment: trust the operator, as for files without one
+    if not same:
+        raise InputError(f"'{name}' is in another CRS than the georeferencing result; "
+                         "export the check points in the result's CRS.")
+
+
+def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
+                  height: Optional[int]) -> Tuple[List[CheckPoint], List[str]]:
+    """The points inside the image (pixel edges included), and a warning for the others."""
+    if not width or not height:
+        return points, []
+    ok = [-0.5 <= p.image[0] <= width - 0.5 and -0.5 <= p.image[1] <= height - 0.5
+          for p in points]
+    inside = [p for p, k in zip(points, ok) if k]
+    if not inside:
+        raise InputError(f"None of the {len(points)} check points in '{name}' lies in the "
+                         f"image ({width} × {height} pixels); col,row count pixel centres "
+                         "from 0, pixel,line are QGIS .points coordinates.")
+    outside = [p.id for p, k in zip(points, ok) if not k]
+    warnings = []
+    if outside:
+        shown = ", ".join(outside[:10]) + (" …" if len(outside) > 10 else "")
+        warnings.append(f"Skipped check points outside the image ({len(outside)}): {shown}.")
+    return inside, warnings
 
 
 def load_review(folder: PathLike) -> Review:
@@ -172,11 +410,15 @@ def load_review(folder: PathLike) -> Review:
     pairs = [{"pair": k, **row, **{key: icp.get(k, {}).get(key) for key in
                                    ("overlap", "icp_rms_px", "iterations", "converged")}}
              for k, row in enumerate(rep.get("pairs", []))]
+    check = state.get("independent_check") or {}
     return Review(folder=folder, name=points[0].stem, crs_wkt=crs_wkt, points=pts,
                   kind=state.get("transform", rep.get("transform", {}).get("kind", "affine")),
                   drop_outliers=bool(state.get("drop_outliers", True)),
                   rejected_pairs={int(p) for p in state.get("rejected_pairs", [])},
-                  pairs=pairs, report=rep)
+                  pairs=pairs, report=rep,
+                  check_points=[CheckPoint(str(p["id"]), tuple(p["image"]), tuple(p["map"]))
+                                for p in check.get("points", [])],
+                  check_file=check.get("file"), check_warnings=list(check.get("warnings", [])))
 
 
 def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str, str]:
@@ -232,7 +474,8 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
                      "switched_off": [k for k, p in enumerate(review.points) if not p.enabled],
                      "manual": [k for k, p in enumerate(review.points) if p.manual],
                      "check_points": n_check,
-                     "check_rmse_m": None if not n_check else round(check_rmse, 4)}
+                     "check_rmse_m": None if not n_check else round(check_rmse, 4),
+                     "independent_check": _independent_json(review, fit)}
     with staged_folder(folder, replace=True, product="georeference_polygons") as tmp:
         for keep in ("overlay.png", "report_auto.json"):
             if (folder / keep).is_file():
@@ -252,3 +495,17 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
     return {"folder": str(folder), "points": str(folder / f"{name}.points"),
             "gcps": str(folder / "gcps.gpkg"), "image": str(folder / f"{name}_georef.tif"),
             "report": str(folder / "report.json"), "html": str(folder / "report.html")}
+
+
+def _independent_json(review: Review, fit: TransformFit) -> Optional[Dict[str, Any]]:
+    """The report's record of the independent check points (``None`` without any)."""
+    check = review.independent_check(fit)
+    if not check["count"]:
+        return None
+    return {"file": review.check_file, "count": check["count"],
+            "rmse_m": round(check["rmse_m"], 4), "rmse_px": round(check["rmse_px"], 5),
+            "warnings": review.check_warnings,
+            "points": [{"id": p["id"], "image": [p["col"], p["row"]], "map": [p["x"], p["y"]],
+                        **{k: p[k] for k in ("dx_map", "dy_map", "residual_map",
+                                             "residual_px")}}
+                       for p in check["points"]]}

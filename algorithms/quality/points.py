@@ -75,7 +75,8 @@ class PointSet:
         return len(self.ids)
 
 
-def _number(token: str) -> Optional[float]:
+def parse_number(token: str) -> Optional[float]:
+    """The finite number a text field holds, else ``None``."""
     try:
         value = float(token)
     except ValueError:
@@ -83,22 +84,24 @@ def _number(token: str) -> Optional[float]:
     return value if math.isfinite(value) else None
 
 
-def _split(line: str, sep: Optional[str]) -> List[str]:
+def split_fields(line: str, sep: Optional[str]) -> List[str]:
     """Fields of a line: by ``sep`` (a CSV with a header), else by any run of separators."""
     parts = line.split(sep) if sep else re.split(r"[,;\s]+", line.strip())
     return [p.strip().strip('"').strip("'").strip() for p in parts]
 
 
-def _separator(line: str) -> Optional[str]:
+def field_separator(line: str) -> Optional[str]:
+    """The separator of a header line: comma, semicolon or tab; ``None`` = whitespace."""
     for sep in (",", ";", "\t"):
         if sep in line:
             return sep
     return None  # whitespace
 
 
-def _find_column(names: Sequence[str], key: str) -> Optional[int]:
+def find_column(names: Sequence[str], candidates: Sequence[str]) -> Optional[int]:
+    """Index of the first of ``candidates`` (lower case) among the column ``names``."""
     lowered = [n.lower() for n in names]
-    for candidate in COLUMN_NAMES[key]:
+    for candidate in candidates:
         if candidate in lowered:
             return lowered.index(candidate)
     return None
@@ -114,38 +117,38 @@ def _read_text(path: Path) -> PointSet:
     if not lines:
         raise InputError(f"The points file '{path.name}' holds no points (only comments or "
                          "empty lines).")
-    sep = _separator(lines[0][1])
-    first = _split(lines[0][1], sep)
+    sep = field_separator(lines[0][1])
+    first = split_fields(lines[0][1], sep)
     columns: Optional[Tuple[Optional[int], int, int, int]] = None
     names = {n for key in ("x", "y", "z") for n in COLUMN_NAMES[key]}
-    header = all(_number(t) is None for t in first if t) and \
+    header = all(parse_number(t) is None for t in first if t) and \
         (sep is not None or any(t.lower() in names for t in first))
     if not header:
         sep = None  # XYZ text: any mix of separators
     else:
-        cx, cy, cz = (_find_column(first, k) for k in ("x", "y", "z"))
+        cx, cy, cz = (find_column(first, COLUMN_NAMES[k]) for k in ("x", "y", "z"))
         if cx is None or cy is None or cz is None:
             raise InputError(
                 f"The header of '{path.name}' has no x/y/z columns (found: {', '.join(first)}); "
                 "name them x, y, z (or easting, northing, height)."
             )
-        columns = (_find_column(first, "id"), cx, cy, cz)
+        columns = (find_column(first, COLUMN_NAMES["id"]), cx, cy, cz)
         lines = lines[1:]
     ids: List[str] = []
     xyz: List[Tuple[float, float, float]] = []
     skipped = 0
     for number, text in lines:
-        tokens = _split(text, sep)
+        tokens = split_fields(text, sep)
         if columns is not None:
             cid, cx, cy, cz = columns
             if max(cx, cy, cz) >= len(tokens):
                 skipped += 1
                 continue
-            values = [_number(tokens[cx]), _number(tokens[cy]), _number(tokens[cz])]
+            values = [parse_number(tokens[c]) for c in (cx, cy, cz)]
             name = tokens[cid] if cid is not None and cid < len(tokens) else str(number)
         else:
-            offset = 1 if tokens and _number(tokens[0]) is None else 0
-            values = [_number(t) for t in tokens[offset:offset + 3]]
+            offset = 1 if tokens and parse_number(tokens[0]) is None else 0
+            values = [parse_number(t) for t in tokens[offset:offset + 3]]
             name = tokens[0] if offset else str(number)
             if len(values) < 3:
                 skipped += 1
@@ -175,8 +178,8 @@ def _read_vector(path: Path) -> PointSet:
             if "Point" not in str(src.schema.get("geometry", "")):
                 continue
             fields = list(src.schema["properties"])
-            zf = _find_column(fields, "z")
-            idf = _find_column(fields, "id")
+            zf = find_column(fields, COLUMN_NAMES["z"])
+            idf = find_column(fields, COLUMN_NAMES["id"])
             crs = src.crs_wkt or None
             for feature in src:
                 geom = feature["geometry"]

@@ -3,8 +3,10 @@
 The operator switches control points off (they become check points), rejects object pairs,
 adds control points by hand, chooses the transform and the outlier removal, and sees the
 residuals and RMSE update at once; *Save* writes the folder's products again
-(:func:`~photodem.algorithms.georef.review.save_review`). The same dialog serves the
-standalone toolbox and QGIS.
+(:func:`~photodem.algorithms.georef.review.save_review`). Independent check points imported
+from a file follow the control points in the point table (role "check (independent)", tinted
+rows without a Use box), with their own colour on the residual map and their own RMSE in the
+summary. The same dialog serves the standalone toolbox and QGIS.
 """
 
 from __future__ import annotations
@@ -19,11 +21,14 @@ from ...algorithms.georef.fit import KINDS
 from ...algorithms.georef.review import Review, load_review, save_review
 from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
-from ..qt import QtCore, QtWidgets, pyqtSignal
+from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
 #: Colours of the point roles on the residual map.
 ROLE_COLOURS = {"control": "tab:blue", "outlier": "tab:orange", "check": "tab:green",
                 "rejected": "tab:red"}
+#: Colour of the independent check points (map) and the tint of their table rows.
+INDEPENDENT_COLOUR = "tab:purple"
+INDEPENDENT_TINT = "#efe6f7"
 
 
 def point_columns() -> List[str]:
@@ -43,7 +48,8 @@ def pair_columns() -> List[str]:
 def role_text(role: str) -> str:
     """The operator's word for a point role."""
     return {"control": tr("control point"), "outlier": tr("outlier (dropped)"),
-            "check": tr("check point (off)"), "rejected": tr("pair rejected")}.get(role, role)
+            "check": tr("check point (off)"), "rejected": tr("pair rejected"),
+            "independent": tr("check (independent)")}.get(role, role)
 
 
 class AddPointDialog(QtWidgets.QDialog):
@@ -103,6 +109,8 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.message_boxes = message_boxes
         self.dirty = False
         self.rows: List[Dict[str, Any]] = []
+        self.check: Dict[str, Any] = {"count": 0, "points": []}  # independent check points
+        self.notes: List[str] = list(self.review.check_warnings)  # of the import, shown below
         self.fit: Any = None
         self.setWindowTitle(tr("Review georeferencing — {0}").format(self.review.name))
         self.resize(1250, 760)
@@ -145,6 +153,11 @@ class GeorefReviewDialog(QtWidgets.QDialog):
 
         # bottom: actions
         self.add_button = QtWidgets.QPushButton(tr("Add control point…"), self)
+        self.import_button = QtWidgets.QPushButton(tr("Import check points…"), self)
+        self.import_button.setToolTip(tr(
+            "Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel "
+            "centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are "
+            "never used in the fit."))
         self.worst_button = QtWidgets.QPushButton(tr("Switch off largest residual"), self)
         self.save_button = QtWidgets.QPushButton(tr("Save"), self)
         self.save_button.setToolTip(tr("Write the control points, the georeferenced image and "
@@ -152,7 +165,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                        "report_auto.json)."))
         self.close_button = QtWidgets.QPushButton(tr("Close"), self)
         buttons = QtWidgets.QHBoxLayout()
-        for b in (self.add_button, self.worst_button):
+        for b in (self.add_button, self.import_button, self.worst_button):
             buttons.addWidget(b)
         buttons.addStretch(1)
         buttons.addWidget(self.save_button)
@@ -175,6 +188,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.pair_table.itemChanged.connect(self._on_pair_item)
         self.point_table.itemSelectionChanged.connect(self._draw)
         self.add_button.clicked.connect(self.add_point)
+        self.import_button.clicked.connect(lambda: self.import_check_points())
         self.worst_button.clicked.connect(self.switch_off_worst)
         self.save_button.clicked.connect(self.save)
         self.close_button.clicked.connect(self.close)
@@ -215,14 +229,23 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         table.blockSignals(False)
 
     def _fill_points(self) -> None:
-        """(Re)build the point rows: the Use check boxes and fixed columns."""
+        """(Re)build the point rows: the Use check boxes and fixed columns; after the control
+        points the independent check points (tinted, no Use box: never in the fit)."""
         table = self.point_table
         table.blockSignals(True)
-        table.setRowCount(len(self.review.points))
+        n = len(self.review.points)
+        table.setRowCount(n + len(self.review.check_points))
         for r, p in enumerate(self.review.points):
             table.setItem(r, 0, self._check_item(p.enabled))
             for c in range(1, table.columnCount()):
                 table.setItem(r, c, QtWidgets.QTableWidgetItem(""))
+        tint = QtGui.QBrush(QtGui.QColor(INDEPENDENT_TINT))
+        for r in range(n, table.rowCount()):
+            for c in range(table.columnCount()):
+                item = QtWidgets.QTableWidgetItem("")
+                item.setFlags(QtCore.Qt.ItemIsEnabled | QtCore.Qt.ItemIsSelectable)
+                item.setBackground(tint)
+                table.setItem(r, c, item)
         table.blockSignals(False)
 
     # -- state changes ---------------------------------------------------------------------------
@@ -239,7 +262,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self._changed()
 
     def _on_point_item(self, item: QtWidgets.QTableWidgetItem) -> None:
-        if item.column() == 0:
+        if item.column() == 0 and item.row() < len(self.review.points):
             self.review.points[item.row()].enabled = item.checkState() == QtCore.Qt.Checked
             self._changed()
 
@@ -276,6 +299,38 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self._changed()
         self.point_table.selectRow(len(self.review.points) - 1)
 
+    def import_check_points(self, path: Optional[str] = None) -> bool:
+        """Import independent check points from a file (asks for it unless ``path`` is
+        given); they replace those imported before. True on success."""
+        if not path:
+            start = self.review.check_file or str(self.review.folder)
+            path = QtWidgets.QFileDialog.getOpenFileName(
+                self, tr("Import check points"), start,
+                tr("Check points (*.csv *.txt *.points);;All files (*)"))[0]
+            if not path:
+                return False
+        try:
+            warnings = self.review.import_check_points(path)
+        except PhotodemError as exc:
+            self._error(str(exc))
+            return False
+        self.notes = warnings
+        self._fill_points()
+        self._changed()
+        self.point_table.resizeColumnToContents(2)  # the role column: the longer role text
+        if warnings and self.message_boxes:
+            QtWidgets.QMessageBox.information(self, tr("PhotoDEM"), " ".join(warnings))
+        self.tabs.setCurrentWidget(self.point_table)
+        # after the event loop: the table's scroll range follows its new rows only then
+        QtCore.QTimer.singleShot(0, self._show_check_rows)
+        return True
+
+    def _show_check_rows(self) -> None:
+        """Scroll the point table to the independent check points."""
+        item = self.point_table.item(len(self.review.points), 0)
+        if item is not None:
+            self.point_table.scrollToItem(item, QtWidgets.QAbstractItemView.PositionAtTop)
+
     def switch_off_worst(self) -> None:
         """Switch off the control point with the largest residual."""
         candidates = [r for r in self.rows if r["role"] == "control"]
@@ -290,6 +345,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             self.fit = self.review.fit()
         except PhotodemError as exc:
             self.fit, self.rows = None, []
+            self.check = {"count": 0, "points": []}
             self.summary.setText(f"<span style='color:#c0392b'>{exc}</span>")
             self.save_button.setEnabled(False)
             self._draw()
@@ -305,6 +361,14 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                       row["residual_map"], row["loo_map"])
             for c, v in enumerate(values, start=1):
                 table.item(r, c).setText(_fmt(v))
+        self.check = self.review.independent_check(self.fit)
+        for r, p in enumerate(self.check["points"], start=len(self.rows)):
+            values = (p["id"], role_text("independent"), "", p["col"], p["row"], p["x"],
+                      p["y"], p["dx_map"] / self.fit.pixel_size,
+                      p["dy_map"] / self.fit.pixel_size, p["residual_px"], p["residual_map"],
+                      None)
+            for c, v in enumerate(values, start=1):
+                table.item(r, c).setText(_fmt(v))
         table.setUpdatesEnabled(True)
         table.blockSignals(False)
         fit = self.fit
@@ -314,8 +378,14 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                     len(self.rows))
         if n_check:
             text += tr("; {0} check points: RMSE {1:.3f} m").format(n_check, check)
+        if self.check["count"]:
+            text += tr("; {0} independent check points: RMSE <b>{1:.3f} px</b> = {2:.3f} m"
+                       ).format(self.check["count"], self.check["rmse_px"],
+                                self.check["rmse_m"])
         if self.dirty:
             text += " — <i>" + tr("not saved") + "</i>"
+        if self.notes:
+            text += "<br><span style='color:#b9770e'>" + " ".join(self.notes) + "</span>"
         self.summary.setText(text)
         self.save_button.setEnabled(True)
         self._draw()
@@ -328,10 +398,14 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             h, w = self.thumb.shape
             ax.imshow(self.thumb, cmap="gray", extent=(-0.5, w * f - 0.5, h * f - 0.5, -0.5))
         xy = self.review.image_xy()
+        ind = self.check["points"] if self.rows else []
+        ind_xy = np.array([[p["col"], p["row"]] for p in ind]).reshape(-1, 2)
+        ind_res = np.array([[p["dcol"], p["drow"]] for p in ind]).reshape(-1, 2)
         if self.rows and len(xy):
             res = np.array([[r["dcol"], r["drow"]] for r in self.rows])
-            longest = float(np.hypot(*res.T).max()) or 1.0
-            span = float(np.ptp(xy, axis=0).max()) or 1.0
+            # one scale for both kinds of points: their arrows compare
+            longest = float(np.hypot(*np.vstack([res, ind_res]).T).max()) or 1.0
+            span = float(np.ptp(np.vstack([xy, ind_xy]), axis=0).max()) or 1.0
             k = 0.08 * span / longest
             for role, colour in ROLE_COLOURS.items():
                 sel = np.array([r["role"] == role for r in self.rows])
@@ -341,13 +415,22 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                               width=0.003)
                     ax.plot(xy[sel, 0], xy[sel, 1], ".", color=colour, ms=3,
                             label=role_text(role))
+            if len(ind_xy):
+                ax.quiver(ind_xy[:, 0], ind_xy[:, 1], ind_res[:, 0] * k, ind_res[:, 1] * k,
+                          color=INDEPENDENT_COLOUR, angles="xy", scale_units="xy", scale=1,
+                          width=0.004)
+                ax.plot(ind_xy[:, 0], ind_xy[:, 1], "^", color=INDEPENDENT_COLOUR, ms=6,
+                        mec="black", mew=0.5, label=role_text("independent"))
             ax.legend(loc="lower right", fontsize=7)
             ax.set_title(tr("Residuals (×{0:.0f})").format(k), fontsize=9)
         elif len(xy):
             ax.plot(xy[:, 0], xy[:, 1], ".", color="0.5", ms=3)
-        selected = sorted({i.row() for i in self.point_table.selectedIndexes()})
-        if selected and len(xy):
-            ax.plot(xy[selected, 0], xy[selected, 1], "o", mfc="none", mec="yellow", ms=9)
+        every = np.vstack([xy, ind_xy])
+        selected = [r for r in sorted({i.row() for i in self.point_table.selectedIndexes()})
+                    if r < len(every)]
+        if selected:
+            ax.plot(every[selected, 0], every[selected, 1], "o", mfc="none", mec="yellow",
+                    ms=9)
         ax.set_aspect("equal")
         if self.thumb is not None:
             h, w = self.thumb.shape
@@ -356,10 +439,12 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.canvas.draw_idle()
 
     def _on_click(self, event: Any) -> None:
-        """Select the control point nearest to a click on the map."""
+        """Select the point (control or independent check point) nearest to a click."""
         if event.inaxes is not self.axes or event.xdata is None:
             return
-        xy = self.review.image_xy()
+        xy = np.vstack([self.review.image_xy(),
+                        np.array([[p["col"], p["row"]] for p in self.check["points"]]
+                                 ).reshape(-1, 2)])
         if not len(xy):
             return
         k = int(np.argmin(np.hypot(xy[:, 0] - event.xdata, xy[:, 1] - event.ydata)))

@@ -14,6 +14,7 @@ pytest.importorskip("pytestqt")
 from photodem.algorithms.processing import registry
 from photodem.algorithms.synthetic.polygon_scene import georef_case
 from photodem.plugin.app.main_window import ToolboxWindow
+from photodem.plugin.qt import QtCore
 from photodem.plugin.widgets.georef_review import GeorefReviewDialog
 
 
@@ -94,3 +95,99 @@ def test_toolbox_opens_the_review(qtbot, folder, tmp_path) -> None:
     dialog.close()
     assert window.open_georef_review(str(tmp_path / "empty")) is None
     assert "no georeferencing result" in window.statusBar().currentMessage()
+
+
+def _survey_file(dialog, path, shift_px: float = 3.0) -> int:
+    """Six control points as independent check points, their map points ``shift_px`` pixels
+    east; one more point outside the image. Returns the number of points inside."""
+    pixel = dialog.fit.pixel_size
+    lines = ["name;col;row;x;y"]
+    for k, p in enumerate(dialog.review.points[:6]):
+        lines.append(f"S{k};{p.image[0]};{p.image[1]};{p.map[0] + shift_px * pixel};{p.map[1]}")
+    lines.append("far;-50;10;0;0")
+    path.write_text("\n".join(lines) + "\n")
+    return 6
+
+
+def _import_through_file_dialog(qtbot, dialog, monkeypatch, path) -> None:
+    from photodem.plugin.qt import QtCore, QtWidgets
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, "getOpenFileName",
+                        lambda *args, **kwargs: (str(path), ""))
+    qtbot.mouseClick(dialog.import_button, QtCore.Qt.LeftButton)
+
+
+def test_import_independent_check_points(qtbot, folder, monkeypatch, tmp_path) -> None:
+    dialog = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(dialog)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    n = dialog.point_table.rowCount()
+    matrix = dialog.fit.matrix.copy()
+    inside = _survey_file(dialog, tmp_path / "survey.csv")
+    _import_through_file_dialog(qtbot, dialog, monkeypatch, tmp_path / "survey.csv")
+    assert dialog.point_table.rowCount() == n + inside
+    assert dialog.point_table.item(n, 1).text() == "S0"
+    assert dialog.point_table.item(n, 2).text() == "check (independent)"
+    assert not dialog.point_table.item(n, 0).flags() & QtCore.Qt.ItemIsUserCheckable
+    assert (dialog.fit.matrix == matrix).all()  # never in the fit
+    check = dialog.check
+    assert check["count"] == inside and check["rmse_px"] == pytest.approx(3.0, abs=0.5)
+    text = dialog.summary.text()
+    assert f"{inside} independent check points: RMSE <b>{check['rmse_px']:.3f} px</b>" in text
+    assert "Skipped check points outside the image (1): far." in text and dialog.dirty
+    # their own colour and legend entry on the residual map
+    assert "check (independent)" in [t.get_text() for t in dialog.axes.get_legend().get_texts()]
+    dialog.point_table.selectRow(n + 2)  # a selected check point is drawn too
+    assert len(dialog.axes.lines[-1].get_xdata()) == 1  # the yellow ring
+    qtbot.wait(50)  # the summary's new height laid out
+    dialog.grab().save("/tmp/photodem_georef_review_check.png")
+    with qtbot.waitSignal(dialog.saved, timeout=60000):
+        assert dialog.save()
+    rep = json.loads((folder / "report.json").read_text())
+    assert rep["review"]["independent_check"]["count"] == inside
+    # a second session sees them again
+    again = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(again)
+    assert again.point_table.rowCount() == n + inside
+    assert again.check["rmse_m"] == pytest.approx(check["rmse_m"], abs=1e-4)
+    assert "outside the image (1): far" in again.summary.text()
+    # a bad file: the message, the points imported before stay
+    (tmp_path / "bad.csv").write_text("col,row,x,y\n1,2,drei,4\n")
+    _import_through_file_dialog(qtbot, again, monkeypatch, tmp_path / "bad.csv")
+    assert "line 2: x 'drei' is not a number" in again.summary.text()
+    assert len(again.review.check_points) == inside
+
+
+def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path) -> None:
+    """The German dialog (the committed .ts compiled with lrelease, as the build does)."""
+    import shutil as sh
+    import subprocess
+    from pathlib import Path
+
+    from photodem.plugin import i18n
+
+    lrelease = sh.which("lrelease") or sh.which("/usr/lib/qt5/bin/lrelease")
+    if lrelease is None:
+        pytest.skip("lrelease not installed (Debian package qttools5-dev-tools)")
+    ts = Path(i18n.__file__).resolve().parents[1] / "i18n" / "photodem_de.ts"
+    subprocess.run([lrelease, "-silent", str(ts), "-qm", str(tmp_path / "photodem_de.qm")],
+                   check=True)
+    monkeypatch.setattr(i18n, "I18N_DIR", tmp_path)
+    try:
+        assert i18n.install_translator("de_DE") is not None
+        dialog = GeorefReviewDialog(folder, message_boxes=False)
+        qtbot.addWidget(dialog)
+        dialog.show()
+        qtbot.waitExposed(dialog)
+        assert dialog.import_button.text() == "Kontrollpunkte importieren…"
+        n = dialog.point_table.rowCount()
+        _survey_file(dialog, tmp_path / "survey.csv")
+        _import_through_file_dialog(qtbot, dialog, monkeypatch, tmp_path / "survey.csv")
+        assert dialog.point_table.item(n, 2).text() == "Kontrollpunkt (unabhängig)"
+        assert "6 unabhängige Kontrollpunkte: RMSE <b>" in dialog.summary.text()
+        qtbot.wait(50)  # the summary's new height laid out
+        dialog.grab().save("/tmp/photodem_georef_review_check_de.png")
+        dialog.dirty = False
+    finally:
+        i18n.remove_translator()
