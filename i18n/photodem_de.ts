@@ -2415,7 +2415,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:237; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:481; plugin/widgets/georef_review.py:486</extracomment>
+            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:237; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:489; plugin/widgets/georef_review.py:494</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2600,22 +2600,22 @@
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:457</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:465</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:458; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:466; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:515</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:523</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:515</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:523</extracomment>
             <translation>nein</translation>
         </message>
         <message>
@@ -2670,12 +2670,12 @@
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:376</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:384</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:486</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:494</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
@@ -2699,28 +2699,33 @@
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
+            <source>Skipped check points outside the image ({0}): {1}.</source>
+            <extracomment>plugin/widgets/georef_review.py:333</extracomment>
+            <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
+        </message>
+        <message>
             <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:359</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:367</extracomment>
             <translation>manuell</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:380</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:388</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:382</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:390</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:386</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>Residuals (×{0:.0f})</source>
-            <extracomment>plugin/widgets/georef_review.py:425</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:433</extracomment>
             <translation>Restfehler (×{0:.0f})</translation>
         </message>
         <message>

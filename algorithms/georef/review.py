@@ -90,7 +90,7 @@ class Review:
     report: Dict[str, Any] = field(default_factory=dict)
     check_points: List[CheckPoint] = field(default_factory=list)  # independent, from a file
     check_file: Optional[str] = None
-    check_warnings: List[str] = field(default_factory=list)  # of the import (skipped points)
+    check_skipped: List[str] = field(default_factory=list)  # ids outside the image
 
     def active(self) -> np.ndarray:
         """Points that may take part in the fit: switched on, pair not rejected."""
@@ -175,7 +175,8 @@ class Review:
 
     def import_check_points(self, path: PathLike) -> List[str]:
         """Read independent check points from a file (:func:`read_check_points`); they
-        replace those imported before. Returns the warnings (points skipped).
+        replace those imported before. Returns the ids of the points skipped (outside the
+        image; :func:`skipped_note` words them).
 
         Raises
         ------
@@ -183,12 +184,12 @@ class Review:
             The file cannot be read or holds no usable check point.
         """
         image = self.report.get("image", {})
-        points, warnings = read_check_points(path, image.get("width"), image.get("height"),
-                                             self.crs_wkt)
+        points, skipped = read_check_points(path, image.get("width"), image.get("height"),
+                                            self.crs_wkt)
         self.check_points = points
         self.check_file = str(Path(path).resolve())
-        self.check_warnings = warnings
-        return warnings
+        self.check_skipped = skipped
+        return skipped
 
     def independent_check(self, fit: TransformFit) -> Dict[str, Any]:
         """Residuals of the independent check points under ``fit``.
@@ -251,7 +252,8 @@ def read_check_points(path: PathLike, width: Optional[int] = None,
 
     Returns
     -------
-    points, warnings
+    points, skipped
+        The check points inside the image, and the ids of those outside it.
 
     Raises
     ------
@@ -364,7 +366,7 @@ def _check_crs(name: str, crs_line: str, crs_wkt: str) -> None:
 
 def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
                   height: Optional[int]) -> Tuple[List[CheckPoint], List[str]]:
-    """The points inside the image (pixel edges included), and a warning for the others."""
+    """The points inside the image (pixel edges included), and the ids of the others."""
     if not width or not height:
         return points, []
     ok = [-0.5 <= p.image[0] <= width - 0.5 and -0.5 <= p.image[1] <= height - 0.5
@@ -374,12 +376,19 @@ def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
         raise InputError(f"None of the {len(points)} check points in '{name}' lies in the "
                          f"image ({width} × {height} pixels); col,row count pixel centres "
                          "from 0, pixel,line are QGIS .points coordinates.")
-    outside = [p.id for p, k in zip(points, ok) if not k]
-    warnings = []
-    if outside:
-        shown = ", ".join(outside[:10]) + (" …" if len(outside) > 10 else "")
-        warnings.append(f"Skipped check points outside the image ({len(outside)}): {shown}.")
-    return inside, warnings
+    return inside, [p.id for p, k in zip(points, ok) if not k]
+
+
+def skipped_ids_text(ids: Sequence[str], most: int = 10) -> str:
+    """The first ``most`` ids, comma-separated (… when there are more)."""
+    return ", ".join(ids[:most]) + (" …" if len(ids) > most else "")
+
+
+def skipped_note(ids: Sequence[str]) -> str:
+    """The report's sentence on check points skipped outside the image ('' without any)."""
+    if not ids:
+        return ""
+    return f"Skipped check points outside the image ({len(ids)}): {skipped_ids_text(ids)}."
 
 
 def load_review(folder: PathLike) -> Review:
@@ -418,7 +427,8 @@ def load_review(folder: PathLike) -> Review:
                   pairs=pairs, report=rep,
                   check_points=[CheckPoint(str(p["id"]), tuple(p["image"]), tuple(p["map"]))
                                 for p in check.get("points", [])],
-                  check_file=check.get("file"), check_warnings=list(check.get("warnings", [])))
+                  check_file=check.get("file"),
+                  check_skipped=[str(i) for i in check.get("skipped", [])])
 
 
 def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str, str]:
@@ -504,7 +514,8 @@ def _independent_json(review: Review, fit: TransformFit) -> Optional[Dict[str, A
         return None
     return {"file": review.check_file, "count": check["count"],
             "rmse_m": round(check["rmse_m"], 4), "rmse_px": round(check["rmse_px"], 5),
-            "warnings": review.check_warnings,
+            "skipped": review.check_skipped,
+            "warnings": [skipped_note(review.check_skipped)] if review.check_skipped else [],
             "points": [{"id": p["id"], "image": [p["col"], p["row"]], "map": [p["x"], p["y"]],
                         **{k: p[k] for k in ("dx_map", "dy_map", "residual_map",
                                              "residual_px")}}

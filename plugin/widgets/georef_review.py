@@ -18,7 +18,7 @@ import numpy as np
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.georef.fit import KINDS
-from ...algorithms.georef.review import Review, load_review, save_review
+from ...algorithms.georef.review import Review, load_review, save_review, skipped_ids_text
 from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
@@ -110,7 +110,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.dirty = False
         self.rows: List[Dict[str, Any]] = []
         self.check: Dict[str, Any] = {"count": 0, "points": []}  # independent check points
-        self.notes: List[str] = list(self.review.check_warnings)  # of the import, shown below
+        self.notes: List[str] = self._skipped_notes(self.review.check_skipped)  # shown below
         self.fit: Any = None
         self.setWindowTitle(tr("Review georeferencing — {0}").format(self.review.name))
         self.resize(1250, 760)
@@ -310,11 +310,11 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             if not path:
                 return False
         try:
-            warnings = self.review.import_check_points(path)
+            skipped = self.review.import_check_points(path)
         except PhotodemError as exc:
             self._error(str(exc))
             return False
-        self.notes = warnings
+        self.notes = warnings = self._skipped_notes(skipped)
         self._fill_points()
         self._changed()
         self.point_table.resizeColumnToContents(2)  # the role column: the longer role text
@@ -324,6 +324,14 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         # after the event loop: the table's scroll range follows its new rows only then
         QtCore.QTimer.singleShot(0, self._show_check_rows)
         return True
+
+    @staticmethod
+    def _skipped_notes(ids: List[str]) -> List[str]:
+        """The note on check points skipped outside the image (none without any)."""
+        if not ids:
+            return []
+        return [tr("Skipped check points outside the image ({0}): {1}.").format(
+            len(ids), skipped_ids_text(ids))]
 
     def _show_check_rows(self) -> None:
         """Scroll the point table to the independent check points."""

@@ -186,6 +186,7 @@ def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path) -> 
         _import_through_file_dialog(qtbot, dialog, monkeypatch, tmp_path / "survey.csv")
         assert dialog.point_table.item(n, 2).text() == "Kontrollpunkt (unabhängig)"
         assert "6 unabhängige Kontrollpunkte: RMSE <b>" in dialog.summary.text()
+        assert "außerhalb des Bildes übersprungen (1): far." in dialog.summary.text()
         qtbot.wait(50)  # the summary's new height laid out
         dialog.grab().save("/tmp/photodem_georef_review_check_de.png")
         dialog.dirty = False

@@ -20,6 +20,7 @@ from photodem.algorithms.georef.review import (
     load_review,
     read_check_points,
     save_review,
+    skipped_note,
 )
 from photodem.algorithms.processing import registry
 from photodem.algorithms.synthetic.polygon_scene import georef_case
@@ -186,8 +187,8 @@ def test_check_point_files_in_every_layout(tmp_path, sep, header, convention) ->
             f"{sep}x{sep}y", f"{sep}mapX{sep}mapY", 1)
     path = tmp_path / "check.txt"
     path.write_text(text)
-    points, warnings = read_check_points(path, 100, 100)
-    assert not warnings and len(points) == len(CHECK_IMAGE)
+    points, skipped = read_check_points(path, 100, 100)
+    assert not skipped and len(points) == len(CHECK_IMAGE)
     assert np.allclose([p.image for p in points], CHECK_IMAGE, atol=1e-9)
     assert np.allclose([p.map for p in points], [_map(*ij) for ij in CHECK_IMAGE])
     assert [p.id for p in points] == ([f"P{k}" for k in range(1, 5)] if "id" in header
@@ -253,9 +254,10 @@ def test_points_outside_the_image_are_skipped_with_a_warning(tmp_path) -> None:
     path = tmp_path / "check.csv"
     path.write_text("id,col,row,x,y\na,-0.5,0,1,2\nb,-0.6,0,1,2\nc,99.5,99.5,1,2\n"
                     "d,10,100,1,2\n")
-    points, warnings = read_check_points(path, 100, 100)
+    points, skipped = read_check_points(path, 100, 100)
     assert [p.id for p in points] == ["a", "c"]  # the pixel edges belong to the image
-    assert warnings == ["Skipped check points outside the image (2): b, d."]
+    assert skipped == ["b", "d"]
+    assert skipped_note(skipped) == "Skipped check points outside the image (2): b, d."
 
 
 def test_independent_check_rmse_closed_form(tmp_path) -> None:
