@@ -258,10 +258,12 @@ def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
-def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int) -> Path:
+def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int,
+                 check: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Path:
     """Control points over the image frame with their residual vectors (exaggerated): points
     in the fit blue, the others (outliers, check points) orange; the convex hull of the
-    points in the fit dashed — where the transform is interpolated, not extrapolated."""
+    points in the fit dashed — where the transform is interpolated, not extrapolated.
+    ``check``: independent check points (image (n, 2), map (n, 2)), purple triangles."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -271,9 +273,13 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     xy = np.array([g.image for g in result["gcps"]], float).reshape(-1, 2)
     mp = np.array([g.map for g in result["gcps"]], float).reshape(-1, 2)
     res = _inverse_points(result, mp) - xy  # measured map point taken into the image
+    cxy = np.zeros((0, 2)) if check is None else np.asarray(check[0], float).reshape(-1, 2)
+    cres = (_inverse_points(result, np.asarray(check[1], float).reshape(-1, 2)) - cxy
+            if len(cxy) else np.zeros((0, 2)))
     fig, ax = plt.subplots(figsize=(7, 7 * height / max(width, 1)))
     ax.add_patch(plt.Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
-    longest = float(np.hypot(*res.T).max()) if len(res) else 0.0
+    both = np.vstack([res, cres])
+    longest = float(np.hypot(*both.T).max()) if len(both) else 0.0
     scale = 0.1 * np.hypot(width, height) / longest if longest > 0 else 1.0
     step = 10.0 ** np.floor(np.log10(scale))  # a round factor: 1, 2 or 5 × 10^k
     scale = step * max(f for f in (1, 2, 5) if f * step <= scale)
@@ -282,6 +288,10 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
             ax.quiver(xy[used, 0], xy[used, 1], res[used, 0] * scale, res[used, 1] * scale,
                       color=colour, angles="xy", scale_units="xy", scale=1, width=0.003)
             ax.plot(xy[used, 0], xy[used, 1], ".", color=colour, ms=3)
+    if len(cxy):
+        ax.quiver(cxy[:, 0], cxy[:, 1], cres[:, 0] * scale, cres[:, 1] * scale,
+                  color="tab:purple", angles="xy", scale_units="xy", scale=1, width=0.003)
+        ax.plot(cxy[:, 0], cxy[:, 1], "^", color="tab:purple", ms=5)
     if fit.used.sum() >= 3:
         from scipy.spatial import ConvexHull, QhullError
 
@@ -294,8 +304,11 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     ax.set_xlim(-0.05 * width, 1.05 * width)
     ax.set_ylim(1.05 * height, -0.05 * height)
     ax.set_aspect("equal")
-    ax.set_title(f"residuals ×{scale:.0f}; RMSE {fit.rmse_px:.2f} px, "
-                 f"{int(fit.used.sum())} of {len(xy)} points in the fit")
+    title = (f"residuals ×{scale:.0f}; RMSE {fit.rmse_px:.2f} px, "
+             f"{int(fit.used.sum())} of {len(xy)} points in the fit")
+    if len(cxy):
+        title += f"\n{len(cxy)} independent check points (purple)"
+    ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -496,8 +496,11 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
         write_gcps_gpkg(tmp / "gcps.gpkg", result)
         write_georeferenced(tmp / f"{name}_georef.tif", source, result, feedback=fb)
         write_with_gcps(tmp / f"{name}_gcps.tif", source, result)
+        check = ((np.array([c.image for c in review.check_points], float),
+                  np.array([c.map for c in review.check_points], float))
+                 if review.check_points else None)
         residual_png(tmp / "residuals.png", result, rep["image"]["width"],
-                     rep["image"]["height"])
+                     rep["image"]["height"], check=check)
         (tmp / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
                                          encoding="utf-8")
         (tmp / "report.html").write_text(report_html(rep, name), encoding="utf-8")

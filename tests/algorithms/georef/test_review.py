@@ -309,6 +309,12 @@ def test_independent_check_points_survive_save_and_load(result, folder, tmp_path
     assert [p["id"] for p in check["points"]] == ["S0", "S1", "S2"]
     html = (folder / "report.html").read_text()
     assert "Independent check points" in html and "survey.csv" in html
+    # residuals.png draws them (tab:purple triangles and vectors)
+    from matplotlib.image import imread
+
+    rgb = imread(folder / "residuals.png")[..., :3]
+    purple = np.all(np.abs(rgb - np.array([0x94, 0x67, 0xBD]) / 255) < 0.05, axis=-1)
+    assert purple.sum() > 20
     again = load_review(folder)
     assert again.check_file == str(path.resolve())
     assert [(p.id, p.image) for p in again.check_points] == \
