@@ -63,6 +63,9 @@ PRESETS: Dict[str, Dict[str, Any]] = {
 }
 PRESET_NAMES = tuple(PRESETS)
 DEFAULT_PRESET = "flat"
+#: Default DSM spacing in GSD; the presets' ``smoothing`` refers to cells of this size, so a
+#: DSM asked for at another spacing gets the same surface, sampled differently.
+SPACING_GSD = 2.0
 
 POINT_FORMATS = ("gpkg", "las")
 
@@ -309,7 +312,8 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     reduction : {"l1", "median", "lower"}, optional
         Groundel reduction mode; default the preset's.
     smoothing : float, optional
-        Curvature weight of the FE interpolation; default the preset's.
+        Curvature weight of the FE interpolation for cells of :data:`SPACING_GSD` GSD (scaled
+        to the DSM spacing, so the surface does not depend on it); default the preset's.
     interpolation : {"fe", "membrane"}
         Finite elements with curvature regularisation, or median per cell + membrane filling.
     points_format : {"gpkg", "las"}
@@ -339,7 +343,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         raise InputError(f"Unknown interpolation '{interpolation}'; use fe or membrane.")
     opts, surface = _options(preset, dict(options, groundel_gsd=None, reduction=reduction,
                                           smoothing=smoothing))
-    setup = prepare_model(project, model, spacing=spacing, spacing_gsd=2.0,
+    setup = prepare_model(project, model, spacing=spacing, spacing_gsd=SPACING_GSD,
                           min_height=min_height, max_height=max_height)
     project, m, pair, grid = setup.project, setup.model, setup.pair, setup.grid
     cell = float(groundel) if groundel else float(surface["groundel_gsd"]) * setup.gsd
@@ -415,6 +419,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         w = 1.0 / (np.maximum(sigma_z[inlier], 1e-3) ** 2 + s1 * s1)
         z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                                    weights=w, smoothing=float(surface.get("smoothing", 1.0)),
+                                   reference_spacing=SPACING_GSD * setup.gsd,
                                    breaklines=setup.breaklines, exclusions=setup.exclusions,
                                    boundaries=setup.boundaries, max_gap=max_gap,
                                    feedback=feedback.step(78, 92))

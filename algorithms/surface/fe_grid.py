@@ -33,6 +33,13 @@ Smoothing (dimensionless, scale-invariant)
     follows details longer than that and smooths shorter ones (noise). Small values (0.01–0.1)
     interpolate, larger ones (1–10) filter noisy matching points.
 
+    Per cell, the same ``smoothing`` smooths more on a coarser grid: the curvature equations
+    approximate :math:`λ s^2 \iint z''^2 dA`, and with the points' density fixed ρ grows as
+    :math:`s^2`, so the wavelength grows as :math:`\sqrt{s}`. With ``reference_spacing``
+    :math:`s_0` the smoothing refers to cells of that size, :math:`λ = \text{smoothing}
+    \cdot\tilde w\cdot(s_0/s)^2` (the same continuum energy, as the cascade's λ/4 per
+    coarsening), and the surface does not depend on the output spacing.
+
 Breaklines
     A curvature equation is dropped when its stencil (the grid edges between its nodes,
     closed at the nodes) is crossed or touched by a breakline segment: the slope, and even the
@@ -415,11 +422,22 @@ def _ramp(n: int, lo_edge: bool, hi_edge: bool, overlap: int) -> Array:
 
 
 # -- public --------------------------------------------------------------------------------
+def _spacing_factor(reference: Optional[float], spacing: float) -> float:
+    """λ factor (reference / spacing)² that keeps the continuum curvature energy of a
+    smoothing stated for cells of ``reference`` m on a grid of ``spacing`` m (1 without one)."""
+    if reference is None:
+        return 1.0
+    if not (reference > 0 and math.isfinite(reference)):
+        raise InputError(f"The reference spacing must be a positive number, got {reference}.")
+    return (float(reference) / float(spacing)) ** 2
+
+
 def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
                    weights: Optional[ArrayLike] = None, smoothing: float = 0.1,
                    breaklines: Sequence[Any] = (), exclusions: Sequence[Any] = (),
                    boundaries: Sequence[Any] = (), max_gap: Optional[float] = None,
-                   robust: bool = False, robust_iterations: int = 5, robust_floor: float = 0.0,
+                   reference_spacing: Optional[float] = None, robust: bool = False,
+                   robust_iterations: int = 5, robust_floor: float = 0.0,
                    breakline_weight: float = 100.0, tile: int = 512, overlap: int = 32,
                    solver: str = "cg", tol: float = 1e-7, maxiter: int = 3000,
                    feedback: Optional[Feedback] = None) -> Tuple[Array, Dict[str, Any]]:
@@ -442,6 +460,10 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         Excluded areas (NaN, no observations); measuring area (NaN outside; none = all).
     max_gap : float, optional
         Largest gap (inscribed diameter, m) that gets heights; default every gap.
+    reference_spacing : float, optional
+        Cell size (m) that ``smoothing`` refers to: λ is scaled by (reference_spacing /
+        spacing)² so that the surface does not depend on the grid spacing (module notes);
+        default the grid's own spacing (λ per cell).
     robust : bool
         Iteratively reweighted solution that suppresses blunders (see the module notes).
     robust_iterations : int
@@ -501,7 +523,7 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         raise InputError("No point lies in the grid's measuring area (outside the boundary or "
                          "in exclusion areas); check the points, polygons and CRS.")
     wref = float(np.median(w[pid]))
-    lam = float(smoothing) * wref
+    lam = float(smoothing) * wref * _spacing_factor(reference_spacing, s)
     count = np.bincount(row[pid] * wd + col[pid], minlength=h * wd).reshape(h, wd)
     # breaklines: segments in node coordinates, 3-D vertices as observations
     segs = _segments(breaklines)

@@ -175,6 +175,30 @@ def test_presets_and_unknown_options(started, tmp_path) -> None:
     assert not (tmp_path / "p").exists()
 
 
+def test_surface_smoothing_refers_to_the_default_spacing(started, tmp_path,
+                                                         monkeypatch) -> None:
+    """A DSM asked for at another spacing gets the preset's smoothing for cells of the default
+    spacing (2 GSD), so a coarser DSM is not also a smoother one."""
+    import photodem.algorithms.surface.fe_grid as fe_grid
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def capture(*args, **kwargs):
+        seen.update(kwargs, spacing=args[3].spacing)
+        raise Stop
+
+    monkeypatch.setattr(fe_grid, "fe_interpolate", capture)
+    gsd = prepare_model(started, MODEL).gsd
+    with pytest.raises(Stop):
+        match_model_fbm_lsm(started, MODEL, tmp_path / "s", spacing=4.0 * gsd)
+    assert seen["spacing"] == pytest.approx(4.0 * gsd)
+    assert seen["reference_spacing"] == pytest.approx(2.0 * gsd)
+    assert not (tmp_path / "s").exists()
+
+
 def test_failure_positions_lie_where_their_rays_meet_the_dsm(block, started) -> None:
     """A pixel without a disparity (a failed window) is placed where its ray meets the DSM,
     not at the middle of the disparity range (hundreds of metres of height away)."""
