@@ -169,8 +169,10 @@ def _origin_rows(xyz: np.ndarray, tmp: Path, have: set) -> List[Dict[str, Any]]:
             moved = xyz + np.array([dx, dy, 0.0])
             f = tmp / f"origin_{i}_{j}.txt"
             if isinstance(how, str):
-                np.savetxt(tmp / "moved.txt", moved, fmt="%.2f", delimiter="\t")
-                res = _run_filter(how, {"input": str(tmp / "moved.txt"), "preset": "default",
+                pts = tmp / f"moved_{j}.txt"  # written once per shift, read by each filter
+                if not pts.exists():
+                    np.savetxt(pts, moved, fmt="%.2f", delimiter="\t")
+                res = _run_filter(how, {"input": str(pts), "preset": "default",
                                         "output": str(tmp / f"origin_out_{i}_{j}")})
                 f = Path(res["labels"])
             else:

@@ -1470,7 +1470,7 @@
         </message>
         <message>
             <source>Iterations</source>
-            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:46</extracomment>
             <translation>Iterationen</translation>
         </message>
         <message>
@@ -2400,12 +2400,12 @@
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:252</extracomment>
+            <extracomment>plugin/app/main_window.py:242</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:253</extracomment>
+            <extracomment>plugin/app/main_window.py:243</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
@@ -2415,13 +2415,8 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:237; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:489; plugin/widgets/georef_review.py:494</extracomment>
+            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:229; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:490; plugin/widgets/georef_review.py:495</extracomment>
             <translation>PhotoDEM</translation>
-        </message>
-        <message>
-            <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/app/main_window.py:230; plugin/qgis/plugin.py:123</extracomment>
-            <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>Running {0} …</source>
@@ -2455,97 +2450,97 @@
         </message>
         <message>
             <source>Use</source>
-            <extracomment>plugin/widgets/georef_review.py:36</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
             <translation>Verwenden</translation>
         </message>
         <message>
             <source>Role</source>
-            <extracomment>plugin/widgets/georef_review.py:36</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
             <translation>Rolle</translation>
         </message>
         <message>
             <source>Pair</source>
-            <extracomment>plugin/widgets/georef_review.py:36</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
             <translation>Paar</translation>
         </message>
         <message>
             <source>Column</source>
-            <extracomment>plugin/widgets/georef_review.py:36</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
             <translation>Spalte</translation>
         </message>
         <message>
             <source>Row</source>
-            <extracomment>plugin/widgets/georef_review.py:36</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
             <translation>Zeile</translation>
         </message>
         <message>
             <source>dX [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
             <translation>dX [px]</translation>
         </message>
         <message>
             <source>dY [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
             <translation>dY [px]</translation>
         </message>
         <message>
             <source>Residual [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
             <translation>Restfehler [px]</translation>
         </message>
         <message>
             <source>Residual [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
             <translation>Restfehler [m]</translation>
         </message>
         <message>
             <source>Leave-one-out [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Ohne diesen Punkt [m]</translation>
         </message>
         <message>
             <source>Reject</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>Verwerfen</translation>
         </message>
         <message>
             <source>Image object</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>Bildobjekt</translation>
         </message>
         <message>
             <source>Reference object</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>Referenzobjekt</translation>
         </message>
         <message>
             <source>Segmentation run</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
             <translation>Segmentierungslauf</translation>
         </message>
         <message>
             <source>Threshold [DN]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
             <translation>Schwellwert [GW]</translation>
         </message>
         <message>
             <source>Overlap</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
             <translation>Überlappung</translation>
         </message>
         <message>
             <source>ICP RMS [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
             <translation>ICP-RMS [px]</translation>
         </message>
         <message>
             <source>Converged</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Konvergiert</translation>
         </message>
         <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:60</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:61</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
@@ -2600,67 +2595,72 @@
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:465</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:466</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:466; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:467; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
+            <source>Output folder of a georeferencing</source>
+            <extracomment>plugin/widgets/georef_review.py:512</extracomment>
+            <translation>Ausgabeordner einer Georeferenzierung</translation>
+        </message>
+        <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:523</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:547</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:523</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:547</extracomment>
             <translation>nein</translation>
         </message>
         <message>
             <source>control point</source>
-            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>Passpunkt</translation>
         </message>
         <message>
             <source>outlier (dropped)</source>
-            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>Ausreißer (entfernt)</translation>
         </message>
         <message>
             <source>check point (off)</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
             <translation>Kontrollpunkt (aus)</translation>
         </message>
         <message>
             <source>pair rejected</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
             <translation>Paar verworfen</translation>
         </message>
         <message>
             <source>check (independent)</source>
-            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Kontrollpunkt (unabhängig)</translation>
         </message>
         <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:63</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:64</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:64</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:65</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:65</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
@@ -2675,12 +2675,12 @@
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:494</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:495</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:72</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:73</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
@@ -2725,7 +2725,7 @@
         </message>
         <message>
             <source>Residuals (×{0:.0f})</source>
-            <extracomment>plugin/widgets/georef_review.py:433</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:434</extracomment>
             <translation>Restfehler (×{0:.0f})</translation>
         </message>
         <message>

@@ -548,13 +548,13 @@ def orientation_score(z: NDArray[np.complex128], T: Array, pts: Array, angles: A
     image pixel → map); the weights are outline length × gradient magnitude. 1: every edge
     runs along the outlines; 0: no relation.
     """
-    num, den, _ = _orientation_terms(z, T, pts, angles, weights)
+    num, den = _orientation_terms(z, T, pts, angles, weights)
     return num / den if den > 0 else 0.0
 
 
 def _orientation_terms(z: NDArray[np.complex128], T: Array, pts: Array, angles: Array,
-                       weights: Array) -> Tuple[float, float, float]:
-    """Σ w·|g|·cos 2Δ, Σ w·|g| and Σ w over the outline points inside the image."""
+                       weights: Array) -> Tuple[float, float]:
+    """Σ w·|g|·cos 2Δ and Σ w·|g| over the outline points inside the image."""
     from scipy import ndimage
 
     Ti = np.linalg.inv(T)
@@ -562,14 +562,14 @@ def _orientation_terms(z: NDArray[np.complex128], T: Array, pts: Array, angles: 
     rows, cols = z.shape
     ok = (q[:, 0] >= 0) & (q[:, 0] <= cols - 1) & (q[:, 1] >= 0) & (q[:, 1] <= rows - 1)
     if not ok.any():
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0
     coords = [q[ok, 1], q[ok, 0]]
     zr = ndimage.map_coordinates(z.real, coords, order=1)
     zi = ndimage.map_coordinates(z.imag, coords, order=1)
     psi = _directions(Ti, pts[ok], angles[ok]) + math.pi / 2
     w = weights[ok]
     num = float(np.sum((zr * np.cos(2 * psi) + zi * np.sin(2 * psi)) * w))
-    return num, float(np.sum(np.hypot(zr, zi) * w)), float(np.sum(w))
+    return num, float(np.sum(np.hypot(zr, zi) * w))
 
 
 @dataclass
@@ -710,17 +710,17 @@ def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = OR
 
 def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
                        sigmas: Sequence[float] = (8.0, 4.0, 2.0, 1.0), spacing: float = 1.0,
-                       objective: str = "cosine", model: str = "affine"
+                       model: str = "affine",
+                       fields: Optional[Dict[float, NDArray[np.complex128]]] = None
                        ) -> Tuple[Array, float]:
-    """Affine refinement of image → map ``T`` along the outlines' directions.
-
-    ``objective`` "cosine" maximises :func:`orientation_score`; "strength" maximises
-    Σ w·|g|·cos 2Δ / (Σ w · mean |g| of the image), the aligned edge strength *under* the
-    outlines (closer on clean synthetic edges: 0.22 against 0.32 px; farther on Everest:
-    0.8–1.3 against 0.6–0.8 px, where the outlines and the edges differ locally). Coarse to
+    """Affine (or similarity, ``model``) refinement of image → map ``T`` along the outlines'
+    directions: maximises :func:`orientation_score` (the aligned edge *strength* instead was
+    closer on clean synthetic edges but farther on Everest; docs/decisions.md). Coarse to
     fine (Gaussian ``sigmas`` in image pixels); the parameters are the displacements (pixels)
-    of three image corners, optimised by Powell's method (to 0.01 px at σ ≤ 2 px, 0.1 px
-    above). The outline points are ``spacing`` image pixels apart.
+    of three image corners (similarity: shift, rotation and scale as displacements),
+    optimised by Powell's method (to 0.01 px at σ ≤ 2 px, 0.1 px above). The outline points
+    are ``spacing`` image pixels apart. ``fields`` caches :func:`gradient_orientation` per σ
+    across calls on the same image.
 
     Returns
     -------
@@ -736,20 +736,20 @@ def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
     pts, ang, wts = boundary_samples(boundaries, px * spacing)
     ctrl = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0]])
     Ac = np.c_[ctrl, np.ones(3)]
+    fields = {} if fields is None else fields
+
+    def moves(x: Array) -> Array:
+        return (_corner_moves(Ac, ctrl, x) if model == "affine" else
+                _similarity_moves(x, cols, rows))
+
     z = np.zeros(grey.shape, complex)
     for sg in sigmas:
-        z = gradient_orientation(grey, valid, sg)
-        mean_g = float(np.mean(np.abs(z[z != 0]))) if np.any(z != 0) else 1.0
+        if sg not in fields:
+            fields[sg] = gradient_orientation(grey, valid, sg)
+        z = fields[sg]
 
-        def moves(x: Array) -> Array:
-            return (_corner_moves(Ac, ctrl, x) if model == "affine" else
-                    _similarity_moves(x, cols, rows))
-
-        def cost(x: Array, z: Array = z, T: Array = T, mean_g: float = mean_g) -> float:
-            num, den, wsum = _orientation_terms(z, T @ np.linalg.inv(moves(x)), pts, ang, wts)
-            if objective == "cosine":
-                return -num / den if den > 0 else 0.0
-            return -num / (wsum * mean_g) if wsum > 0 else 0.0
+        def cost(x: Array, z: Array = z, T: Array = T) -> float:
+            return -orientation_score(z, T @ np.linalg.inv(moves(x)), pts, ang, wts)
 
         r = optimize.minimize(cost, np.zeros(6 if model == "affine" else 4), method="Powell",
                               options={"xtol": 0.01 if sg <= 2 else 0.1, "ftol": 1e-7})
@@ -818,10 +818,11 @@ def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIEN
     rows, cols = grey.shape
     corners = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0],
                         [cols - 1.0, rows - 1.0]])
+    fields: Dict[float, NDArray[np.complex128]] = {}  # gradient fields per σ, computed once
     screened = []
     for c in cands:
         T, sc = refine_orientation(grey, boundaries, c.transform, sigmas=(8.0, 4.0),
-                                   spacing=2.0, model="similarity")
+                                   spacing=2.0, model="similarity", fields=fields)
         screened.append((sc, T, c))
     screened.sort(key=lambda t: -t[0])
     sc0, T0, best = screened[0]
@@ -839,12 +840,12 @@ def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIEN
     finals = []
     for Tb in basin:
         T, score = refine_orientation(grey, boundaries, Tb, sigmas=(2.0, 1.0),
-                                      model="similarity")
+                                      model="similarity", fields=fields)
         finals.append((score, T))
     score, T = max(finals, key=lambda t: t[0])
     # an affine only where it explains clearly more than a similarity: its two extra
     # parameters otherwise fit local differences between outlines and edges
-    Ta, score_a = refine_orientation(grey, boundaries, T, sigmas=(1.0,))
+    Ta, score_a = refine_orientation(grey, boundaries, T, sigmas=(1.0,), fields=fields)
     if score_a >= score + AFFINE_GAIN:
         T, score = Ta, score_a
     info = [{"angle_deg": round(c.angle_deg, 2), "scale": round(c.scale, 5),

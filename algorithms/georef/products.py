@@ -41,6 +41,18 @@ def image_from_points_source(x: Any, y: Any) -> Tuple[Any, Any]:
     return x - 0.5, -y - 0.5
 
 
+def skipped_ids_text(ids: List[str], most: int = 10) -> str:
+    """The first ``most`` ids, comma-separated (… when there are more)."""
+    return ", ".join(ids[:most]) + (" …" if len(ids) > most else "")
+
+
+def skipped_note(ids: List[str]) -> str:
+    """The report's sentence on check points skipped outside the image ('' without any)."""
+    if not ids:
+        return ""
+    return f"Skipped check points outside the image ({len(ids)}): {skipped_ids_text(ids)}."
+
+
 def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
     """The QGIS Georeferencer ``.points`` file (see the module notes for the convention)."""
     fit = result["fit"]
@@ -391,11 +403,11 @@ def _independent_html(review: Dict[str, Any]) -> str:
         f"<td>{p['image'][1]:.2f}</td><td>{p['map'][0]:.2f}</td><td>{p['map'][1]:.2f}</td>"
         f"<td>{p['residual_px']:.3f}</td><td>{p['residual_map']:.3f}</td></tr>"
         for p in check["points"])
-    notes = "".join(f"<li>{html.escape(w)}</li>" for w in check.get("warnings", []))
+    note = skipped_note([str(i) for i in check.get("skipped", [])])
     return (f"<h2>Independent check points</h2><p>{check['count']} points from "
             f"{html.escape(str(check.get('file')))}, not used in the fit: RMSE "
             f"<b>{check['rmse_px']:.3f} px</b> = {check['rmse_m']:.3f} m.</p>"
-            + (f"<ul>{notes}</ul>" if notes else "")
+            + (f"<p>{html.escape(note)}</p>" if note else "")
             + "<table><tr><th>id</th><th>col</th><th>row</th><th>X</th><th>Y</th>"
             f"<th>residual px</th><th>residual m</th></tr>{rows}</table>")
 

@@ -176,7 +176,7 @@ class Review:
     def import_check_points(self, path: PathLike) -> List[str]:
         """Read independent check points from a file (:func:`read_check_points`); they
         replace those imported before. Returns the ids of the points skipped (outside the
-        image; :func:`skipped_note` words them).
+        image; :func:`~.products.skipped_note` words them).
 
         Raises
         ------
@@ -379,18 +379,6 @@ def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
     return inside, [p.id for p, k in zip(points, ok) if not k]
 
 
-def skipped_ids_text(ids: Sequence[str], most: int = 10) -> str:
-    """The first ``most`` ids, comma-separated (… when there are more)."""
-    return ", ".join(ids[:most]) + (" …" if len(ids) > most else "")
-
-
-def skipped_note(ids: Sequence[str]) -> str:
-    """The report's sentence on check points skipped outside the image ('' without any)."""
-    if not ids:
-        return ""
-    return f"Skipped check points outside the image ({len(ids)}): {skipped_ids_text(ids)}."
-
-
 def load_review(folder: PathLike) -> Review:
     """The review state of a ``georeference_polygons`` output folder.
 
@@ -518,7 +506,6 @@ def _independent_json(review: Review, fit: TransformFit) -> Optional[Dict[str, A
     return {"file": review.check_file, "count": check["count"],
             "rmse_m": round(check["rmse_m"], 4), "rmse_px": round(check["rmse_px"], 5),
             "skipped": review.check_skipped,
-            "warnings": [skipped_note(review.check_skipped)] if review.check_skipped else [],
             "points": [{"id": p["id"], "image": [p["col"], p["row"]], "map": [p["x"], p["y"]],
                         **{k: p[k] for k in ("dx_map", "dy_map", "residual_map",
                                              "residual_px")}}

@@ -222,24 +222,14 @@ class ToolboxWindow(QtWidgets.QMainWindow):
     def open_georef_review(self, folder: Optional[str] = None) -> Optional[QtWidgets.QDialog]:
         """Open the review dialog of a georeferencing output folder (asks for it unless
         given; the last result of this session is offered first)."""
-        from ...algorithms.errors import PhotodemError
-        from ..widgets.georef_review import GeorefReviewDialog
+        from ..widgets.georef_review import open_review
 
-        if not folder:
-            folder = QtWidgets.QFileDialog.getExistingDirectory(
-                self, tr("Output folder of a georeferencing"), self.last_georef or "")
-            if not folder:
-                return None
-        try:
-            dialog = GeorefReviewDialog(folder, self, message_boxes=self.message_boxes)
-        except PhotodemError as exc:
+        def report(text: str) -> None:
             if self.message_boxes:
-                QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(exc))
-            self.statusBar().showMessage(str(exc))
-            return None
-        dialog.setAttribute(QtCore.Qt.WA_DeleteOnClose)
-        dialog.show()
-        return dialog
+                QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), text)
+            self.statusBar().showMessage(text)
+
+        return open_review(self, folder, self.last_georef, self.message_boxes, report)
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
         if self.run_panel.is_running():

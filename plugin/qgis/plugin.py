@@ -14,7 +14,7 @@ from qgis.core import Qgis, QgsApplication, QgsMessageLog
 
 from ...algorithms.processing import registry
 from ..i18n import install_translator, remove_translator, tr
-from ..qt import QAction, QIcon, Qt
+from ..qt import QAction, QIcon
 from .provider import ICON_PATH, PROVIDER_ID, PhotodemProvider
 
 MENU_TITLE = "&PhotoDEM"
@@ -112,26 +112,16 @@ class PhotodemPlugin:
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
         the folder unless given); returns the dialog or ``None``."""
-        from qgis.PyQt.QtWidgets import QFileDialog
+        from ..widgets.georef_review import open_review
 
-        from ...algorithms.errors import PhotodemError
-        from ..widgets.georef_review import GeorefReviewDialog
+        def report(text: str) -> None:
+            if self.iface is not None:
+                self.iface.messageBar().pushWarning("PhotoDEM", text)
 
         parent = self.iface.mainWindow() if self.iface is not None else None
-        if not folder:
-            folder = QFileDialog.getExistingDirectory(
-                parent, tr("Output folder of a georeferencing"))
-            if not folder:
-                return None
-        try:
-            dialog = GeorefReviewDialog(folder, parent)
-        except PhotodemError as exc:
-            if self.iface is not None:
-                self.iface.messageBar().pushWarning("PhotoDEM", str(exc))
-            return None
-        dialog.setAttribute(Qt.WA_DeleteOnClose)
-        dialog.show()
-        self._review = dialog  # keep a reference while it is open
+        dialog = open_review(parent, folder, on_error=report)
+        if dialog is not None:
+            self._review = dialog  # keep a reference while it is open
         return dialog
 
     def open_dialog(self, algorithm_id: str) -> None:

@@ -12,13 +12,14 @@ summary. The same dialog serves the standalone toolbox and QGIS.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.georef.fit import KINDS
-from ...algorithms.georef.review import Review, load_review, save_review, skipped_ids_text
+from ...algorithms.georef.products import skipped_ids_text
+from ...algorithms.georef.review import Review, load_review, save_review
 from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
@@ -110,7 +111,6 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.dirty = False
         self.rows: List[Dict[str, Any]] = []
         self.check: Dict[str, Any] = {"count": 0, "points": []}  # independent check points
-        self.notes: List[str] = self._skipped_notes(self.review.check_skipped)  # shown below
         self.fit: Any = None
         self.setWindowTitle(tr("Review georeferencing — {0}").format(self.review.name))
         self.resize(1250, 760)
@@ -314,7 +314,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         except PhotodemError as exc:
             self._error(str(exc))
             return False
-        self.notes = warnings = self._skipped_notes(skipped)
+        warnings = self._skipped_notes(skipped)
         self._fill_points()
         self._changed()
         self.point_table.resizeColumnToContents(2)  # the role column: the longer role text
@@ -392,8 +392,9 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                 self.check["rmse_m"])
         if self.dirty:
             text += " — <i>" + tr("not saved") + "</i>"
-        if self.notes:
-            text += "<br><span style='color:#b9770e'>" + " ".join(self.notes) + "</span>"
+        notes = self._skipped_notes(self.review.check_skipped)
+        if notes:
+            text += "<br><span style='color:#b9770e'>" + " ".join(notes) + "</span>"
         self.summary.setText(text)
         self.save_button.setEnabled(True)
         self._draw()
@@ -497,6 +498,29 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                 event.ignore()
                 return
         super().closeEvent(event)
+
+
+def open_review(parent: Optional[QtWidgets.QWidget], folder: Optional[str] = None,
+                start: str = "", message_boxes: bool = True,
+                on_error: Optional[Callable[[str], None]] = None
+                ) -> Optional[GeorefReviewDialog]:
+    """Open (and show) the review dialog of a georeferencing output folder — the toolbox's
+    and the QGIS plugin's entry. Asks for the folder (starting at ``start``) unless given;
+    a folder without a result goes to ``on_error`` and gives ``None``."""
+    if not folder:
+        folder = QtWidgets.QFileDialog.getExistingDirectory(
+            parent, tr("Output folder of a georeferencing"), start)
+        if not folder:
+            return None
+    try:
+        dialog = GeorefReviewDialog(folder, parent, message_boxes=message_boxes)
+    except PhotodemError as exc:
+        if on_error is not None:
+            on_error(str(exc))
+        return None
+    dialog.setAttribute(QtCore.Qt.WA_DeleteOnClose)
+    dialog.show()
+    return dialog
 
 
 def _thumbnail(path: Path, max_side: int = 800) -> tuple:

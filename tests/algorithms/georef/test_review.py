@@ -13,14 +13,13 @@ import rasterio
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.georef.fit import corner_error
-from photodem.algorithms.georef.products import points_source
+from photodem.algorithms.georef.products import points_source, skipped_note
 from photodem.algorithms.georef.review import (
     Review,
     ReviewPoint,
     load_review,
     read_check_points,
     save_review,
-    skipped_note,
 )
 from photodem.algorithms.processing import registry
 from photodem.algorithms.synthetic.polygon_scene import georef_case
