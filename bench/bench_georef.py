@@ -31,6 +31,7 @@ DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "everest_landsa
 
 
 def _run(image: str, reference: str, **kw: Any):
+    """(result or None, seconds, failure message, counts — of the result or the failure)."""
     from photodem.algorithms.errors import PhotodemError
     from photodem.algorithms.georef.pipeline import georeference
 
@@ -38,8 +39,8 @@ def _run(image: str, reference: str, **kw: Any):
     try:
         res = georeference(image, reference, **kw)
     except PhotodemError as exc:
-        return None, time.perf_counter() - t0, str(exc)
-    return res, time.perf_counter() - t0, ""
+        return None, time.perf_counter() - t0, str(exc), getattr(exc, "counts", {})
+    return res, time.perf_counter() - t0, "", res["counts"]
 
 
 def _synthetic(tmp: Path, n: int = 50) -> Dict[str, Any]:
@@ -50,7 +51,7 @@ def _synthetic(tmp: Path, n: int = 50) -> Dict[str, Any]:
     for seed in range(n):
         case = georef_case(tmp / f"syn{seed}", seed=seed)
         mirrored += int(np.linalg.det(case["truth"][:2, :2]) > 0)
-        res, dt, why = _run(case["image"], case["reference"])
+        res, dt, why, _ = _run(case["image"], case["reference"])
         times.append(dt)
         if res is None:
             errs.append(float("inf"))
@@ -80,7 +81,7 @@ def _textured(tmp: Path, n: int = 10) -> Dict[str, Any]:
     for seed in range(n):
         case = georef_case(tmp / f"tex{seed}", seed=seed, width=600, height=600, texture=12.0,
                            noise=4.0, scale_range=(0.8, 1.25), shear=0.05)
-        res, dt, _why = _run(case["image"], case["reference"])
+        res, dt, _why, _ = _run(case["image"], case["reference"])
         times.append(dt)
         if res is None:
             errs.append(float("inf"))
@@ -131,15 +132,9 @@ def _truth_iou(image: Path, reference: Path, truth: np.ndarray) -> np.ndarray:
     return np.array(best)
 
 
-def _boundary_scores(res: Any, why: str) -> str:
-    """"score/coarse/runner-up" of the boundary-orientation search of one run ("–": none)."""
-    import re
-
-    if res is not None:
-        c = res["counts"]
-    else:
-        c = {k.replace(" ", "_"): v for k, v in re.findall(
-            r"(boundary (?:score|screen|runner up)) ([0-9.]+)", why)}
+def _boundary_scores(c: Dict[str, Any]) -> str:
+    """"score/coarse/runner-up" of the boundary-orientation search of one run's counts
+    ("–": none)."""
     if "boundary_score" not in c:
         return "–"
     return f"{c['boundary_score']}/{c.get('boundary_screen')}/{c.get('boundary_runner_up')}"
@@ -184,9 +179,9 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
         with rasterio.open(path, "r+") as dst:
             dst.nodata = 0
         truth = T0 @ P
-        res, dt, why = _run(str(path), str(ref))
+        res, dt, why, counts = _run(str(path), str(ref))
         times.append(dt)
-        scores.append(_boundary_scores(res, why))
+        scores.append(_boundary_scores(counts))
         if res is None:
             errs.append(float("inf"))
             fails.append(why.split("(")[0].strip())
@@ -195,7 +190,7 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
             stages.append(res["stage"])
     e = np.array(errs)
     fin = e[np.isfinite(e)]
-    res0, dt0, why0 = _run(str(image), str(ref))
+    res0, dt0, why0, _ = _run(str(image), str(ref))
     iou = _truth_iou(image, ref, T0)
     return {"row": {"case": f"Everest Landsat 7 {bands} vs RGI 6.0, {n} resampled "
                             "perturbations",
@@ -259,7 +254,7 @@ def _ortho(tmp: Path) -> Dict[str, Any]:
     from photodem.algorithms.synthetic.polygon_scene import ortho_case
 
     c = ortho_case(tmp / "ortho", seed=1)
-    res, dt, _why = _run(c["image"], c["reference"])
+    res, dt, _why, _ = _run(c["image"], c["reference"])
     rows = [{"case": "image vs orthophoto (rotated 35°, scale 1.3): PhotoDEM",
              "corner_px": (float(corner_error(res["fit"], c["truth"], c["width"],
                                               c["height"]).max()) if res else None),
@@ -287,7 +282,7 @@ def _speed(tmp: Path) -> Dict[str, Any]:
                        n_lake=15)
     with fiona.open(case["reference"]) as src:
         n = len(src)
-    res, dt, _why = _run(case["image"], case["reference"])
+    res, dt, _why, _ = _run(case["image"], case["reference"])
     return {"row": {"case": f"speed: 1000 × 1000 px image, {n} reference polygons",
                     "seconds": dt, "goal_s": 20.0, "recovered": res is not None}}
 

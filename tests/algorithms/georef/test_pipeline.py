@@ -88,10 +88,11 @@ def test_bad_inputs_write_nothing(case, tmp_path) -> None:
             "class_value": "desert", "output": str(out)})
     # a map of another area: no common objects → the failure report, not a wrong answer
     other = write_scene(make_scene(99), tmp_path / "other.gpkg")
-    with pytest.raises(GeometryError, match="Georeferencing failed"):
+    with pytest.raises(GeometryError, match="Georeferencing failed") as info:
         registry.run("georeference_polygons", {
             "image": case["image"], "reference": str(other), "output": str(out)})
     assert not out.exists()
+    assert "boundary_score" in info.value.counts  # the figures also as data
 
 
 def test_reference_dissolves_split_polygons_and_reprojects(tmp_path) -> None:
