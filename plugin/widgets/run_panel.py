@@ -106,13 +106,16 @@ class RunPanel(QtWidgets.QWidget):
         worker.finished.connect(self._on_finished)
         worker.failed.connect(self._on_failed)
         worker.cancelled.connect(self._on_cancelled)
-        worker.done.connect(self._on_done)
         self._worker = worker
         self._status = "running"
         self._payload = None
         self.run_button.setEnabled(False)
         self.cancel_button.setEnabled(True)
-        self._thread = start_in_thread(worker)
+        # The panel owns the thread: dropping the Python reference to a thread that is still
+        # winding down would destroy it while it runs, which aborts the process. The run counts
+        # as finished only once the thread has ended, so a new run can start right away.
+        self._thread = start_in_thread(worker, self)
+        self._thread.finished.connect(self._on_done)
         return worker
 
     def cancel(self) -> None:
@@ -164,7 +167,7 @@ class RunPanel(QtWidgets.QWidget):
         self.append_log("warning", message)
 
     def _on_done(self) -> None:
-        self._worker = None
+        self._worker = self._thread = None
         self.run_button.setEnabled(True)
         self.cancel_button.setEnabled(False)
         self.run_finished.emit(self._status, self._payload)

@@ -15,7 +15,7 @@ from typing import Any, Dict, Optional
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.processing import registry
 from ...algorithms.processing.feedback import Feedback
-from ..qt import QObject, QThread, pyqtSignal, pyqtSlot
+from ..qt import QObject, Qt, QThread, pyqtSignal, pyqtSlot
 
 
 class AlgorithmWorker(QObject):
@@ -86,7 +86,9 @@ def start_in_thread(worker: AlgorithmWorker, parent: Optional[QObject] = None) -
     thread = QThread(parent)
     worker.moveToThread(thread)
     thread.started.connect(worker.run)
-    worker.done.connect(thread.quit)
+    # Direct: quit() is thread-safe, and the thread then ends even while the GUI thread is
+    # blocked in QThread.wait() (a queued quit would only run after that wait timed out).
+    worker.done.connect(thread.quit, Qt.DirectConnection)
     worker.done.connect(worker.deleteLater)
     thread.finished.connect(thread.deleteLater)
     thread.start()

@@ -153,6 +153,20 @@ def test_operator_error_and_bug_are_shown_in_log(qtbot, window, tmp_path):
     assert "Unexpected error" in window.run_panel.log_view.toPlainText()
 
 
+def test_runs_back_to_back_and_wait_returns(qtbot, window, tmp_path):
+    # A run counts as finished only once its thread has ended: starting the next run at once
+    # used to drop the last reference to a thread still winding down (SIGABRT, 1 run in 6).
+    window.select_algorithm("fake_chatty")
+    window.form.set_values({"input": str(tmp_path / "missing.tif")})
+    for _ in range(30):
+        with qtbot.waitSignal(window.run_panel.run_finished, timeout=10000) as blocker:
+            window.run_current()
+        assert blocker.args[0] == "failed" and not window.run_panel.is_running()
+    # The GUI thread blocked in wait() does not keep the thread from ending.
+    window.run_current()
+    assert window.run_panel.wait(5000)
+
+
 def test_filter_hides_algorithms(qtbot, window):
     qtbot.keyClicks(window.filter_edit, "crash")
     testing = next(window.tree.topLevelItem(i) for i in range(window.tree.topLevelItemCount())
