@@ -270,6 +270,33 @@ def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
+def residual_scale(residuals: np.ndarray, extent: float, share: float = 0.1) -> float:
+    """A round exaggeration for residual vectors: 1, 2 or 5 × 10^k, at most the factor that
+    draws the longest of ``residuals`` (n, 2) as ``share`` of ``extent`` (both in pixels)."""
+    longest = float(np.hypot(*np.asarray(residuals, float).reshape(-1, 2).T).max(initial=0.0))
+    if longest <= 0 or extent <= 0:
+        return 1.0
+    scale = share * extent / longest
+    step = 10.0 ** np.floor(np.log10(scale))
+    return float(step * max(f for f in (1, 2, 5) if f * step <= scale))
+
+
+def draw_residuals(ax: Any, xy: np.ndarray, residuals: np.ndarray, scale: float, colour: str,
+                   marker: str = ".", size: float = 3, width: float = 0.003,
+                   **marker_style: Any) -> None:
+    """Points ``xy`` (n, 2, image col/row) with their ``residuals`` (n, 2, px) drawn as arrows
+    ``scale`` times their length on the matplotlib axes ``ax``; ``marker_style`` goes to the
+    points (``label``, ``mec``, …)."""
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    if not len(xy):
+        return
+    d = np.asarray(residuals, float).reshape(-1, 2) * scale
+    ax.quiver(xy[:, 0], xy[:, 1], d[:, 0], d[:, 1], color=colour, angles="xy",
+              scale_units="xy", scale=1, width=width)
+    ax.plot(xy[:, 0], xy[:, 1], marker, color=colour, ms=size, linestyle="none",
+            **marker_style)
+
+
 def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int,
                  check: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Path:
     """Control points over the image frame with their residual vectors (exaggerated): points
@@ -290,20 +317,10 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
             if len(cxy) else np.zeros((0, 2)))
     fig, ax = plt.subplots(figsize=(7, 7 * height / max(width, 1)))
     ax.add_patch(plt.Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
-    both = np.vstack([res, cres])
-    longest = float(np.hypot(*both.T).max()) if len(both) else 0.0
-    scale = 0.1 * np.hypot(width, height) / longest if longest > 0 else 1.0
-    step = 10.0 ** np.floor(np.log10(scale))  # a round factor: 1, 2 or 5 × 10^k
-    scale = step * max(f for f in (1, 2, 5) if f * step <= scale)
+    scale = residual_scale(np.vstack([res, cres]), float(np.hypot(width, height)))
     for used, colour in ((fit.used, "tab:blue"), (~fit.used, "tab:orange")):
-        if used.any():
-            ax.quiver(xy[used, 0], xy[used, 1], res[used, 0] * scale, res[used, 1] * scale,
-                      color=colour, angles="xy", scale_units="xy", scale=1, width=0.003)
-            ax.plot(xy[used, 0], xy[used, 1], ".", color=colour, ms=3)
-    if len(cxy):
-        ax.quiver(cxy[:, 0], cxy[:, 1], cres[:, 0] * scale, cres[:, 1] * scale,
-                  color="tab:purple", angles="xy", scale_units="xy", scale=1, width=0.003)
-        ax.plot(cxy[:, 0], cxy[:, 1], "^", color="tab:purple", ms=5)
+        draw_residuals(ax, xy[used], res[used], scale, colour)
+    draw_residuals(ax, cxy, cres, scale, "tab:purple", marker="^", size=5)
     if fit.used.sum() >= 3:
         from scipy.spatial import ConvexHull, QhullError
 

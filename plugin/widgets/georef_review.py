@@ -18,7 +18,7 @@ import numpy as np
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.georef.fit import KINDS
-from ...algorithms.georef.products import skipped_ids_text
+from ...algorithms.georef.products import draw_residuals, residual_scale, skipped_ids_text
 from ...algorithms.georef.review import Review, load_review, save_review
 from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
@@ -413,23 +413,16 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         if self.rows and len(xy):
             res = np.array([[r["dcol"], r["drow"]] for r in self.rows])
             # one scale for both kinds of points: their arrows compare
-            longest = float(np.hypot(*np.vstack([res, ind_res]).T).max()) or 1.0
-            span = float(np.ptp(np.vstack([xy, ind_xy]), axis=0).max()) or 1.0
-            k = 0.08 * span / longest
+            span = float(np.ptp(np.vstack([xy, ind_xy]), axis=0).max())
+            k = residual_scale(np.vstack([res, ind_res]), span, share=0.08)
             for role, colour in ROLE_COLOURS.items():
                 sel = np.array([r["role"] == role for r in self.rows])
                 if sel.any():
-                    ax.quiver(xy[sel, 0], xy[sel, 1], res[sel, 0] * k, res[sel, 1] * k,
-                              color=colour, angles="xy", scale_units="xy", scale=1,
-                              width=0.003)
-                    ax.plot(xy[sel, 0], xy[sel, 1], ".", color=colour, ms=3,
-                            label=role_text(role))
+                    draw_residuals(ax, xy[sel], res[sel], k, colour, label=role_text(role))
             if len(ind_xy):
-                ax.quiver(ind_xy[:, 0], ind_xy[:, 1], ind_res[:, 0] * k, ind_res[:, 1] * k,
-                          color=INDEPENDENT_COLOUR, angles="xy", scale_units="xy", scale=1,
-                          width=0.004)
-                ax.plot(ind_xy[:, 0], ind_xy[:, 1], "^", color=INDEPENDENT_COLOUR, ms=6,
-                        mec="black", mew=0.5, label=role_text("independent"))
+                draw_residuals(ax, ind_xy, ind_res, k, INDEPENDENT_COLOUR, marker="^",
+                               size=6, width=0.004, mec="black", mew=0.5,
+                               label=role_text("independent"))
             ax.legend(loc="lower right", fontsize=7)
             ax.set_title(tr("Residuals (×{0:.0f})").format(k), fontsize=9)
         elif len(xy):

@@ -13,7 +13,7 @@ import rasterio
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.georef.fit import corner_error
-from photodem.algorithms.georef.products import points_source, skipped_note
+from photodem.algorithms.georef.products import points_source, residual_scale, skipped_note
 from photodem.algorithms.georef.review import (
     Review,
     ReviewPoint,
@@ -320,3 +320,18 @@ def test_independent_check_points_survive_save_and_load(result, folder, tmp_path
         [(p.id, p.image) for p in review.check_points]
     assert again.independent_check(again.fit())["rmse_m"] == pytest.approx(check["rmse_m"],
                                                                            abs=1e-4)
+
+
+@pytest.mark.parametrize("longest, extent, share, expected", [
+    (0.5, 1000.0, 0.1, 200.0),   # 100 / 0.5 = 200 exactly
+    (0.3, 1000.0, 0.1, 200.0),   # 333 → the round 200 below it
+    (3.0, 1000.0, 0.08, 20.0),   # 26.7 → 20
+    (40.0, 100.0, 0.1, 0.2),     # 0.25 → 0.2: long residuals are shortened
+    (0.0, 1000.0, 0.1, 1.0),     # nothing to scale
+])
+def test_residual_scale_is_round_and_never_too_long(longest, extent, share, expected) -> None:
+    res = np.array([[0.0, longest], [longest / 2, 0.0]])
+    k = residual_scale(res, extent, share)
+    assert k == pytest.approx(expected)
+    if longest:
+        assert k * longest <= share * extent + 1e-9
