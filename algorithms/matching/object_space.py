@@ -946,7 +946,7 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     n_nodes = 0
     failures = 0
     with staged_folder(out, replace=True, product="refine_object_space") as tmp:
-        profile = gtiff_profile(W, H, 1, "float32", project.crs or None, nodata=float("nan"),
+        profile = gtiff_profile(W, H, 1, "float32", project.crs, nodata=float("nan"),
                                 predictor=3, transform=out_grid.transform)
         with open_image(tmp / "dsm.tif", "w", **profile) as dst_z, \
                 open_image(tmp / "sigma.tif", "w", **profile) as dst_s, \

@@ -540,7 +540,7 @@ def mosaic_orthos(
         nb = len(infos[0].colour)
         halo = math.ceil(feather_px / 2.0) + 1 if feather_px >= 1.0 else 0
         img_wins = [_window_of(i, transform, W, H) for i in infos]
-        prof = gtiff_profile(W, H, nb + 1, dtype, crs or None, transform=transform,
+        prof = gtiff_profile(W, H, nb + 1, dtype, crs, transform=transform,
                              nodata=None)
         tile = max(int(tile), 64)
         tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]

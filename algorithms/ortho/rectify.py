@@ -459,7 +459,7 @@ def _profile(width: int, height: int, count: int, dtype: str, transform: Affine,
              ) -> Dict[str, Any]:
     # horizontal differencing + fast deflate: smaller and faster to write than plain deflate;
     # blocks are compressed on all cores while the next tile is computed
-    return gtiff_profile(width, height, count, dtype, crs or None, transform=transform,
+    return gtiff_profile(width, height, count, dtype, crs, transform=transform,
                          nodata=None, zlevel=1, num_threads="all_cpus",
                          predictor=3 if np.issubdtype(np.dtype(dtype), np.floating) else 2)
 

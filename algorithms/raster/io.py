@@ -42,14 +42,15 @@ def gtiff_profile(width: int, height: int, count: int = 1, dtype: str = "float32
     """The creation profile of a ``height × width`` GeoTIFF of the project.
 
     :data:`GTIFF_PROFILE` (deflate, 256² tiles) with the size, band count and data type;
-    ``crs`` only when one is given (image-space rasters have none); every other profile key
+    ``crs`` only when one is given (image-space rasters have none; ``None``, ``""`` and an
+    empty rasterio CRS count as none); every other profile key
     or creation option (``transform``, ``nodata``, ``predictor`` …) as given. A raster smaller
     than one tile in either direction is written in strips: its tiles would be mostly padding.
     """
     profile = dict(GTIFF_PROFILE)
     profile.update(width=int(width), height=int(height), count=int(count), dtype=dtype,
                    **options)
-    if crs is not None and crs != "":
+    if crs:
         profile["crs"] = crs
     if width < GTIFF_PROFILE["blockxsize"] or height < GTIFF_PROFILE["blockysize"]:
         profile.update(tiled=False)
