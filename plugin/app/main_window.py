@@ -36,7 +36,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         super().__init__(parent)
         self.message_boxes = message_boxes
         self.setWindowTitle(tr("PhotoDEM toolbox"))
-        self.resize(1100, 720)
+        self.resize(1200, 720)
         self.form: Optional[ParameterForm] = None
         self.last_georef = ""  # output folder of the last georeferencing run
         self.algorithm: Optional[Algorithm] = None
@@ -48,6 +48,8 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.tree = QtWidgets.QTreeWidget()
         self.tree.setHeaderHidden(True)
         self.tree.setUniformRowHeights(True)
+        # names of one group often differ only at their end: "Filter DSM to DTM (…)"
+        self.tree.setTextElideMode(QtCore.Qt.ElideMiddle)
         left = QtWidgets.QWidget()
         left_layout = QtWidgets.QVBoxLayout(left)
         left_layout.setContentsMargins(6, 6, 0, 6)
@@ -93,7 +95,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         splitter.addWidget(right)
         splitter.setStretchFactor(0, 1)
         splitter.setStretchFactor(1, 3)
-        splitter.setSizes([270, 830])
+        splitter.setSizes([360, 840])
         self.setCentralWidget(splitter)
 
         self._build_menu()
