@@ -2345,87 +2345,87 @@
         </message>
         <message>
             <source>Choose an algorithm on the left.</source>
-            <extracomment>plugin/app/main_window.py:100</extracomment>
+            <extracomment>plugin/app/main_window.py:102</extracomment>
             <translation>Links einen Algorithmus wählen.</translation>
         </message>
         <message>
             <source>&amp;File</source>
-            <extracomment>plugin/app/main_window.py:110</extracomment>
+            <extracomment>plugin/app/main_window.py:112</extracomment>
             <translation>&amp;Datei</translation>
         </message>
         <message>
             <source>&amp;Quit</source>
-            <extracomment>plugin/app/main_window.py:111</extracomment>
+            <extracomment>plugin/app/main_window.py:113</extracomment>
             <translation>&amp;Beenden</translation>
         </message>
         <message>
             <source>&amp;Tools</source>
-            <extracomment>plugin/app/main_window.py:114</extracomment>
+            <extracomment>plugin/app/main_window.py:116</extracomment>
             <translation>&amp;Werkzeuge</translation>
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:115; plugin/qgis/plugin.py:105</extracomment>
+            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:105</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:116; plugin/qgis/plugin.py:107</extracomment>
+            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:107</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:119</extracomment>
+            <extracomment>plugin/app/main_window.py:121</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:120</extracomment>
+            <extracomment>plugin/app/main_window.py:122</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:210</extracomment>
+            <extracomment>plugin/app/main_window.py:212</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:210</extracomment>
+            <extracomment>plugin/app/main_window.py:212</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:211</extracomment>
+            <extracomment>plugin/app/main_window.py:213</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:242</extracomment>
+            <extracomment>plugin/app/main_window.py:244</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:243</extracomment>
+            <extracomment>plugin/app/main_window.py:245</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:130</extracomment>
+            <extracomment>plugin/app/main_window.py:132</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:215; plugin/app/main_window.py:229; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:490; plugin/widgets/georef_review.py:495</extracomment>
+            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:483; plugin/widgets/georef_review.py:488</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:203; plugin/widgets/run_panel.py:101</extracomment>
+            <extracomment>plugin/app/main_window.py:205; plugin/widgets/run_panel.py:101</extracomment>
             <translation>{0} läuft …</translation>
         </message>
         <message>
             <source>Tools → Review georeferencing checks and edits its control points.</source>
-            <extracomment>plugin/app/main_window.py:219</extracomment>
+            <extracomment>plugin/app/main_window.py:221</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
@@ -2595,27 +2595,27 @@
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:466</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:459</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:467; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:460; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:512</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:505</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:547</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:540</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:547</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:540</extracomment>
             <translation>nein</translation>
         </message>
         <message>
@@ -2675,7 +2675,7 @@
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:495</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:488</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
@@ -2724,9 +2724,9 @@
             <translation>nicht gespeichert</translation>
         </message>
         <message>
-            <source>Residuals (×{0:.0f})</source>
-            <extracomment>plugin/widgets/georef_review.py:434</extracomment>
-            <translation>Restfehler (×{0:.0f})</translation>
+            <source>Residuals (×{0:g})</source>
+            <extracomment>plugin/widgets/georef_review.py:427</extracomment>
+            <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>
             <source>Browse</source>
@@ -2835,7 +2835,7 @@
         </message>
         <message>
             <source>Finished.</source>
-            <extracomment>plugin/widgets/run_panel.py:152</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:155</extracomment>
             <translation>Fertig.</translation>
         </message>
         <message>
@@ -2850,22 +2850,22 @@
         </message>
         <message>
             <source>Cancelling …</source>
-            <extracomment>plugin/widgets/run_panel.py:123</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:126</extracomment>
             <translation>Wird abgebrochen …</translation>
         </message>
         <message>
             <source>Warning: </source>
-            <extracomment>plugin/widgets/run_panel.py:143</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:146</extracomment>
             <translation>Warnung: </translation>
         </message>
         <message>
             <source>Error: </source>
-            <extracomment>plugin/widgets/run_panel.py:157</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:160</extracomment>
             <translation>Fehler: </translation>
         </message>
         <message>
             <source>Unexpected error (please report it):</source>
-            <extracomment>plugin/widgets/run_panel.py:159</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:162</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
         </message>
         <message>

@@ -333,7 +333,7 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     ax.set_xlim(-0.05 * width, 1.05 * width)
     ax.set_ylim(1.05 * height, -0.05 * height)
     ax.set_aspect("equal")
-    title = (f"residuals ×{scale:.0f}; RMSE {fit.rmse_px:.2f} px, "
+    title = (f"residuals ×{scale:g}; RMSE {fit.rmse_px:.2f} px, "
              f"{int(fit.used.sum())} of {len(xy)} points in the fit")
     if len(cxy):
         title += f"\n{len(cxy)} independent check points (purple)"

@@ -424,7 +424,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                size=6, width=0.004, mec="black", mew=0.5,
                                label=role_text("independent"))
             ax.legend(loc="lower right", fontsize=7)
-            ax.set_title(tr("Residuals (×{0:.0f})").format(k), fontsize=9)
+            ax.set_title(tr("Residuals (×{0:g})").format(k), fontsize=9)
         elif len(xy):
             ax.plot(xy[:, 0], xy[:, 1], ".", color="0.5", ms=3)
         every = np.vstack([xy, ind_xy])
