@@ -7,9 +7,19 @@ a traceback and exits 2; QGIS and the standalone tool show it in their log.
 
 from __future__ import annotations
 
+from typing import Any, Dict, Optional
+
 
 class PhotodemError(Exception):
-    """An error the operator can fix; the message is shown as it is."""
+    """An error the operator can fix; the message is shown as it is.
+
+    ``counts``: the figures behind the message as data (e.g. a failed georeferencing's pair
+    and score counts); empty where there are none.
+    """
+
+    def __init__(self, message: str = "", counts: Optional[Dict[str, Any]] = None) -> None:
+        super().__init__(message)
+        self.counts: Dict[str, Any] = dict(counts or {})
 
 
 class InputError(PhotodemError):

@@ -39,7 +39,7 @@ def _run(image: str, reference: str, **kw: Any):
     try:
         res = georeference(image, reference, **kw)
     except PhotodemError as exc:
-        return None, time.perf_counter() - t0, str(exc), getattr(exc, "counts", {})
+        return None, time.perf_counter() - t0, str(exc), exc.counts
     return res, time.perf_counter() - t0, "", res["counts"]
 
 

@@ -319,12 +319,10 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
 def _fail(counts: Dict[str, Any], why: str) -> None:
     """Raise the failure message; the exception's ``counts`` keep the figures as data."""
     detail = ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
-    err = GeometryError(
+    raise GeometryError(
         f"Georeferencing failed: {why} ({detail}). Check that image and reference show the "
         "same objects completely (class field/value), try other thresholds or a larger "
-        "relative difference.")
-    err.counts = dict(counts)  # type: ignore[attr-defined]
-    raise err
+        "relative difference.", counts)
 
 
 def _hull_share(xy: np.ndarray, shape: Sequence[int]) -> float:
