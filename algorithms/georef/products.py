@@ -23,6 +23,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 import numpy as np
 
 from ..processing.feedback import Feedback
+from ..quality.report import new_figure
 from .correspondence import apply
 from .fit import points_summary
 
@@ -190,15 +191,12 @@ def write_with_gcps(path: PathLike, image: PathLike, result: Dict[str, Any]) -> 
 
 def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
     """Matched image polygons (green) and reference polygons taken into the image (red)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     grey = result["grey"]
     fi, fr = result["img_features"], result["ref_features"]
     H, W = grey.shape
-    fig, ax = plt.subplots(figsize=(8, 8 * H / max(W, 1)))
+    # no pyplot: the review saves from inside QGIS, whose backend must stay as it is
+    fig = new_figure(8, 8 * H / max(W, 1))
+    ax = fig.add_subplot()
     ax.imshow(grey, cmap="gray", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
     outlines = [(fi[h.i].obj.ring, "lime") for h in result["pairs"]]
     outlines += [(_inverse_points(result, fr[h.j].obj.ring), "red") for h in result["pairs"]]
@@ -217,7 +215,6 @@ def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
                  "matched objects: image (green), reference (red); control points (+)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
-    plt.close(fig)
     return Path(path)
 
 
@@ -303,10 +300,7 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     in the fit blue, the others (outliers, check points) orange; the convex hull of the
     points in the fit dashed — where the transform is interpolated, not extrapolated.
     ``check``: independent check points (image (n, 2), map (n, 2)), purple triangles."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
 
     fit = result["fit"]
     xy = np.array([g.image for g in result["gcps"]], float).reshape(-1, 2)
@@ -315,8 +309,9 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     cxy = np.zeros((0, 2)) if check is None else np.asarray(check[0], float).reshape(-1, 2)
     cres = (_inverse_points(result, np.asarray(check[1], float).reshape(-1, 2)) - cxy
             if len(cxy) else np.zeros((0, 2)))
-    fig, ax = plt.subplots(figsize=(7, 7 * height / max(width, 1)))
-    ax.add_patch(plt.Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
+    fig = new_figure(7, 7 * height / max(width, 1))
+    ax = fig.add_subplot()
+    ax.add_patch(Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
     scale = residual_scale(np.vstack([res, cres]), float(np.hypot(width, height)))
     for used, colour in ((fit.used, "tab:blue"), (~fit.used, "tab:orange")):
         draw_residuals(ax, xy[used], res[used], scale, colour)
@@ -340,7 +335,6 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
-    plt.close(fig)
     return Path(path)
 
 
