@@ -25,7 +25,7 @@ import numpy as np
 from ..processing.feedback import Feedback
 from ..quality.report import new_figure
 from .correspondence import apply
-from .fit import points_summary
+from .fit import TransformFit, points_summary
 
 PathLike = Union[str, Path]
 
@@ -267,6 +267,15 @@ def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
+def image_residuals(fit: TransformFit, img: np.ndarray, res_map: np.ndarray) -> np.ndarray:
+    """Map residuals (fitted − measured) at image points taken into the image, in pixels (for
+    drawing): through the local inverse of the transform (finite differences, the same for
+    every kind of transform)."""
+    J = np.stack([fit.forward(img + [0.5, 0]) - fit.forward(img - [0.5, 0]),
+                  fit.forward(img + [0, 0.5]) - fit.forward(img - [0, 0.5])], axis=-1)
+    return np.linalg.solve(J, res_map[..., None])[..., 0]
+
+
 def residual_scale(residuals: np.ndarray, extent: float, share: float = 0.1) -> float:
     """A round exaggeration for residual vectors: 1, 2 or 5 × 10^k, at most the factor that
     draws the longest of ``residuals`` (n, 2) as ``share`` of ``extent`` (both in pixels)."""
@@ -296,19 +305,21 @@ def draw_residuals(ax: Any, xy: np.ndarray, residuals: np.ndarray, scale: float,
 
 def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int,
                  check: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Path:
-    """Control points over the image frame with their residual vectors (exaggerated): points
-    in the fit blue, the others (outliers, check points) orange; the convex hull of the
-    points in the fit dashed — where the transform is interpolated, not extrapolated.
+    """Control points over the image frame with their residual vectors (fitted − measured,
+    exaggerated, as in the review dialog): points in the fit blue, the others (outliers,
+    check points) orange; the convex hull of the points in the fit dashed — where the
+    transform is interpolated, not extrapolated.
     ``check``: independent check points (image (n, 2), map (n, 2)), purple triangles."""
     from matplotlib.patches import Rectangle
 
     fit = result["fit"]
     xy = np.array([g.image for g in result["gcps"]], float).reshape(-1, 2)
     mp = np.array([g.map for g in result["gcps"]], float).reshape(-1, 2)
-    res = _inverse_points(result, mp) - xy  # measured map point taken into the image
+    # fitted − measured, in the image: the arrows of the review dialog
+    res = image_residuals(fit, xy, fit.forward(xy) - mp)
     cxy = np.zeros((0, 2)) if check is None else np.asarray(check[0], float).reshape(-1, 2)
-    cres = (_inverse_points(result, np.asarray(check[1], float).reshape(-1, 2)) - cxy
-            if len(cxy) else np.zeros((0, 2)))
+    cres = (image_residuals(fit, cxy, fit.forward(cxy) - np.asarray(check[1], float)
+                            .reshape(-1, 2)) if len(cxy) else np.zeros((0, 2)))
     fig = new_figure(7, 7 * height / max(width, 1))
     ax = fig.add_subplot()
     ax.add_patch(Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))

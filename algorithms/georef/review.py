@@ -30,7 +30,7 @@ from ..errors import InputError
 from ..processing.feedback import Feedback
 from ..quality.points import COLUMN_NAMES, field_separator, find_column, parse_number, split_fields
 from .fit import KINDS, MIN_POINTS, TransformFit, fit_transform, points_summary
-from .products import image_from_points_source
+from .products import image_from_points_source, image_residuals
 
 PathLike = Union[str, Path]
 #: Pair index of a control point the operator added by hand.
@@ -148,7 +148,7 @@ class Review:
         (switched off), ``rejected`` (its object pair is rejected).
         """
         fit = fit or self.fit()
-        d_img = _image_residuals(fit, self.image_xy(), fit.extras["all_residuals_map"])
+        d_img = image_residuals(fit, self.image_xy(), fit.extras["all_residuals_map"])
         rows = []
         for k, (p, r) in enumerate(zip(self.points, points_summary(fit))):
             if p.pair in self.rejected_pairs:
@@ -207,7 +207,7 @@ class Review:
         if not len(img):
             return {"count": 0, "rmse_m": float("nan"), "rmse_px": float("nan"), "points": []}
         res = fit.forward(img) - mp
-        d_img = _image_residuals(fit, img, res)
+        d_img = image_residuals(fit, img, res)
         dist = np.hypot(res[:, 0], res[:, 1])
         rmse = float(np.sqrt(np.mean(dist * dist)))
         points = [{"id": p.id, "col": p.image[0], "row": p.image[1], "x": p.map[0],
@@ -218,14 +218,6 @@ class Review:
                   for p, r, d, di in zip(self.check_points, res, dist, d_img)]
         return {"count": len(points), "rmse_m": rmse, "rmse_px": rmse / fit.pixel_size,
                 "points": points}
-
-
-def _image_residuals(fit: TransformFit, img: np.ndarray, res_map: np.ndarray) -> np.ndarray:
-    """Map residuals at image points taken into the image (for drawing): through the local
-    inverse of the transform (finite differences: the same for every kind of transform)."""
-    J = np.stack([fit.forward(img + [0.5, 0]) - fit.forward(img - [0.5, 0]),
-                  fit.forward(img + [0, 0.5]) - fit.forward(img - [0, 0.5])], axis=-1)
-    return np.linalg.solve(J, res_map[..., None])[..., 0]
 
 
 # -- independent check points from a file -------------------------------------------------------

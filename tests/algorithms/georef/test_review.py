@@ -13,7 +13,12 @@ import rasterio
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.georef.fit import corner_error
-from photodem.algorithms.georef.products import points_source, residual_scale, skipped_note
+from photodem.algorithms.georef.products import (
+    image_residuals,
+    points_source,
+    residual_scale,
+    skipped_note,
+)
 from photodem.algorithms.georef.review import (
     Review,
     ReviewPoint,
@@ -335,3 +340,15 @@ def test_residual_scale_is_round_and_never_too_long(longest, extent, share, expe
     assert k == pytest.approx(expected)
     if longest:
         assert k * longest <= share * extent + 1e-9
+
+
+def test_image_residuals_closed_form_for_an_affine() -> None:
+    # the map residual taken into the image is A⁻¹·res for x = A·(col, row) + t
+    from photodem.algorithms.georef.fit import fit_transform
+
+    A = np.array([[2.0, 0.3], [-0.4, -1.5]])
+    img = np.array([[0, 0], [100, 0], [0, 80], [100, 80], [50, 40]], float)
+    fit = fit_transform(img, img @ A.T + [500.0, 900.0], "affine")
+    res_map = np.array([[1.0, 0.0], [0.0, 1.0], [0.5, -0.5], [2.0, 1.0], [0.0, 0.0]])
+    np.testing.assert_allclose(image_residuals(fit, img, res_map),
+                               res_map @ np.linalg.inv(A).T, atol=1e-9)
