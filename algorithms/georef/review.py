@@ -411,10 +411,13 @@ def load_review(folder: PathLike) -> Review:
                   check_skipped=[str(i) for i in check.get("skipped", [])])
 
 
-def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str, str]:
+def save_review(review: Review, feedback: Optional[Feedback] = None,
+                fit: Optional[TransformFit] = None) -> Dict[str, str]:
     """Write the folder's products again under the reviewed transform (atomically).
 
-    The automatic result stays as ``report_auto.json``. Returns the paths written.
+    The automatic result stays as ``report_auto.json``. ``fit``: the review's current
+    :meth:`Review.fit`, if the caller has it (a dialog does), else it is computed. Returns
+    the paths written.
 
     Raises
     ------
@@ -437,7 +440,8 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
     from .refinement import ControlPoint
 
     fb = feedback or Feedback()
-    fit = review.fit()  # first: a bad state fails before anything is written
+    if fit is None:
+        fit = review.fit()  # first: a bad state fails before anything is written
     folder, name = review.folder, review.name
     source = folder / f"{name}_gcps.tif"
     if not source.is_file():
@@ -481,10 +485,10 @@ def save_review(review: Review, feedback: Optional[Feedback] = None) -> Dict[str
                  if review.check_points else None)
         residual_png(tmp / "residuals.png", result, rep["image"]["width"],
                      rep["image"]["height"], check=check)
-        (tmp / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
-                                         encoding="utf-8")
+        text = json.dumps(json_ready(rep), indent=1)
+        (tmp / "report.json").write_text(text, encoding="utf-8")
         (tmp / "report.html").write_text(report_html(rep, name), encoding="utf-8")
-    review.report = json.loads((folder / "report.json").read_text(encoding="utf-8"))
+    review.report = json.loads(text)
     return {"folder": str(folder), "points": str(folder / f"{name}.points"),
             "gcps": str(folder / "gcps.gpkg"), "image": str(folder / f"{name}_georef.tif"),
             "report": str(folder / "report.json"), "html": str(folder / "report.html")}

@@ -358,6 +358,10 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             self.save_button.setEnabled(False)
             self._draw()
             return
+        self._show_fit()
+
+    def _show_fit(self) -> None:
+        """Fill the residual columns and the summary from ``self.fit``, redraw the map."""
         self.rows = self.review.table(self.fit)
         table = self.point_table
         table.blockSignals(True)
@@ -464,7 +468,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                                      QtWidgets.QApplication.processEvents()))
         progress.canceled.connect(feedback.cancel)
         try:
-            paths = save_review(self.review, feedback=feedback)
+            paths = save_review(self.review, feedback=feedback, fit=self.fit)
         except Cancelled:
             return False
         except PhotodemError as exc:
@@ -473,7 +477,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         finally:
             progress.close()
         self.dirty = False
-        self.refresh()
+        self._show_fit()  # the state is unchanged: only the summary loses "not saved"
         self.saved.emit(paths)
         return True
 
