@@ -443,15 +443,27 @@ def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],
     name = Path(image).stem
     out = Path(output)
     with staged_folder(out, replace=replace, product="georeference_polygons") as tmp:
-        write_points_file(tmp / f"{name}.points", result)
-        write_gcps_gpkg(tmp / "gcps.gpkg", result)
-        write_georeferenced(tmp / f"{name}_georef.tif", image, result, feedback=feedback)
-        write_with_gcps(tmp / f"{name}_gcps.tif", image, result)
+        write_transform_products(tmp, image, result, name, feedback)
         write_report(tmp, result, name)
-    return {"folder": str(out), "points": str(out / f"{name}.points"),
-            "gcps": str(out / "gcps.gpkg"), "image": str(out / f"{name}_georef.tif"),
-            "image_gcps": str(out / f"{name}_gcps.tif"), "report": str(out / "report.json"),
-            "html": str(out / "report.html")}
+    return product_paths(out, name)
+
+
+def write_transform_products(folder: Path, image: PathLike, result: Dict[str, Any], name: str,
+                             feedback: Optional[Feedback] = None) -> None:
+    """The products of the transform in ``folder``: the ``.points`` file, ``gcps.gpkg``, the
+    georeferenced image and the image copy with GCPs (automatic run and review alike)."""
+    write_points_file(folder / f"{name}.points", result)
+    write_gcps_gpkg(folder / "gcps.gpkg", result)
+    write_georeferenced(folder / f"{name}_georef.tif", image, result, feedback=feedback)
+    write_with_gcps(folder / f"{name}_gcps.tif", image, result)
+
+
+def product_paths(folder: Path, name: str) -> Dict[str, str]:
+    """The paths of a georeferencing folder's products (the algorithm's outputs)."""
+    return {"folder": str(folder), "points": str(folder / f"{name}.points"),
+            "gcps": str(folder / "gcps.gpkg"), "image": str(folder / f"{name}_georef.tif"),
+            "image_gcps": str(folder / f"{name}_gcps.tif"),
+            "report": str(folder / "report.json"), "html": str(folder / "report.html")}
 
 
 def summary(result: Dict[str, Any], paths: Dict[str, Any]) -> Dict[str, Any]:

@@ -429,13 +429,11 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
     from ..processing.spec import json_ready
     from ..raster.io import staged_folder
     from .products import (
+        product_paths,
         report_html,
         residual_png,
         transform_json,
-        write_gcps_gpkg,
-        write_georeferenced,
-        write_points_file,
-        write_with_gcps,
+        write_transform_products,
     )
     from .refinement import ControlPoint
 
@@ -476,10 +474,7 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
                 shutil.copy2(folder / keep, tmp / keep)
         if auto:
             shutil.copy2(folder / "report.json", tmp / "report_auto.json")
-        write_points_file(tmp / f"{name}.points", result)
-        write_gcps_gpkg(tmp / "gcps.gpkg", result)
-        write_georeferenced(tmp / f"{name}_georef.tif", source, result, feedback=fb)
-        write_with_gcps(tmp / f"{name}_gcps.tif", source, result)
+        write_transform_products(tmp, source, result, name, fb)
         check = ((np.array([c.image for c in review.check_points], float),
                   np.array([c.map for c in review.check_points], float))
                  if review.check_points else None)
@@ -489,9 +484,7 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
         (tmp / "report.json").write_text(text, encoding="utf-8")
         (tmp / "report.html").write_text(report_html(rep, name), encoding="utf-8")
     review.report = json.loads(text)
-    return {"folder": str(folder), "points": str(folder / f"{name}.points"),
-            "gcps": str(folder / "gcps.gpkg"), "image": str(folder / f"{name}_georef.tif"),
-            "report": str(folder / "report.json"), "html": str(folder / "report.html")}
+    return product_paths(folder, name)
 
 
 def _independent_json(review: Review, fit: TransformFit) -> Optional[Dict[str, Any]]:
