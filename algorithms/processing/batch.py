@@ -110,9 +110,7 @@ class Task:
     @property
     def name(self) -> Optional[str]:
         """The item's name: a model or image name, or a file's name without suffix."""
-        if self.item is None or self.item_kind != "file":
-            return self.item
-        return Path(self.item).stem
+        return _item_label(self.item, self.item_kind)
 
     @property
     def key(self) -> str:
@@ -134,14 +132,11 @@ class BatchPlan:
     run_dir: Path
     workers: int
     steps: List[str]
+    #: The folder of the resume state (.photodem/batch-state.json): the project, or the
+    #: batch file's folder for a batch over files.
+    state_home: Path
     tasks: List[Task] = field(default_factory=list)
     file: Optional[Path] = None
-    state_root: Optional[Path] = None  # holds .photodem/batch-state.json; default: project
-
-    @property
-    def state_home(self) -> Path:
-        """The folder of the resume state: the project, or the batch file's folder."""
-        return Path(self.state_root or self.project or ".")
 
     def to_dict(self) -> Dict[str, Any]:
         return {
@@ -221,7 +216,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     if not isinstance(steps, list) or not steps:
         raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
     plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
-                     state_root=home)
+                     state_home=home)
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, dict):
             raise InputError(f"Batch file: step {number} is not a table.")
@@ -314,7 +309,7 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         values = {"run": str(plan.run_dir), "step": name}
         if plan.project is not None:
             values["project"] = str(plan.project)
-        label = Path(item).stem if item is not None and item_kind == "file" else item
+        label = _item_label(item, item_kind)
         if label is not None:
             values[item_kind] = label  # type: ignore[index]
         task_params = {k: _anchored(alg, k, _substitute(v, values, name), base_dir)
@@ -324,6 +319,11 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         log = plan.run_dir / (f"{name}.log" if label is None else f"{name}/{_safe(label)}.log")
         plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
                                item_kind=item_kind, params=task_params, log=log))
+
+
+def _item_label(item: Optional[str], kind: Optional[str]) -> Optional[str]:
+    """A model or image name as it is; a file by its name without suffix ({file}, logs)."""
+    return Path(item).stem if item is not None and kind == "file" else item
 
 
 def _anchored(alg: Any, name: str, value: Any, base_dir: Path) -> Any:
