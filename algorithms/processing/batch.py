@@ -334,8 +334,14 @@ def _anchored(alg: Any, name: str, value: Any, base_dir: Path) -> Any:
         return value
     if kind not in (*INPUT_PATH_KINDS, *OUTPUT_KINDS, "multiple_rasters"):
         return value
+    if kind == "multiple_rasters" and isinstance(value, str):
+        value = [v.strip() for v in value.split(",") if v.strip()]  # as Parameter.convert
     if isinstance(value, list):
-        return [_anchored(alg, name, v, base_dir) for v in value]
+        return [_anchored_path(v, base_dir) for v in value]
+    return _anchored_path(value, base_dir)
+
+
+def _anchored_path(value: Any, base_dir: Path) -> Any:
     if not isinstance(value, str) or not value or Path(value).expanduser().is_absolute():
         return value
     return str(base_dir.resolve() / Path(value).expanduser())

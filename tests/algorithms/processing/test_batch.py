@@ -249,3 +249,14 @@ def test_file_batch_runs_past_a_failure_and_resumes(fake_algs, tmp_path):
     assert (root / ".photodem" / "batch-state.json").is_file()
     again = batch.run_batch(batch.load_batch(file, run_dir=root / "runs" / "two"))
     assert again["counts"]["skipped"] == 2 and again["counts"]["failed"] == 1
+
+
+def test_relative_raster_lists_are_taken_from_the_batch_file_folder(tmp_path):
+    # "a.tif,b.tif" is split as the parameter splits it, then every part is anchored
+    from photodem.algorithms.processing import registry
+
+    alg = registry.algorithms()["dsm_merge"]
+    base = tmp_path / "b"
+    expected = [str(base.resolve() / "a.tif"), str(base.resolve() / "m" / "b.tif")]
+    assert batch._anchored(alg, "inputs", "a.tif, m/b.tif", base) == expected
+    assert batch._anchored(alg, "inputs", ["a.tif", "m/b.tif"], base) == expected
