@@ -548,13 +548,6 @@ def orientation_score(z: NDArray[np.complex128], T: Array, pts: Array, angles: A
     image pixel → map); the weights are outline length × gradient magnitude. 1: every edge
     runs along the outlines; 0: no relation.
     """
-    num, den = _orientation_terms(z, T, pts, angles, weights)
-    return num / den if den > 0 else 0.0
-
-
-def _orientation_terms(z: NDArray[np.complex128], T: Array, pts: Array, angles: Array,
-                       weights: Array) -> Tuple[float, float]:
-    """Σ w·|g|·cos 2Δ and Σ w·|g| over the outline points inside the image."""
     from scipy import ndimage
 
     Ti = np.linalg.inv(T)
@@ -562,14 +555,15 @@ def _orientation_terms(z: NDArray[np.complex128], T: Array, pts: Array, angles: 
     rows, cols = z.shape
     ok = (q[:, 0] >= 0) & (q[:, 0] <= cols - 1) & (q[:, 1] >= 0) & (q[:, 1] <= rows - 1)
     if not ok.any():
-        return 0.0, 0.0
+        return 0.0
     coords = [q[ok, 1], q[ok, 0]]
     zr = ndimage.map_coordinates(z.real, coords, order=1)
     zi = ndimage.map_coordinates(z.imag, coords, order=1)
     psi = _directions(Ti, pts[ok], angles[ok]) + math.pi / 2
     w = weights[ok]
-    num = float(np.sum((zr * np.cos(2 * psi) + zi * np.sin(2 * psi)) * w))
-    return num, float(np.sum(np.hypot(zr, zi) * w))
+    den = float(np.sum(np.hypot(zr, zi) * w))  # Σ w·|g|
+    num = float(np.sum((zr * np.cos(2 * psi) + zi * np.sin(2 * psi)) * w))  # Σ w·|g|·cos 2Δ
+    return num / den if den > 0 else 0.0
 
 
 @dataclass
@@ -731,7 +725,6 @@ def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
     from scipy import optimize
 
     rows, cols = grey.shape
-    valid = np.isfinite(grey)
     px = math.sqrt(abs(np.linalg.det(T[:2, :2])))
     pts, ang, wts = boundary_samples(boundaries, px * spacing)
     ctrl = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0]])
@@ -742,10 +735,9 @@ def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
         return (_corner_moves(Ac, ctrl, x) if model == "affine" else
                 _similarity_moves(x, cols, rows))
 
-    z = np.zeros(grey.shape, complex)
     for sg in sigmas:
         if sg not in fields:
-            fields[sg] = gradient_orientation(grey, valid, sg)
+            fields[sg] = gradient_orientation(grey, np.isfinite(grey), sg)
         z = fields[sg]
 
         def cost(x: Array, z: Array = z, T: Array = T) -> float:
