@@ -19,6 +19,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..processing.feedback import Feedback
+from .correspondence import apply
+from .fit import centre_matrix
 from .objects import REFERENCE, PolygonObject, orient_ring
 
 PathLike = Union[str, Path]
@@ -227,11 +229,10 @@ def reference_objects_from_raster(path: PathLike, thresholds: Sequence[float],
     if not crs.is_projected:
         raise InputError(f"The reference raster '{Path(path).name}' is in a geographic CRS; "
                          "reproject it to a projected CRS first.")
-    A = np.array([[transform.a, transform.b], [transform.d, transform.e]])
-    t = np.array([transform.c, transform.f])
+    to_map = centre_matrix(transform)
     out = []
     for o in objs:
-        ring = (o.ring + 0.5) @ A.T + t
+        ring = apply(to_map, o.ring)
         out.append(PolygonObject(id=o.id, ring=orient_ring(ring), source=REFERENCE, run=o.run,
                                  threshold=o.threshold, touches_border=o.touches_border,
                                  attributes=o.attributes))

@@ -219,12 +219,11 @@ def write_raster(
     count, height, width = arr.shape
     if nodata is None and np.issubdtype(arr.dtype, np.floating):
         nodata = float("nan")
-    profile = gtiff_profile(width, height, count, arr.dtype.name, crs, nodata=nodata)
-    if transform is not None:
-        profile["transform"] = transform
+    extra: Dict[str, Any] = {} if transform is None else {"transform": transform}
     if np.issubdtype(arr.dtype, np.floating):
-        profile["predictor"] = 3
-    profile.update(options)
+        extra["predictor"] = 3
+    profile = gtiff_profile(width, height, count, arr.dtype.name, crs, nodata=nodata,
+                            **{**extra, **options})
     if not overviews:
         with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
             dst.write(arr)

@@ -235,10 +235,9 @@ def _combine(stack: Array, mode: str, sigma: Optional[Array]) -> Array:
 
 def _profile(width: int, height: int, dtype: str, transform: Affine, crs: Any,
              nodata: Optional[float]) -> Dict[str, Any]:
-    prof = gtiff_profile(width, height, 1, dtype, crs, nodata=nodata, transform=transform)
-    if dtype.startswith("float"):
-        prof["predictor"] = 3
-    return prof
+    extra = {"predictor": 3} if dtype.startswith("float") else {}
+    return gtiff_profile(width, height, 1, dtype, crs, nodata=nodata, transform=transform,
+                         **extra)
 
 
 def _overviews(dst: Any, width: int, height: int, resampling: Any) -> None:
