@@ -183,6 +183,16 @@ def fit_transform(image_xy: NDArray[np.float64], map_xy: NDArray[np.float64],
     return fit
 
 
+def inverse_for_resampling(fit: TransformFit, img: NDArray[np.float64],
+                           map_xy: NDArray[np.float64]) -> Optional[TransformFit]:
+    """The map → image transform a poly2 ``fit`` needs for resampling (it has no closed
+    inverse): a poly2 fitted the other way on the points given; ``None`` for the kinds with
+    a matrix, whose inverse is exact."""
+    if fit.kind != "poly2":
+        return None
+    return fit_transform(map_xy, img, "poly2", robust=False)
+
+
 def centre_matrix(transform: Any) -> NDArray[np.float64]:
     """3 × 3 image → map matrix of a raster's geotransform (a rasterio ``Affine``), with the
     project's pixel convention: pixel centres at integer (col, row)."""

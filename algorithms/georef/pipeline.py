@@ -19,7 +19,7 @@ from ..errors import GeometryError, InputError
 from ..processing.feedback import Feedback, StepFeedback
 from .area import area_search, boundary_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
-from .fit import fit_transform
+from .fit import fit_transform, inverse_for_resampling
 from .invariants import object_features
 from .reference_layer import (
     is_raster,
@@ -219,9 +219,7 @@ def _object_stage(grey: np.ndarray, img_info: Dict[str, Any], reference: PathLik
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
     fit = fit_transform(img_xy, map_xy, transform)
-    # poly2 has no closed inverse: a map → image poly2 on the same points (for resampling)
-    inverse_fit = (fit_transform(map_xy[fit.used], img_xy[fit.used], "poly2", robust=False)
-                   if transform == "poly2" else None)
+    inverse_fit = inverse_for_resampling(fit, img_xy[fit.used], map_xy[fit.used])
     fb.progress(85)
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = int(sum(g.sharp for g, u in zip(gcps, fit.used) if u))
@@ -292,8 +290,7 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
     fit = fit_transform(img_xy, map_xy, transform)
-    inverse_fit = (fit_transform(map_xy, img_xy, "poly2", robust=False)
-                   if transform == "poly2" else None)
+    inverse_fit = inverse_for_resampling(fit, img_xy, map_xy)
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = 0
     how = (f"ECC affine, correlation {res.ecc:.2f}" if area_info["method"] == "ecc" else

@@ -29,7 +29,14 @@ import numpy as np
 from ..errors import InputError
 from ..processing.feedback import Feedback
 from ..quality.points import COLUMN_NAMES, field_separator, find_column, parse_number, split_fields
-from .fit import KINDS, MIN_POINTS, TransformFit, fit_transform, points_summary
+from .fit import (
+    KINDS,
+    MIN_POINTS,
+    TransformFit,
+    fit_transform,
+    inverse_for_resampling,
+    points_summary,
+)
 from .products import image_from_points_source, image_residuals
 
 PathLike = Union[str, Path]
@@ -446,10 +453,8 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
         raise InputError(f"'{source.name}' is missing in '{folder}'; the review resamples that "
                          "copy of the image. Run the georeferencing again.")
     gcps = [ControlPoint(p.image, p.map, 0.0, p.pair, p.sharp) for p in review.points]
-    inverse_fit = None
-    if fit.kind == "poly2":  # no closed inverse: a map → image poly2 for resampling
-        inverse_fit = fit_transform(review.map_xy()[fit.used], review.image_xy()[fit.used],
-                                    "poly2", robust=False)
+    inverse_fit = inverse_for_resampling(fit, review.image_xy()[fit.used],
+                                         review.map_xy()[fit.used])
     result = {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps,
               "crs": pyproj.CRS.from_wkt(review.crs_wkt)}
     rep = dict(review.report)
