@@ -1470,7 +1470,7 @@
         </message>
         <message>
             <source>Iterations</source>
-            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:46</extracomment>
+            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:48</extracomment>
             <translation>Iterationen</translation>
         </message>
         <message>
@@ -2415,7 +2415,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:322; plugin/widgets/georef_review.py:483; plugin/widgets/georef_review.py:488</extracomment>
+            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:324; plugin/widgets/georef_review.py:489; plugin/widgets/georef_review.py:494</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2450,282 +2450,282 @@
         </message>
         <message>
             <source>Use</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Verwenden</translation>
         </message>
         <message>
             <source>Role</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Rolle</translation>
         </message>
         <message>
             <source>Pair</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Paar</translation>
         </message>
         <message>
             <source>Column</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Spalte</translation>
         </message>
         <message>
             <source>Row</source>
-            <extracomment>plugin/widgets/georef_review.py:37</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
             <translation>Zeile</translation>
         </message>
         <message>
             <source>dX [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
             <translation>dX [px]</translation>
         </message>
         <message>
             <source>dY [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
             <translation>dY [px]</translation>
         </message>
         <message>
             <source>Residual [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
             <translation>Restfehler [px]</translation>
         </message>
         <message>
             <source>Residual [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:38</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
             <translation>Restfehler [m]</translation>
         </message>
         <message>
             <source>Leave-one-out [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:41</extracomment>
             <translation>Ohne diesen Punkt [m]</translation>
         </message>
         <message>
             <source>Reject</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Verwerfen</translation>
         </message>
         <message>
             <source>Image object</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Bildobjekt</translation>
         </message>
         <message>
             <source>Reference object</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Referenzobjekt</translation>
         </message>
         <message>
             <source>Segmentation run</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>Segmentierungslauf</translation>
         </message>
         <message>
             <source>Threshold [DN]</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>Schwellwert [GW]</translation>
         </message>
         <message>
             <source>Overlap</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>Überlappung</translation>
         </message>
         <message>
             <source>ICP RMS [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>ICP-RMS [px]</translation>
         </message>
         <message>
             <source>Converged</source>
-            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:48</extracomment>
             <translation>Konvergiert</translation>
         </message>
         <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:61</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:63</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
             <source>Drop outliers (&gt; 3 σ0)</source>
-            <extracomment>plugin/widgets/georef_review.py:123</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:125</extracomment>
             <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:147</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:149</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:148</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:155</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:157</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:156</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:158</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:157</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:161</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:163</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:164</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:163</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:165</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/georef_review.py:166</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:459</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:465</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:460; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:466; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:505</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:511</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:540</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:546</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:540</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:546</extracomment>
             <translation>nein</translation>
         </message>
         <message>
             <source>control point</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Passpunkt</translation>
         </message>
         <message>
             <source>outlier (dropped)</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Ausreißer (entfernt)</translation>
         </message>
         <message>
             <source>check point (off)</source>
-            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
             <translation>Kontrollpunkt (aus)</translation>
         </message>
         <message>
             <source>pair rejected</source>
-            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
             <translation>Paar verworfen</translation>
         </message>
         <message>
             <source>check (independent)</source>
-            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:55</extracomment>
             <translation>Kontrollpunkt (unabhängig)</translation>
         </message>
         <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:64</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:65</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:68</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:69</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
             <source>Transform:</source>
-            <extracomment>plugin/widgets/georef_review.py:129</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:131</extracomment>
             <translation>Transformation:</translation>
         </message>
         <message>
+            <source>Skipped check points outside the image ({0}): {1}.</source>
+            <extracomment>plugin/widgets/georef_review.py:335</extracomment>
+            <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
+        </message>
+        <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:384</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:390</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:488</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:494</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:73</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:75</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
             <source>Review georeferencing — {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:115</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:117</extracomment>
             <translation>Georeferenzierung prüfen — {0}</translation>
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:308</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:310</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:309</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:311</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
-            <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:333</extracomment>
-            <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
-        </message>
-        <message>
             <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:367</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:373</extracomment>
             <translation>manuell</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:388</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:390</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:396</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:400</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:427</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:433</extracomment>
             <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>

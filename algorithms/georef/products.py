@@ -42,6 +42,13 @@ def image_from_points_source(x: Any, y: Any) -> Tuple[Any, Any]:
     return x - 0.5, -y - 0.5
 
 
+#: Colours of the control point roles on the residual maps (report and review dialog).
+ROLE_COLOURS = {"control": "tab:blue", "outlier": "tab:orange", "check": "tab:green",
+                "rejected": "tab:red"}
+#: Colour of the independent check points on the residual maps.
+INDEPENDENT_COLOUR = "tab:purple"
+
+
 def skipped_ids_text(ids: List[str], most: int = 10) -> str:
     """The first ``most`` ids, comma-separated (… when there are more)."""
     return ", ".join(ids[:most]) + (" …" if len(ids) > most else "")
@@ -324,16 +331,16 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     ax = fig.add_subplot()
     ax.add_patch(Rectangle((-0.5, -0.5), width, height, fill=False, color="0.3"))
     scale = residual_scale(np.vstack([res, cres]), float(np.hypot(width, height)))
-    for used, colour in ((fit.used, "tab:blue"), (~fit.used, "tab:orange")):
-        draw_residuals(ax, xy[used], res[used], scale, colour)
-    draw_residuals(ax, cxy, cres, scale, "tab:purple", marker="^", size=5)
+    for used, role in ((fit.used, "control"), (~fit.used, "outlier")):
+        draw_residuals(ax, xy[used], res[used], scale, ROLE_COLOURS[role])
+    draw_residuals(ax, cxy, cres, scale, INDEPENDENT_COLOUR, marker="^", size=5)
     if fit.used.sum() >= 3:
         from scipy.spatial import ConvexHull, QhullError
 
         try:
             hull = ConvexHull(xy[fit.used])
             ring = xy[fit.used][np.append(hull.vertices, hull.vertices[0])]
-            ax.plot(ring[:, 0], ring[:, 1], "--", color="tab:blue", lw=0.8)
+            ax.plot(ring[:, 0], ring[:, 1], "--", color=ROLE_COLOURS["control"], lw=0.8)
         except QhullError:  # collinear points: no hull to draw
             pass
     ax.set_xlim(-0.05 * width, 1.05 * width)

@@ -18,17 +18,19 @@ import numpy as np
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.georef.fit import KINDS
-from ...algorithms.georef.products import draw_residuals, residual_scale, skipped_ids_text
+from ...algorithms.georef.products import (
+    INDEPENDENT_COLOUR,
+    ROLE_COLOURS,
+    draw_residuals,
+    residual_scale,
+    skipped_ids_text,
+)
 from ...algorithms.georef.review import Review, load_review, save_review
 from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
-#: Colours of the point roles on the residual map.
-ROLE_COLOURS = {"control": "tab:blue", "outlier": "tab:orange", "check": "tab:green",
-                "rejected": "tab:red"}
-#: Colour of the independent check points (map) and the tint of their table rows.
-INDEPENDENT_COLOUR = "tab:purple"
+#: Tint of the independent check points' table rows.
 INDEPENDENT_TINT = "#efe6f7"
 
 
@@ -314,24 +316,24 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         except PhotodemError as exc:
             self._error(str(exc))
             return False
-        warnings = self._skipped_notes(skipped)
+        warning = self._skipped_note(skipped)
         self._fill_points()
         self._changed()
         self.point_table.resizeColumnToContents(2)  # the role column: the longer role text
-        if warnings and self.message_boxes:
-            QtWidgets.QMessageBox.information(self, tr("PhotoDEM"), " ".join(warnings))
+        if warning and self.message_boxes:
+            QtWidgets.QMessageBox.information(self, tr("PhotoDEM"), warning)
         self.tabs.setCurrentWidget(self.point_table)
         # after the event loop: the table's scroll range follows its new rows only then
         QtCore.QTimer.singleShot(0, self._show_check_rows)
         return True
 
     @staticmethod
-    def _skipped_notes(ids: List[str]) -> List[str]:
-        """The note on check points skipped outside the image (none without any)."""
+    def _skipped_note(ids: List[str]) -> str:
+        """The note on check points skipped outside the image ('' without any)."""
         if not ids:
-            return []
-        return [tr("Skipped check points outside the image ({0}): {1}.").format(
-            len(ids), skipped_ids_text(ids))]
+            return ""
+        return tr("Skipped check points outside the image ({0}): {1}.").format(
+            len(ids), skipped_ids_text(ids))
 
     def _show_check_rows(self) -> None:
         """Scroll the point table to the independent check points."""
@@ -396,9 +398,9 @@ class GeorefReviewDialog(QtWidgets.QDialog):
                                 self.check["rmse_m"])
         if self.dirty:
             text += " — <i>" + tr("not saved") + "</i>"
-        notes = self._skipped_notes(self.review.check_skipped)
-        if notes:
-            text += "<br><span style='color:#b9770e'>" + " ".join(notes) + "</span>"
+        note = self._skipped_note(self.review.check_skipped)
+        if note:
+            text += "<br><span style='color:#b9770e'>" + note + "</span>"
         self.summary.setText(text)
         self.save_button.setEnabled(True)
         self._draw()
