@@ -141,6 +141,8 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.canvas = FigureCanvasQTAgg(self.figure)
         self.canvas.setMinimumWidth(380)
         self.axes = self.figure.add_subplot(111)
+        self._ring: Any = None  # the selection marker, moved without redrawing the map
+        self._every = np.zeros((0, 2))  # image positions of the table's rows
         self.thumb, self.thumb_factor = _thumbnail(self.review.folder
                                                    / f"{self.review.name}_gcps.tif")
         self.point_table = self._table(point_columns())
@@ -188,7 +190,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.outlier_box.toggled.connect(self._on_outliers)
         self.point_table.itemChanged.connect(self._on_point_item)
         self.pair_table.itemChanged.connect(self._on_pair_item)
-        self.point_table.itemSelectionChanged.connect(self._draw)
+        self.point_table.itemSelectionChanged.connect(self._show_selection)
         self.add_button.clicked.connect(self.add_point)
         self.import_button.clicked.connect(lambda: self.import_check_points())
         self.worst_button.clicked.connect(self.switch_off_worst)
@@ -433,17 +435,23 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             ax.set_title(tr("Residuals (×{0:g})").format(k), fontsize=9)
         elif len(xy):
             ax.plot(xy[:, 0], xy[:, 1], ".", color="0.5", ms=3)
-        every = np.vstack([xy, ind_xy])
-        selected = [r for r in sorted({i.row() for i in self.point_table.selectedIndexes()})
-                    if r < len(every)]
-        if selected:
-            ax.plot(every[selected, 0], every[selected, 1], "o", mfc="none", mec="yellow",
-                    ms=9)
+        self._every = np.vstack([xy, ind_xy])
+        self._ring, = ax.plot([], [], "o", mfc="none", mec="yellow", ms=9)
         ax.set_aspect("equal")
         if self.thumb is not None:
             h, w = self.thumb.shape
             ax.set_xlim(-0.5, w * self.thumb_factor - 0.5)
             ax.set_ylim(h * self.thumb_factor - 0.5, -0.5)
+        self._show_selection()
+
+    def _show_selection(self) -> None:
+        """Ring the selected table rows' points on the map."""
+        if self._ring is None:
+            return
+        every = self._every
+        selected = [r for r in sorted({i.row() for i in self.point_table.selectedIndexes()})
+                    if r < len(every)]
+        self._ring.set_data(every[selected, 0], every[selected, 1])
         self.canvas.draw_idle()
 
     def _on_click(self, event: Any) -> None:
