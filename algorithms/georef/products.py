@@ -61,6 +61,14 @@ def skipped_note(ids: List[str]) -> str:
     return f"Skipped check points outside the image ({len(ids)}): {skipped_ids_text(ids)}."
 
 
+def points_crs(text: str) -> Optional[str]:
+    """The CRS of a QGIS ``.points`` file's text: its ``#CRS:`` line (``None`` without one)."""
+    for raw in text.splitlines():
+        if raw.startswith("#CRS:"):
+            return raw.removeprefix("#CRS:").strip()
+    return None
+
+
 def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
     """The QGIS Georeferencer ``.points`` file (see the module notes for the convention)."""
     fit = result["fit"]

@@ -28,7 +28,14 @@ import numpy as np
 
 from ..errors import InputError
 from ..processing.feedback import Feedback
-from ..quality.points import COLUMN_NAMES, field_separator, find_column, parse_number, split_fields
+from ..quality.points import (
+    COLUMN_NAMES,
+    field_separator,
+    find_column,
+    numbered_lines,
+    parse_number,
+    split_fields,
+)
 from .fit import (
     KINDS,
     MIN_POINTS,
@@ -37,7 +44,7 @@ from .fit import (
     inverse_for_resampling,
     points_summary,
 )
-from .products import image_from_points_source, image_residuals
+from .products import image_from_points_source, image_residuals, points_crs
 
 PathLike = Union[str, Path]
 #: Pair index of a control point the operator added by hand.
@@ -263,7 +270,8 @@ def read_check_points(path: PathLike, width: Optional[int] = None,
     path = Path(path)
     if not path.is_file():
         raise InputError(f"The check-point file '{path}' does not exist.")
-    crs_line, lines = _check_lines(path)
+    text = path.read_text(encoding="utf-8-sig", errors="replace")
+    crs_line, lines = points_crs(text), numbered_lines(text)
     if not lines:
         raise InputError(f"The check-point file '{path.name}' holds no check points.")
     sep = field_separator(lines[0][1])
@@ -281,19 +289,6 @@ def read_check_points(path: PathLike, width: Optional[int] = None,
     points = [CheckPoint(i, (float(c), float(r)), (float(u), float(v)))
               for i, c, r, u, v in zip(ids, col, row, x, y)]
     return _inside_image(path.name, points, width, height)
-
-
-def _check_lines(path: Path) -> Tuple[Optional[str], List[Tuple[int, str]]]:
-    """A ``#CRS:`` comment (QGIS ``.points``) and the numbered lines without comments."""
-    crs_line, lines = None, []
-    text = path.read_text(encoding="utf-8-sig", errors="replace")
-    for number, raw in enumerate(text.splitlines(), start=1):
-        if raw.startswith("#CRS:"):
-            crs_line = raw.removeprefix("#CRS:").strip()
-        stripped = raw.split("#", 1)[0].strip()
-        if stripped:
-            lines.append((number, stripped))
-    return crs_line, lines
 
 
 def _check_columns(name: str, header: Sequence[str]) -> Tuple[List[Optional[int]], bool]:
@@ -395,7 +390,7 @@ def load_review(folder: PathLike) -> Review:
                          "against polygons'.")
     try:
         rep = json.loads(report_path.read_text(encoding="utf-8"))
-        crs_wkt = points[0].read_text(encoding="utf-8").splitlines()[0].removeprefix("#CRS: ")
+        crs_wkt = points_crs(points[0].read_text(encoding="utf-8")) or ""
         pts = [ReviewPoint(tuple(g["image"]), tuple(g["map"]), int(g.get("pair", 0)),
                            bool(g.get("sharp", False)), bool(g.get("enabled", True)))
                for g in rep["gcps"]]

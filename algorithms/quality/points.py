@@ -107,13 +107,18 @@ def find_column(names: Sequence[str], candidates: Sequence[str]) -> Optional[int
     return None
 
 
-def _read_text(path: Path) -> PointSet:
+def numbered_lines(text: str) -> List[Tuple[int, str]]:
+    """The non-empty lines of a text file without ``#`` comments, with their numbers (from 1)."""
     lines = []
-    for number, raw in enumerate(path.read_text(encoding="utf-8-sig", errors="replace")
-                                 .splitlines(), start=1):
-        text = raw.split("#", 1)[0].strip()
-        if text:
-            lines.append((number, text))
+    for number, raw in enumerate(text.splitlines(), start=1):
+        stripped = raw.split("#", 1)[0].strip()
+        if stripped:
+            lines.append((number, stripped))
+    return lines
+
+
+def _read_text(path: Path) -> PointSet:
+    lines = numbered_lines(path.read_text(encoding="utf-8-sig", errors="replace"))
     if not lines:
         raise InputError(f"The points file '{path.name}' holds no points (only comments or "
                          "empty lines).")
