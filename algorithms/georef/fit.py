@@ -101,8 +101,7 @@ class TransformFit:
 
     @property
     def rmse_map(self) -> float:
-        r = self.residuals_map
-        return float(np.sqrt(np.mean(np.sum(r * r, axis=1)))) if len(r) else float("nan")
+        return rmse(self.residuals_map)
 
     @property
     def rmse_px(self) -> float:
@@ -217,18 +216,27 @@ def corner_error(matrix_or_fit: Any, truth: NDArray[np.float64], width: int, hei
     return np.hypot(*(back - corners).T)
 
 
-def points_summary(fit: TransformFit) -> List[Dict[str, float]]:
-    """Per point: residuals (map, px), leave-one-out, used flag.
+def rmse(residuals: NDArray[np.float64]) -> float:
+    """Root mean square length of (n, 2) residual vectors (NaN without any)."""
+    r = np.asarray(residuals, float).reshape(-1, 2)
+    return float(np.sqrt(np.mean(np.sum(r * r, axis=1)))) if len(r) else float("nan")
+
+
+def residual_fields(r: NDArray[np.float64], pixel_size: float) -> Dict[str, float]:
+    """One point's residual (fitted − measured, map units) as the reports give it: dx, dy,
+    length in map units and in pixels.
 
     Rounded to 1e-4 map units and 1e-5 px: a residual is the difference of two map coordinates
     (10⁵–10⁶ m in a projected CRS), so digits below about 1e-9 m are round-off and differ
     between builds of the numerical libraries.
     """
+    d = float(np.hypot(*r))
+    return {"dx_map": round(float(r[0]), 4), "dy_map": round(float(r[1]), 4),
+            "residual_map": round(d, 4), "residual_px": round(d / pixel_size, 5)}
+
+
+def points_summary(fit: TransformFit) -> List[Dict[str, float]]:
+    """Per point: residuals (map, px; :func:`residual_fields`), leave-one-out, used flag."""
     res = fit.extras["all_residuals_map"]
-    out = []
-    for k, (r, u) in enumerate(zip(res, fit.used)):
-        d = float(np.hypot(*r))
-        out.append({"dx_map": round(float(r[0]), 4), "dy_map": round(float(r[1]), 4),
-                    "residual_map": round(d, 4), "residual_px": round(d / fit.pixel_size, 5),
-                    "loo_map": round(float(fit.loo_map[k]), 4), "used": bool(u)})
-    return out
+    return [{**residual_fields(r, fit.pixel_size), "loo_map": round(float(fit.loo_map[k]), 4),
+             "used": bool(u)} for k, (r, u) in enumerate(zip(res, fit.used))]

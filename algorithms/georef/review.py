@@ -43,6 +43,8 @@ from .fit import (
     fit_transform,
     inverse_for_resampling,
     points_summary,
+    residual_fields,
+    rmse,
 )
 from .products import image_from_points_source, image_residuals, points_crs
 
@@ -183,9 +185,7 @@ class Review:
         """RMSE (map units) and count of the check points: the points the operator took out
         (switched off, or of a rejected pair) — not the outliers the robust step dropped."""
         res = fit.extras["all_residuals_map"][~self.active()]
-        if not len(res):
-            return float("nan"), 0
-        return float(np.sqrt(np.mean(np.sum(res * res, axis=1)))), len(res)
+        return rmse(res), len(res)
 
     def import_check_points(self, path: PathLike) -> List[str]:
         """Read independent check points from a file (:func:`read_check_points`); they
@@ -222,15 +222,12 @@ class Review:
             return {"count": 0, "rmse_m": float("nan"), "rmse_px": float("nan"), "points": []}
         res = fit.forward(img) - mp
         d_img = image_residuals(fit, img, res)
-        dist = np.hypot(res[:, 0], res[:, 1])
-        rmse = float(np.sqrt(np.mean(dist * dist)))
         points = [{"id": p.id, "col": p.image[0], "row": p.image[1], "x": p.map[0],
-                   "y": p.map[1], "dx_map": round(float(r[0]), 4),
-                   "dy_map": round(float(r[1]), 4), "residual_map": round(float(d), 4),
-                   "residual_px": round(float(d) / fit.pixel_size, 5),
+                   "y": p.map[1], **residual_fields(r, fit.pixel_size),
                    "dcol": float(di[0]), "drow": float(di[1])}
-                  for p, r, d, di in zip(self.check_points, res, dist, d_img)]
-        return {"count": len(points), "rmse_m": rmse, "rmse_px": rmse / fit.pixel_size,
+                  for p, r, di in zip(self.check_points, res, d_img)]
+        e = rmse(res)
+        return {"count": len(points), "rmse_m": e, "rmse_px": e / fit.pixel_size,
                 "points": points}
 
 
