@@ -37,8 +37,25 @@ Semantics (kept simple on purpose):
   ``{step}`` (step name), ``{model}`` / ``{image}`` / ``{file}`` (the task's item). Other braces
   stay as they are.
 - **Order.** Steps run one after the other; the tasks of one step run in parallel on ``workers``
-  processes (``spawn`` context; ``workers = 1`` runs them in this process). Every task calls
-  :func:`.registry.run`, so its result is the same as from Python, the CLI or QGIS.
+  processes (``spawn`` context, each running one task at a time and reused across steps;
+  ``workers = 1`` runs them in this process). Every task calls :func:`.registry.run`, so its
+  result is the same as from Python, the CLI or QGIS.
+- **Lost workers.** A worker process that dies without a result (killed, out of memory) costs
+  only its own task: the task runs once more on a new worker (logged); a second death makes it
+  ``failed`` ("worker process N died (signal 9, SIGKILL) …"). A task that failed with an error
+  is not run again. Other tasks and later steps go on as after any failure.
+- **Parent death.** Workers end with the batch: on Linux the kernel sends them SIGTERM when the
+  batch process dies (``PR_SET_PDEATHSIG``), elsewhere a thread watches the parent pid. A worker
+  told so cancels its task (which discards its staged output) and exits within
+  :data:`ORPHAN_GRACE` seconds.
+- **Lock.** ``<project>/.photodem/batch.lock`` (beside the resume state) is created atomically
+  with the pid, host, start time and run folder of the batch; a second batch on the same
+  project is refused at once with an operator error naming the holder. A lock whose process
+  (on this host) is no longer running is taken over with a line in the batch log. The lock is
+  removed on every exit of :func:`run_batch`; ``--dry-run`` does not take it.
+- **Run folders** are unique: the default ``runs/<timestamp>/`` is created with an atomic
+  ``mkdir``; if it exists already, ``<timestamp>-2`` (``-3`` …) is used and the tasks are
+  planned again for it.
 - **Failures.** A failed task does not stop the other tasks of its step. A later step's task for
   the same model/image is not run (status ``failed``, "not run because …"); other tasks go on.
   The batch status is ``failed`` and the CLI exits 1.
@@ -50,7 +67,9 @@ Semantics (kept simple on purpose):
   file contents are not hashed.
 - **Cancel.** :meth:`Feedback.cancel` (Ctrl-C in the CLI) stops scheduling; running tasks are
   asked to stop (a shared event their Feedback checks), which makes the algorithms discard their
-  staged outputs; workers that do not stop within ``grace`` seconds are terminated.
+  staged outputs; workers that do not stop within ``grace`` seconds are killed. The batch is
+  ``cancelled`` only when a task was: a task that finished before the cancel reached it stays
+  ``done``, and a cancel after the last task changes nothing.
 - **Logs.** ``<run>/batch.log`` (the whole run), one log per task (``<run>/<step>.log`` or
   ``<run>/<step>/<item>.log``) and ``<run>/summary.json`` with each task's status
   (``done``/``skipped``/``failed``/``cancelled``), outputs, duration and error message.
@@ -58,20 +77,25 @@ Semantics (kept simple on purpose):
 
 from __future__ import annotations
 
-import concurrent.futures as cf
+import collections
 import contextlib
+import ctypes
 import datetime as _dt
 import hashlib
 import json
 import multiprocessing
+import multiprocessing.connection as mp_connection
 import os
 import re
 import signal
+import socket
+import sys
+import threading
 import time
 import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO, Union
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, TextIO, Tuple, Union
 
 from ..errors import Cancelled, InputError, PhotodemError
 from ..project import toml_io
@@ -82,6 +106,8 @@ from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
 STATE_FILE = Path(".photodem") / "batch-state.json"
+#: The lock of a running batch, beside the resume state: one batch per project at a time.
+LOCK_FILE = Path(".photodem") / "batch.lock"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
 _FILE_OUTPUT_KINDS = ("file", "folder", "raster", "vector")
@@ -137,6 +163,12 @@ class BatchPlan:
     state_home: Path
     tasks: List[Task] = field(default_factory=list)
     file: Optional[Path] = None
+    #: The parsed batch file and its folder: :func:`run_batch` plans again when the default
+    #: run folder was taken meanwhile (another batch started in the same second).
+    config: Optional[Dict[str, Any]] = field(default=None, repr=False)
+    base_dir: Optional[Path] = field(default=None, repr=False)
+    #: True when the run folder is the default ``runs/<timestamp>/`` (not named by the batch).
+    run_auto: bool = False
 
     def to_dict(self) -> Dict[str, Any]:
         return {
@@ -202,6 +234,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     if workers < 1:
         raise InputError(f"Batch file: workers = {head.get('workers')!r} must be a whole "
                          "number ≥ 1.")
+    run_auto = run_dir is None and not head.get("output")
     if run_dir is None:
         if head.get("output"):
             text = _substitute(str(head["output"]),
@@ -216,7 +249,8 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     if not isinstance(steps, list) or not steps:
         raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
     plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
-                     state_home=home)
+                     state_home=home, config=config, base_dir=Path(base_dir),
+                     run_auto=run_auto)
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, dict):
             raise InputError(f"Batch file: step {number} is not a table.")
@@ -516,27 +550,275 @@ def execute_task(algorithm: str, params: Dict[str, Any], log_path: PathLike,
     return result
 
 
-_worker_cancel: Any = None
-_worker_queue: Any = None
+# -- worker processes ----------------------------------------------------------------------------
+#: Seconds an orphaned worker (its batch parent died) gets to discard its staged output before
+#: it exits anyway (an algorithm that does not check its feedback in time).
+ORPHAN_GRACE = 3.0
+_PR_SET_PDEATHSIG = 1  # from linux/prctl.h
+
+#: In a worker: a task is running (a parent's death then cancels it before the worker exits).
+_busy = False
+#: In a worker: the batch parent is gone (or sent SIGTERM); the running task is cancelled.
+_orphaned = threading.Event()
 
 
-def _init_worker(cancel_event: Any, queue: Any, modules: Sequence[str]) -> None:
-    """Worker start: the parent handles Ctrl-C (and tells us through ``cancel_event``)."""
-    global _worker_cancel, _worker_queue
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _worker_cancel, _worker_queue = cancel_event, queue
+def _worker_main(conn: Any, cancel_event: Any, modules: Sequence[str], parent_pid: int) -> None:
+    """A worker process: run the tasks the parent sends until it sends ``None`` or is gone.
+
+    Each job is ``(index, algorithm, params, log)``; the worker answers with
+    ``("progress", index, pct)`` messages and one ``("result", index, dict)``.
+    """
+    global _busy
+    _die_with_parent(parent_pid)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C (cancel_event)
     registry.add_modules(modules)
 
+    def is_canceled() -> bool:
+        return cancel_event.is_set() or _orphaned.is_set()
 
-def _worker_run(index: int, algorithm: str, params: Dict[str, Any], log: str) -> Dict[str, Any]:
+    while True:
+        try:
+            job = conn.recv()
+        except (EOFError, OSError):  # the parent is gone
+            return
+        if job is None:
+            return
+        index, algorithm, params, log = job
+        _busy = True  # until the result is sent: a SIGTERM then lets the task finish or cancel
+        result = execute_task(algorithm, params, log, is_canceled, _progress_sender(conn, index))
+        sent = _send(conn, ("result", index, result))
+        _busy = False
+        if not sent or _orphaned.is_set():
+            return
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """End this worker when the batch parent dies (SIGTERM on Linux, else a watchdog thread)."""
+    signal.signal(signal.SIGTERM, lambda signum, frame: _orphan())
+    armed = False
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):  # no libc symbol: fall back to the watchdog
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0) == 0
+    if os.getppid() != parent_pid:  # the parent died before the signal was armed
+        os._exit(0)
+    if not armed:
+        threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
+
+
+def _watch_parent(parent_pid: int) -> None:
+    while os.getppid() == parent_pid:
+        time.sleep(0.5)
+    _orphan()
+
+
+def _orphan() -> None:
+    """The parent is gone: exit now when idle, else cancel the task and exit soon after."""
+    if _orphaned.is_set():
+        return
+    _orphaned.set()  # the task's feedback now reports cancel: its staged output is discarded
+    if not _busy:
+        os._exit(0)
+    timer = threading.Timer(ORPHAN_GRACE, os._exit, args=(1,))
+    timer.daemon = True
+    timer.start()
+
+
+def _progress_sender(conn: Any, index: int) -> Callable[[float], None]:
     last = [-1.0]
 
     def progress(pct: float) -> None:
         if pct - last[0] >= 1.0 or pct >= 100.0:  # at most ~100 messages per task
             last[0] = pct
-            _worker_queue.put((index, pct))
+            if not _send(conn, ("progress", index, pct)):
+                _orphan()  # the parent's end of the pipe is closed
 
-    return execute_task(algorithm, params, log, _worker_cancel.is_set, progress)
+    return progress
+
+
+def _send(conn: Any, message: Any) -> bool:
+    """Send on a pipe; False when the other end is gone."""
+    try:
+        conn.send(message)
+    except (OSError, ValueError):  # BrokenPipeError, or a closed connection
+        return False
+    return True
+
+
+def _exit_cause(exitcode: Optional[int]) -> str:
+    """``died (signal 9, SIGKILL)`` or ``ended with exit code 1`` for a worker's exit code."""
+    if exitcode is not None and exitcode < 0:
+        try:
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = "unknown signal"
+        return f"died (signal {-exitcode}, {name})"
+    return f"ended with exit code {exitcode}"
+
+
+@dataclass
+class _Worker:
+    """A worker process, the parent's end of its pipe and the task it runs (None: idle)."""
+
+    process: Any
+    conn: Any
+    task: Optional[Task] = None
+
+
+class _Pool:
+    """At most ``n`` spawned worker processes; a worker that dies costs only its own task.
+
+    A task whose worker dies without a result runs once more on a new worker; a second death
+    makes it ``failed``. Cancellation is a shared event the tasks' feedback checks.
+    """
+
+    def __init__(self, n: int, modules: Sequence[str], log: Callable[..., None],
+                 finish: Callable[[Task, Dict[str, Any]], None], progress: _Progress) -> None:
+        self.ctx = multiprocessing.get_context("spawn")
+        self.n = n
+        self.modules = tuple(modules)
+        self.log = log  # log(message, warning=False, quiet=False): batch.log (and operator)
+        self.finish = finish  # records a task's result
+        self.progress = progress
+        self.cancel_event = self.ctx.Event()
+        self.workers: List[_Worker] = []
+
+    # -- workers ---------------------------------------------------------------------------------
+    def _spawn(self) -> _Worker:
+        conn, child = self.ctx.Pipe()
+        process = self.ctx.Process(
+            target=_worker_main, name="photodem-batch-worker",
+            args=(child, self.cancel_event, self.modules, os.getpid()),
+        )
+        process.start()
+        child.close()  # a worker's death then shows as EOF on our end
+        worker = _Worker(process, conn)
+        self.workers.append(worker)
+        return worker
+
+    def _idle(self) -> Optional[_Worker]:
+        """An idle live worker (a new one while fewer than ``n`` run), or None."""
+        for worker in [w for w in self.workers if w.task is None and not w.process.is_alive()]:
+            self._drop(worker)  # died between tasks: nothing lost
+        for worker in self.workers:
+            if worker.task is None:
+                return worker
+        return self._spawn() if len(self.workers) < self.n else None
+
+    def _busy(self) -> List[_Worker]:
+        return [w for w in self.workers if w.task is not None]
+
+    def _drop(self, worker: _Worker) -> None:
+        with contextlib.suppress(Exception):
+            worker.conn.close()
+        self.workers.remove(worker)
+
+    def _collect(self, worker: _Worker) -> None:
+        """Read the worker's messages; a result finishes its task."""
+        while worker.task is not None:
+            try:
+                if not worker.conn.poll():
+                    return
+                kind, index, value = worker.conn.recv()
+            except (EOFError, OSError):  # the worker died; the caller sees its exit
+                return
+            if kind == "progress":
+                self.progress.set(index, min(value, 99.0))
+            elif kind == "result":
+                task, worker.task = worker.task, None
+                self.finish(task, value)
+
+    # -- a step ----------------------------------------------------------------------------------
+    def run(self, tasks: List[Task], feedback: Feedback, grace: float) -> None:
+        """Run ``tasks`` on the workers; return when all are finished (or cancelled)."""
+        queue = collections.deque(tasks)
+        lost: Dict[int, int] = {}  # task index → deaths of its workers
+        cancel_deadline: Optional[float] = None
+        while queue or self._busy():
+            if feedback.is_canceled() and cancel_deadline is None:
+                self.cancel_event.set()  # running tasks stop at their next progress check
+                queue.clear()  # tasks not started keep their record "cancelled"
+                cancel_deadline = time.monotonic() + grace
+            if cancel_deadline is not None and time.monotonic() > cancel_deadline:
+                self._kill_busy("worker killed: it did not stop within the grace time "
+                                "after the cancel")
+                return
+            while queue and (worker := self._idle()) is not None:
+                task = queue.popleft()
+                worker.task = task
+                self.log(f"{task.key}: started on worker process {worker.process.pid}",
+                         quiet=True)
+                _send(worker.conn, (task.index, task.algorithm, task.params, str(task.log)))
+            busy = self._busy()
+            mp_connection.wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
+                               timeout=0.1)
+            for worker in busy:
+                self._collect(worker)
+                if worker.task is not None and not worker.process.is_alive():
+                    self._lost(worker, feedback, queue, lost)
+
+    def _lost(self, worker: _Worker, feedback: Feedback, queue: collections.deque[Task],
+              lost: Dict[int, int]) -> None:
+        """A worker died: its task runs again once, or fails (is cancelled during a cancel)."""
+        worker.process.join(1.0)
+        self._collect(worker)  # a result sent just before the exit still counts
+        task = worker.task
+        self._drop(worker)
+        if task is None:
+            return
+        cause = f"worker process {worker.process.pid} {_exit_cause(worker.process.exitcode)}"
+        lost[task.index] = lost.get(task.index, 0) + 1
+        if feedback.is_canceled():
+            self.finish(task, _no_result("cancelled", f"{cause} during the cancel"))
+        elif lost[task.index] == 1:
+            self.log(f"{task.key}: {cause}; running the task once more", warning=True)
+            queue.appendleft(task)
+        else:
+            self.finish(task, _no_result(
+                "failed", f"{cause}, the second time for this task; if memory ran out, "
+                          "use fewer workers"))
+
+    def _kill_busy(self, reason: str) -> None:
+        """Kill the workers that still run a task; their tasks end ``cancelled``."""
+        busy = self._busy()
+        for worker in busy:
+            worker.process.kill()
+        for worker in busy:
+            worker.process.join(2.0)
+            self._collect(worker)  # finished after all: keep the result
+            if worker.task is not None:
+                self.finish(worker.task, _no_result("cancelled", reason))
+                worker.task = None
+            self._drop(worker)
+
+    def close(self) -> None:
+        """End the workers: idle ones at once; running ones (an interrupted batch) are
+        cancelled, then killed after a few seconds."""
+        self.cancel_event.set()  # only tasks of an interrupted batch still run
+        deadline = time.monotonic() + 3.0
+        while time.monotonic() < deadline:
+            live = [w for w in self._busy() if w.process.is_alive()]
+            if not live:
+                break
+            mp_connection.wait([w.conn for w in live] + [w.process.sentinel for w in live],
+                               timeout=0.1)
+            for worker in live:
+                self._collect(worker)  # a task that finished or was cancelled meanwhile
+        for worker in self._busy():
+            self._collect(worker)
+        self._kill_busy("worker killed: the batch was interrupted")
+        for worker in self.workers:
+            _send(worker.conn, None)
+        for worker in list(self.workers):
+            worker.process.join(2.0)
+            if worker.process.is_alive():
+                worker.process.kill()
+                worker.process.join(1.0)
+            self._drop(worker)
+
+
+def _no_result(status: str, error: str) -> Dict[str, Any]:
+    return {"status": status, "outputs": {}, "duration_s": 0.0, "error": error}
 
 
 # -- the batch -----------------------------------------------------------------------------------
@@ -568,7 +850,8 @@ def run_batch(
     Parameters
     ----------
     plan : BatchPlan
-        From :func:`load_batch`.
+        From :func:`load_batch`. A default (timestamped) run folder that exists already is
+        replaced by a new one (``…-2``), and the tasks' ``{run}`` values with it.
     feedback : Feedback, optional
         Receives the overall progress (share of tasks finished, including the running tasks'
         own progress), one log line per task, and cancellation.
@@ -581,7 +864,7 @@ def run_batch(
         :data:`.registry.EXTRA_MODULES_ENV`, which workers inherit).
     grace : float
         Seconds that running tasks get to stop after a cancel before their workers are
-        terminated.
+        killed.
 
     Returns
     -------
@@ -589,10 +872,32 @@ def run_batch(
         ``status`` (``done``, ``failed`` or ``cancelled``), ``counts`` per task status, the
         ``run`` folder, ``summary`` path and ``tasks`` (step, algorithm, item, status, outputs,
         duration_s, error, log).
+
+    Raises
+    ------
+    InputError
+        When another batch holds the lock of the project (or of the resume state's folder), or
+        the run folder cannot be created.
     """
     feedback = ensure_feedback(feedback)
     n_workers = max(1, int(workers if workers is not None else plan.workers))
-    plan.run_dir.mkdir(parents=True, exist_ok=True)
+    lock, notes = _acquire_lock(plan)
+    try:
+        run_dir = plan.run_dir
+        _claim_run_dir(plan)
+        if plan.run_dir != run_dir:
+            notes.append(f"run folder {run_dir} exists already; this run writes to "
+                         f"{plan.run_dir}")
+            _atomic_json(lock, _lock_info(plan))
+        modules = [*extra_modules, *registry.extra_modules()]
+        return _run_locked(plan, feedback, n_workers, resume, modules, grace, notes)
+    finally:
+        _release_lock(lock)
+
+
+def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: bool,
+                modules: Sequence[str], grace: float, notes: List[str]) -> Dict[str, Any]:
+    """The body of :func:`run_batch`, with the lock held and the run folder created."""
     started = _dt.datetime.now().isoformat(timespec="seconds")
     t0 = time.perf_counter()
     state = _read_state(plan.state_home) if resume else {}
@@ -605,10 +910,12 @@ def run_batch(
     progress = _Progress(feedback, len(plan.tasks))
     batch_log = open(plan.run_dir / "batch.log", "a", encoding="utf-8")  # noqa: SIM115
 
-    def log(message: str, warning: bool = False) -> None:
+    def log(message: str, warning: bool = False, quiet: bool = False) -> None:
+        """A line in batch.log and (unless ``quiet``) for the operator."""
         batch_log.write(f"{time.strftime('%H:%M:%S')} {message}\n")
         batch_log.flush()
-        (feedback.warning if warning else feedback.info)(message)
+        if not quiet:
+            (feedback.warning if warning else feedback.info)(message)
 
     def finish(task: Task, result: Dict[str, Any]) -> None:
         record = records[task.index]
@@ -632,6 +939,8 @@ def run_batch(
 
     log(f"batch {plan.file or ''}: {len(plan.tasks)} task(s) in {len(plan.steps)} step(s), "
         f"{n_workers} worker(s), run folder {plan.run_dir}")
+    for note in notes:
+        log(note)
     failed_items: Dict[tuple, str] = {}
     pool: Optional[_Pool] = None
     try:
@@ -642,9 +951,9 @@ def run_batch(
             for task in (t for t in plan.tasks if t.step == step):
                 blocker = failed_items.get((task.item_kind, task.item))
                 if task.item is not None and blocker is not None:
-                    finish(task, {"status": "failed", "duration_s": 0.0, "outputs": {},
-                                  "error": f"not run because step '{blocker}' failed for "
-                                           f"{task.item_kind} '{task.name}'"})
+                    finish(task, _no_result("failed", f"not run because step '{blocker}' "
+                                                      f"failed for {task.item_kind} "
+                                                      f"'{task.name}'"))
                     continue
                 outputs = _resumable(task, state) if resume else None
                 if outputs is not None:
@@ -660,43 +969,51 @@ def run_batch(
                 _run_in_process(todo, feedback, progress, finish)
             else:
                 if pool is None:
-                    pool = _Pool(n_workers, [*extra_modules, *registry.extra_modules()])
-                pool.run(todo, feedback, progress, finish, grace)
+                    pool = _Pool(n_workers, modules, log, finish, progress)
+                pool.run(todo, feedback, grace)
             for task in todo:
                 if records[task.index]["status"] == "failed" and task.item is not None:
                     failed_items.setdefault((task.item_kind, task.item), step)
     finally:
         if pool is not None:
             pool.close()
-        counts = {s: sum(r["status"] == s for r in records) for s in TASK_STATUSES}
-        if feedback.is_canceled() or counts["cancelled"]:
-            status = "cancelled"
-        elif counts["failed"]:
-            status = "failed"
-        else:
-            status = "done"
-        summary = {
-            "file": str(plan.file) if plan.file else None,
-            "project": str(plan.project) if plan.project else None,
-            "run": str(plan.run_dir),
-            "status": status,
-            "started": started,
-            "duration_s": round(time.perf_counter() - t0, 3),
-            "workers": n_workers,
-            "resume": resume,
-            "counts": counts,
-            "summary": str(plan.run_dir / SUMMARY_FILE),
-            "tasks": records,
-        }
+        summary = _summary(plan, records, started, t0, n_workers, resume)
         _atomic_json(plan.run_dir / SUMMARY_FILE, summary)
-        batch_log.write(f"{time.strftime('%H:%M:%S')} batch {status}: "
-                        + ", ".join(f"{v} {k}" for k, v in counts.items() if v) + "\n")
+        batch_log.write(f"{time.strftime('%H:%M:%S')} batch {summary['status']}: "
+                        + ", ".join(f"{v} {k}" for k, v in summary["counts"].items() if v)
+                        + "\n")
         batch_log.close()
     return summary
 
 
+def _summary(plan: BatchPlan, records: List[Dict[str, Any]], started: str, t0: float,
+             n_workers: int, resume: bool) -> Dict[str, Any]:
+    """The batch summary; its status comes from the tasks' records only, so a cancel that
+    came after every task had finished does not make the batch ``cancelled``."""
+    counts = {s: sum(r["status"] == s for r in records) for s in TASK_STATUSES}
+    if counts["cancelled"]:
+        status = "cancelled"
+    elif counts["failed"]:
+        status = "failed"
+    else:
+        status = "done"
+    return {
+        "file": str(plan.file) if plan.file else None,
+        "project": str(plan.project) if plan.project else None,
+        "run": str(plan.run_dir),
+        "status": status,
+        "started": started,
+        "duration_s": round(time.perf_counter() - t0, 3),
+        "workers": n_workers,
+        "resume": resume,
+        "counts": counts,
+        "summary": str(plan.run_dir / SUMMARY_FILE),
+        "tasks": records,
+    }
+
+
 def _atomic_json(path: Path, data: Dict[str, Any]) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     tmp.write_text(json.dumps(data, indent=2, default=str), encoding="utf-8")
     os.replace(tmp, path)
 
@@ -711,73 +1028,207 @@ def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
         finish(task, result)
 
 
-class _Pool:
-    """Worker processes (spawn context) with a shared cancel event and a progress queue."""
+# -- the run folder ------------------------------------------------------------------------------
+_STAMP = re.compile(r"(\d{8}-\d{6})(?:-(\d+))?")
 
-    def __init__(self, n: int, modules: Sequence[str]) -> None:
-        ctx = multiprocessing.get_context("spawn")
-        self.cancel_event = ctx.Event()
-        self.queue = ctx.Queue()
-        self.executor = cf.ProcessPoolExecutor(
-            max_workers=n, mp_context=ctx, initializer=_init_worker,
-            initargs=(self.cancel_event, self.queue, tuple(modules)),
-        )
-        self.broken = False
 
-    def _drain(self, progress: _Progress) -> None:
+def _claim_run_dir(plan: BatchPlan) -> None:
+    """Create the run folder; a default one that exists already becomes ``<stamp>-N``.
+
+    ``mkdir`` without ``exist_ok`` is atomic: two batches started in the same second get
+    different folders. A run folder the batch file names (``output``) may be reused.
+    """
+    try:
+        if not plan.run_auto or plan.config is None:
+            plan.run_dir.mkdir(parents=True, exist_ok=True)
+            return
         while True:
             try:
-                index, pct = self.queue.get_nowait()
-            except Exception:  # queue.Empty (and EOF when a worker died)
+                plan.run_dir.mkdir(parents=True, exist_ok=False)
                 return
-            progress.set(index, min(pct, 99.0))
+            except FileExistsError:
+                _replan(plan, _next_run_dir(plan.run_dir))
+    except OSError as exc:
+        raise InputError(f"Cannot create the run folder '{plan.run_dir}': "
+                         f"{exc.strerror or exc}; set output = \"…\" in [batch] to a "
+                         "writable folder.") from exc
 
-    def run(self, tasks: List[Task], feedback: Feedback, progress: _Progress,
-            finish: Callable[[Task, Dict[str, Any]], None], grace: float) -> None:
-        futures = {
-            self.executor.submit(_worker_run, t.index, t.algorithm, t.params, str(t.log)): t
-            for t in tasks
-        }
-        pending = set(futures)
-        cancel_deadline: Optional[float] = None
-        while pending:
-            done, pending = cf.wait(pending, timeout=0.1, return_when=cf.FIRST_COMPLETED)
-            self._drain(progress)
-            for future in done:
-                task = futures[future]
-                if future.cancelled():
-                    continue  # recorded as cancelled already
-                try:
-                    finish(task, future.result())
-                except Exception as exc:  # the worker process died (BrokenProcessPool)
-                    self.broken = True
-                    status = "cancelled" if feedback.is_canceled() else "failed"
-                    finish(task, {"status": status, "outputs": {}, "duration_s": 0.0,
-                                  "error": f"worker process ended: {type(exc).__name__}: {exc}"})
-            if feedback.is_canceled() and cancel_deadline is None:
-                self.cancel_event.set()  # running tasks stop at their next progress check
-                for future in list(pending):
-                    if future.cancel():
-                        pending.discard(future)
-                cancel_deadline = time.monotonic() + grace
-            if cancel_deadline is not None and pending and time.monotonic() > cancel_deadline:
-                self.terminate()
-                for future in pending:
-                    finish(futures[future], {"status": "cancelled", "outputs": {},
-                                             "duration_s": 0.0,
-                                             "error": "worker terminated after cancel"})
-                return
 
-    def terminate(self) -> None:
-        self.broken = True
-        for process in list(getattr(self.executor, "_processes", {}).values()):
-            if process.is_alive():
-                process.terminate()
+def _next_run_dir(run: Path) -> Path:
+    match = _STAMP.fullmatch(run.name)
+    if match is None:
+        return run.with_name(f"{run.name}-2")
+    return run.with_name(f"{match.group(1)}-{int(match.group(2) or 1) + 1}")
 
-    def close(self) -> None:
-        with contextlib.suppress(Exception):  # a broken pool on shutdown
-            self.executor.shutdown(wait=not self.broken, cancel_futures=True)
-        self.queue.close()
+
+def _replan(plan: BatchPlan, run: Path) -> None:
+    """Plan the tasks again for another run folder (``{run}`` and the logs move with it)."""
+    fresh = plan_batch(plan.config or {}, plan.base_dir or ".", run_dir=run)
+    plan.run_dir, plan.tasks = fresh.run_dir, fresh.tasks
+
+
+# -- the lock ------------------------------------------------------------------------------------
+#: Seconds after which an unreadable lock file (its writer died while creating it) is stale.
+_LOCK_UNREADABLE_STALE_S = 30.0
+
+
+def _lock_path(plan: BatchPlan) -> Path:
+    return plan.state_home / LOCK_FILE
+
+
+def _lock_info(plan: BatchPlan) -> Dict[str, Any]:
+    pid = os.getpid()
+    return {"pid": pid, "host": socket.gethostname(), "pid_start": _process_start(pid),
+            "started": _dt.datetime.now().isoformat(timespec="seconds"),
+            "run": str(plan.run_dir)}
+
+
+def _acquire_lock(plan: BatchPlan) -> Tuple[Path, List[str]]:
+    """Take ``<state home>/.photodem/batch.lock`` (O_CREAT|O_EXCL); a stale one is taken over.
+
+    Returns the lock's path and notes for the batch log.
+
+    Raises
+    ------
+    InputError
+        When a running batch holds the lock (naming its pid, start and run folder), or the
+        lock cannot be written.
+    """
+    path = _lock_path(plan)
+    notes: List[str] = []
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        for _ in range(5):
+            try:
+                fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+            except FileExistsError:
+                holder = _read_lock(path)
+                if holder is None:
+                    continue  # released just now
+                if not _lock_is_stale(path, holder):
+                    raise InputError(_held_message(plan, path, holder)) from None
+                if _remove_stale_lock(path, holder):
+                    notes.append(f"took over the stale lock {path} of batch pid "
+                                 f"{holder.get('pid', '?')} (started "
+                                 f"{holder.get('started', '?')}), which is no longer running")
+                continue
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                json.dump(_lock_info(plan), f)
+            return path, notes
+    except OSError as exc:
+        raise InputError(f"Cannot write the batch lock '{path}': {exc.strerror or exc}; check "
+                         "that the folder is writable.") from exc
+    raise InputError(f"Cannot take the batch lock '{path}': other batches keep taking it; "
+                     "try again.")
+
+
+def _read_lock(path: Path) -> Optional[Dict[str, Any]]:
+    """The lock's holder; ``{}`` when unreadable, ``None`` when the lock is gone."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _lock_is_stale(path: Path, holder: Dict[str, Any]) -> bool:
+    """A lock whose process (on this host) is dead, or that stayed unreadable for long."""
+    if not holder:
+        with contextlib.suppress(OSError):
+            return time.time() - path.stat().st_mtime > _LOCK_UNREADABLE_STALE_S
+        return False
+    if holder.get("host") != socket.gethostname():
+        return False  # cannot tell from here
+    pid = holder.get("pid")
+    if not isinstance(pid, int) or pid <= 0:
+        return True
+    return not _process_alive(pid, holder.get("pid_start"))
+
+
+def _held_message(plan: BatchPlan, path: Path, holder: Dict[str, Any]) -> str:
+    where = ("this project" if plan.project is not None
+             else f"the batch files of '{plan.state_home}'")
+    if not holder:
+        who = "another batch (its lock is being written)"
+    else:
+        host = holder.get("host")
+        on = "" if host == socket.gethostname() else f" on host {host}"
+        who = (f"another batch (pid {holder.get('pid', '?')}{on}, started "
+               f"{holder.get('started', '?')}, run folder {holder.get('run', '?')})")
+    return (f"{who} is running on {where}; wait for it to finish or stop it (if no batch is "
+            f"running, delete '{path}').")
+
+
+def _remove_stale_lock(path: Path, holder: Dict[str, Any]) -> bool:
+    """Delete the stale lock unless another batch took it over meanwhile."""
+    guard = path.with_name(path.name + ".takeover")
+    with _exclusive(guard):  # one takeover at a time: check and delete are one step
+        if _read_lock(path) != holder:
+            return False
+        with contextlib.suppress(FileNotFoundError):
+            path.unlink()
+    return True
+
+
+@contextlib.contextmanager
+def _exclusive(path: Path) -> Iterator[None]:
+    """Hold an advisory lock on ``path`` (POSIX ``flock``; elsewhere no guard)."""
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        yield
+        return
+    with open(path, "a", encoding="utf-8") as f:
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+
+
+def _release_lock(path: Path) -> None:
+    """Delete the lock if it is still ours."""
+    holder = _read_lock(path)
+    if holder and holder.get("pid") == os.getpid() and holder.get("host") == socket.gethostname():
+        with contextlib.suppress(OSError):
+            path.unlink()
+
+
+def _process_stat(pid: int) -> Optional[List[str]]:
+    """Fields of ``/proc/<pid>/stat`` after the command name (Linux), else None."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    return text.rsplit(")", 1)[-1].split()
+
+
+def _process_start(pid: int) -> Optional[str]:
+    """The start time of a process in clock ticks since boot (Linux), to tell a reused pid."""
+    fields = _process_stat(pid)
+    return fields[19] if fields and len(fields) > 19 else None
+
+
+def _process_alive(pid: int, start: Optional[str] = None) -> bool:
+    """True when process ``pid`` runs (and, if ``start`` is given, started then)."""
+    if pid == os.getpid():
+        return True
+    if os.name == "nt":  # os.kill would end the process; let the operator decide
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # EPERM: it runs under another user
+        return True
+    fields = _process_stat(pid)
+    if fields is None:
+        return True
+    if fields[0] == "Z":  # a zombie has ended
+        return False
+    return start is None or len(fields) <= 19 or fields[19] == start
 
 
 # -- template ------------------------------------------------------------------------------------

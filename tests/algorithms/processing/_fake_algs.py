@@ -7,6 +7,8 @@ Register them with ``PHOTODEM_EXTRA_ALGORITHMS=_fake_algs`` (this folder on ``sy
 from __future__ import annotations
 
 import json
+import os
+import signal
 import time
 from pathlib import Path
 
@@ -149,7 +151,48 @@ class FileSize(Algorithm):
         return {"output": params["output"]}
 
 
-ALGORITHMS = [SleepWrite, FailOn, Crash, Chatty, FileSize]
+class DieOnModels(Algorithm):
+    """Kills its own process (SIGKILL) for the models in ``die``, ``deaths`` times per model.
+
+    The deaths so far are counted as files ``<marks>/<model>.<n>``. Run it on worker processes
+    only (``workers`` ≥ 2): in-process it would kill the caller.
+    """
+
+    id = "fake_die"
+    name = "Fake: die on some models"
+    group = "Testing"
+    group_id = "testing"
+    help = "SIGKILLs its process for the models named in `die`."
+    iterates_over = "model"
+    parameters = (
+        Parameter("project", "project", "Project folder"),
+        Parameter("model", "model", "Stereo model"),
+        Parameter("die", "string", "Comma-separated models to die on", default=""),
+        Parameter("deaths", "integer", "Deaths per model", default=1, minimum=0, maximum=9),
+        Parameter("marks", "string", "Folder counting the deaths"),
+        Parameter("seconds", "number", "Duration [s]", default=0.2, minimum=0, maximum=60),
+        Parameter("output", "output_file", "Output"),
+    )
+    outputs = (Output("output", "file", "The file"),)
+
+    def run(self, params, feedback):
+        model = params["model"]
+        marks = Path(params["marks"])
+        for i in range(10):
+            time.sleep(params["seconds"] / 10)
+            feedback.progress(10.0 * (i + 1))
+            if i == 4 and model in params["die"].split(","):
+                died = len(list(marks.glob(f"{model}.*")))
+                if died < params["deaths"]:
+                    marks.mkdir(parents=True, exist_ok=True)
+                    (marks / f"{model}.{died}").write_text(str(os.getpid()))
+                    os.kill(os.getpid(), signal.SIGKILL)
+        with atomic_output(params["output"]) as tmp:
+            Path(tmp).write_text(model)
+        return {"output": params["output"]}
+
+
+ALGORITHMS = [SleepWrite, FailOn, Crash, Chatty, FileSize, DieOnModels]
 
 
 def install(monkeypatch) -> None:

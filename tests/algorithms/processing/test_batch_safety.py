@@ -1,0 +1,403 @@
+"""Batch safety (issue 16, point 5): lost workers, the parent's death, the lock, run folders."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from photodem.algorithms.errors import InputError
+from photodem.algorithms.processing import batch
+from photodem.algorithms.processing.feedback import Feedback
+
+HERE = Path(__file__).resolve().parent
+linux_only = pytest.mark.skipif(not sys.platform.startswith("linux"),
+                                reason="SIGKILL and /proc are Linux features")
+
+
+@pytest.fixture
+def project4(tmp_path):
+    """A project with four stereo models (a step of four tasks)."""
+    from photodem.algorithms.project.model import Project, StereoModel
+
+    root = tmp_path / "proj"
+    Project(root=root, name="t", crs="EPSG:25832",
+            models=[StereoModel(f"{a}_{b}", a, b) for a, b in
+                    (("a", "b"), ("b", "c"), ("c", "d"), ("d", "e"))]).save()
+    return root
+
+
+def _config(project, steps, **head):
+    return {"batch": {"project": str(project), **head}, "steps": steps}
+
+
+def _sleep_step(**params):
+    return {"algorithm": "fake_sleep_write", "name": "sleep",
+            "params": {"seconds": 0.05, "output": "{project}/products/{step}/{model}.json",
+                       **params}}
+
+
+def _die_steps(marks, deaths):
+    """A step of four tasks whose b_c worker dies ``deaths`` times, and a step after it."""
+    return [
+        {"algorithm": "fake_die", "name": "work",
+         "params": {"die": "b_c", "deaths": deaths, "marks": str(marks), "seconds": 0.3,
+                    "output": "{project}/products/{step}/{model}.txt"}},
+        {"algorithm": "fake_fail_on", "name": "next",
+         "params": {"output": "{project}/products/{step}/{model}.txt"}},
+    ]
+
+
+def _statuses(summary):
+    return {f"{t['step']}/{t['item']}": t["status"] for t in summary["tasks"]}
+
+
+def _files(folder):
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*") if p.is_file())
+
+
+# -- a lost worker costs only its own task -----------------------------------------------------
+@linux_only
+def test_a_killed_worker_costs_only_its_task_which_runs_again(fake_algs, project4, tmp_path):
+    plan = batch.plan_batch(_config(project4, _die_steps(tmp_path / "marks", 1), workers=2),
+                            run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan)
+    assert summary["status"] == "done", summary
+    assert set(_statuses(summary).values()) == {"done"}
+    assert len(list((tmp_path / "marks").iterdir())) == 1  # b_c's first worker died
+    assert (project4 / "products" / "work" / "b_c.txt").read_text() == "b_c"
+    assert (project4 / "products" / "next" / "b_c.txt").is_file()  # the next step ran
+    text = (tmp_path / "run" / "batch.log").read_text()
+    assert "work/b_c: worker process" in text and "SIGKILL" in text
+    assert "running the task once more" in text
+    assert json.loads((tmp_path / "run" / "summary.json").read_text())["status"] == "done"
+
+
+@linux_only
+def test_a_task_whose_worker_dies_twice_fails_and_the_batch_goes_on(fake_algs, project4,
+                                                                     tmp_path):
+    plan = batch.plan_batch(_config(project4, _die_steps(tmp_path / "marks", 2), workers=2),
+                            run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan)
+    status = _statuses(summary)
+    assert status.pop("work/b_c") == "failed" and status.pop("next/b_c") == "failed"
+    assert set(status.values()) == {"done"}  # the three other models, in both steps
+    assert summary["status"] == "failed"  # truthful: not "cancelled"
+    assert summary["counts"] == {"done": 6, "skipped": 0, "failed": 2, "cancelled": 0}
+    errors = {f"{t['step']}/{t['item']}": t["error"] for t in summary["tasks"]}
+    assert "died (signal 9, SIGKILL), the second time" in errors["work/b_c"]
+    assert "not run because step 'work' failed" in errors["next/b_c"]
+    assert len(list((tmp_path / "marks").iterdir())) == 2
+    assert not (project4 / "products" / "work" / "b_c.txt").exists()
+
+
+def test_an_operator_error_is_not_run_again(fake_algs, project4, tmp_path):
+    step = {"algorithm": "fake_fail_on", "name": "check",
+            "params": {"fail": "a_b", "output": "{project}/products/{step}/{model}.txt"}}
+    plan = batch.plan_batch(_config(project4, [step], workers=2), run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan)
+    assert _statuses(summary)["check/a_b"] == "failed"
+    text = (tmp_path / "run" / "batch.log").read_text()
+    assert text.count("check/a_b: started on worker process") == 1
+
+
+# -- processes outside the test process ------------------------------------------------------
+def _env():
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(HERE), env.get("PYTHONPATH", "")])
+    env["PHOTODEM_EXTRA_ALGORITHMS"] = "_fake_algs"
+    return env
+
+
+def _start_cli_batch(file, *args):
+    return subprocess.Popen([sys.executable, "-m", "photodem.algorithms.cli", "batch",
+                             str(file), "--quiet", *args],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=_env())
+
+
+def _write_batch(project, run, step, workers=2):
+    file = project.parent / "b.toml"
+    params = "".join(f"{k} = {json.dumps(v)}\n" for k, v in step["params"].items())
+    file.write_text(f'[batch]\nproject = "{project}"\nworkers = {workers}\noutput = "{run}"\n'
+                    f'[[steps]]\nalgorithm = "{step["algorithm"]}"\nname = "{step["name"]}"\n'
+                    f"[steps.params]\n{params}")
+    return file
+
+
+def _worker_pids(run, n, proc, timeout=60.0):
+    """The pids of the first ``n`` tasks' workers, from batch.log, once they run."""
+    log = Path(run) / "batch.log"
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        text = log.read_text() if log.exists() else ""
+        pids = [int(line.rsplit(" ", 1)[-1]) for line in text.splitlines()
+                if "started on worker process" in line]
+        if len(pids) >= n:
+            return pids[:n]
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(0.1)
+    raise AssertionError(f"no {n} workers started: {log.read_text() if log.exists() else ''}")
+
+
+def _proc_stat(pid):
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[-1].split()
+    except OSError:
+        return None
+
+
+def _descendants(pid):
+    """Pids (with their start times) of all processes below ``pid``."""
+    children = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            fields = _proc_stat(int(entry.name))
+            if fields:
+                children.setdefault(int(fields[1]), []).append((int(entry.name), fields[19]))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child[0])
+    return found
+
+
+def _alive(pid, start):
+    fields = _proc_stat(pid)
+    return fields is not None and fields[19] == start and fields[0] != "Z"
+
+
+@linux_only
+def test_a_worker_killed_from_outside_is_replaced(fake_algs, project4, tmp_path):
+    run = tmp_path / "run"
+    file = _write_batch(project4, run, _sleep_step(seconds=2.0, steps=20))
+    proc = _start_cli_batch(file)
+    victim = _worker_pids(run, 1, proc)[0]
+    time.sleep(0.5)
+    os.kill(victim, signal.SIGKILL)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["status"] == "done" and summary["counts"]["done"] == 4
+    assert f"worker process {victim} died (signal 9, SIGKILL)" in (run / "batch.log").read_text()
+    assert len(_files(project4 / "products")) == 4
+
+
+@linux_only
+def test_killing_the_batch_parent_ends_its_workers_and_a_rerun_takes_over(fake_algs, project4,
+                                                                          tmp_path):
+    run = tmp_path / "run"
+    # two progress reports in 60 s: the workers learn of the death by the signal, not the pipe
+    file = _write_batch(project4, run, _sleep_step(seconds=60.0, steps=2))
+    proc = _start_cli_batch(file)
+    _worker_pids(run, 2, proc)
+    logs = [run / "sleep" / f"{m}.log" for m in ("a_b", "b_c")]
+    deadline = time.monotonic() + 30
+    while not all(p.exists() for p in logs) and time.monotonic() < deadline:
+        time.sleep(0.05)  # both workers run their task (not merely start up)
+    family = _descendants(proc.pid)
+    assert len(family) >= 2
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=10)
+    deadline = time.monotonic() + 6.0
+    while any(_alive(*p) for p in family) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [p for p in family if _alive(*p)], "processes outlived the batch"
+    assert _files(project4 / "products") == []  # the cancelled tasks wrote nothing
+    lock = project4 / ".photodem" / "batch.lock"
+    assert json.loads(lock.read_text())["pid"] == proc.pid  # left behind by the kill
+
+    file = _write_batch(project4, tmp_path / "run2", _sleep_step(seconds=0.05))
+    rerun = _start_cli_batch(file)
+    _, err = rerun.communicate(timeout=60)
+    assert rerun.returncode == 0, err
+    assert "took over the stale lock" in (tmp_path / "run2" / "batch.log").read_text()
+    assert not lock.exists()
+    assert len(_files(project4 / "products")) == 4
+
+
+# -- the lock --------------------------------------------------------------------------------------
+def _lock(project):
+    return project / ".photodem" / "batch.lock"
+
+
+def test_a_second_batch_on_the_project_is_refused_naming_the_first(fake_algs, project4,
+                                                                   tmp_path):
+    first = batch.plan_batch(_config(project4, [_sleep_step(seconds=0.4)]),
+                             run_dir=tmp_path / "run1")
+    done = {}
+    thread = threading.Thread(target=lambda: done.update(batch.run_batch(first, workers=1)))
+    thread.start()
+    try:
+        deadline = time.monotonic() + 10
+        while not _lock(project4).exists() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        second = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run2")
+        with pytest.raises(InputError) as info:
+            batch.run_batch(second, workers=1)
+    finally:
+        thread.join()
+    message = str(info.value)
+    assert f"another batch (pid {os.getpid()}, started " in message
+    assert f"run folder {tmp_path / 'run1'})" in message
+    assert "is running on this project; wait for it to finish or stop it" in message
+    assert "\n" not in message
+    assert not (tmp_path / "run2").exists()  # refused before anything was written
+    assert done["status"] == "done"
+    assert not _lock(project4).exists()  # released
+
+
+def _dead_pid():
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid
+
+
+def _write_lock(project, **info):
+    _lock(project).parent.mkdir(parents=True, exist_ok=True)
+    _lock(project).write_text(json.dumps({"host": socket.gethostname(), "started": "earlier",
+                                          "run": "/somewhere/runs/old", **info}))
+
+
+@pytest.mark.skipif(os.name == "nt", reason="no liveness probe on Windows")
+def test_a_stale_lock_is_taken_over_with_a_log_line(fake_algs, project4, tmp_path):
+    pid = _dead_pid()
+    _write_lock(project4, pid=pid)
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan, workers=1)
+    assert summary["status"] == "done"
+    text = (tmp_path / "run" / "batch.log").read_text()
+    assert f"took over the stale lock {_lock(project4)} of batch pid {pid}" in text
+    assert not _lock(project4).exists()
+
+
+@pytest.mark.parametrize(("info", "age", "message"), [
+    ({"pid": 1, "host": "elsewhere"}, 0, "(pid 1 on host elsewhere, started earlier"),
+    ({"pid": "own"}, 0, "run folder /somewhere/runs/old) is running"),
+    (None, 0, "its lock is being written"),
+])
+def test_a_live_or_foreign_or_fresh_unreadable_lock_refuses(fake_algs, project4, tmp_path,
+                                                            info, age, message):
+    if info is None:
+        _lock(project4).parent.mkdir(parents=True)
+        _lock(project4).write_text("")
+    else:
+        _write_lock(project4, **{**info, "pid": os.getpid() if info["pid"] == "own"
+                                 else info["pid"]})
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+    with pytest.raises(InputError, match=r"delete '.*batch\.lock'") as exc:
+        batch.run_batch(plan, workers=1)
+    assert message in str(exc.value)
+    assert _lock(project4).exists()  # not ours: left alone
+
+
+def test_an_old_unreadable_lock_is_stale(fake_algs, project4, tmp_path):
+    _lock(project4).parent.mkdir(parents=True)
+    _lock(project4).write_text("{")
+    old = time.time() - 600
+    os.utime(_lock(project4), (old, old))
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+    assert batch.run_batch(plan, workers=1)["status"] == "done"
+
+
+def test_the_lock_is_released_on_an_interrupt(fake_algs, project4, tmp_path):
+    def interrupt(pct):
+        if pct > 10:
+            raise KeyboardInterrupt
+
+    plan = batch.plan_batch(_config(project4, [_sleep_step(seconds=1.0, steps=50)]),
+                            run_dir=tmp_path / "run")
+    with pytest.raises(KeyboardInterrupt):
+        batch.run_batch(plan, Feedback(on_progress=interrupt), workers=1)
+    assert not _lock(project4).exists()
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["status"] == "cancelled"
+
+
+def test_a_batch_over_files_locks_beside_its_resume_state(fake_algs, tmp_path):
+    root = tmp_path / "b"
+    (root / "scenes").mkdir(parents=True)
+    (root / "scenes" / "s1.tif").write_bytes(b"x")
+    config = {"steps": [{"algorithm": "fake_file_size", "name": "size",
+                         "files": "scenes/*.tif", "params": {"output": "{run}/{step}/{file}"}}]}
+    _write_lock(root, pid=os.getpid())
+    with pytest.raises(InputError, match="on the batch files of"):
+        batch.run_batch(batch.plan_batch(config, base_dir=root), workers=1)
+    _lock(root).unlink()
+    assert batch.run_batch(batch.plan_batch(config, base_dir=root), workers=1)["status"] == "done"
+    assert not _lock(root).exists()
+
+
+def test_cli_refuses_a_locked_project_in_one_line_and_dry_run_takes_no_lock(
+        fake_algs, project4, tmp_path, capsys):
+    from photodem.algorithms import cli
+
+    file = _write_batch(project4, tmp_path / "run", _sleep_step(), workers=1)
+    _write_lock(project4, pid=os.getpid())
+    assert cli.main(["batch", str(file), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("photodem: error: another batch (pid ")
+    _lock(project4).unlink()
+    assert cli.main(["batch", str(file), "--dry-run"]) == 0
+    assert not _lock(project4).exists() and not (tmp_path / "run").exists()
+
+
+# -- run folders and late cancels ------------------------------------------------------------------
+def test_batches_started_in_the_same_second_get_their_own_run_folders(fake_algs, project4):
+    now = dt.datetime(2026, 11, 25, 21, 0, 0)
+    steps = [_sleep_step(note="{run}")]
+    plans = [batch.plan_batch(_config(project4, steps), now=now) for _ in range(3)]
+    assert len({p.run_dir for p in plans}) == 1  # planned alike: none exists yet
+    runs = [batch.run_batch(p, workers=1, resume=False)["run"] for p in plans]
+    names = [Path(r).name for r in runs]
+    assert names == ["20261125-210000", "20261125-210000-2", "20261125-210000-3"]
+    last = plans[-1]
+    assert last.tasks[0].params["note"] == runs[-1]  # {run} follows the new folder
+    assert last.tasks[0].log.parent.parent == Path(runs[-1])
+    assert (Path(runs[-1]) / "sleep" / "a_b.log").is_file()
+    assert "exists already; this run writes to" in (Path(runs[-1]) / "batch.log").read_text()
+    assert json.loads((Path(runs[0]) / "summary.json").read_text())["run"] == runs[0]
+
+
+def test_a_named_run_folder_may_be_reused(fake_algs, project4, tmp_path):
+    for _ in range(2):
+        plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+        assert batch.run_batch(plan, workers=1)["run"] == str((tmp_path / "run").resolve())
+
+
+def test_run_folder_that_cannot_be_created_is_an_operator_error(fake_algs, project4, tmp_path):
+    (tmp_path / "file").write_text("x")
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "file" / "r")
+    with pytest.raises(InputError, match="Cannot create the run folder"):
+        batch.run_batch(plan, workers=1)
+    assert not _lock(project4).exists()
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_cancel_after_the_last_task_changes_nothing(fake_algs, project4, tmp_path, workers):
+    feedback = Feedback()
+    finished = []
+
+    def on_log(level, message):  # Ctrl-C right after the last task was recorded
+        if ": done in" in message:
+            finished.append(message)
+        if len(finished) == 4:
+            feedback.cancel()
+
+    feedback._on_log = on_log
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan, feedback, workers=workers)
+    assert feedback.is_canceled()
+    assert summary["status"] == "done"
+    assert set(_statuses(summary).values()) == {"done"}
