@@ -1084,7 +1084,7 @@ def _lock_info(plan: BatchPlan) -> Dict[str, Any]:
 
 
 def _acquire_lock(plan: BatchPlan) -> Tuple[Path, List[str]]:
-    """Take ``<state home>/.photodem/batch.lock`` (O_CREAT|O_EXCL); a stale one is taken over.
+    """Take ``<state home>/.photodem/batch.lock`` (atomically); a stale one is taken over.
 
     Returns the lock's path and notes for the batch log.
 
@@ -1099,27 +1099,54 @@ def _acquire_lock(plan: BatchPlan) -> Tuple[Path, List[str]]:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         for _ in range(5):
-            try:
-                fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-            except FileExistsError:
+            if _create_lock(path, _lock_info(plan)):
+                return path, notes
+            holder = _read_lock(path)
+            for _wait in range(10):  # a lock created without a hard link is written just after
+                if holder != {}:
+                    break
+                time.sleep(0.05)
                 holder = _read_lock(path)
-                if holder is None:
-                    continue  # released just now
-                if not _lock_is_stale(path, holder):
-                    raise InputError(_held_message(plan, path, holder)) from None
-                if _remove_stale_lock(path, holder):
-                    notes.append(f"took over the stale lock {path} of batch pid "
-                                 f"{holder.get('pid', '?')} (started "
-                                 f"{holder.get('started', '?')}), which is no longer running")
-                continue
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                json.dump(_lock_info(plan), f)
-            return path, notes
+            if holder is None:
+                continue  # released just now
+            if not _lock_is_stale(path, holder):
+                raise InputError(_held_message(plan, path, holder))
+            if _remove_stale_lock(path, holder):
+                notes.append(f"took over the stale lock {path} of batch pid "
+                             f"{holder.get('pid', '?')} (started "
+                             f"{holder.get('started', '?')}), which is no longer running")
     except OSError as exc:
         raise InputError(f"Cannot write the batch lock '{path}': {exc.strerror or exc}; check "
                          "that the folder is writable.") from exc
     raise InputError(f"Cannot take the batch lock '{path}': other batches keep taking it; "
                      "try again.")
+
+
+def _create_lock(path: Path, info: Dict[str, Any]) -> bool:
+    """Create the lock file with its content in one atomic step; False if it exists.
+
+    The content is written to a private file first and hard-linked to the lock's name (which
+    fails when it exists, like ``O_CREAT|O_EXCL``), so no other batch ever reads a half-written
+    lock. Where hard links are not supported, the lock is created with ``O_CREAT|O_EXCL``.
+    """
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(info), encoding="utf-8")
+    try:
+        os.link(tmp, path)
+        return True
+    except FileExistsError:
+        return False
+    except OSError:  # no hard links on this file system
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:
+            return False
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(info, f)
+        return True
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
 
 
 def _read_lock(path: Path) -> Optional[Dict[str, Any]]:
