@@ -663,6 +663,8 @@ class _Worker:
     process: Any
     conn: Any
     task: Optional[Task] = None
+    #: The worker cancelled its task on a SIGTERM that was not the batch's cancel; it exits.
+    stopped: bool = False
 
 
 class _Pool:
@@ -724,6 +726,9 @@ class _Pool:
                 return
             if kind == "progress":
                 self.progress.set(index, min(value, 99.0))
+            elif kind == "result" and value.get("status") == "cancelled" \
+                    and not self.cancel_event.is_set():
+                worker.stopped = True  # someone stopped the worker: as if it had died
             elif kind == "result":
                 task, worker.task = worker.task, None
                 self.finish(task, value)
@@ -766,7 +771,8 @@ class _Pool:
         self._drop(worker)
         if task is None:
             return
-        cause = f"worker process {worker.process.pid} {_exit_cause(worker.process.exitcode)}"
+        cause = f"worker process {worker.process.pid} " + (
+            "was stopped (SIGTERM)" if worker.stopped else _exit_cause(worker.process.exitcode))
         lost[task.index] = lost.get(task.index, 0) + 1
         if feedback.is_canceled():
             self.finish(task, _no_result("cancelled", f"{cause} during the cancel"))
@@ -1190,8 +1196,7 @@ def _held_message(plan: BatchPlan, path: Path, holder: Dict[str, Any]) -> str:
 
 def _remove_stale_lock(path: Path, holder: Dict[str, Any]) -> bool:
     """Delete the stale lock unless another batch took it over meanwhile."""
-    guard = path.with_name(path.name + ".takeover")
-    with _exclusive(guard):  # one takeover at a time: check and delete are one step
+    with _exclusive(path.parent):  # one takeover at a time: check and delete are one step
         if _read_lock(path) != holder:
             return False
         with contextlib.suppress(FileNotFoundError):
@@ -1200,19 +1205,20 @@ def _remove_stale_lock(path: Path, holder: Dict[str, Any]) -> bool:
 
 
 @contextlib.contextmanager
-def _exclusive(path: Path) -> Iterator[None]:
-    """Hold an advisory lock on ``path`` (POSIX ``flock``; elsewhere no guard)."""
+def _exclusive(folder: Path) -> Iterator[None]:
+    """Hold an advisory lock on ``folder`` itself (POSIX ``flock``, no extra file; elsewhere
+    no guard)."""
     try:
         import fcntl
     except ImportError:  # Windows
         yield
         return
-    with open(path, "a", encoding="utf-8") as f:
-        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the flock
 
 
 def _release_lock(path: Path) -> None:

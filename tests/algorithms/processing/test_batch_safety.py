@@ -178,19 +178,24 @@ def _alive(pid, start):
 
 
 @linux_only
-def test_a_worker_killed_from_outside_is_replaced(fake_algs, project4, tmp_path):
+@pytest.mark.parametrize(("sig", "cause"), [(signal.SIGKILL, "died (signal 9, SIGKILL)"),
+                                            (signal.SIGTERM, "was stopped (SIGTERM)")])
+def test_a_worker_killed_from_outside_is_replaced(fake_algs, project4, tmp_path, sig, cause):
     run = tmp_path / "run"
     file = _write_batch(project4, run, _sleep_step(seconds=2.0, steps=20))
     proc = _start_cli_batch(file)
     victim = _worker_pids(run, 1, proc)[0]
-    time.sleep(0.5)
-    os.kill(victim, signal.SIGKILL)
+    while not (run / "sleep" / "a_b.log").exists():
+        time.sleep(0.05)  # the worker runs its task
+    time.sleep(0.3)
+    os.kill(victim, sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
     assert "Traceback" not in err
     summary = json.loads((run / "summary.json").read_text())
     assert summary["status"] == "done" and summary["counts"]["done"] == 4
-    assert f"worker process {victim} died (signal 9, SIGKILL)" in (run / "batch.log").read_text()
+    assert f"worker process {victim} {cause}; running the task once more" in (
+        run / "batch.log").read_text()
     assert len(_files(project4 / "products")) == 4
 
 
@@ -401,3 +406,32 @@ def test_a_cancel_after_the_last_task_changes_nothing(fake_algs, project4, tmp_p
     assert feedback.is_canceled()
     assert summary["status"] == "done"
     assert set(_statuses(summary).values()) == {"done"}
+
+
+@pytest.mark.skipif(os.name == "nt", reason="no liveness probe on Windows")
+def test_two_batches_taking_over_one_stale_lock_get_it_once(fake_algs, project4, tmp_path):
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "run")
+    dead = _dead_pid()
+    for _ in range(20):
+        _write_lock(project4, pid=dead)
+        barrier = threading.Barrier(2)
+        outcomes = []
+
+        def take():
+            barrier.wait()
+            try:
+                outcomes.append(batch._acquire_lock(plan)[0])
+            except InputError as exc:
+                outcomes.append(str(exc))
+
+        threads = [threading.Thread(target=take) for _ in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        taken = [o for o in outcomes if isinstance(o, Path)]
+        refused = [o for o in outcomes if isinstance(o, str)]
+        assert len(taken) == 1 and len(refused) == 1, outcomes
+        assert "another batch (pid" in refused[0]
+        assert json.loads(_lock(project4).read_text())["pid"] == os.getpid()
+        _lock(project4).unlink()
