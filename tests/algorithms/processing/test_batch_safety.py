@@ -417,7 +417,7 @@ def test_two_batches_taking_over_one_stale_lock_get_it_once(fake_algs, project4,
         barrier = threading.Barrier(2)
         outcomes = []
 
-        def take():
+        def take(barrier=barrier, outcomes=outcomes):
             barrier.wait()
             try:
                 outcomes.append(batch._acquire_lock(plan)[0])
