@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -435,3 +436,45 @@ def test_two_batches_taking_over_one_stale_lock_get_it_once(fake_algs, project4,
         assert "another batch (pid" in refused[0]
         assert json.loads(_lock(project4).read_text())["pid"] == os.getpid()
         _lock(project4).unlink()
+
+
+# -- Ctrl-C at random moments ---------------------------------------------------------------
+@linux_only
+@pytest.mark.parametrize("moment", [round(random.Random(16 + i).uniform(1.0, 4.0), 2)
+                                    for i in range(5)])
+def test_ctrl_c_at_a_random_moment_leaves_what_the_summary_says(fake_algs, project4, tmp_path,
+                                                                moment):
+    run = tmp_path / "run"
+    file = _write_batch(project4, run, _sleep_step(seconds=0.6, steps=12))
+    proc = _start_cli_batch(file)
+    time.sleep(moment)
+    family = _descendants(proc.pid)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert "Traceback" not in err
+    products = project4 / "products" / "sleep"
+    on_disk = set(_files(products)) if products.exists() else set()
+    if (run / "summary.json").exists():
+        summary = json.loads((run / "summary.json").read_text())
+        assert proc.returncode == (130 if summary["status"] == "cancelled" else 0), err
+        done = {f"{t['item']}.json" for t in summary["tasks"] if t["status"] == "done"}
+        assert on_disk == done  # complete products only, and each one recorded
+        assert set(_statuses(summary).values()) <= {"done", "cancelled"}
+    else:  # interrupted before the batch began
+        assert proc.returncode == 130 and on_disk == set()
+        done = set()
+    for name in on_disk:
+        assert json.loads((products / name).read_text())["model"] == name[:-5]
+    assert not _lock(project4).exists()
+    deadline = time.monotonic() + 6.0
+    while any(_alive(*p) for p in family) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [p for p in family if _alive(*p)], "processes outlived the batch"
+
+    rerun = _start_cli_batch(_write_batch(project4, tmp_path / "run2",
+                                          _sleep_step(seconds=0.6, steps=12)))
+    _, err = rerun.communicate(timeout=60)
+    assert rerun.returncode == 0, err
+    summary = json.loads((tmp_path / "run2" / "summary.json").read_text())
+    assert summary["counts"]["skipped"] == len(done)
+    assert set(_files(products)) == {f"{m}.json" for m in ("a_b", "b_c", "c_d", "d_e")}
