@@ -42,8 +42,9 @@ Semantics (kept simple on purpose):
   result is the same as from Python, the CLI or QGIS.
 - **Lost workers.** A worker process that dies without a result (killed, out of memory) costs
   only its own task: the task runs once more on a new worker (logged); a second death makes it
-  ``failed`` ("worker process N died (signal 9, SIGKILL) …"). A task that failed with an error
-  is not run again. Other tasks and later steps go on as after any failure.
+  ``failed`` ("worker process N died (signal 9, SIGKILL) …"). A worker stopped with SIGTERM
+  (not by the batch's cancel) cancels its task and counts as lost. A task that failed with an
+  error is not run again. Other tasks and later steps go on as after any failure.
 - **Parent death.** Workers end with the batch: on Linux the kernel sends them SIGTERM when the
   batch process dies (``PR_SET_PDEATHSIG``), elsewhere a thread watches the parent pid. A worker
   told so cancels its task (which discards its staged output) and exits within
@@ -596,6 +597,8 @@ def _die_with_parent(parent_pid: int) -> None:
     """End this worker when the batch parent dies (SIGTERM on Linux, else a watchdog thread)."""
     signal.signal(signal.SIGTERM, lambda signum, frame: _orphan())
     armed = False
+    # The kernel signals when the *thread* that started us ends: run_batch starts the workers
+    # and ends them before it returns, so that thread outlives them.
     if sys.platform.startswith("linux"):
         with contextlib.suppress(Exception):  # no libc symbol: fall back to the watchdog
             libc = ctypes.CDLL(None, use_errno=True)
@@ -1019,6 +1022,7 @@ def _summary(plan: BatchPlan, records: List[Dict[str, Any]], started: str, t0: f
 
 
 def _atomic_json(path: Path, data: Dict[str, Any]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)  # the summary even if a task removed it
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     tmp.write_text(json.dumps(data, indent=2, default=str), encoding="utf-8")
     os.replace(tmp, path)
