@@ -219,26 +219,29 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     if unknown:
         raise InputError(f"Batch file: unknown table(s) {', '.join(sorted(unknown))}; "
                          "expected [batch] and [[steps]].")
-    head = dict(config.get("batch", {}))
+    head = config.get("batch", {})
+    if not isinstance(head, dict):
+        raise InputError("Batch file: batch must be a table: write [batch] on a line of its own "
+                         "with project = …, workers = …, output = … below it.")
+    head = dict(head)
     _check_keys(head, _BATCH_KEYS, "[batch]")
+    for key in ("project", "output"):
+        _text(head, key, "[batch]")
     project: Any = None
     project_dir: Optional[Path] = None
     if "project" in head:
-        project_dir = (Path(base_dir) / Path(str(head["project"])).expanduser()).resolve()
+        project_dir = (Path(base_dir) / Path(head["project"]).expanduser()).resolve()
         project = Project.load(project_dir)
         project_dir = project.root.resolve()
     home = project_dir or Path(base_dir).resolve()
-    try:
-        workers = int(head.get("workers", 1))
-    except (TypeError, ValueError):
-        workers = 0
-    if workers < 1:
-        raise InputError(f"Batch file: workers = {head.get('workers')!r} must be a whole "
+    workers = head.get("workers", 1)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError(f"Batch file: workers = {workers!r} in [batch] must be a whole "
                          "number ≥ 1.")
     run_auto = run_dir is None and not head.get("output")
     if run_dir is None:
         if head.get("output"):
-            text = _substitute(str(head["output"]),
+            text = _substitute(head["output"],
                                {"project": str(project_dir)} if project_dir else {},
                                "[batch] output", keep_others=True)
             run_dir = Path(base_dir) / Path(text).expanduser()
@@ -247,6 +250,8 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     run = Path(run_dir).resolve()
 
     steps = config.get("steps", [])
+    if isinstance(steps, dict):
+        raise InputError("Batch file: write each step as [[steps]] (two brackets), not [steps].")
     if not isinstance(steps, list) or not steps:
         raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
     plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
@@ -257,6 +262,13 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
             raise InputError(f"Batch file: step {number} is not a table.")
         _plan_step(plan, project, step, number, Path(base_dir))
     return plan
+
+
+def _text(table: Dict[str, Any], key: str, where: str) -> None:
+    """Refuse a value that is not a string (a number or list where a name or path belongs)."""
+    if key in table and not isinstance(table[key], str):
+        raise InputError(f"Batch file: {key} = {table[key]!r} in {where} must be a string in "
+                         f"quotes, e.g. {key} = \"…\".")
 
 
 def _check_keys(table: Dict[str, Any], allowed: set, where: str) -> None:
@@ -279,8 +291,10 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
     _check_keys(step, _STEP_KEYS, f"step {number}")
     if "algorithm" not in step:
         raise InputError(f"Batch file: step {number} needs algorithm = \"id\".")
-    alg = registry.get(str(step["algorithm"]))
-    name = str(step.get("name") or alg.id)
+    for key in ("algorithm", "name"):
+        _text(step, key, f"step {number}")
+    alg = registry.get(step["algorithm"])
+    name = step.get("name") or alg.id
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
         raise InputError(f"Batch file: step name {name!r} may hold only letters, digits, "
                          "'_', '-' and '.' (it names the log files).")
@@ -351,9 +365,28 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
                        for k, v in params.items()}
         if item is not None:
             task_params[iterate] = item  # type: ignore[index]
+        _check_params(alg, task_params, name)
         log = plan.run_dir / (f"{name}.log" if label is None else f"{name}/{_safe(label)}.log")
         plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
                                item_kind=item_kind, params=task_params, log=log))
+
+
+def _check_params(alg: Any, params: Dict[str, Any], step: str) -> None:
+    """Refuse unknown names, missing required values and values of the wrong type or range
+    while planning, so that a typo stops the batch before its first task runs.
+
+    Input files are not looked for: an earlier step may make them.
+    """
+    known = {p.name for p in alg.parameters}
+    unknown = sorted(set(params) - known)
+    if unknown:
+        raise InputError(f"Batch file: step '{step}' ({alg.id}): unknown parameter(s) "
+                         f"{', '.join(unknown)}; known are {', '.join(sorted(known))}.")
+    for p in alg.parameters:
+        try:
+            p.convert(params.get(p.name))
+        except InputError as exc:
+            raise InputError(f"Batch file: step '{step}' ({alg.id}): {exc}") from None
 
 
 def _item_label(item: Optional[str], kind: Optional[str]) -> Optional[str]:
@@ -1107,8 +1140,8 @@ def _acquire_lock(plan: BatchPlan) -> Tuple[Path, List[str]]:
     path = _lock_path(plan)
     notes: List[str] = []
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         for _ in range(5):
+            path.parent.mkdir(parents=True, exist_ok=True)  # again: a releaser may remove it
             if _create_lock(path, _lock_info(plan)):
                 return path, notes
             holder = _read_lock(path)
@@ -1140,11 +1173,11 @@ def _create_lock(path: Path, info: Dict[str, Any]) -> bool:
     lock. Where hard links are not supported, the lock is created with ``O_CREAT|O_EXCL``.
     """
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(info), encoding="utf-8")
     try:
+        tmp.write_text(json.dumps(info), encoding="utf-8")
         os.link(tmp, path)
         return True
-    except FileExistsError:
+    except (FileExistsError, FileNotFoundError):  # taken, or the folder went: look again
         return False
     except OSError:  # no hard links on this file system
         try:
@@ -1226,11 +1259,14 @@ def _exclusive(folder: Path) -> Iterator[None]:
 
 
 def _release_lock(path: Path) -> None:
-    """Delete the lock if it is still ours."""
+    """Delete the lock if it is still ours, and its folder if that is empty now (a batch
+    that could not start leaves nothing behind)."""
     holder = _read_lock(path)
     if holder and holder.get("pid") == os.getpid() and holder.get("host") == socket.gethostname():
         with contextlib.suppress(OSError):
             path.unlink()
+        with contextlib.suppress(OSError):  # not empty: the resume state lives there
+            path.parent.rmdir()
 
 
 def _process_stat(pid: int) -> Optional[List[str]]:
