@@ -931,6 +931,11 @@ def run_batch(
             notes.append(f"run folder {run_dir} exists already; this run writes to "
                          f"{plan.run_dir}")
             _atomic_json(lock, _lock_info(plan))
+        for folder in (lock.parent, plan.run_dir):
+            removed = _remove_stale_temps(folder)
+            if removed:
+                notes.append(f"removed {len(removed)} temporary file(s) of ended batches in "
+                             f"{folder}: {', '.join(removed)}")
         modules = [*extra_modules, *registry.extra_modules()]
         return _run_locked(plan, feedback, n_workers, resume, modules, grace, notes)
     finally:
@@ -1069,6 +1074,24 @@ def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
         result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
                               lambda pct, i=task.index: progress.set(i, pct))
         finish(task, result)
+
+
+#: The temporary files of the batch's own atomic writes: ``.<name>.<pid>.tmp``.
+_TEMP_NAME = re.compile(r"\..+\.(\d+)\.tmp")
+
+
+def _remove_stale_temps(folder: Path) -> List[str]:
+    """Delete the batch's temporary files in ``folder`` whose writer (on this host) has
+    ended, e.g. a batch killed while writing its state; return their names."""
+    removed = []
+    with contextlib.suppress(OSError):
+        for path in folder.iterdir():
+            match = _TEMP_NAME.fullmatch(path.name)
+            if match and path.is_file() and not _process_alive(int(match.group(1))):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+                    removed.append(path.name)
+    return sorted(removed)
 
 
 # -- the run folder ------------------------------------------------------------------------------

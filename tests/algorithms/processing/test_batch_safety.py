@@ -598,3 +598,28 @@ def test_a_batch_that_cannot_start_is_one_line_and_writes_nothing(fake_algs, pro
     assert message in err
     after = _hashes(root)
     assert after == before, set(after) ^ set(before)
+
+
+@pytest.mark.skipif(os.name == "nt", reason="no liveness probe on Windows")
+def test_temporary_files_of_killed_batches_are_removed_and_named(fake_algs, project4, tmp_path):
+    dead = _dead_pid()
+    state = project4 / ".photodem"
+    run = tmp_path / "run"
+    state.mkdir()
+    run.mkdir()
+    (state / f".batch-state.json.{dead}.tmp").write_text("{")
+    (state / f".batch.lock.{dead}.tmp").write_text("{")
+    (run / f".summary.json.{dead}.tmp").write_text("{")
+    alive = state / f".batch-state.json.{os.getppid()}.tmp"  # a running writer's: kept
+    alive.write_text("{")
+    mine = state / "notes.tmp"  # not a batch temporary: kept
+    mine.write_text("x")
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=run)
+    assert batch.run_batch(plan, workers=1)["status"] == "done"
+    assert sorted(p.name for p in state.iterdir()) == sorted(
+        [alive.name, "batch-state.json", "notes.tmp"])
+    assert not (run / f".summary.json.{dead}.tmp").exists()
+    text = (run / "batch.log").read_text()
+    assert (f"removed 2 temporary file(s) of ended batches in {state}: "
+            f".batch-state.json.{dead}.tmp, .batch.lock.{dead}.tmp") in text
+    assert f"in {run}: .summary.json.{dead}.tmp" in text
