@@ -623,3 +623,35 @@ def test_temporary_files_of_killed_batches_are_removed_and_named(fake_algs, proj
     assert (f"removed 2 temporary file(s) of ended batches in {state}: "
             f".batch-state.json.{dead}.tmp, .batch.lock.{dead}.tmp") in text
     assert f"in {run}: .summary.json.{dead}.tmp" in text
+
+
+@linux_only
+def test_two_batches_started_together_run_each_task_once(fake_algs, project4, tmp_path):
+    file = project4.parent / "b.toml"  # default run folders: runs/<timestamp>/
+    file.write_text(_HEAD + "workers = 2\n" + '[[steps]]\nalgorithm = "fake_sleep_write"\n'
+                    'name = "sleep"\n[steps.params]\nseconds = 1.0\n'
+                    'output = "{project}/products/{step}/{model}.json"\n')
+    procs = [_start_cli_batch(file) for _ in range(2)]
+    results = [(p.wait(timeout=90), p.communicate()[1]) for p in procs]
+    codes = sorted(code for code, _ in results)
+    assert codes in ([0, 0], [0, 2]), results
+    for code, err in results:
+        assert "Traceback" not in err
+        if code == 2:
+            assert "another batch (pid " in err and err.count("\n") == 1
+    runs = sorted((project4 / "runs").iterdir())
+    assert len(runs) == codes.count(0)  # a refused batch makes no run folder
+    done = [line for run in runs for line in (run / "batch.log").read_text().splitlines()
+            if ": done in" in line]
+    assert len(done) == 4  # each task once: the second batch (if it ran) resumed them all
+    assert all((run / "summary.json").is_file() for run in runs)
+    assert not _lock(project4).exists()
+
+
+def test_the_watchdog_tells_a_worker_when_its_parent_is_gone(monkeypatch):
+    called = threading.Event()
+    monkeypatch.setattr(batch, "_orphan", called.set)
+    monkeypatch.setattr(batch.os, "getppid", lambda: 1)  # reparented: the parent died
+    thread = threading.Thread(target=batch._watch_parent, args=(12345,), daemon=True)
+    thread.start()
+    assert called.wait(5.0)
