@@ -54,6 +54,11 @@ Semantics (kept simple on purpose):
   project is refused at once with an operator error naming the holder. A lock whose process
   (on this host) is no longer running is taken over with a line in the batch log. The lock is
   removed on every exit of :func:`run_batch`; ``--dry-run`` does not take it.
+- **Leftovers.** At its start a batch deletes the temporary files (``.<name>.<pid>.tmp``) that
+  ended batches left in ``.photodem`` and in its run folder, and names them in the batch log.
+- **Checks first.** The batch file, every step's parameters (names, types, ranges, options),
+  the lock and the run folder are checked before the first task runs; input files are not
+  looked for then (an earlier step may make them).
 - **Run folders** are unique: the default ``runs/<timestamp>/`` is created with an atomic
   ``mkdir``; if it exists already, ``<timestamp>-2`` (``-3`` …) is used and the tasks are
   planned again for it.
