@@ -72,7 +72,7 @@ Semantics (kept simple on purpose):
   therefore never resume (each run has a new folder); put products under ``{project}``. Input
   file contents are not hashed.
 - **Cancel.** :meth:`Feedback.cancel` (Ctrl-C in the CLI) stops scheduling; running tasks are
-  asked to stop (a shared event their Feedback checks), which makes the algorithms discard their
+  asked to stop (a shared flag their Feedback checks), which makes the algorithms discard their
   staged outputs; workers that do not stop within ``grace`` seconds are killed. The batch is
   ``cancelled`` only when a task was: a task that finished before the cancel reached it stays
   ``done``, and a cancel after the last task changes nothing.
@@ -601,7 +601,7 @@ _busy = False
 _orphaned = threading.Event()
 
 
-def _worker_main(conn: Any, cancel_event: Any, modules: Sequence[str], parent_pid: int) -> None:
+def _worker_main(conn: Any, cancel_flag: Any, modules: Sequence[str], parent_pid: int) -> None:
     """A worker process: run the tasks the parent sends until it sends ``None`` or is gone.
 
     Each job is ``(index, algorithm, params, log)``; the worker answers with
@@ -609,11 +609,11 @@ def _worker_main(conn: Any, cancel_event: Any, modules: Sequence[str], parent_pi
     """
     global _busy
     _die_with_parent(parent_pid)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C (cancel_event)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C (cancel_flag)
     registry.add_modules(modules)
 
     def is_canceled() -> bool:
-        return cancel_event.is_set() or _orphaned.is_set()
+        return bool(cancel_flag.value) or _orphaned.is_set()
 
     while True:
         try:
@@ -712,7 +712,7 @@ class _Pool:
     """At most ``n`` spawned worker processes; a worker that dies costs only its own task.
 
     A task whose worker dies without a result runs once more on a new worker; a second death
-    makes it ``failed``. Cancellation is a shared event the tasks' feedback checks.
+    makes it ``failed``. Cancellation is a shared flag the tasks' feedback checks.
     """
 
     def __init__(self, n: int, modules: Sequence[str], log: Callable[..., None],
@@ -723,7 +723,9 @@ class _Pool:
         self.log = log  # log(message, warning=False, quiet=False): batch.log (and operator)
         self.finish = finish  # records a task's result
         self.progress = progress
-        self.cancel_event = self.ctx.Event()
+        # A shared byte, not an Event: a worker killed while holding an Event's internal lock
+        # would leave every other worker blocked in is_set().
+        self.cancel_flag = self.ctx.RawValue("b", 0)
         self.workers: List[_Worker] = []
 
     # -- workers ---------------------------------------------------------------------------------
@@ -731,7 +733,7 @@ class _Pool:
         conn, child = self.ctx.Pipe()
         process = self.ctx.Process(
             target=_worker_main, name="photodem-batch-worker",
-            args=(child, self.cancel_event, self.modules, os.getpid()),
+            args=(child, self.cancel_flag, self.modules, os.getpid()),
         )
         process.start()
         child.close()  # a worker's death then shows as EOF on our end
@@ -768,7 +770,7 @@ class _Pool:
             if kind == "progress":
                 self.progress.set(index, min(value, 99.0))
             elif kind == "result" and value.get("status") == "cancelled" \
-                    and not self.cancel_event.is_set():
+                    and not self.cancel_flag.value:
                 worker.stopped = True  # someone stopped the worker: as if it had died
             elif kind == "result":
                 task, worker.task = worker.task, None
@@ -782,7 +784,7 @@ class _Pool:
         cancel_deadline: Optional[float] = None
         while queue or self._busy():
             if feedback.is_canceled() and cancel_deadline is None:
-                self.cancel_event.set()  # running tasks stop at their next progress check
+                self.cancel_flag.value = 1  # running tasks stop at their next progress check
                 queue.clear()  # tasks not started keep their record "cancelled"
                 cancel_deadline = time.monotonic() + grace
             if cancel_deadline is not None and time.monotonic() > cancel_deadline:
@@ -841,7 +843,7 @@ class _Pool:
     def close(self) -> None:
         """End the workers: idle ones at once; running ones (an interrupted batch) are
         cancelled, then killed after a few seconds."""
-        self.cancel_event.set()  # only tasks of an interrupted batch still run
+        self.cancel_flag.value = 1  # only tasks of an interrupted batch still run
         deadline = time.monotonic() + 3.0
         while time.monotonic() < deadline:
             live = [w for w in self._busy() if w.process.is_alive()]
