@@ -96,7 +96,11 @@ def contained(path: PathLike, folder: PathLike, what: str) -> Path:
 # -- product marks -------------------------------------------------------------------------------
 def folder_product(folder: PathLike) -> Optional[str]:
     """The algorithm id in a folder's :data:`PRODUCT_MARKER`, or ``None``."""
-    marker = Path(folder) / PRODUCT_MARKER
+    return folder_product_file(Path(folder) / PRODUCT_MARKER)
+
+
+def folder_product_file(marker: Path) -> Optional[str]:
+    """The ``product`` of a marker file, or ``None`` (missing or unreadable)."""
     try:
         data = json.loads(marker.read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -105,18 +109,34 @@ def folder_product(folder: PathLike) -> Optional[str]:
     return str(product) if product else None
 
 
-def write_marker(folder: PathLike, product: str, written: str) -> None:
-    """Write :data:`PRODUCT_MARKER` into ``folder``."""
+def write_marker(folder: PathLike, product: str, written: str,
+                 name: str = PRODUCT_MARKER) -> None:
+    """Write a product marker (default :data:`PRODUCT_MARKER`) into ``folder``."""
     text = json.dumps({"product": product, "written": written})
-    (Path(folder) / PRODUCT_MARKER).write_text(text, encoding="utf-8")
+    (Path(folder) / name).write_text(text, encoding="utf-8")
+
+
+def file_mark(path: PathLike) -> Path:
+    """The hidden mark ``.<name>.photodem-product.json`` of a file product that is no GeoTIFF
+    (a GeoTIFF carries :data:`PRODUCT_TAG` inside instead)."""
+    path = Path(path)
+    return path.with_name(f".{path.name}.photodem-product.json")
+
+
+def is_tiff(path: PathLike) -> bool:
+    """True for ``.tif`` / ``.tiff`` names (products that carry the tag inside)."""
+    return Path(path).suffix.lower() in (".tif", ".tiff")
 
 
 def file_product(path: PathLike) -> Optional[str]:
-    """The :data:`PRODUCT_TAG` of a GeoTIFF (read from its first directory), or ``None``.
+    """The algorithm that wrote a file product: a GeoTIFF's :data:`PRODUCT_TAG` (read from
+    its first directory), another file's :func:`file_mark`; ``None`` if none.
 
     Pure Python on purpose: a check before the run must not depend on GDAL or fail on a
     corrupt file (a file that cannot be read is simply not a product).
     """
+    if not is_tiff(path):
+        return folder_product_file(file_mark(path))
     try:
         xml = _gdal_metadata(Path(path))
     except (OSError, struct.error, ValueError):
@@ -468,7 +488,9 @@ __all__ = [
     "contained",
     "current",
     "current_product",
+    "file_mark",
     "file_product",
+    "is_tiff",
     "forget_last",
     "folder_product",
     "last_scope",

@@ -82,10 +82,6 @@ def tag_product(path: PathLike, product: str) -> None:
         dst.update_tags(**{PRODUCT_TAG: product})
 
 
-def _is_tiff(path: Path) -> bool:
-    return path.suffix.lower() in (".tif", ".tiff")
-
-
 @contextlib.contextmanager
 def atomic_output(path: PathLike, tag: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it to ``path`` only on success.
@@ -102,9 +98,13 @@ def atomic_output(path: PathLike, tag: bool = True) -> Iterator[Path]:
     tmp = path.with_name(output_policy.staging_name(path.stem, suffix=path.suffix))
     try:
         yield tmp
-        product = _product_of_file(path) if tag and _is_tiff(path) else ""
-        if product and tmp.is_file():
+        product = _product_of_file(path) if tag else ""
+        if product and output_policy.is_tiff(path):
             tag_product(tmp, product)
+        elif product:  # other files: a hidden mark beside them
+            output_policy.write_marker(output_policy.file_mark(path).parent, product,
+                                       time.strftime("%Y-%m-%dT%H:%M:%S"),
+                                       output_policy.file_mark(path).name)
         with output_policy.sigint_blocked():
             os.replace(tmp, path)
             output_policy.commit(path)
