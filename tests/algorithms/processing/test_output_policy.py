@@ -13,7 +13,6 @@ import pytest
 from photodem.algorithms import cli, output_policy
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.processing.spec import Algorithm, Output, Parameter
 from photodem.algorithms.raster.io import PRODUCT_MARKER, write_raster
 
