@@ -169,7 +169,7 @@ def test_a_folder_of_another_algorithm_is_refused(block, tmp_path):
 def test_a_sidecar_of_someone_else_is_refused(tif_algs, tmp_path):
     out = tmp_path / "r.tif"
     (tmp_path / "r_report.json").write_text("operator's notes")
-    with pytest.raises(InputError, match="r_report.json"):
+    with pytest.raises(InputError, match=r"r_report\.json"):
         registry.run("test_write_tif", {"output": str(out)})
     assert not out.exists()
 

@@ -66,14 +66,12 @@ def test_staging_names_carry_the_process_id(tmp_path):
 
 
 def test_a_failure_leaves_nothing(tmp_path):
-    with pytest.raises(RuntimeError):
-        with atomic_output(tmp_path / "a.tif") as tmp:
-            tmp.write_bytes(b"x")
-            raise RuntimeError("boom")
-    with pytest.raises(RuntimeError):
-        with staged_folder(tmp_path / "f", product="t") as tmp:
-            (tmp / "x").write_text("x")
-            raise RuntimeError("boom")
+    with pytest.raises(RuntimeError), atomic_output(tmp_path / "a.tif") as tmp:
+        tmp.write_bytes(b"x")
+        raise RuntimeError("boom")
+    with pytest.raises(RuntimeError), staged_folder(tmp_path / "f", product="t") as tmp:
+        (tmp / "x").write_text("x")
+        raise RuntimeError("boom")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -129,9 +127,9 @@ def test_staged_folder_replaces_only_the_same_product(tmp_path):
     with staged_folder(out, replace=True, product="alpha") as tmp:
         (tmp / "v").write_text("2")
     assert (out / "v").read_text() == "2"
-    with pytest.raises(InputError, match="product of 'alpha'"):
-        with staged_folder(out, replace=True, product="beta"):
-            pass
+    with pytest.raises(InputError, match="product of 'alpha'"), \
+            staged_folder(out, replace=True, product="beta"):
+        pass
     assert (out / "v").read_text() == "2"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
@@ -142,9 +140,9 @@ def test_staged_folder_never_replaces_or_marks_a_project(tmp_path):
         (tmp / "project.toml").write_text('name = "x"\n')
     assert not (out / PRODUCT_MARKER).exists()
     (out / PRODUCT_MARKER).write_text(json.dumps({"product": "dem_compare"}))  # old marker
-    with pytest.raises(InputError, match="project"):
-        with staged_folder(out, replace=True, product="dem_compare"):
-            pass
+    with pytest.raises(InputError, match="project"), \
+            staged_folder(out, replace=True, product="dem_compare"):
+        pass
     assert (out / "project.toml").is_file()
 
 
@@ -162,9 +160,9 @@ def test_an_interrupt_during_the_swap_leaves_the_new_folder(tmp_path, monkeypatc
         real_replace(src, dst)
 
     monkeypatch.setattr(rio.os, "replace", replace_with_interrupt)
-    with pytest.raises(KeyboardInterrupt):
-        with staged_folder(out, replace=True, product="alpha") as tmp:
-            (tmp / "v").write_text("new")
+    with pytest.raises(KeyboardInterrupt), \
+            staged_folder(out, replace=True, product="alpha") as tmp:
+        (tmp / "v").write_text("new")
     assert len(calls) == 2  # the interrupt waited for both renames
     assert (out / "v").read_text() == "new"
 
