@@ -119,7 +119,7 @@ class Parameter:
         kind = self.kind
         try:
             if kind in INPUT_PATH_KINDS or kind in OUTPUT_KINDS:
-                return str(Path(str(value)).expanduser())
+                return self._path_text(value)
             if kind in ("model", "image", "string", "crs"):
                 return str(value)
             if kind == "number":
@@ -141,12 +141,23 @@ class Parameter:
             if kind == "multiple_rasters":
                 items = [value] if isinstance(value, str) else list(value)
                 parts = [p for v in items for p in str(v).split(",")]  # "a.tif,b.tif" or a list
-                return [str(Path(p.strip()).expanduser()) for p in parts if p.strip()]
+                return [self._path_text(p.strip()) for p in parts if p.strip()]
         except InputError:
             raise
         except (TypeError, ValueError):
             pass
         raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
+
+    def _path_text(self, value: Any) -> str:
+        """A path as ``str``; names that are not valid UTF-8 are refused (GDAL needs it)."""
+        text = str(Path(str(value)).expanduser())
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            shown = text.encode("utf-8", "replace").decode("utf-8")
+            raise InputError(f"Parameter '{self.name}': the path '{shown}' is not valid UTF-8; "
+                             "rename it (GDAL reads and writes UTF-8 names only).") from None
+        return text
 
     def _check_range(self, number: float) -> None:
         if not math.isfinite(number):

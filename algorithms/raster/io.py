@@ -236,6 +236,21 @@ def _swap_in(tmp: Path, path: Path) -> None:
 
 
 @contextlib.contextmanager
+def scratch_folder(folder: PathLike, label: str) -> Iterator[Path]:
+    """A hidden work folder in ``folder`` named after this process; removed afterwards.
+
+    Named like a staged output (``.<label>.<pid>.<random>.partial``), so that the one of a
+    killed run is removed by a later run writing there (:func:`..output_policy.remove_stale`).
+    """
+    path = Path(folder) / output_policy.staging_name(label)
+    path.mkdir(parents=True)
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+@contextlib.contextmanager
 def open_image(path: PathLike, mode: str = "r", **profile: Any) -> Iterator[Any]:
     """``rasterio.open`` for rasters in image space (aerial images, epipolar images).
 
