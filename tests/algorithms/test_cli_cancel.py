@@ -174,3 +174,24 @@ def test_sigint_at_a_random_moment_matches_the_disk(project, tmp_path, seed):
         capture_output=True, text=True, timeout=120)
     assert rerun.returncode == 0, rerun.stderr
     assert (out / "stats.json").is_file() and _hidden(tmp_path) == []
+
+
+@pytest.mark.skipif(not PHOTODEM.exists(), reason="console script not installed")
+@pytest.mark.parametrize("seed", [4, 5])
+def test_a_killed_run_leaves_nothing_a_rerun_does_not_clean(project, tmp_path, seed):
+    delay = random.Random(seed).uniform(1.0, 2.5)
+    out = tmp_path / "cmp"
+    argv = [str(PHOTODEM), "run", "dem_compare", "--dem", str(project / "truth/dsm.tif"),
+            "--reference", str(project / "truth/dtm.tif"), "--output", str(out)]
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(delay)
+    proc.kill()
+    proc.wait(timeout=60)
+    left = _hidden(tmp_path)
+    if out.exists():  # killed after the rename: the product is complete
+        assert (out / PRODUCT_MARKER).is_file()
+    rerun = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert rerun.returncode == 0, rerun.stderr
+    assert _hidden(tmp_path) == []
+    if left:
+        assert f"process {proc.pid}, no longer running" in rerun.stderr

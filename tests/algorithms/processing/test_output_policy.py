@@ -255,3 +255,34 @@ def test_every_algorithm_refuses_a_forbidden_output_before_running(alg_id, block
         message = str(info.value)
         assert p.name in message and ("project" in message or "input" in message), message
     assert tree_hash(block) == before
+
+
+def test_a_sidecar_path_that_is_a_folder_is_refused_before_work(tif_algs, tmp_path):
+    (tmp_path / "r_report.json").mkdir()
+    with pytest.raises(InputError, match="is a folder, but a file is expected"):
+        registry.run("test_write_tif", {"output": str(tmp_path / "r.tif")})
+    assert not (tmp_path / "r.tif").exists()
+
+
+def test_a_non_utf8_name_is_one_line(block, tmp_path, capsys):
+    bad = str(tmp_path).encode() + b"/cmp\xff"
+    code = cli.main(["run", "dem_compare", "--dem", str(block / "truth/dsm.tif"),
+                     "--reference", str(block / "truth/dtm.tif"),
+                     "--output", bad.decode("utf-8", "surrogateescape")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "not valid UTF-8" in err
+
+
+def test_the_default_outputs_of_a_project_stay_in_products(block):
+    for alg_id, values, expected in [
+        ("match_model", {"model": "0101_0102"}, "products/dsm/0101_0102"),
+        ("epipolar_pair", {"model": "0101_0102"}, "products/epipolar/0101_0102"),
+        ("orthorectify", {"image": "0101", "dem": str(block / "truth/dsm.tif")},
+         "products/ortho/0101.tif"),
+        ("mosaic", {"dem": str(block / "truth/dsm.tif")}, "products/mosaic/mosaic.tif"),
+        ("refine_object_space", {"dsm": str(block / "truth/dsm.tif")},
+         "products/dsm_refined/dsm"),
+    ]:
+        alg = registry.get(alg_id)
+        targets = alg.output_targets({"project": str(block), **values})
+        assert targets[0].path == block / expected, alg_id
