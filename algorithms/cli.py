@@ -41,6 +41,7 @@ import traceback
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence
 
+from . import output_policy
 from .errors import Cancelled, PhotodemError
 from .processing import batch as batch_mod
 from .processing import registry
@@ -50,6 +51,8 @@ from .processing.spec import Algorithm, Parameter
 
 PROG = "photodem"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_CANCELLED = 0, 1, 2, 130
+#: Said when Ctrl-C came after the run had committed its outputs (the run then finishes).
+LATE_INTERRUPT = "the run had finished writing before the interrupt; its outputs are complete."
 #: Option names of ``run`` itself; no algorithm parameter may use them.
 RESERVED = ("json", "quiet", "help")
 
@@ -276,6 +279,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 result = registry.run(alg.id, params, feedback)
         finally:
             feedback.close()
+    if feedback.is_canceled():  # the interrupt came after the outputs were committed
+        feedback.warning(LATE_INTERRUPT)
     _print_result(result, namespace.json)
     return EXIT_OK
 
@@ -369,12 +374,21 @@ def cmd_gui() -> int:
 # -- helpers -------------------------------------------------------------------------------------
 @contextlib.contextmanager
 def _cancel_on_sigint(feedback: Feedback) -> Iterator[None]:
-    """First Ctrl-C cancels ``feedback`` (the run cleans up); a second one interrupts."""
+    """First Ctrl-C cancels ``feedback`` (the run cleans up); a second one interrupts.
+
+    Once the run has committed an output it is no longer interrupted: it finishes its product
+    set, so that what is on disk is complete and matches the message.
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def handler(signum: int, frame: Any) -> None:
+        if feedback.is_committed():
+            feedback.cancel()
+            print(f"\n{PROG}: the outputs are being written; finishing the run.",
+                  file=sys.stderr)
+            return
         if feedback.is_canceled():
             raise KeyboardInterrupt
         feedback.cancel()
@@ -408,6 +422,15 @@ def _stdout_to_stderr() -> Iterator[None]:
             os.close(fd_saved)
 
 
+def _written_before_stop() -> str:
+    """What a stopped run left on disk, from its run scope (so the message matches it)."""
+    scope = output_policy.last_scope()
+    if scope is None or not scope.committed:
+        return "no output was written."
+    return ("already complete before the stop: "
+            + ", ".join(str(p) for p in scope.committed) + ".")
+
+
 def _error(message: str) -> None:
     text = " ".join(str(message).split())  # one line
     print(f"{PROG}: error: {text}", file=sys.stderr)
@@ -438,10 +461,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     except Cancelled:
-        print(f"{PROG}: cancelled; no output was written.", file=sys.stderr)
+        print(f"{PROG}: cancelled; {_written_before_stop()}", file=sys.stderr)
         return EXIT_CANCELLED
     except KeyboardInterrupt:
-        print(f"\n{PROG}: interrupted.", file=sys.stderr)
+        print(f"\n{PROG}: interrupted; {_written_before_stop()}", file=sys.stderr)
         return EXIT_CANCELLED
     except PhotodemError as exc:
         _error(str(exc))

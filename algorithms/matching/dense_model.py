@@ -28,7 +28,6 @@ boundary, outside exclusions) that hold a height.
 
 from __future__ import annotations
 
-import tempfile
 import time
 from pathlib import Path
 from typing import Any, Dict, Optional, Union
@@ -128,7 +127,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     dict
         ``{"dsm", "count", "report", "points", "metrics"}``.
     """
-    from ..raster.io import open_image, staged_folder
+    from ..raster.io import open_image, scratch_folder, staged_folder
     from .model_setup import prepare_model
 
     feedback = ensure_feedback(feedback)
@@ -154,8 +153,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     out = Path(output_dir)
     timings: Dict[str, float] = {}
     with staged_folder(out, replace=True, product="match_model") as tmp, \
-            tempfile.TemporaryDirectory(prefix="photodem-dense-", dir=str(tmp.parent)) as work:
-        work = Path(work)
+            scratch_folder(tmp.parent, f"{out.name}.dense") as work:
         t0 = time.perf_counter()
         grey = {}
         for i, side in enumerate(SIDES):

@@ -47,8 +47,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
-import tempfile
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass
@@ -62,7 +60,13 @@ from scipy import ndimage
 
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
-from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
+from ..raster.io import (
+    atomic_output,
+    cog_output,
+    gtiff_profile,
+    overview_factors,
+    scratch_folder,
+)
 from . import balance as bal
 from . import seamlines as sl
 
@@ -719,8 +723,7 @@ def mosaic_project(
         dtm = dem
     out = Path(output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    scratch = Path(tempfile.mkdtemp(prefix=f".{out.stem}.orthos.", dir=str(out.parent)))
-    try:
+    with scratch_folder(out.parent, f"{out.stem}.orthos") as scratch:
         orthos, info = [], {}
         for k, name in enumerate(names):
             step = fb.step(40.0 * k / len(names), 40.0 * (k + 1) / len(names))
@@ -731,8 +734,6 @@ def mosaic_project(
             info[name] = {"gsd": res.get("gsd"), "occluded_pct": res.get("occluded_pct")}
         result = mosaic_orthos(orthos, out, gsd=gsd, dsm=dsm, dtm=dtm, project=proj,
                                feedback=fb.step(40, 100), **mosaic_options)
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
     result["orthos"] = info
     return result
 

@@ -33,6 +33,7 @@ class Feedback:
         self._on_progress = on_progress
         self._on_log = on_log
         self._cancel = threading.Event()
+        self._committed = threading.Event()
         self.percent = 0.0
         self.lines: List[str] = []
         self.warnings: List[str] = []
@@ -46,9 +47,21 @@ class Feedback:
         """True once :meth:`cancel` was called."""
         return self._cancel.is_set()
 
+    def mark_committed(self) -> None:
+        """The run has renamed an output into place: from now on it finishes, cancelled or not.
+
+        Called by the run scope (:func:`..output_policy.commit`); a product set is never left
+        half-replaced because an interrupt came late.
+        """
+        self._committed.set()
+
+    def is_committed(self) -> bool:
+        """True once the run has committed an output (see :meth:`mark_committed`)."""
+        return self._committed.is_set()
+
     def check(self) -> None:
-        """Raise :class:`Cancelled` if cancellation was requested."""
-        if self.is_canceled():
+        """Raise :class:`Cancelled` if cancellation was requested and nothing is committed yet."""
+        if self.is_canceled() and not self.is_committed():
             raise Cancelled()
 
     # -- progress and log ---------------------------------------------------------------------
@@ -90,6 +103,12 @@ class StepFeedback(Feedback):
 
     def is_canceled(self) -> bool:
         return self.parent.is_canceled()
+
+    def mark_committed(self) -> None:
+        self.parent.mark_committed()
+
+    def is_committed(self) -> bool:
+        return self.parent.is_committed()
 
     def progress(self, percent: float) -> None:
         self.percent = float(min(max(percent, 0.0), 100.0))

@@ -10,8 +10,10 @@ from __future__ import annotations
 import importlib
 import os
 import time
+from pathlib import Path
 from typing import Any, Dict, Iterable, List, Optional
 
+from .. import output_policy
 from ..errors import InputError
 from .feedback import Feedback, ensure_feedback
 from .spec import Algorithm, json_ready, prepare_parameters
@@ -101,21 +103,55 @@ def run(
     """Run an algorithm from raw parameter values and return its JSON-ready outputs.
 
     This is the single entry point of every face: parameters are checked and converted by
-    :func:`~.spec.prepare_parameters`, the algorithm runs, and its outputs are made JSON-ready.
+    :func:`~.spec.prepare_parameters`, every output the run will write is checked against the
+    output policy (:func:`check_outputs`) and stale staging leftovers beside it are removed —
+    all before the first computation — then the algorithm runs in a run scope that records
+    its committed outputs, and its outputs are made JSON-ready. Once an output is committed a
+    cancellation no longer raises: the run finishes its product set (the caller sees
+    ``feedback.is_canceled()`` and reports a late interrupt).
 
     Raises
     ------
     PhotodemError
         For anything the operator can fix (including :class:`~..errors.Cancelled`).
     """
+    output_policy.forget_last()
     alg = get(algorithm_id)
     feedback = ensure_feedback(feedback)
     prepared = prepare_parameters(alg, params)
+    targets = check_outputs(alg, prepared)
+    output_policy.remove_stale(_folders_written(targets), feedback.info)
     start = time.perf_counter()
-    result = alg.run(prepared, feedback)
-    feedback.progress(100.0)
+    with output_policy.run_scope(alg.id, lambda path: feedback.mark_committed(), targets):
+        result = alg.run(prepared, feedback)
+        feedback.progress(100.0)
     feedback.info(f"{alg.id} finished in {time.perf_counter() - start:.1f} s.")
     return json_ready(result)
+
+
+def check_outputs(alg: Algorithm, prepared: Dict[str, Any]) -> List[output_policy.Target]:
+    """The outputs a run of ``alg`` with converted ``prepared`` values writes, once checked.
+
+    Raises
+    ------
+    InputError
+        When an output is forbidden (see :mod:`..output_policy`).
+    """
+    targets = alg.output_targets(prepared)
+    if targets:
+        inputs, protected = alg.input_paths(prepared)
+        output_policy.check_targets(alg.id, targets, inputs, protected)
+    return targets
+
+
+def _folders_written(targets: Iterable[output_policy.Target]) -> List[Path]:
+    """The folders a run writes in: each output's parent and every folder output."""
+    folders: List[Path] = []
+    for t in targets:
+        folders.append(t.path.parent)
+        if t.kind == "folder":
+            folders.append(t.path)
+    return folders
 
 
 def groups() -> List[str]:

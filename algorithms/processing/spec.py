@@ -13,9 +13,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import InputError
+from ..output_policy import Target, contained
 from .feedback import Feedback
 
 #: Parameter kinds. Paths are passed on as ``str``.
@@ -118,7 +119,7 @@ class Parameter:
         kind = self.kind
         try:
             if kind in INPUT_PATH_KINDS or kind in OUTPUT_KINDS:
-                return str(Path(str(value)).expanduser())
+                return self._path_text(value)
             if kind in ("model", "image", "string", "crs"):
                 return str(value)
             if kind == "number":
@@ -140,12 +141,23 @@ class Parameter:
             if kind == "multiple_rasters":
                 items = [value] if isinstance(value, str) else list(value)
                 parts = [p for v in items for p in str(v).split(",")]  # "a.tif,b.tif" or a list
-                return [str(Path(p.strip()).expanduser()) for p in parts if p.strip()]
+                return [self._path_text(p.strip()) for p in parts if p.strip()]
         except InputError:
             raise
         except (TypeError, ValueError):
             pass
         raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
+
+    def _path_text(self, value: Any) -> str:
+        """A path as ``str``; names that are not valid UTF-8 are refused (GDAL needs it)."""
+        text = str(Path(str(value)).expanduser())
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            shown = text.encode("utf-8", "replace").decode("utf-8")
+            raise InputError(f"Parameter '{self.name}': the path '{shown}' is not valid UTF-8; "
+                             "rename it (GDAL reads and writes UTF-8 names only).") from None
+        return text
 
     def _check_range(self, number: float) -> None:
         if not math.isfinite(number):
@@ -238,6 +250,65 @@ class Algorithm:
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         raise NotImplementedError
 
+    # -- outputs: where a run writes, known before it starts ---------------------------------
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """The ``output`` used when none is given (derived from the project), or ``None``.
+
+        Algorithms with a derived default override this; :meth:`output_path` (used by
+        :meth:`run`) and :meth:`output_targets` (checked before the run) both go through it.
+        """
+        return None
+
+    def output_path(self, params: Dict[str, Any], name: str = "output") -> Optional[Path]:
+        """The path of output parameter ``name``: the given one, else the derived default."""
+        value = params.get(name)
+        if value:
+            return Path(value)
+        return self.default_output(params) if name == "output" else None
+
+    def sidecars(self, name: str, path: Path) -> List[Path]:
+        """Files written beside the file output ``name`` at ``path`` (reports, masks)."""
+        return []
+
+    def output_targets(self, params: Dict[str, Any]) -> List[Target]:
+        """Every path a run with ``params`` writes, for the output policy."""
+        targets: List[Target] = []
+        for p in self.parameters:
+            if not p.is_output:
+                continue
+            path = self.output_path(params, p.name)
+            if path is None:
+                continue
+            kind = "folder" if p.kind == "output_folder" else "file"
+            targets.append(Target(path, kind, p.name))
+            if kind == "file":
+                targets += [Target(side, "file", p.name, owner=path)
+                            for side in self.sidecars(p.name, path)]
+        return targets
+
+    def input_paths(self, params: Dict[str, Any]) -> Tuple[List[Path], List[Path]]:
+        """The input paths of a run and the files a ``project`` input brings in.
+
+        Returns
+        -------
+        inputs, protected : list of Path
+            The paths given as inputs; the project files (``project.toml``, ``edits.gpkg``,
+            ``images/`` and every image it references) of project inputs.
+        """
+        inputs: List[Path] = []
+        protected: List[Path] = []
+        for p in self.parameters:
+            value = params.get(p.name)
+            if value is None:
+                continue
+            if p.kind == "multiple_rasters":
+                inputs += [Path(v) for v in value]
+            elif p.kind in INPUT_PATH_KINDS:
+                inputs.append(Path(value))
+            if p.kind == "project":
+                protected += _project_files(Path(value))
+        return inputs, protected
+
     def to_dict(self) -> Dict[str, Any]:
         return {
             "id": self.id,
@@ -292,6 +363,35 @@ def prepare_parameters(algorithm: Algorithm, values: Dict[str, Any]) -> Dict[str
     return params
 
 
+def project_product(params: Dict[str, Any], step: str, name: str, what: str) -> Path:
+    """``<project>/products/<step>/<name>``, checked to stay inside ``products/<step>/``.
+
+    ``what`` names the source of ``name`` in the message (e.g. "Stereo model 'x'").
+    """
+    from ..project.model import Project
+
+    base = Project.load(params["project"]).products_dir(step)
+    return contained(base / name, base, what)
+
+
+def model_product(params: Dict[str, Any], step: str) -> Path:
+    """``<project>/products/<step>/<model>/`` of the ``model`` parameter."""
+    from ..project.model import Project
+
+    name = Project.load(params["project"]).model(params["model"]).name
+    return project_product(params, step, name, f"Stereo model '{name}'")
+
+
+def _project_files(path: Path) -> List[Path]:
+    """The files of the project at ``path`` that no output may replace."""
+    from ..project.model import Project
+
+    project = Project.load(path)
+    files = [project.project_file, project.edits_path, project.root / "images",
+             project.root / ".photodem"]
+    return files + [project.image_path(rec) for rec in project.images]
+
+
 def json_ready(value: Any) -> Any:
     """Convert paths, numpy scalars/arrays and tuples so that ``json.dumps`` accepts them."""
     if isinstance(value, dict):
@@ -339,5 +439,7 @@ __all__ = [
     "Output",
     "Parameter",
     "json_ready",
+    "model_product",
     "prepare_parameters",
+    "project_product",
 ]

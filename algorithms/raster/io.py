@@ -12,7 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-import uuid
+import time
 import warnings
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Tuple, Union
@@ -22,6 +22,10 @@ import rasterio
 from affine import Affine
 from numpy.typing import NDArray
 from rasterio.enums import Resampling
+
+from .. import output_policy
+from ..output_policy import PRODUCT_MARKER as PRODUCT_MARKER  # re-exported
+from ..output_policy import PRODUCT_TAG
 
 PathLike = Union[str, Path]
 
@@ -59,24 +63,51 @@ def gtiff_profile(width: int, height: int, count: int = 1, dtype: str = "float32
     return profile
 
 
-def _temp_sibling(path: Path) -> Path:
-    return path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.partial")
+def _temp_sibling(path: Path, kind: str = "partial") -> Path:
+    """A hidden sibling of ``path`` named after this process (see :mod:`..output_policy`)."""
+    return path.with_name(output_policy.staging_name(path.name, kind))
+
+
+def _product_of_file(path: Path) -> str:
+    """The algorithm id to tag ``path`` with: set when it is a main file output of the run."""
+    scope = output_policy.current()
+    if scope is None or not scope.targets or not scope.is_product_file(path):
+        return ""
+    return scope.product
+
+
+def tag_product(path: PathLike, product: str) -> None:
+    """Write the :data:`PRODUCT_TAG` into a finished (not Cloud-Optimised) GeoTIFF."""
+    with open_image(path, "r+") as dst:
+        dst.update_tags(**{PRODUCT_TAG: product})
 
 
 @contextlib.contextmanager
-def atomic_output(path: PathLike) -> Iterator[Path]:
+def atomic_output(path: PathLike, tag: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it to ``path`` only on success.
 
     The suffix is kept (``.tif``) so that drivers recognise the format. On any exception
     (including :class:`~photodem.algorithms.errors.Cancelled`) the temporary file is removed
-    and ``path`` stays as it was.
+    and ``path`` stays as it was. The rename is the commit point of the output: SIGINT is held
+    back around it, and it is recorded in the run scope (:func:`..output_policy.commit`). A
+    GeoTIFF that is a main output of the run gets the product tag first (``tag=False``: the
+    caller tags it, see :func:`cog_output`).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex[:8]}.partial{path.suffix}")
+    tmp = path.with_name(output_policy.staging_name(path.stem, suffix=path.suffix))
     try:
         yield tmp
-        os.replace(tmp, path)
+        product = _product_of_file(path) if tag else ""
+        if product and output_policy.is_tiff(path):
+            tag_product(tmp, product)
+        elif product:  # other files: a hidden mark beside them
+            output_policy.write_marker(output_policy.file_mark(path).parent, product,
+                                       time.strftime("%Y-%m-%dT%H:%M:%S"),
+                                       output_policy.file_mark(path).name)
+        with output_policy.sigint_blocked():
+            os.replace(tmp, path)
+            output_policy.commit(path)
     finally:
         _remove_with_sidecars(tmp)
 
@@ -109,19 +140,19 @@ def cog_output(path: PathLike, profile: Dict[str, Any]
     scratch_profile = {k: v for k, v in profile.items()
                        if k not in ("compress", "predictor", "zlevel", "num_threads")}
     scratch_profile["compress"] = "none"
-    with atomic_output(path) as final:
+    with atomic_output(path, tag=False) as final:
         scratch = final.with_name(f"{final.stem}.scratch{final.suffix}")
         try:
             yield scratch, scratch_profile
             from rasterio.shutil import copy
 
+            product = _product_of_file(Path(path))
+            if product:  # tagged before the copy: rewriting a COG would spoil its layout
+                tag_product(scratch, product)
+
             copy(str(scratch), str(final), driver="GTiff", copy_src_overviews=True, **creation)
         finally:
             _remove_with_sidecars(scratch)
-
-
-#: Marker file in every folder a PhotoDEM algorithm wrote; only such folders are ever replaced.
-PRODUCT_MARKER = ".photodem-product.json"
 
 
 @contextlib.contextmanager
@@ -133,53 +164,90 @@ def staged_folder(path: PathLike, replace: bool = False, product: str = "") -> I
     path : path
         The output folder.
     replace : bool
-        Allow replacing an existing folder of that name (after success) — but only one that
-        PhotoDEM wrote itself (it holds :data:`PRODUCT_MARKER`): an operator's own folder is
-        never deleted. Projects are created with ``replace=False`` so that edits are never lost.
+        Allow replacing an existing folder of that name (after success) — but only an earlier
+        product of the same algorithm (its :data:`PRODUCT_MARKER` names ``product``): an
+        operator's own folder, another algorithm's product and a project are never deleted.
     product : str
-        What is written (the algorithm id), recorded in the marker file.
+        What is written (the algorithm id; default: the current run's), recorded in the marker
+        file. A folder that holds ``project.toml`` gets no marker: a project is never a product
+        that a later run may replace.
 
     Raises
     ------
     InputError
         Before any work is done, when ``path`` exists, is not empty and may not be replaced.
     """
-    import json
-    import time
-
-    from ..errors import InputError
-
     path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise InputError(f"The output '{path}' is a file, not a folder; choose a folder.")
-    if path.exists() and any(path.iterdir()):
-        if not replace:
-            raise InputError(
-                f"The output folder '{path}' exists and is not empty; choose a new folder "
-                "(PhotoDEM does not overwrite earlier results here)."
-            )
-        if not (path / PRODUCT_MARKER).is_file():
-            raise InputError(
-                f"The output folder '{path}' holds files PhotoDEM did not write; choose an empty "
-                "or new folder (PhotoDEM only replaces its own earlier results)."
-            )
+    product = product or output_policy.current_product()
+    _check_staged_target(path, replace, product)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temp_sibling(path)
     tmp.mkdir()
     try:
         yield tmp
-        marker = {"product": product, "written": time.strftime("%Y-%m-%dT%H:%M:%S")}
-        (tmp / PRODUCT_MARKER).write_text(json.dumps(marker), encoding="utf-8")
-        if path.exists():
-            old = _temp_sibling(path)
-            os.replace(path, old)
-            os.replace(tmp, path)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, path)
+        if not (tmp / output_policy.PROJECT_FILE).exists():
+            output_policy.write_marker(tmp, product, time.strftime("%Y-%m-%dT%H:%M:%S"))
+        _swap_in(tmp, path)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _check_staged_target(path: Path, replace: bool, product: str) -> None:
+    """The second line of defence of :func:`staged_folder` (the first is the registry's)."""
+    from ..errors import InputError
+
+    if path.exists() and not path.is_dir():
+        raise InputError(f"The output '{path}' is a file, not a folder; choose a folder.")
+    if not (path.exists() and any(path.iterdir())):
+        return
+    if (path / output_policy.PROJECT_FILE).exists():
+        raise InputError(f"The output folder '{path}' is a PhotoDEM project; choose another "
+                         "folder (a project is never replaced).")
+    if not replace:
+        raise InputError(
+            f"The output folder '{path}' exists and is not empty; choose a new folder "
+            "(PhotoDEM does not overwrite earlier results here)."
+        )
+    found = output_policy.folder_product(path)
+    if found is None or (product and found != product):
+        what = f"a product of '{found}'" if found else "files PhotoDEM did not write"
+        raise InputError(
+            f"The output folder '{path}' holds {what}; choose an empty or new folder "
+            f"(PhotoDEM only replaces earlier results of the same algorithm)."
+        )
+
+
+def _swap_in(tmp: Path, path: Path) -> None:
+    """Rename ``tmp`` to ``path`` (moving an old ``path`` aside first) as one commit step.
+
+    SIGINT is held back over both renames and the record, so an interrupt can never leave
+    neither the old nor the new folder; the old one is deleted afterwards.
+    """
+    old: Optional[Path] = None
+    with output_policy.sigint_blocked():
+        if path.exists():
+            old = _temp_sibling(path, "old")
+            os.replace(path, old)
+        os.replace(tmp, path)
+        output_policy.commit(path)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def scratch_folder(folder: PathLike, label: str) -> Iterator[Path]:
+    """A hidden work folder in ``folder`` named after this process; removed afterwards.
+
+    Named like a staged output (``.<label>.<pid>.<random>.partial``), so that the one of a
+    killed run is removed by a later run writing there (:func:`..output_policy.remove_stale`).
+    """
+    path = Path(folder) / output_policy.staging_name(label)
+    path.mkdir(parents=True)
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
 
 
 @contextlib.contextmanager

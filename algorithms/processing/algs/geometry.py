@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, Dict
+from typing import Any, Dict, Optional
 
 import numpy as np
 
@@ -12,7 +12,7 @@ from ...geometry.epipolar import SIDES, EpipolarPair
 from ...project.model import Project
 from ...raster.io import gtiff_profile, open_image, staged_folder
 from ..feedback import Feedback
-from ..spec import Algorithm, Output, Parameter, json_ready
+from ..spec import Algorithm, Output, Parameter, json_ready, model_product
 
 #: Pixels per resampled row block (per band): bounds the memory of the resampling.
 _BLOCK_PIXELS = 1_000_000
@@ -103,13 +103,16 @@ class EpipolarPairAlgorithm(Algorithm):
     )
     iterates_over = "model"
 
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """``<project>/products/epipolar/<model>/``."""
+        return model_product(params, "epipolar")
+
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         project = Project.load(params["project"])
         model = project.model(params["model"])
         recs = [project.image(model.left), project.image(model.right)]
         cams = [project.camera_of(r) for r in recs]
-        out_dir = Path(params["output"]) if params.get("output") else \
-            project.products_dir("epipolar") / model.name
+        out_dir = self.output_path(params)
         pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
                                               scale=float(params["scale"]),
                                               names=(recs[0].name, recs[1].name))

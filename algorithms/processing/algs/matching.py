@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, Tuple
+from pathlib import Path
+from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
@@ -12,7 +13,7 @@ from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
 from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
 from ...raster.io import atomic_output, gtiff_profile, open_image
 from ..feedback import Feedback
-from ..spec import Algorithm, Output, Parameter
+from ..spec import Algorithm, Output, Parameter, model_product
 
 GROUP = "Matching"
 GROUP_ID = "matching"
@@ -224,15 +225,16 @@ class MatchModel(Algorithm):
     )
     iterates_over = "model"
 
-    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from pathlib import Path
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """``<project>/products/dsm/<model>/``."""
+        return model_product(params, "dsm")
 
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...project.model import Project
 
         project = Project.load(params["project"])
         model = project.model(params["model"])
-        out = Path(params["output"]) if params.get("output") else \
-            project.products_dir("dsm") / model.name
+        out = self.output_path(params)
         method = params.get("method") or "fbm_lsm"
         common = {"spacing": params.get("spacing") or None,
                   "min_height": params.get("min_height"),

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Dict
+from typing import Any, Dict, List, Optional
 
 from ...errors import InputError
 from ..feedback import Feedback
-from ..spec import Algorithm, Output, Parameter
+from ..spec import Algorithm, Output, Parameter, project_product
 
 GROUP = "Orthophotos"
 GROUP_ID = "ortho"
@@ -61,6 +61,17 @@ class Orthorectify(Algorithm):
     )
     iterates_over = "image"
 
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """``<project>/products/ortho/<image>.tif``."""
+        name = Path(params["image"]).name
+        return project_product(params, "ortho", f"{name}.tif", f"The image name '{name}'")
+
+    def sidecars(self, name: str, path: Path) -> List[Path]:
+        """``<name>_visibility.tif`` beside the ortho."""
+        from ...ortho.rectify import visibility_path
+
+        return [visibility_path(path)]
+
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...ortho.rectify import orthorectify_image
         from ...project.model import Project
@@ -70,8 +81,7 @@ class Orthorectify(Algorithm):
             raise InputError("A true ortho needs a DSM: set 'dsm' (and use the DSM as 'dem' "
                              "too), or switch true_ortho off.")
         project = Project.load(params["project"])
-        output = params.get("output") or str(
-            project.products_dir("ortho") / f"{Path(params['image']).name}.tif")
+        output = str(self.output_path(params))
         res = orthorectify_image(
             project, params["image"], params["dem"], output,
             gsd=params.get("gsd") or None, resampling=params.get("resampling") or "bilinear",
@@ -281,17 +291,26 @@ class Mosaic(Algorithm):
         Output("balance", "json", "Mean difference in the overlaps before/after balancing"),
     )
 
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """``<project>/products/mosaic/mosaic.tif`` when a project is given."""
+        if not params.get("project"):
+            return None
+        return project_product(params, "mosaic", "mosaic.tif", "The mosaic")
+
+    def sidecars(self, name: str, path: Path) -> List[Path]:
+        """``<name>_seamlines.gpkg`` and ``<name>_balance.json`` beside the mosaic."""
+        from ...ortho.mosaic import sibling_paths
+
+        return [p for k, p in sibling_paths(path).items() if k != "mosaic"]
+
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...ortho.mosaic import mosaic_orthos, mosaic_project
         from ...project.model import Project
 
         g = params.get
         project = Project.load(params["project"]) if g("project") else None
-        if g("output"):
-            output = Path(params["output"])
-        elif project is not None:
-            output = project.products_dir("mosaic") / "mosaic.tif"
-        else:
+        output = self.output_path(params)
+        if output is None:
             raise InputError("Give the output file of the mosaic (or a project, whose "
                              "products/mosaic/ folder is then used).")
         options = {"seamlines": g("seamlines") or "auto",

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any, Dict
+from pathlib import Path
+from typing import Any, Dict, List, Optional
 
 from ..feedback import Feedback
-from ..spec import Algorithm, Output, Parameter
+from ..spec import Algorithm, Output, Parameter, project_product
 
 GROUP = "Surfaces"
 GROUP_ID = "surface"
@@ -47,6 +48,12 @@ class DsmMerge(Algorithm):
         Output("csv", "file", "Seam statistics (CSV)"),
         Output("coverage", "number", "Share of cells with a height"),
     )
+
+    def sidecars(self, name: str, path: Path) -> List[Path]:
+        """``<name>_count.tif``, ``<name>_seams.json`` and ``.csv`` beside the DSM."""
+        from ...surface.merge import sibling_paths
+
+        return [p for k, p in sibling_paths(path).items() if k != "dsm"]
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...surface.merge import merge_dsms
@@ -105,6 +112,10 @@ class InterpolateDem(Algorithm):
         Output("filled", "number", "Interpolated cells"),
         Output("coverage", "number", "Share of cells with a height"),
     )
+
+    def sidecars(self, name: str, path: Path) -> List[Path]:
+        """``<name>_count.tif`` beside the DEM."""
+        return [path.with_name(f"{path.stem}_count.tif")]
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...surface.interpolate import interpolate_dem
@@ -179,16 +190,18 @@ class RefineObjectSpace(Algorithm):
         Output("metrics", "json", "Metrics"),
     )
 
-    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from pathlib import Path
+    def default_output(self, params: Dict[str, Any]) -> Optional[Path]:
+        """``<project>/products/dsm_refined/<DSM name>/``."""
+        stem = Path(params["dsm"]).stem
+        return project_product(params, "dsm_refined", stem, f"The DSM name '{stem}'")
 
+    def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...matching.object_space import refine_object_space
         from ...project.model import Project
 
         project = Project.load(params["project"])
         dsm = Path(params["dsm"])
-        out = Path(params["output"]) if params.get("output") else \
-            project.products_dir("dsm_refined") / dsm.stem
+        out = self.output_path(params)
         images = [n.strip() for n in (params.get("images") or "").split(",") if n.strip()]
         return refine_object_space(
             project, dsm, out, spacing=params.get("spacing") or None,
