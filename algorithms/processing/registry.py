@@ -13,6 +13,7 @@ import time
 from typing import Any, Dict, Iterable, List, Optional
 
 from ..errors import InputError
+from ..input_errors import check_raster_parameters, operator_errors
 from .feedback import Feedback, ensure_feedback
 from .spec import Algorithm, json_ready, prepare_parameters
 
@@ -110,9 +111,11 @@ def run(
     """
     alg = get(algorithm_id)
     feedback = ensure_feedback(feedback)
-    prepared = prepare_parameters(alg, params)
-    start = time.perf_counter()
-    result = alg.run(prepared, feedback)
+    with operator_errors():  # damaged inputs end as one-line operator errors
+        prepared = prepare_parameters(alg, params)
+        check_raster_parameters(alg.parameters, prepared)  # before any work
+        start = time.perf_counter()
+        result = alg.run(prepared, feedback)
     feedback.progress(100.0)
     feedback.info(f"{alg.id} finished in {time.perf_counter() - start:.1f} s.")
     return json_ready(result)
