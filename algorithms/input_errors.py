@@ -22,8 +22,9 @@ import contextlib
 import csv
 import errno
 import os
+import warnings
 from pathlib import Path
-from typing import Iterable, Iterator, List, Optional, Tuple, Type, Union
+from typing import Any, Iterable, Iterator, List, Optional, Tuple, Type, Union
 
 from .errors import InputError, PhotodemError
 
@@ -159,20 +160,51 @@ def _translate(exc: BaseException, path: Optional[PathLike], what: str) -> Optio
     return None
 
 
+class InputWarning(UserWarning):
+    """An input was repaired or is used with a restriction; the run goes on.
+
+    Raised with :func:`warn_input` deep in the readers (which have no feedback);
+    :func:`operator_errors` passes it to the run's feedback.
+    """
+
+
+def warn_input(message: str) -> None:
+    """Tell the operator that an input was repaired or is used with a restriction."""
+    warnings.warn(message, InputWarning, stacklevel=2)
+
+
 @contextlib.contextmanager
-def operator_errors() -> Iterator[None]:
+def operator_errors(feedback: Any = None) -> Iterator[None]:
     """Turn the file libraries' exceptions raised inside into :class:`InputError`.
 
     Used once around a whole run; programming errors pass through unchanged (with their
     traceback) so that they are found and fixed.
+
+    Parameters
+    ----------
+    feedback : Feedback, optional
+        Receives every :class:`InputWarning` raised inside (each one, also repeated ones)
+        through its ``warning`` method; without one they are shown as Python warnings.
     """
-    try:
-        yield
-    except Exception as exc:
-        error = _translate(exc, None, "file")
-        if error is None:
-            raise
-        raise error from exc
+    with warnings.catch_warnings():
+        if feedback is not None:
+            warnings.simplefilter("always", InputWarning)
+            shown = warnings.showwarning
+
+            def show(message: Any, category: Any, *args: Any, **kwargs: Any) -> None:
+                if issubclass(category, InputWarning):
+                    feedback.warning(str(message))
+                else:
+                    shown(message, category, *args, **kwargs)
+
+            warnings.showwarning = show
+        try:
+            yield
+        except Exception as exc:
+            error = _translate(exc, None, "file")
+            if error is None:
+                raise
+            raise error from exc
 
 
 @contextlib.contextmanager
@@ -210,8 +242,6 @@ def check_raster(path: PathLike, what: str = "raster") -> None:
     if p.is_dir():
         return
     check_encodable(p, what)
-    import warnings
-
     import rasterio
     from rasterio.errors import NotGeoreferencedWarning
     from rasterio.windows import Window
@@ -281,6 +311,17 @@ def check_text_file(path: PathLike, what: str = "text file") -> str:
         return p.read_text(encoding="utf-8")
 
 
-__all__ = ["RASTER_SUFFIXES", "check_encodable", "check_raster", "check_raster_parameters",
-           "check_rasters", "check_text_file", "describe",
-           "display_path", "operator_errors", "reading"]
+__all__ = [
+    "RASTER_SUFFIXES",
+    "InputWarning",
+    "check_encodable",
+    "check_raster",
+    "check_raster_parameters",
+    "check_rasters",
+    "check_text_file",
+    "describe",
+    "display_path",
+    "operator_errors",
+    "reading",
+    "warn_input",
+]

@@ -415,7 +415,7 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
 
     keep_polys, remove_polys = [], []
     for geom, props in _geoms("exclusion_areas"):
-        action = str(props.get("action") or "remove").strip().lower()
+        action = props.get("action") or "remove"  # checked by read_layer
         (keep_polys if action == "keep" else remove_polys).append(geom)
     cons.keep = polygon_mask(keep_polys, grid)
     cons.remove = polygon_mask(remove_polys, grid) & ~cons.keep

@@ -111,7 +111,7 @@ def run(
     """
     alg = get(algorithm_id)
     feedback = ensure_feedback(feedback)
-    with operator_errors():  # damaged inputs end as one-line operator errors
+    with operator_errors(feedback):  # damaged inputs end as one-line operator errors
         prepared = prepare_parameters(alg, params)
         check_raster_parameters(alg.parameters, prepared)  # before any work
         start = time.perf_counter()
