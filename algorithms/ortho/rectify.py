@@ -398,6 +398,9 @@ def _grid(extent: Extent, gsd: float) -> Tuple[Affine, int, int]:
     ymax = round(math.ceil(extent[3] / gsd - 1e-9) * gsd, 6)
     width = max(math.ceil((extent[2] - xmin) / gsd - 1e-9), 1)
     height = max(math.ceil((ymax - extent[1]) / gsd - 1e-9), 1)
+    if width * height > 2 ** 36:  # as the mosaic: no disk holds such an ortho
+        raise InputError(f"The ortho would have {width} × {height} cells at {gsd:g} m; "
+                         "give a larger gsd.")
     return Affine(gsd, 0.0, xmin, 0.0, -gsd, ymax), width, height
 
 
