@@ -38,7 +38,6 @@ the tile size (plus the image window and DEM window a tile needs), not by the ou
 from __future__ import annotations
 
 import contextlib
-import functools
 import math
 import os
 import threading
@@ -52,6 +51,7 @@ import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
 
+from ..crs_check import same_horizontal_crs
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
@@ -81,36 +81,6 @@ def _cv2() -> Any:
 
 
 # -- rasters in the project CRS ---------------------------------------------------------------
-def same_horizontal_crs(a: Any, b: Any) -> bool:
-    """True when two CRSs have the same horizontal part (compound CRSs reduced to it).
-
-    A DEM in "projected + vertical" (compound) CRS whose projected part is the project CRS
-    needs no reprojection: the heights are used as they are (their datum is the operator's
-    choice, as for any DEM).
-    """
-    try:
-        wkt_a, wkt_b = a.to_wkt(), b.to_wkt()
-    except Exception:  # an unparsable CRS is never "the same"
-        return False
-    return _same_horizontal_wkt(wkt_a, wkt_b)
-
-
-@functools.lru_cache(maxsize=64)
-def _same_horizontal_wkt(wkt_a: str, wkt_b: str) -> bool:
-    # cached: pyproj's parsing costs milliseconds, and every ortho of a block asks again
-    try:
-        import pyproj
-
-        pa, pb = pyproj.CRS.from_wkt(wkt_a), pyproj.CRS.from_wkt(wkt_b)
-    except Exception:  # an unparsable CRS is never "the same"
-        return False
-
-    def horizontal(c: Any) -> Any:
-        return c.sub_crs_list[0] if c.is_compound and c.sub_crs_list else c
-
-    return bool(horizontal(pa).equals(horizontal(pb), ignore_axis_order=True))
-
-
 @contextlib.contextmanager
 def open_surface(path: PathLike, crs: str, feedback: Optional[Feedback] = None,
                  what: str = "DEM") -> Iterator[Any]:

@@ -187,8 +187,8 @@ def _check_heights(project: Project, records: List[Any], dem: Any,
     sampler = None
     if dem is not None and records:
         try:
-            sampler = load_dem(dem, block_bounds(project))
-        except Exception as exc:  # a DEM that does not cover the block
+            sampler = load_dem(dem, block_bounds(project), crs=project.crs or None)
+        except InputError as exc:  # another CRS, a DEM that does not cover the block…
             rep.errors.append(f"The DEM cannot be used for this block: {exc}")
             return
     known = sampler is not None or project.terrain_height is not None
