@@ -290,6 +290,9 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     if n < MIN_POINTS:
         raise InputError(f"'{path.name}' has only {n} valid point(s); a filter needs at least "
                          f"{MIN_POINTS}.")
+    from ..quality.points import check_distinct_points
+
+    n = check_distinct_points(xyz[ok, 0], xyz[ok, 1], path.name, MIN_POINTS, "a filter")
     given = to_crs(crs)
     out_crs = given if given is not None else to_crs(file_crs)
     if given is not None and file_crs is not None and to_crs(file_crs) != given:
@@ -300,7 +303,7 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     if spacing is None or not spacing > 0:
         x, y = xyz[ok, 0], xyz[ok, 1]
         dx, dy = float(np.ptp(x)), float(np.ptp(y))
-        est = math.sqrt(max(dx * dy, 1e-12) / n)
+        est = math.sqrt(max(dx * dy, 1e-12) / n)  # n: distinct positions
         # the points' bounding box misses half a spacing on every side: one correction step
         est = math.sqrt((dx + est) * (dy + est) / n)
         spacing = nice_spacing(est)
