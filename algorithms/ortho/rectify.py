@@ -55,6 +55,7 @@ from ..crs_check import same_horizontal_crs
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
+from ..input_errors import check_raster
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
@@ -368,9 +369,6 @@ def _grid(extent: Extent, gsd: float) -> Tuple[Affine, int, int]:
     ymax = round(math.ceil(extent[3] / gsd - 1e-9) * gsd, 6)
     width = max(math.ceil((extent[2] - xmin) / gsd - 1e-9), 1)
     height = max(math.ceil((ymax - extent[1]) / gsd - 1e-9), 1)
-    if width * height > 2 ** 36:  # as the mosaic: no disk holds such an ortho
-        raise InputError(f"The ortho would have {width} × {height} cells at {gsd:g} m; "
-                         "give a larger gsd.")
     return Affine(gsd, 0.0, xmin, 0.0, -gsd, ymax), width, height
 
 
@@ -539,6 +537,7 @@ def orthorectify_image(
     if not image_path.is_file():
         raise InputError(f"Image file '{image_path}' of image '{rec.name}' does not exist; fix "
                          "its path in project.toml.")
+    check_raster(image_path, "image")  # a truncated image fails here, before any work
     output = Path(output)
     vis_path = visibility_path(output)
     cv2 = _cv2()

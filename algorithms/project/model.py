@@ -256,7 +256,10 @@ class Project:
         if not path.is_file():
             raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
                              "fix its path in project.toml.")
-        with open_image(path) as src:
+        from ..input_errors import check_encodable, reading
+
+        check_encodable(path, "image")
+        with reading(path, "image"), open_image(path) as src:
             if (src.width, src.height) != (cam.width, cam.height):
                 raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
                                  f"'{cam.name}' is {cam.width}×{cam.height} px.")
