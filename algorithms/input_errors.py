@@ -143,7 +143,10 @@ def _translate(exc: BaseException, path: Optional[PathLike], what: str) -> Optio
     if isinstance(exc, PhotodemError):
         return None
     if isinstance(exc, UnicodeEncodeError) and "surrogates not allowed" in str(exc):
-        name = display_path(path) if path is not None else "an input"
+        name = display_path(path if path is not None else exc.object)
+        if path is None and ("\n" in name or len(name) > 4096):  # a text, not a name
+            return InputError("A file name that is not valid UTF-8 text could not be written "
+                              "into a report; rename the file with UTF-8 characters only.")
         return InputError(f"The {what} name '{name}' is not valid UTF-8 text; GDAL cannot open "
                           "it. Rename the file (or its folder) with UTF-8 characters only.")
     if isinstance(exc, OSError) and exc.errno in _OPERATOR_ERRNOS:
