@@ -275,7 +275,8 @@ RASTER_SUFFIXES = (".tif", ".tiff", ".vrt", ".img", ".jp2", ".png", ".jpg", ".jp
 
 
 def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
-    """Pre-flight check of every raster input of a run, before any work.
+    """Pre-flight check of every raster input of a run, before any work (and of the names of
+    raster and vector outputs, which GDAL must be able to take).
 
     Parameters
     ----------
@@ -293,6 +294,12 @@ def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
         kind, name = getattr(param, "kind", ""), getattr(param, "name", "")
         value = values.get(name)
         if value is None:
+            continue
+        if kind in ("output_raster", "output_vector"):  # written by GDAL/OGR
+            try:
+                check_encodable(value, "output")
+            except InputError as exc:
+                raise InputError(f"Parameter '{name}': {exc}") from None
             continue
         paths = list(value) if kind == "multiple_rasters" else [value]
         if kind == "file":
