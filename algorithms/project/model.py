@@ -360,7 +360,10 @@ class Project:
             raise InputError(f"Cannot read {where}: {exc.strerror or exc}.") from None
         top = _Table(data, where, "")
         head = top.table("project")
-        unit = check_angle_unit(head.text("angle_unit", "degrees"))
+        try:
+            unit = check_angle_unit(head.text("angle_unit", "degrees"))
+        except InputError as exc:
+            raise InputError(f"{head.where}: {exc}") from None
         cameras = {}
         for cam_name, cam in top.table("cameras").tables_by_name():
             check_identifier(cam_name, "camera", where)
