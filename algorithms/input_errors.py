@@ -270,7 +270,8 @@ def check_rasters(paths: Iterable[Optional[PathLike]], what: str = "raster") -> 
             check_raster(path, what)
 
 
-#: File endings of "file" parameters that are checked as rasters before a run.
+#: File endings of "file" parameters that are checked as rasters before a run (when GDAL
+#: recognises them as rasters: such a parameter may also take points or text).
 RASTER_SUFFIXES = (".tif", ".tiff", ".vrt", ".img", ".jp2", ".png", ".jpg", ".jpeg")
 
 
@@ -307,10 +308,27 @@ def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
         elif kind not in ("raster", "multiple_rasters"):
             continue
         for path in paths:
+            if kind == "file" and not _opens_as_raster(path):
+                continue  # a "file" may be points or text: the algorithm decides
             try:
                 check_raster(path)
             except InputError as exc:
                 raise InputError(f"Parameter '{name}': {exc}") from exc.__cause__
+
+
+def _opens_as_raster(path: PathLike) -> bool:
+    """True when GDAL recognises ``path`` as a raster (its blocks are not read)."""
+    import rasterio
+    from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
+
+    try:
+        check_encodable(path)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NotGeoreferencedWarning)
+            with rasterio.open(path):
+                return True
+    except (RasterioIOError, InputError):
+        return False
 
 
 def check_text_file(path: PathLike, what: str = "text file") -> str:

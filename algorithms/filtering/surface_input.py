@@ -389,7 +389,10 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
     target = to_crs(crs) if crs is not None else None
     if target is None:
         target = to_crs(prj.crs) if prj.crs else None
-    layers = fiona.listlayers(str(edits))
+    from ..input_errors import reading
+
+    with reading(edits, "GeoPackage"):
+        layers = fiona.listlayers(str(edits))
     wanted = [name for name in ("exclusion_areas", "ground_points", "breaklines")
               if name in layers]
     features: Dict[str, List[Tuple[Any, Dict[str, Any]]]] = {}
