@@ -300,3 +300,24 @@ def test_a_grid_beyond_memory_is_refused_naming_the_spacing(block: Path, tmp_pat
                      "--spacing", "0.0001", "--output", str(tmp_path / "d.tif")])
     assert_operator_error(code, capsys.readouterr().err, "spacing")
     assert list(tmp_path.iterdir()) == []
+
+
+# -- the pre-flight covers every raster parameter of every algorithm --------------------------
+def _raster_parameters() -> List[Tuple[str, str]]:
+    return [(alg.id, p.name) for alg in registry.algorithms().values() for p in alg.parameters
+            if p.kind in ("raster", "multiple_rasters")]
+
+
+@pytest.mark.parametrize("alg_id, name", _raster_parameters())
+@pytest.mark.parametrize("damage", ["trunc", "garbage", "empty"])
+def test_preflight_refuses_damaged_rasters_for_every_parameter(
+        alg_id: str, name: str, damage: str, bad: Dict[str, Path]) -> None:
+    from photodem.algorithms.input_errors import check_raster_parameters
+
+    alg = registry.get(alg_id)
+    value = [str(bad[damage])] if alg.parameter(name).kind == "multiple_rasters" \
+        else str(bad[damage])
+    with pytest.raises(InputError) as info:
+        check_raster_parameters(alg.parameters, {name: value})
+    text = str(info.value)
+    assert f"Parameter '{name}'" in text and bad[damage].name in text and "\n" not in text
