@@ -290,6 +290,9 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     if n < MIN_POINTS:
         raise InputError(f"'{path.name}' has only {n} valid point(s); a filter needs at least "
                          f"{MIN_POINTS}.")
+    from ..quality.points import check_distinct_points
+
+    n = check_distinct_points(xyz[ok, 0], xyz[ok, 1], path.name, MIN_POINTS, "a filter")
     given = to_crs(crs)
     out_crs = given if given is not None else to_crs(file_crs)
     if given is not None and file_crs is not None and to_crs(file_crs) != given:
@@ -300,7 +303,7 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     if spacing is None or not spacing > 0:
         x, y = xyz[ok, 0], xyz[ok, 1]
         dx, dy = float(np.ptp(x)), float(np.ptp(y))
-        est = math.sqrt(max(dx * dy, 1e-12) / n)
+        est = math.sqrt(max(dx * dy, 1e-12) / n)  # n: distinct positions
         # the points' bounding box misses half a spacing on every side: one correction step
         est = math.sqrt((dx + est) * (dy + est) / n)
         spacing = nice_spacing(est)
@@ -386,7 +389,10 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
     target = to_crs(crs) if crs is not None else None
     if target is None:
         target = to_crs(prj.crs) if prj.crs else None
-    layers = fiona.listlayers(str(edits))
+    from ..input_errors import reading
+
+    with reading(edits, "GeoPackage"):
+        layers = fiona.listlayers(str(edits))
     wanted = [name for name in ("exclusion_areas", "ground_points", "breaklines")
               if name in layers]
     features: Dict[str, List[Tuple[Any, Dict[str, Any]]]] = {}
@@ -415,7 +421,7 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
 
     keep_polys, remove_polys = [], []
     for geom, props in _geoms("exclusion_areas"):
-        action = str(props.get("action") or "remove").strip().lower()
+        action = props.get("action") or "remove"  # checked by read_layer
         (keep_polys if action == "keep" else remove_polys).append(geom)
     cons.keep = polygon_mask(keep_polys, grid)
     cons.remove = polygon_mask(remove_polys, grid) & ~cons.keep

@@ -89,12 +89,28 @@ def image_labels(names: Sequence[str]) -> Dict[str, str]:
 
 
 # -- DEM -------------------------------------------------------------------------------------------
-def load_dem(dem: DemLike, bounds: Optional[Sequence[float]] = None) -> Any:
-    """A :class:`~..raster.sample.DemSampler` from a path (window ``bounds``), or ``dem`` as is."""
+def load_dem(dem: DemLike, bounds: Optional[Sequence[float]] = None, crs: Any = None) -> Any:
+    """A :class:`~..raster.sample.DemSampler` from a path (window ``bounds``), or ``dem`` as is.
+
+    With ``crs`` (the project CRS) a DEM file in another CRS is refused, naming both
+    (:func:`~..crs_check.check_surface_crs`): its heights would be sampled at wrong places.
+    """
     if dem is None:
         return None
     if isinstance(dem, (str, Path)):
         from ..raster.sample import DemSampler
+
+        if crs:
+            import rasterio
+
+            from ..crs_check import check_surface_crs
+            from ..input_errors import check_encodable, reading
+
+            check_encodable(dem, "DEM")
+            if Path(dem).is_file():
+                with reading(dem, "raster"), rasterio.open(dem) as src:
+                    file_crs = src.crs
+                check_surface_crs(dem, file_crs, crs, "DEM")
 
         return DemSampler.from_file(dem, bounds=None if bounds is None else tuple(bounds))
     return dem
@@ -202,7 +218,8 @@ def block_footprints(project: Any, dem: DemLike = None, height: Optional[float] 
     The terrain comes from ``dem`` (mean height under each footprint), else ``height``, else
     ``project.terrain_height``, else 0 m.
     """
-    sampler = load_dem(dem, block_bounds(project)) if dem is not None else None
+    sampler = (load_dem(dem, block_bounds(project), crs=project.crs or None)
+               if dem is not None else None)
     h = _terrain_default(project) if height is None else float(height)
     wanted = None if names is None else set(names)
     out: Footprints = {}

@@ -178,6 +178,44 @@ def tile_size_for(memory_mb: float, min_d: int, max_d: int, margin: int) -> int:
     return int(max(64, side))
 
 
+def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
+                          right_shape: Tuple[int, int], margin: int = 48,
+                          parameter: str = "min_disparity/max_disparity"
+                          ) -> Tuple[int, int]:
+    """The search range limited to disparities the two images can have, checked against the
+    memory of one tile's matching — before any work.
+
+    A left pixel ``u`` has a partner ``u − d`` inside the right image only for
+    ``−(w_right − 1) ≤ d ≤ w_left − 1``; a wider range costs memory and time for nothing, so
+    it is cut to that. What remains must fit: the smallest tile's SGM needs about
+    ``8·D·(64 + 2m)·(64 + 2m + D)`` bytes (``D`` disparities, ``m`` margin; see
+    :func:`tile_size_for`), since a tile whose range the coarse pass cannot narrow is
+    searched over all of it.
+
+    Raises
+    ------
+    InputError
+        When the range holds no possible disparity, or cannot fit in memory; the message
+        names ``parameter``.
+    """
+    from ..memory import check_allocation
+
+    lo = max(int(min_d), -(int(right_shape[1]) - 1))
+    hi = min(int(max_d), int(left_shape[1]) - 1)
+    if lo > hi:
+        raise InputError(
+            f"The disparity range {min_d}…{max_d} px holds no possible disparity of these "
+            f"images (widths {left_shape[1]} and {right_shape[1]} px allow "
+            f"{-(right_shape[1] - 1)}…{left_shape[1] - 1}); change {parameter}."
+        )
+    num_d = _num_disparities(lo, hi)
+    side = 64 + 2 * int(margin)
+    check_allocation(8.0 * num_d * side * (side + num_d + 16),
+                     f"dense matching over {num_d} disparities ({lo}…{hi} px)",
+                     f"{parameter} (a narrower disparity range)")
+    return lo, hi
+
+
 def iter_disparity_tiles(
     left: GreySource,
     right: GreySource,
@@ -202,6 +240,7 @@ def iter_disparity_tiles(
     margin: int = 48,
     coarse_above: int = COARSE_ABOVE,
     feedback: Optional[Feedback] = None,
+    disparity_parameter: str = "min_disparity/max_disparity",
 ) -> Iterator[Tuple[int, int, Array]]:
     """Disparity of the left image tile by tile: yields ``(row0, col0, block)``.
 
@@ -246,6 +285,9 @@ def iter_disparity_tiles(
         the module docstring); 0 = never.
     feedback : Feedback, optional
         Progress per tile; cancelling raises :class:`~photodem.algorithms.errors.Cancelled`.
+    disparity_parameter : str
+        What the operator changes for a narrower range, named by the memory check
+        (:func:`check_disparity_range`, which also cuts the range to possible disparities).
     """
     cv2 = _cv2()
     feedback = ensure_feedback(feedback)
@@ -256,6 +298,8 @@ def iter_disparity_tiles(
     if max_d < min_d:
         raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
                          "give min_disparity ≤ max_disparity.")
+    min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
+                                         disparity_parameter)
     block = int(block_size) | 1
     p1 = int(8 * block * block if p1 is None else p1)
     p2 = int(32 * block * block if p2 is None else p2)

@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import GeometryError, InputError
 from ..geometry.epipolar import EpipolarPair
 from ..surface.gridding import Grid
+from .dense import check_disparity_range
 
 
 @dataclass
@@ -181,6 +182,9 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     widen = 0.1 * (d_hi - d_lo)
     min_d = math.floor(d_lo - widen) - int(disparity_margin)
     max_d = math.ceil(d_hi + widen) + int(disparity_margin)
+    (w_l, h_l), (w_r, h_r) = pair.sizes
+    check_disparity_range(min_d, max_d, (h_l, w_l), (h_r, w_r),
+                          parameter="min_height/max_height (or disparity_margin)")
     excl, bounds, lines = (read_constraints(project.edits_path)
                            if Path(project.edits_path).is_file() else ([], [], []))
     check_breaklines(lines)

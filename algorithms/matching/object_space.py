@@ -891,12 +891,9 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
             raise InputError(f"Image file '{p}' of image '{rec.name}' does not exist; fix its "
                              "path in project.toml.")
     with open_image(dsm) as src:
-        if src.crs is not None and project.crs:
-            from rasterio.crs import CRS
+        from ..crs_check import check_surface_crs
 
-            if CRS.from_user_input(project.crs) != src.crs:
-                raise InputError(f"The DSM '{dsm.name}' is in another CRS than the project; "
-                                 "reproject it to the project CRS first.")
+        check_surface_crs(dsm, src.crs, project.crs, "DSM")
         t = src.transform
         if t.b != 0 or t.d != 0 or abs(abs(t.a) - abs(t.e)) > 1e-9 * abs(t.a):
             raise InputError(f"The DSM '{dsm.name}' must be north-up with square cells.")

@@ -38,7 +38,6 @@ the tile size (plus the image window and DEM window a tile needs), not by the ou
 from __future__ import annotations
 
 import contextlib
-import functools
 import math
 import os
 import threading
@@ -52,9 +51,11 @@ import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
 
+from ..crs_check import same_horizontal_crs
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
+from ..input_errors import check_raster
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
@@ -81,36 +82,6 @@ def _cv2() -> Any:
 
 
 # -- rasters in the project CRS ---------------------------------------------------------------
-def same_horizontal_crs(a: Any, b: Any) -> bool:
-    """True when two CRSs have the same horizontal part (compound CRSs reduced to it).
-
-    A DEM in "projected + vertical" (compound) CRS whose projected part is the project CRS
-    needs no reprojection: the heights are used as they are (their datum is the operator's
-    choice, as for any DEM).
-    """
-    try:
-        wkt_a, wkt_b = a.to_wkt(), b.to_wkt()
-    except Exception:  # an unparsable CRS is never "the same"
-        return False
-    return _same_horizontal_wkt(wkt_a, wkt_b)
-
-
-@functools.lru_cache(maxsize=64)
-def _same_horizontal_wkt(wkt_a: str, wkt_b: str) -> bool:
-    # cached: pyproj's parsing costs milliseconds, and every ortho of a block asks again
-    try:
-        import pyproj
-
-        pa, pb = pyproj.CRS.from_wkt(wkt_a), pyproj.CRS.from_wkt(wkt_b)
-    except Exception:  # an unparsable CRS is never "the same"
-        return False
-
-    def horizontal(c: Any) -> Any:
-        return c.sub_crs_list[0] if c.is_compound and c.sub_crs_list else c
-
-    return bool(horizontal(pa).equals(horizontal(pb), ignore_axis_order=True))
-
-
 @contextlib.contextmanager
 def open_surface(path: PathLike, crs: str, feedback: Optional[Feedback] = None,
                  what: str = "DEM") -> Iterator[Any]:
@@ -566,6 +537,7 @@ def orthorectify_image(
     if not image_path.is_file():
         raise InputError(f"Image file '{image_path}' of image '{rec.name}' does not exist; fix "
                          "its path in project.toml.")
+    check_raster(image_path, "image")  # a truncated image fails here, before any work
     output = Path(output)
     vis_path = visibility_path(output)
     cv2 = _cv2()

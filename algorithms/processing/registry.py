@@ -15,6 +15,7 @@ from typing import Any, Dict, Iterable, List, Optional
 
 from .. import output_policy
 from ..errors import InputError
+from ..input_errors import check_raster_parameters, operator_errors
 from .feedback import Feedback, ensure_feedback
 from .spec import Algorithm, json_ready, prepare_parameters
 
@@ -118,13 +119,15 @@ def run(
     output_policy.forget_last()
     alg = get(algorithm_id)
     feedback = ensure_feedback(feedback)
-    prepared = prepare_parameters(alg, params)
-    targets = check_outputs(alg, prepared)
-    output_policy.remove_stale(_folders_written(targets), feedback.info)
-    start = time.perf_counter()
-    with output_policy.run_scope(alg.id, lambda path: feedback.mark_committed(), targets):
-        result = alg.run(prepared, feedback)
-        feedback.progress(100.0)
+    with operator_errors(feedback):  # damaged inputs end as one-line operator errors
+        prepared = prepare_parameters(alg, params)
+        check_raster_parameters(alg.parameters, prepared)  # before any work
+        targets = check_outputs(alg, prepared)
+        output_policy.remove_stale(_folders_written(targets), feedback.info)
+        start = time.perf_counter()
+        with output_policy.run_scope(alg.id, lambda path: feedback.mark_committed(), targets):
+            result = alg.run(prepared, feedback)
+            feedback.progress(100.0)
     feedback.info(f"{alg.id} finished in {time.perf_counter() - start:.1f} s.")
     return json_ready(result)
 

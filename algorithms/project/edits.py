@@ -14,6 +14,18 @@ ground_points      3D Point          ``note``
 seamlines          LineString        ``note``
 check_points       3D Point          ``id``
 =================  ================  ===============================================================
+
+Every feature is checked when it is read (:func:`check_feature`, for :func:`read_layer` and
+:func:`read_geometries` alike):
+
+* ``exclusion_areas.action`` must be empty (= ``remove``) or one of :data:`EXCLUSION_ACTIONS`
+  (case and surrounding blanks do not matter); any other value is an error naming the feature;
+* an invalid polygon (self-intersecting, a bow tie…) of any polygon layer is repaired
+  (``make_valid``; ``buffer(0)`` where shapely lacks it) with a warning naming layer and fid;
+  one that cannot be repaired is an error;
+* a 2-D breakline (digitised without Z) is used as a barrier only — the surface may jump
+  across it, but it gives no heights — with a warning naming it. 3-D breaklines also give their
+  heights (matching, interpolation).
 """
 
 from __future__ import annotations
@@ -42,6 +54,90 @@ EDIT_LAYERS: Dict[str, Tuple[str, OrderedDict[str, str]]] = {
 
 #: Allowed values of ``exclusion_areas.action``.
 EXCLUSION_ACTIONS = ("keep", "remove", "exclude")
+
+
+def _where(path: PathLike, layer: str, fid: Any) -> str:
+    return f"'{Path(path).name}' layer {layer}, feature {fid}"
+
+
+def check_action(value: Any, where: str) -> Optional[str]:
+    """The normalised ``action`` of an exclusion area (``None`` when empty = ``remove``).
+
+    Raises
+    ------
+    InputError
+        For any other value, naming the feature and the allowed values.
+    """
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    text = str(value).strip().lower()
+    if text not in EXCLUSION_ACTIONS:
+        raise InputError(f"{where}: action '{value}' is not one of {', '.join(EXCLUSION_ACTIONS)} "
+                         "(empty = remove); fix it in edits.gpkg.")
+    return text
+
+
+def repair_polygon(geom: Any, where: str) -> Any:
+    """``geom`` if it is a valid polygon, else its repaired form, with a warning.
+
+    ``shapely.validation.make_valid`` (shapely ≥ 1.8) keeps every part of a bow tie;
+    ``buffer(0)`` is the fallback. Only the polygonal parts of the result are kept.
+
+    Raises
+    ------
+    InputError
+        When nothing of the polygon is left after the repair.
+    """
+    if geom.is_valid:
+        return geom
+    from shapely.ops import unary_union
+    from shapely.validation import explain_validity
+
+    reason = explain_validity(geom)
+    try:
+        from shapely.validation import make_valid
+
+        fixed = make_valid(geom)
+    except ImportError:  # pragma: no cover - shapely < 1.8
+        fixed = geom.buffer(0)
+    parts = [g for g in getattr(fixed, "geoms", [fixed])
+             if g.geom_type in ("Polygon", "MultiPolygon") and not g.is_empty]
+    fixed = unary_union(parts) if parts else None
+    if fixed is None or fixed.is_empty or fixed.area <= 0:
+        raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
+                         "repairing it; redraw it in edits.gpkg.")
+    from ..input_errors import warn_input
+
+    warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
+               f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
+    return fixed
+
+
+def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
+                  props: Dict[str, Any]) -> Tuple[Any, Dict[str, Any]]:
+    """One feature as read, checked and repaired (see the module notes).
+
+    Returns
+    -------
+    (geometry, properties)
+        The polygon repaired if it was invalid, ``action`` normalised.
+
+    Raises
+    ------
+    InputError
+        For an unknown exclusion action or a polygon that cannot be repaired.
+    """
+    where = _where(path, layer, fid)
+    if layer == "exclusion_areas" and "action" in props:
+        props = {**props, "action": check_action(props.get("action"), where)}
+    if geom.geom_type in ("Polygon", "MultiPolygon"):
+        geom = repair_polygon(geom, where)
+    if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
+        from ..input_errors import warn_input
+
+        warn_input(f"{where}: the breakline has no heights (2-D); it only separates the surface "
+                   "and gives no heights. Digitise it with Z to use its heights.")
+    return geom, props
 
 
 def _crs_wkt(crs: str) -> str:
@@ -105,8 +201,8 @@ def add_features(path: PathLike, layer: str,
         unknown = sorted(set(props) - set(fields))
         if unknown:
             raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
-        if layer == "exclusion_areas" and props.get("action") not in (None, *EXCLUSION_ACTIONS):
-            raise InputError(f"exclusion_areas.action must be one of {EXCLUSION_ACTIONS}.")
+        if layer == "exclusion_areas":
+            props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
         records.append({"geometry": mapping(geom),
                         "properties": OrderedDict((k, props.get(k)) for k in fields)})
     with fiona.open(str(path), "a", driver="GPKG", layer=layer) as dst:
@@ -127,21 +223,26 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Edits file '{path}' not found; create it with project_create.")
-    if layer not in fiona.listlayers(str(path)):
-        raise InputError(f"'{path}' has no layer '{layer}'.")
+    from ..input_errors import reading
+
     out: List[Tuple[Any, Dict[str, Any]]] = []
-    with fiona.open(str(path), layer=layer) as src:
-        for feat in src:
-            geom = feat["geometry"]
-            if geom is None:
-                continue
-            # fiona ≥ 1.10 returns Geometry objects, 1.9 dicts; shape() takes both
-            geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-            out.append((shape(geom), dict(feat["properties"])))
+    with reading(path, "GeoPackage"):
+        if layer not in fiona.listlayers(str(path)):
+            raise InputError(f"'{path}' has no layer '{layer}'.")
+        with fiona.open(str(path), layer=layer) as src:
+            for feat in src:
+                geom = feat["geometry"]
+                if geom is None:
+                    continue
+                # fiona ≥ 1.10 returns Geometry objects, 1.9 dicts; shape() takes both
+                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
+                out.append(check_feature(path, layer, feat["id"], shape(geom),
+                                         dict(feat["properties"])))
     return out
 
 
-__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features", "create_edits", "read_layer"]
+__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features", "check_action", "check_feature",
+           "create_edits", "read_layer", "repair_polygon"]
 
 
 def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
@@ -162,28 +263,34 @@ def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Vector file '{path}' does not exist.")
+    from ..input_errors import check_encodable, reading
+
+    check_encodable(path, "vector file")
     try:
         names = fiona.listlayers(str(path))
     except Exception as exc:  # driver-specific errors
         raise InputError(f"Cannot read the vector file '{path.name}': {exc}") from exc
     out: List[Any] = []
-    for name in names:
-        if layers is not None and name not in layers:
-            continue
-        with fiona.open(str(path), layer=name) as src:
-            src_crs = CRS.from_wkt(src.crs_wkt) if src.crs_wkt else None
-            for feat in src:
-                geom = feat["geometry"]
-                if geom is None:
-                    continue
-                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-                if not any(k in geom["type"] for k in kinds):
-                    continue
-                if skip_keep and (dict(feat["properties"]).get("action") or "") == "keep":
-                    continue
-                if crs is not None and src_crs is not None and src_crs != crs:
-                    geom = transform_geom(src_crs, crs, geom)
-                out.append(shape(geom))
+    with reading(path, "vector file"):
+        for name in names:
+            if layers is not None and name not in layers:
+                continue
+            with fiona.open(str(path), layer=name) as src:
+                src_crs = CRS.from_wkt(src.crs_wkt) if src.crs_wkt else None
+                for feat in src:
+                    geom = feat["geometry"]
+                    if geom is None:
+                        continue
+                    geom = geom if isinstance(geom, dict) else geom.__geo_interface__
+                    if not any(k in geom["type"] for k in kinds):
+                        continue
+                    checked, props = check_feature(path, name, feat["id"], shape(geom),
+                                                   dict(feat["properties"]))
+                    if skip_keep and props.get("action") == "keep":
+                        continue
+                    if crs is not None and src_crs is not None and src_crs != crs:
+                        checked = shape(transform_geom(src_crs, crs, mapping(checked)))
+                    out.append(checked)
     return out
 
 

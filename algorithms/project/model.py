@@ -25,6 +25,91 @@ PROJECT_FILE = "project.toml"
 EDITS_FILE = "edits.gpkg"
 FORMAT_VERSION = 1
 
+#: Characters an identifier that becomes a path part (model, image, camera, step name) may not
+#: hold: path separators; control characters are refused as well (see :func:`check_identifier`).
+_SEPARATORS = ("/", "\\")
+
+
+def identifier_problem(name: Any) -> Optional[str]:
+    """Why ``name`` cannot be an identifier that becomes a path part, or ``None`` if it can.
+
+    Model, image, camera and batch step names become folder and file names
+    (``products/<model>/``), so they must be non-empty text without path separators, not
+    ``.``/``..``, without a leading dot (hidden files, staging names) and without control
+    characters.
+    """
+    if not isinstance(name, str):
+        return f"it must be text, not {type(name).__name__}"
+    if not name.strip():
+        return "it is empty"
+    if any(sep in name for sep in _SEPARATORS):
+        return "it contains a path separator ('/' or '\\')"
+    if name in (".", ".."):
+        return "'.' and '..' name folders"
+    if name.startswith("."):
+        return "it starts with a dot"
+    if any(ord(c) < 32 or ord(c) == 127 or 0x80 <= ord(c) < 0xA0 for c in name):
+        return "it contains a control character"
+    if any(0xD800 <= ord(c) <= 0xDFFF for c in name):
+        return "it is not valid UTF-8 text"
+    return None
+
+
+def check_identifier(name: Any, what: str, where: str = "") -> str:
+    """Return ``name`` if it can become a path part, else raise :class:`InputError`.
+
+    Parameters
+    ----------
+    name : object
+        The identifier (model, image, camera or step name).
+    what : str
+        What it names ("stereo model", "image", "camera", "batch step"), for the message.
+    where : str
+        Where it was read (e.g. the project file), prefixed to the message.
+
+    Raises
+    ------
+    InputError
+        Naming the identifier, why it is refused and what to do.
+    """
+    problem = identifier_problem(name)
+    if problem is None:
+        return name
+    prefix = f"{where}: " if where else ""
+    shown = repr(name) if not isinstance(name, str) else "'" + name.encode(
+        "utf-8", "surrogateescape").decode("utf-8", "backslashreplace").encode(
+        "unicode_escape").decode("ascii") + "'"
+    raise InputError(
+        f"{prefix}the {what} name {shown} cannot be used: {problem}. Names become folder names; "
+        "use letters, digits, '-' and '_'."
+    )
+
+
+def identifier_errors(project: Project) -> List[str]:
+    """Operator-readable messages for every image, camera and model name of ``project`` that
+    cannot become a path part (see :func:`check_identifier`)."""
+    named = ([("camera", n) for n in project.cameras]
+             + [("image", r.name) for r in project.images]
+             + [("camera", r.camera) for r in project.images]
+             + [("stereo model", m.name) for m in project.models]
+             + [("image", n) for m in project.models for n in (m.left, m.right)])
+    errors: List[str] = []
+    for what, name in named:
+        try:
+            check_identifier(name, what)
+        except InputError as exc:
+            if str(exc) not in errors:
+                errors.append(str(exc))
+    return errors
+
+
+def check_identifiers(project: Project, where: str = "") -> None:
+    """Raise one :class:`InputError` for the first unusable name of ``project``, if any."""
+    errors = identifier_errors(project)
+    if errors:
+        prefix = f"{where}: " if where else ""
+        raise InputError(prefix + errors[0][0].upper() + errors[0][1:])
+
 
 @dataclass
 class ImageRecord:
@@ -171,7 +256,10 @@ class Project:
         if not path.is_file():
             raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
                              "fix its path in project.toml.")
-        with open_image(path) as src:
+        from ..input_errors import check_encodable, reading
+
+        check_encodable(path, "image")
+        with reading(path, "image"), open_image(path) as src:
             if (src.width, src.height) != (cam.width, cam.height):
                 raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
                                  f"'{cam.name}' is {cam.width}×{cam.height} px.")
@@ -235,6 +323,7 @@ class Project:
 
     def save(self) -> Path:
         """Write ``project.toml`` atomically (temporary file, then rename)."""
+        check_identifiers(self)  # names become folder names: never write one that cannot
         self.root.mkdir(parents=True, exist_ok=True)
         target = self.project_file
         tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
@@ -258,35 +347,190 @@ class Project:
                 f"'{path}' is not a PhotoDEM project: {PROJECT_FILE} not found. "
                 "Create one with project_create or synthetic_block."
             )
+        where = f"'{file}'"
         try:
             data = toml_io.loads(file.read_text(encoding="utf-8"))
-        except Exception as exc:  # tomllib.TOMLDecodeError and friends
-            raise InputError(f"Cannot read {file}: {exc}") from exc
-        head = data.get("project", {})
-        unit = check_angle_unit(head.get("angle_unit", "degrees"))
-        cameras = {n: Camera.from_dict(n, d) for n, d in data.get("cameras", {}).items()}
-        images = [
-            ImageRecord(
-                name=str(d["name"]),
-                path=str(d["path"]),
-                camera=str(d["camera"]),
-                eo=ExteriorOrientation.from_opk(np.asarray(d["position"], float), *d["opk"],
-                                                unit=unit),
-            )
-            for d in data.get("images", [])
-        ]
+        except UnicodeDecodeError as exc:
+            raise InputError(f"{where} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
+                             f"position {exc.start}); save it as UTF-8.") from None
+        except toml_io.tomllib.TOMLDecodeError as exc:
+            raise InputError(f"{where} is not valid TOML ({exc}); fix the line it names."
+                             ) from None
+        except OSError as exc:
+            raise InputError(f"Cannot read {where}: {exc.strerror or exc}.") from None
+        top = _Table(data, where, "")
+        head = top.table("project")
+        try:
+            unit = check_angle_unit(head.text("angle_unit", "degrees"))
+        except InputError as exc:
+            raise InputError(f"{head.where}: {exc}") from None
+        cameras = {}
+        for cam_name, cam in top.table("cameras").tables_by_name():
+            check_identifier(cam_name, "camera", where)
+            cameras[cam_name] = cam.camera(cam_name)
+        images = []
+        for d in top.table_list("images"):
+            name = check_identifier(d.text("name"), "image", d.where)
+            d = d.named(f"image '{name}'")
+            images.append(ImageRecord(
+                name=name,
+                path=d.text("path"),
+                camera=check_identifier(d.text("camera"), "camera", d.where),
+                eo=ExteriorOrientation.from_opk(np.asarray(d.numbers("position", 3)),
+                                                *d.numbers("opk", 3), unit=unit),
+            ))
+        models = []
+        for d in top.table_list("models"):
+            name = check_identifier(d.text("name"), "stereo model", d.where)
+            d = d.named(f"stereo model '{name}'")
+            models.append(StereoModel(
+                name=name,
+                left=check_identifier(d.text("left"), "image", d.where),
+                right=check_identifier(d.text("right"), "image", d.where),
+                kind=d.text("kind", "manual"),
+                base=d.number("base_m", float("nan")),
+                b_h=d.number("b_h", float("nan")),
+                overlap=d.number("overlap_pct", float("nan")) / 100.0,
+                gsd=d.number("gsd_m", float("nan")),
+                height_above_ground=d.number("height_above_ground_m", float("nan")),
+            ))
+        terrain = head.number("terrain_height_m", None)
         return cls(
             root=file.parent,
-            name=str(head.get("name", file.parent.name)),
-            crs=str(head.get("crs", "")),
+            name=head.text("name", file.parent.name),
+            crs=head.text("crs", ""),
             cameras=cameras,
             images=images,
-            models=[StereoModel.from_dict(d) for d in data.get("models", [])],
-            terrain_height=head.get("terrain_height_m"),
-            presets=dict(data.get("presets", {})),
-            products=dict(data.get("products", {})),
+            models=models,
+            terrain_height=terrain,
+            presets=top.table("presets").data,
+            products=top.table("products").data,
             angle_unit=unit,
         )
+
+
+_MISSING: Any = object()
+
+
+class _Table:
+    """Typed access to one table of ``project.toml``: a missing key or a value of the wrong type
+    is an :class:`InputError` naming the file, the entry and the key.
+
+    Parameters
+    ----------
+    data : dict
+        The table as parsed.
+    file : str
+        The project file, quoted, for messages.
+    label : str
+        The entry, e.g. ``[[images]] #2``; empty for the whole file.
+    """
+
+    def __init__(self, data: Any, file: str, label: str) -> None:
+        self.data: Dict[str, Any] = data
+        self.file = file
+        self.where = f"{file} {label}" if label else file
+
+    def named(self, label: str) -> _Table:
+        """The same table, its messages naming it by ``label`` instead of its position."""
+        return _Table(self.data, self.file, label)
+
+    def _fail(self, key: str, problem: str) -> InputError:
+        return InputError(f"{self.where}: '{key}' {problem}; fix it in the project file.")
+
+    def _get(self, key: str, default: Any) -> Any:
+        if key in self.data:
+            return self.data[key]
+        if default is _MISSING:
+            raise self._fail(key, "is missing")
+        return default
+
+    def text(self, key: str, default: Any = _MISSING) -> str:
+        """A string value (a whole number is accepted and written as text)."""
+        value = self._get(key, default)
+        if isinstance(value, bool) or not isinstance(value, (str, int)):
+            raise self._fail(key, f"must be text, not {_shown(value)}")
+        return str(value)
+
+    def number(self, key: str, default: Any = _MISSING) -> Any:
+        """A number (int or float) as float; ``default`` when absent."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return default
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self._fail(key, f"must be a number, not {_shown(value)}")
+        return float(value)
+
+    def integer(self, key: str, default: Any = _MISSING) -> int:
+        """A whole number."""
+        value = self.number(key, default)
+        if value is None or value != int(value):
+            raise self._fail(key, f"must be a whole number, not {_shown(self.data.get(key))}")
+        return int(value)
+
+    def numbers(self, key: str, length: int, default: Any = _MISSING) -> List[float]:
+        """A list of exactly ``length`` numbers."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return default
+        if (not isinstance(value, list) or len(value) != length
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
+            raise self._fail(key, f"must be a list of {length} numbers, not {_shown(value)}")
+        return [float(v) for v in value]
+
+    def table(self, key: str) -> _Table:
+        """A sub-table (empty when absent)."""
+        value = self._get(key, {})
+        if not isinstance(value, dict):
+            raise self._fail(key, f"must be a table ([{key}]), not {_shown(value)}")
+        label = self.where[len(self.file):].strip()
+        return _Table(value, self.file, f"{label} [{key}]".strip())
+
+    def table_list(self, key: str) -> List[_Table]:
+        """An array of tables (``[[key]]``; empty when absent)."""
+        value = self._get(key, [])
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            raise self._fail(key, f"must be an array of tables ([[{key}]]), not {_shown(value)}")
+        return [_Table(v, self.file, f"[[{key}]] #{i + 1}") for i, v in enumerate(value)]
+
+    def tables_by_name(self) -> List[Any]:
+        """``(name, sub-table)`` pairs of a table of tables (``[cameras.<name>]``)."""
+        out = []
+        for name, value in self.data.items():
+            if not isinstance(value, dict):
+                raise self._fail(name, f"must be a table, not {_shown(value)}")
+            out.append((name, _Table(value, self.file, f"camera '{name}'")))
+        return out
+
+    def camera(self, name: str) -> Camera:
+        """The camera this table describes (checked key by key first)."""
+        d = dict(self.data)
+        d["width"] = self.integer("width")
+        d["height"] = self.integer("height")
+        d["focal_length_mm"] = self.number("focal_length_mm")
+        d["pixel_size_mm"] = self.numbers("pixel_size_mm", 2)
+        d["principal_point_mm"] = self.numbers("principal_point_mm", 2, [0.0, 0.0])
+        dist = self.table("distortion")
+        d["distortion"] = {k: dist.number(k, 0.0) for k in ("k1", "k2", "k3", "p1", "p2")}
+        fid = self._get("fiducial_affine", None)
+        if fid is not None:
+            rows = fid if isinstance(fid, list) and len(fid) == 2 else None
+            if rows is None or not all(
+                    isinstance(r, list) and len(r) == 3
+                    and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in r)
+                    for r in rows):
+                raise self._fail("fiducial_affine", "must be 2 rows of 3 numbers, not "
+                                 + _shown(fid))
+        try:
+            return Camera.from_dict(name, d)
+        except InputError as exc:
+            raise InputError(f"{self.where}: {exc}") from None
+
+
+def _shown(value: Any) -> str:
+    """A short description of a wrong value for a message."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "…"
 
 
 def _drop_empty(d: Dict[str, Any]) -> Dict[str, Any]:

@@ -2,6 +2,8 @@
 
 Errors (the project cannot be used as it is):
 
+* an image, camera or model name cannot become a folder name (see
+  :func:`.model.check_identifier`);
 * the CRS is missing, not understood by pyproj, or geographic (positions must be metric);
 * two images share a name; an image names an unknown camera;
 * an image file is missing, or its size differs from its camera's (read from the header only);
@@ -24,7 +26,7 @@ from typing import Any, Dict, List, Optional
 import numpy as np
 
 from ..errors import InputError
-from .model import Project
+from .model import Project, identifier_errors
 
 #: Flying heights above ground (m) outside this range are reported as a warning.
 PLAUSIBLE_HEIGHT_M = (20.0, 15000.0)
@@ -98,6 +100,7 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
     if crs_error:
         rep.errors.append(crs_error)
 
+    rep.errors += identifier_errors(project)  # names become folder names
     if not project.images:
         rep.errors.append("The project has no images.")
     counts: Dict[str, int] = {}
@@ -184,8 +187,8 @@ def _check_heights(project: Project, records: List[Any], dem: Any,
     sampler = None
     if dem is not None and records:
         try:
-            sampler = load_dem(dem, block_bounds(project))
-        except Exception as exc:  # a DEM that does not cover the block
+            sampler = load_dem(dem, block_bounds(project), crs=project.crs or None)
+        except InputError as exc:  # another CRS, a DEM that does not cover the block…
             rep.errors.append(f"The DEM cannot be used for this block: {exc}")
             return
     known = sampler is not None or project.terrain_height is not None

@@ -250,6 +250,53 @@ def _read_las(path: Path) -> PointSet:
                     int(np.count_nonzero(~ok)))
 
 
+def distinct_positions(x: ArrayLike, y: ArrayLike) -> int:
+    """Number of distinct finite (x, y) positions."""
+    xy = np.column_stack([np.asarray(x, float).ravel(), np.asarray(y, float).ravel()])
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    if len(xy) == 0:
+        return 0
+    return len(np.unique(xy, axis=0))
+
+
+def check_distinct_points(x: ArrayLike, y: ArrayLike, name: str, minimum: int,
+                          purpose: str) -> int:
+    """The number of distinct point positions; a warning when points repeat a position, an
+    error when fewer than ``minimum`` distinct positions remain.
+
+    Thousands of copies of one point carry no more information than one: they are kept (the
+    per-cell rules — lowest, median — combine them), but the operator is told, and a surface
+    is not built on fewer distinct positions than it needs.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Point coordinates (non-finite ones are not counted).
+    name : str
+        The file, for the messages.
+    minimum : int
+        Fewest distinct positions ``purpose`` needs.
+    purpose : str
+        What the points are for ("a filter", "an interpolation"), for the messages.
+
+    Raises
+    ------
+    InputError
+        When fewer than ``minimum`` distinct positions remain.
+    """
+    from ..input_errors import warn_input
+
+    n_ok = int(np.sum(np.isfinite(np.asarray(x, float)) & np.isfinite(np.asarray(y, float))))
+    n_distinct = distinct_positions(x, y)
+    if n_distinct < minimum:
+        raise InputError(f"'{name}' has only {n_distinct} distinct point position(s) ({n_ok} "
+                         f"valid points); {purpose} needs at least {minimum}.")
+    if n_distinct < n_ok:
+        warn_input(f"'{name}': {n_ok - n_distinct} of {n_ok} points repeat the x, y of another "
+                   f"point ({n_distinct} distinct positions); check the file for duplicates.")
+    return n_distinct
+
+
 def read_points(path: PathLike) -> PointSet:
     """Read check points from XYZ text, CSV with a header, a vector file or LAS/LAZ.
 
@@ -396,6 +443,7 @@ def point_compare(points: PathLike, dem: PathLike, *, residuals_path: PathLike,
 
     feedback = ensure_feedback(feedback)
     pts = read_points(points)
+    check_distinct_points(pts.x, pts.y, Path(points).name, 1, "a comparison")
     if pts.skipped:
         feedback.warning(f"{pts.skipped} line(s)/feature(s) of '{Path(points).name}' were not "
                          "points with x, y, z and were skipped.")
@@ -437,4 +485,5 @@ def point_compare(points: PathLike, dem: PathLike, *, residuals_path: PathLike,
     }
 
 
-__all__ = ["PointSet", "point_compare", "read_points", "sample_dem", "write_residuals"]
+__all__ = ["PointSet", "check_distinct_points", "distinct_positions", "point_compare",
+           "read_points", "sample_dem", "write_residuals"]

@@ -521,10 +521,14 @@ def write_csv(path: PathLike, result: Dict[str, Any],
 
 
 def write_json(path: PathLike, data: Dict[str, Any]) -> Path:
-    """JSON (numpy values converted, NaN → null), written atomically."""
+    """JSON (numpy values converted, NaN → null), written atomically.
+
+    File names that are not UTF-8 (kept by Python as lone surrogates) are written as JSON
+    escapes (``\\udce9``), which read back as the same name.
+    """
     with atomic_output(path) as tmp:
         tmp.write_text(json.dumps(json_ready(data), indent=1, ensure_ascii=False) + "\n",
-                       encoding="utf-8")
+                       encoding="utf-8", errors="backslashreplace")
     return Path(path)
 
 

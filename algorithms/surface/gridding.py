@@ -61,6 +61,26 @@ PathLike = Union[str, Path]
 Array = NDArray[Any]
 
 
+#: Bytes per cell a grid costs at least while it is worked on (a float32 result and one
+#: float32 working copy); larger needs are checked where they arise.
+GRID_BYTES_PER_CELL = 8
+
+
+def check_grid_memory(width: int, height: int, spacing: float) -> None:
+    """Refuse a grid that cannot be held in memory, before any work.
+
+    Raises
+    ------
+    InputError
+        Naming the grid size and the spacing to change.
+    """
+    from ..memory import check_allocation
+
+    check_allocation(float(width) * float(height) * GRID_BYTES_PER_CELL,
+                     f"a grid of {width} × {height} cells at {spacing:g} m",
+                     "the spacing (a coarser grid) or the extent")
+
+
 @dataclass
 class Grid:
     """A north-up grid: ``transform`` (cell corners), ``width``, ``height``, ``spacing``."""
@@ -82,6 +102,7 @@ class Grid:
         y0 = math.ceil(ymax / spacing) * spacing
         w = max(1, math.ceil((xmax - x0) / spacing))
         h = max(1, math.ceil((y0 - ymin) / spacing))
+        check_grid_memory(w, h, spacing)
         return cls(Affine(spacing, 0.0, x0, 0.0, -spacing, y0), w, h, float(spacing))
 
     @property

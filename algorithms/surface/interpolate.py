@@ -35,10 +35,13 @@ import numpy as np
 from ..errors import InputError
 from ..processing.feedback import Feedback, ensure_feedback
 from ..project.edits import read_constraints, read_geometries
-from ..quality.points import read_points
+from ..quality.points import check_distinct_points, read_points
 from ..raster.io import atomic_output, write_raster
 from .fe_grid import fe_interpolate
 from .gridding import Grid, GridAccumulator, GridResult, finish_grid
+
+#: Fewest distinct point positions a DEM is interpolated from (a plane needs three).
+MIN_DISTINCT_POINTS = 3
 
 PathLike = Union[str, Path]
 
@@ -150,6 +153,8 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     ok = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
     if not ok.any():
         raise InputError(f"'{Path(points).name}' has no point with finite coordinates.")
+    check_distinct_points(x[ok], y[ok], Path(points).name, MIN_DISTINCT_POINTS,
+                          "an interpolated DEM")
     # points on the upper edge still get a cell: pad the upper bounds slightly
     pad = 1e-6 * spacing
     xmin, ymin = float(x[ok].min()), float(y[ok].min())

@@ -81,7 +81,7 @@ class ProjectCreate(Algorithm):
 
         dem = params.get("dem")
         if dem is not None:
-            dem = load_dem(dem, block_bounds(project))
+            dem = load_dem(dem, block_bounds(project), crs=project.crs)
             footprints = block_footprints(project, dem=dem)
             project.terrain_height = round(mean_terrain_height(footprints), 3)
             feedback.info(f"Mean terrain height under the footprints (DEM): "
@@ -227,7 +227,8 @@ class StereoModels(Algorithm):
         if params["b_h_min"] >= params["b_h_max"]:
             raise InputError(f"Minimum B/H ({params['b_h_min']:g}) must be below the maximum "
                              f"({params['b_h_max']:g}).")
-        dem = load_dem(params["dem"], block_bounds(project)) if params["dem"] else None
+        dem = (load_dem(params["dem"], block_bounds(project), crs=project.crs)
+               if params["dem"] else None)
         models = []
         if params["detect"]:
             models = detect_stereo_models(

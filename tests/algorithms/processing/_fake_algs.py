@@ -137,7 +137,7 @@ class FileSize(Algorithm):
     help = "Writes the size of `image`; an InputError for files whose name starts with bad."
     iterates_over = "image"
     parameters = (
-        Parameter("image", "raster", "Image"),
+        Parameter("image", "file", "Image"),  # not a real raster: no pre-flight read
         Parameter("output", "output_file", "Output"),
     )
     outputs = (Output("output", "file", "The file"),)
