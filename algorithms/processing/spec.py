@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import InputError
+from ..input_errors import display_path
 from ..output_policy import Target, contained
 from .feedback import Feedback
 
@@ -149,14 +150,17 @@ class Parameter:
         raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
 
     def _path_text(self, value: Any) -> str:
-        """A path as ``str``; names that are not valid UTF-8 are refused (GDAL needs it)."""
+        """A path as ``str``. Output names that are not valid UTF-8 are refused: GDAL writes
+        UTF-8 names only. Such input names pass; a raster among them is refused by the
+        pre-flight check (:func:`~..input_errors.check_raster_parameters`), text files work."""
         text = str(Path(str(value)).expanduser())
-        try:
-            text.encode("utf-8")
-        except UnicodeEncodeError:
-            shown = text.encode("utf-8", "replace").decode("utf-8")
-            raise InputError(f"Parameter '{self.name}': the path '{shown}' is not valid UTF-8; "
-                             "rename it (GDAL reads and writes UTF-8 names only).") from None
+        if self.is_output:
+            try:
+                text.encode("utf-8")
+            except UnicodeEncodeError:
+                raise InputError(
+                    f"Parameter '{self.name}': the path '{display_path(text)}' is not valid "
+                    "UTF-8; rename it (GDAL reads and writes UTF-8 names only).") from None
         return text
 
     def _check_range(self, number: float) -> None:
