@@ -210,9 +210,12 @@ def stderr_lines(err: str) -> List[str]:
     return [line for line in err.splitlines() if line.strip()]
 
 
-def assert_operator_error(code: int, err: str) -> None:
-    """Exit 2 and exactly one stderr line ``photodem: error: …`` (so no traceback)."""
+def assert_operator_error(code: int, err: str, allow_warnings: bool = False) -> None:
+    """Exit 2 and exactly one stderr line ``photodem: error: …`` (so no traceback); with
+    ``allow_warnings``, ``photodem: warning: …`` lines may come before it."""
     lines = stderr_lines(err)
+    if allow_warnings:
+        lines = [line for line in lines if not line.startswith(WARNING_PREFIX)]
     assert "Traceback" not in err, f"traceback instead of an operator error:\n{err[-2000:]}"
     assert code == 2, f"exit {code}, expected 2; stderr:\n{err[-2000:]}"
     assert len(lines) == 1 and lines[0].startswith(ERROR_PREFIX), \

@@ -69,18 +69,34 @@ def _run(argv: List[str], cwd: Path, timeout: float = 300.0) -> Tuple[int, str]:
     return proc.returncode, os.fsdecode(proc.stderr)
 
 
-def _content(path: Path) -> Dict[str, int]:
-    """What a product holds: file names (sizes left out: they vary) or a raster's shape."""
-    if path.is_dir():
-        return {p.name: 1 for p in path.iterdir()}
-    import rasterio
+def _product_names(folder: Path) -> List[str]:
+    """The product's entries in ``folder``: the output and its sidecars (``out_seamlines.gpkg``
+    …), i.e. visible names starting with ``out``."""
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("out"))
 
-    with rasterio.open(path) as src:
-        return {"width": src.width, "height": src.height, "count": src.count}
+
+def _beside(folder: Path) -> List[str]:
+    """Entries of ``folder`` that are not part of the product (staging leftovers and such)."""
+    return sorted(p.name for p in folder.iterdir() if not p.name.startswith("out"))
+
+
+def _content(folder: Path, out: Path) -> Dict[str, object]:
+    """What a product holds: its file names (and a folder's file names, or a raster's shape)."""
+    content: Dict[str, object] = {"names": _product_names(folder)}
+    if not out.exists():
+        return content
+    if out.is_dir():
+        content["files"] = sorted(p.name for p in out.iterdir())
+    else:
+        import rasterio
+
+        with rasterio.open(out) as src:
+            content["shape"] = (src.count, src.height, src.width)
+    return content
 
 
 @pytest.fixture(scope="module")
-def references(tmp_path_factory, tiny_project) -> Dict[str, Tuple[float, Dict[str, int]]]:
+def references(tmp_path_factory, tiny_project) -> Dict[str, Tuple[float, Dict[str, object]]]:
     """Each subject run once undisturbed: (duration in s, content of its complete product)."""
     result = {}
     for s in SUBJECTS:
@@ -89,13 +105,55 @@ def references(tmp_path_factory, tiny_project) -> Dict[str, Tuple[float, Dict[st
         start = time.perf_counter()
         code, err = _run(s.argv(tiny_project, out) + ["--quiet"], folder)
         assert code == 0, err
-        result[s.name] = (time.perf_counter() - start, _content(out))
+        result[s.name] = (time.perf_counter() - start, _content(folder, out))
     return result
 
 
-def _beside(folder: Path, out: Path) -> List[str]:
-    """Entries of ``folder`` other than the output."""
-    return sorted(p.name for p in folder.iterdir() if p != out)
+def _check_after_interrupt(code: int, err: str, folder: Path, out: Path,
+                           complete: Dict[str, object], when: str) -> None:
+    """The disk holds the complete product and the run says it finished (exit 0), or nothing
+    and the run says it was cancelled (exit 130); never a leftover."""
+    assert "Traceback" not in err, err
+    names = _product_names(folder)
+    if names:
+        assert _content(folder, out) == complete, \
+            f"{when}: a partial product {names} (exit {code}):\n{err}"
+        assert code == 0, f"{when}: the product is complete but the exit is {code}:\n{err}"
+        assert "no output was written" not in err, f"{when}: says cancelled:\n{err}"
+    else:
+        assert code == 130, f"{when}: nothing written, exit {code} (expected 130):\n{err}"
+        assert "cancel" in err.lower(), f"{when}: exit 130 without 'cancelled':\n{err}"
+    assert _beside(folder) == [], f"{when}: left beside the output: {_beside(folder)}"
+
+
+def _rerun(subject: Subject, project: Path, folder: Path, out: Path,
+           complete: Dict[str, object], quiet: bool = True) -> str:
+    """Run again into the same output: it succeeds and leaves only the product. (When a
+    complete product is there already, a clean one-line refusal is accepted too.)"""
+    existed = out.exists()
+    code, err = _run(subject.argv(project, out) + (["--quiet"] if quiet else []), folder)
+    if existed and code == 2:
+        assert err.strip().splitlines()[-1].startswith("photodem: error:"), err
+    else:
+        assert code == 0, f"rerun failed (exit {code}):\n{err}"
+    assert _content(folder, out) == complete
+    assert _beside(folder) == [], f"rerun left: {_beside(folder)}"
+    return err
+
+
+def _start(subject: Subject, project: Path, folder: Path, out: Path) -> subprocess.Popen:
+    return subprocess.Popen(subject.argv(project, out) + ["--quiet"], cwd=folder,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def _wait_for_staging(proc: subprocess.Popen, folder: Path, limit: float) -> bool:
+    """Poll until a staging entry appears beside the output (True) or the run ends (False)."""
+    end = time.monotonic() + limit
+    while proc.poll() is None and time.monotonic() < end:
+        if _beside(folder):
+            return True
+        time.sleep(0.005)
+    return False
 
 
 @pytest.mark.parametrize("subject,k,share", MOMENTS,
@@ -105,50 +163,50 @@ def test_sigint_at_random_moment(subject: Subject, k: int, share: float, referen
     duration, complete = references[subject.name]
     out = subject.out_path(tmp_path)
     inputs = snapshot([tiny_project])
-    proc = subprocess.Popen(subject.argv(tiny_project, out) + ["--quiet"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = _start(subject, tiny_project, tmp_path, out)
     time.sleep(share * duration)
-    sent = proc.poll() is None
-    if sent:
+    if proc.poll() is None:
         proc.send_signal(signal.SIGINT)
-    _, err_bytes = proc.communicate(timeout=max(120.0, 5 * duration))
-    code, err = proc.returncode, os.fsdecode(err_bytes)
-    assert "Traceback" not in err, err
-    assert code in (0, 130), f"exit {code} after SIGINT at {share:.2f}×{duration:.1f} s:\n{err}"
-    if code == 0:
-        assert out.exists(), f"exit 0 but no output:\n{err}"
-        assert _content(out) == complete, f"exit 0 with an incomplete product:\n{err}"
-        assert "no output was written" not in err, f"says cancelled, output complete:\n{err}"
-    else:
-        assert not out.exists(), f"exit 130 ('{err.strip()}') but {out} exists"
-        assert "cancel" in err.lower() or "interrupt" in err.lower(), err
-    assert _beside(tmp_path, out) == [], f"left beside the output: {_beside(tmp_path, out)}"
+    _, err = proc.communicate(timeout=max(120.0, 5 * duration))
+    _check_after_interrupt(proc.returncode, os.fsdecode(err), tmp_path, out, complete,
+                           f"SIGINT at {share:.2f} × {duration:.1f} s")
     assert not changed_inputs(inputs, snapshot([tiny_project]))
-    # a rerun into the same output succeeds (replacing its own product) and leaves nothing else
-    code, err = _run(subject.argv(tiny_project, out) + ["--quiet"], tmp_path)
-    assert code == 0, f"rerun failed (exit {code}):\n{err}"
-    assert _content(out) == complete
-    assert _beside(tmp_path, out) == [], f"rerun left: {_beside(tmp_path, out)}"
+    _rerun(subject, tiny_project, tmp_path, out, complete)
 
 
-@pytest.mark.parametrize("subject", SUBJECTS[:2], ids=[s.name for s in SUBJECTS[:2]])
-@pytest.mark.parametrize("share", [0.4, 0.8])
-def test_sigkill_then_rerun_cleans_up(subject: Subject, share: float, references,
-                                      tiny_project: Path, tmp_path: Path) -> None:
-    """SIGKILL mid-run; the rerun succeeds, removes the dead run's staging leftovers and says
-    so (it names what it removed)."""
+@pytest.mark.parametrize("subject", SUBJECTS, ids=[s.name for s in SUBJECTS])
+def test_sigint_while_staged(subject: Subject, references, tiny_project: Path,
+                             tmp_path: Path) -> None:
+    """SIGINT the moment a staged output appears: the window before the final rename."""
     duration, complete = references[subject.name]
     out = subject.out_path(tmp_path)
-    proc = subprocess.Popen(subject.argv(tiny_project, out) + ["--quiet"], cwd=tmp_path,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(share * duration)
+    proc = _start(subject, tiny_project, tmp_path, out)
+    staged = _wait_for_staging(proc, tmp_path, limit=10 * duration)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=max(120.0, 5 * duration))
+    _check_after_interrupt(proc.returncode, os.fsdecode(err), tmp_path, out, complete,
+                           f"SIGINT while staged (staging seen: {staged})")
+    _rerun(subject, tiny_project, tmp_path, out, complete)
+
+
+@pytest.mark.parametrize("subject", SUBJECTS, ids=[s.name for s in SUBJECTS])
+@pytest.mark.parametrize("moment", ["staged", "midrun"])
+def test_sigkill_then_rerun_cleans_up(subject: Subject, moment: str, references,
+                                      tiny_project: Path, tmp_path: Path) -> None:
+    """SIGKILL while the output is staged (or half-way); the rerun succeeds, removes the dead
+    run's staging leftovers and says so in its log."""
+    duration, complete = references[subject.name]
+    out = subject.out_path(tmp_path)
+    proc = _start(subject, tiny_project, tmp_path, out)
+    if moment == "staged":
+        _wait_for_staging(proc, tmp_path, limit=10 * duration)
+    else:
+        time.sleep(0.5 * duration)
     proc.kill()
-    proc.wait(timeout=60)
-    stale = _beside(tmp_path, out)  # what the dead run left (none when killed before staging)
-    code, err = _run(subject.argv(tiny_project, out), tmp_path)  # not quiet: the log line
-    assert code == 0, f"rerun after SIGKILL failed (exit {code}):\n{err}"
-    assert _content(out) == complete
-    assert _beside(tmp_path, out) == [], f"stale leftovers not removed: {_beside(tmp_path, out)}"
+    proc.communicate(timeout=60)
+    stale = _beside(tmp_path)  # what the dead run left (none when killed before staging)
+    err = _rerun(subject, tiny_project, tmp_path, out, complete, quiet=False)
     assert not leftovers(str(p) for p in tmp_path.rglob("*"))
     if stale:
         said = [line for line in err.splitlines()
