@@ -8,7 +8,10 @@ complete product with exit 0 (and no "no output was written"), or nothing at all
 and a message that says so; never a staging leftover. A rerun into the same output succeeds
 and leaves nothing beside the output.
 
-SIGKILL of a run leaves staging leftovers of a dead process; the rerun removes them and says so.
+Two targeted moments complete the random ones: SIGINT as soon as a staged output appears, and
+SIGINT right after the final rename (the commit point: the run must then report success).
+SIGKILL of a run (while staged, or half-way) leaves staging leftovers of a dead process; the
+rerun removes them and says so.
 """
 
 from __future__ import annotations
@@ -187,6 +190,25 @@ def test_sigint_while_staged(subject: Subject, references, tiny_project: Path,
     _, err = proc.communicate(timeout=max(120.0, 5 * duration))
     _check_after_interrupt(proc.returncode, os.fsdecode(err), tmp_path, out, complete,
                            f"SIGINT while staged (staging seen: {staged})")
+    _rerun(subject, tiny_project, tmp_path, out, complete)
+
+
+@pytest.mark.parametrize("subject", SUBJECTS, ids=[s.name for s in SUBJECTS])
+def test_sigint_right_after_commit(subject: Subject, references, tiny_project: Path,
+                                   tmp_path: Path) -> None:
+    """SIGINT the moment the final output appears (the commit point, issue point 4): the run
+    must report success (exit 0), never "cancelled; no output was written"."""
+    duration, complete = references[subject.name]
+    out = subject.out_path(tmp_path)
+    proc = _start(subject, tiny_project, tmp_path, out)
+    end = time.monotonic() + 10 * duration
+    while proc.poll() is None and not out.exists() and time.monotonic() < end:
+        time.sleep(0.001)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=max(120.0, 5 * duration))
+    _check_after_interrupt(proc.returncode, os.fsdecode(err), tmp_path, out, complete,
+                           "SIGINT right after the final rename")
     _rerun(subject, tiny_project, tmp_path, out, complete)
 
 
