@@ -230,7 +230,8 @@ def assert_success(code: int, err: str, warning: bool) -> None:
     others = [line for line in lines if not line.startswith(WARNING_PREFIX)]
     assert not others, f"unexpected stderr lines under --quiet: {others}"
     if warning:
-        assert lines, "expected a warning line (the input was used after a repair)"
+        assert lines, ("expected a warning line: the input is usable only with a repair, "
+                       "a reprojection or a caveat the operator must read")
 
 
 # -- running photodem ----------------------------------------------------------------------------
