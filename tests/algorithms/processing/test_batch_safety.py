@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.output_policy import PRODUCT_MARKER
 from photodem.algorithms.processing import batch
 from photodem.algorithms.processing.feedback import Feedback
 
@@ -63,7 +64,9 @@ def _statuses(summary):
 
 
 def _files(folder):
-    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*") if p.is_file())
+    """The product files below ``folder``, without the hidden marks of non-GeoTIFF products."""
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*")
+                  if p.is_file() and not p.name.endswith(PRODUCT_MARKER))
 
 
 # -- a lost worker costs only its own task -----------------------------------------------------
