@@ -53,6 +53,8 @@ PROG = "photodem"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_CANCELLED = 0, 1, 2, 130
 #: Said when Ctrl-C came after the run had committed its outputs (the run then finishes).
 LATE_INTERRUPT = "the run had finished writing before the interrupt; its outputs are complete."
+#: Set by :func:`main` for the console script: Ctrl-C after the work is ignored.
+_IGNORE_LATE_SIGINT = False
 #: Option names of ``run`` itself; no algorithm parameter may use them.
 RESERVED = ("json", "quiet", "help")
 
@@ -398,7 +400,7 @@ def _cancel_on_sigint(feedback: Feedback) -> Iterator[None]:
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.signal(signal.SIGINT, signal.SIG_IGN if _IGNORE_LATE_SIGINT else previous)
 
 
 @contextlib.contextmanager
@@ -438,6 +440,10 @@ def _error(message: str) -> None:
 
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of the ``photodem`` console script; returns the exit code."""
+    global _IGNORE_LATE_SIGINT
+    # the console script: the process ends when main returns, so a Ctrl-C after the work
+    # (while the result is printed) is ignored instead of killing it with a complete output
+    _IGNORE_LATE_SIGINT = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     try:
@@ -464,7 +470,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"{PROG}: cancelled; {_written_before_stop()}", file=sys.stderr)
         return EXIT_CANCELLED
     except KeyboardInterrupt:
-        print(f"\n{PROG}: interrupted; {_written_before_stop()}", file=sys.stderr)
+        print(f"\n{PROG}: cancelled (interrupted); {_written_before_stop()}", file=sys.stderr)
         return EXIT_CANCELLED
     except PhotodemError as exc:
         _error(str(exc))

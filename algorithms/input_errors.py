@@ -201,8 +201,13 @@ def operator_errors(feedback: Any = None) -> Iterator[None]:
                     shown(message, category, *args, **kwargs)
 
             warnings.showwarning = show
+        import rasterio
+
         try:
-            yield
+            # inside a rasterio environment GDAL's messages go to Python's logging, not as
+            # extra "ERROR 1: …" lines to stderr beside the one-line error
+            with rasterio.Env():
+                yield
         except Exception as exc:
             error = _translate(exc, None, "file")
             if error is None:

@@ -295,6 +295,11 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     n = check_distinct_points(xyz[ok, 0], xyz[ok, 1], path.name, MIN_POINTS, "a filter")
     given = to_crs(crs)
     out_crs = given if given is not None else to_crs(file_crs)
+    if out_crs is None:
+        from ..input_errors import warn_input
+
+        warn_input(f"The points of '{path.name}' carry no CRS; the DTM is written without one "
+                   "(give the crs parameter or a project).")
     if given is not None and file_crs is not None and to_crs(file_crs) != given:
         from rasterio.warp import transform
 

@@ -180,8 +180,8 @@ def tile_size_for(memory_mb: float, min_d: int, max_d: int, margin: int) -> int:
 
 def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
                           right_shape: Tuple[int, int], margin: int = 48,
-                          parameter: str = "min_disparity/max_disparity"
-                          ) -> Tuple[int, int]:
+                          parameter: str = "min_disparity/max_disparity",
+                          quiet: bool = False) -> Tuple[int, int]:
     """The search range limited to disparities the two images can have, checked against the
     memory of one tile's matching — before any work.
 
@@ -190,7 +190,8 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
     it is cut to that. What remains must fit: the smallest tile's SGM needs about
     ``8·D·(64 + 2m)·(64 + 2m + D)`` bytes (``D`` disparities, ``m`` margin; see
     :func:`tile_size_for`), since a tile whose range the coarse pass cannot narrow is
-    searched over all of it.
+    searched over all of it. A cut range is told to the operator as a warning, except with
+    ``quiet`` (the coarse pass cuts its own scaled range).
 
     Raises
     ------
@@ -198,10 +199,14 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
         When the range holds no possible disparity, or cannot fit in memory; the message
         names ``parameter``.
     """
+    from ..input_errors import warn_input
     from ..memory import check_allocation
 
     lo = max(int(min_d), -(int(right_shape[1]) - 1))
     hi = min(int(max_d), int(left_shape[1]) - 1)
+    if not quiet and lo <= hi and (lo, hi) != (int(min_d), int(max_d)):
+        warn_input(f"The disparity range {min_d}…{max_d} px was cut to {lo}…{hi} px, the "
+                   f"disparities images {left_shape[1]} and {right_shape[1]} px wide can have.")
     if lo > hi:
         raise InputError(
             f"The disparity range {min_d}…{max_d} px holds no possible disparity of these "
@@ -299,7 +304,8 @@ def iter_disparity_tiles(
         raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
                          "give min_disparity ≤ max_disparity.")
     min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
-                                         disparity_parameter)
+                                         disparity_parameter,
+                                         quiet=coarse_above == 0)  # the coarse pass's own cut
     block = int(block_size) | 1
     p1 = int(8 * block * block if p1 is None else p1)
     p2 = int(32 * block * block if p2 is None else p2)

@@ -145,7 +145,7 @@ class Parameter:
                 return [self._path_text(p.strip()) for p in parts if p.strip()]
         except InputError:
             raise
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):  # OverflowError: int(inf)
             pass
         raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
 
@@ -285,7 +285,7 @@ class Algorithm:
                 continue
             kind = "folder" if p.kind == "output_folder" else "file"
             targets.append(Target(path, kind, p.name))
-            if kind == "file":
+            if kind == "file" and path.name and not path.is_dir():  # else refused as a target
                 targets += [Target(side, "file", p.name, owner=path)
                             for side in self.sidecars(p.name, path)]
         return targets

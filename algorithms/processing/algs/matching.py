@@ -104,6 +104,9 @@ class StereoDisparity(Algorithm):
             raise InputError(f"The output '{out_path}' must be a GeoTIFF (.tif).")
         if int(params["max_disparity"]) < int(params["min_disparity"]):
             raise InputError("max_disparity must not be smaller than min_disparity.")
+        if params["block_size"] % 2 == 0:
+            raise InputError(f"Parameter 'block_size' = {params['block_size']} px must be odd "
+                             "(1, 3, 5 … 11): the window needs a centre pixel.")
         with open_image(params["left"]) as src_l, open_image(params["right"]) as src_r:
             if src_l.height != src_r.height:
                 feedback.warning(f"The images have {src_l.height} and {src_r.height} rows; "
