@@ -180,3 +180,31 @@ def test_raise_first_error_names_the_count_and_the_first() -> None:
     with pytest.raises(InputError, match=r"^The project has 2 errors \(listed above\): first\.$"):
         rep.raise_first_error()
     ValidationReport().raise_first_error()
+
+
+# -- save: a file that load would refuse is never written --------------------------------------
+def test_save_refuses_a_broken_structure(tmp_path: Path) -> None:
+    from photodem.algorithms.geometry.camera import Camera
+    from photodem.algorithms.geometry.orientation import ExteriorOrientation
+    from photodem.algorithms.project.model import ImageRecord, StereoModel, structure_errors
+
+    eo = ExteriorOrientation.from_opk([0.0, 0.0, 1000.0], 0.0, 0.0, 0.0)
+    p = Project(root=tmp_path / "p", name="p", crs="EPSG:32633",
+                cameras={"c": Camera("c", 100, 80, 1.0, (0.01, 0.01))},
+                images=[ImageRecord("a", "a.tif", "c", eo), ImageRecord("b", "b.tif", "c", eo)],
+                models=[StereoModel("a_b", "a", "b")])
+    assert structure_errors(p) == []
+    Project.load(p.save())  # sound: written and read back
+    for broken, words in [
+        (StereoModel("a_x", "a", "x"), "names image 'x'"),
+        (StereoModel("a_a", "a", "a"), "on both sides"),
+        (StereoModel("a_b", "b", "a"), "'a_b' is used 2 times"),
+    ]:
+        p.models.append(broken)
+        with pytest.raises(InputError, match=words):
+            p.save()
+        p.models.pop()
+    p.images.append(ImageRecord("c", "c.tif", "nocam", eo))
+    with pytest.raises(InputError, match="names camera 'nocam'"):
+        p.save()
+    assert Project.load(p.root).images[-1].name == "b"  # the last sound file is kept
