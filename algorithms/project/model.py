@@ -5,6 +5,20 @@
 stored relative to the project folder when they lie below it, else absolute, so a project can be
 moved together with its images. ``edits.gpkg`` holds the operator's edits (see :mod:`.edits`).
 Products go to ``products/<model or step>/``, logs and reports to ``runs/<timestamp>/``.
+
+What is wrong with a project file is sorted by kind (issue 16):
+
+* **Structure** — :meth:`Project.load` raises one :class:`~..errors.InputError` naming
+  ``project.toml``, the entry and what to do, because nothing downstream can work with such a
+  file: no ``[project]`` table (an empty file), an unsupported ``format_version``, a value of the
+  wrong type (``crs``, names, ``left``/``right`` not text; ``images`` not an array of tables…),
+  a name that cannot become a path part (:func:`check_identifier`), an image naming an unknown
+  camera, a stereo model naming an unknown image (or the same image twice), and image or model
+  names used twice. A model is never silently dropped.
+* **Content** — the file is well formed but the block cannot be used as it is: a CRS that PROJ
+  does not understand, no images, tilts over the limit, missing image files, implausible
+  heights… These are errors and warnings of :func:`.validate.validate_project`; each algorithm
+  decides when to raise them (``project_info`` lists them all and then exits with an error).
 """
 
 from __future__ import annotations
@@ -109,6 +123,26 @@ def check_identifiers(project: Project, where: str = "") -> None:
     if errors:
         prefix = f"{where}: " if where else ""
         raise InputError(prefix + errors[0][0].upper() + errors[0][1:])
+
+
+def structure_errors(project: Project) -> List[str]:
+    """What makes ``project`` a file that :meth:`Project.load` would refuse, beyond its names:
+    image or model names used twice, an image naming an unknown camera, a stereo model naming
+    an unknown image or the same image twice (see the module notes)."""
+    errors: List[str] = []
+    images = [r.name for r in project.images]
+    models = [m.name for m in project.models]
+    for what, names in (("image", images), ("stereo model", models)):
+        errors += [f"the {what} name '{n}' is used {names.count(n)} times"
+                   for n in sorted(set(names)) if names.count(n) > 1]
+    errors += [f"image '{r.name}' names camera '{r.camera}', which is not defined"
+               for r in project.images if r.camera not in project.cameras]
+    errors += [f"stereo model '{m.name}' names image '{n}', which is not defined"
+               for m in project.models for n in dict.fromkeys((m.left, m.right))
+               if n not in images]
+    errors += [f"stereo model '{m.name}' has image '{m.left}' on both sides"
+               for m in project.models if m.left == m.right]
+    return errors
 
 
 @dataclass
@@ -322,8 +356,19 @@ class Project:
         }
 
     def save(self) -> Path:
-        """Write ``project.toml`` atomically (temporary file, then rename)."""
+        """Write ``project.toml`` atomically (temporary file, then rename).
+
+        Raises
+        ------
+        InputError
+            When the project holds a name that cannot become a path part or a broken reference
+            (see :func:`structure_errors`): a file :meth:`load` would refuse is never written.
+        """
         check_identifiers(self)  # names become folder names: never write one that cannot
+        broken = structure_errors(self)
+        if broken:
+            raise InputError(f"Project '{self.name}' cannot be saved: {broken[0]}. Fix the "
+                             "project's images, cameras and stereo models first.")
         self.root.mkdir(parents=True, exist_ok=True)
         target = self.project_file
         tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
@@ -359,7 +404,12 @@ class Project:
         except OSError as exc:
             raise InputError(f"Cannot read {where}: {exc.strerror or exc}.") from None
         top = _Table(data, where, "")
+        if "project" not in data:
+            state = "it is empty" if not data else "it is not a PhotoDEM project file"
+            raise InputError(f"{where} has no [project] table ({state}); restore it from a copy "
+                             "or create the project again with project_create.")
         head = top.table("project")
+        _check_format_version(head)
         try:
             unit = check_angle_unit(head.text("angle_unit", "degrees"))
         except InputError as exc:
@@ -368,25 +418,38 @@ class Project:
         for cam_name, cam in top.table("cameras").tables_by_name():
             check_identifier(cam_name, "camera", where)
             cameras[cam_name] = cam.camera(cam_name)
-        images = []
+        images: List[ImageRecord] = []
+        seen: Dict[str, str] = {}  # name -> entry that used it first
         for d in top.table_list("images"):
             name = check_identifier(d.text("name"), "image", d.where)
+            _check_unique(name, "image", d, seen)
             d = d.named(f"image '{name}'")
+            camera = check_identifier(d.text("camera"), "camera", d.where)
+            _check_known(camera, "camera", cameras, d, "[cameras]", "camera")
             images.append(ImageRecord(
                 name=name,
                 path=d.text("path"),
-                camera=check_identifier(d.text("camera"), "camera", d.where),
+                camera=camera,
                 eo=ExteriorOrientation.from_opk(np.asarray(d.numbers("position", 3)),
                                                 *d.numbers("opk", 3), unit=unit),
             ))
+        image_names = set(seen)
         models = []
+        seen = {}
         for d in top.table_list("models"):
             name = check_identifier(d.text("name"), "stereo model", d.where)
+            _check_unique(name, "stereo model", d, seen)
             d = d.named(f"stereo model '{name}'")
+            left, right = (check_identifier(d.text(k), "image", d.where) for k in ("left", "right"))
+            for key, image in (("left", left), ("right", right)):
+                _check_known(image, "image", image_names, d, "[[images]]", key)
+            if left == right:
+                raise InputError(f"{d.where}: 'left' and 'right' are both image '{left}'; a "
+                                 "stereo model needs two images: fix it in the project file.")
             models.append(StereoModel(
                 name=name,
-                left=check_identifier(d.text("left"), "image", d.where),
-                right=check_identifier(d.text("right"), "image", d.where),
+                left=left,
+                right=right,
                 kind=d.text("kind", "manual"),
                 base=d.number("base_m", float("nan")),
                 b_h=d.number("b_h", float("nan")),
@@ -410,6 +473,36 @@ class Project:
 
 
 _MISSING: Any = object()
+
+
+def _check_format_version(head: _Table) -> None:
+    """Refuse a ``format_version`` this PhotoDEM cannot read (absent means the current one)."""
+    version = head.integer("format_version", FORMAT_VERSION)
+    if version == FORMAT_VERSION:
+        return
+    why = ("it was written by a newer PhotoDEM; update PhotoDEM to open it"
+           if version > FORMAT_VERSION else "no PhotoDEM wrote it; fix the value")
+    raise InputError(f"{head.where}: 'format_version' is {version} but this PhotoDEM reads "
+                     f"format_version {FORMAT_VERSION} only: {why}.")
+
+
+def _check_unique(name: str, what: str, entry: _Table, seen: Dict[str, str]) -> None:
+    """Refuse a second image or model of the same name (``seen``: name -> first entry)."""
+    if name in seen:
+        raise InputError(f"{entry.where}: the {what} name '{name}' is used already by "
+                         f"{seen[name]}; give each {what} its own name in the project file.")
+    seen[name] = entry.where[len(entry.file):].strip()
+
+
+def _check_known(name: str, what: str, known: Any, entry: _Table, table: str, key: str) -> None:
+    """Refuse a reference (``key`` of ``entry``) to a camera or image that the project file does
+    not define in ``table``."""
+    if name in known:
+        return
+    listed = ", ".join(sorted(known)[:10]) + (" …" if len(known) > 10 else "")
+    defined = f"defined: {listed}" if listed else "it is empty"
+    raise InputError(f"{entry.where}: '{key}' names {what} '{name}', which is not defined in "
+                     f"{table} ({defined}); fix the name or add the {what} in the project file.")
 
 
 class _Table:
@@ -446,11 +539,12 @@ class _Table:
         return default
 
     def text(self, key: str, default: Any = _MISSING) -> str:
-        """A string value (a whole number is accepted and written as text)."""
+        """A string value; anything else (a number too) is refused, since names and CRS codes
+        written without quotes change their meaning (``left = 101`` is not image "0101")."""
         value = self._get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (str, int)):
-            raise self._fail(key, f"must be text, not {_shown(value)}")
-        return str(value)
+        if not isinstance(value, str):
+            raise self._fail(key, f"must be text in quotes, not {_shown(value)}")
+        return value
 
     def number(self, key: str, default: Any = _MISSING) -> Any:
         """A number (int or float) as float; ``default`` when absent."""

@@ -1,5 +1,10 @@
 """Checks of a project before any work is done, with messages an operator can act on.
 
+These are the *content* checks: a project file whose structure is broken (wrong types, unknown
+references, duplicate names, an unsupported format version) is refused by
+:meth:`.model.Project.load` already (see :mod:`.model`). Callers decide what to do with the
+report: :meth:`ValidationReport.raise_if_errors` raises all errors on one line.
+
 Errors (the project cannot be used as it is):
 
 * an image, camera or model name cannot become a folder name (see
@@ -46,15 +51,25 @@ class ValidationReport:
         return not self.errors
 
     def raise_if_errors(self) -> None:
-        """Raise one :class:`InputError` listing every error."""
+        """Raise one :class:`InputError` listing every error on one line (joined with "; ")."""
         if self.errors:
-            n = len(self.errors)
-            raise InputError(
-                f"The project has {n} error{'s' if n > 1 else ''}:\n- " + "\n- ".join(self.errors)
-            )
+            raise InputError(f"The project has {_count(self.errors)}: " + "; ".join(
+                e.rstrip(".") for e in self.errors) + ".")
+
+    def raise_first_error(self) -> None:
+        """Raise one :class:`InputError` naming the number of errors and the first one, for
+        callers that have reported every error already (through their feedback)."""
+        if self.errors:
+            raise InputError(f"The project has {_count(self.errors)} (listed above): "
+                             f"{self.errors[0]}")
 
     def to_dict(self) -> Dict[str, List[str]]:
         return {"errors": list(self.errors), "warnings": list(self.warnings)}
+
+
+def _count(errors: List[str]) -> str:
+    """``"1 error"`` or ``"N errors"``."""
+    return f"{len(errors)} error{'s' if len(errors) != 1 else ''}"
 
 
 def check_crs(crs: Optional[str]) -> Optional[str]:

@@ -137,7 +137,9 @@ class ProjectInfo(Algorithm):
     help = (
         "Lists a project's CRS, images (position, angles in degrees, whether the file exists), "
         "cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the "
-        "result of its validation."
+        "result of its validation. Validation warnings and errors are reported; a project with "
+        "errors (a CRS PROJ does not know, no images, missing image files…) ends with an error "
+        "naming the first of them."
     )
     parameters = (Parameter("project", "project", "Project folder"),)
     outputs = (
@@ -169,6 +171,7 @@ class ProjectInfo(Algorithm):
             feedback.warning(w)
         for e in report.errors:
             feedback.warning("ERROR: " + e)
+        report.raise_first_error()  # every error is listed above; exit 2 with the first
         return {
             "name": project.name,
             "crs": project.crs,
