@@ -99,7 +99,7 @@ def test_second_ctrl_c_before_any_commit_leaves_nothing(tmp_path, capsys):
     code, _, err = _main(capsys, "run", "test_interrupted", "--output", str(out),
                          "--when", "before,before2")
     assert code == 130
-    assert "interrupted; no output was written" in err
+    assert "cancelled (interrupted); no output was written" in err
     assert not out.exists() and _hidden(tmp_path) == []
 
 
