@@ -22,6 +22,7 @@ import contextlib
 import csv
 import errno
 import os
+import threading
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Iterator, List, Optional, Tuple, Type, Union
@@ -166,14 +167,24 @@ def _translate(exc: BaseException, path: Optional[PathLike], what: str) -> Optio
 class InputWarning(UserWarning):
     """An input was repaired or is used with a restriction; the run goes on.
 
-    Raised with :func:`warn_input` deep in the readers (which have no feedback);
-    :func:`operator_errors` passes it to the run's feedback.
+    Raised with :func:`warn_input` deep in the readers (which have no feedback); inside
+    :func:`operator_errors` it goes to the run's feedback instead.
     """
 
 
+#: The feedback of the run going on in this thread (set by :func:`operator_errors`). Thread-local,
+#: not a swapped ``warnings.showwarning``: QGIS runs algorithms in threads side by side.
+_RUN = threading.local()
+
+
 def warn_input(message: str) -> None:
-    """Tell the operator that an input was repaired or is used with a restriction."""
-    warnings.warn(message, InputWarning, stacklevel=2)
+    """Tell the operator that an input was repaired or is used with a restriction: through the
+    feedback of this thread's run, else as an :class:`InputWarning`."""
+    feedback = getattr(_RUN, "feedback", None)
+    if feedback is not None:
+        feedback.warning(message)
+    else:
+        warnings.warn(message, InputWarning, stacklevel=2)
 
 
 @contextlib.contextmanager
@@ -186,33 +197,25 @@ def operator_errors(feedback: Any = None) -> Iterator[None]:
     Parameters
     ----------
     feedback : Feedback, optional
-        Receives every :class:`InputWarning` raised inside (each one, also repeated ones)
-        through its ``warning`` method; without one they are shown as Python warnings.
+        Receives every :func:`warn_input` message of this thread inside (each one, also
+        repeated ones) through its ``warning`` method; without one they are Python warnings.
     """
-    with warnings.catch_warnings():
-        if feedback is not None:
-            warnings.simplefilter("always", InputWarning)
-            shown = warnings.showwarning
-
-            def show(message: Any, category: Any, *args: Any, **kwargs: Any) -> None:
-                if issubclass(category, InputWarning):
-                    feedback.warning(str(message))
-                else:
-                    shown(message, category, *args, **kwargs)
-
-            warnings.showwarning = show
+    outer = getattr(_RUN, "feedback", None)
+    _RUN.feedback = feedback if feedback is not None else outer
+    try:
         import rasterio
 
-        try:
-            # inside a rasterio environment GDAL's messages go to Python's logging, not as
-            # extra "ERROR 1: …" lines to stderr beside the one-line error
-            with rasterio.Env():
-                yield
-        except Exception as exc:
-            error = _translate(exc, None, "file")
-            if error is None:
-                raise
-            raise error from exc
+        # inside a rasterio environment GDAL's messages go to Python's logging, not as extra
+        # "ERROR 1: …" lines to stderr beside the one-line error
+        with rasterio.Env():
+            yield
+    except Exception as exc:
+        error = _translate(exc, None, "file")
+        if error is None:
+            raise
+        raise error from exc
+    finally:
+        _RUN.feedback = outer
 
 
 @contextlib.contextmanager
