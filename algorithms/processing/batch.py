@@ -59,6 +59,15 @@ Semantics (kept simple on purpose):
 - **Checks first.** The batch file, every step's parameters (names, types, ranges, options),
   the lock and the run folder are checked before the first task runs; input files are not
   looked for then (an earlier step may make them).
+- **Output policy while planning.** Every task's outputs (given or derived) are checked with
+  :func:`.output_policy.check_targets`, as :func:`.registry.run` checks them again when the
+  task runs: a forbidden output (a project, a project's ``images/`` or ``project.toml``, an
+  input of the task, a file or folder another algorithm or the operator made, the run folder)
+  stops the batch with one line naming the step and item before any task runs. Inputs an
+  earlier step makes may be missing then; an output derived from a project an earlier step
+  makes is left to the check at run time. The run folder is refused likewise when it is, holds
+  or lies in a project part, is a file or holds an image of the project; it is written into,
+  never replaced, so a named run folder may be reused.
 - **Run folders** are unique: the default ``runs/<timestamp>/`` is created with an atomic
   ``mkdir``; if it exists already, ``<timestamp>-2`` (``-3`` …) is used and the tasks are
   planned again for it.
@@ -284,7 +293,8 @@ def _plan_batch(config: Dict[str, Any], base_dir: PathLike, run_dir: Optional[Pa
 
 #: In the thread that plans a batch: ``{(project.toml, mtime, size): Project}``, else unset.
 _PLANNING = threading.local()
-_CACHED_LOAD_LOCK = threading.Lock()
+#: One planning thread at a time swaps ``Project.load`` (others wait; planning is quick).
+_PLANNING_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
@@ -292,22 +302,26 @@ def _projects_read_once() -> Iterator[None]:
     """While this thread plans a batch, ``Project.load`` parses each ``project.toml`` once.
 
     The output checks of a step over hundreds of models would otherwise parse the project
-    two or three times per task (derived outputs, the project's files). A file changed
-    meanwhile (other mtime or size) is read again; other threads are not affected.
+    two or three times per task (derived outputs). A file changed meanwhile (other mtime or
+    size) is read again. Other threads keep the plain ``load`` (the wrapper asks this thread's
+    cache only), and the plain one is back when the plan is made.
     """
     from ..project.model import Project
 
-    with _CACHED_LOAD_LOCK:  # once per process: a wrapper that asks this thread's cache
-        if not getattr(Project.load, "_batch_cached", False):
-            Project.load = classmethod(_cached_load(Project.__dict__["load"].__func__))
     if getattr(_PLANNING, "cache", None) is not None:  # a plan inside a plan
         yield
         return
-    _PLANNING.cache = {}
-    try:
-        yield
-    finally:
-        _PLANNING.cache = None
+    with _PLANNING_LOCK:
+        plain = Project.__dict__.get("load")
+        if isinstance(plain, classmethod):
+            Project.load = classmethod(_cached_load(plain.__func__))  # type: ignore[assignment]
+        _PLANNING.cache = {}
+        try:
+            yield
+        finally:
+            _PLANNING.cache = None
+            if isinstance(plain, classmethod):
+                Project.load = plain  # type: ignore[assignment]
 
 
 def _cached_load(load: Callable[..., Any]) -> Callable[..., Any]:
@@ -327,7 +341,6 @@ def _cached_load(load: Callable[..., Any]) -> Callable[..., Any]:
             cache[key] = load(cls, path)
         return cache[key]
 
-    cached._batch_cached = True  # type: ignore[attr-defined]
     cached.__doc__ = load.__doc__
     return cached
 

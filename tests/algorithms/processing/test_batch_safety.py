@@ -844,6 +844,7 @@ def test_derived_outputs_are_checked_while_planning(project4, tmp_path):
 def test_planning_reads_the_project_once(project4, tmp_path, monkeypatch):
     from photodem.algorithms.project import model, toml_io
 
+    plain = model.Project.__dict__["load"]
     reads = []
     loads = toml_io.loads
     monkeypatch.setattr(toml_io, "loads", lambda text: reads.append(1) or loads(text))
@@ -851,6 +852,7 @@ def test_planning_reads_the_project_once(project4, tmp_path, monkeypatch):
     plan = batch.plan_batch(_config(project4, [step]), run_dir=tmp_path / "run")
     assert len(plan.tasks) == 4
     assert len(reads) == 1
+    assert model.Project.__dict__["load"] is plain  # the plain load is back
     model.Project.load(project4)  # outside a plan, every load reads the file
     model.Project.load(project4)
     assert len(reads) == 3
