@@ -70,12 +70,16 @@ class Target:
         The parameter or output it comes from (named in messages).
     owner : Path, optional
         For a sidecar file: the product it belongs to; it may be replaced when that one may.
+    reuse : bool
+        A folder that is written into but never replaced (a batch's run folder): what it
+        holds already stays, so the rule on existing outputs does not apply; all others do.
     """
 
     path: Path
     kind: str = "file"
     name: str = "output"
     owner: Optional[Path] = None
+    reuse: bool = False
 
 
 def contained(path: PathLike, folder: PathLike, what: str) -> Path:
@@ -246,7 +250,8 @@ def check_targets(algorithm: str, targets: Sequence[Target], inputs: Iterable[Pa
             if out == inp or out in inp.parents:
                 raise InputError(f"{label} is or contains the input '{inp}'; PhotoDEM never "
                                  "overwrites its inputs. Choose another output.")
-        _check_existing(out, target, algorithm, label)
+        if not target.reuse:
+            _check_existing(out, target, algorithm, label)
 
 
 def _check_parent(out: Path, label: str) -> None:

@@ -59,6 +59,15 @@ Semantics (kept simple on purpose):
 - **Checks first.** The batch file, every step's parameters (names, types, ranges, options),
   the lock and the run folder are checked before the first task runs; input files are not
   looked for then (an earlier step may make them).
+- **Output policy while planning.** Every task's outputs (given or derived) are checked with
+  :func:`.output_policy.check_targets`, as :func:`.registry.run` checks them again when the
+  task runs: a forbidden output (a project, a project's ``images/`` or ``project.toml``, an
+  input of the task, a file or folder another algorithm or the operator made, the run folder)
+  stops the batch with one line naming the step and item before any task runs. Inputs an
+  earlier step makes may be missing then; an output derived from a project an earlier step
+  makes is left to the check at run time. The run folder is refused likewise when it is, holds
+  or lies in a project part, is a file or holds an image of the project; it is written into,
+  never replaced, so a named run folder may be reused.
 - **Run folders** are unique: the default ``runs/<timestamp>/`` is created with an atomic
   ``mkdir``; if it exists already, ``<timestamp>-2`` (``-3`` …) is used and the tasks are
   planned again for it.
@@ -103,11 +112,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, TextIO, Tuple, Union
 
+from .. import output_policy
 from ..errors import Cancelled, InputError, PhotodemError
 from ..project import toml_io
 from . import registry
 from .feedback import Feedback, ensure_feedback
-from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS
+from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS, _project_files
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
@@ -217,7 +227,16 @@ def load_batch(path: PathLike, run_dir: Optional[PathLike] = None,
 def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
                run_dir: Optional[PathLike] = None,
                now: Optional[_dt.datetime] = None) -> BatchPlan:
-    """Plan the tasks of a batch given as a dict (the parsed TOML)."""
+    """Plan the tasks of a batch given as a dict (the parsed TOML).
+
+    Every task's parameters and outputs are checked here, before the first task runs.
+    """
+    with _projects_read_once():
+        return _plan_batch(config, base_dir, run_dir, now)
+
+
+def _plan_batch(config: Dict[str, Any], base_dir: PathLike, run_dir: Optional[PathLike],
+                now: Optional[_dt.datetime]) -> BatchPlan:
     from ..project.model import Project  # numpy and friends only when a batch is planned
 
     unknown = set(config) - {"batch", "steps"}
@@ -244,6 +263,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
         raise InputError(f"Batch file: workers = {workers!r} in [batch] must be a whole "
                          "number ≥ 1.")
     run_auto = run_dir is None and not head.get("output")
+    given = run_dir is not None
     if run_dir is None:
         if head.get("output"):
             text = _substitute(head["output"],
@@ -253,6 +273,8 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
         else:
             run_dir = _timestamped(home / "runs", now)
     run = Path(run_dir).resolve()
+    named = "[batch] output" if head.get("output") and not given else "the run folder"
+    _check_run_folder(run, project_dir, named)
 
     steps = config.get("steps", [])
     if isinstance(steps, dict):
@@ -267,6 +289,60 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
             raise InputError(f"Batch file: step {number} is not a table.")
         _plan_step(plan, project, step, number, Path(base_dir))
     return plan
+
+
+#: In the thread that plans a batch: ``{(project.toml, mtime, size): Project}``, else unset.
+_PLANNING = threading.local()
+#: One planning thread at a time swaps ``Project.load`` (others wait; planning is quick).
+_PLANNING_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def _projects_read_once() -> Iterator[None]:
+    """While this thread plans a batch, ``Project.load`` parses each ``project.toml`` once.
+
+    The output checks of a step over hundreds of models would otherwise parse the project
+    two or three times per task (derived outputs). A file changed meanwhile (other mtime or
+    size) is read again. Other threads keep the plain ``load`` (the wrapper asks this thread's
+    cache only), and the plain one is back when the plan is made.
+    """
+    from ..project.model import Project
+
+    if getattr(_PLANNING, "cache", None) is not None:  # a plan inside a plan
+        yield
+        return
+    with _PLANNING_LOCK:
+        plain = Project.__dict__.get("load")
+        if isinstance(plain, classmethod):
+            Project.load = classmethod(_cached_load(plain.__func__))  # type: ignore[assignment]
+        _PLANNING.cache = {}
+        try:
+            yield
+        finally:
+            _PLANNING.cache = None
+            if isinstance(plain, classmethod):
+                Project.load = plain  # type: ignore[assignment]
+
+
+def _cached_load(load: Callable[..., Any]) -> Callable[..., Any]:
+    """``load`` (the function of ``Project.load``) memoised in the planning thread's cache."""
+
+    def cached(cls: Any, path: Any) -> Any:
+        cache = getattr(_PLANNING, "cache", None)
+        if cache is None:
+            return load(cls, path)
+        file = Path(path) / output_policy.PROJECT_FILE if Path(path).is_dir() else Path(path)
+        try:
+            stat = file.stat()
+        except OSError:
+            return load(cls, path)  # the load names the problem
+        key = (str(file.resolve()), stat.st_mtime_ns, stat.st_size)
+        if key not in cache:
+            cache[key] = load(cls, path)
+        return cache[key]
+
+    cached.__doc__ = load.__doc__
+    return cached
 
 
 def _text(table: Dict[str, Any], key: str, where: str) -> None:
@@ -370,28 +446,161 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
                        for k, v in params.items()}
         if item is not None:
             task_params[iterate] = item  # type: ignore[index]
-        _check_params(alg, task_params, name)
+        values = _check_params(alg, task_params, name)
+        where = f"step '{name}' ({alg.id})" + ("" if label is None
+                                                  else f", {item_kind} '{label}'")
+        _check_task_outputs(alg, values, plan.run_dir, where)
         log = plan.run_dir / (f"{name}.log" if label is None else f"{name}/{_safe(label)}.log")
         plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
                                item_kind=item_kind, params=task_params, log=log))
 
 
-def _check_params(alg: Any, params: Dict[str, Any], step: str) -> None:
+def _check_params(alg: Any, params: Dict[str, Any], step: str) -> Dict[str, Any]:
     """Refuse unknown names, missing required values and values of the wrong type or range
     while planning, so that a typo stops the batch before its first task runs.
 
     Input files are not looked for: an earlier step may make them.
+
+    Returns
+    -------
+    dict
+        The converted values (as :meth:`Parameter.convert` gives them to the run).
     """
     known = {p.name for p in alg.parameters}
     unknown = sorted(set(params) - known)
     if unknown:
         raise InputError(f"Batch file: step '{step}' ({alg.id}): unknown parameter(s) "
                          f"{', '.join(unknown)}; known are {', '.join(sorted(known))}.")
+    values = {}
     for p in alg.parameters:
         try:
-            p.convert(params.get(p.name))
+            values[p.name] = p.convert(params.get(p.name))
         except InputError as exc:
             raise InputError(f"Batch file: step '{step}' ({alg.id}): {exc}") from None
+    return values
+
+
+def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
+    """Refuse a run folder the output policy forbids, before anything is written.
+
+    The batch writes its logs and summary into the run folder but never replaces it, so a
+    named run folder may be reused; everything else of :func:`.output_policy.check_targets`
+    applies: no project folder, nothing that holds one, no project part (``images/``,
+    ``.photodem/``, ``project.toml``, ``edits.gpkg``, an image), no file, no working folder.
+
+    Parameters
+    ----------
+    run : Path
+        The resolved run folder.
+    project : Path, optional
+        The batch project, whose files no run folder may be or contain.
+    named : str
+        Where the run folder comes from, for the message (``[batch] output``).
+
+    Raises
+    ------
+    InputError
+        One line naming the run folder and what to do.
+    """
+    protected = _project_files(project) if project is not None else []
+    target = output_policy.Target(run, "folder", "output", reuse=True)
+    try:
+        output_policy.check_targets("batch", [target], protected=protected)
+    except InputError as exc:
+        raise InputError(f"Batch file: {named} (where the batch writes its logs): {exc}"
+                         ) from None
+
+
+def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str) -> None:
+    """Check a task's outputs with the policy :func:`.registry.check_outputs` applies when
+    the task runs, but while planning: a forbidden output stops the batch before its first
+    task.
+
+    Inputs an earlier step makes need not exist yet. A ``project`` input that is no project
+    yet counts with its own path only (its files cannot be listed); an output derived from
+    such a project is left to the check when the task runs.
+
+    Parameters
+    ----------
+    alg : Algorithm
+        The step's algorithm.
+    values : dict
+        The task's converted values (from :func:`_check_params`).
+    run : Path
+        The resolved run folder: no output may be or contain it.
+    where : str
+        ``step 'name' (algorithm)[, model 'name']`` for the message.
+
+    Raises
+    ------
+    InputError
+        One line: ``where`` and the policy's message.
+    """
+    projects = [p.name for p in alg.parameters if p.kind == "project" and values.get(p.name)]
+    pending = [name for name in projects if not _is_project(values[name])]
+    try:
+        targets = alg.output_targets(values)
+    except PhotodemError as exc:
+        if pending:  # derived from a project an earlier step makes: the run checks it
+            return
+        raise InputError(f"Batch file: {where}: {exc}") from None
+    if not targets:
+        return
+    try:
+        for target in targets:
+            out = target.path.resolve()
+            if out == run or out in run.parents:
+                raise InputError(f"Parameter '{target.name}': the output '{target.path}' is or "
+                                 f"contains the run folder '{run}', where the batch writes its "
+                                 "logs; choose another output.")
+        # The project files as Algorithm.input_paths lists them, but listed and resolved once
+        # per project, and only those an output is or contains (the only ones compared).
+        inputs, protected = alg.input_paths({**values, **dict.fromkeys(projects)})
+        outs = [t.path.resolve() for t in targets]
+        for name in projects:
+            inputs.append(Path(values[name]))
+            if name not in pending:
+                protected += _covered(_resolved_project_files(values[name]), outs)
+        output_policy.check_targets(alg.id, targets, inputs, protected)
+    except PhotodemError as exc:
+        raise InputError(f"Batch file: {where}: {exc}") from None
+
+
+def _resolved_project_files(project: Any) -> List[Path]:
+    """The files of ``project`` no output may be or contain (``spec._project_files``),
+    resolved; read once per project while a batch is planned."""
+    cache = getattr(_PLANNING, "cache", None)
+    file = Path(project) / output_policy.PROJECT_FILE if Path(project).is_dir() else Path(project)
+    stat = file.stat()
+    key = ("files", str(file.resolve()), stat.st_mtime_ns, stat.st_size)
+    if cache is not None and key in cache:
+        return cache[key]
+    files = [p.resolve() for p in _project_files(Path(project))]
+    if cache is not None:
+        cache[key] = files
+    return files
+
+
+def _covered(paths: Sequence[Path], outs: Sequence[Path]) -> List[Path]:
+    """The resolved ``paths`` that one of the resolved ``outs`` is or contains (by name: no
+    file system calls, which matter for a project of a thousand images and tasks)."""
+    prefixes = []
+    for out in outs:
+        text = os.path.normcase(str(out))
+        prefixes.append((text, text if text.endswith(os.sep) else text + os.sep))
+    found = []
+    for path in paths:
+        text = os.path.normcase(str(path))
+        if any(text == same or text.startswith(below) for same, below in prefixes):
+            found.append(path)
+    return found
+
+
+def _is_project(value: Any) -> bool:
+    """True when ``value`` names a project folder (or its ``project.toml``) that exists."""
+    path = Path(value)
+    file = path / output_policy.PROJECT_FILE if path.is_dir() else path
+    return file.is_file()
 
 
 def _item_label(item: Optional[str], kind: Optional[str]) -> Optional[str]:

@@ -391,8 +391,8 @@ def test_a_named_run_folder_may_be_reused(fake_algs, project4, tmp_path):
 
 
 def test_run_folder_that_cannot_be_created_is_an_operator_error(fake_algs, project4, tmp_path):
-    (tmp_path / "file").write_text("x")
     plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=tmp_path / "file" / "r")
+    (tmp_path / "file").write_text("x")  # after planning, which refuses it (see below)
     with pytest.raises(InputError, match="Cannot create the run folder"):
         batch.run_batch(plan, workers=1)
     assert not _lock(project4).exists()
@@ -582,8 +582,8 @@ def test_a_bad_batch_file_is_one_line_and_writes_nothing(fake_algs, project4, ca
     ("folder", "does not exist"),
     ("lock-live", "another batch (pid "),
     ("lock-foreign", "on host elsewhere"),
-    ("run-is-file", "Cannot create the run folder"),
-    ("run-inside-file", "Cannot create the run folder"),
+    ("run-is-file", "runfile' is a file, but a folder is expected"),
+    ("run-inside-file", "which is a file; choose a path in a folder"),
 ])
 def test_a_batch_that_cannot_start_is_one_line_and_writes_nothing(fake_algs, project4, capsys,
                                                                   setup, message):
@@ -663,3 +663,201 @@ def test_the_watchdog_tells_a_worker_when_its_parent_is_gone(monkeypatch):
     thread = threading.Thread(target=batch._watch_parent, args=(12345,), daemon=True)
     thread.start()
     assert called.wait(5.0)
+
+
+# -- outputs checked while planning (issue 16, points 1 and 3) --------------------------------
+_CAMERA_AND_IMAGE = """
+[cameras.c]
+width = 224
+height = 288
+focal_length_mm = 100.0
+pixel_size_mm = [0.4, 0.4]
+principal_point_mm = [0.0, 0.0]
+
+[[images]]
+name = "x1"
+path = "{path}"
+camera = "c"
+position = [0.0, 0.0, 100.0]
+opk = [0.0, 0.0, 0.0]
+"""
+
+
+@pytest.fixture
+def project_with_outside_image(project4):
+    """``project4`` with an image that lives outside the project, in ``<tmp>/imgs/``."""
+    image = project4.parent / "imgs" / "x1.tif"
+    image.parent.mkdir()
+    image.write_bytes(b"II*\x00 not really a tiff")
+    with open(project4 / "project.toml", "a", encoding="utf-8") as fh:
+        fh.write(_CAMERA_AND_IMAGE.replace("{path}", image.as_posix()))
+    return project4
+
+
+@pytest.mark.parametrize(("output", "message"), [
+    ("{project}", "is or contains a PhotoDEM project"),
+    (".", "is or contains a PhotoDEM project"),  # the batch file's folder holds the project
+    ("{project}/images", "(images)"),
+    ("{project}/images/r", "(images)"),
+    ("{project}/.photodem", "(.photodem)"),
+    ("{project}/edits.gpkg", "(edits.gpkg)"),
+    ("{project}/project.toml", "is a file, but a folder is expected"),
+    ("imgs", "is or contains the input"),
+    ("imgs/x1.tif", "is a file, but a folder is expected"),
+    ("runfile", "is a file, but a folder is expected"),
+])
+def test_a_forbidden_run_folder_is_refused_before_anything_is_written(
+        fake_algs, project_with_outside_image, capsys, output, message):
+    root = project_with_outside_image.parent
+    (root / "runfile").write_text("x")
+    file = root / "b.toml"
+    file.write_text(_HEAD + f'output = "{output}"\n' + _STEP + _OUT)
+    before = _hashes(root)
+    code, err = _cli(capsys, "batch", str(file), "--quiet")
+    assert code == 2, err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("photodem: error: Batch file: [batch] output (where the batch writes "
+                          "its logs): ")
+    assert message in err
+    assert _hashes(root) == before  # no run folder, no log, no lock, the project intact
+
+
+def test_a_forbidden_run_folder_given_to_the_planner_is_refused(fake_algs, project4):
+    with pytest.raises(InputError, match=r"^Batch file: the run folder \(where the batch "
+                                         r"writes its logs\): .* is or contains a PhotoDEM"):
+        batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=project4)
+
+
+def test_a_reused_run_folder_is_no_replaced_output(fake_algs, project4, tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "notes.txt").write_text("the operator's")  # written into, never replaced
+    plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=run)
+    assert batch.run_batch(plan, workers=1)["status"] == "done"
+    assert (run / "notes.txt").read_text() == "the operator's"
+
+
+def _plan_error(project, step, run):
+    with pytest.raises(InputError) as info:
+        batch.plan_batch(_config(project, [step]), run_dir=run)
+    return str(info.value)
+
+
+@pytest.mark.parametrize(("output", "message"), [
+    ("{project}/images/{model}.json", "(images)"),
+    ("{project}/project.toml", "(project.toml)"),
+    ("{project}/.photodem/{model}.json", "(.photodem)"),
+    ("{tmp}/imgs/x1.tif", "is or contains the input"),
+    ("{tmp}/notes.txt", "exists and is a file PhotoDEM did not write"),
+    ("{tmp}/other.json", "exists and is a product of 'fake_fail_on'"),
+    ("{tmp}/folder", "is a folder, but a file is expected"),
+    ("{tmp}/file/{model}.json", "which is a file; choose a path in a folder"),
+    ("{run}", "contains the run folder"),
+    ("{tmp}", "contains the run folder"),
+])
+def test_a_forbidden_step_output_is_refused_while_planning(
+        fake_algs, project_with_outside_image, tmp_path, output, message):
+    from photodem.algorithms.output_policy import file_mark, write_marker
+
+    project = project_with_outside_image
+    tmp = project.parent
+    (tmp / "notes.txt").write_text("the operator's")
+    (tmp / "other.json").write_text("{}")
+    write_marker(tmp, "fake_fail_on", "now", name=file_mark(tmp / "other.json").name)
+    (tmp / "folder").mkdir()
+    (tmp / "file").write_text("x")
+    run = tmp / "run"
+    before = _hashes(tmp)
+    text = _plan_error(project, _sleep_step(output=output.replace("{tmp}", str(tmp))), run)
+    assert text.startswith("Batch file: step 'sleep' (fake_sleep_write), model 'a_b': "
+                           "Parameter 'output': "), text
+    assert message in text
+    assert "\n" not in text
+    assert _hashes(tmp) == before and not run.exists()
+
+
+@pytest.mark.parametrize(("output", "message"), [
+    ("{project}", "is or contains a PhotoDEM project"),
+    ("{tmp}", "is or contains a PhotoDEM project"),
+    ("{project}/images", "(images)"),
+    ("{tmp}/imgs", "is or contains the input"),
+    ("{run}/..", "contains the run folder"),
+])
+def test_a_forbidden_folder_output_is_refused_while_planning(project_with_outside_image, output,
+                                                             message):
+    project = project_with_outside_image
+    tmp = project.parent
+    step = {"algorithm": "epipolar_pair", "name": "epi", "models": ["b_c"],
+            "params": {"output": output.replace("{tmp}", str(tmp))}}
+    text = _plan_error(project, step, tmp.with_name(tmp.name + "-runs") / "r")
+    assert text.startswith("Batch file: step 'epi' (epipolar_pair), model 'b_c': "
+                           "Parameter 'output': "), text
+    assert message in text
+
+
+def test_a_step_output_that_is_an_input_made_by_an_earlier_step_is_refused(fake_algs, project4,
+                                                                            tmp_path):
+    made = "{project}/products/sleep/a_b.json"  # does not exist yet: step 'sleep' makes it
+    steps = [_sleep_step(), {"algorithm": "fake_file_size", "name": "size",
+                             "params": {"image": made, "output": made}}]
+    with pytest.raises(InputError, match=r"^Batch file: step 'size' \(fake_file_size\): "
+                                         r"Parameter 'output': .* is or contains the input"):
+        batch.plan_batch(_config(project4, steps), run_dir=tmp_path / "run")
+
+
+def test_a_refused_step_output_runs_no_task_in_the_cli(fake_algs, project4, capsys):
+    root = project4.parent
+    file = root / "b.toml"
+    file.write_text(_GOOD + '[[steps]]\nalgorithm = "fake_fail_on"\n[steps.params]\n'
+                    'output = "{project}/images/{model}.txt"\n')
+    before = _hashes(root)
+    code, err = _cli(capsys, "batch", str(file), "--quiet")
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.startswith("photodem: error: Batch file: step 'fake_fail_on' (fake_fail_on), "
+                          "model 'a_b': Parameter 'output': ")
+    assert _hashes(root) == before  # the first step did not run either
+
+
+def test_inputs_that_an_earlier_step_makes_are_not_looked_for(fake_algs, project4, tmp_path):
+    steps = [_sleep_step(), {"algorithm": "fake_file_size", "name": "size",
+                             "params": {"image": "{project}/products/sleep/a_b.json",
+                                        "output": "{project}/products/size/a_b.txt"}}]
+    plan = batch.plan_batch(_config(project4, steps), run_dir=tmp_path / "run")
+    summary = batch.run_batch(plan, workers=1)
+    assert summary["status"] == "done", summary
+    assert (project4 / "products" / "size" / "a_b.txt").is_file()
+
+
+def test_a_project_that_an_earlier_step_makes_leaves_its_derived_output_to_the_run(project4,
+                                                                                  tmp_path):
+    steps = [{"algorithm": "synthetic_block", "params": {"output": "{run}/synth"}},
+             {"algorithm": "epipolar_pair", "params": {"project": "{run}/synth",
+                                                       "model": "0101_0102"}}]
+    plan = batch.plan_batch(_config(project4, steps), run_dir=tmp_path / "run")
+    assert [t.algorithm for t in plan.tasks] == ["synthetic_block", "epipolar_pair"]
+
+
+def test_derived_outputs_are_checked_while_planning(project4, tmp_path):
+    (project4 / "products" / "epipolar").mkdir(parents=True)
+    (project4 / "products" / "epipolar" / "b_c").write_text("not a folder")
+    step = {"algorithm": "epipolar_pair", "name": "epi"}  # default: products/epipolar/<model>
+    text = _plan_error(project4, step, tmp_path / "run")
+    assert text.startswith("Batch file: step 'epi' (epipolar_pair), model 'b_c': "), text
+    assert "is a file, but a folder is expected" in text
+
+
+def test_planning_reads_the_project_once(project4, tmp_path, monkeypatch):
+    from photodem.algorithms.project import model, toml_io
+
+    plain = model.Project.__dict__["load"]
+    reads = []
+    loads = toml_io.loads
+    monkeypatch.setattr(toml_io, "loads", lambda text: reads.append(1) or loads(text))
+    step = {"algorithm": "epipolar_pair", "name": "epi"}  # derived outputs load the project
+    plan = batch.plan_batch(_config(project4, [step]), run_dir=tmp_path / "run")
+    assert len(plan.tasks) == 4
+    assert len(reads) == 1
+    assert model.Project.__dict__["load"] is plain  # the plain load is back
+    model.Project.load(project4)  # outside a plan, every load reads the file
+    model.Project.load(project4)
+    assert len(reads) == 3
