@@ -117,7 +117,7 @@ from ..errors import Cancelled, InputError, PhotodemError
 from ..project import toml_io
 from . import registry
 from .feedback import Feedback, ensure_feedback
-from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS, _project_files
+from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS, project_files
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
@@ -231,12 +231,6 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
 
     Every task's parameters and outputs are checked here, before the first task runs.
     """
-    with _projects_read_once():
-        return _plan_batch(config, base_dir, run_dir, now)
-
-
-def _plan_batch(config: Dict[str, Any], base_dir: PathLike, run_dir: Optional[PathLike],
-                now: Optional[_dt.datetime]) -> BatchPlan:
     from ..project.model import Project  # numpy and friends only when a batch is planned
 
     unknown = set(config) - {"batch", "steps"}
@@ -289,60 +283,6 @@ def _plan_batch(config: Dict[str, Any], base_dir: PathLike, run_dir: Optional[Pa
             raise InputError(f"Batch file: step {number} is not a table.")
         _plan_step(plan, project, step, number, Path(base_dir))
     return plan
-
-
-#: In the thread that plans a batch: ``{(project.toml, mtime, size): Project}``, else unset.
-_PLANNING = threading.local()
-#: One planning thread at a time swaps ``Project.load`` (others wait; planning is quick).
-_PLANNING_LOCK = threading.Lock()
-
-
-@contextlib.contextmanager
-def _projects_read_once() -> Iterator[None]:
-    """While this thread plans a batch, ``Project.load`` parses each ``project.toml`` once.
-
-    The output checks of a step over hundreds of models would otherwise parse the project
-    two or three times per task (derived outputs). A file changed meanwhile (other mtime or
-    size) is read again. Other threads keep the plain ``load`` (the wrapper asks this thread's
-    cache only), and the plain one is back when the plan is made.
-    """
-    from ..project.model import Project
-
-    if getattr(_PLANNING, "cache", None) is not None:  # a plan inside a plan
-        yield
-        return
-    with _PLANNING_LOCK:
-        plain = Project.__dict__.get("load")
-        if isinstance(plain, classmethod):
-            Project.load = classmethod(_cached_load(plain.__func__))  # type: ignore[assignment]
-        _PLANNING.cache = {}
-        try:
-            yield
-        finally:
-            _PLANNING.cache = None
-            if isinstance(plain, classmethod):
-                Project.load = plain  # type: ignore[assignment]
-
-
-def _cached_load(load: Callable[..., Any]) -> Callable[..., Any]:
-    """``load`` (the function of ``Project.load``) memoised in the planning thread's cache."""
-
-    def cached(cls: Any, path: Any) -> Any:
-        cache = getattr(_PLANNING, "cache", None)
-        if cache is None:
-            return load(cls, path)
-        file = Path(path) / output_policy.PROJECT_FILE if Path(path).is_dir() else Path(path)
-        try:
-            stat = file.stat()
-        except OSError:
-            return load(cls, path)  # the load names the problem
-        key = (str(file.resolve()), stat.st_mtime_ns, stat.st_size)
-        if key not in cache:
-            cache[key] = load(cls, path)
-        return cache[key]
-
-    cached.__doc__ = load.__doc__
-    return cached
 
 
 def _text(table: Dict[str, Any], key: str, where: str) -> None:
@@ -502,7 +442,7 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
     InputError
         One line naming the run folder and what to do.
     """
-    protected = _project_files(project) if project is not None else []
+    protected = project_files(project) if project is not None else []
     target = output_policy.Target(run, "folder", "output", reuse=True)
     try:
         output_policy.check_targets("batch", [target], protected=protected)
@@ -560,25 +500,10 @@ def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str)
         for name in projects:
             inputs.append(Path(values[name]))
             if name not in pending:
-                protected += _covered(_resolved_project_files(values[name]), outs)
+                protected += _covered(project_files(values[name]), outs)
         output_policy.check_targets(alg.id, targets, inputs, protected)
     except PhotodemError as exc:
         raise InputError(f"Batch file: {where}: {exc}") from None
-
-
-def _resolved_project_files(project: Any) -> List[Path]:
-    """The files of ``project`` no output may be or contain (``spec._project_files``),
-    resolved; read once per project while a batch is planned."""
-    cache = getattr(_PLANNING, "cache", None)
-    file = Path(project) / output_policy.PROJECT_FILE if Path(project).is_dir() else Path(project)
-    stat = file.stat()
-    key = ("files", str(file.resolve()), stat.st_mtime_ns, stat.st_size)
-    if cache is not None and key in cache:
-        return cache[key]
-    files = [p.resolve() for p in _project_files(Path(project))]
-    if cache is not None:
-        cache[key] = files
-    return files
 
 
 def _covered(paths: Sequence[Path], outs: Sequence[Path]) -> List[Path]:

@@ -17,7 +17,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import InputError
 from ..input_errors import display_path
-from ..output_policy import Target, contained
+from ..output_policy import PROJECT_FILE, Target, contained
 from .feedback import Feedback
 
 #: Parameter kinds. Paths are passed on as ``str``.
@@ -310,7 +310,7 @@ class Algorithm:
             elif p.kind in INPUT_PATH_KINDS:
                 inputs.append(Path(value))
             if p.kind == "project":
-                protected += _project_files(Path(value))
+                protected += project_files(Path(value))
         return inputs, protected
 
     def to_dict(self) -> Dict[str, Any]:
@@ -372,28 +372,49 @@ def project_product(params: Dict[str, Any], step: str, name: str, what: str) -> 
 
     ``what`` names the source of ``name`` in the message (e.g. "Stereo model 'x'").
     """
-    from ..project.model import Project
-
-    base = Project.load(params["project"]).products_dir(step)
+    base = _read_project(params["project"])[0].products_dir(step)
     return contained(base / name, base, what)
 
 
 def model_product(params: Dict[str, Any], step: str) -> Path:
     """``<project>/products/<step>/<model>/`` of the ``model`` parameter."""
-    from ..project.model import Project
-
-    name = Project.load(params["project"]).model(params["model"]).name
+    name = _read_project(params["project"])[0].model(params["model"]).name
     return project_product(params, step, name, f"Stereo model '{name}'")
 
 
-def _project_files(path: Path) -> List[Path]:
-    """The files of the project at ``path`` that no output may replace."""
-    from ..project.model import Project
+def project_files(path: Path) -> List[Path]:
+    """The files of the project at ``path`` that no output may replace, resolved:
+    ``project.toml``, ``edits.gpkg``, ``images/``, ``.photodem/`` and every image."""
+    return _read_project(path)[1]
 
-    project = Project.load(path)
-    files = [project.project_file, project.edits_path, project.root / "images",
-             project.root / ".photodem"]
-    return files + [project.image_path(rec) for rec in project.images]
+
+#: Projects read for the output checks, by file identity (path, mtime, size) → (project, its
+#: resolved files). The checks of a batch over hundreds of models would otherwise parse
+#: ``project.toml`` and resolve every image path several times per task. Read-only use.
+_PROJECTS: Dict[Tuple[str, int, int], Tuple[Any, List[Path]]] = {}
+
+
+def _read_project(path: Any) -> Tuple[Any, List[Path]]:
+    """The project at ``path`` and its resolved files, read again only when the file changed."""
+    from ..project.model import Project  # numpy and friends only when a project is used
+
+    file = Path(path) / PROJECT_FILE if Path(path).is_dir() else Path(path)
+    try:
+        stat = file.stat()
+    except OSError:
+        Project.load(path)  # names the problem
+        raise
+    key = (str(file.resolve()), stat.st_mtime_ns, stat.st_size)
+    entry = _PROJECTS.get(key)
+    if entry is None:
+        project = Project.load(path)
+        files = [project.project_file, project.edits_path, project.root / "images",
+                 project.root / ".photodem", *(project.image_path(r) for r in project.images)]
+        entry = (project, [f.resolve() for f in files])
+        if len(_PROJECTS) >= 16:
+            _PROJECTS.clear()
+        _PROJECTS[key] = entry
+    return entry
 
 
 def json_ready(value: Any) -> Any:

@@ -666,14 +666,7 @@ def test_the_watchdog_tells_a_worker_when_its_parent_is_gone(monkeypatch):
 
 
 # -- outputs checked while planning (issue 16, points 1 and 3) --------------------------------
-_CAMERA_AND_IMAGE = """
-[cameras.c]
-width = 224
-height = 288
-focal_length_mm = 100.0
-pixel_size_mm = [0.4, 0.4]
-principal_point_mm = [0.0, 0.0]
-
+_IMAGE = """
 [[images]]
 name = "x1"
 path = "{path}"
@@ -690,7 +683,7 @@ def project_with_outside_image(project4):
     image.parent.mkdir()
     image.write_bytes(b"II*\x00 not really a tiff")
     with open(project4 / "project.toml", "a", encoding="utf-8") as fh:
-        fh.write(_CAMERA_AND_IMAGE.replace("{path}", image.as_posix()))
+        fh.write(_IMAGE.replace("{path}", image.as_posix()))
     return project4
 
 
@@ -846,18 +839,19 @@ def test_derived_outputs_are_checked_while_planning(project4, tmp_path):
     assert "is a file, but a folder is expected" in text
 
 
-def test_planning_reads_the_project_once(project4, tmp_path, monkeypatch):
-    from photodem.algorithms.project import model, toml_io
+def test_planning_reads_the_project_a_fixed_number_of_times(project4, tmp_path, monkeypatch):
+    from photodem.algorithms.processing import spec
+    from photodem.algorithms.project import toml_io
 
-    plain = model.Project.__dict__["load"]
     reads = []
     loads = toml_io.loads
     monkeypatch.setattr(toml_io, "loads", lambda text: reads.append(1) or loads(text))
+    monkeypatch.setattr(spec, "_PROJECTS", {})
     step = {"algorithm": "epipolar_pair", "name": "epi"}  # derived outputs load the project
     plan = batch.plan_batch(_config(project4, [step]), run_dir=tmp_path / "run")
     assert len(plan.tasks) == 4
-    assert len(reads) == 1
-    assert model.Project.__dict__["load"] is plain  # the plain load is back
-    model.Project.load(project4)  # outside a plan, every load reads the file
-    model.Project.load(project4)
+    assert len(reads) == 2  # the batch's own load and the output checks' one, not one per task
+    text = (project4 / "project.toml").read_text()
+    (project4 / "project.toml").write_text(text + "\n")  # a changed file is read again
+    spec.project_files(project4)
     assert len(reads) == 3
