@@ -312,19 +312,41 @@ def staging_name(name: str, kind: str = "partial", suffix: str = "") -> str:
     return f".{name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.{kind}{suffix}"
 
 
-def pid_alive(pid: int) -> bool:
-    """True when a process with this id runs (or cannot be asked: then it is assumed alive)."""
-    if pid <= 0:
+def pid_alive(pid: int, start: Optional[str] = None) -> bool:
+    """True when process ``pid`` runs (and, if ``start`` is given, started then: a reused pid
+    is another process). A process that cannot be asked is assumed alive: leftovers and locks
+    of a live process must never be taken."""
+    if pid <= 0 or pid == os.getpid():
         return True
-    if pid == os.getpid():
+    if os.name == "nt":  # os.kill with signal 0 would end the process there
         return True
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except (PermissionError, OSError):
+    except OSError:  # EPERM: it runs under another user
         return True
-    return True
+    fields = _process_stat(pid)
+    if fields is None:
+        return True
+    if fields[0] == "Z":  # a zombie has ended
+        return False
+    return start is None or len(fields) <= 19 or fields[19] == start
+
+
+def process_start(pid: int) -> Optional[str]:
+    """The start time of a process in clock ticks since boot (Linux), to tell a reused pid."""
+    fields = _process_stat(pid)
+    return fields[19] if fields and len(fields) > 19 else None
+
+
+def _process_stat(pid: int) -> Optional[List[str]]:
+    """Fields of ``/proc/<pid>/stat`` after the command name (Linux), else None."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    return text.rsplit(")", 1)[-1].split()
 
 
 def stale_leftovers(folder: PathLike) -> List[tuple]:

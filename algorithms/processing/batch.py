@@ -54,8 +54,9 @@ Semantics (kept simple on purpose):
   project is refused at once with an operator error naming the holder. A lock whose process
   (on this host) is no longer running is taken over with a line in the batch log. The lock is
   removed on every exit of :func:`run_batch`; ``--dry-run`` does not take it.
-- **Leftovers.** At its start a batch deletes the temporary files (``.<name>.<pid>.tmp``) that
-  ended batches left in ``.photodem`` and in its run folder, and names them in the batch log.
+- **Leftovers.** The batch's own files (state, lock, summary) are written atomically through
+  staging names of :mod:`.output_policy`; at its start a batch removes those that ended
+  processes left in ``.photodem`` and in its run folder, and names them in the batch log.
 - **Checks first.** The batch file, every step's parameters (names, types, ranges, options),
   the lock and the run folder are checked before the first task runs; input files are not
   looked for then (an earlier step may make them).
@@ -631,11 +632,7 @@ def _read_state(project: Path) -> Dict[str, Any]:
 
 
 def _write_state(project: Path, tasks: Dict[str, Any]) -> None:
-    path = _state_path(project)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps({"format_version": 1, "tasks": tasks}, indent=1), encoding="utf-8")
-    os.replace(tmp, path)
+    _atomic_json(_state_path(project), {"format_version": 1, "tasks": tasks})
 
 
 def _output_paths(algorithm: str, outputs: Dict[str, Any]) -> List[str]:
@@ -1072,11 +1069,7 @@ def run_batch(
             notes.append(f"run folder {run_dir} exists already; this run writes to "
                          f"{plan.run_dir}")
             _atomic_json(lock, _lock_info(plan))
-        for folder in (lock.parent, plan.run_dir):
-            removed = _remove_stale_temps(folder)
-            if removed:
-                notes.append(f"removed {len(removed)} temporary file(s) of ended batches in "
-                             f"{folder}: {', '.join(removed)}")
+        output_policy.remove_stale([lock.parent, plan.run_dir], notes.append)
         modules = [*extra_modules, *registry.extra_modules()]
         return _run_locked(plan, feedback, n_workers, resume, modules, grace, notes)
     finally:
@@ -1202,7 +1195,7 @@ def _summary(plan: BatchPlan, records: List[Dict[str, Any]], started: str, t0: f
 
 def _atomic_json(path: Path, data: Dict[str, Any]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)  # the summary even if a task removed it
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp = path.with_name(output_policy.staging_name(path.name))
     tmp.write_text(json.dumps(data, indent=2, default=str), encoding="utf-8")
     os.replace(tmp, path)
 
@@ -1215,24 +1208,6 @@ def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
         result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
                               lambda pct, i=task.index: progress.set(i, pct))
         finish(task, result)
-
-
-#: The temporary files of the batch's own atomic writes: ``.<name>.<pid>.tmp``.
-_TEMP_NAME = re.compile(r"\..+\.(\d+)\.tmp")
-
-
-def _remove_stale_temps(folder: Path) -> List[str]:
-    """Delete the batch's temporary files in ``folder`` whose writer (on this host) has
-    ended, e.g. a batch killed while writing its state; return their names."""
-    removed = []
-    with contextlib.suppress(OSError):
-        for path in folder.iterdir():
-            match = _TEMP_NAME.fullmatch(path.name)
-            if match and path.is_file() and not _process_alive(int(match.group(1))):
-                with contextlib.suppress(OSError):
-                    path.unlink()
-                    removed.append(path.name)
-    return sorted(removed)
 
 
 # -- the run folder ------------------------------------------------------------------------------
@@ -1285,7 +1260,8 @@ def _lock_path(plan: BatchPlan) -> Path:
 
 def _lock_info(plan: BatchPlan) -> Dict[str, Any]:
     pid = os.getpid()
-    return {"pid": pid, "host": socket.gethostname(), "pid_start": _process_start(pid),
+    return {"pid": pid, "host": socket.gethostname(),
+            "pid_start": output_policy.process_start(pid),
             "started": _dt.datetime.now().isoformat(timespec="seconds"),
             "run": str(plan.run_dir)}
 
@@ -1336,7 +1312,7 @@ def _create_lock(path: Path, info: Dict[str, Any]) -> bool:
     fails when it exists, like ``O_CREAT|O_EXCL``), so no other batch ever reads a half-written
     lock. Where hard links are not supported, the lock is created with ``O_CREAT|O_EXCL``.
     """
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp = path.with_name(output_policy.staging_name(path.name))
     try:
         tmp.write_text(json.dumps(info), encoding="utf-8")
         os.link(tmp, path)
@@ -1378,7 +1354,7 @@ def _lock_is_stale(path: Path, holder: Dict[str, Any]) -> bool:
     pid = holder.get("pid")
     if not isinstance(pid, int) or pid <= 0:
         return True
-    return not _process_alive(pid, holder.get("pid_start"))
+    return not output_policy.pid_alive(pid, holder.get("pid_start"))
 
 
 def _held_message(plan: BatchPlan, path: Path, holder: Dict[str, Any]) -> str:
@@ -1433,42 +1409,6 @@ def _release_lock(path: Path) -> None:
             path.parent.rmdir()
 
 
-def _process_stat(pid: int) -> Optional[List[str]]:
-    """Fields of ``/proc/<pid>/stat`` after the command name (Linux), else None."""
-    try:
-        text = Path(f"/proc/{pid}/stat").read_text(encoding="utf-8", errors="replace")
-    except OSError:
-        return None
-    return text.rsplit(")", 1)[-1].split()
-
-
-def _process_start(pid: int) -> Optional[str]:
-    """The start time of a process in clock ticks since boot (Linux), to tell a reused pid."""
-    fields = _process_stat(pid)
-    return fields[19] if fields and len(fields) > 19 else None
-
-
-def _process_alive(pid: int, start: Optional[str] = None) -> bool:
-    """True when process ``pid`` runs (and, if ``start`` is given, started then)."""
-    if pid == os.getpid():
-        return True
-    if os.name == "nt":  # os.kill would end the process; let the operator decide
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # EPERM: it runs under another user
-        return True
-    fields = _process_stat(pid)
-    if fields is None:
-        return True
-    if fields[0] == "Z":  # a zombie has ended
-        return False
-    return start is None or len(fields) <= 19 or fields[19] == start
-
-
-# -- template ------------------------------------------------------------------------------------
 def batch_template(project: PathLike) -> str:
     """An example batch file for ``project`` (``photodem batch --template PROJECT``).
 

@@ -615,22 +615,23 @@ def test_temporary_files_of_killed_batches_are_removed_and_named(fake_algs, proj
     run = tmp_path / "run"
     state.mkdir()
     run.mkdir()
-    (state / f".batch-state.json.{dead}.tmp").write_text("{")
-    (state / f".batch.lock.{dead}.tmp").write_text("{")
-    (run / f".summary.json.{dead}.tmp").write_text("{")
-    alive = state / f".batch-state.json.{os.getppid()}.tmp"  # a running writer's: kept
+    stale = [state / f".batch-state.json.{dead}.0123abcd.partial",
+             state / f".batch.lock.{dead}.0123abcd.partial",
+             run / f".summary.json.{dead}.0123abcd.partial"]
+    for path in stale:
+        path.write_text("{")
+    alive = state / f".batch-state.json.{os.getppid()}.0123abcd.partial"  # a live writer's
     alive.write_text("{")
-    mine = state / "notes.tmp"  # not a batch temporary: kept
+    mine = state / "notes.tmp"  # not a staging name: kept
     mine.write_text("x")
     plan = batch.plan_batch(_config(project4, [_sleep_step()]), run_dir=run)
     assert batch.run_batch(plan, workers=1)["status"] == "done"
     assert sorted(p.name for p in state.iterdir()) == sorted(
         [alive.name, "batch-state.json", "notes.tmp"])
-    assert not (run / f".summary.json.{dead}.tmp").exists()
+    assert not any(path.exists() for path in stale)
     text = (run / "batch.log").read_text()
-    assert (f"removed 2 temporary file(s) of ended batches in {state}: "
-            f".batch-state.json.{dead}.tmp, .batch.lock.{dead}.tmp") in text
-    assert f"in {run}: .summary.json.{dead}.tmp" in text
+    for path in stale:
+        assert f"Removed the leftover '{path}' of process {dead}, no longer running." in text
 
 
 @linux_only
