@@ -42,11 +42,11 @@ from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence
 
 from . import output_policy
+from .cli_feedback import CliFeedback
 from .errors import Cancelled, PhotodemError
+from .feedback import Feedback
 from .processing import batch as batch_mod
 from .processing import registry
-from .processing.cli_feedback import CliFeedback
-from .processing.feedback import Feedback
 from .processing.spec import Algorithm, Parameter
 
 PROG = "photodem"
@@ -334,11 +334,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps(plan.to_dict(), indent=2, default=str))
         else:
-            state = batch_mod._read_state(plan.state_home) if args.resume else {}
+            state = batch_mod.read_state(plan.state_home) if args.resume else {}
             print(f"project: {plan.project}\nrun folder: {plan.run_dir}\n"
                   f"workers: {plan.workers}")
             for t in plan.tasks:
-                would = "skip" if batch_mod._resumable(t, state) is not None else "run"
+                would = "skip" if batch_mod.resumable(t, state) is not None else "run"
                 print(f"  [{would}] {t.key}: {t.algorithm} {json.dumps(t.params)}")
         return EXIT_OK
     feedback = CliFeedback(quiet=args.quiet)
@@ -361,10 +361,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 
 def cmd_gui() -> int:
-    import importlib
-
     try:
-        app = importlib.import_module("..plugin.app.main", __package__)
+        from ..plugin.app import main as app  # here, not above: Qt only when the GUI starts
     except ImportError as exc:
         raise PhotodemError(
             f"The standalone toolbox needs PyQt5 ({exc}); install it with "

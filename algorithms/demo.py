@@ -29,10 +29,10 @@ from typing import Any, Dict, List, Optional, Union
 import numpy as np
 
 from .errors import PhotodemError
+from .feedback import Feedback, ensure_feedback
 from .geometry.epipolar import EpipolarPair
 from .processing import registry
 from .processing.batch import load_batch, run_batch
-from .processing.feedback import Feedback, ensure_feedback
 from .project.model import Project
 from .quality.targets import target_centroids
 from .raster.io import PRODUCT_MARKER, open_image

@@ -105,7 +105,7 @@ from affine import Affine
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..surface.gridding import Grid, line_barrier
 
 Array = NDArray[Any]

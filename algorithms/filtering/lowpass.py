@@ -72,7 +72,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..surface.gridding import Grid
 from .presets import lowpass_preset
 from .surface_input import (

@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import numpy as np
 
 from ..errors import GeometryError, InputError
-from ..processing.feedback import Feedback, StepFeedback
+from ..feedback import Feedback, StepFeedback
 from .area import area_search, boundary_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform, inverse_for_resampling

@@ -22,7 +22,8 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from ..processing.feedback import Feedback
+from ..feedback import Feedback
+from ..jsonable import json_ready
 from ..quality.report import new_figure
 from .correspondence import apply
 from .fit import TransformFit, points_summary
@@ -366,7 +367,6 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
 
 def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, Path]:
     """report.json, report.html, overlay.png and residuals.png in ``folder``."""
-    from ..processing.spec import json_ready
 
     rep = report_dict(result)
     rep["extensions"] = [e for e in rep["extensions"] if e]

@@ -18,7 +18,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ..errors import InputError
-from ..processing.feedback import Feedback
+from ..feedback import Feedback
 from .correspondence import apply
 from .fit import centre_matrix
 from .objects import REFERENCE, PolygonObject, orient_ring

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback
+from ..feedback import Feedback
 from .objects import IMAGE, PolygonObject, orient_ring
 
 #: Default thresholds (DN of 8-bit data), over- to under-segmentation (seed-001 §2.19).

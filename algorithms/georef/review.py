@@ -27,7 +27,8 @@ from typing import Any, Dict, List, Optional, Sequence, Set, Tuple, Union
 import numpy as np
 
 from ..errors import InputError
-from ..processing.feedback import Feedback
+from ..feedback import Feedback
+from ..jsonable import json_ready
 from ..quality.points import (
     COLUMN_NAMES,
     field_separator,
@@ -425,7 +426,6 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
     """
     import pyproj
 
-    from ..processing.spec import json_ready
     from ..raster.io import staged_folder
     from .products import (
         product_paths,

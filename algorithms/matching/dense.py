@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 
 #: Matching methods; the first is the default.
 METHODS = ("sgm", "opencv_sgbm")

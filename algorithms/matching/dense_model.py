@@ -34,8 +34,8 @@ from typing import Any, Dict, Optional, Union
 
 import numpy as np
 
+from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import SIDES, EpipolarPair
-from ..processing.feedback import Feedback, ensure_feedback
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from .dense import iter_disparity_tiles
 

@@ -39,8 +39,8 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 import numpy as np
 
 from ..errors import InputError
+from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import SIDES
-from ..processing.feedback import Feedback, ensure_feedback
 from .model_setup import ModelSetup, footprint, prepare_model
 
 PathLike = Union[str, Path]

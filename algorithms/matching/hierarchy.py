@@ -87,7 +87,7 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 from ..errors import InputError
-from ..processing.feedback import ensure_feedback
+from ..feedback import ensure_feedback
 from .fbm import (
     FLAG_FEATURE_SUBPIXEL,
     FBMResult,

@@ -34,8 +34,8 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from ..processing.feedback import Feedback, ensure_feedback
-from ..processing.spec import json_ready
+from ..feedback import Feedback, ensure_feedback
+from ..jsonable import json_ready
 from ..quality.rasters import horn_gradient, shade
 from ..quality.report import (
     _CSS,

@@ -103,8 +103,8 @@ from numpy.typing import NDArray
 from scipy import sparse
 
 from ..errors import GeometryError, InputError
+from ..feedback import Feedback, ensure_feedback
 from ..geometry.projection import world_to_pixel
-from ..processing.feedback import Feedback, ensure_feedback
 from .pyramid import build_pyramid, to_level
 
 PathLike = Union[str, Path]

@@ -53,10 +53,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..crs_check import same_horizontal_crs
 from ..errors import InputError
+from ..feedback import Feedback, ensure_feedback
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
 from ..input_errors import check_raster
-from ..processing.feedback import Feedback, ensure_feedback
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
 from .visibility import march_margin, occluded

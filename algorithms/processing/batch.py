@@ -115,9 +115,9 @@ from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Text
 
 from .. import output_policy
 from ..errors import Cancelled, InputError, PhotodemError
+from ..feedback import Feedback, ensure_feedback
 from ..project import toml_io
 from . import registry
-from .feedback import Feedback, ensure_feedback
 from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS, project_files
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
@@ -621,7 +621,9 @@ def _state_path(project: Path) -> Path:
     return project / STATE_FILE
 
 
-def _read_state(project: Path) -> Dict[str, Any]:
+def read_state(project: Path) -> Dict[str, Any]:
+    """The resume records of the tasks of earlier batches of ``project`` (by task key); empty
+    when there are none or the state file is unreadable."""
     path = _state_path(project)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -649,7 +651,7 @@ def _output_paths(algorithm: str, outputs: Dict[str, Any]) -> List[str]:
     return paths
 
 
-def _resumable(task: Task, state: Dict[str, Any]) -> Optional[Dict[str, Any]]:
+def resumable(task: Task, state: Dict[str, Any]) -> Optional[Dict[str, Any]]:
     """The recorded outputs when ``task`` is complete from an earlier run, else ``None``."""
     record = state.get(task.key)
     if not isinstance(record, dict) or record.get("hash") != task.params_hash:
@@ -1081,7 +1083,7 @@ def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: boo
     """The body of :func:`run_batch`, with the lock held and the run folder created."""
     started = _dt.datetime.now().isoformat(timespec="seconds")
     t0 = time.perf_counter()
-    state = _read_state(plan.state_home) if resume else {}
+    state = read_state(plan.state_home) if resume else {}
     records: List[Dict[str, Any]] = [
         {"step": t.step, "algorithm": t.algorithm, "item": t.item, "status": "cancelled",
          "outputs": {}, "duration_s": 0.0, "error": None, "log": str(t.log),
@@ -1107,7 +1109,7 @@ def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: boo
             progress.set(task.index, 100.0)
         label = task.key
         if record["status"] == "done":
-            state_all = _read_state(plan.state_home)
+            state_all = read_state(plan.state_home)
             state_all[task.key] = {"hash": task.params_hash, "algorithm": task.algorithm,
                                    "outputs": record["outputs"], "run": str(plan.run_dir),
                                    "finished": _dt.datetime.now().isoformat(timespec="seconds")}
@@ -1136,7 +1138,7 @@ def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: boo
                                                       f"failed for {task.item_kind} "
                                                       f"'{task.name}'"))
                     continue
-                outputs = _resumable(task, state) if resume else None
+                outputs = resumable(task, state) if resume else None
                 if outputs is not None:
                     finish(task, {"status": "skipped", "outputs": outputs, "duration_s": 0.0,
                                   "error": None})
@@ -1470,5 +1472,7 @@ __all__ = [
     "execute_task",
     "load_batch",
     "plan_batch",
+    "read_state",
+    "resumable",
     "run_batch",
 ]

@@ -15,9 +15,10 @@ from typing import Any, Dict, Iterable, List, Optional
 
 from .. import output_policy
 from ..errors import InputError
+from ..feedback import Feedback, ensure_feedback
 from ..input_errors import check_raster_parameters, operator_errors
-from .feedback import Feedback, ensure_feedback
-from .spec import Algorithm, json_ready, prepare_parameters
+from ..jsonable import json_ready
+from .spec import Algorithm, prepare_parameters
 
 #: Modules below ``algorithms/processing/algs`` that declare algorithms, in toolbox order.
 ALGORITHM_MODULES = (

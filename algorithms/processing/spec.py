@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import InputError
+from ..feedback import Feedback
 from ..input_errors import display_path
 from ..output_policy import PROJECT_FILE, Target, contained
-from .feedback import Feedback
 
 #: Parameter kinds. Paths are passed on as ``str``.
 INPUT_PATH_KINDS = ("raster", "vector", "file", "folder", "project")
@@ -417,21 +417,6 @@ def _read_project(path: Any) -> Tuple[Any, List[Path]]:
     return entry
 
 
-def json_ready(value: Any) -> Any:
-    """Convert paths, numpy scalars/arrays and tuples so that ``json.dumps`` accepts them."""
-    if isinstance(value, dict):
-        return {str(k): json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_ready(v) for v in value]
-    if isinstance(value, Path):
-        return str(value)
-    if hasattr(value, "tolist"):  # numpy scalars and arrays
-        return json_ready(value.tolist())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def _to_bool(value: Any) -> bool:
     if isinstance(value, bool):
         return value
@@ -463,7 +448,6 @@ __all__ = [
     "Algorithm",
     "Output",
     "Parameter",
-    "json_ready",
     "model_product",
     "prepare_parameters",
     "project_product",

@@ -36,7 +36,7 @@ from rasterio.vrt import WarpedVRT
 from rasterio.windows import Window
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile
 from .coregister import nuth_kaab
 from .stats import SLOPE_LABELS, DifferenceAccumulator, _label_key, slope_class_index

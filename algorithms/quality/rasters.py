@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile
 
 PathLike = Union[str, Path]

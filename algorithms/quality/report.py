@@ -32,8 +32,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from ..processing.feedback import Feedback, ensure_feedback
-from ..processing.spec import json_ready
+from ..feedback import Feedback, ensure_feedback
+from ..jsonable import json_ready
 from ..raster.io import atomic_output
 from .rasters import DIFFERENCE_CLASSES, difference_bounds, difference_colors
 

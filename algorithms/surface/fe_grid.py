@@ -89,7 +89,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from .gridding import Grid, polygon_mask
 
 Array = NDArray[Any]

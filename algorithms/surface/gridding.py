@@ -55,7 +55,7 @@ from affine import Affine
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]

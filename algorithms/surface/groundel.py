@@ -77,7 +77,7 @@ from affine import Affine
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from .gridding import Grid
 
 Array = NDArray[Any]

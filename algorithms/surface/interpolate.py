@@ -33,7 +33,7 @@ from typing import Any, Dict, List, Optional, Union
 import numpy as np
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..project.edits import read_constraints, read_geometries
 from ..quality.points import check_distinct_points, read_points
 from ..raster.io import atomic_output, write_raster

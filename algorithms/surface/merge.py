@@ -47,7 +47,7 @@ from affine import Affine
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
 
 PathLike = Union[str, Path]

@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output
 
 PathLike = Union[str, Path]

@@ -46,7 +46,7 @@ import numpy as np
 from rasterio.errors import NotGeoreferencedWarning
 
 from ..errors import InputError
-from ..processing.feedback import Feedback, ensure_feedback
+from ..feedback import Feedback, ensure_feedback
 from ..project.model import ImageRecord, Project, StereoModel
 from ..raster.io import staged_folder, write_raster
 from .flight import SIZES, STEEP_GSD_FACTOR, FlightPlan, footprint_points, plan_flight

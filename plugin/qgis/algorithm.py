@@ -51,8 +51,8 @@ from qgis.core import (
 )
 
 from ...algorithms.errors import PhotodemError
+from ...algorithms.feedback import Feedback
 from ...algorithms.processing import registry
-from ...algorithms.processing.feedback import Feedback
 from ...algorithms.processing.spec import Algorithm, Output, Parameter
 from ..i18n import tr
 from ..qt import QIcon

@@ -17,6 +17,7 @@ from typing import Any, Callable, Dict, List, Optional
 import numpy as np
 
 from ...algorithms.errors import Cancelled, PhotodemError
+from ...algorithms.feedback import Feedback
 from ...algorithms.georef.fit import KINDS
 from ...algorithms.georef.products import (
     INDEPENDENT_COLOUR,
@@ -26,7 +27,6 @@ from ...algorithms.georef.products import (
     skipped_ids_text,
 )
 from ...algorithms.georef.review import Review, load_review, save_review
-from ...algorithms.processing.feedback import Feedback
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 

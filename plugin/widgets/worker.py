@@ -1,7 +1,7 @@
 """Running an algorithm off the GUI thread: a QObject worker in a QThread.
 
 The worker calls :func:`photodem.algorithms.processing.registry.run` — the same call as the CLI,
-batch and QGIS — with a :class:`~photodem.algorithms.processing.feedback.Feedback` whose
+batch and QGIS — with a :class:`~photodem.algorithms.feedback.Feedback` whose
 ``on_progress``/``on_log`` emit Qt signals (queued across threads, so widgets are only touched in
 the GUI thread). Cancel is :meth:`Feedback.cancel`; the algorithm stops at its next progress
 check and discards its staged outputs.
@@ -13,8 +13,8 @@ import traceback
 from typing import Any, Dict, Optional
 
 from ...algorithms.errors import Cancelled, PhotodemError
+from ...algorithms.feedback import Feedback
 from ...algorithms.processing import registry
-from ...algorithms.processing.feedback import Feedback
 from ..qt import QObject, Qt, QThread, pyqtSignal, pyqtSlot
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from photodem.algorithms import cli
-from photodem.algorithms.processing.cli_feedback import CliFeedback
+from photodem.algorithms.cli_feedback import CliFeedback
 
 FAKES = Path(__file__).resolve().parent / "processing"
 if str(FAKES) not in sys.path:

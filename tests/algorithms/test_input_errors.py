@@ -19,6 +19,7 @@ import rasterio
 
 from photodem.algorithms import cli
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.input_errors import (
     check_raster,
     display_path,
@@ -27,7 +28,6 @@ from photodem.algorithms.input_errors import (
 )
 from photodem.algorithms.memory import check_allocation, format_bytes
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 
 NON_UTF8 = os.fsdecode(b"\xe9t\xe9")  # a Latin-1 name as Linux passes it: surrogate escapes
 

@@ -18,7 +18,7 @@ import numpy as np
 from affine import Affine
 
 from photodem.algorithms.errors import InputError
-from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing.spec import Algorithm, Output, Parameter
 from photodem.algorithms.raster.io import atomic_output, staged_folder, write_raster
 

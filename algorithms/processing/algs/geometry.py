@@ -8,11 +8,12 @@ from typing import Any, Dict, Optional
 
 import numpy as np
 
+from ...feedback import Feedback
 from ...geometry.epipolar import SIDES, EpipolarPair
+from ...jsonable import json_ready
 from ...project.model import Project
 from ...raster.io import gtiff_profile, open_image, staged_folder
-from ..feedback import Feedback
-from ..spec import Algorithm, Output, Parameter, json_ready, model_product
+from ..spec import Algorithm, Output, Parameter, model_product
 
 #: Pixels per resampled row block (per band): bounds the memory of the resampling.
 _BLOCK_PIXELS = 1_000_000

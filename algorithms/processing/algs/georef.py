@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Dict
 
-from ..feedback import Feedback, StepFeedback
+from ...feedback import Feedback, StepFeedback
 from ..spec import Algorithm, Output, Parameter
 
 GROUP = "Georeferencing"

@@ -9,10 +9,10 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from ...errors import InputError
+from ...feedback import Feedback
 from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
 from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
 from ...raster.io import atomic_output, gtiff_profile, open_image
-from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, model_product
 
 GROUP = "Matching"

@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 from ...errors import InputError
-from ..feedback import Feedback
+from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, project_product
 
 GROUP = "Orthophotos"

@@ -7,8 +7,8 @@ from pathlib import Path
 from typing import Any, Dict
 
 from ...errors import InputError
+from ...feedback import Feedback
 from ...project.model import Project
-from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
 

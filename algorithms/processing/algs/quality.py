@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Dict
 
+from ...feedback import Feedback
 from ...raster.io import staged_folder
-from ..feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
 GROUP = "Quality control"

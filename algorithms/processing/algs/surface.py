@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Dict, List, Optional
 
-from ..feedback import Feedback
+from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, project_product
 
 GROUP = "Surfaces"

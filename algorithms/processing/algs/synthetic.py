@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Dict
 
-from ..feedback import Feedback
+from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
 

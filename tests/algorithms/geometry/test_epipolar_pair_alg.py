@@ -11,12 +11,12 @@ import rasterio
 from affine import Affine
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.epipolar import EpipolarPair
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.geometry.projection import ray_at_height
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.model import ImageRecord, Project, StereoModel
 from photodem.algorithms.raster.io import write_raster
 from photodem.algorithms.raster.sample import bilinear

@@ -10,12 +10,12 @@ import pytest
 from scipy import ndimage
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.matching.dense import (
     fill_holes_rows,
     sgm_disparity,
 )
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.raster.io import open_image, write_raster
 
 H, W = 150, 240

@@ -11,9 +11,9 @@ import rasterio
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, GeometryError, InputError, PhotodemError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.matching.dense_model import match_model_dense
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.quality.compare import compare_dems
 
 MODEL = "0102_0103"

@@ -9,6 +9,7 @@ import pytest
 from scipy import ndimage
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.matching.fbm import window_components
 from photodem.algorithms.matching.hierarchy import (
     FLAG_GRID,
@@ -18,7 +19,6 @@ from photodem.algorithms.matching.hierarchy import (
     _suspect_components,
     match_epipolar_fbm_lsm,
 )
-from photodem.algorithms.processing.feedback import Feedback
 
 H = W = 480
 

@@ -20,6 +20,7 @@ from scipy.sparse.linalg import spsolve
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.matching.object_space import (
@@ -31,7 +32,6 @@ from photodem.algorithms.matching.object_space import (
     refine_object_space,
 )
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.edits import add_features, create_edits
 from photodem.algorithms.project.model import ImageRecord, Project
 from photodem.algorithms.raster.io import write_raster

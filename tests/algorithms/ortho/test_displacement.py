@@ -16,6 +16,7 @@ import rasterio
 from affine import Affine
 
 from photodem.algorithms.errors import GeometryError, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.geometry.projection import ray_at_height, world_to_pixel
@@ -29,7 +30,6 @@ from photodem.algorithms.ortho.displacement import (
     write_shift_points,
 )
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.model import ImageRecord, Project
 from photodem.algorithms.raster.io import write_raster
 

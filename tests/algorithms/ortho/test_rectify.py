@@ -18,6 +18,7 @@ rasterio = pytest.importorskip("rasterio")
 pytest.importorskip("cv2")
 
 from photodem.algorithms.errors import Cancelled, InputError  # noqa: E402
+from photodem.algorithms.feedback import Feedback  # noqa: E402
 from photodem.algorithms.geometry.camera import Camera  # noqa: E402
 from photodem.algorithms.geometry.orientation import ExteriorOrientation  # noqa: E402
 from photodem.algorithms.geometry.projection import world_to_pixel  # noqa: E402
@@ -27,7 +28,6 @@ from photodem.algorithms.ortho.rectify import (  # noqa: E402
     surface_heights,
 )
 from photodem.algorithms.processing import registry  # noqa: E402
-from photodem.algorithms.processing.feedback import Feedback  # noqa: E402
 from photodem.algorithms.project.model import ImageRecord, Project  # noqa: E402
 from photodem.algorithms.quality.targets import target_centroids  # noqa: E402
 from photodem.algorithms.raster.io import (  # noqa: E402

@@ -9,8 +9,8 @@ import time
 import pytest
 
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing import batch
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project import toml_io
 
 

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.output_policy import PRODUCT_MARKER
 from photodem.algorithms.processing import batch
-from photodem.algorithms.processing.feedback import Feedback
 
 HERE = Path(__file__).resolve().parent
 linux_only = pytest.mark.skipif(not sys.platform.startswith("linux"),

@@ -14,9 +14,9 @@ from shapely.geometry import LineString, Polygon
 from photodem.algorithms import cli
 from photodem.algorithms.crs_check import check_surface_crs, same_horizontal_crs
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.input_errors import InputWarning
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.edits import (
     check_action,
     create_edits,

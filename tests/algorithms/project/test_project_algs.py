@@ -11,9 +11,9 @@ import rasterio
 from scipy.ndimage import map_coordinates
 
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.projection import world_to_pixel
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.edits import EDIT_LAYERS
 from photodem.algorithms.project.model import Project
 

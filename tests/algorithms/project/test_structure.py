@@ -17,8 +17,8 @@ import pytest
 
 from photodem.algorithms import cli
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.project.model import Project
 from photodem.algorithms.project.validate import ValidationReport, validate_project
 

@@ -13,7 +13,7 @@ from rasterio.crs import CRS
 from scipy import ndimage
 
 from photodem.algorithms.errors import Cancelled, InputError
-from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.quality.compare import compare_dems
 from photodem.algorithms.quality.stats import difference_stats
 

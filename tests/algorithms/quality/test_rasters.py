@@ -12,7 +12,7 @@ import rasterio
 from affine import Affine
 
 from photodem.algorithms.errors import Cancelled, InputError
-from photodem.algorithms.processing.feedback import Feedback
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.quality.rasters import (
     DIFFERENCE_CLASSES,
     difference_style_qml,

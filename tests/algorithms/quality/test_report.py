@@ -14,8 +14,8 @@ import rasterio
 from affine import Affine
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.quality.report import (
     box_summary,
     csv_rows,

@@ -14,8 +14,8 @@ import pytest
 
 from photodem.algorithms import output_policy
 from photodem.algorithms.errors import InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.processing.spec import Algorithm, Output, Parameter
 from photodem.algorithms.raster import io as rio
 from photodem.algorithms.raster.io import (

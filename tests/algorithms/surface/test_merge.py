@@ -11,8 +11,8 @@ import rasterio
 from affine import Affine
 
 from photodem.algorithms.errors import Cancelled, InputError
+from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.processing import registry
-from photodem.algorithms.processing.feedback import Feedback
 from photodem.algorithms.raster.io import write_raster
 from photodem.algorithms.surface.merge import merge_dsms, sibling_paths
 

@@ -13,9 +13,9 @@ rasterio = pytest.importorskip("rasterio")
 fiona = pytest.importorskip("fiona")
 
 from photodem.algorithms.errors import Cancelled  # noqa: E402
+from photodem.algorithms.feedback import Feedback  # noqa: E402
 from photodem.algorithms.geometry.projection import world_to_pixel  # noqa: E402
 from photodem.algorithms.processing import registry  # noqa: E402
-from photodem.algorithms.processing.feedback import Feedback  # noqa: E402
 from photodem.algorithms.project.model import Project  # noqa: E402
 from photodem.algorithms.synthetic.block import build_scene, generate_block  # noqa: E402
 from photodem.algorithms.synthetic.objects import (  # noqa: E402

@@ -11,7 +11,7 @@ from __future__ import annotations
 import threading
 from typing import Callable, List, Optional
 
-from ..errors import Cancelled
+from .errors import Cancelled
 
 
 class Feedback:
