@@ -83,8 +83,9 @@ def _library_errors() -> Tuple[Type[BaseException], ...]:
     try:
         import fiona.errors as fio
 
-        classes += [fio.DriverError, fio.DataIOError, fio.CRSError, fio.PathError,
-                    fio.UnsupportedGeometryTypeError]
+        names = ("DriverError", "DataIOError", "CRSError", "PathError",  # PathError: ≥ 1.10
+                 "UnsupportedGeometryTypeError")
+        classes += [getattr(fio, n) for n in names if hasattr(fio, n)]
     except ImportError:  # pragma: no cover - fiona is a dependency
         pass
     try:
