@@ -119,9 +119,9 @@
             <translation>Projektinformationen</translation>
         </message>
         <message>
-            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation.</source>
+            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation. Validation warnings and errors are reported; a project with errors (a CRS PROJ does not know, no images, missing image files…) ends with an error naming the first of them.</source>
             <extracomment>project_info: help</extracomment>
-            <translation>Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf.</translation>
+            <translation>Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf. Warnungen und Fehler der Prüfung werden gemeldet; ein Projekt mit Fehlern (ein KBS, das PROJ nicht kennt, keine Bilder, fehlende Bilddateien …) endet mit einem Fehler, der den ersten davon nennt.</translation>
         </message>
         <message>
             <source>Project name</source>
@@ -2415,7 +2415,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:324; plugin/widgets/georef_review.py:489; plugin/widgets/georef_review.py:494</extracomment>
+            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:326; plugin/widgets/georef_review.py:497; plugin/widgets/georef_review.py:502</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2550,72 +2550,72 @@
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:149</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:151</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:152</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:157</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:158</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:160</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:161</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:163</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:165</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/georef_review.py:164</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:166</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:165</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:167</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:170</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:465</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:473</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:466; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:474; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:511</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:519</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:546</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:554</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:546</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:554</extracomment>
             <translation>nein</translation>
         </message>
         <message>
@@ -2670,17 +2670,17 @@
         </message>
         <message>
             <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:335</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:337</extracomment>
             <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:390</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:392</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:494</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:502</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
@@ -2695,37 +2695,37 @@
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:310</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:312</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:311</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:313</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
             <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:373</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:375</extracomment>
             <translation>manuell</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:396</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:396</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:398</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:400</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:402</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:433</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:435</extracomment>
             <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>

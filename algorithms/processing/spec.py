@@ -18,7 +18,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 from ..errors import InputError
 from ..feedback import Feedback
 from ..input_errors import display_path
-from ..output_policy import PROJECT_FILE, Target, contained
+from ..output_policy import PROJECT_FILE, PROJECT_PARTS, Target, contained
 
 #: Parameter kinds. Paths are passed on as ``str``.
 INPUT_PATH_KINDS = ("raster", "vector", "file", "folder", "project")
@@ -384,8 +384,16 @@ def model_product(params: Dict[str, Any], step: str) -> Path:
 
 def project_files(path: Path) -> List[Path]:
     """The files of the project at ``path`` that no output may replace, resolved:
-    ``project.toml``, ``edits.gpkg``, ``images/``, ``.photodem/`` and every image."""
-    return _read_project(path)[1]
+    ``project.toml``, ``edits.gpkg``, ``images/``, ``.photodem/`` and every image.
+
+    A project that cannot be read yields its parts by name only: the run that reads it names
+    the problem itself, and the parts stay protected meanwhile.
+    """
+    try:
+        return _read_project(path)[1]
+    except InputError:
+        root = Path(path).parent if Path(path).suffix == ".toml" else Path(path)
+        return [(root / part).resolve() for part in PROJECT_PARTS]
 
 
 #: Projects read for the output checks, by file identity (path, mtime, size) → (project, its

@@ -22,6 +22,7 @@ Expectations that are not "exit 2":
 from __future__ import annotations
 
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -74,6 +75,17 @@ def _edit_toml(old: str, new: str, count: int = 1) -> Prep:
         text = path.read_text(encoding="utf-8")
         assert old in text, f"{old!r} not in project.toml"
         path.write_text(text.replace(old, new, count), encoding="utf-8")
+    return prep
+
+
+def _edit_toml_first(pattern: str, new: str) -> Prep:
+    """Replace the first match of the regular expression ``pattern`` (for values whose digits
+    vary with the numpy version, such as a synthetic block's angles)."""
+    def prep(ws: Workspace) -> None:
+        path = ws.p / "project.toml"
+        text = path.read_text(encoding="utf-8")
+        assert re.search(pattern, text), f"{pattern!r} not in project.toml"
+        path.write_text(re.sub(pattern, lambda _: new, text, count=1), encoding="utf-8")
     return prep
 
 
@@ -446,7 +458,7 @@ CASES: List[Case] = [
          prep=_edit_toml("position = [402273.01432063925, 5674670.423631551, 127.56881843801533]",
                          "position = [1.0, 2.0]")),
     Case("p6-toml-opk-strings", PI,
-         prep=_edit_toml("opk = [-0.885810852746979", 'opk = ["a", "b", "c"]\nx_ = [0')),
+         prep=_edit_toml_first(r"opk = \[[^\]]*\]", 'opk = ["a", "b", "c"]')),
     Case("p6-toml-crs-int", PI, prep=_edit_toml('crs = "EPSG:25832"', "crs = 25832")),
     Case("p6-toml-crs-unknown", PI, prep=_edit_toml('crs = "EPSG:25832"', 'crs = "EPSG:1"')),
     Case("p6-toml-format-version", PI, prep=_edit_toml("format_version = 1",
