@@ -23,3 +23,22 @@ def shared_data(name: str) -> Path:
 def ngi_block() -> Path:
     """The NGI aerial block (4 frames, EO/IO, reference DEM)."""
     return shared_data("ngi_aerial_block")
+
+
+@pytest.fixture
+def chain_project(tmp_path):
+    """A factory of small projects without image files: ``chain_project("abc")`` makes
+    ``<tmp>/proj`` with images a, b, c on one camera and the stereo models a_b, b_c."""
+    def make(names: str) -> Path:
+        from photodem.algorithms.geometry.camera import Camera
+        from photodem.algorithms.geometry.orientation import ExteriorOrientation
+        from photodem.algorithms.project.model import ImageRecord, Project, StereoModel
+
+        root = tmp_path / "proj"
+        eo = ExteriorOrientation.from_opk([0.0, 0.0, 1000.0], 0.0, 0.0, 0.0)
+        images = [ImageRecord(n, f"{n}.tif", "c", eo) for n in names]  # no files
+        Project(root=root, name="t", crs="EPSG:25832",
+                cameras={"c": Camera("c", 100, 80, 1.0, (0.01, 0.01))}, images=images,
+                models=[StereoModel(f"{a}_{b}", a, b) for a, b in zip(names, names[1:])]).save()
+        return root
+    return make

@@ -30,18 +30,8 @@ def fakes(monkeypatch):
 
 
 @pytest.fixture
-def project(tmp_path):
-    from photodem.algorithms.geometry.camera import Camera
-    from photodem.algorithms.geometry.orientation import ExteriorOrientation
-    from photodem.algorithms.project.model import ImageRecord, Project, StereoModel
-
-    root = tmp_path / "proj"
-    eo = ExteriorOrientation.from_opk([0.0, 0.0, 1000.0], 0.0, 0.0, 0.0)
-    images = [ImageRecord(n, f"{n}.tif", "c", eo) for n in "abc"]  # no files
-    Project(root=root, name="t", crs="EPSG:25832",
-            cameras={"c": Camera("c", 100, 80, 1.0, (0.01, 0.01))}, images=images,
-            models=[StereoModel("a_b", "a", "b"), StereoModel("b_c", "b", "c")]).save()
-    return root
+def project(chain_project):
+    return chain_project("abc")
 
 
 @pytest.fixture

@@ -27,20 +27,9 @@ linux_only = pytest.mark.skipif(not sys.platform.startswith("linux"),
 
 
 @pytest.fixture
-def project4(tmp_path):
+def project4(chain_project):
     """A project with four stereo models (a step of four tasks)."""
-    from photodem.algorithms.geometry.camera import Camera
-    from photodem.algorithms.geometry.orientation import ExteriorOrientation
-    from photodem.algorithms.project.model import ImageRecord, Project, StereoModel
-
-    root = tmp_path / "proj"
-    eo = ExteriorOrientation.from_opk([0.0, 0.0, 1000.0], 0.0, 0.0, 0.0)
-    images = [ImageRecord(n, f"{n}.tif", "c", eo) for n in "abcde"]  # no files
-    Project(root=root, name="t", crs="EPSG:25832",
-            cameras={"c": Camera("c", 100, 80, 1.0, (0.01, 0.01))}, images=images,
-            models=[StereoModel(f"{a}_{b}", a, b) for a, b in
-                    (("a", "b"), ("b", "c"), ("c", "d"), ("d", "e"))]).save()
-    return root
+    return chain_project("abcde")
 
 
 def _config(project, steps, **head):
