@@ -98,15 +98,42 @@ import math
 import time
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
-from affine import Affine
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from ..surface.gridding import Grid, line_barrier
+from ..surface.gridding import Grid
+from .lp_pyramid import (
+    BreaklineSides,
+    breakline_sides,
+    hard_grid,
+    level_grid,
+    local_slope,
+    pyramid_levels,
+    reduce_lowest,
+    reduce_scale,
+    terrain_slope,
+    tile_offset,
+    touches_border,
+    upsample_sides,
+)
+from .presets import linear_prediction_preset
+from .surface_input import (
+    check_ground_points,
+    dtm_slope,
+    grey_opening,
+    ground_bumps,
+    low_outliers,
+    lowest_points,
+    read_filter_constraints,
+    read_filter_input,
+    write_filter_outputs,
+)
+from .tiles import MAX_CELLS, filter_in_tiles
 
 Array = NDArray[Any]
 PathLike = Union[str, Path]
@@ -291,68 +318,6 @@ def predict_dense(xy: Array, values: Array, xy_new: Array, c0: float, corr: floa
 
 
 # -- covariance operator on a grid ----------------------------------------------------------------
-class _Sides:
-    """Breakline sides of a grid: labels 0…k−1 (k−1 = the breakline cells themselves)."""
-
-    def __init__(self, labels: Array, k: int) -> None:
-        from scipy import ndimage
-
-        self.labels = labels
-        self.k = k
-        self.slices = ndimage.find_objects(labels + 1, max_label=k)
-
-
-def _extended_lines(lines: Sequence[Any], length: float) -> List[Any]:
-    """Each line part's two end segments extended by ``length`` (m) in their directions."""
-    from shapely.geometry import LineString
-
-    out = []
-    for g in lines:
-        for part in getattr(g, "geoms", [g]):
-            c = np.asarray(part.coords, float)[:, :2]
-            if len(c) < 2:
-                continue
-            for a, b in ((c[0], c[1]), (c[-1], c[-2])):
-                u = a - b
-                n = float(np.hypot(*u))
-                if n > 0:
-                    out.append(LineString([tuple(a), tuple(a + u / n * length)]))
-    return out
-
-
-def breakline_sides(lines: Sequence[Any], grid: Grid) -> Tuple[Optional[_Sides], Array, Array]:
-    """Partition of the grid by breaklines and their extensions to the grid border.
-
-    Returns
-    -------
-    (sides or None without lines, barrier mask, barrier heights)
-        Sides are the 4-connected components of the cells no (extended) line touches; cells
-        touched only by an extension join the nearest side; the breakline cells form a class
-        of their own (they correlate along the line, not with either side).
-    """
-    from rasterio.features import rasterize
-    from scipy import ndimage
-
-    lines = [g for g in (lines or []) if g is not None and not g.is_empty]
-    barrier, zline = line_barrier(lines, grid)
-    if not lines or not barrier.any():
-        return None, barrier, zline
-    diag = grid.spacing * math.hypot(grid.width, grid.height)
-    ext = _extended_lines(lines, 2.0 * diag)
-    cut = barrier.copy()
-    if ext:
-        cut |= rasterize([(g, 1) for g in ext], out_shape=grid.shape, transform=grid.transform,
-                         fill=0, all_touched=True, dtype="uint8").astype(bool)
-    labels, n = ndimage.label(~cut)
-    labels = labels.astype(np.int32) - 1  # −1 on cut cells
-    only_ext = cut & ~barrier
-    if only_ext.any() and n > 0:
-        # nearest cell of a side (cut cells are the background of the transform)
-        _, (ir, ic) = ndimage.distance_transform_edt(cut, return_indices=True)
-        labels[only_ext] = labels[ir[only_ext], ic[only_ext]]
-    labels[barrier] = n
-    return _Sides(labels, n + 1), barrier, zline
-
 
 #: Largest negative eigenvalue (relative to C₀) the truncated covariance may have: a fifth of
 #: the smallest noise variance :func:`fit_covariance` gives (10⁻²·C₀).
@@ -400,7 +365,6 @@ def _smooth(x: Array, k: Array) -> Array:
     along axis 0 strides through memory and is ~2.5 × slower; every output cell is the same
     sum of the same products in the same order, so the strips give bit-identical values.
     """
-    from scipy import ndimage
 
     h, w = x.shape
     r = len(k) // 2
@@ -417,7 +381,8 @@ def _smooth(x: Array, k: Array) -> Array:
     return ndimage.correlate1d(y, k, axis=1, mode="constant", output=np.float32)
 
 
-def covariance_apply(x: Array, c0: float, corr: float, sides: Optional[_Sides] = None) -> Array:
+def covariance_apply(x: Array, c0: float, corr: float,
+                     sides: Optional[BreaklineSides] = None) -> Array:
     r"""Covariance times a grid vector: :math:`(\mathbf C\mathbf x)_i = \sum_j C(d_{ij}) x_j`.
 
     Cells of different breakline sides do not correlate:
@@ -479,7 +444,7 @@ def _pcg(matvec: Callable[[Array], Array], b: Array, x: Array, minv: Array, tol:
 
 
 def lp_solve(lz: Array, active: Array, cov: Covariance, noise_scale: Optional[Array] = None,
-             sides: Optional[_Sides] = None, x0: Optional[Array] = None, tol: float = 1e-3,
+             sides: Optional[BreaklineSides] = None, x0: Optional[Array] = None, tol: float = 1e-3,
              maxiter: int = 300, feedback: Optional[Feedback] = None
              ) -> Tuple[Array, Array, int]:
     r"""Grid prediction :math:`\hat{\mathbf s} = \mathbf C(\mathbf C+\mathbf D)^{-1}\mathbf l`.
@@ -631,148 +596,6 @@ def residual_shift(r: Array, factor: float, max_shift: float) -> float:
 
 
 # -- pyramid ---------------------------------------------------------------------------------------
-def _reduce_min(a: Array) -> Array:
-    """Lowest finite value of every 2×2 block (NaN if none)."""
-    h, w = a.shape
-    p = np.full((h + h % 2, w + w % 2), np.nan, np.float32)
-    p[:h, :w] = a
-    return np.fmin(np.fmin(p[0::2, 0::2], p[1::2, 0::2]), np.fmin(p[0::2, 1::2], p[1::2, 1::2]))
-
-
-def _limited_slope(z: Array, axis: int) -> Array:
-    """Slope per cell along ``axis`` by the monotonised central (MC) limiter.
-
-    The central difference where both one-sided differences agree in sign, but at most twice
-    the smaller of them (0 at a sign change): exact on a plane, while a building or a wall
-    next to the cell cannot tilt it by more than twice the terrain's own slope.
-    """
-    d = np.diff(z, axis=axis)
-    pad = [(0, 0), (0, 0)]
-    pad[axis] = (1, 0)
-    back = np.pad(d, pad, mode="edge")
-    pad[axis] = (0, 1)
-    fwd = np.pad(d, pad, mode="edge")
-    mag = np.minimum(np.minimum(2.0 * np.abs(back), 2.0 * np.abs(fwd)), 0.5 * np.abs(back + fwd))
-    return np.where(np.sign(back) == np.sign(fwd), np.sign(fwd) * mag, 0.0)
-
-
-def _reduce_lowest(a: Array, max_slope: float = 1.5) -> Array:
-    r"""Mean of the two lowest cells of every 2×2 block, moved to the block centre along the slope.
-
-    The lowest cells keep the ground and drop objects: a building edge or corner covers at
-    most two cells of a block, so objects shrink by about a fine cell per side and level.
-    Two rather than the single lowest cell, because the minimum of four is the lowest noise
-    or roughness value (−1.03 σ for Gaussian noise, −0.66 σ for the mean of the two lowest)
-    and, on terraced slopes, the lower terrace; the bias piles up over the levels (metres at
-    16 m cells on 50 % slopes: the finer levels' candidate band then cuts the slope). On a
-    slope the lowest cells lie on the block's downhill side: with the gradient
-    ``(g_x, g_y)`` of the level (:func:`_limited_slope` per cell, averaged over the block,
-    clipped to ``max_slope``) and the mean offset ``(δx, δy)`` of the two cells from the
-    block centre (±½ fine cell each), the block value is :math:`\bar z_2 - g_x δx - g_y δy`.
-    """
-    from scipy import ndimage
-
-    h, w = a.shape
-    p = np.full((h + h % 2, w + w % 2), np.nan, np.float32)
-    p[:h, :w] = a
-    subs = np.stack([p[0::2, 0::2], p[0::2, 1::2], p[1::2, 0::2], p[1::2, 1::2]])
-    order = np.argsort(np.where(np.isfinite(subs), subs, np.inf), axis=0, kind="stable")
-    v0 = np.take_along_axis(subs, order[:1], axis=0)[0]
-    v1 = np.take_along_axis(subs, order[1:2], axis=0)[0]
-    two = np.isfinite(v1)  # blocks with a single cell take that cell
-    i1 = np.where(two, order[1], order[0])
-    out = np.where(two, 0.5 * (v0 + v1), v0)
-    ok = np.isfinite(a)
-    if ok.sum() < 4 or min(a.shape) < 3:
-        return out.astype(np.float32)
-    dcol = np.array([-0.5, 0.5, -0.5, 0.5])  # offset in fine cells: +x to the right
-    drow = np.array([-0.5, -0.5, 0.5, 0.5])  # rows grow downwards
-    _, (ir, ic) = ndimage.distance_transform_edt(~ok, return_indices=True)
-    zf = np.asarray(a, np.float64)[ir, ic]  # gaps take the nearest value for the gradient
-    hh, ww = p.shape[0] // 2, p.shape[1] // 2
-    grads = []
-    for axis in (0, 1):
-        g = np.pad(_limited_slope(zf, axis), ((0, h % 2), (0, w % 2)), mode="edge")
-        grads.append(np.clip(g.reshape(hh, 2, ww, 2).mean(axis=(1, 3)), -max_slope, max_slope))
-    gr, gc = grads
-    dc = 0.5 * (dcol[order[0]] + dcol[i1])
-    dr = 0.5 * (drow[order[0]] + drow[i1])
-    return (out - gc * dc - gr * dr).astype(np.float32)
-
-
-def _up1(a: Array, axis: int, n: int) -> Array:
-    a = np.moveaxis(a, axis, 0)
-    prev = np.concatenate([a[:1], a[:-1]])
-    nxt = np.concatenate([a[1:], a[-1:]])
-    out = np.empty((2 * a.shape[0],) + a.shape[1:], np.float32)
-    out[0::2] = 0.75 * a + 0.25 * prev
-    out[1::2] = 0.75 * a + 0.25 * nxt
-    return np.moveaxis(out[:n], 0, axis)
-
-
-def upsample2(a: Array, shape: Tuple[int, int]) -> Array:
-    """Bilinear ×2 upsampling of a level to the next finer level of ``shape``.
-
-    Coarse cell i covers fine cells 2i, 2i+1, so fine cell 2i lies a quarter coarse cell
-    before coarse centre i: :math:`f_{2i} = ¾a_i + ¼a_{i-1}`, :math:`f_{2i+1} = ¾a_i + ¼a_{i+1}`
-    (edges clamped).
-    """
-    return _up1(_up1(np.asarray(a, np.float32), 0, shape[0]), 1, shape[1])
-
-
-def _upsample_sides(a: Array, shape: Tuple[int, int], sides_c: Optional[_Sides],
-                    sides_f: Optional[_Sides]) -> Array:
-    """Upsampling that takes every fine cell's value only from coarse cells of its side."""
-    from scipy import ndimage
-
-    up = upsample2(a, shape)
-    if sides_c is None or sides_f is None:
-        return up
-    hc, wc = a.shape
-    # side of a coarse cell = side of the fine cell at its upper-left corner (same geometry)
-    rr = np.minimum(np.arange(hc) * 2, shape[0] - 1)
-    cc = np.minimum(np.arange(wc) * 2, shape[1] - 1)
-    lab_c = sides_f.labels[np.ix_(rr, cc)].copy()
-    lab_c[sides_c.labels == sides_c.k - 1] = -1  # coarse breakline cells belong to no side
-    out = up.copy()
-    for lab, sl in enumerate(sides_f.slices[:-1]):
-        if sl is None:
-            continue
-        c0 = max(sl[0].start // 2 - 2, 0), max(sl[1].start // 2 - 2, 0)
-        c1 = min(sl[0].stop // 2 + 2, hc), min(sl[1].stop // 2 + 2, wc)
-        sub_lab = lab_c[c0[0]:c1[0], c0[1]:c1[1]]
-        have = sub_lab == lab
-        if not have.any():
-            continue
-        sub = a[c0[0]:c1[0], c0[1]:c1[1]]
-        if not have.all():  # other sides' cells take the nearest value of this side
-            _, (ir, ic) = ndimage.distance_transform_edt(~have, return_indices=True)
-            sub = sub[ir, ic]
-        f0 = (2 * c0[0], 2 * c0[1])
-        fine = upsample2(sub, (min(2 * c1[0], shape[0]) - f0[0],
-                               min(2 * c1[1], shape[1]) - f0[1]))
-        m = sides_f.labels[f0[0]:f0[0] + fine.shape[0], f0[1]:f0[1] + fine.shape[1]] == lab
-        view = out[f0[0]:f0[0] + fine.shape[0], f0[1]:f0[1] + fine.shape[1]]
-        view[m] = fine[m]
-    return out
-
-
-def _level_grid(grid: Grid, level: int) -> Grid:
-    f = 2 ** level
-    t = grid.transform
-    return Grid(Affine(t.a * f, t.b, t.c, t.d, t.e * f, t.f), -(-grid.width // f),
-                -(-grid.height // f), grid.spacing * f)
-
-
-def pyramid_levels(shape: Tuple[int, int], spacing: float, coarse_spacing: float) -> int:
-    """Number of reductions: the first level whose cell reaches ``coarse_spacing``, keeping
-    at least 8 cells along the shorter side."""
-    n = 0
-    while spacing * 2 ** n < coarse_spacing and min(shape) / 2 ** (n + 1) >= 8:
-        n += 1
-    return n
-
-
 def _robust_plane(z: Array, valid: Array, prm: LPParameters, cutoff: float) -> Array:
     """Plane trend of the coarsest level, fitted with the asymmetric weights (5 iterations)."""
     rows, cols = np.nonzero(valid)
@@ -797,26 +620,306 @@ def _robust_plane(z: Array, valid: Array, prm: LPParameters, cutoff: float) -> A
             ).astype(np.float32)
 
 
-def _cells_of(points: Array, grid: Grid) -> Tuple[Array, Array]:
-    """Flat cell index (−1 outside) and heights of 3-D points on a grid."""
-    pts = np.asarray(points, float).reshape(-1, 3)
-    r, c = grid.cell_of(pts[:, 0], pts[:, 1]) if len(pts) else (np.zeros(0, int),) * 2
-    return np.where(r >= 0, r * grid.width + c, -1), pts[:, 2]
-
-
-def _hard_grid(points: Array, grid: Grid) -> Array:
-    """Mean height of the ground points per cell (NaN elsewhere)."""
-    flat, z = _cells_of(points, grid)
-    out = np.full(grid.width * grid.height, np.nan, np.float32)
-    ok = flat >= 0
-    if ok.any():
-        n = np.bincount(flat[ok], minlength=out.size)
-        s = np.bincount(flat[ok], weights=z[ok], minlength=out.size)
-        out = np.where(n > 0, s / np.maximum(n, 1), np.nan).astype(np.float32)
-    return out.reshape(grid.shape)
-
 
 # -- the filter -----------------------------------------------------------------------------------
+@dataclass
+class _TileRun:
+    """Filters one tile of a large grid (the callback of :func:`.tiles.filter_in_tiles`)."""
+
+    grid: Grid  # the whole grid (places the tile's σ window)
+    prm: LPParameters
+    sigma: Optional[Array]  # σ_z of the whole grid
+
+    def __call__(self, zt: Array, gt: Grid, ct: Any, fb: Feedback) -> Dict[str, Any]:
+        r0, c0 = tile_offset(self.grid, gt)
+        st = None if self.sigma is None else self.sigma[r0:r0 + gt.height, c0:c0 + gt.width]
+        res = filter_linear_prediction(zt, gt, self.prm, ct, st, fb, False, max_cells=zt.size)
+        return {"dtm": res.dtm, "ground": res.ground, "iterations": res.iterations,
+                "ground_points_disagreeing": res.disagreeing}
+
+
+def _filter_tiled(z: Array, grid: Grid, prm: LPParameters, constraints: Any,
+                  sigma: Optional[Array], limit: int, feedback: Feedback) -> LPResult:
+    """:func:`filter_linear_prediction` of a grid larger than ``limit`` cells, tile by tile."""
+    overlap = math.ceil(TILE_OVERLAP_COARSE * prm.coarse_spacing / grid.spacing)
+    tile_sigma = None if sigma is None else np.asarray(sigma)
+    tiled = filter_in_tiles(_TileRun(grid, prm, tile_sigma), z, grid, constraints, overlap,
+                            limit, feedback)
+    feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
+    return LPResult(tiled["dtm"], tiled["ground"], np.full(z.shape, np.nan, np.float32),
+                    tiled["first"].get("iterations", []),
+                    tiled["ground_points_disagreeing"], [])
+
+
+@dataclass
+class _Observations:
+    """The DSM and the operator's edits on the level-0 grid.
+
+    Attributes
+    ----------
+    z0 : ndarray float32
+        DSM, NaN = no data.
+    keep, remove : ndarray bool
+        Keep / remove areas (remove without the keep cells).
+    gpts : ndarray (n, 3)
+        Manual ground points.
+    lines : list
+        Breaklines.
+    obs0 : ndarray float32
+        Observations: the DSM without keep/remove cells and low blunders.
+    noise_scale0 : ndarray float32 or None
+        (σ_i / median σ)² per cell.
+    """
+
+    z0: Array
+    keep: Array
+    remove: Array
+    gpts: Array
+    lines: List[Any]
+    obs0: Array
+    noise_scale0: Optional[Array]
+
+    @property
+    def valid0(self) -> Array:
+        """Cells with a DSM height."""
+        return np.isfinite(self.z0)
+
+
+def _noise_scale(sigma: Optional[Array]) -> Optional[Array]:
+    """(σ_i / median σ)² per cell (1 where σ is unknown); None without usable σ."""
+    if sigma is None:
+        return None
+    sg = np.asarray(sigma, float)
+    med = np.nanmedian(sg[np.isfinite(sg) & (sg > 0)]) if np.any(sg > 0) else np.nan
+    if not np.isfinite(med):
+        return None
+    return np.where(np.isfinite(sg) & (sg > 0), (sg / med) ** 2, 1.0).astype(np.float32)
+
+
+def _observations(z: Array, prm: LPParameters, constraints: Any,
+                  sigma: Optional[Array]) -> _Observations:
+    """The level-0 observations and edits (see :class:`_Observations`).
+
+    Raises
+    ------
+    InputError
+        Fewer than 10 usable cells.
+    """
+    z0 = np.array(z, dtype=np.float32)
+    z0[~np.isfinite(z0)] = np.nan
+    keep = np.zeros(z0.shape, bool)
+    remove = np.zeros(z0.shape, bool)
+    gpts = np.zeros((0, 3))
+    lines: List[Any] = []
+    if constraints is not None:
+        keep = np.asarray(constraints.keep, bool)
+        remove = np.asarray(constraints.remove, bool) & ~keep
+        gpts = np.asarray(constraints.ground_points, float).reshape(-1, 3)
+        lines = list(constraints.breaklines or [])
+    # keep cells are no observations either: the terrain around an embankment is predicted
+    # without it (a 6 m dam would make the Gaussian prediction ring), then the DSM is put back
+    obs0 = np.where(remove | keep, np.nan, z0).astype(np.float32)
+    if prm.low_outlier > 0:
+        # isolated low blunders would pull the lowest-cell pyramid (and with it every level's
+        # candidate band) down by metres: cut them before the reduction
+        obs0[low_outliers(obs0, prm.low_outlier)] = np.nan
+    if np.count_nonzero(np.isfinite(obs0)) + len(gpts) < 10:
+        raise InputError("Fewer than 10 DSM cells are left for the linear prediction (all "
+                         "no data or inside 'remove' exclusion areas); check the input and the "
+                         "exclusion areas.")
+    return _Observations(z0, keep, remove, gpts, lines, obs0, _noise_scale(sigma))
+
+
+@dataclass
+class _Level:
+    """One pyramid level: its observations, trend, candidates and weight-function settings."""
+
+    lv: int
+    grid: Grid
+    zl: Array  # heights with the ground points and 3-D breakline heights set
+    hard: Array  # mean ground-point height per cell (NaN elsewhere)
+    is_hard: Array
+    sides: Optional[BreaklineSides]
+    valid: Array
+    forced: Array  # cells of hard constraints and breaklines (always candidates)
+    trend: Array
+    cand: Array  # ground candidates
+    lz: Array  # trend-removed heights
+    cutoff: Any  # weight cut-off per cell (grows with the slope)
+    half_w: Any  # half-weight residual per cell
+    corr_rng: Tuple[float, float]  # range of the correlation length (cells)
+
+    @property
+    def max_lag(self) -> int:
+        """Longest lag (cells) of the empirical covariance."""
+        return math.ceil(2 * self.corr_rng[1]) + 1
+
+
+@dataclass
+class _Coarser:
+    """What a level takes from the coarser one: its DTM, its sides and the terrain slope."""
+
+    dtm: Optional[Array] = None
+    sides: Optional[BreaklineSides] = None
+    slope: float = 0.0  # least slope allowance (m/m), set at the coarsest level
+
+
+def _level_heights(zl: Array, g_lv: Grid, obs: _Observations
+                   ) -> Tuple[Array, Array, Array, Optional[BreaklineSides], Array]:
+    """A level's heights with the ground points and 3-D breakline heights set.
+
+    Returns
+    -------
+    (heights, ground-point heights, ground-point cells, sides, forced cells)
+    """
+    hard = hard_grid(obs.gpts, g_lv)
+    is_hard = np.isfinite(hard)
+    sides, _, bz = breakline_sides(obs.lines, g_lv) if obs.lines else (None, None, None)
+    zl = np.where(is_hard, hard, zl).astype(np.float32)
+    soft_line = np.zeros(zl.shape, bool)
+    if bz is not None:
+        soft_line = np.isfinite(bz) & ~is_hard
+        zl = np.where(soft_line, bz, zl).astype(np.float32)
+    forced = (soft_line | is_hard) & np.isfinite(zl)
+    return zl, hard, is_hard, sides, forced
+
+
+def _setup_level(lv: int, grid: Grid, zl: Array, obs: _Observations, prm: LPParameters,
+                 coarser: _Coarser) -> _Level:
+    """Trend, candidates and weight settings of level ``lv`` (sets ``coarser.slope`` at the
+    coarsest level)."""
+    g_lv = level_grid(grid, lv)
+    zl, hard, is_hard, sides, forced = _level_heights(zl, g_lv, obs)
+    valid = np.isfinite(zl)
+    up = None
+    if coarser.dtm is None:
+        coarser.slope = max(prm.slope, terrain_slope(zl, g_lv.spacing))
+        slope_f: Any = coarser.slope
+    else:
+        up = upsample_sides(coarser.dtm, zl.shape, coarser.sides, sides)
+        slope_f = np.maximum(coarser.slope, local_slope(up, g_lv.spacing))
+    slope_allow = slope_f * g_lv.spacing / 2.0
+    if up is None:
+        trend = _robust_plane(zl, valid, prm, prm.cutoff + coarser.slope * g_lv.spacing)
+        cand = valid.copy()
+        corr_rng = (prm.corr_min, max(prm.corr_max, 2.0 * prm.corr_max))
+    else:
+        trend = up
+        dz = zl - trend
+        band_up = prm.band_above + slope_f * g_lv.spacing  # = slope · coarse cell / 2
+        cand = valid & (((dz <= band_up) & (dz >= -prm.band_below)) | forced)
+        corr_rng = (prm.corr_min, prm.corr_max)
+    lz = np.where(valid, zl - trend, 0.0).astype(np.float32)
+    return _Level(lv, g_lv, zl, hard, is_hard, sides, valid, forced, trend, cand, lz,
+                  prm.cutoff + slope_allow, prm.half_weight + slope_allow / 2.0, corr_rng)
+
+
+def _start_weights(lvl: _Level, prm: LPParameters, coarsest: bool
+                   ) -> Tuple[Covariance, Array, Array]:
+    """The level's first covariance model, starting weights and cells of full weight."""
+    corr_fixed = None if prm.corr_length is None else prm.corr_length / lvl.grid.spacing
+    cov = fit_covariance(empirical_covariance(lvl.lz, lvl.cand, lvl.max_lag)[0], *lvl.corr_rng,
+                         noise_share=prm.noise_share, min_noise_share=prm.min_noise_share,
+                         corr=corr_fixed, max_noise=prm.max_noise)
+    p = np.where(lvl.cand, 1.0, 0.0).astype(np.float32)
+    # full weight where terrain is certain: hard constraints, and (below the coarsest
+    # level) the candidates on the opening (:func:`_on_terrain`)
+    sure = lvl.forced | (_on_terrain(lvl.zl, lvl.cand, prm, lvl.grid.spacing) if not coarsest
+                         else np.zeros(lvl.zl.shape, bool))
+    if not coarsest:
+        # the coarser DTM is the first surface: its residuals give the starting weights
+        # (one robust iteration for free)
+        g0 = residual_shift(lvl.lz[lvl.cand & ~lvl.forced], prm.shift_factor, prm.max_shift)
+        p = asymmetric_weights(np.where(lvl.cand, lvl.lz, np.nan), g0, lvl.half_w,
+                               prm.exponent, lvl.cutoff, prm.low_cutoff).astype(np.float32)
+        p[sure] = 1.0
+    return cov, p, sure
+
+
+@dataclass
+class _LevelFit:
+    """Outcome of a level's robust iterations."""
+
+    cov: Covariance
+    p: Array  # the weights of the last prediction
+    s: Array  # the last prediction of the trend-removed heights
+    x: Array  # its CG solution (warm start of the ground-point check)
+    shift: float
+    bumps: Array  # level 0: low objects (no ground)
+
+
+def _iteration_row(lvl: _Level, cov: Covariance, p: Array, p_new: Array, g: float, its: int,
+                   number: int) -> Dict[str, Any]:
+    """Report row of one robust iteration."""
+    n_valid = max(int(lvl.valid.sum()), 1)
+    elim = int(np.count_nonzero(lvl.valid & (p_new == 0)))
+    return {"iteration": number, "level": lvl.lv, "spacing_m": float(lvl.grid.spacing),
+            "candidates": int(lvl.cand.sum()),
+            "eliminated_share": float(np.count_nonzero(lvl.valid & (p_new == 0)
+                                                       & (p > 0))) / n_valid,
+            "eliminated_total_share": elim / n_valid,
+            "shift_m": round(float(g), 4), "c0_m2": round(cov.c0, 5),
+            "noise_share": round(cov.noise_share, 4),
+            "corr_length_m": round(cov.corr * lvl.grid.spacing, 3),
+            "cg_iterations": its}
+
+
+def _robust_iterations(lvl: _Level, prm: LPParameters, scale_lv: Optional[Array],
+                       coarsest: bool, rows: List[Dict[str, Any]], fb: Feedback) -> _LevelFit:
+    """Predict, re-weight, repeat: the robust iterations of one level (rows appended)."""
+    cov, p, sure = _start_weights(lvl, prm, coarsest)
+    bumps = np.zeros(lvl.zl.shape, bool)
+    n_iter = prm.fine_iterations if lvl.lv <= 1 else prm.iterations
+    x = None
+    for k in range(max(n_iter, 1)):
+        active = p > 0
+        scale = np.where(active, 1.0 / np.maximum(p, 1e-6), 1.0).astype(np.float32)
+        if scale_lv is not None:
+            scale *= scale_lv
+        scale[lvl.is_hard] = HARD_NOISE * cov.c0 / max(cov.noise, 1e-12)
+        s, x, its = lp_solve(lvl.lz, active, cov, scale, lvl.sides, x0=x, tol=prm.cg_tol,
+                             maxiter=300 if lvl.lz.size > 10 ** 6 else 2000, feedback=fb)
+        r = np.where(lvl.valid, lvl.lz - s, np.nan)
+        g = residual_shift(r[lvl.cand & ~lvl.forced], prm.shift_factor, prm.max_shift)
+        p_new = asymmetric_weights(np.where(lvl.cand, r, np.nan), g, lvl.half_w, prm.exponent,
+                                   lvl.cutoff, prm.low_cutoff).astype(np.float32)
+        p_new[sure] = 1.0
+        if lvl.lv == 0 and k == 0:
+            # low objects narrower than a few metres get no weight: the weight function
+            # only halves it below h + slope allowance, and they lift the surface
+            bumps = _bumps(lvl.zl, lvl.cand & ~lvl.forced & (p_new > 0), lvl.trend + s, prm,
+                           lvl.grid.spacing)
+        p_new[bumps] = 0.0
+        if k == 0 and coarsest and prm.noise_share is None and prm.corr_length is None:
+            # coarsest level (objects among the candidates): re-estimate the covariance
+            # from the cells that now look like ground
+            cov = fit_covariance(empirical_covariance(lvl.lz, p_new > 0.5, lvl.max_lag)[0],
+                                 *lvl.corr_rng, min_noise_share=prm.min_noise_share,
+                                 max_noise=prm.max_noise)
+        rows.append(_iteration_row(lvl, cov, p, p_new, g, its, len(rows) + 1))
+        if k < n_iter - 1:
+            p = p_new
+        fb.progress(100.0 * (k + 1) / max(n_iter, 1))
+    return _LevelFit(cov, p, s, x, g, bumps)
+
+
+def _final_ground(dtm_c: Array, obs: _Observations, bumps: Array, grid: Grid,
+                  prm: LPParameters) -> Tuple[Array, Array]:
+    """The DTM without wide border holes (``max_gap``) and the ground cells."""
+    valid0, remove, keep = obs.valid0, obs.remove, obs.keep
+    dtm = np.asarray(dtm_c, np.float32)
+    if prm.max_gap > 0 and not valid0.all():
+        far = ndimage.distance_transform_edt(~(valid0 | remove)) * grid.spacing > prm.max_gap / 2
+        outer = far & touches_border(~(valid0 | remove))
+        dtm = np.where(outer, np.nan, dtm).astype(np.float32)
+    tol = prm.ground_tolerance + prm.ground_slope_factor * grid.spacing * np.nan_to_num(
+        dtm_slope(dtm, grid.spacing))
+    with np.errstate(invalid="ignore"):
+        ground = valid0 & (np.abs(obs.z0 - dtm) <= tol) & ~remove & ~bumps
+    ground |= keep & valid0
+    return dtm, ground
+
+
 def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters] = None,
                              constraints: Any = None, sigma: Optional[Array] = None,
                              feedback: Optional[Feedback] = None,
@@ -848,207 +951,48 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
     InputError
         Fewer than 10 usable cells (all NaN or all removed).
     """
-    from scipy import ndimage
-
-    from .tiles import MAX_CELLS, filter_in_tiles
-
     feedback = ensure_feedback(feedback)
     prm = params or LPParameters()
     limit = MAX_CELLS if max_cells is None else int(max_cells)
     if z.shape[0] * z.shape[1] > limit:
-        overlap = math.ceil(TILE_OVERLAP_COARSE * prm.coarse_spacing / grid.spacing)
-        tile_sigma = None if sigma is None else np.asarray(sigma)
-
-        def run_tile(zt: Array, gt: Grid, ct: Any, fb: Feedback) -> Dict[str, Any]:
-            r0, c0 = _offset(grid, gt)
-            st = None if tile_sigma is None else tile_sigma[r0:r0 + gt.height, c0:c0 + gt.width]
-            res = filter_linear_prediction(zt, gt, prm, ct, st, fb, False, max_cells=zt.size)
-            return {"dtm": res.dtm, "ground": res.ground, "iterations": res.iterations,
-                    "ground_points_disagreeing": res.disagreeing}
-
-        tiled = filter_in_tiles(run_tile, z, grid, constraints, overlap, limit, feedback)
-        feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
-        return LPResult(tiled["dtm"], tiled["ground"], np.full(z.shape, np.nan, np.float32),
-                        tiled["first"].get("iterations", []),
-                        tiled["ground_points_disagreeing"], [])
-    z0 = np.array(z, dtype=np.float32)
-    z0[~np.isfinite(z0)] = np.nan
-    shape = z0.shape
-    keep = np.zeros(shape, bool)
-    remove = np.zeros(shape, bool)
-    gpts = np.zeros((0, 3))
-    lines: List[Any] = []
-    if constraints is not None:
-        keep = np.asarray(constraints.keep, bool)
-        remove = np.asarray(constraints.remove, bool) & ~keep
-        gpts = np.asarray(constraints.ground_points, float).reshape(-1, 3)
-        lines = list(constraints.breaklines or [])
-    valid0 = np.isfinite(z0)
-    # keep cells are no observations either: the terrain around an embankment is predicted
-    # without it (a 6 m dam would make the Gaussian prediction ring), then the DSM is put back
-    obs0 = np.where(remove | keep, np.nan, z0).astype(np.float32)
-    if prm.low_outlier > 0:
-        # isolated low blunders would pull the lowest-cell pyramid (and with it every level's
-        # candidate band) down by metres: cut them before the reduction
-        from .surface_input import low_outliers
-
-        obs0[low_outliers(obs0, prm.low_outlier)] = np.nan
-    if np.count_nonzero(np.isfinite(obs0)) + len(gpts) < 10:
-        raise InputError("Fewer than 10 DSM cells are left for the linear prediction (all "
-                         "no data or inside 'remove' exclusion areas); check the input and the "
-                         "exclusion areas.")
-    noise_scale0 = None
-    if sigma is not None:
-        sg = np.asarray(sigma, float)
-        med = np.nanmedian(sg[np.isfinite(sg) & (sg > 0)]) if np.any(sg > 0) else np.nan
-        if np.isfinite(med):
-            noise_scale0 = np.where(np.isfinite(sg) & (sg > 0), (sg / med) ** 2, 1.0
-                                    ).astype(np.float32)
-
-    # pyramid: lowest cell per 2×2 block
-    n_red = pyramid_levels(shape, grid.spacing, prm.coarse_spacing)
-    zs, scales = [obs0], [noise_scale0]
+        return _filter_tiled(z, grid, prm, constraints, sigma, limit, feedback)
+    obs = _observations(z, prm, constraints, sigma)
+    # pyramid: lowest cells per 2×2 block
+    n_red = pyramid_levels(obs.z0.shape, grid.spacing, prm.coarse_spacing)
+    zs, scales = [obs.obs0], [obs.noise_scale0]
     for _ in range(n_red):
-        zs.append(_reduce_lowest(zs[-1]))
-        scales.append(_reduce_scale(scales[-1]))
+        zs.append(reduce_lowest(zs[-1]))
+        scales.append(reduce_scale(scales[-1]))
     rows: List[Dict[str, Any]] = []
     levels_out: List[Array] = []
-    dtm_c: Optional[Array] = None
-    sides_c: Optional[_Sides] = None
-    weights0 = np.full(shape, np.nan, np.float32)
+    coarser = _Coarser()
+    weights0 = np.full(obs.z0.shape, np.nan, np.float32)
     disagreeing: List[Dict[str, Any]] = []
     total_work = sum(4.0 ** -lv for lv in range(n_red + 1))
     done = 0.0
-    it_no = 0
     t_start = time.perf_counter()
     for lv in range(n_red, -1, -1):
-        fb = feedback.step(100.0 * done / total_work,
-                           100.0 * (done + 4.0 ** -lv) / total_work)
+        fb = feedback.step(100.0 * done / total_work, 100.0 * (done + 4.0 ** -lv) / total_work)
         done += 4.0 ** -lv
-        g_lv = _level_grid(grid, lv)
-        zl = zs[lv]
-        hard = _hard_grid(gpts, g_lv)
-        is_hard = np.isfinite(hard)
-        sides, _, bz = breakline_sides(lines, g_lv) if lines else (None, None, None)
-        zl = np.where(is_hard, hard, zl).astype(np.float32)
-        soft_line = np.zeros(zl.shape, bool)
-        if bz is not None:
-            soft_line = np.isfinite(bz) & ~is_hard
-            zl = np.where(soft_line, bz, zl).astype(np.float32)
-        valid = np.isfinite(zl)
-        forced = (soft_line | is_hard) & valid
-        if dtm_c is None:
-            slope = max(prm.slope, _terrain_slope(zl, g_lv.spacing))
-        if dtm_c is None:
-            slope_f: Any = slope
-        else:
-            slope_f = np.maximum(slope, _local_slope(
-                _upsample_sides(dtm_c, zl.shape, sides_c, sides), g_lv.spacing))
-        slope_allow = slope_f * g_lv.spacing / 2.0
-        cutoff = prm.cutoff + slope_allow
-        half_w = prm.half_weight + slope_allow / 2.0
-        if dtm_c is None:
-            trend = _robust_plane(zl, valid, prm, prm.cutoff + slope * g_lv.spacing)
-            cand = valid.copy()
-            corr_rng = (prm.corr_min, max(prm.corr_max, 2.0 * prm.corr_max))
-        else:
-            trend = _upsample_sides(dtm_c, zl.shape, sides_c, sides)
-            dz = zl - trend
-            band_up = prm.band_above + slope_f * g_lv.spacing  # = slope · coarse cell / 2
-            cand = valid & (((dz <= band_up) & (dz >= -prm.band_below)) | forced)
-            corr_rng = (prm.corr_min, prm.corr_max)
-        lz = np.where(valid, zl - trend, 0.0).astype(np.float32)
-        corr_fixed = None if prm.corr_length is None else prm.corr_length / g_lv.spacing
-        max_lag = math.ceil(2 * corr_rng[1]) + 1
-        cov = fit_covariance(empirical_covariance(lz, cand, max_lag)[0], *corr_rng,
-                             noise_share=prm.noise_share, min_noise_share=prm.min_noise_share,
-                             corr=corr_fixed, max_noise=prm.max_noise)
-        p = np.where(cand, 1.0, 0.0).astype(np.float32)
-        # full weight where terrain is certain: hard constraints, and (below the coarsest
-        # level) the candidates on the opening (:func:`_on_terrain`)
-        sure = forced | (_on_terrain(zl, cand, prm, g_lv.spacing) if dtm_c is not None
-                         else np.zeros(zl.shape, bool))
-        if dtm_c is not None:
-            # the coarser DTM is the first surface: its residuals give the starting weights
-            # (one robust iteration for free)
-            g0 = residual_shift(lz[cand & ~forced], prm.shift_factor, prm.max_shift)
-            p = asymmetric_weights(np.where(cand, lz, np.nan), g0, half_w, prm.exponent,
-                                   cutoff, prm.low_cutoff).astype(np.float32)
-            p[sure] = 1.0
-        bumps = np.zeros(zl.shape, bool)
-        n_valid = max(int(valid.sum()), 1)
-        n_iter = prm.fine_iterations if lv <= 1 else prm.iterations
-        x = None
-        s = np.zeros(shape, np.float32)
-        g = 0.0
-        for k in range(max(n_iter, 1)):
-            active = p > 0
-            scale = np.where(active, 1.0 / np.maximum(p, 1e-6), 1.0).astype(np.float32)
-            if scales[lv] is not None:
-                scale *= scales[lv]
-            scale[is_hard] = HARD_NOISE * cov.c0 / max(cov.noise, 1e-12)
-            s, x, its = lp_solve(lz, active, cov, scale, sides, x0=x, tol=prm.cg_tol,
-                                 maxiter=300 if lz.size > 10 ** 6 else 2000, feedback=fb)
-            r = np.where(valid, lz - s, np.nan)
-            rc = r[cand & ~forced]
-            g = residual_shift(rc, prm.shift_factor, prm.max_shift)
-            p_new = asymmetric_weights(np.where(cand, r, np.nan), g, half_w,
-                                       prm.exponent, cutoff, prm.low_cutoff).astype(np.float32)
-            p_new[sure] = 1.0
-            if lv == 0 and k == 0:
-                # low objects narrower than a few metres get no weight: the weight function
-                # only halves it below h + slope allowance, and they lift the surface
-                bumps = _bumps(zl, cand & ~forced & (p_new > 0), trend + s, prm, g_lv.spacing)
-            p_new[bumps] = 0.0
-            if k == 0 and lv == n_red and prm.noise_share is None and prm.corr_length is None:
-                # coarsest level (objects among the candidates): re-estimate the covariance
-                # from the cells that now look like ground
-                cov = fit_covariance(empirical_covariance(lz, p_new > 0.5, max_lag)[0],
-                                     *corr_rng, min_noise_share=prm.min_noise_share,
-                                     max_noise=prm.max_noise)
-            it_no += 1
-            elim = int(np.count_nonzero(valid & (p_new == 0)))
-            rows.append({"iteration": it_no, "level": lv, "spacing_m": float(g_lv.spacing),
-                         "candidates": int(cand.sum()),
-                         "eliminated_share": float(np.count_nonzero(valid & (p_new == 0)
-                                                                    & (p > 0))) / n_valid,
-                         "eliminated_total_share": elim / n_valid,
-                         "shift_m": round(float(g), 4), "c0_m2": round(cov.c0, 5),
-                         "noise_share": round(cov.noise_share, 4),
-                         "corr_length_m": round(cov.corr * g_lv.spacing, 3),
-                         "cg_iterations": its})
-            if k < n_iter - 1:
-                p = p_new
-            fb.progress(100.0 * (k + 1) / max(n_iter, 1))
+        lvl = _setup_level(lv, grid, zs[lv], obs, prm, coarser)
+        fit = _robust_iterations(lvl, prm, scales[lv], lv == n_red, rows, fb)
         # final surface of the level: prediction with the last weights
-        dtm_l = (trend + s).astype(np.float32)
+        dtm_l = (lvl.trend + fit.s).astype(np.float32)
         if lv == 0:
-            weights0 = np.where(valid, p, np.nan).astype(np.float32)
-            if is_hard.any():
-                disagreeing = _ground_point_check(lz, trend, p, cov, scales[0], sides, x,
-                                                  is_hard, gpts, grid, prm, fb)
-            dtm_l = np.where(is_hard, hard, dtm_l)
-            dtm_l = np.where(keep & valid0, z0, dtm_l)
+            weights0 = np.where(lvl.valid, fit.p, np.nan).astype(np.float32)
+            if lvl.is_hard.any():
+                disagreeing = _ground_point_check(lvl, fit, scales[0], obs.gpts, grid, prm, fb)
+            dtm_l = np.where(lvl.is_hard, lvl.hard, dtm_l)
+            dtm_l = np.where(obs.keep & obs.valid0, obs.z0, dtm_l)
         if keep_levels:
             levels_out.append(dtm_l)
-        dtm_c, sides_c = dtm_l, sides
-        feedback.info(f"Level {lv} ({g_lv.spacing:g} m, {g_lv.width} × {g_lv.height} cells): "
-                      f"c = {cov.corr * g_lv.spacing:.1f} m, noise share "
-                      f"{cov.noise_share:.2f}, shift {g:+.2f} m, "
+        coarser.dtm, coarser.sides = dtm_l, lvl.sides
+        feedback.info(f"Level {lv} ({lvl.grid.spacing:g} m, {lvl.grid.width} × "
+                      f"{lvl.grid.height} cells): c = {fit.cov.corr * lvl.grid.spacing:.1f} m, "
+                      f"noise share {fit.cov.noise_share:.2f}, shift {fit.shift:+.2f} m, "
                       f"{100.0 * rows[-1]['eliminated_total_share']:.1f} % eliminated "
                       f"({time.perf_counter() - t_start:.1f} s).")
-    dtm = np.asarray(dtm_c, np.float32)
-    if prm.max_gap > 0 and not valid0.all():
-        far = ndimage.distance_transform_edt(~(valid0 | remove)) * grid.spacing > prm.max_gap / 2
-        outer = far & _touches_border(~(valid0 | remove))
-        dtm = np.where(outer, np.nan, dtm).astype(np.float32)
-    from .surface_input import dtm_slope
-
-    tol = prm.ground_tolerance + prm.ground_slope_factor * grid.spacing * np.nan_to_num(
-        dtm_slope(dtm, grid.spacing))
-    with np.errstate(invalid="ignore"):
-        ground = valid0 & (np.abs(z0 - dtm) <= tol) & ~remove & ~bumps
-    ground |= keep & valid0
+    dtm, ground = _final_ground(coarser.dtm, obs, fit.bumps, grid, prm)
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
 
 
@@ -1061,8 +1005,6 @@ def _on_terrain(z: Array, cand: Array, prm: LPParameters, spacing: float) -> Arr
     prediction passes below it at a break of slope — the weight function alone would reject
     it there.
     """
-    from .surface_input import grey_opening
-
     size = max(3, round(prm.coarse_spacing / spacing) | 1)
     with np.errstate(invalid="ignore"):
         return cand & (z - grey_opening(z, size) <= prm.half_weight)
@@ -1072,73 +1014,27 @@ def _bumps(z: Array, cand: Array, surface: Array, prm: LPParameters, spacing: fl
     """Candidates more than the ground tolerance above their neighbourhood's lower envelope
     (:func:`~.surface_input.ground_bumps` with ``ground_tolerance`` and
     ``ground_slope_factor``)."""
-    from .surface_input import ground_bumps
-
     return ground_bumps(z, cand, surface, spacing, prm.ground_tolerance,
                         prm.ground_slope_factor)
 
 
-def _offset(grid: Grid, sub: Grid) -> Tuple[int, int]:
-    """(row, col) of a sub-grid's first cell in ``grid``."""
-    t, u = grid.transform, sub.transform
-    return round((u.f - t.f) / t.e), round((u.c - t.c) / t.a)
 
-
-def _terrain_slope(z: Array, spacing: float) -> float:
-    """Median gradient magnitude (m/m) of the coarsest level: the slope allowance actually
-    needed (the preset's ``slope`` is the least one), so one default serves steep terrain."""
-    gy, gx = np.gradient(np.asarray(z, np.float64), spacing)
-    g = np.hypot(gx, gy)
-    g = g[np.isfinite(g)]
-    return float(np.median(g)) if g.size else 0.0
-
-
-def _local_slope(z: Array, spacing: float) -> Array:
-    """Gradient magnitude (m/m) per cell of a surface (central differences)."""
-    gy, gx = np.gradient(np.asarray(z, np.float64), spacing)
-    g = np.hypot(gx, gy)
-    return np.where(np.isfinite(g), g, 0.0)
-
-
-def _reduce_scale(sc: Optional[Array]) -> Optional[Array]:
-    """Noise scale of a coarse cell: the smallest of its block (the lowest cell is one of them)."""
-    if sc is None:
-        return None
-    return np.nan_to_num(_reduce_min(sc), nan=1.0).astype(np.float32)
-
-
-def _touches_border(mask: Array) -> Array:
-    """Cells of the components of ``mask`` that touch the grid border."""
-    from scipy import ndimage
-
-    lab, n = ndimage.label(mask)
-    if n == 0:
-        return np.zeros(mask.shape, bool)
-    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
-    return np.isin(lab, edge[edge > 0])
-
-
-def _ground_point_check(lz: Array, trend: Array, p: Array, cov: Covariance,
-                        scale0: Optional[Array], sides: Optional[_Sides], x: Array,
-                        is_hard: Array, gpts: Array, grid: Grid, prm: LPParameters,
+def _ground_point_check(lvl: _Level, fit: _LevelFit, scale0: Optional[Array], gpts: Array,
+                        grid: Grid, prm: LPParameters,
                         feedback: Feedback) -> List[Dict[str, Any]]:
     """Ground points against the level-0 surface predicted *without* them."""
-    from .surface_input import check_ground_points
-
-    active = (p > 0) & ~is_hard
-    scale = np.where(active, 1.0 / np.maximum(p, 1e-6), 1.0).astype(np.float32)
+    active = (fit.p > 0) & ~lvl.is_hard
+    scale = np.where(active, 1.0 / np.maximum(fit.p, 1e-6), 1.0).astype(np.float32)
     if scale0 is not None:
         scale *= scale0
-    s, _, _ = lp_solve(lz, active, cov, scale, sides, x0=np.where(is_hard, 0.0, x),
-                       tol=prm.cg_tol, feedback=feedback)
-    return check_ground_points(trend + s, grid, gpts, prm.ground_tolerance)
+    s, _, _ = lp_solve(lvl.lz, active, fit.cov, scale, lvl.sides,
+                       x0=np.where(lvl.is_hard, 0.0, fit.x), tol=prm.cg_tol, feedback=feedback)
+    return check_ground_points(lvl.trend + s, grid, gpts, prm.ground_tolerance)
 
 
 # -- the algorithm ------------------------------------------------------------------------------
 def _sigma_grid(inp: Any) -> Optional[Array]:
     """σ_z of the lowest point of every cell (the point the cell's height comes from)."""
-    from .surface_input import lowest_points
-
     if inp.sigma is None or inp.points is None or inp.point_cells is None:
         return None
     low = lowest_points(inp)
@@ -1182,9 +1078,6 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
     dict
         ``dtm``, ``ndsm``, ``mask`` or ``labels``, ``report``, ``metrics``.
     """
-    from .presets import linear_prediction_preset
-    from .surface_input import read_filter_constraints, read_filter_input, write_filter_outputs
-
     feedback = ensure_feedback(feedback)
     values = linear_prediction_preset(preset)
     values.update({k: v for k, v in (overrides or {}).items() if v is not None})
@@ -1232,7 +1125,7 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
                                 product="filter_linear_prediction")
 
 
-__all__ = ["Covariance", "LPParameters", "LPResult", "asymmetric_weights", "breakline_sides",
-           "covariance_apply", "empirical_covariance", "filter_linear_prediction",
-           "fit_covariance", "gaussian_covariance", "lp_solve", "predict_dense",
-           "pyramid_levels", "residual_shift", "run_filter_linear_prediction", "upsample2"]
+__all__ = ["Covariance", "LPParameters", "LPResult", "asymmetric_weights", "covariance_apply",
+           "empirical_covariance", "filter_linear_prediction", "fit_covariance",
+           "gaussian_covariance", "lp_solve", "predict_dense", "residual_shift",
+           "run_filter_linear_prediction"]

@@ -23,8 +23,8 @@ from photodem.algorithms.filtering.linear_prediction import (
     predict_dense,
     residual_shift,
     run_filter_linear_prediction,
-    upsample2,
 )
+from photodem.algorithms.filtering.lp_pyramid import reduce_lowest, reduce_min, upsample2
 from photodem.algorithms.filtering.presets import LINEAR_PREDICTION_PRESETS, PRESET_NAMES
 from photodem.algorithms.filtering.surface_input import FilterConstraints
 from photodem.algorithms.surface.gridding import Grid, line_barrier
@@ -354,22 +354,20 @@ def test_low_blunders_do_not_pull_the_dtm_down() -> None:
 
 def test_pyramid_reduction_keeps_slopes_and_drops_objects() -> None:
     """Two lowest cells per block, moved along the slope: unbiased on a steep noisy plane."""
-    from photodem.algorithms.filtering.linear_prediction import _reduce_lowest, _reduce_min
-
     rng = np.random.default_rng(9)
     rr, cc = _xy((120, 120))
     plane = 0.6 * cc - 0.3 * rr  # 67 % slope
     z = (plane + rng.normal(0.0, 0.2, plane.shape)).astype(np.float32)
     centre = 0.6 * (cc[0::2, 0::2] + 0.5) - 0.3 * (rr[0::2, 0::2] + 0.5)
-    e = (_reduce_lowest(z) - centre)[2:-2, 2:-2]
+    e = (reduce_lowest(z) - centre)[2:-2, 2:-2]
     # measured −0.05 m (σ = 0.2 m); the plain minimum lies about (0.6 + 0.3)/2 m below the
     # block centre
     assert abs(float(np.mean(e))) < 0.1 and float(np.std(e)) < 0.2
-    assert float(np.mean((_reduce_min(z) - centre)[2:-2, 2:-2])) < -0.4
+    assert float(np.mean((reduce_min(z) - centre)[2:-2, 2:-2])) < -0.4
     # a box whose edges cut blocks in half: those blocks stay on the ground
     flat = np.zeros((40, 40), np.float32)
     flat[9:31, 9:31] = 8.0
-    red = _reduce_lowest(flat)
+    red = reduce_lowest(flat)
     assert np.all(red[4:16, 4:16][[0, -1], 1:-1] == 0.0)  # half-covered edge blocks
     assert np.all(red[5:15, 5:15] == 8.0)  # fully covered blocks keep the object
 
