@@ -65,15 +65,21 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from affine import Affine
 from numpy.typing import NDArray
+from scipy import ndimage, sparse
+from scipy.ndimage import uniform_filter
+from scipy.sparse.linalg import cg
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from ..surface.gridding import Grid
+from ..project.model import Project
+from ..surface.gridding import Grid, polygon_mask
 from .presets import lowpass_preset
 from .surface_input import (
     FilterConstraints,
@@ -84,8 +90,10 @@ from .surface_input import (
     low_outliers,
     read_filter_constraints,
     read_filter_input,
+    to_crs,
     write_filter_outputs,
 )
+from .tiles import MAX_CELLS, filter_in_tiles
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -126,8 +134,6 @@ def plane_smooth(z: Array, weight: Array, radius: int, min_count: int = 3,
     ndarray float32 (h, w)
         The plane heights; the window mean where the plane is undetermined; NaN without support.
     """
-    from scipy.ndimage import uniform_filter
-
     z = np.asarray(z)
     h, w = z.shape
     size = 2 * int(radius) + 1
@@ -193,8 +199,6 @@ def height_above_opening(z: Array, support: Array, radius: int) -> Array:
 
 
 def _sub_grid(grid: Grid, r0: int, c0: int, h: int, w: int) -> Grid:
-    from affine import Affine
-
     t = grid.transform
     return Grid(t * Affine.translation(c0, r0), w, h, grid.spacing)
 
@@ -206,8 +210,6 @@ def breakline_sides(lines: Sequence[Any], grid: Grid, reach: float
     The sides are the single-sided buffers of width ``reach`` (m) — the cells a smoothing
     window centred on one side could reach on the other.
     """
-    from ..surface.gridding import polygon_mask
-
     out = []
     for line in lines:
         for part in getattr(line, "geoms", [line]):
@@ -299,9 +301,6 @@ def _relax(values: Array, known: Array, barrier: Array, iterations: int) -> Arra
     4-neighbours form a symmetric positive definite system in the unknown cells; it is solved
     by conjugate gradients from the current values (at most ``iterations`` steps).
     """
-    from scipy import sparse
-    from scipy.sparse.linalg import cg
-
     h, w = values.shape
     free = ~known & ~barrier
     idx = np.flatnonzero(free)
@@ -358,8 +357,6 @@ def membrane_fill(values: Array, known: Array, barrier: Optional[Array] = None,
     ndarray float32
         ``values`` at known cells, the interpolation elsewhere (NaN only without any known cell).
     """
-    from scipy import ndimage
-
     values = np.asarray(values, np.float32)
     known = np.asarray(known, bool) & np.isfinite(values)
     barrier = np.zeros(values.shape, bool) if barrier is None else np.asarray(barrier, bool)
@@ -410,18 +407,67 @@ def membrane_fill(values: Array, known: Array, barrier: Optional[Array] = None,
 
 
 # -- the filter -----------------------------------------------------------------------------------
-def lowpass_parameters(preset: str = "default",
-                       overrides: Optional[Dict[str, Any]] = None) -> Dict[str, Any]:
-    """The preset's parameters with the operator's overrides applied.
+@dataclass
+class LowpassParameters:
+    """Parameters of the iterative low-pass filter, in operator units (see :mod:`.presets`).
 
-    Overrides: ``max_window`` (m; all windows scaled in the preset's proportions),
-    ``iterations`` (windows and thresholds resampled geometrically between the first and the
-    last), ``threshold`` (m, last iteration; earlier ones scaled in proportion), ``slope``
-    (%), or any key of the preset tables. ``None`` values are ignored.
+    Attributes
+    ----------
+    windows_m : list of float
+        Side of the smoothing window of every iteration (m), largest first.
+    thresholds_m : list of float
+        Height above the smoothed surface (m) beyond which a cell is an object, per iteration.
+    down_threshold_m : float
+        Depth below the smoothed surface (m) beyond which a cell is a blunder.
+    slope_pct : float
+        Slope allowance (%): the thresholds grow by ``slope_pct/100 · window/4``.
+    final_smoothing_m : float
+        Window (m) of a last light smoothing of the ground cells; 0 = off.
+    height_margin_m : float
+        Margin (m) beyond the 0.5 % / 99.5 % height quantiles of gross blunders.
+    ground_tolerance_m : float
+        Label tolerance (m) on flat terrain.
+    low_outlier_m : float or None
+        Depth (m) of isolated pits below their second lowest neighbour; 0 or None = off.
+    ground_slope_factor : float
+        Growth of the label tolerance with the slope (× slope × spacing).
+    preset : str
+        Name of the preset the values come from.
+    height_range : (float, float) or None
+        Height quantiles of the blunder test; None = those of the grid (tiles get the whole
+        DSM's, so that every tile makes the same test).
     """
-    par = lowpass_preset(preset)
-    par["preset"] = (preset or "default").strip().lower()
-    ov = {k: v for k, v in (overrides or {}).items() if v is not None}
+
+    windows_m: List[float]
+    thresholds_m: List[float]
+    down_threshold_m: float = 5.0
+    slope_pct: float = 0.0
+    final_smoothing_m: float = 0.0
+    height_margin_m: float = 10.0
+    ground_tolerance_m: float = 0.5
+    low_outlier_m: Optional[float] = 0.0
+    ground_slope_factor: float = 0.0
+    preset: str = "default"
+    height_range: Optional[Tuple[float, float]] = None
+
+    @classmethod
+    def from_dict(cls, values: Dict[str, Any]) -> LowpassParameters:
+        """Parameters from a preset table (unknown keys raise)."""
+        names = {f.name for f in fields(cls)}
+        for k in values:
+            if k not in names:
+                raise InputError(f"Unknown low-pass parameter '{k}'.")
+        return cls(**values)
+
+    def report(self) -> Dict[str, Any]:
+        """The parameters the report lists (without the preset name and the tiles' range)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if f.name not in ("preset", "height_range")}
+
+
+def _schedule(par: Dict[str, Any], ov: Dict[str, Any]) -> Tuple[List[float], List[float]]:
+    """Windows and thresholds of the preset ``par`` with the overrides ``iterations``,
+    ``max_window`` and ``threshold`` (popped from ``ov``)."""
     windows = [float(x) for x in ov.pop("windows_m", par["windows_m"])]
     thresholds = [float(x) for x in ov.pop("thresholds_m", par["thresholds_m"])]
     if len(windows) != len(thresholds) or not windows:
@@ -446,6 +492,22 @@ def lowpass_parameters(preset: str = "default",
             raise InputError("The height threshold must be positive.")
         scale = float(thr) / thresholds[-1]
         thresholds = [x * scale for x in thresholds]
+    return windows, thresholds
+
+
+def lowpass_parameters(preset: str = "default",
+                       overrides: Optional[Dict[str, Any]] = None) -> LowpassParameters:
+    """The preset's parameters with the operator's overrides applied.
+
+    Overrides: ``max_window`` (m; all windows scaled in the preset's proportions),
+    ``iterations`` (windows and thresholds resampled geometrically between the first and the
+    last), ``threshold`` (m, last iteration; earlier ones scaled in proportion), ``slope``
+    (%), or any field of :class:`LowpassParameters`. ``None`` values are ignored.
+    """
+    par = lowpass_preset(preset)
+    par["preset"] = (preset or "default").strip().lower()
+    ov = {k: v for k, v in (overrides or {}).items() if v is not None}
+    windows, thresholds = _schedule(par, ov)
     slope = ov.pop("slope", None)
     if slope is not None:
         par["slope_pct"] = float(slope)
@@ -455,10 +517,200 @@ def lowpass_parameters(preset: str = "default",
         par[k] = v
     par["windows_m"] = [round(float(x), 3) for x in windows]
     par["thresholds_m"] = [round(float(x), 3) for x in thresholds]
-    return par
+    return LowpassParameters.from_dict(par)
 
 
-def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
+def _filter_tiled(z: Array, spacing: float, params: LowpassParameters,
+                  constraints: Optional[FilterConstraints], grid: Grid, limit: int,
+                  feedback: Feedback, start: float) -> Dict[str, Any]:
+    """:func:`lowpass_filter` of a grid larger than ``limit`` cells, tile by tile."""
+    shape = tuple(np.shape(z))
+    overlap = math.ceil(TILE_OVERLAP_WINDOWS * max(params.windows_m) / spacing)
+    zall = np.asarray(z)
+    if not np.isfinite(zall).any():
+        raise InputError("The DSM holds no height (every cell is nodata).")
+    # the blunder range of the whole DSM, not of each tile (same test everywhere)
+    tile_params = replace(params, height_range=_height_range(zall[np.isfinite(zall)]))
+    tiled = filter_in_tiles(_TileRun(spacing, tile_params), z, grid, constraints, overlap,
+                            limit, feedback)
+    first = tiled["first"]
+    valid = np.isfinite(z)
+    n_valid = int(valid.sum())
+    keep = (np.zeros(shape, bool) if constraints is None
+            else np.asarray(constraints.keep, bool))
+    n_filterable = max(int((valid & ~keep).sum()), 1)
+    elim = int((valid & ~keep & ~tiled["ground"]).sum())
+    feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
+    return {"dtm": tiled["dtm"], "ground": tiled["ground"],
+            "iterations": first.get("iterations", []), "differences": [],
+            "ground_points_disagreeing": tiled["ground_points_disagreeing"],
+            "eliminated_share": elim / n_filterable, "cells_valid": n_valid,
+            "cells_ground": int(tiled["ground"].sum()), "tiles": tiled["tiles"],
+            "tile_overlap_cells": overlap, "seconds": time.perf_counter() - start}
+
+
+@dataclass
+class _TileRun:
+    """Filters one tile of a large grid (the callback of :func:`.tiles.filter_in_tiles`)."""
+
+    spacing: float
+    params: LowpassParameters
+
+    def __call__(self, zt: Array, gt: Grid, ct: Optional[FilterConstraints],
+                 fb: Feedback) -> Dict[str, Any]:
+        return lowpass_filter(zt, self.spacing, self.params, ct, gt, False, fb,
+                              max_cells=zt.size)
+
+
+@dataclass
+class _State:
+    """The filter's grids: the DSM, the edits, and the surface being thinned out.
+
+    Attributes
+    ----------
+    dsm : ndarray float32
+    valid : ndarray bool
+        Cells with a DSM height.
+    keep, barrier : ndarray bool
+        Keep areas and breakline cells.
+    gp : ndarray (n, 3)
+        Manual ground points; ``gp_cells`` / ``gp_z`` their cells and heights.
+    support : ndarray bool
+        Remaining cells (updated by every elimination).
+    m : ndarray float32
+        The remaining surface (NaN where eliminated).
+    n_filterable : int
+        Valid cells outside keep areas (denominator of the shares).
+    """
+
+    dsm: Array
+    valid: Array
+    keep: Array
+    barrier: Array
+    gp: Array
+    gp_cells: Array
+    gp_z: Array
+    support: Array
+    m: Array
+    n_filterable: int
+
+
+def _prepare(z: Array, params: LowpassParameters, cons: FilterConstraints,
+             grid: Grid) -> Tuple[_State, Dict[str, Any]]:
+    """The filter's state before the first iteration and the report row of that step
+    (height range, low outliers and remove areas eliminated)."""
+    dsm = np.asarray(z, np.float32)
+    shape = dsm.shape
+    keep = np.asarray(cons.keep, bool)
+    remove = np.asarray(cons.remove, bool)
+    barrier = (np.asarray(cons.barrier, bool) if cons.barrier is not None
+               else np.zeros(shape, bool))
+    valid = np.isfinite(dsm)
+    if int(valid.sum()) == 0:
+        raise InputError("The DSM holds no height (every cell is nodata).")
+    # manual ground points: their cells take the point height and are protected
+    gp = np.asarray(cons.ground_points, float).reshape(-1, 3)
+    gp_cells = np.zeros(shape, bool)
+    gp_z = np.full(shape, np.nan, np.float32)
+    if gp.size:
+        r, c = grid.cell_of(gp[:, 0], gp[:, 1])
+        ins = r >= 0
+        gp_cells[r[ins], c[ins]] = True
+        gp_z[r[ins], c[ins]] = gp[ins, 2]
+    # height range: robust quantiles ± margin (gross blunders)
+    margin = float(params.height_margin_m)
+    lo, hi = params.height_range or _height_range(dsm[valid])
+    out_of_range = valid & ((dsm < lo - margin) | (dsm > hi + margin)) & ~keep
+    # isolated low blunders (a local, slope-invariant test: the iterations' planes cannot tell
+    # a pit from the foot of a slope)
+    low_depth = float(params.low_outlier_m or 0.0)
+    if low_depth > 0:
+        out_of_range |= low_outliers(np.where(keep | remove, np.nan, dsm), low_depth) & valid
+    support = valid & ~keep & ~remove & ~out_of_range
+    m = dsm.copy()
+    m[gp_cells] = gp_z[gp_cells]
+    support |= gp_cells
+    n_filterable = max(int((valid & ~keep).sum()), 1)
+    pre = int((valid & ~keep & (remove | out_of_range)).sum())
+    row = {"iteration": 0, "window_m": 0.0, "threshold_m": float("nan"),
+           "eliminated": pre, "eliminated_share": pre / n_filterable,
+           "eliminated_total_share": pre / n_filterable,
+           "step": "height range, low outliers and remove areas"}
+    return _State(dsm, valid, keep, barrier, gp, gp_cells, gp_z, support, m, n_filterable), row
+
+
+def _sides(cons: FilterConstraints, grid: Grid, radius: int, spacing: float) -> List[Any]:
+    """Breakline sides for windows of ``radius`` cells (none without breaklines)."""
+    return breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
+        if cons.breaklines else []
+
+
+def _eliminate(st: _State, wm: float, tk: float, params: LowpassParameters,
+               cons: FilterConstraints, grid: Grid, spacing: float) -> Tuple[Array, int, float]:
+    """One iteration: smooth with a window of ``wm`` m, eliminate objects and blunders.
+
+    Returns
+    -------
+    (the smoothed surface, cells eliminated, the threshold used)
+    """
+    radius = max(1, round(wm / spacing / 2.0))
+    sides = _sides(cons, grid, radius, spacing)
+    slope = float(params.slope_pct) / 100.0
+    thr = tk + slope * wm / 4.0
+    above = height_above_opening(st.m, st.support, radius)
+    with np.errstate(invalid="ignore"):
+        # objects (cells far above the opening) do not support the planes that judge
+        # them; manual ground points always do
+        fit = st.support & ~(above > thr) | (st.support & st.gp_cells)
+        # cells on the opening lie on terrain it keeps: the plane's error at a break of
+        # slope (the upper edge of a bank) is no reason to eliminate them
+        on_terrain = above <= tk
+    t = smooth(st.m, fit, radius, sides, st.barrier)
+    d = st.m - t
+    # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
+    # it lies s·w/4 below a ridge: the blunder depth grows alike
+    thr_down = float(params.down_threshold_m) + slope * wm / 4.0
+    with np.errstate(invalid="ignore"):
+        elim = st.support & ~st.gp_cells & (((d > thr) & ~on_terrain) | (d < -thr_down))
+    # cells without any support in the window keep their height (nothing to compare)
+    elim &= np.isfinite(t)
+    st.support &= ~elim
+    st.m[elim] = np.nan
+    return t, int(elim.sum()), thr
+
+
+def _fill(st: _State, params: LowpassParameters, cons: FilterConstraints, grid: Grid,
+          spacing: float, feedback: Feedback, done: float) -> Tuple[Array, List[Dict[str, Any]]]:
+    """Optional final smoothing and the hole filling: the DTM and the ground-point check."""
+    # optional light smoothing of the ground cells ("interpolation with filtering")
+    ground_vals = st.m.copy()
+    fs = float(params.final_smoothing_m)
+    if fs > spacing:
+        radius = max(1, round(fs / spacing / 2.0))
+        t = smooth(st.m, st.support, radius, _sides(cons, grid, radius, spacing), st.barrier)
+        upd = st.support & ~st.gp_cells & np.isfinite(t)
+        ground_vals[upd] = t[upd]
+    # known values of the hole filling: ground survivors, keep areas (DSM), ground points
+    known = st.support.copy()
+    keep_known = st.keep & st.valid
+    ground_vals[keep_known] = st.dsm[keep_known]
+    known |= keep_known
+    # DSM nodata reaching the raster border stays nodata (no extrapolation into nothing)
+    outside = _border_nodata(st.valid)  # also where an exclusion area reaches beyond the data
+    disagree: List[Dict[str, Any]] = []
+    if st.gp.size:
+        free = membrane_fill(ground_vals, known & ~st.gp_cells, st.barrier, cons.barrier_z)
+        disagree = check_ground_points(free, grid, st.gp, float(params.ground_tolerance_m))
+        del free
+    feedback.progress(done)
+    dtm = membrane_fill(ground_vals, known, st.barrier, cons.barrier_z)
+    dtm[keep_known] = st.dsm[keep_known]
+    dtm[st.gp_cells] = st.gp_z[st.gp_cells]
+    dtm[outside] = np.nan
+    return dtm, disagree
+
+
+def lowpass_filter(z: Array, spacing: float, params: LowpassParameters,
                    constraints: Optional[FilterConstraints] = None, grid: Optional[Grid] = None,
                    keep_differences: bool = False,
                    feedback: Optional[Feedback] = None,
@@ -471,7 +723,7 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         DSM, NaN = no data.
     spacing : float
         Cell size (m).
-    params : dict
+    params : LowpassParameters
         :func:`lowpass_parameters`.
     constraints : FilterConstraints, optional
         The operator's edits on this grid (``grid`` is then needed for the ground points and
@@ -492,186 +744,55 @@ def lowpass_filter(z: Array, spacing: float, params: Dict[str, Any],
         ``eliminated_share``, ``cells_valid``, ``cells_ground``, ``cells_bumps`` (cells
         eliminated by :func:`.surface_input.ground_bumps`; untiled grids), ``seconds``.
     """
-    from .tiles import MAX_CELLS, filter_in_tiles
-
     feedback = ensure_feedback(feedback)
     start = time.perf_counter()
     shape = tuple(np.shape(z))
     if grid is None:
-        from affine import Affine
-
         grid = Grid(Affine(spacing, 0, 0, 0, -spacing, shape[0] * spacing), shape[1], shape[0],
                     spacing)
     limit = MAX_CELLS if max_cells is None else int(max_cells)
     if shape[0] * shape[1] > limit:
-        overlap = math.ceil(TILE_OVERLAP_WINDOWS * max(params["windows_m"]) / spacing)
-
-        zall = np.asarray(z)
-        if not np.isfinite(zall).any():
-            raise InputError("The DSM holds no height (every cell is nodata).")
-        # the blunder range of the whole DSM, not of each tile (same test everywhere)
-        tile_params = dict(params, height_range=_height_range(zall[np.isfinite(zall)]))
-
-        def run_tile(zt: Array, gt: Grid, ct: Optional[FilterConstraints],
-                     fb: Feedback) -> Dict[str, Any]:
-            return lowpass_filter(zt, spacing, tile_params, ct, gt, False, fb,
-                                  max_cells=zt.size)
-
-        tiled = filter_in_tiles(run_tile, z, grid, constraints, overlap, limit, feedback)
-        first = tiled["first"]
-        valid = np.isfinite(z)
-        n_valid = int(valid.sum())
-        keep = (np.zeros(shape, bool) if constraints is None
-                else np.asarray(constraints.keep, bool))
-        n_filterable = max(int((valid & ~keep).sum()), 1)
-        elim = int((valid & ~keep & ~tiled["ground"]).sum())
-        feedback.info(f"Filtered in {tiled['tiles']} tiles (overlap {overlap} cells).")
-        return {"dtm": tiled["dtm"], "ground": tiled["ground"],
-                "iterations": first.get("iterations", []), "differences": [],
-                "ground_points_disagreeing": tiled["ground_points_disagreeing"],
-                "eliminated_share": elim / n_filterable, "cells_valid": n_valid,
-                "cells_ground": int(tiled["ground"].sum()), "tiles": tiled["tiles"],
-                "tile_overlap_cells": overlap, "seconds": time.perf_counter() - start}
-    dsm = np.asarray(z, np.float32)
+        return _filter_tiled(z, spacing, params, constraints, grid, limit, feedback, start)
     cons = constraints if constraints is not None else FilterConstraints.empty(grid)
-    keep = np.asarray(cons.keep, bool)
-    remove = np.asarray(cons.remove, bool)
-    barrier = (np.asarray(cons.barrier, bool) if cons.barrier is not None
-               else np.zeros(shape, bool))
-    valid = np.isfinite(dsm)
-    n_valid = int(valid.sum())
-    if n_valid == 0:
-        raise InputError("The DSM holds no height (every cell is nodata).")
-    # manual ground points: their cells take the point height and are protected
-    gp = np.asarray(cons.ground_points, float).reshape(-1, 3)
-    gp_cells = np.zeros(shape, bool)
-    gp_z = np.full(shape, np.nan, np.float32)
-    if gp.size:
-        r, c = grid.cell_of(gp[:, 0], gp[:, 1])
-        ins = r >= 0
-        gp_cells[r[ins], c[ins]] = True
-        gp_z[r[ins], c[ins]] = gp[ins, 2]
-    # height range: robust quantiles ± margin (gross blunders)
-    margin = float(params.get("height_margin_m", 10.0))
-    lo, hi = params.get("height_range") or _height_range(dsm[valid])
-    out_of_range = valid & ((dsm < lo - margin) | (dsm > hi + margin)) & ~keep
-    # isolated low blunders (a local, slope-invariant test: the iterations' planes cannot tell
-    # a pit from the foot of a slope)
-    low_depth = float(params.get("low_outlier_m", 0.0) or 0.0)
-    if low_depth > 0:
-        out_of_range |= low_outliers(np.where(keep | remove, np.nan, dsm), low_depth) & valid
-    support = valid & ~keep & ~remove & ~out_of_range
-    m = dsm.copy()
-    m[gp_cells] = gp_z[gp_cells]
-    support |= gp_cells
-    rows: List[Dict[str, Any]] = []
+    st, row0 = _prepare(z, params, cons, grid)
+    rows: List[Dict[str, Any]] = [row0]
     diffs: List[Array] = []
-    windows = [float(x) for x in params["windows_m"]]
-    thresholds = [float(x) for x in params["thresholds_m"]]
-    down = float(params.get("down_threshold_m", 5.0))
-    slope = float(params.get("slope_pct", 0.0)) / 100.0
-    n_filterable = max(int((valid & ~keep).sum()), 1)
-    pre = int((valid & ~keep & (remove | out_of_range)).sum())
-    rows.append({"iteration": 0, "window_m": 0.0, "threshold_m": float("nan"),
-                 "eliminated": pre, "eliminated_share": pre / n_filterable,
-                 "eliminated_total_share": pre / n_filterable,
-                 "step": "height range, low outliers and remove areas"})
-    eliminated_total = pre
+    eliminated_total = row0["eliminated"]
+    windows = [float(x) for x in params.windows_m]
     n_steps = len(windows) + 2
-    last_plane = m  # the smooth surface of the last iteration (judges the bumps)
-    for k, (wm, tk) in enumerate(zip(windows, thresholds), start=1):
+    last_plane = st.m  # the smooth surface of the last iteration (judges the bumps)
+    for k, (wm, tk) in enumerate(zip(windows, [float(x) for x in params.thresholds_m]),
+                                 start=1):
         feedback.progress(100.0 * (k - 1) / n_steps)
-        radius = max(1, round(wm / spacing / 2.0))
-        sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
-            if cons.breaklines else []
-        thr = tk + slope * wm / 4.0
-        above = height_above_opening(m, support, radius)
-        with np.errstate(invalid="ignore"):
-            # objects (cells far above the opening) do not support the planes that judge
-            # them; manual ground points always do
-            fit = support & ~(above > thr) | (support & gp_cells)
-            # cells on the opening lie on terrain it keeps: the plane's error at a break of
-            # slope (the upper edge of a bank) is no reason to eliminate them
-            on_terrain = above <= tk
-        t = smooth(m, fit, radius, sides, barrier)
-        last_plane = t
-        d = m - t
-        # a plane lies s·w/4 above a valley (foot of a slope, a terrace below a wall) just as
-        # it lies s·w/4 below a ridge: the blunder depth grows alike
-        thr_down = down + slope * wm / 4.0
-        with np.errstate(invalid="ignore"):
-            elim = support & ~gp_cells & (((d > thr) & ~on_terrain) | (d < -thr_down))
-        # cells without any support in the window keep their height (nothing to compare)
-        elim &= np.isfinite(t)
-        n_el = int(elim.sum())
-        support &= ~elim
-        m[elim] = np.nan
+        last_plane, n_el, thr = _eliminate(st, wm, tk, params, cons, grid, spacing)
         eliminated_total += n_el
         rows.append({"iteration": k, "window_m": wm, "threshold_m": round(thr, 3),
-                     "eliminated": n_el, "eliminated_share": n_el / n_filterable,
-                     "eliminated_total_share": eliminated_total / n_filterable,
+                     "eliminated": n_el, "eliminated_share": n_el / st.n_filterable,
+                     "eliminated_total_share": eliminated_total / st.n_filterable,
                      "step": "smoothing and elimination"})
         feedback.info(f"Iteration {k}: window {wm:g} m, threshold {thr:.2f} m, "
-                      f"{n_el} cells eliminated ({100.0 * n_el / n_filterable:.1f} %).")
+                      f"{n_el} cells eliminated ({100.0 * n_el / st.n_filterable:.1f} %).")
         if keep_differences:
-            diffs.append(np.where(valid, dsm - t, np.nan).astype(np.float32))
-        del d
+            diffs.append(np.where(st.valid, st.dsm - last_plane, np.nan).astype(np.float32))
     # low objects narrower than a few metres pass the windows' planes (they lift them little):
     # at the label resolution a ground cell is within the label tolerance of its neighbourhood
-    bumps = ground_bumps(m, support & ~gp_cells, last_plane, spacing,
-                         float(params.get("ground_tolerance_m", 0.5)),
-                         float(params.get("ground_slope_factor", 0.0)))
+    bumps = ground_bumps(st.m, st.support & ~st.gp_cells, last_plane, spacing,
+                         float(params.ground_tolerance_m), float(params.ground_slope_factor))
     n_bumps = int(bumps.sum())
-    support &= ~bumps
-    m[bumps] = np.nan
+    st.support &= ~bumps
+    st.m[bumps] = np.nan
     eliminated_total += n_bumps
     feedback.info(f"{n_bumps} cells stand above their neighbourhood by more than the ground "
                   "tolerance (low objects): eliminated.")
     feedback.progress(100.0 * len(windows) / n_steps)
-    # optional light smoothing of the ground cells ("interpolation with filtering")
-    ground_vals = m.copy()
-    fs = float(params.get("final_smoothing_m", 0.0))
-    if fs > spacing:
-        radius = max(1, round(fs / spacing / 2.0))
-        sides = breakline_sides(cons.breaklines, grid, (radius + 1) * spacing * 1.5) \
-            if cons.breaklines else []
-        t = smooth(m, support, radius, sides, barrier)
-        upd = support & ~gp_cells & np.isfinite(t)
-        ground_vals[upd] = t[upd]
-    # known values of the hole filling: ground survivors, keep areas (DSM), ground points
-    known = support.copy()
-    keep_known = keep & valid
-    ground_vals[keep_known] = dsm[keep_known]
-    known |= keep_known
-    # DSM nodata reaching the raster border stays nodata (no extrapolation into nothing)
-    outside = _border_nodata(valid)  # also where an exclusion area reaches beyond the data
-    free_known = known & ~gp_cells
-    disagree: List[Dict[str, Any]] = []
-    tol = float(params.get("ground_tolerance_m", 0.5))
-    if gp.size:
-        free = membrane_fill(ground_vals, free_known, barrier, cons.barrier_z)
-        disagree = check_ground_points(free, grid, gp, tol)
-        del free
-    feedback.progress(100.0 * (len(windows) + 1) / n_steps)
-    dtm = membrane_fill(ground_vals, known, barrier, cons.barrier_z)
-    dtm[keep_known] = dsm[keep_known]
-    dtm[gp_cells] = gp_z[gp_cells]
-    dtm[outside] = np.nan
-    ground = (support | keep_known | gp_cells) & valid
-    n_ground = int(ground.sum())
-    result = {
-        "dtm": dtm,
-        "ground": ground,
-        "iterations": rows,
-        "differences": diffs,
-        "ground_points_disagreeing": disagree,
-        "eliminated_share": eliminated_total / n_filterable,
-        "cells_valid": n_valid,
-        "cells_ground": n_ground,
-        "cells_bumps": n_bumps,
-        "seconds": time.perf_counter() - start,
-    }
-    return result
+    dtm, disagree = _fill(st, params, cons, grid, spacing, feedback,
+                          100.0 * (len(windows) + 1) / n_steps)
+    ground = (st.support | (st.keep & st.valid) | st.gp_cells) & st.valid
+    return {"dtm": dtm, "ground": ground, "iterations": rows, "differences": diffs,
+            "ground_points_disagreeing": disagree,
+            "eliminated_share": eliminated_total / st.n_filterable,
+            "cells_valid": int(st.valid.sum()), "cells_ground": int(ground.sum()),
+            "cells_bumps": n_bumps, "seconds": time.perf_counter() - start}
 
 
 def _height_range(zv: Array) -> Tuple[float, float]:
@@ -689,8 +810,6 @@ def _border_nodata(has: Array, reach: int = 3) -> Array:
     They stay NaN in the DTM (no extrapolation into areas without data); the first few cells
     are filled so that points at the edge of a gridded point cloud still have a DTM height.
     """
-    from scipy import ndimage
-
     empty = ~has
     if not empty.any() or not has.any():
         return empty
@@ -739,12 +858,8 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
     params = lowpass_parameters(preset, overrides)
     inp: FilterInput = read_filter_input(input, spacing=spacing, crs=crs, feedback=feedback)
     if project is not None and str(project) != "" and inp.crs is None:
-        from ..project.model import Project
-
         prj_crs = Project.load(project).crs
         if prj_crs:
-            from .surface_input import to_crs
-
             inp.crs = to_crs(prj_crs)
     cons = read_filter_constraints(project, inp.grid, inp.crs)
     feedback.progress(5.0)
@@ -757,14 +872,14 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
                          f"({b['status']}); the DTM passes through the point.")
     report = {
         "algorithm": "filter_lowpass",
-        "preset": params["preset"],
-        "parameters": {k: v for k, v in params.items() if k != "preset"},
+        "preset": params.preset,
+        "parameters": params.report(),
         "iterations": res["iterations"],
         "eliminated_share": res["eliminated_share"],
         "cells_valid": res["cells_valid"],
         "cells_ground": res["cells_ground"],
-        "ground_tolerance_m": params["ground_tolerance_m"],
-        "ground_slope_factor": params.get("ground_slope_factor", 0.0),
+        "ground_tolerance_m": params.ground_tolerance_m,
+        "ground_slope_factor": params.ground_slope_factor,
         "grid": {"width": inp.grid.width, "height": inp.grid.height,
                  "spacing": inp.grid.spacing},
         "constraints": {"keep_cells": int(cons.keep.sum()),
@@ -784,5 +899,5 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
     return out
 
 
-__all__ = ["breakline_sides", "height_above_opening", "lowpass_filter", "lowpass_parameters",
-           "membrane_fill", "plane_smooth", "run_filter_lowpass", "smooth"]
+__all__ = ["LowpassParameters", "breakline_sides", "height_above_opening", "lowpass_filter",
+           "lowpass_parameters", "membrane_fill", "plane_smooth", "run_filter_lowpass", "smooth"]

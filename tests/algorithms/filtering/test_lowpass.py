@@ -214,11 +214,11 @@ def test_parameters_presets_and_overrides() -> None:
     assert set(LOWPASS_PRESETS) == set(PRESET_NAMES)
     for name in PRESET_NAMES:
         p = lowpass_parameters(name)
-        assert len(p["windows_m"]) == len(p["thresholds_m"]) and p["windows_m"][0] > 0
+        assert len(p.windows_m) == len(p.thresholds_m) and p.windows_m[0] > 0
     p = lowpass_parameters("default", {"max_window": 90, "threshold": 0.25, "iterations": 3,
                                        "slope": 0, "final_smoothing_m": 0})
-    assert p["windows_m"][0] == 90 and len(p["windows_m"]) == 3
-    assert p["thresholds_m"][-1] == 0.25 and p["slope_pct"] == 0 and p["final_smoothing_m"] == 0
+    assert p.windows_m[0] == 90 and len(p.windows_m) == 3
+    assert p.thresholds_m[-1] == 0.25 and p.slope_pct == 0 and p.final_smoothing_m == 0
     with pytest.raises(InputError, match="Unknown preset"):
         lowpass_parameters("marsh")
 
