@@ -62,10 +62,19 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
+import rasterio
 from numpy.typing import ArrayLike, NDArray
+from rasterio.enums import Resampling
+from rasterio.vrt import WarpedVRT
+from rasterio.windows import Window
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..quality.compare import compare_dems
+from ..quality.points import sample_dem
+from ..quality.report import write_json
+from ..quality.stats import difference_stats
+from ..raster.io import staged_folder
 
 PathLike = Union[str, Path]
 
@@ -282,8 +291,6 @@ def _is_raster(path: PathLike) -> bool:
 
 
 def _open_mask(path: PathLike, what: str) -> Any:
-    import rasterio
-
     p = Path(path)
     if not p.exists():
         raise InputError(f"The {what} raster '{p}' does not exist.")
@@ -319,10 +326,6 @@ def confusion_rasters(labels: PathLike, reference: PathLike,
     (Confusion, dict)
         The table and ``{"cells", "labelled_cells", "reference_cells"}``.
     """
-    from rasterio.enums import Resampling
-    from rasterio.vrt import WarpedVRT
-    from rasterio.windows import Window
-
     fb = ensure_feedback(feedback)
     total = Confusion(0, 0, 0, 0)
     n_lab = n_ref = 0
@@ -362,8 +365,6 @@ def confusion_rasters(labels: PathLike, reference: PathLike,
 
 def sample_mask(path: PathLike, x: ArrayLike, y: ArrayLike) -> NDArray[np.int64]:
     """Mask value (0/1) of the cell containing each point; −1 outside or nodata."""
-    from rasterio.windows import Window
-
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     out = np.full(x.shape, -1, dtype=np.int64)
@@ -395,8 +396,6 @@ def _dtm_subset(stats: Dict[str, Any]) -> Dict[str, Any]:
 def dtm_against_reference(dtm: PathLike, reference_dtm: PathLike,
                           feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """DTM − reference DTM on the reference grid: count, mean, std, RMS, NMAD, 95 % |Δh| …"""
-    from ..quality.compare import compare_dems
-
     res = compare_dems(dtm, reference_dtm, feedback=feedback)
     return _dtm_subset(res["stats"])
 
@@ -404,9 +403,6 @@ def dtm_against_reference(dtm: PathLike, reference_dtm: PathLike,
 def dtm_at_points(dtm: PathLike, xyz: NDArray[np.float64],
                   crs: Any = None) -> Dict[str, Any]:
     """DTM (bilinear) minus point heights at the given points; ``outside`` = not sampled."""
-    from ..quality.points import sample_dem
-    from ..quality.stats import difference_stats
-
     z = sample_dem(dtm, xyz[:, 0], xyz[:, 1], crs=crs)
     d = z - xyz[:, 2]
     out = _dtm_subset(difference_stats(d))
@@ -563,9 +559,6 @@ def run_filter_evaluate(labels: PathLike, reference: PathLike, output: PathLike,
         ``{"report": path of report.json, "csv": path of report.csv, "metrics": {Type I/II,
         total error, kappa (percent), counts, DTM statistics}}``.
     """
-    from ..quality.report import write_json
-    from ..raster.io import staged_folder
-
     fb = ensure_feedback(feedback)
     result = evaluate(labels, reference, column=column, dtm=dtm, reference_dtm=reference_dtm,
                       feedback=fb.step(0, 95))

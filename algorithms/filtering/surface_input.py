@@ -36,12 +36,25 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
+import fiona
 import numpy as np
+import rasterio
 from numpy.typing import NDArray
+from rasterio.crs import CRS
+from rasterio.warp import transform, transform_geom
+from scipy import ndimage
+from shapely.geometry import mapping
+from shapely.geometry import shape as to_shape
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from ..surface.gridding import Grid
+from ..input_errors import reading, warn_input
+from ..project.edits import read_layer
+from ..project.model import Project
+from ..project.points_io import check_distinct_points, read_points
+from ..quality.report import _CSS, _embed, _table, new_figure, write_json
+from ..raster.io import staged_folder, write_raster
+from ..surface.gridding import Grid, line_barrier, polygon_mask
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -139,8 +152,6 @@ def to_crs(crs: Any) -> Any:
     """
     if crs is None or (isinstance(crs, str) and not crs.strip()):
         return None
-    from rasterio.crs import CRS
-
     if isinstance(crs, CRS):
         return crs
     try:
@@ -160,8 +171,6 @@ def nice_spacing(value: float) -> float:
 
 
 def _read_raster(path: Path, crs: Any) -> FilterInput:
-    import rasterio
-
     try:
         with rasterio.open(path) as src:
             t = src.transform
@@ -195,7 +204,7 @@ def _read_raster(path: Path, crs: Any) -> FilterInput:
 
 def _read_las(path: Path) -> Tuple[Array, Any]:
     try:
-        import laspy
+        import laspy  # optional dependency: only LAS input needs it
     except ImportError as exc:
         raise InputError(f"Reading '{path.name}' needs the Python package laspy (with lazrs for "
                          "LAZ): pip install laspy[lazrs]; or convert it to XYZ text.") from exc
@@ -216,8 +225,6 @@ def _read_las(path: Path) -> Tuple[Array, Any]:
 
 def _read_gpkg_sigma(path: Path, n: int) -> Optional[Array]:
     """``sigma_z`` of the first point layer, if it has one and the count matches."""
-    import fiona
-
     try:
         for layer in fiona.listlayers(str(path)):
             with fiona.open(str(path), layer=layer) as src:
@@ -269,8 +276,6 @@ def grid_lowest(xyz: Array, spacing: float) -> Tuple[Array, Grid, Array]:
 
 
 def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
-    from ..quality.points import read_points
-
     sigma = None
     if path.suffix.lower() in (".las", ".laz"):
         xyz, file_crs = _read_las(path)
@@ -290,19 +295,13 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     if n < MIN_POINTS:
         raise InputError(f"'{path.name}' has only {n} valid point(s); a filter needs at least "
                          f"{MIN_POINTS}.")
-    from ..quality.points import check_distinct_points
-
     n = check_distinct_points(xyz[ok, 0], xyz[ok, 1], path.name, MIN_POINTS, "a filter")
     given = to_crs(crs)
     out_crs = given if given is not None else to_crs(file_crs)
     if out_crs is None:
-        from ..input_errors import warn_input
-
         warn_input(f"The points of '{path.name}' carry no CRS; the DTM is written without one "
                    "(give the crs parameter or a project).")
     if given is not None and file_crs is not None and to_crs(file_crs) != given:
-        from rasterio.warp import transform
-
         xs, ys = transform(to_crs(file_crs), given, xyz[:, 0].tolist(), xyz[:, 1].tolist())
         xyz = np.column_stack([xs, ys, xyz[:, 2]])
     if spacing is None or not spacing > 0:
@@ -381,12 +380,6 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
     cons = FilterConstraints.empty(grid)
     if project is None or str(project) == "":
         return cons
-    import fiona
-
-    from ..project.edits import read_layer
-    from ..project.model import Project
-    from ..surface.gridding import line_barrier, polygon_mask
-
     prj = Project.load(project)
     edits = Path(prj.edits_path)
     if not edits.is_file():
@@ -394,8 +387,6 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
     target = to_crs(crs) if crs is not None else None
     if target is None:
         target = to_crs(prj.crs) if prj.crs else None
-    from ..input_errors import reading
-
     with reading(edits, "GeoPackage"):
         layers = fiona.listlayers(str(edits))
     wanted = [name for name in ("exclusion_areas", "ground_points", "breaklines")
@@ -417,10 +408,7 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
         for geom, props in features.get(name, []):
             s = src_crs.get(name)
             if s is not None and s != target:
-                from rasterio.warp import transform_geom
-                from shapely.geometry import mapping, shape
-
-                geom = shape(transform_geom(s, target, mapping(geom)))
+                geom = to_shape(transform_geom(s, target, mapping(geom)))
             out.append((geom, props))
         return out
 
@@ -657,8 +645,6 @@ def grey_opening(z: Array, size: int) -> Array:
     -------
     ndarray float32 (h, w)
     """
-    from scipy import ndimage
-
     zz = np.asarray(z, np.float32)
     h, w = zz.shape
     r = min(int(size) // 2, h - 1, w - 1)
@@ -735,8 +721,6 @@ def ground_bumps(z: Array, support: Array, surface: Array, spacing: float, tol: 
 
 # -- outputs ------------------------------------------------------------------------------------
 def _iteration_figure(rows: Sequence[Dict[str, Any]]) -> Any:
-    from ..quality.report import new_figure
-
     fig = new_figure(6.0, 3.2)
     ax = fig.add_subplot(111)
     it = [r.get("iteration", i + 1) for i, r in enumerate(rows)]
@@ -755,8 +739,6 @@ def _iteration_figure(rows: Sequence[Dict[str, Any]]) -> Any:
 
 
 def _html_report(report: Dict[str, Any], title: str) -> str:
-    from ..quality.report import _CSS, _embed, _table
-
     parts = [f"<h1>{html.escape(title)}</h1>",
              f"<p>Input <b>{html.escape(Path(str(report.get('input', ''))).name)}</b> "
              f"({html.escape(str(report.get('source', '')))}), preset "
@@ -844,9 +826,6 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
         ``dtm``, ``ndsm``, ``mask`` (raster input) or None, ``labels`` (point input) or None,
         ``report`` (paths in their final place) and ``metrics`` (the report dict).
     """
-    from ..quality.report import write_json
-    from ..raster.io import staged_folder, write_raster
-
     feedback = ensure_feedback(feedback)
     folder = Path(folder)
     dtm = np.asarray(dtm, np.float32)

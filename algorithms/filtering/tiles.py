@@ -23,11 +23,12 @@ import math
 from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple
 
 import numpy as np
+from affine import Affine
 from numpy.typing import NDArray
 
 from ..feedback import Feedback, ensure_feedback
 from ..surface.gridding import Grid
-from .surface_input import FilterConstraints
+from .surface_input import FilterConstraints, check_ground_points
 
 Array = NDArray[Any]
 
@@ -91,8 +92,6 @@ def feather(pad: Window, shape: Tuple[int, int], overlap: int) -> Array:
 
 def sub_grid(grid: Grid, window: Window) -> Grid:
     """The grid of a window ``(r0, r1, c0, c1)``."""
-    from affine import Affine
-
     r0, r1, c0, c1 = window
     return Grid(grid.transform * Affine.translation(c0, r0), c1 - c0, r1 - r0, grid.spacing)
 
@@ -181,8 +180,6 @@ def filter_in_tiles(run_tile: Callable[[Array, Grid, Optional[FilterConstraints]
     dtm_all = dtm_all.astype(np.float32)
     del acc, wsum
     if constraints is not None and len(constraints.ground_points):
-        from .surface_input import check_ground_points
-
         disagree += [b for b in check_ground_points(dtm_all, grid, constraints.ground_points,
                                                     float("inf"))
                      if b["status"] == "outside"]

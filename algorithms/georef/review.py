@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import InputError
 from ..feedback import Feedback
 from ..jsonable import json_ready
-from ..quality.points import (
+from ..project.points_io import (
     COLUMN_NAMES,
     field_separator,
     find_column,

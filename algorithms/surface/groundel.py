@@ -70,7 +70,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 from affine import Affine
@@ -385,6 +385,146 @@ def _reduce_chunk(lid: Array, x: Array, y: Array, z: Array, p: Optional[Array], 
             "iterations": np.array(iterations)}
 
 
+def _check_options(mode: str, cell: float, lower_percentile: float, min_points: int,
+                   plane_min_points: int) -> None:
+    """InputError for an unknown mode or a parameter out of range."""
+    if mode not in MODES:
+        raise InputError(f"Unknown groundel mode '{mode}'; use one of {', '.join(MODES)}.")
+    if not (cell > 0 and math.isfinite(cell)):
+        raise InputError(f"The groundel size must be positive, got {cell}.")
+    if not 0.0 <= lower_percentile <= 100.0:
+        raise InputError(f"The lower-envelope percentile must be within 0…100, got "
+                         f"{lower_percentile}.")
+    if min_points < 1 or plane_min_points < 3:
+        raise InputError("min_points must be ≥ 1 and plane_min_points ≥ 3.")
+
+
+@dataclass
+class _Cells:
+    """The valid points sorted by cell, and the occupied cells.
+
+    Attributes
+    ----------
+    x0, y0 : float
+        Upper-left corner of the cell grid.
+    pts : ndarray int64
+        Input index of every valid point, sorted by cell.
+    starts, counts : ndarray
+        First sorted point and number of points of every cell.
+    row, col : ndarray int64
+        Cell indices (relative to the corner).
+    cx, cy : ndarray
+        Cell centres.
+    """
+
+    x0: float
+    y0: float
+    pts: Array
+    starts: Array
+    counts: Array
+    row: Array
+    col: Array
+    cx: Array
+    cy: Array
+
+
+def _sort_into_cells(x: Array, y: Array, idx: Array, cell: float,
+                     origin: Optional[Tuple[float, float]]) -> _Cells:
+    """Sort the valid points (``idx``) by cell (stable: input order within a cell)."""
+    if origin is None:
+        x0 = math.floor(float(x[idx].min()) / cell) * cell
+        y0 = math.ceil(float(y[idx].max()) / cell) * cell
+    else:
+        x0, y0 = float(origin[0]), float(origin[1])
+    col = np.floor((x[idx] - x0) / cell).astype(np.int64)
+    row = np.floor((y0 - y[idx]) / cell).astype(np.int64)
+    rmin, cmin = int(row.min()), int(col.min())
+    ncols = int(col.max()) - cmin + 1
+    key = (row - rmin) * ncols + (col - cmin)
+    del row, col
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    pts = idx[order]  # input index of each sorted point
+    del key, order
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(skey)) + 1])
+    counts = np.diff(np.append(starts, skey.size))
+    ckey = skey[starts]
+    del skey
+    crow = ckey // ncols + rmin
+    ccol = ckey % ncols + cmin
+    return _Cells(x0, y0, pts, starts, counts, crow, ccol, x0 + (ccol + 0.5) * cell,
+                  y0 - (crow + 0.5) * cell)
+
+
+def _chunk_bounds(cells: _Cells, chunk_points: int) -> Tuple[List[int], Array]:
+    """Chunks of whole cells, about ``chunk_points`` points each.
+
+    Returns
+    -------
+    (first cell of every chunk and the end, first sorted point of every cell and the end)
+    """
+    m = cells.starts.size
+    bounds = [0]
+    cum = np.append(cells.starts, cells.pts.size)
+    while bounds[-1] < m:
+        target = cum[bounds[-1]] + max(int(chunk_points), 1)
+        nxt = int(np.searchsorted(cum, target, side="right")) - 1
+        bounds.append(min(max(nxt, bounds[-1] + 1), m))
+    return bounds, cum
+
+
+@dataclass
+class _Outputs:
+    """Per-cell and per-point results, filled chunk by chunk."""
+
+    z: Array
+    sigma: Array
+    plane: Array
+    slope: Array
+    outliers: Array
+    rep: Array
+    residual: Array
+    outlier: Array
+    cell_index: Array
+    max_it: int = 0
+
+    @classmethod
+    def empty(cls, m: int, n_raw: int) -> _Outputs:
+        """Outputs of ``m`` cells and ``n_raw`` input points."""
+        return cls(np.empty(m), np.empty(m), np.zeros(m, bool), np.zeros((m, 2)),
+                   np.zeros(m, np.int64), np.empty(m, np.int64), np.full(n_raw, np.nan),
+                   np.zeros(n_raw, bool), np.full(n_raw, -1, np.int64))
+
+
+def _reduce_cells(x: Array, y: Array, z: Array, p_all: Optional[Array], cells: _Cells,
+                  opts: Dict[str, Any], chunk_points: int, feedback: Feedback) -> _Outputs:
+    """Run :func:`_reduce_chunk` over chunks of whole cells and gather the results."""
+    out = _Outputs.empty(cells.starts.size, x.size)
+    bounds, cum = _chunk_bounds(cells, chunk_points)
+    for ci, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+        feedback.progress(100.0 * ci / (len(bounds) - 1))
+        s, e = int(cum[a]), int(cum[b])
+        sel = cells.pts[s:e]
+        cnt = cells.counts[a:b]
+        start = cells.starts[a:b] - s
+        lid = np.repeat(np.arange(b - a), cnt)
+        res = _reduce_chunk(lid, x[sel], y[sel], z[sel], None if p_all is None else p_all[sel],
+                            start, cnt, cells.cx[a:b], cells.cy[a:b], opts)
+        out.z[a:b] = res["z"]
+        out.sigma[a:b] = res["sigma"]
+        out.plane[a:b] = res["plane"]
+        out.slope[a:b, 0] = res["c1"]
+        out.slope[a:b, 1] = res["c2"]
+        out.outliers[a:b] = res["outliers"]
+        out.rep[a:b] = sel[res["rep"]]
+        out.residual[sel] = res["v"]
+        out.outlier[sel] = res["outlier"]
+        out.cell_index[sel] = np.arange(a, b)[lid]
+        out.max_it = max(out.max_it, int(res["iterations"]))
+    feedback.progress(100.0)
+    return out
+
+
 def reduce_groundels(x: ArrayLike, y: ArrayLike, z: ArrayLike, cell: float, *,
                      origin: Optional[Tuple[float, float]] = None, mode: str = "l1",
                      lower_percentile: float = 10.0, min_points: int = 3,
@@ -440,21 +580,12 @@ def reduce_groundels(x: ArrayLike, y: ArrayLike, z: ArrayLike, cell: float, *,
         Bad parameters, arrays of different lengths, or no finite point.
     """
     feedback = ensure_feedback(feedback)
-    if mode not in MODES:
-        raise InputError(f"Unknown groundel mode '{mode}'; use one of {', '.join(MODES)}.")
-    if not (cell > 0 and math.isfinite(cell)):
-        raise InputError(f"The groundel size must be positive, got {cell}.")
-    if not 0.0 <= lower_percentile <= 100.0:
-        raise InputError(f"The lower-envelope percentile must be within 0…100, got "
-                         f"{lower_percentile}.")
-    if min_points < 1 or plane_min_points < 3:
-        raise InputError("min_points must be ≥ 1 and plane_min_points ≥ 3.")
+    _check_options(mode, cell, lower_percentile, min_points, plane_min_points)
     x = np.ravel(np.asarray(x, dtype=np.float64))
     y = np.ravel(np.asarray(y, dtype=np.float64))
     z = np.ravel(np.asarray(z, dtype=np.float64))
     if not (x.size == y.size == z.size):
         raise InputError(f"x, y, z have different lengths ({x.size}, {y.size}, {z.size}).")
-    n_raw = x.size
     valid = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
     p_all = None
     if weights is not None:
@@ -463,92 +594,31 @@ def reduce_groundels(x: ArrayLike, y: ArrayLike, z: ArrayLike, cell: float, *,
     idx = np.flatnonzero(valid)
     if idx.size == 0:
         raise InputError("No finite point to reduce (all coordinates NaN or outside).")
-    if origin is None:
-        x0 = math.floor(float(x[idx].min()) / cell) * cell
-        y0 = math.ceil(float(y[idx].max()) / cell) * cell
-    else:
-        x0, y0 = float(origin[0]), float(origin[1])
-    col = np.floor((x[idx] - x0) / cell).astype(np.int64)
-    row = np.floor((y0 - y[idx]) / cell).astype(np.int64)
-    rmin, cmin = int(row.min()), int(col.min())
-    ncols = int(col.max()) - cmin + 1
-    key = (row - rmin) * ncols + (col - cmin)
-    del row, col
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    pts = idx[order]  # input index of each sorted point
-    del key, order, idx
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(skey)) + 1])
-    m = starts.size
-    counts = np.diff(np.append(starts, skey.size))
-    ckey = skey[starts]
-    del skey
-    crow = ckey // ncols + rmin
-    ccol = ckey % ncols + cmin
-    cx = x0 + (ccol + 0.5) * cell
-    cy = y0 - (crow + 0.5) * cell
-
-    out_z = np.empty(m)
-    out_sigma = np.empty(m)
-    out_plane = np.zeros(m, bool)
-    out_slope = np.zeros((m, 2))
-    out_outliers = np.zeros(m, np.int64)
-    out_rep = np.empty(m, np.int64)
-    residual = np.full(n_raw, np.nan)
-    outlier = np.zeros(n_raw, bool)
-    cell_index = np.full(n_raw, -1, np.int64)
-
+    cells = _sort_into_cells(x, y, idx, cell, origin)
+    del idx
     opts = {"mode": mode, "cell": float(cell), "lower_percentile": float(lower_percentile),
             "min_points": int(min_points), "plane_min_points": int(plane_min_points),
             "k": float(k), "floor": float(floor), "slope_test": float(slope_test),
             "max_iter": int(max_iter), "tol": float(tol),
             "rel_tol": float(rel_tol)}
-    # chunks of whole cells, about chunk_points points each
-    bounds = [0]
-    cum = np.append(starts, pts.size)
-    while bounds[-1] < m:
-        target = cum[bounds[-1]] + max(int(chunk_points), 1)
-        nxt = int(np.searchsorted(cum, target, side="right")) - 1
-        bounds.append(min(max(nxt, bounds[-1] + 1), m))
-    max_it = 0
-    for ci, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
-        feedback.progress(100.0 * ci / (len(bounds) - 1))
-        s, e = int(cum[a]), int(cum[b])
-        sel = pts[s:e]
-        cnt = counts[a:b]
-        start = starts[a:b] - s
-        lid = np.repeat(np.arange(b - a), cnt)
-        res = _reduce_chunk(lid, x[sel], y[sel], z[sel], None if p_all is None else p_all[sel],
-                            start, cnt, cx[a:b], cy[a:b], opts)
-        out_z[a:b] = res["z"]
-        out_sigma[a:b] = res["sigma"]
-        out_plane[a:b] = res["plane"]
-        out_slope[a:b, 0] = res["c1"]
-        out_slope[a:b, 1] = res["c2"]
-        out_outliers[a:b] = res["outliers"]
-        out_rep[a:b] = sel[res["rep"]]
-        residual[sel] = res["v"]
-        outlier[sel] = res["outlier"]
-        cell_index[sel] = np.arange(a, b)[lid]
-        max_it = max(max_it, int(res["iterations"]))
-    feedback.progress(100.0)
-
+    out = _reduce_cells(x, y, z, p_all, cells, opts, chunk_points, feedback)
+    counts = cells.counts
     reliable = counts >= min_points
     if reliable.any():
-        sigma1 = float(np.nanmean(out_sigma[reliable]))
+        sigma1 = float(np.nanmean(out.sigma[reliable]))
         n_mean = float(counts[reliable].mean())
         sigma2 = F * sigma1 / math.sqrt(n_mean)
     else:
         sigma1 = sigma2 = n_mean = float("nan")
     return GroundelResult(
-        cell_size=float(cell), origin=(x0, y0), mode=mode, row=crow, col=ccol, x=cx, y=cy,
-        z=out_z, n=counts.astype(np.int64), sigma1=out_sigma, plane=out_plane,
-        slope=out_slope, outliers=out_outliers, rep_index=out_rep, rep_x=x[out_rep],
-        rep_y=y[out_rep], rep_z=z[out_rep], residual=residual, outlier=outlier,
-        cell_index=cell_index, sigma1_mean=sigma1, sigma2=sigma2, n_mean=n_mean,
-        points_raw=int(n_raw), points_valid=int(pts.size), F=float(F), k=float(k),
-        min_points=int(min_points),
-        options={**opts, "irls_iterations": max_it},
+        cell_size=float(cell), origin=(cells.x0, cells.y0), mode=mode, row=cells.row,
+        col=cells.col, x=cells.cx, y=cells.cy, z=out.z, n=counts.astype(np.int64),
+        sigma1=out.sigma, plane=out.plane, slope=out.slope, outliers=out.outliers,
+        rep_index=out.rep, rep_x=x[out.rep], rep_y=y[out.rep], rep_z=z[out.rep],
+        residual=out.residual, outlier=out.outlier, cell_index=out.cell_index,
+        sigma1_mean=sigma1, sigma2=sigma2, n_mean=n_mean, points_raw=int(x.size),
+        points_valid=int(cells.pts.size), F=float(F), k=float(k), min_points=int(min_points),
+        options={**opts, "irls_iterations": out.max_it},
     )
 
 

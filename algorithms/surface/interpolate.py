@@ -1,6 +1,6 @@
 r"""Points (+ breaklines, exclusion areas, boundaries) → DEM grid.
 
-Points are read with :func:`..quality.points.read_points` (XYZ text, CSV with a header, or
+Points are read with :func:`..project.points_io.read_points` (XYZ text, CSV with a header, or
 3-D points / points with a height field in a GeoPackage, Shapefile, GeoJSON). They are reduced
 to one height per cell of side ``spacing`` — the median of the cell's points — and the empty
 cells are interpolated by the membrane (Laplace) interpolation of
@@ -27,15 +27,21 @@ Grid
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
+from numpy.typing import NDArray
+from rasterio.crs import CRS
+from rasterio.warp import transform
+from shapely.ops import unary_union
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..project.edits import read_constraints, read_geometries
-from ..quality.points import check_distinct_points, read_points
+from ..project.model import Project
+from ..project.points_io import PointSet, check_distinct_points, read_points
 from ..raster.io import atomic_output, write_raster
 from .fe_grid import fe_interpolate
 from .gridding import Grid, GridAccumulator, GridResult, finish_grid
@@ -44,11 +50,11 @@ from .gridding import Grid, GridAccumulator, GridResult, finish_grid
 MIN_DISTINCT_POINTS = 3
 
 PathLike = Union[str, Path]
+Array = NDArray[Any]
 
 
 def _crs(value: Any) -> Any:
-    from rasterio.crs import CRS
-
+    """A rasterio CRS from anything it understands (None or "" stay None)."""
     if value is None or value == "":
         return None
     if isinstance(value, CRS):
@@ -57,6 +63,160 @@ def _crs(value: Any) -> Any:
         return CRS.from_user_input(value)
     except Exception as exc:  # rasterio raises CRSError
         raise InputError(f"'{value}' is not a CRS (give e.g. EPSG:25832).") from exc
+
+
+def _check_options(output: Path, spacing: float, method: str, smoothing: float) -> None:
+    """InputError for an output that is no GeoTIFF, a bad spacing, method or smoothing."""
+    if output.suffix.lower() not in (".tif", ".tiff"):
+        raise InputError(f"The output '{output}' must be a GeoTIFF (.tif).")
+    if not spacing or not spacing > 0:
+        raise InputError(f"The spacing must be positive, got {spacing}.")
+    if method not in ("membrane", "fe"):
+        raise InputError(f"Unknown interpolation method '{method}'; use 'membrane' or 'fe'.")
+    if method == "fe" and not (smoothing is not None and smoothing > 0):
+        raise InputError(f"The smoothing must be positive, got {smoothing}.")
+
+
+@dataclass
+class _Target:
+    """The DEM's CRS and the project's edits file (if any)."""
+
+    crs: Any
+    edits: Optional[Path]
+
+
+def _target(pts: PointSet, points: PathLike, crs: Any, project: Optional[PathLike]) -> _Target:
+    """The DEM's CRS: ``crs``, else the project's, else the points' (see the module notes)."""
+    edits: Optional[Path] = None
+    target = _crs(crs)
+    if project is not None and str(project) != "":
+        prj = Project.load(project)
+        if target is None and prj.crs:
+            target = _crs(prj.crs)
+        edits = Path(prj.edits_path)
+    if target is None and pts.crs:
+        target = _crs(pts.crs)
+    if target is None:
+        raise InputError(f"The points of '{Path(points).name}' carry no CRS; give the CRS "
+                         "(e.g. --crs EPSG:25832) or a project.")
+    return _Target(target, edits)
+
+
+def _points_xyz(pts: PointSet, target: Any) -> Tuple[Array, Array, Array]:
+    """The points' coordinates in the DEM's CRS."""
+    pts_crs = _crs(pts.crs) if pts.crs else None
+    x, y, z = pts.x, pts.y, pts.z
+    if pts_crs is not None and pts_crs != target:
+        xs, ys = transform(pts_crs, target, x.tolist(), y.tolist())
+        x, y = np.asarray(xs, float), np.asarray(ys, float)
+    return x, y, z
+
+
+@dataclass
+class _Constraints:
+    """Exclusion areas, boundaries and breaklines in the DEM's CRS."""
+
+    exclusions: List[Any] = field(default_factory=list)
+    boundaries: List[Any] = field(default_factory=list)
+    breaklines: List[Any] = field(default_factory=list)
+
+
+def _constraints(target: _Target, breaklines: Optional[PathLike],
+                 exclusions: Optional[PathLike], boundary: Optional[PathLike]) -> _Constraints:
+    """The project's edits plus the given vector files."""
+    out = _Constraints()
+    if target.edits is not None and target.edits.is_file():
+        out.exclusions, out.boundaries, out.breaklines = read_constraints(target.edits,
+                                                                          target.crs)
+    if exclusions:
+        out.exclusions += read_geometries(exclusions, ("Polygon",), target.crs, skip_keep=True)
+    if boundary:
+        got = read_geometries(boundary, ("Polygon",), target.crs)
+        if not got:
+            raise InputError(f"'{Path(boundary).name}' holds no polygon; give the measuring "
+                             "area as polygons.")
+        out.boundaries += got
+    if breaklines:
+        out.breaklines += read_geometries(breaklines, ("LineString",), target.crs)
+    return out
+
+
+def _dem_grid(x: Array, y: Array, spacing: float, boundaries: List[Any]) -> Grid:
+    """The points' extent (clipped to the boundaries' extent) on cells of ``spacing``."""
+    # points on the upper edge still get a cell: pad the upper bounds slightly
+    pad = 1e-6 * spacing
+    xmin, ymin = float(x.min()), float(y.min())
+    xmax, ymax = float(x.max()) + pad, float(y.max()) + pad
+    if boundaries:
+        bx0, by0, bx1, by1 = unary_union(boundaries).bounds
+        xmin, ymin, xmax, ymax = max(xmin, bx0), max(ymin, by0), min(xmax, bx1), min(ymax, by1)
+        if not (xmax > xmin and ymax > ymin):
+            raise InputError("No point lies within the boundary's extent; check the boundary "
+                             "and the CRS of the points.")
+    grid = Grid.from_bounds(xmin, ymin, xmax, ymax, spacing)
+    if grid.width * grid.height > 2 ** 28:
+        raise InputError(f"The DEM would have {grid.width} × {grid.height} cells; give a larger "
+                         "spacing.")
+    return grid
+
+
+def _grid_heights(x: Array, y: Array, z: Array, grid: Grid, cons: _Constraints, gap: float,
+                  method: str, smoothing: float, robust: bool,
+                  feedback: Feedback) -> Tuple[GridResult, int, Dict[str, Any]]:
+    """The DEM by finite elements or by median per cell + membrane filling.
+
+    Returns
+    -------
+    (grid result, points used, finite-element statistics or {})
+    """
+    if method == "fe":
+        zf, fe_info = fe_interpolate(x, y, z, grid, smoothing=float(smoothing),
+                                     breaklines=cons.breaklines, exclusions=cons.exclusions,
+                                     boundaries=cons.boundaries, max_gap=gap, robust=robust,
+                                     feedback=feedback.step(10.0, 90.0))
+        count = fe_info["count"]
+        return (GridResult(zf, count, np.isfinite(zf) & (count == 0), grid), fe_info["used"],
+                fe_info)
+    acc = GridAccumulator(grid)
+    try:
+        acc.add(x, y, z)
+        used = acc.points
+        zg, count = acc.reduce(feedback.step(10.0, 40.0))
+    finally:
+        acc.close()
+    feedback.progress(45.0)
+    res = finish_grid(zg, count, grid, gap, exclusions=cons.exclusions,
+                      boundary=cons.boundaries, breaklines=cons.breaklines)
+    return res, used, {}
+
+
+def _write_dem(output: Path, res: GridResult, crs: Any) -> Path:
+    """Write the DEM and ``<stem>_count.tif`` (points per cell) together; the count's path."""
+    count_path = output.with_name(f"{output.stem}_count.tif")
+    counts = np.minimum(res.count, np.iinfo(np.uint16).max).astype(np.uint16)
+    with atomic_output(count_path) as tmp_count:
+        write_raster(tmp_count, counts, transform=res.grid.transform, crs=crs, nodata=None,
+                     overviews=True)
+        write_raster(output, res.z.astype(np.float32), transform=res.grid.transform, crs=crs,
+                     overviews=True)
+    return count_path
+
+
+def _report(result: Dict[str, Any], fe_info: Dict[str, Any], smoothing: float, robust: bool,
+            n_points: int, feedback: Feedback) -> None:
+    """Tell the operator what the DEM holds."""
+    feedback.info(f"DEM {result['width']} × {result['height']} cells of "
+                  f"{result['spacing']:g} m from {result['used']} points: "
+                  f"{result['measured']} cells measured, {result['filled']} interpolated, "
+                  f"{100.0 * result['coverage']:.1f} % with a height.")
+    if fe_info:
+        feedback.info(f"Finite elements (smoothing {smoothing:g}): point residuals RMS "
+                      f"{fe_info['rms']:.3f} m, σ(MAD) {fe_info['sigma_mad']:.3f} m"
+                      + (f", {fe_info['downweighted']} point(s) down-weighted as blunders."
+                         if robust else "."))
+    if result["used"] < n_points:
+        feedback.warning(f"{n_points - result['used']} point(s) lie outside the grid "
+                         "(boundary).")
 
 
 def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
@@ -104,126 +264,37 @@ def interpolate_dem(points: PathLike, output: PathLike, spacing: float,
     """
     feedback = ensure_feedback(feedback)
     output = Path(output)
-    if output.suffix.lower() not in (".tif", ".tiff"):
-        raise InputError(f"The output '{output}' must be a GeoTIFF (.tif).")
-    if not spacing or not spacing > 0:
-        raise InputError(f"The spacing must be positive, got {spacing}.")
-    if method not in ("membrane", "fe"):
-        raise InputError(f"Unknown interpolation method '{method}'; use 'membrane' or 'fe'.")
-    if method == "fe" and not (smoothing is not None and smoothing > 0):
-        raise InputError(f"The smoothing must be positive, got {smoothing}.")
+    _check_options(output, spacing, method, smoothing)
     pts = read_points(points)
-    edits: Optional[Path] = None
-    target = _crs(crs)
-    if project is not None and str(project) != "":
-        from ..project.model import Project
-
-        prj = Project.load(project)
-        if target is None and prj.crs:
-            target = _crs(prj.crs)
-        edits = Path(prj.edits_path)
-    pts_crs = _crs(pts.crs) if pts.crs else None
-    if target is None:
-        target = pts_crs
-    if target is None:
-        raise InputError(f"The points of '{Path(points).name}' carry no CRS; give the CRS "
-                         "(e.g. --crs EPSG:25832) or a project.")
-    x, y, z = pts.x, pts.y, pts.z
-    if pts_crs is not None and pts_crs != target:
-        from rasterio.warp import transform
-
-        xs, ys = transform(pts_crs, target, x.tolist(), y.tolist())
-        x, y = np.asarray(xs, float), np.asarray(ys, float)
+    target = _target(pts, points, crs, project)
+    x, y, z = _points_xyz(pts, target.crs)
     feedback.progress(5.0)
-    excl: List[Any] = []
-    bnds: List[Any] = []
-    lines: List[Any] = []
-    if edits is not None and edits.is_file():
-        excl, bnds, lines = read_constraints(edits, target)
-    if exclusions:
-        excl += read_geometries(exclusions, ("Polygon",), target, skip_keep=True)
-    if boundary:
-        got = read_geometries(boundary, ("Polygon",), target)
-        if not got:
-            raise InputError(f"'{Path(boundary).name}' holds no polygon; give the measuring "
-                             "area as polygons.")
-        bnds += got
-    if breaklines:
-        lines += read_geometries(breaklines, ("LineString",), target)
+    cons = _constraints(target, breaklines, exclusions, boundary)
     ok = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
     if not ok.any():
         raise InputError(f"'{Path(points).name}' has no point with finite coordinates.")
     check_distinct_points(x[ok], y[ok], Path(points).name, MIN_DISTINCT_POINTS,
                           "an interpolated DEM")
-    # points on the upper edge still get a cell: pad the upper bounds slightly
-    pad = 1e-6 * spacing
-    xmin, ymin = float(x[ok].min()), float(y[ok].min())
-    xmax, ymax = float(x[ok].max()) + pad, float(y[ok].max()) + pad
-    if bnds:
-        from shapely.ops import unary_union
-
-        bx0, by0, bx1, by1 = unary_union(bnds).bounds
-        xmin, ymin, xmax, ymax = max(xmin, bx0), max(ymin, by0), min(xmax, bx1), min(ymax, by1)
-        if not (xmax > xmin and ymax > ymin):
-            raise InputError("No point lies within the boundary's extent; check the boundary "
-                             "and the CRS of the points.")
-    grid = Grid.from_bounds(xmin, ymin, xmax, ymax, spacing)
-    if grid.width * grid.height > 2 ** 28:
-        raise InputError(f"The DEM would have {grid.width} × {grid.height} cells; give a larger "
-                         "spacing.")
+    grid = _dem_grid(x[ok], y[ok], spacing, cons.boundaries)
     gap = float("inf") if max_gap is None else float(max_gap)
-    fe_info: Dict[str, Any] = {}
-    if method == "fe":
-        zf, fe_info = fe_interpolate(x[ok], y[ok], z[ok], grid, smoothing=float(smoothing),
-                                     breaklines=lines, exclusions=excl, boundaries=bnds,
-                                     max_gap=gap, robust=robust,
-                                     feedback=feedback.step(10.0, 90.0))
-        count = fe_info["count"]
-        used = fe_info["used"]
-        res = GridResult(zf, count, np.isfinite(zf) & (count == 0), grid)
-    else:
-        acc = GridAccumulator(grid)
-        try:
-            acc.add(x[ok], y[ok], z[ok])
-            used = acc.points
-            zg, count = acc.reduce(feedback.step(10.0, 40.0))
-        finally:
-            acc.close()
-        feedback.progress(45.0)
-        res = finish_grid(zg, count, grid, gap, exclusions=excl, boundary=bnds,
-                          breaklines=lines)
+    res, used, fe_info = _grid_heights(x[ok], y[ok], z[ok], grid, cons, gap, method, smoothing,
+                                       robust, feedback)
     feedback.progress(90.0)
-    count_path = output.with_name(f"{output.stem}_count.tif")
-    counts = np.minimum(res.count, np.iinfo(np.uint16).max).astype(np.uint16)
-    with atomic_output(count_path) as tmp_count:
-        write_raster(tmp_count, counts, transform=grid.transform, crs=target, nodata=None,
-                     overviews=True)
-        write_raster(output, res.z.astype(np.float32), transform=grid.transform, crs=target,
-                     overviews=True)
+    count_path = _write_dem(output, res, target.crs)
     cells = grid.width * grid.height
-    valid = int(np.isfinite(res.z).sum())
-    measured = int((res.count > 0).sum())
     result = {
         "dem": str(output), "count": str(count_path), "points": len(pts), "used": int(used),
         "width": grid.width, "height": grid.height, "spacing": float(spacing), "cells": cells,
-        "measured": measured, "filled": int(res.filled.sum()), "coverage": valid / float(cells),
-        "breaklines": len(lines), "exclusions": len(excl), "boundaries": len(bnds),
-        "method": method,
+        "measured": int((res.count > 0).sum()), "filled": int(res.filled.sum()),
+        "coverage": int(np.isfinite(res.z).sum()) / float(cells),
+        "breaklines": len(cons.breaklines), "exclusions": len(cons.exclusions),
+        "boundaries": len(cons.boundaries), "method": method,
     }
     if fe_info:
         result.update(residual_rms=fe_info["rms"], residual_sigma_mad=fe_info["sigma_mad"],
                       downweighted=fe_info["downweighted"])
     feedback.progress(100.0)
-    feedback.info(f"DEM {grid.width} × {grid.height} cells of {spacing:g} m from {used} points: "
-                  f"{measured} cells measured, {result['filled']} interpolated, "
-                  f"{100.0 * result['coverage']:.1f} % with a height.")
-    if fe_info:
-        feedback.info(f"Finite elements (smoothing {smoothing:g}): point residuals RMS "
-                      f"{fe_info['rms']:.3f} m, σ(MAD) {fe_info['sigma_mad']:.3f} m"
-                      + (f", {fe_info['downweighted']} point(s) down-weighted as blunders."
-                         if robust else "."))
-    if used < len(pts):
-        feedback.warning(f"{len(pts) - used} point(s) lie outside the grid (boundary).")
+    _report(result, fe_info, smoothing, robust, len(pts), feedback)
     return result
 
 

@@ -36,6 +36,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..project.points_io import import_laspy as _import_laspy
+from ..project.points_io import laz_check as _laz_check
+from ..project.points_io import read_las
 from ..raster.io import atomic_output
 
 PathLike = Union[str, Path]
@@ -195,22 +198,6 @@ def _py_values(arr: Array) -> List[Any]:
 
 
 # -- LAS ------------------------------------------------------------------------------------------
-def _import_laspy() -> Any:
-    try:
-        import laspy
-    except ImportError as exc:
-        raise InputError("LAS/LAZ files need the Python package laspy: install laspy "
-                         "(pip install laspy; for .laz: pip install \"laspy[lazrs]\"), or "
-                         "write a GeoPackage (.gpkg).") from exc
-    return laspy
-
-
-def _laz_check(laspy: Any, path: Path) -> None:
-    if path.suffix.lower() == ".laz" and not laspy.LazBackend.detect_available():
-        raise InputError(f"'{path.name}' is a compressed LAZ file, which needs a LAZ backend: "
-                         "install lazrs (pip install \"laspy[lazrs]\") or use .las.")
-
-
 def _las_extra_type(arr: Array) -> Any:
     if arr.dtype.kind == "b":
         return np.uint8
@@ -268,48 +255,6 @@ def _write_las(path: Path, x: Array, y: Array, z: Array, cols: Dict[str, Array],
             writer.write_points(rec)
     feedback.progress(100.0)
     return path
-
-
-def read_las(path: PathLike, chunk: int = 2_000_000) -> Tuple[Array, Array, Array, Any,
-                                                               Dict[str, Array]]:
-    """Read the coordinates, the CRS (WKT or None) and the extra-bytes fields of a LAS file.
-
-    Raises
-    ------
-    InputError
-        laspy (or the LAZ backend) missing, or the file is not LAS.
-    """
-    laspy = _import_laspy()
-    path = Path(path)
-    _laz_check(laspy, path)
-    try:
-        with laspy.open(str(path)) as reader:
-            n = int(reader.header.point_count)
-            try:
-                pcrs = reader.header.parse_crs()
-            except Exception:  # a broken or unsupported CRS record: the points are still read
-                pcrs = None
-            names = list(reader.header.point_format.extra_dimension_names)
-            x, y, z = np.empty(n), np.empty(n), np.empty(n)
-            extra: Dict[str, Array] = {}
-            pos = 0
-            for part in reader.chunk_iterator(chunk):
-                k = len(part)
-                x[pos:pos + k] = np.asarray(part.x, dtype=np.float64)
-                y[pos:pos + k] = np.asarray(part.y, dtype=np.float64)
-                z[pos:pos + k] = np.asarray(part.z, dtype=np.float64)
-                for name in names:
-                    values = np.asarray(part[name])
-                    if name not in extra:
-                        extra[name] = np.empty(n, dtype=values.dtype)
-                    extra[name][pos:pos + k] = values
-                pos += k
-    except InputError:
-        raise
-    except Exception as exc:  # laspy raises LaspyException, OSError, ValueError…
-        raise InputError(f"Cannot read the LAS file '{path.name}': {exc}") from exc
-    wkt = pcrs.to_wkt() if pcrs is not None else None
-    return x[:pos], y[:pos], z[:pos], wkt, {k: v[:pos] for k, v in extra.items()}
 
 
 __all__ = ["FORMATS", "read_las", "write_points"]

@@ -11,7 +11,8 @@ from affine import Affine
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.processing import registry
-from photodem.algorithms.quality.points import point_compare, read_points, sample_dem
+from photodem.algorithms.project.points_io import read_points
+from photodem.algorithms.quality.points import point_compare, sample_dem
 from photodem.algorithms.raster.io import write_raster
 
 CELL = 1.0
