@@ -365,7 +365,6 @@ def _smooth(x: Array, k: Array) -> Array:
     along axis 0 strides through memory and is ~2.5 × slower; every output cell is the same
     sum of the same products in the same order, so the strips give bit-identical values.
     """
-
     h, w = x.shape
     r = len(k) // 2
     rows = max(32, STRIP_CELLS // max(w, 1))

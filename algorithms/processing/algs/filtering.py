@@ -91,7 +91,7 @@ class FilterLowpass(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...filtering.lowpass import run_filter_lowpass
+        from ...filtering.lowpass import run_filter_lowpass  # lazy: keeps photodem list fast
 
         return run_filter_lowpass(
             params["input"], params["output"], preset=params.get("preset") or "default",

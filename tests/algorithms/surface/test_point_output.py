@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from photodem.algorithms.errors import InputError
-from photodem.algorithms.quality.points import read_points
+from photodem.algorithms.project.points_io import read_points
 from photodem.algorithms.surface import point_output
 from photodem.algorithms.surface.point_output import write_points
 
