@@ -59,6 +59,7 @@ from ..geometry.orientation import ExteriorOrientation
 from ..input_errors import check_raster
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
+from ..raster.sample import bilinear, bilinear_grid
 from .visibility import march_margin, occluded
 
 PathLike = Union[str, Path]
@@ -164,40 +165,18 @@ def read_surface(ds: Any, bounds: Extent, margin_cells: int = 2,
 def surface_heights(array: Array, transform: Affine, xs: Array, ys: Array) -> Array:
     """Bilinear heights on the grid ``xs`` (columns) × ``ys`` (rows), shape (len(ys), len(xs)).
 
-    For a north-up DEM the interpolation is separable: rows first (two gathered rows per
-    output row), then columns — the same values as :func:`..raster.sample.bilinear` (NaN
-    outside the hull of cell centres or next to nodata with non-zero weight) at a fraction of
-    the cost.
+    :func:`..raster.sample.bilinear_grid` with NaN outside the hull of cell centres or next to
+    nodata with non-zero weight. For a north-up DEM the interpolation runs between the rows
+    first (two gathered rows per output row), then between the columns, a fraction of the
+    cost of interpolating every cell on its own.
     """
     if transform.b != 0.0 or transform.d != 0.0:  # rotated DEM: the general sampler
-        from ..raster.sample import bilinear
-
         return bilinear(array, transform, xs[None, :], ys[:, None])
-    h, w = array.shape
     inv = ~transform
     col = inv.a * xs + inv.c - 0.5
     row = inv.e * ys + inv.f - 0.5
-    cin = (col >= 0) & (col <= w - 1)
-    rin = (row >= 0) & (row <= h - 1)
-    c = np.where(cin, col, 0.0)
-    r = np.where(rin, row, 0.0)
-    c0 = np.clip(np.floor(c).astype(np.intp), 0, max(w - 2, 0))
-    r0 = np.clip(np.floor(r).astype(np.intp), 0, max(h - 2, 0))
-    c1, r1 = np.minimum(c0 + 1, w - 1), np.minimum(r0 + 1, h - 1)
-    fc, fr = c - c0, r - r0
-    rows = _lerp(array[r0], array[r1], fr[:, None])  # (len(ys), w)
-    z = _lerp(rows[:, c0], rows[:, c1], fc[None, :])
-    z[~rin, :] = np.nan
-    z[:, ~cin] = np.nan
-    return z
-
-
-def _lerp(a: Array, b: Array, f: Array) -> Array:
-    """(1 − f)·a + f·b where a term with weight 0 contributes 0 even if its value is NaN."""
-    out = (1.0 - f) * a + f * b
-    if np.isnan(out).any():
-        out = (np.where(f == 1.0, 0.0, (1.0 - f) * a) + np.where(f == 0.0, 0.0, f * b))
-    return out
+    return bilinear_grid(array, col[None, :], row[:, None], edge="nan", nodata="weighted",
+                         order="rows")
 
 
 # -- geometry --------------------------------------------------------------------------------
