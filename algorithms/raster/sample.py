@@ -21,8 +21,10 @@ from pathlib import Path
 from typing import Optional, Tuple, Union
 
 import numpy as np
+import rasterio
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from rasterio.windows import Window, from_bounds
 
 from ..errors import InputError
 
@@ -240,9 +242,6 @@ class DemSampler:
         band : int
             Band number (1-based).
         """
-        import rasterio
-        from rasterio.windows import Window, from_bounds
-
         path = Path(path)
         if not path.is_file():
             raise InputError(f"DEM '{path}' does not exist.")

@@ -50,13 +50,13 @@ class ProjectCreate(Algorithm):
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...geometry.stereo import load_dem, mean_terrain_height
+        from ...project.edits import create_edits
+        from ...project.importers import import_project
         from ...project.stereo_models import (
             block_bounds,
             block_footprints,
             detect_stereo_models,
         )
-        from ...project.edits import create_edits
-        from ...project.importers import import_project
         from ...project.validate import validate_project
         from ...raster.io import staged_folder
 
