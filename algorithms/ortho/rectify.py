@@ -48,7 +48,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
-import cv2
 import numpy as np
 import rasterio
 from affine import Affine
@@ -70,6 +69,12 @@ from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
 from ..raster.sample import bilinear, bilinear_grid
 from .visibility import march_margin, occluded
+
+try:
+    import cv2
+except ImportError as exc:  # pragma: no cover - dependency is declared
+    raise InputError("Orthorectification needs OpenCV: install 'opencv-python-headless' "
+                     "(PyPI) or 'python3-opencv' (Debian).") from exc
 
 PathLike = Union[str, Path]
 Array = NDArray[np.float64]
