@@ -54,6 +54,7 @@ from ..project.model import Project
 from ..project.points_io import check_distinct_points, read_points
 from ..quality.report import _CSS, _embed, _table, new_figure, write_json
 from ..raster.io import staged_folder, write_raster
+from ..raster.sample import bilinear_grid
 from ..surface.gridding import Grid, line_barrier, polygon_mask
 
 PathLike = Union[str, Path]
@@ -435,23 +436,13 @@ def sample_bilinear(z: Array, grid: Grid, x: Array, y: Array) -> Array:
     """Bilinear heights of a grid at world points (cell centres as nodes).
 
     Outside the hull of cell centres the nearest edge value is used (points on the outer half
-    cells); NaN where a used node is NaN.
+    cells); NaN where a used node is NaN (:func:`..raster.sample.bilinear_grid` with
+    ``edge="clamp"``, ``nodata="any"``).
     """
     t = grid.transform
     col = (np.asarray(x, float) - t.c) / t.a - 0.5
     row = (np.asarray(y, float) - t.f) / t.e - 0.5
-    h, w = z.shape
-    col = np.clip(col, 0.0, w - 1.0)
-    row = np.clip(row, 0.0, h - 1.0)
-    c0 = np.clip(np.floor(col).astype(np.int64), 0, max(w - 2, 0))
-    r0 = np.clip(np.floor(row).astype(np.int64), 0, max(h - 2, 0))
-    c1 = np.minimum(c0 + 1, w - 1)
-    r1 = np.minimum(r0 + 1, h - 1)
-    fc = col - c0
-    fr = row - r0
-    zz = np.asarray(z, float)
-    return ((zz[r0, c0] * (1 - fc) + zz[r0, c1] * fc) * (1 - fr)
-            + (zz[r1, c0] * (1 - fc) + zz[r1, c1] * fc) * fr)
+    return bilinear_grid(z, col, row, edge="clamp", nodata="any", order="columns")
 
 
 def check_ground_points(dtm: Array, grid: Grid, ground_points: Array,

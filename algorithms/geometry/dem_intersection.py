@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..raster.sample import DemSampler
 from .camera import Camera
 from .orientation import ExteriorOrientation
-from .projection import pixel_to_ray
+from .projection import border_rays, pixel_to_ray
 
 Array = NDArray[np.float64]
 
@@ -226,10 +226,8 @@ def ground_footprint(camera: Camera, eo: ExteriorOrientation, dem: DemSampler,
 
     Returns the (4·per_edge, 3) points and a warning text when some border rays miss the DEM.
     """
-    c = camera.corners()
-    t = np.linspace(0.0, 1.0, per_edge, endpoint=False)[:, None]
-    border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
-    pts = pixel_to_ground(border[:, 0], border[:, 1], camera, eo, dem)
+    _, origin, directions = border_rays(camera, eo, per_edge)
+    pts = intersect_rays_dem(origin, directions, dem)
     missing = int(np.isnan(pts[:, 0]).sum())
     warning = (f"{missing} of {len(pts)} border rays miss the DEM; the footprint is incomplete."
                if missing else None)

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import GeometryError, InputError
 from .camera import Camera
 from .orientation import ExteriorOrientation
+from .projection import border_pixels
 
 Array = NDArray[np.float64]
 SIDES = ("left", "right")
@@ -142,9 +143,7 @@ class EpipolarPair:
         # extents: original borders in normal coordinates (col with cx=0, row with cy=0)
         u_rng, w_rng = [], []
         for s, cam in enumerate(pair.cameras):
-            c = cam.corners()
-            t = np.linspace(0.0, 1.0, border_samples, endpoint=False)[:, None]
-            border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
+            border = border_pixels(cam, border_samples)
             u, w = pair._original_to_normal(s, border[:, 0], border[:, 1])
             if not (np.isfinite(u).all() and np.isfinite(w).all()):
                 raise GeometryError("An image border looks away from the normal image plane; "
@@ -234,7 +233,7 @@ class EpipolarPair:
         bilinear interpolation (:func:`scipy.ndimage.map_coordinates`, order 1) of every band,
         0 outside the original image. Integer inputs are rounded and clipped to their type.
         """
-        from scipy.ndimage import map_coordinates
+        from scipy.ndimage import map_coordinates  # lazy: keeps photodem list fast
 
         img = np.asarray(image)
         if img.ndim == 2:

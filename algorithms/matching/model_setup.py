@@ -67,12 +67,9 @@ def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
     """Image footprint polygon on the plane Z = ``height``."""
     from shapely.geometry import Polygon
 
-    from ..geometry.projection import ray_at_height
+    from ..geometry.projection import border_at_height
 
-    c = cam.corners()
-    t = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
-    border = np.concatenate([c[i] + t * (c[(i + 1) % 4] - c[i]) for i in range(4)])
-    pts = ray_at_height(border[:, 0], border[:, 1], height, cam, eo)
+    pts = border_at_height(cam, eo, height, n)
     ok = np.isfinite(pts).all(axis=1)
     if ok.sum() < 3:
         return Polygon()

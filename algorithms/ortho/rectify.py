@@ -44,22 +44,37 @@ import threading
 import time
 from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import rasterio
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from rasterio.crs import CRS
+from rasterio.enums import ColorInterp, Resampling
+from rasterio.vrt import WarpedVRT
+from rasterio.windows import Window, from_bounds
+from scipy.ndimage import binary_opening
 
 from ..crs_check import same_horizontal_crs
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
+from ..geometry.projection import border_rays
 from ..input_errors import check_raster
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
+from ..raster.sample import bilinear, bilinear_grid
 from .visibility import march_margin, occluded
+
+try:
+    import cv2
+except ImportError as exc:  # pragma: no cover - dependency is declared
+    raise InputError("Orthorectification needs OpenCV: install 'opencv-python-headless' "
+                     "(PyPI) or 'python3-opencv' (Debian).") from exc
 
 PathLike = Union[str, Path]
 Array = NDArray[np.float64]
@@ -70,15 +85,6 @@ RESAMPLING = ("nearest", "bilinear", "cubic")
 OUTSIDE, VISIBLE, OCCLUDED = 0, 1, 2
 #: cells of one output raster at most (a typo in the GSD must not fill the disk)
 MAX_CELLS = 2_000_000_000
-
-
-def _cv2() -> Any:
-    try:
-        import cv2
-    except ImportError as exc:  # pragma: no cover - dependency is declared
-        raise InputError("Orthorectification needs OpenCV: install 'opencv-python-headless' "
-                         "(PyPI) or 'python3-opencv' (Debian).") from exc
-    return cv2
 
 
 # -- rasters in the project CRS ---------------------------------------------------------------
@@ -97,11 +103,6 @@ def open_surface(path: PathLike, crs: str, feedback: Optional[Feedback] = None,
     InputError
         When the file cannot be read as a raster.
     """
-    import rasterio
-    from rasterio.crs import CRS
-    from rasterio.enums import Resampling
-    from rasterio.vrt import WarpedVRT
-
     feedback = ensure_feedback(feedback)
     path = Path(path)
     if not path.is_file():
@@ -138,8 +139,6 @@ def read_surface(ds: Any, bounds: Extent, margin_cells: int = 2,
     ``max_cells`` reads a decimated version (nearest) when the window is larger, for
     statistics. Returns ``None`` when the window misses the raster.
     """
-    from rasterio.windows import Window, from_bounds
-
     win = from_bounds(*bounds, transform=ds.transform)
     col0 = math.floor(win.col_off) - margin_cells
     row0 = math.floor(win.row_off) - margin_cells
@@ -164,40 +163,18 @@ def read_surface(ds: Any, bounds: Extent, margin_cells: int = 2,
 def surface_heights(array: Array, transform: Affine, xs: Array, ys: Array) -> Array:
     """Bilinear heights on the grid ``xs`` (columns) × ``ys`` (rows), shape (len(ys), len(xs)).
 
-    For a north-up DEM the interpolation is separable: rows first (two gathered rows per
-    output row), then columns — the same values as :func:`..raster.sample.bilinear` (NaN
-    outside the hull of cell centres or next to nodata with non-zero weight) at a fraction of
-    the cost.
+    :func:`..raster.sample.bilinear_grid` with NaN outside the hull of cell centres or next to
+    nodata with non-zero weight. For a north-up DEM the interpolation runs between the rows
+    first (two gathered rows per output row), then between the columns, a fraction of the
+    cost of interpolating every cell on its own.
     """
     if transform.b != 0.0 or transform.d != 0.0:  # rotated DEM: the general sampler
-        from ..raster.sample import bilinear
-
         return bilinear(array, transform, xs[None, :], ys[:, None])
-    h, w = array.shape
     inv = ~transform
     col = inv.a * xs + inv.c - 0.5
     row = inv.e * ys + inv.f - 0.5
-    cin = (col >= 0) & (col <= w - 1)
-    rin = (row >= 0) & (row <= h - 1)
-    c = np.where(cin, col, 0.0)
-    r = np.where(rin, row, 0.0)
-    c0 = np.clip(np.floor(c).astype(np.intp), 0, max(w - 2, 0))
-    r0 = np.clip(np.floor(r).astype(np.intp), 0, max(h - 2, 0))
-    c1, r1 = np.minimum(c0 + 1, w - 1), np.minimum(r0 + 1, h - 1)
-    fc, fr = c - c0, r - r0
-    rows = _lerp(array[r0], array[r1], fr[:, None])  # (len(ys), w)
-    z = _lerp(rows[:, c0], rows[:, c1], fc[None, :])
-    z[~rin, :] = np.nan
-    z[:, ~cin] = np.nan
-    return z
-
-
-def _lerp(a: Array, b: Array, f: Array) -> Array:
-    """(1 − f)·a + f·b where a term with weight 0 contributes 0 even if its value is NaN."""
-    out = (1.0 - f) * a + f * b
-    if np.isnan(out).any():
-        out = (np.where(f == 1.0, 0.0, (1.0 - f) * a) + np.where(f == 0.0, 0.0, f * b))
-    return out
+    return bilinear_grid(array, col[None, :], row[:, None], edge="nan", nodata="weighted",
+                         order="rows")
 
 
 # -- geometry --------------------------------------------------------------------------------
@@ -254,16 +231,6 @@ def project_grid(camera: Camera, eo: ExteriorOrientation, xs: Array, ys: Array, 
                           np.asarray(ys, float)[:, None], z)
 
 
-def _rays(camera: Camera, eo: ExteriorOrientation, n: int = 24) -> Tuple[Array, Array]:
-    """Pixel positions along the image border (4n, 2) and their world ray directions."""
-    (c0, r0), (c1, _), (_, r1), _ = camera.corners()
-    t = np.linspace(0.0, 1.0, n, endpoint=False)
-    cols = np.concatenate([c0 + (c1 - c0) * t, np.full(n, c1), c1 - (c1 - c0) * t, np.full(n, c0)])
-    rows = np.concatenate([np.full(n, r0), r0 + (r1 - r0) * t, np.full(n, r1), r1 - (r1 - r0) * t])
-    d = np.einsum("ij,nj->ni", eo.rotation, camera.pixel_to_camera(cols, rows))
-    return np.stack([cols, rows], axis=1), d
-
-
 def footprint_bounds(camera: Camera, eo: ExteriorOrientation, z_low: float, z_high: float,
                      max_range: float = 20.0) -> Optional[Extent]:
     """Bounding box of the image border rays between the heights ``z_low`` and ``z_high``.
@@ -271,7 +238,7 @@ def footprint_bounds(camera: Camera, eo: ExteriorOrientation, z_low: float, z_hi
     Rays that do not reach a height (pointing above the horizon) are cut at ``max_range``
     times the flying height above ``z_low``. ``None`` if no border ray points downwards.
     """
-    _, d = _rays(camera, eo)
+    _, _, d = border_rays(camera, eo, 24, unit=False)  # 24 rays per edge, unscaled
     C = eo.position
     pts: List[Array] = []
     for z in (z_low, z_high):
@@ -309,13 +276,17 @@ def _height_stats(ds: Any, bounds: Extent) -> Optional[Tuple[float, float, float
     return float(a.min()), float(a.mean()), float(a.max())
 
 
-def image_footprint(camera: Camera, eo: ExteriorOrientation, dem: Any, name: str = "",
-                    dem_name: str = "DEM") -> Tuple[Extent, float, float]:
-    """The image footprint on an open DEM: its bounding box (clipped to the DEM), the mean
-    and the highest DEM height in it.
+def dem_footprint_box(camera: Camera, eo: ExteriorOrientation, dem: Any, name: str = "",
+                      dem_name: str = "DEM") -> Tuple[Extent, float, float]:
+    """The ortho's extent on an open DEM: the bounding box (clipped to the DEM) of the image
+    footprint over the DEM's whole height range under it, the mean and the highest DEM
+    height in it.
 
     The border rays are cut with the lowest and the highest DEM height under the footprint,
-    found by two refinements starting from the whole DEM's mean height.
+    found by two refinements starting from the whole DEM's mean height, so that the box holds
+    every cell the image can see. This differs from the footprint *polygon* of
+    :func:`..geometry.stereo.image_footprint` (the outline on one plane at the mean terrain
+    height, for overlaps and B/H), which would cut off the image's view of low ground.
 
     Raises
     ------
@@ -380,8 +351,6 @@ class _ImageSource:
     """Reads windows of the colour bands (and the validity mask) of an image file."""
 
     def __init__(self, ds: Any) -> None:
-        from rasterio.enums import ColorInterp
-
         self.ds = ds
         alpha = [i + 1 for i, c in enumerate(ds.colorinterp) if c == ColorInterp.alpha]
         self.bands = [i for i in range(1, ds.count + 1) if i not in alpha] or [1]
@@ -392,15 +361,13 @@ class _ImageSource:
     def read(self, col0: int, row0: int, col1: int, row1: int
              ) -> Tuple[NDArray[Any], Optional[NDArray[np.uint8]]]:
         """Bands (rows, cols, bands) and the mask (255 valid) of a window, or no mask."""
-        from rasterio.windows import Window
-
         win = Window(col0, row0, col1 - col0, row1 - row0)
         data = self.ds.read(self.bands, window=win)
         mask = self.ds.read_masks(self.bands[0], window=win) if self.masked else None
         return np.ascontiguousarray(np.moveaxis(data, 0, -1)), mask
 
 
-def _remap(cv2: Any, src: NDArray[Any], mapx: NDArray[np.float32], mapy: NDArray[np.float32],
+def _remap(src: NDArray[Any], mapx: NDArray[np.float32], mapy: NDArray[np.float32],
            interpolation: int) -> NDArray[Any]:
     """cv2.remap for any band count and dtype; returns (rows, cols, bands)."""
     dtype = src.dtype
@@ -522,59 +489,18 @@ def orthorectify_image(
     """
     start = time.perf_counter()
     feedback = ensure_feedback(feedback)
-    if resampling not in RESAMPLING:
-        raise InputError(f"Unknown resampling '{resampling}'; use one of "
-                         f"{', '.join(RESAMPLING)}.")
-    if int(tile) < 16:
-        raise InputError("The tile size must be at least 16 cells.")
-    tile = int(tile)
+    tile = _checked_tile(resampling, tile)
     if not isinstance(project, Project):
         project = Project.load(project)
     rec = project.image(image)
     camera = project.camera_of(rec)
-    eo = rec.eo
-    image_path = project.image_path(rec)
-    if not image_path.is_file():
-        raise InputError(f"Image file '{image_path}' of image '{rec.name}' does not exist; fix "
-                         "its path in project.toml.")
-    check_raster(image_path, "image")  # a truncated image fails here, before any work
+    image_path = _checked_image(project, rec)
     output = Path(output)
     vis_path = visibility_path(output)
-    cv2 = _cv2()
-    interpolation = {"nearest": cv2.INTER_NEAREST, "bilinear": cv2.INTER_LINEAR,
-                     "cubic": cv2.INTER_CUBIC}[resampling]
-
     with contextlib.ExitStack() as stack:
-        dem_ds = _SerialReads(stack.enter_context(open_surface(dem, project.crs, feedback,
-                                                               "DEM")))
-        dsm_ds = None
-        if dsm is not None:
-            if Path(dsm).resolve() != Path(dem).resolve():
-                feedback.warning("The true ortho rectifies onto the DEM and tests visibility "
-                                 "against a different DSM: cells below roofs and trees of the "
-                                 "DSM count as occluded. Use the DSM as DEM for a true ortho.")
-            dsm_ds = _SerialReads(stack.enter_context(open_surface(dsm, project.crs, feedback,
-                                                                   "DSM")))
-        src = stack.enter_context(open_image(image_path))
-        if (src.width, src.height) != (camera.width, camera.height):
-            raise InputError(f"Image '{rec.name}' is {src.width}×{src.height} px but camera "
-                             f"'{camera.name}' is {camera.width}×{camera.height} px.")
-        source = _ImageSource(_SerialReads(src))
-
-        box, mean_z, _ = image_footprint(camera, eo, dem_ds, rec.name, "DEM")
-        if extent is not None:
-            ext = tuple(float(v) for v in extent)
-            if not (ext[0] < ext[2] and ext[1] < ext[3]):
-                raise InputError(f"The extent {ext} is empty; give xmin,ymin,xmax,ymax.")
-            if _intersect(ext, _bounds_of(dem_ds)) is None:  # type: ignore[arg-type]
-                raise InputError(f"The extent {ext} does not overlap the DEM; use an extent "
-                                 "inside the DEM.")
-            box = ext  # type: ignore[assignment]
-        if gsd is None:
-            gsd = default_gsd(camera, eo, mean_z)
-        gsd = float(gsd)
-        if not gsd > 0:
-            raise InputError(f"The GSD must be positive, got {gsd}.")
+        dem_ds, dsm_ds = _open_surfaces(stack, project.crs, dem, dsm, feedback)
+        source = _open_source(stack, image_path, rec.name, camera)
+        box, gsd = _extent_and_gsd(camera, rec.eo, dem_ds, rec.name, extent, gsd)
         transform, width, height = _grid(box, gsd)
         if width * height > MAX_CELLS:
             raise InputError(f"The ortho would have {width}×{height} cells at {gsd:g} m; choose "
@@ -586,63 +512,176 @@ def orthorectify_image(
         feedback.info(f"Orthorectifying '{rec.name}' onto '{Path(dem).name}': {width}×{height} "
                       f"cells of {gsd:g} m, {resampling}"
                       + (f", occlusion test against '{Path(dsm).name}'." if dsm else "."))
-
-        n_bands = len(source.bands)
-        dtype = source.dtype.name
-        alpha_value = 255
-        profile = _profile(width, height, n_bands + 1, dtype, transform, project.crs)
-        vprofile = _profile(width, height, 1, "uint8", transform, project.crs)
-        # a Cloud-Optimised GeoTIFF, through an uncompressed scratch file (see cog_output)
-        ortho_tmp, profile = stack.enter_context(cog_output(output, profile))
-        vis_tmp = stack.enter_context(atomic_output(vis_path))
-        dst = stack.enter_context(open_image(ortho_tmp, "w", **profile))
-        vdst = stack.enter_context(open_image(vis_tmp, "w", **vprofile))
-
-        workers = os.cpu_count() or 1
-        tiles = _tiles(width, height, tile, workers)
-        counts = np.zeros(3, dtype=np.int64)
-        from rasterio.windows import Window
-
-        def rectify(cells: Tuple[int, int, int, int]) -> Tuple[NDArray[Any], NDArray[np.uint8]]:
-            return _rectify_tile(cv2, interpolation, source, camera, eo, dem_ds, dsm_ds,
-                                 zmax_dsm, transform, cells, alpha_value)
-
-        # tiles are computed on all cores (numpy and OpenCV release the GIL) and written here
-        # in order; at most one tile per worker waits, which bounds the memory
-        workers = max(1, min(workers, len(tiles)))
-        pool = ThreadPoolExecutor(workers)
-        try:
-            todo = iter(tiles)
-            running: deque[Tuple[Tuple[int, int, int, int], Future[Any]]] = deque()
-            for cells in todo:
-                running.append((cells, pool.submit(rectify, cells)))
-                if len(running) > workers:
-                    break
-            for k in range(len(tiles)):
-                feedback.progress(95.0 * k / len(tiles))
-                (r0, c0, th, tw), future = running.popleft()
-                bands, vis = future.result()
-                nxt = next(todo, None)
-                if nxt is not None:
-                    running.append((nxt, pool.submit(rectify, nxt)))
-                win = Window(c0, r0, tw, th)
-                dst.write(bands, window=win)
-                vdst.write(vis[None], window=win)
-                counts += np.bincount(vis.ravel(), minlength=3)[:3]
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+        job = _OrthoJob(_INTERPOLATION[resampling], source, camera, rec.eo, dem_ds, dsm_ds,
+                        zmax_dsm, transform, width, height)
+        dst, vdst = _open_outputs(stack, output, vis_path, job, project.crs)
+        counts = _write_tiles(job, dst, vdst, tile, feedback)
         feedback.progress(96.0)
-        _finish(dst, vdst, source, rec.name, eo, dem, dsm, width, height, gsd)
+        _finish(dst, vdst, source, rec.name, rec.eo, dem, dsm, width, height, gsd)
         if counts[VISIBLE] == 0:
             raise InputError(f"No cell of the ortho of image '{rec.name}' is visible (the "
                              "footprint misses the DEM or the extent); nothing was written.")
+    return _summary(job, counts, gsd, output, vis_path, rec.name, bool(dsm),
+                    time.perf_counter() - start, feedback)
+
+
+def _checked_tile(resampling: str, tile: int) -> int:
+    """The tile size as int, after checking it and the resampling name."""
+    if resampling not in RESAMPLING:
+        raise InputError(f"Unknown resampling '{resampling}'; use one of "
+                         f"{', '.join(RESAMPLING)}.")
+    if int(tile) < 16:
+        raise InputError("The tile size must be at least 16 cells.")
+    return int(tile)
+
+
+def _checked_image(project: Project, rec: Any) -> Path:
+    """The image file of a project image, checked to exist and to read as a raster."""
+    image_path = project.image_path(rec)
+    if not image_path.is_file():
+        raise InputError(f"Image file '{image_path}' of image '{rec.name}' does not exist; fix "
+                         "its path in project.toml.")
+    check_raster(image_path, "image")  # a truncated image fails here, before any work
+    return image_path
+
+
+def _open_surfaces(stack: contextlib.ExitStack, crs: str, dem: PathLike,
+                   dsm: Optional[PathLike], feedback: Feedback) -> Tuple[Any, Any]:
+    """The DEM and the DSM (or None) opened in the project CRS for reading from threads."""
+    dem_ds = _SerialReads(stack.enter_context(open_surface(dem, crs, feedback, "DEM")))
+    dsm_ds = None
+    if dsm is not None:
+        if Path(dsm).resolve() != Path(dem).resolve():
+            feedback.warning("The true ortho rectifies onto the DEM and tests visibility "
+                             "against a different DSM: cells below roofs and trees of the "
+                             "DSM count as occluded. Use the DSM as DEM for a true ortho.")
+        dsm_ds = _SerialReads(stack.enter_context(open_surface(dsm, crs, feedback, "DSM")))
+    return dem_ds, dsm_ds
+
+
+def _open_source(stack: contextlib.ExitStack, image_path: Path, name: str, camera: Camera
+                 ) -> _ImageSource:
+    """The image opened for windowed reads from threads; its size must match the camera."""
+    src = stack.enter_context(open_image(image_path))
+    if (src.width, src.height) != (camera.width, camera.height):
+        raise InputError(f"Image '{name}' is {src.width}×{src.height} px but camera "
+                         f"'{camera.name}' is {camera.width}×{camera.height} px.")
+    return _ImageSource(_SerialReads(src))
+
+
+def _extent_and_gsd(camera: Camera, eo: ExteriorOrientation, dem_ds: Any, name: str,
+                    extent: Optional[Sequence[float]], gsd: Optional[float]
+                    ) -> Tuple[Extent, float]:
+    """The output extent (given, or the footprint box on the DEM) and the cell size (given,
+    or :func:`default_gsd` at the DEM's mean height under the footprint)."""
+    box, mean_z, _ = dem_footprint_box(camera, eo, dem_ds, name, "DEM")
+    if extent is not None:
+        ext = tuple(float(v) for v in extent)
+        if not (ext[0] < ext[2] and ext[1] < ext[3]):
+            raise InputError(f"The extent {ext} is empty; give xmin,ymin,xmax,ymax.")
+        if _intersect(ext, _bounds_of(dem_ds)) is None:  # type: ignore[arg-type]
+            raise InputError(f"The extent {ext} does not overlap the DEM; use an extent "
+                             "inside the DEM.")
+        box = ext  # type: ignore[assignment]
+    if gsd is None:
+        gsd = default_gsd(camera, eo, mean_z)
+    gsd = float(gsd)
+    if not gsd > 0:
+        raise InputError(f"The GSD must be positive, got {gsd}.")
+    return box, gsd
+
+
+#: OpenCV interpolation of each resampling name
+_INTERPOLATION = {"nearest": cv2.INTER_NEAREST, "bilinear": cv2.INTER_LINEAR,
+                  "cubic": cv2.INTER_CUBIC}
+
+
+@dataclass
+class _OrthoJob:
+    """What every tile of one ortho needs: the interpolation, the image and its orientation,
+    the opened surfaces (DSM and its highest height for true orthos, else None) and the
+    output grid."""
+
+    interpolation: int
+    source: _ImageSource
+    camera: Camera
+    eo: ExteriorOrientation
+    dem_ds: Any
+    dsm_ds: Any
+    zmax_dsm: Optional[float]
+    transform: Affine
+    width: int
+    height: int
+
+    def rectify(self, cells: Tuple[int, int, int, int]
+                ) -> Tuple[NDArray[Any], NDArray[np.uint8]]:
+        """One tile (:func:`_rectify_tile`), alpha 255 on valid cells."""
+        return _rectify_tile(self.interpolation, self.source, self.camera, self.eo,
+                             self.dem_ds, self.dsm_ds, self.zmax_dsm, self.transform, cells, 255)
+
+
+def _open_outputs(stack: contextlib.ExitStack, output: Path, vis_path: Path, job: _OrthoJob,
+                  crs: str) -> Tuple[Any, Any]:
+    """The ortho (a Cloud-Optimised GeoTIFF, through an uncompressed scratch file, see
+    :func:`..raster.io.cog_output`) and the visibility raster, open for writing under
+    temporary names."""
+    n_bands = len(job.source.bands)
+    dtype = job.source.dtype.name
+    profile = _profile(job.width, job.height, n_bands + 1, dtype, job.transform, crs)
+    vprofile = _profile(job.width, job.height, 1, "uint8", job.transform, crs)
+    ortho_tmp, profile = stack.enter_context(cog_output(output, profile))
+    vis_tmp = stack.enter_context(atomic_output(vis_path))
+    dst = stack.enter_context(open_image(ortho_tmp, "w", **profile))
+    vdst = stack.enter_context(open_image(vis_tmp, "w", **vprofile))
+    return dst, vdst
+
+
+def _write_tiles(job: _OrthoJob, dst: Any, vdst: Any, tile: int, feedback: Feedback
+                 ) -> NDArray[np.int64]:
+    """Rectify all tiles and write them; the counts of the visibility codes.
+
+    Tiles are computed on all cores (numpy and OpenCV release the GIL) and written here in
+    order; at most one tile per worker waits, which bounds the memory.
+    """
+    workers = os.cpu_count() or 1
+    tiles = _tiles(job.width, job.height, tile, workers)
+    counts = np.zeros(3, dtype=np.int64)
+    workers = max(1, min(workers, len(tiles)))
+    pool = ThreadPoolExecutor(workers)
+    try:
+        todo = iter(tiles)
+        running: deque[Tuple[Tuple[int, int, int, int], Future[Any]]] = deque()
+        for cells in todo:
+            running.append((cells, pool.submit(job.rectify, cells)))
+            if len(running) > workers:
+                break
+        for k in range(len(tiles)):
+            feedback.progress(95.0 * k / len(tiles))
+            (r0, c0, th, tw), future = running.popleft()
+            bands, vis = future.result()
+            nxt = next(todo, None)
+            if nxt is not None:
+                running.append((nxt, pool.submit(job.rectify, nxt)))
+            win = Window(c0, r0, tw, th)
+            dst.write(bands, window=win)
+            vdst.write(vis[None], window=win)
+            counts += np.bincount(vis.ravel(), minlength=3)[:3]
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    return counts
+
+
+def _summary(job: _OrthoJob, counts: NDArray[np.int64], gsd: float, output: Path,
+             vis_path: Path, name: str, true_ortho: bool, seconds: float, feedback: Feedback
+             ) -> Dict[str, Any]:
+    """The result of :func:`orthorectify_image`, reported to the feedback too."""
+    width, height, transform = job.width, job.height, job.transform
     inside = int(counts[VISIBLE] + counts[OCCLUDED])
     occ_pct = 100.0 * float(counts[OCCLUDED]) / inside if inside else 0.0
-    seconds = time.perf_counter() - start
-    feedback.info(f"Ortho of '{rec.name}': {width * height / 1e6:.2f} Mcells in {seconds:.1f} s "
+    feedback.info(f"Ortho of '{name}': {width * height / 1e6:.2f} Mcells in {seconds:.1f} s "
                   f"({width * height / 1e6 / max(seconds, 1e-9):.2f} Mcells/s), "
                   f"{100.0 * counts[VISIBLE] / (width * height):.1f} % valid"
-                  + (f", {occ_pct:.2f} % occluded." if dsm else "."))
+                  + (f", {occ_pct:.2f} % occluded." if true_ortho else "."))
     return {
         "ortho": str(output),
         "visibility": str(vis_path),
@@ -656,7 +695,7 @@ def orthorectify_image(
     }
 
 
-def _rectify_tile(cv2: Any, interpolation: int, source: _ImageSource, camera: Camera,
+def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
                   eo: ExteriorOrientation, dem_ds: Any, dsm_ds: Any, zmax_dsm: Optional[float],
                   transform: Affine, cells: Tuple[int, int, int, int], alpha_value: int
                   ) -> Tuple[NDArray[Any], NDArray[np.uint8]]:
@@ -705,7 +744,7 @@ def _rectify_tile(cv2: Any, interpolation: int, source: _ImageSource, camera: Ca
     mapy = (row - wr0).astype(np.float32)
     mapx[~valid] = -1.0
     mapy[~valid] = -1.0
-    res = _remap(cv2, data, mapx, mapy, interpolation)
+    res = _remap(data, mapx, mapy, interpolation)
     if mask is not None:  # cells on masked image pixels (nearest) are outside the image
         m = cv2.remap(mask, mapx, mapy, cv2.INTER_NEAREST, borderMode=cv2.BORDER_REPLICATE)
         vis[(m == 0) & valid] = OUTSIDE
@@ -742,16 +781,12 @@ def _occlusion(dsm_ds: Any, zmax: Optional[float], eo: ExteriorOrientation, xs: 
     # A wall seen edge-on (parallel to the rays) is a staircase of mixed cells in the DSM:
     # rays from cells on it graze the neighbouring steps and give occlusion lines one cell
     # wide. Real occlusions (behind buildings and trees) are wider; a 2 × 2 opening keeps them.
-    from scipy.ndimage import binary_opening
-
     return binary_opening(occ, structure=np.ones((2, 2), dtype=bool))
 
 
 def _finish(dst: Any, vdst: Any, source: _ImageSource, name: str, eo: ExteriorOrientation,
             dem: PathLike, dsm: Optional[PathLike], width: int, height: int, gsd: float) -> None:
     """Colour interpretation, tags and overviews of the two rasters."""
-    from rasterio.enums import ColorInterp, Resampling
-
     dst.colorinterp = [*source.colorinterp, ColorInterp.alpha]
     C = eo.position
     dst.update_tags(PHOTODEM_IMAGE=name, PHOTODEM_CAMERA_X=f"{C[0]:.4f}",
@@ -762,8 +797,6 @@ def _finish(dst: Any, vdst: Any, source: _ImageSource, name: str, eo: ExteriorOr
     vdst.update_tags(PHOTODEM_IMAGE=name, PHOTODEM_VISIBILITY="0 outside, 1 visible, 2 occluded")
     factors = overview_factors(width, height)
     if factors:
-        import rasterio
-
         with rasterio.Env(GDAL_NUM_THREADS="ALL_CPUS"):  # flushing compresses on all cores
             dst.build_overviews(factors, Resampling.average)
             dst.update_tags(ns="rio_overview", resampling="average")
@@ -774,8 +807,8 @@ def _finish(dst: Any, vdst: Any, source: _ImageSource, name: str, eo: ExteriorOr
 __all__ = [
     "RESAMPLING",
     "default_gsd",
+    "dem_footprint_box",
     "footprint_bounds",
-    "image_footprint",
     "open_surface",
     "orthorectify_image",
     "project_grid",

@@ -104,7 +104,7 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
         Largest plausible |ω| and |φ| in degrees (30° for vertical aerial images).
     stereo_partners : bool
         Warn about images without a stereo partner; uses ``project.models`` or, when the project
-        has none, :func:`~..geometry.stereo.detect_stereo_models` with its defaults.
+        has none, :func:`~.stereo_models.detect_stereo_models` with its defaults.
 
     Returns
     -------
@@ -153,7 +153,7 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
     if stereo_partners and not rep.errors and len(project.images) > 0:
         models = project.models
         if not models:
-            from ..geometry.stereo import detect_stereo_models
+            from .stereo_models import detect_stereo_models
 
             try:
                 models = detect_stereo_models(project, dem=dem)
@@ -197,7 +197,8 @@ def _check_files(project: Project, records: List[Any], rep: ValidationReport) ->
 
 def _check_heights(project: Project, records: List[Any], dem: Any,
                    rep: ValidationReport) -> None:
-    from ..geometry.stereo import block_bounds, footprint_and_height, load_dem
+    from ..geometry.stereo import footprint_and_height, load_dem
+    from .stereo_models import block_bounds
 
     sampler = None
     if dem is not None and records:

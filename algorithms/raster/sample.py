@@ -21,8 +21,10 @@ from pathlib import Path
 from typing import Optional, Tuple, Union
 
 import numpy as np
+import rasterio
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from rasterio.windows import Window, from_bounds
 
 from ..errors import InputError
 
@@ -47,41 +49,131 @@ def grid_to_world(transform: Affine, col: ArrayLike, row: ArrayLike) -> Tuple[Ar
     return t.a * c + t.b * r + t.c, t.d * c + t.e * r + t.f
 
 
-def bilinear_grid(array: NDArray, col: ArrayLike, row: ArrayLike) -> Array:
-    """Bilinear interpolation of a 2-D array at fractional (col, row), centres at integers.
+#: edge policies of :func:`bilinear_grid`
+EDGES = ("nan", "clamp")
+#: NaN policies: a NaN neighbour spoils the value when its weight is non-zero / always
+NODATA = ("weighted", "any")
+#: evaluation orders of the four-neighbour formula (they differ in the last bits only)
+ORDERS = ("weights", "rows", "columns")
 
-    NaN outside ``0 ≤ col ≤ width−1, 0 ≤ row ≤ height−1`` and wherever one of the four
-    neighbours with non-zero weight is NaN.
+
+def bilinear_grid(array: NDArray, col: ArrayLike, row: ArrayLike, *, edge: str = "nan",
+                  nodata: str = "weighted", order: str = "weights") -> Array:
+    r"""Bilinear interpolation of a 2-D array at fractional (col, row), centres at integers.
+
+    The one bilinear sampler of the package; callers state their choices explicitly.
+
+    Parameters
+    ----------
+    array : ndarray, shape (rows, cols)
+        Values; NaN is nodata. Gathered values are converted to float64.
+    col, row : array_like
+        Fractional positions (broadcast against each other). A ``row`` of shape (m, 1) and a
+        ``col`` of shape (1, n) with ``order="rows"`` take a separable path (one gathered row
+        pair per output row) with the same values.
+    edge : {"nan", "clamp"}
+        Outside ``0 ≤ col ≤ width−1, 0 ≤ row ≤ height−1``: ``"nan"`` gives NaN; ``"clamp"``
+        moves the position onto the nearest edge of the hull of cell centres first (the outer
+        half cells take the edge values). NaN positions give NaN either way.
+    nodata : {"weighted", "any"}
+        ``"weighted"``: NaN only where a neighbour with non-zero weight is NaN (exactly at a
+        valid cell centre, NaN neighbours do not matter); ``"any"``: NaN where any of the four
+        neighbours is NaN.
+    order : {"weights", "rows", "columns"}
+        How the four neighbours :math:`z_{00}, z_{01}, z_{10}, z_{11}` are combined — the same
+        formula, rounded differently:
+        ``"weights"`` :math:`\sum w_k z_k` with :math:`w_{00} = (1-f_r)(1-f_c)` …;
+        ``"rows"`` first between the rows, then between the columns;
+        ``"columns"`` first between the columns, then between the rows
+        (each step :math:`(1-f)\,a + f\,b`).
+
+    Returns
+    -------
+    ndarray
+        Interpolated values (float64), shape of the broadcast positions.
     """
+    _check_choice("edge", edge, EDGES)
+    _check_choice("nodata", nodata, NODATA)
+    _check_choice("order", order, ORDERS)
     a = np.asarray(array)
     if a.ndim != 2:
         raise ValueError("bilinear sampling needs a 2-D array")
     h, w = a.shape
     col = np.asarray(col, dtype=float)
     row = np.asarray(row, dtype=float)
-    inside = (col >= 0) & (col <= w - 1) & (row >= 0) & (row <= h - 1)  # NaN compares False
-    c = np.where(inside, col, 0.0)
-    r = np.where(inside, row, 0.0)
-    # the lower-left neighbour index is clipped so that the last row/column still has a partner
-    c0 = np.clip(np.floor(c).astype(np.intp), 0, max(w - 2, 0))
-    r0 = np.clip(np.floor(r).astype(np.intp), 0, max(h - 2, 0))
-    c1 = np.minimum(c0 + 1, w - 1)
-    r1 = np.minimum(r0 + 1, h - 1)
-    fc = c - c0
-    fr = r - r0
-    z00 = a[r0, c0].astype(float)
-    z01 = a[r0, c1].astype(float)
-    z10 = a[r1, c0].astype(float)
-    z11 = a[r1, c1].astype(float)
-    z = (_term((1.0 - fr) * (1.0 - fc), z00) + _term((1.0 - fr) * fc, z01)
-         + _term(fr * (1.0 - fc), z10) + _term(fr * fc, z11))
+    if edge == "clamp":
+        col = np.clip(col, 0.0, w - 1.0)
+        row = np.clip(row, 0.0, h - 1.0)
+    col_in = (col >= 0) & (col <= w - 1)  # NaN compares False
+    row_in = (row >= 0) & (row <= h - 1)
+    if order == "rows" and col.ndim == 2 and row.ndim == 2 and col.shape[0] == 1 \
+            and row.shape[1] == 1:
+        return _separable_rows(a, _Axis(col[0], col_in[0], w), _Axis(row[:, 0], row_in[:, 0], h),
+                               nodata == "weighted")
+    inside = col_in & row_in
+    cx = _Axis(np.where(inside, col, 0.0), inside, w)
+    rx = _Axis(np.where(inside, row, 0.0), inside, h)
+    z00 = a[rx.i0, cx.i0].astype(float)
+    z01 = a[rx.i0, cx.i1].astype(float)
+    z10 = a[rx.i1, cx.i0].astype(float)
+    z11 = a[rx.i1, cx.i1].astype(float)
+    skip = nodata == "weighted"
+    fc, fr = cx.f, rx.f
+    if order == "weights":
+        term = _term if skip else np.multiply
+        z = (term((1.0 - fr) * (1.0 - fc), z00) + term((1.0 - fr) * fc, z01)
+             + term(fr * (1.0 - fc), z10) + term(fr * fc, z11))
+    elif order == "rows":
+        z = _lerp(_lerp(z00, z10, fr, skip), _lerp(z01, z11, fr, skip), fc, skip)
+    else:
+        z = _lerp(_lerp(z00, z01, fc, skip), _lerp(z10, z11, fc, skip), fr, skip)
     return np.where(inside, z, np.nan)
+
+
+class _Axis:
+    """Neighbour indices and fraction along one axis of :func:`bilinear_grid`.
+
+    ``i0`` is clipped so that the last row/column still has a partner ``i1 = i0 + 1``;
+    ``f = pos − i0`` (in [0, 1] inside). ``inside`` is kept for the caller.
+    """
+
+    def __init__(self, pos: Array, inside: NDArray[np.bool_], n: int) -> None:
+        self.pos = np.where(inside, pos, 0.0)
+        self.inside = inside
+        self.i0 = np.clip(np.floor(self.pos).astype(np.intp), 0, max(n - 2, 0))
+        self.i1 = np.minimum(self.i0 + 1, n - 1)
+        self.f = self.pos - self.i0
+
+
+def _separable_rows(a: NDArray, cx: _Axis, rx: _Axis, skip: bool) -> Array:
+    """``order="rows"`` on the grid ``rx.pos`` (rows) × ``cx.pos`` (columns): every output row
+    interpolates its two gathered array rows once (full width), then between the columns."""
+    rows = _lerp(a[rx.i0].astype(float), a[rx.i1].astype(float), rx.f[:, None], skip)
+    z = _lerp(rows[:, cx.i0], rows[:, cx.i1], cx.f[None, :], skip)
+    z[~rx.inside, :] = np.nan
+    z[:, ~cx.inside] = np.nan
+    return z
+
+
+def _check_choice(name: str, value: str, allowed: Tuple[str, ...]) -> None:
+    if value not in allowed:
+        raise ValueError(f"bilinear_grid: {name} must be one of {', '.join(allowed)}, "
+                         f"not {value!r}")
 
 
 def _term(weight: Array, value: Array) -> Array:
     """weight·value, but 0 where the weight is 0 (a NaN neighbour that does not contribute,
     e.g. exactly at a valid cell centre, must not turn the result into NaN)."""
     return np.where(weight == 0.0, 0.0, weight * value)
+
+
+def _lerp(a: Array, b: Array, f: Array, skip: bool) -> Array:
+    """(1 − f)·a + f·b; with ``skip`` a term of weight 0 contributes 0 even if its value is
+    NaN (computed only when the plain formula gives a NaN: the same values otherwise)."""
+    out = (1.0 - f) * a + f * b
+    if skip and np.isnan(out).any():
+        out = (np.where(f == 1.0, 0.0, (1.0 - f) * a) + np.where(f == 0.0, 0.0, f * b))
+    return out
 
 
 def bilinear(array: NDArray, transform: Affine, x: ArrayLike, y: ArrayLike) -> Array:
@@ -150,9 +242,6 @@ class DemSampler:
         band : int
             Band number (1-based).
         """
-        import rasterio
-        from rasterio.windows import Window, from_bounds
-
         path = Path(path)
         if not path.is_file():
             raise InputError(f"DEM '{path}' does not exist.")

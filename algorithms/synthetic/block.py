@@ -403,12 +403,12 @@ def _geometry_summary(scene: Scene, models: List[StereoModel]) -> Dict[str, Any]
 
 def _detected_models(project: Project, scene: Scene, feedback: Feedback) -> List[StereoModel]:
     """The planned in-strip pairs with the figures of
-    :func:`..geometry.stereo.detect_stereo_models` (run on the true DTM) when that finds them
+    :func:`..project.stereo_models.detect_stereo_models` (run on the true DTM) when that finds them
     all; else the planned pairs with our own figures and a warning. Further pairs the detection
     may accept (e.g. image 1 with image 3 over high mountains) are not added: the block's
     models are the consecutive in-strip pairs."""
     try:
-        from ..geometry.stereo import detect_stereo_models
+        from ..project.stereo_models import detect_stereo_models
         from ..raster.sample import DemSampler
     except ImportError:  # pragma: no cover - stereo module not yet available
         return list(scene.models)

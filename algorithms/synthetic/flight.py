@@ -285,12 +285,6 @@ def _window(frame: Camera, image: PlannedImage, centre: np.ndarray, spec: SizeSp
 def footprint_points(camera: Camera, eo: ExteriorOrientation, height: float,
                      per_edge: int = 8) -> np.ndarray:
     """Ground points (N, 2) of the image outline intersected with the plane Z = ``height``."""
-    from ..geometry.projection import ray_at_height
+    from ..geometry.projection import border_at_height
 
-    w, h = camera.width - 0.5, camera.height - 0.5
-    s = np.linspace(0.0, 1.0, per_edge, endpoint=False)
-    cols = np.concatenate([-0.5 + s * (w + 0.5), np.full_like(s, w), w - s * (w + 0.5),
-                           np.full_like(s, -0.5)])
-    rows = np.concatenate([np.full_like(s, -0.5), -0.5 + s * (h + 0.5), np.full_like(s, h),
-                           h - s * (h + 0.5)])
-    return ray_at_height(cols, rows, height, camera, eo)[:, :2]
+    return border_at_height(camera, eo, height, per_edge)[:, :2]

@@ -49,15 +49,14 @@ class ProjectCreate(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...geometry.stereo import (
+        from ...geometry.stereo import load_dem, mean_terrain_height
+        from ...project.edits import create_edits
+        from ...project.importers import import_project
+        from ...project.stereo_models import (
             block_bounds,
             block_footprints,
             detect_stereo_models,
-            load_dem,
-            mean_terrain_height,
         )
-        from ...project.edits import create_edits
-        from ...project.importers import import_project
         from ...project.validate import validate_project
         from ...raster.io import staged_folder
 
@@ -218,11 +217,11 @@ class StereoModels(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...geometry.stereo import (
+        from ...geometry.stereo import load_dem
+        from ...project.stereo_models import (
             block_bounds,
             detect_stereo_models,
             image_labels,
-            load_dem,
             manual_model,
         )
 

@@ -13,16 +13,18 @@ from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.geometry.projection import world_to_pixel
 from photodem.algorithms.geometry.stereo import (
-    block_footprints,
-    detect_stereo_models,
     dominant_direction,
     footprint_and_height,
     image_footprint,
+)
+from photodem.algorithms.project.model import ImageRecord, Project
+from photodem.algorithms.project.stereo_models import (
+    block_footprints,
+    detect_stereo_models,
     manual_model,
     model_geometry,
     overlap_polygon,
 )
-from photodem.algorithms.project.model import ImageRecord, Project
 from photodem.algorithms.raster.io import write_raster
 
 # f = 10 mm, 1000 × 800 px of 0.01 mm: at H = 1000 m the footprint is 1000 m × 800 m, GSD 1 m
@@ -150,7 +152,7 @@ def test_block_footprints_uses_project_terrain() -> None:
 
 
 def test_image_labels_drop_shared_parts() -> None:
-    from photodem.algorithms.geometry.stereo import image_labels
+    from photodem.algorithms.project.stereo_models import image_labels
 
     ngi = ["3324c_2015_1004_05_0182_RGB", "3324c_2015_1004_05_0184_RGB",
            "3324c_2015_1004_06_0251_RGB", "3324c_2015_1004_06_0253_RGB"]

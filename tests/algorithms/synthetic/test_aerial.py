@@ -118,7 +118,7 @@ def test_geometry_and_outputs(block) -> None:
 
 
 def test_models_detected(block) -> None:
-    from photodem.algorithms.geometry.stereo import detect_stereo_models
+    from photodem.algorithms.project.stereo_models import detect_stereo_models
     from photodem.algorithms.raster.sample import DemSampler
 
     result, project = block
