@@ -96,13 +96,25 @@ from .fbm import (
     detect_features,
     fbm_level,
     fill_nodata,
-    group_weighted_median,
-    group_wls,
     window_components,
 )
 from .interest import InterestPoints
 from .lsm import lsm_match
 from .ncc import ncc_epipolar
+from .prediction import (
+    COARSE,
+    NEIGHBOURS,
+    NONE,
+    RANGE,
+    SEED,
+    ApproxGrid,
+    CoarsePlanes,
+    Predictor,
+    eval_planes,
+    fill_planes,
+    points_planes,
+    suspect_components,
+)
 from .pyramid import build_pyramid, from_level, levels_for_disparity, to_level
 
 FLAG_LSM = 1
@@ -115,7 +127,6 @@ __all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_GRI
            "FLAG_LSM_FAILED", "FLAG_RETRY", "EpipolarMatches", "FbmLsmOptions",
            "match_epipolar_fbm_lsm"]
 
-_NONE, _COARSE, _NEIGHBOURS, _RANGE, _SEED = 0, 1, 2, 3, 4
 
 
 @dataclass
@@ -287,112 +298,12 @@ def _reduce_any(mask: NDArray) -> NDArray:
 
 
 def _mask_pyramid(mask: Optional[NDArray], n: int) -> List[Optional[NDArray]]:
+    """``n`` levels of a boolean mask (2 × 2 'any' per level; None stays None)."""
     if mask is None:
         return [None] * n
     out = [np.asarray(mask, bool)]
     for _ in range(n - 1):
         out.append(_reduce_any(out[-1]))
-    return out
-
-
-def _eval_planes(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
-                 ) -> NDArray:
-    """Disparity of the groups' planes d = p0 + p1·u + p2·v at points (NaN for g < 0)."""
-    out = np.full(np.shape(cols), np.nan)
-    ok = g >= 0
-    if ok.any():
-        gg = g[ok]
-        u, v = grouping.uv(cols[ok], rows[ok], gg)
-        p = plane[gg]
-        out[ok] = p[:, 0] + p[:, 1] * u + p[:, 2] * v
-    return out
-
-
-def _point_neighbours(edges: NDArray, g: NDArray) -> Tuple[NDArray, NDArray, NDArray]:
-    """Every point's neighbour groups along ``edges`` (group → group).
-
-    Returns ``(point, neighbour, count)``: one (point index, neighbour group) pair per edge
-    leaving the point's group ``g`` (none for ``g < 0``), and the number of pairs per point.
-    """
-    order = np.argsort(edges[:, 0], kind="stable")
-    src, dst = edges[order, 0], edges[order, 1]
-    start = np.searchsorted(src, g, side="left")
-    stop = np.searchsorted(src, g, side="right")
-    cnt = np.where(g >= 0, stop - start, 0)
-    pi = np.repeat(np.arange(g.size), cnt)
-    first = np.cumsum(cnt) - cnt
-    return pi, dst[start[pi] + (np.arange(pi.size) - first[pi])], cnt
-
-
-def _plane_range(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
-                 ) -> Tuple[NDArray, NDArray]:
-    """Lowest and highest disparity of a group's own plane and its neighbours' planes at
-    each point (NaN for g < 0): where they disagree (a roof beside the ground) the point's
-    disparity is not known better than that."""
-    lo = _eval_planes(plane, grouping, g, cols, rows)
-    hi = lo.copy()
-    e = grouping.edges
-    if e.size == 0 or g.size == 0:
-        return lo, hi
-    pi, nb, cnt = _point_neighbours(e, g)
-    if cnt.sum() == 0:
-        return lo, hi
-    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
-    ok = np.isfinite(val)
-    np.fmin.at(lo, pi[ok], val[ok])
-    np.fmax.at(hi, pi[ok], val[ok])
-    return lo, hi
-
-
-def _neighbour_prediction(plane: NDArray, grouping: Grouping, matched: NDArray, g: NDArray,
-                          cols: NDArray, rows: NDArray) -> NDArray:
-    """Mean of the matched neighbour components' planes, evaluated at each point."""
-    out = np.full(np.shape(cols), np.nan)
-    e = grouping.edges
-    if e.size == 0 or g.size == 0:
-        return out
-    e = e[matched[e[:, 1]]]
-    if e.size == 0:
-        return out
-    pi, nb, cnt = _point_neighbours(e, g)
-    if cnt.sum() == 0:
-        return out
-    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
-    s = np.bincount(pi, val, g.size)
-    has = cnt > 0
-    out[has] = s[has] / cnt[has]
-    return out
-
-
-def _fill_planes(plane: NDArray, grouping: Grouping, matched: NDArray, masked: NDArray
-                 ) -> NDArray:
-    """Planes for unmatched, unmasked components from their neighbours (over the graph).
-
-    Wave by wave, each open component takes the mean of its filled neighbours' planes
-    evaluated at its centre (slopes averaged). The graph has no edges across barriers.
-    """
-    out = plane.copy()
-    have = matched.copy()
-    e = grouping.edges
-    c = grouping.centres
-    ws = grouping.window
-    while e.size:
-        sel = have[e[:, 1]] & ~have[e[:, 0]] & ~masked[e[:, 0]]
-        if not sel.any():
-            break
-        s, d = e[sel, 0], e[sel, 1]
-        u = (c[s, 0] - c[d, 0]) / ws
-        v = (c[s, 1] - c[d, 1]) / ws
-        p0 = out[d, 0] + out[d, 1] * u + out[d, 2] * v
-        n = np.bincount(s, minlength=len(out)).astype(float)
-        new = n > 0
-        acc = np.zeros_like(out)
-        acc[:, 0] = np.bincount(s, p0, len(out))
-        acc[:, 1] = np.bincount(s, out[d, 1], len(out))
-        acc[:, 2] = np.bincount(s, out[d, 2], len(out))
-        out[new] = acc[new] / n[new, None]
-        have |= new
-    out[~have] = np.nan
     return out
 
 
@@ -419,7 +330,17 @@ class _Collected:
         return tuple(np.concatenate(p) for p in zip(*self.parts))
 
 
-def _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx):
+def _check_inputs(left: NDArray, right: NDArray, min_d: float, max_d: float,
+                  mask: Optional[NDArray], barriers: Optional[NDArray],
+                  seeds: Optional[NDArray], approx: Optional[Tuple[NDArray, float]]
+                  ) -> Tuple[NDArray, NDArray]:
+    """The two images as float32 after checking shapes, range, seeds and approximation.
+
+    Raises
+    ------
+    InputError
+        Naming what is wrong and how to fix it.
+    """
     L = np.asarray(left, dtype=np.float32)
     R = np.asarray(right, dtype=np.float32)
     if L.ndim != 2 or R.ndim != 2:
@@ -442,53 +363,6 @@ def _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx):
         if np.ndim(grid) != 2 or not step > 0:
             raise InputError("approx must be (2-D disparity grid, positive step in px)")
     return L, R
-
-
-class _CoarsePlanes:
-    """Predictions from the coarser level's (filled) planes, × 2 to this level."""
-
-    has_span = True
-
-    def __init__(self, plane: NDArray, grouping: Grouping) -> None:
-        self.plane = plane
-        self.grouping = grouping
-
-    def _at(self, cols: NDArray, rows: NDArray) -> Tuple[NDArray, NDArray, NDArray]:
-        c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
-        return c1, r1, self.grouping.of(c1, r1, nearest=True)
-
-    def predict(self, cols: NDArray, rows: NDArray) -> NDArray:
-        """Disparity of the coarser plane under each point (NaN where none)."""
-        c1, r1, g1 = self._at(cols, rows)
-        return 2.0 * _eval_planes(self.plane, self.grouping, g1, c1, r1)
-
-    def span(self, cols: NDArray, rows: NDArray) -> Tuple[NDArray, NDArray]:
-        """Lowest and highest of the coarser own and neighbouring planes at each point."""
-        c1, r1, g1 = self._at(cols, rows)
-        lo, hi = _plane_range(self.plane, self.grouping, g1, c1, r1)
-        return 2.0 * lo, 2.0 * hi
-
-
-class _ApproxGrid:
-    """Predictions from the caller's level-0 disparity grid (``approx``) at level ``k``."""
-
-    has_span = False
-
-    def __init__(self, grid: NDArray, step: float, k: int, scale: float) -> None:
-        self.grid = grid
-        self.step = step
-        self.k = k
-        self.scale = scale
-
-    def predict(self, cols: NDArray, rows: NDArray) -> NDArray:
-        """Grid value of the level-0 cell holding each point, in level-k px (NaN outside)."""
-        grid, step = self.grid, self.step
-        i = np.floor((from_level(rows, self.k) + 0.5) / step).astype(np.int64)
-        j = np.floor((from_level(cols, self.k) + 0.5) / step).astype(np.int64)
-        ok = (i >= 0) & (i < grid.shape[0]) & (j >= 0) & (j < grid.shape[1])
-        out = np.full(np.shape(cols), np.nan)
-        out[ok] = grid[i[ok], j[ok]] / self.scale
-        return out
 
 
 @dataclass
@@ -713,7 +587,7 @@ def _seed_disparities(seeds: NDArray, run: _Run, lv: _Level, fb: Any
     return seed_d, has, int(ok.sum())
 
 
-def _initial_modes(run: _Run, lv: _Level, prev: Optional[_CoarsePlanes],
+def _initial_modes(run: _Run, lv: _Level, prev: Optional[CoarsePlanes],
                    approx: Optional[Tuple[NDArray, float]], seeds: Optional[NDArray], fb: Any
                    ) -> Tuple[NDArray, NDArray, Any, Optional[int]]:
     """Prediction mode per component, seed disparities, coarse predictor, seeds used.
@@ -728,91 +602,21 @@ def _initial_modes(run: _Run, lv: _Level, prev: Optional[_CoarsePlanes],
     seed_d = np.full(ng, np.nan)
     n_seeds: Optional[int] = None
     if prev is not None:
-        mode[:] = _COARSE
+        mode[:] = COARSE
         c = lv.grouping.centres
-        mode[~np.isfinite(prev.predict(c[:, 0], c[:, 1]))] = _RANGE
+        mode[~np.isfinite(prev.predict(c[:, 0], c[:, 1]))] = RANGE
         return mode, seed_d, prev, n_seeds
     coarse = None
     if approx is not None:
-        coarse = _ApproxGrid(np.asarray(approx[0], dtype=np.float64), float(approx[1]),
+        coarse = ApproxGrid(np.asarray(approx[0], dtype=np.float64), float(approx[1]),
                              lv.k, lv.scale)
-        mode[:] = _COARSE
+        mode[:] = COARSE
     if seeds is not None:
         seed_d, has, n_seeds = _seed_disparities(seeds, run, lv, fb)
-        mode[has] = _SEED
+        mode[has] = SEED
     elif approx is None:
-        mode[:] = _RANGE
+        mode[:] = RANGE
     return mode, seed_d, coarse, n_seeds
-
-
-@dataclass
-class _Predictor:
-    """``predict(cols, rows) -> (d_pred, pull_in)`` of one wave (:func:`.fbm.fbm_level`).
-
-    ``mode``, ``plane`` and ``matched`` are the level's arrays (updated in place by the
-    waves); ``todo`` is the wave's set of components to match.
-    """
-
-    grouping: Grouping
-    mode: NDArray
-    plane: NDArray
-    matched: NDArray
-    seed_d: NDArray
-    coarse: Any
-    mid: float
-    half: float
-    pull_ref: float
-    pull_grow: float
-    todo: NDArray
-
-    def __call__(self, cols: NDArray, rows: NDArray, active: Optional[NDArray] = None,
-                 context: Optional[NDArray] = None) -> Tuple[NDArray, NDArray]:
-        """(d_pred, pull_in) at left positions of this level; NaN = not matched now.
-
-        ``active`` (per component) replaces the wave's to-do set; ``context``
-        components predict from their own plane (enlarged windows).
-        """
-        g = self.grouping.of(cols, rows)
-        gg = np.maximum(g, 0)
-        d = np.full(np.shape(cols), np.nan)
-        p = np.full(np.shape(cols), np.nan)
-        act = (g >= 0) & (self.todo if active is None else active)[gg]
-        m = np.where(act, self.mode[gg], _NONE)
-        sel = m == _COARSE
-        if sel.any() and self.coarse is not None:
-            self._from_coarse(cols, rows, sel, d, p)
-        sel = m == _SEED
-        if sel.any():
-            d[sel] = self.seed_d[g[sel]]
-            p[sel] = self.pull_grow
-        sel = m == _RANGE
-        if sel.any():
-            d[sel] = self.mid
-            p[sel] = self.half
-        sel = m == _NEIGHBOURS
-        if sel.any():
-            d[sel] = _neighbour_prediction(self.plane, self.grouping, self.matched, g[sel],
-                                           cols[sel], rows[sel])
-            p[sel] = self.pull_grow
-        if context is not None:
-            own = (g >= 0) & context[gg] & ~act
-            if own.any():
-                d[own] = _eval_planes(self.plane, self.grouping, g[own], cols[own], rows[own])
-                p[own] = self.pull_ref
-        return d, p
-
-    def _from_coarse(self, cols: NDArray, rows: NDArray, sel: NDArray, d: NDArray,
-                     p: NDArray) -> None:
-        """Fill ``d``, ``p`` at ``sel`` from the coarser level (or the approximation)."""
-        if self.coarse.has_span:
-            # between disagreeing coarse planes (e.g. a window's roof plane
-            # extrapolated over ground) search their whole span, up to 4 pull-ins
-            lo, hi = self.coarse.span(cols[sel], rows[sel])
-            d[sel] = 0.5 * (lo + hi)
-            p[sel] = self.pull_ref + np.minimum(0.5 * (hi - lo), 3.0 * self.pull_ref)
-        else:
-            d[sel] = self.coarse.predict(cols[sel], rows[sel])
-            p[sel] = self.pull_ref
 
 
 @dataclass
@@ -834,11 +638,11 @@ class _LevelState:
     wave: int = 0
     big: Optional[Grouping] = None
 
-    def predictor(self, run: _Run, lv: _Level) -> _Predictor:
+    def predictor(self, run: _Run, lv: _Level) -> Predictor:
         """The predictor of the current wave (its own copy of the to-do set)."""
         mid_k = 0.5 * (run.min_d + run.max_d) / lv.scale
         half_k = 0.5 * (run.max_d - run.min_d) / lv.scale + 1.0
-        return _Predictor(lv.grouping, self.mode, self.plane, self.matched, self.seed_d,
+        return Predictor(lv.grouping, self.mode, self.plane, self.matched, self.seed_d,
                           self.coarse, mid_k, half_k, run.pull_ref, run.pull_grow,
                           self.todo.copy())
 
@@ -854,7 +658,7 @@ def _new_state(lv: _Level, mode: NDArray, seed_d: NDArray, coarse: Any,
           "range_fallback": 0}
     return _LevelState(mode, seed_d, coarse, np.zeros(ng, bool), np.full((ng, 3), np.nan),
                        np.full(ng, -1, np.int64), np.zeros(ng, bool), np.zeros(ng, bool),
-                       (mode != _NONE) & ~lv.masked, _Collected(), st, lv.k != top)
+                       (mode != NONE) & ~lv.masked, _Collected(), st, lv.k != top)
 
 
 def _matched_neighbours(grouping: Grouping, matched: NDArray) -> NDArray:
@@ -868,14 +672,14 @@ def _redo_suspects(run: _Run, lv: _Level, s: _LevelState) -> None:
     """Consistency between windows: a component whose plane disagrees with the median of
     (≥ 3) matched neighbours is redone from its neighbours, once."""
     tol = max(float(run.opt.neighbour_tol), run.pull_ref / 2.0)
-    sus = _suspect_components(s.plane, lv.grouping, s.matched & ~s.suspect_done, s.matched,
+    sus = suspect_components(s.plane, lv.grouping, s.matched & ~s.suspect_done, s.matched,
                               tol)
     if sus.any():
         s.suspect_done |= sus
         s.matched &= ~sus
         s.plane[sus] = np.nan
         s.collected.drop_groups(sus)
-        s.mode[sus] = _NEIGHBOURS
+        s.mode[sus] = NEIGHBOURS
         s.tried_nb[sus] = -1
         s.todo = sus
         s.st["suspect_redone"] = s.st.get("suspect_redone", 0) + int(sus.sum())
@@ -895,15 +699,15 @@ def _next_todo(run: _Run, lv: _Level, s: _LevelState) -> bool:
         return False
     s.fallback_done = True
     s.todo = (s.tried_nb < 0) & ~s.matched & ~lv.masked
-    s.mode[s.todo] = _RANGE
+    s.mode[s.todo] = RANGE
     s.st["range_fallback"] = int(s.todo.sum())
     return bool(s.todo.any())
 
 
-def _match_wave(run: _Run, lv: _Level, s: _LevelState, predict: _Predictor) -> NDArray:
+def _match_wave(run: _Run, lv: _Level, s: _LevelState, predict: Predictor) -> NDArray:
     """One wave of :func:`.fbm.fbm_level` over the to-do set; returns its new failures."""
     todo_now = predict.todo
-    retry = (s.mode == _NEIGHBOURS) & (s.wave > 0)
+    retry = (s.mode == NEIGHBOURS) & (s.wave > 0)
     nb_count = _matched_neighbours(lv.grouping, s.matched)
     s.tried_nb[todo_now] = nb_count[todo_now].astype(np.int64)
     res = fbm_level(lv.left, lv.right, lv.fl, lv.fr, lv.grouping, predict,
@@ -920,7 +724,7 @@ def _match_wave(run: _Run, lv: _Level, s: _LevelState, predict: _Predictor) -> N
     return todo_now & ~ok & ~s.cascaded
 
 
-def _enlarge(run: _Run, lv: _Level, s: _LevelState, predict: _Predictor,
+def _enlarge(run: _Run, lv: _Level, s: _LevelState, predict: Predictor,
              failed: NDArray) -> None:
     """Failure cascade, step 1: match the failed components in 2 × larger windows.
 
@@ -952,14 +756,14 @@ def _enlarge(run: _Run, lv: _Level, s: _LevelState, predict: _Predictor,
         keep &= ok2[np.maximum(g2, 0)]
         res2.group = g2
         s.collected.add(res2, keep, FLAG_ENLARGED)
-        s.plane[ok2] = _points_planes(grouping, res2.col[keep], res2.row[keep],
+        s.plane[ok2] = points_planes(grouping, res2.col[keep], res2.row[keep],
                                       res2.disparity[keep], g2[keep])[ok2]
         s.matched |= ok2
         s.st["enlarged_recovered"] += int(ok2.sum())
     failed &= ~ok2
 
 
-def _densify(run: _Run, lv: _Level, s: _LevelState, predict: _Predictor,
+def _densify(run: _Run, lv: _Level, s: _LevelState, predict: Predictor,
              failed: NDArray) -> None:
     """Failure cascade, step 2: reduce the step (denser Förstner points) in failed windows.
 
@@ -1029,7 +833,7 @@ def _match_level(run: _Run, lv: _Level, s: _LevelState, progress: _Progress) -> 
             _densify(run, lv, s, predict, failed)
         nb_count = _matched_neighbours(lv.grouping, s.matched)
         s.todo = ~s.matched & ~lv.masked & (nb_count > 0) & (nb_count > s.tried_nb)
-        s.mode[s.todo] = _NEIGHBOURS
+        s.mode[s.todo] = NEIGHBOURS
         s.wave += 1
         progress.wave(lv.k, s.wave)
     s.st["waves"] = s.wave
@@ -1094,7 +898,7 @@ def _grid_densify(run: _Run, Lf: NDArray, Rf: NDArray, lv: _Level, s: _LevelStat
     Failed components are predicted from their neighbours' planes (wider search).
     """
     t_grid = time.perf_counter()
-    g_plane = _fill_planes(s.plane, lv.grouping, s.matched, lv.masked)
+    g_plane = fill_planes(s.plane, lv.grouping, s.matched, lv.masked)
     g_pull = np.where(s.matched, run.pull_ref, run.pull_grow)
     g_parts, g_stats = _grid_points(Lf, Rf, lv.grouping, g_plane, g_pull, lv.excl,
                                     lv.valid_left, lv.margin, int(run.opt.grid_step), run.opt,
@@ -1167,7 +971,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     n_levels = pyr.n_levels
     top = n_levels - 1
     progress = _Progress(fb, np.array([4.0 ** -k for k in range(n_levels)]))
-    prev: Optional[_CoarsePlanes] = None  # filled planes of the coarser level
+    prev: Optional[CoarsePlanes] = None  # filled planes of the coarser level
     prev_matched = np.zeros((0, 3))
     stats_levels: Dict[str, Any] = {}
     failures: List[NDArray] = []
@@ -1183,7 +987,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
         pts = _level_points(lv, s, failures)
         # predictions for the next level everywhere (also into masked components, which
         # only sharpens the overlap there; nothing is matched in them)
-        prev = _CoarsePlanes(_fill_planes(s.plane, lv.grouping, s.matched,
+        prev = CoarsePlanes(fill_planes(s.plane, lv.grouping, s.matched,
                                           np.zeros(lv.ng, bool)), lv.grouping)
         prev_matched = np.where(s.matched[:, None], s.plane, np.nan)  # measured planes only
         if k == 0 or opt.keep_coarse:
@@ -1206,35 +1010,6 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     total["failure_pct_level0"] = stats_levels["0"]["failure_pct"]
     total["seconds"] = round(time.perf_counter() - t_start, 3)
     return EpipolarMatches(*pts, {"levels": stats_levels, "total": total}, fail_arr)
-
-
-def _suspect_components(plane: NDArray, grouping: Grouping, test: NDArray, matched: NDArray,
-                        tol: float) -> NDArray:
-    """Components (of ``test``) whose plane disagrees with their matched neighbours.
-
-    At the component's centre, the planes of its matched neighbours (over the barrier-free
-    graph) are evaluated; with at least 3 of them, the component is suspect when its own
-    plane differs from their median by more than ``tol`` px. A single wrong window (a
-    consistent but false set of correlation peaks, e.g. from a wrong coarse prediction)
-    is thus caught by the majority around it; real relief changes smoothly across windows.
-    """
-    ng = grouping.n_groups
-    out = np.zeros(ng, bool)
-    e = grouping.edges
-    if e.size == 0:
-        return out
-    e = e[test[e[:, 0]] & matched[e[:, 1]]]
-    if e.size == 0:
-        return out
-    c = grouping.centres
-    s, d = e[:, 0], e[:, 1]
-    u, v = grouping.uv(c[s, 0], c[s, 1], d)
-    val = plane[d, 0] + plane[d, 1] * u + plane[d, 2] * v
-    cnt = np.bincount(s, minlength=ng)
-    med = group_weighted_median(val, np.ones(val.size), s, ng)
-    own = plane[:, 0]  # the plane at its own centre (u = v = 0)
-    out = (cnt >= 3) & test & np.isfinite(med) & (np.abs(own - med) > tol)
-    return out
 
 
 def _overlap_width(valid_left: NDArray, valid_right: NDArray, min_d: float, max_d: float
@@ -1310,7 +1085,7 @@ def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
     sel = ok_px[rr, cc]
     rr, cc = rr[sel].astype(float), cc[sel].astype(float)
     g = grouping.of(cc, rr)
-    d = _eval_planes(plane, grouping, g, cc, rr)
+    d = eval_planes(plane, grouping, g, cc, rr)
     sel = np.isfinite(d)
     rr, cc, d, p = rr[sel], cc[sel], d[sel], pull[g[sel]]
     st["nodes"] = int(rr.size)
@@ -1364,15 +1139,3 @@ def _detect_crop(img: NDArray, valid: Optional[NDArray], excl: Optional[NDArray]
                         None if excl is None else excl[crop], **kw)
     return InterestPoints(f.cols + c0, f.rows + r0, f.w, f.q)
 
-
-def _points_planes(grouping: Grouping, col: NDArray, row: NDArray, d: NDArray, g: NDArray
-                   ) -> NDArray:
-    """Absolute plane d = p0 + p1·u + p2·v per group from accepted points (NaN where none)."""
-    ng = grouping.n_groups
-    out = np.full((ng, 3), np.nan)
-    if col.size:
-        u, v = grouping.uv(col, row, g)
-        a = group_wls(u, v, d, np.ones(col.size), g, ng, 1e-3)
-        has = np.bincount(g, minlength=ng) > 0
-        out[has] = a[has]
-    return out
