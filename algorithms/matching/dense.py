@@ -49,6 +49,7 @@ without coarse disparities takes the range of a growing neighbourhood, finally t
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any, Callable, Iterator, Optional, Tuple
 
 import numpy as np
@@ -56,6 +57,8 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..input_errors import warn_input
+from ..memory import check_allocation
 
 #: Matching methods; the first is the default.
 METHODS = ("sgm", "opencv_sgbm")
@@ -72,7 +75,7 @@ GreySource = Callable[[int, int, int, int], Array]
 
 def _cv2() -> Any:
     try:
-        import cv2
+        import cv2  # lazy: keeps photodem list fast (the declarations import this module)
     except ImportError as exc:  # pragma: no cover - dependency is declared
         raise InputError("Dense matching needs OpenCV: install 'opencv-python-headless' "
                          "(PyPI) or 'python3-opencv' (Debian).") from exc
@@ -199,9 +202,6 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
         When the range holds no possible disparity, or cannot fit in memory; the message
         names ``parameter``.
     """
-    from ..input_errors import warn_input
-    from ..memory import check_allocation
-
     lo = max(int(min_d), -(int(right_shape[1]) - 1))
     hi = min(int(max_d), int(left_shape[1]) - 1)
     if not quiet and lo <= hi and (lo, hi) != (int(min_d), int(max_d)):
@@ -219,6 +219,152 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
                      f"dense matching over {num_d} disparities ({lo}…{hi} px)",
                      f"{parameter} (a narrower disparity range)")
     return lo, hi
+
+
+@dataclass
+class _TileMatcher:
+    """Disparities of tile cores: one SGBM set-up per tile, its margin as context."""
+
+    cv2: Any
+    left: GreySource
+    right: GreySource
+    margin: int
+    block: int
+    p1: int
+    p2: int
+    uniqueness: int
+    ours: bool
+    lr_max_diff: float
+    normalise_window: int
+    speckle_window: int
+    speckle_range: int
+    fill_max_width: int
+    edge_erosion: int
+    range_guard: float
+
+    def _matcher(self, lo: int, n_d: int) -> Any:
+        """SGBM for ``n_d`` disparities from ``lo``.
+
+        Our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the
+        plain mode.
+        """
+        cv2, ours = self.cv2, self.ours
+        mode = cv2.STEREO_SGBM_MODE_HH if ours else cv2.STEREO_SGBM_MODE_SGBM
+        sp_range = int(self.speckle_range) * (16 if ours else 1)  # 1/16-px values in SGBM
+        return _sgbm(cv2, lo, n_d, self.block, self.p1, self.p2, self.uniqueness,
+                     0 if ours else self.speckle_window, sp_range if not ours else 0, mode)
+
+    def __call__(self, r0: int, r1: int, c0: int, c1: int, lo: int, hi: int) -> Array:
+        """Disparities of the tile core rows r0:r1, cols c0:c1 searched in lo..hi."""
+        margin, block = self.margin, self.block
+        R0, R1 = r0 - margin, r1 + margin
+        C0, C1 = c0 - margin, c1 + margin
+        lwin = self.left(R0, R1, C0, C1)
+        if not np.isfinite(lwin[margin:margin + r1 - r0, margin:margin + c1 - c0]).any():
+            # nothing to match in the core (outside the image, masked)
+            return np.full((r1 - r0, c1 - c0), np.nan, np.float32)
+        n_d = _num_disparities(lo, hi)
+        matcher = self._matcher(lo, n_d)
+        # common frame: left pixel u ↔ right pixel u − d; start so that SGBM's dead lead
+        # columns (numDisparities + block) and the largest disparity lie left of the content
+        f0 = C0 - max(hi, 0) - (n_d + block)
+        f1 = max(C1, C1 - lo) + 1
+        lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
+        lg[:, C0 - f0:C1 - f0] = lwin
+        rg = self.right(R0, R1, f0, f1)
+        disp = _match_frame(self.cv2, matcher, lg, rg, lo, hi, n_d, self.ours, block,
+                            self.lr_max_diff, self.normalise_window, self.speckle_window,
+                            int(self.speckle_range), self.fill_max_width,
+                            int(self.edge_erosion), float(self.range_guard))
+        return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
+
+
+@dataclass
+class _SearchRange:
+    """Search range of a tile: the full range, or narrowed by the coarse disparities."""
+
+    coarse: Optional[Array]
+    factor: int
+    margin: int
+    full: Tuple[int, int]
+
+    @property
+    def slack(self) -> int:
+        return 2 * self.factor + 8
+
+    def __call__(self, r0: int, r1: int, c0: int, c1: int) -> Tuple[int, int]:
+        if self.coarse is None:
+            return self.full
+        return _range_from_coarse(self.coarse, self.factor, (r0, r1, c0, c1), self.margin,
+                                  self.full, self.slack)
+
+
+def _checked_settings(method: str, min_disparity: int, max_disparity: int,
+                      left_shape: Tuple[int, int], right_shape: Tuple[int, int], margin: int,
+                      disparity_parameter: str, coarse_above: int, block_size: int,
+                      p1: Optional[int], p2: Optional[int]) -> Tuple[int, int, int, int, int]:
+    """Method, range (cut to possible disparities) and penalties checked: min_d, max_d,
+    block, p1, p2.
+
+    Raises
+    ------
+    InputError
+        Unknown method, empty range, or P2 ≤ P1.
+    """
+    if method not in METHODS:
+        raise InputError(f"Unknown dense matching method '{method}'; use one of "
+                         f"{', '.join(METHODS)}.")
+    min_d, max_d = int(min_disparity), int(max_disparity)
+    if max_d < min_d:
+        raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
+                         "give min_disparity ≤ max_disparity.")
+    min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
+                                         disparity_parameter,
+                                         quiet=coarse_above == 0)  # the coarse pass's own cut
+    block = int(block_size) | 1
+    p1 = int(8 * block * block if p1 is None else p1)
+    p2 = int(32 * block * block if p2 is None else p2)
+    if p2 <= p1:
+        raise InputError(f"P2 ({p2}) must be larger than P1 ({p1}).")
+    return min_d, max_d, block, p1, p2
+
+
+def _coarse_factor(num_d: int) -> int:
+    """Power-of-two reduction that brings ``num_d`` to ≤ COARSE_DISPARITIES."""
+    factor = 1
+    while num_d / factor > COARSE_DISPARITIES:
+        factor *= 2
+    return factor
+
+
+def _tiles(match: _TileMatcher, search: _SearchRange, shape: Tuple[int, int], side: int,
+           fixed: bool, max_memory_mb: float, feedback: Feedback
+           ) -> Iterator[Tuple[int, int, Array]]:
+    """Tile the left image with cores of about ``side`` px and match each one.
+
+    Unless the side is ``fixed``, a tile whose range is too deep for the memory budget is
+    matched in smaller parts, each with its own range.
+    """
+    h, w = shape
+    ty, tx = max(1, math.ceil(h / side)), max(1, math.ceil(w / side))
+    th, tw = math.ceil(h / ty), math.ceil(w / tx)
+    n_tiles, done = ty * tx, 0
+    for iy in range(ty):
+        for ix in range(tx):
+            feedback.progress(100.0 * done / n_tiles)
+            r0, r1 = iy * th, min(h, (iy + 1) * th)
+            c0, c1 = ix * tw, min(w, (ix + 1) * tw)
+            lo, hi = search(r0, r1, c0, c1)
+            sub = side if fixed else tile_size_for(max_memory_mb, lo, hi, match.margin)
+            if sub >= max(r1 - r0, c1 - c0):
+                yield r0, c0, match(r0, r1, c0, c1, lo, hi)
+            else:
+                for s0 in range(r0, r1, sub):
+                    for t0 in range(c0, c1, sub):
+                        s1, t1 = min(s0 + sub, r1), min(t0 + sub, c1)
+                        yield s0, t0, match(s0, s1, t0, t1, *search(s0, s1, t0, t1))
+            done += 1
+    feedback.progress(100.0)
 
 
 def iter_disparity_tiles(
@@ -296,58 +442,18 @@ def iter_disparity_tiles(
     """
     cv2 = _cv2()
     feedback = ensure_feedback(feedback)
-    if method not in METHODS:
-        raise InputError(f"Unknown dense matching method '{method}'; use one of "
-                         f"{', '.join(METHODS)}.")
-    min_d, max_d = int(min_disparity), int(max_disparity)
-    if max_d < min_d:
-        raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
-                         "give min_disparity ≤ max_disparity.")
-    min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
-                                         disparity_parameter,
-                                         quiet=coarse_above == 0)  # the coarse pass's own cut
-    block = int(block_size) | 1
-    p1 = int(8 * block * block if p1 is None else p1)
-    p2 = int(32 * block * block if p2 is None else p2)
-    if p2 <= p1:
-        raise InputError(f"P2 ({p2}) must be larger than P1 ({p1}).")
+    min_d, max_d, block, p1, p2 = _checked_settings(
+        method, min_disparity, max_disparity, left_shape, right_shape, margin,
+        disparity_parameter, coarse_above, block_size, p1, p2)
     num_d = _num_disparities(min_d, max_d)
-    ours = method == "sgm"
-    mode = cv2.STEREO_SGBM_MODE_HH if ours else cv2.STEREO_SGBM_MODE_SGBM
-    sp_range = int(speckle_range) * (16 if ours else 1)  # on 1/16-px values inside SGBM
-    # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the plain mode
-    h, w = left_shape  # the right source pads with NaN outside its own right_shape
-
-    def match(r0: int, r1: int, c0: int, c1: int, lo: int, hi: int) -> Array:
-        """Disparities of the tile core rows r0:r1, cols c0:c1 searched in lo..hi."""
-        R0, R1 = r0 - margin, r1 + margin
-        C0, C1 = c0 - margin, c1 + margin
-        lwin = left(R0, R1, C0, C1)
-        if not np.isfinite(lwin[margin:margin + r1 - r0, margin:margin + c1 - c0]).any():
-            # nothing to match in the core (outside the image, masked)
-            return np.full((r1 - r0, c1 - c0), np.nan, np.float32)
-        n_d = _num_disparities(lo, hi)
-        # our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the
-        # plain mode
-        matcher = _sgbm(cv2, lo, n_d, block, p1, p2, uniqueness,
-                        0 if ours else speckle_window, sp_range if not ours else 0, mode)
-        # common frame: left pixel u ↔ right pixel u − d; start so that SGBM's dead lead
-        # columns (numDisparities + block) and the largest disparity lie left of the content
-        f0 = C0 - max(hi, 0) - (n_d + block)
-        f1 = max(C1, C1 - lo) + 1
-        lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
-        lg[:, C0 - f0:C1 - f0] = lwin
-        rg = right(R0, R1, f0, f1)
-        disp = _match_frame(cv2, matcher, lg, rg, lo, hi, n_d, ours, block, lr_max_diff,
-                            normalise_window, speckle_window, int(speckle_range),
-                            fill_max_width, int(edge_erosion), float(range_guard))
-        return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
-
+    # the right source pads with NaN outside its own right_shape
+    match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
+                         lr_max_diff, normalise_window, speckle_window, speckle_range,
+                         fill_max_width, edge_erosion, range_guard)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
-        while num_d / factor > COARSE_DISPARITIES:
-            factor *= 2
+        factor = _coarse_factor(num_d)
         options = {"method": method, "block_size": block, "p1": p1, "p2": p2,
                    "uniqueness": uniqueness, "lr_max_diff": lr_max_diff,
                    "normalise_window": normalise_window, "speckle_window": speckle_window,
@@ -355,38 +461,14 @@ def iter_disparity_tiles(
                    "margin": margin}
         coarse = _coarse_disparity(left, right, left_shape, right_shape, min_d, max_d, factor,
                                    options, feedback)
-    slack = 2 * factor + 8
-
-    def search_range(r0: int, r1: int, c0: int, c1: int) -> Tuple[int, int]:
-        if coarse is None:
-            return min_d, max_d
-        return _range_from_coarse(coarse, factor, (r0, r1, c0, c1), margin, (min_d, max_d),
-                                  slack)
-
+    search = _SearchRange(coarse, factor, margin, (min_d, max_d))
     if tile_size:
         side = int(tile_size)
     else:  # sized for a typical narrowed range; a tile whose range is wider is split below
-        typical = num_d if coarse is None else min(num_d, COARSE_DISPARITIES + 2 * slack)
+        typical = num_d if coarse is None else min(num_d, COARSE_DISPARITIES + 2 * search.slack)
         side = tile_size_for(max_memory_mb, 0, typical - 1, margin)
-    ty, tx = max(1, math.ceil(h / side)), max(1, math.ceil(w / side))
-    th, tw = math.ceil(h / ty), math.ceil(w / tx)
-    n_tiles, done = ty * tx, 0
-    for iy in range(ty):
-        for ix in range(tx):
-            feedback.progress(100.0 * done / n_tiles)
-            r0, r1 = iy * th, min(h, (iy + 1) * th)
-            c0, c1 = ix * tw, min(w, (ix + 1) * tw)
-            lo, hi = search_range(r0, r1, c0, c1)
-            sub = side if tile_size else tile_size_for(max_memory_mb, lo, hi, margin)
-            if sub >= max(r1 - r0, c1 - c0):
-                yield r0, c0, match(r0, r1, c0, c1, lo, hi)
-            else:  # too deep a range for the budget: smaller parts, each with its own range
-                for s0 in range(r0, r1, sub):
-                    for t0 in range(c0, c1, sub):
-                        s1, t1 = min(s0 + sub, r1), min(t0 + sub, c1)
-                        yield s0, t0, match(s0, s1, t0, t1, *search_range(s0, s1, t0, t1))
-            done += 1
-    feedback.progress(100.0)
+    yield from _tiles(match, search, left_shape, side, bool(tile_size), max_memory_mb,
+                      feedback)
 
 
 def block_mean_source(source: GreySource, shape: Tuple[int, int], factor: int,

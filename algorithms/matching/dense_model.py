@@ -29,15 +29,20 @@ boundary, outside exclusions) that hold a height.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Optional, Tuple, Union
 
 import numpy as np
+from rasterio.windows import Window
 
 from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import SIDES, EpipolarPair
+from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
-from .dense import iter_disparity_tiles
+from .dense import GreySource, iter_disparity_tiles
+from .model_report import write_model_report
+from .model_setup import ModelSetup, prepare_model
 
 PathLike = Union[str, Path]
 
@@ -53,10 +58,6 @@ _BLOCK_PIXELS = 1_000_000
 def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
                 feedback: Feedback) -> None:
     """Grey (band mean) epipolar image as float32, NaN outside the original image."""
-    from rasterio.windows import Window
-
-    from ..raster.io import gtiff_profile, open_image
-
     w, h = pair.sizes[SIDES.index(side)]
     profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), compress="none")
     chunk = max(1, _BLOCK_PIXELS // max(w, 1))
@@ -68,9 +69,8 @@ def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
             feedback.check()
 
 
-def _window_source(src: Any):
-    from rasterio.windows import Window
-
+def _window_source(src: Any) -> Tuple[GreySource, Tuple[int, int]]:
+    """Window reader of band 1 of a float32 scratch image (NaN beyond the image)."""
     h, w = src.height, src.width
 
     def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
@@ -82,6 +82,110 @@ def _window_source(src: Any):
         return out
 
     return read, (h, w)
+
+
+@dataclass
+class _MatchCounts:
+    """Left pixels with data, valid disparities and the matching time over all tiles."""
+
+    n_left: int = 0
+    n_valid: int = 0
+    seconds: float = 0.0
+
+
+def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
+                memory_mb: float, dense_options: Dict[str, Any],
+                feedback: Feedback) -> _MatchCounts:
+    """Tiled SGM of the scratch epipolar images; every tile's points into ``acc``.
+
+    The time of the matching (the tile generator) is told apart from the triangulation.
+    """
+    pair = setup.pair
+    counts = _MatchCounts()
+    with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
+        left, shape_l = _window_source(src_l)
+        right, shape_r = _window_source(src_r)
+        tiles = iter_disparity_tiles(left, right, shape_l, shape_r, setup.min_d, setup.max_d,
+                                     max_memory_mb=memory_mb,
+                                     feedback=feedback.step(20, 85), **dense_options)
+        while True:
+            t1 = time.perf_counter()
+            try:
+                r0, c0, block = next(tiles)
+            except StopIteration:
+                break
+            counts.seconds += time.perf_counter() - t1
+            counts.n_left += int(np.isfinite(left(r0, r0 + block.shape[0], c0,
+                                                  c0 + block.shape[1])).sum())
+            ok = np.isfinite(block)
+            counts.n_valid += int(ok.sum())
+            if not ok.any():
+                continue
+            rr, cc = np.nonzero(ok)
+            pts = pair.disparity_to_world(block[ok], cc + c0, rr + r0)
+            acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
+    return counts
+
+
+@dataclass
+class _Outliers:
+    """The DSM outlier test (:func:`~..surface.gridding.reject_outliers`)."""
+
+    radius: float
+    threshold: float
+    k: float
+
+
+def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCounts,
+             max_gap: float, outliers: _Outliers) -> Dict[str, Any]:
+    """Headline figures: points, coverage of the measuring area, valid and filled shares."""
+    grid = setup.grid
+    area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions, grid)
+    n_area = int(area.sum())
+    n_have = int((np.isfinite(res.z) & area).sum())
+    coverage = 100.0 * n_have / n_area if n_area else 0.0
+    n_left, n_valid = counts.n_left, counts.n_valid
+    return {
+        "points": int(acc.points),
+        "coverage_pct": coverage,
+        "valid_disparity_pct": 100.0 * n_valid / n_left if n_left else 0.0,
+        "filled_pct": 100.0 * int(res.filled.sum()) / n_area if n_area else 0.0,
+        "spacing_m": setup.spacing,
+        "cells": [grid.width, grid.height],
+        "disparity_range_px": [setup.min_d, setup.max_d],
+        "height_range_m": [setup.z_min, setup.z_max],
+        "max_gap_m": max_gap,
+        "outlier_radius_m": outliers.radius,
+        "outlier_threshold_m": outliers.threshold,
+        "epipolar_mpx": setup.pair.sizes[0][0] * setup.pair.sizes[0][1] / 1e6,
+    }
+
+
+def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap: float,
+                    outliers: _Outliers, feedback: Feedback) -> Any:
+    """Median per cell, outlier test, gap filling; dsm.tif and count.tif written."""
+    grid, crs = setup.grid, setup.project.crs
+    zg, count = acc.reduce(feedback.step(85, 92))
+    res = finish_grid(zg, count, grid, max_gap, setup.exclusions, setup.boundaries,
+                      setup.breaklines, outlier_radius=outliers.radius,
+                      outlier_threshold=outliers.threshold, outlier_k=outliers.k)
+    feedback.check()
+    write_grid(tmp / "dsm.tif", res.z, grid, crs=crs)
+    write_grid(tmp / "count.tif", np.minimum(res.count, 65535).astype(np.uint16), grid,
+               crs=crs, overviews=False)
+    return res
+
+
+def _report(setup: ModelSetup, metrics: Dict[str, Any], dense_options: Dict[str, Any],
+            timings: Dict[str, float]) -> Dict[str, Any]:
+    """The content of report.json (keys in the order of the report)."""
+    recs = setup.records
+    report = {"model": setup.model.name, "images": [recs[0].name, recs[1].name],
+              "method": "dense", "crs": setup.project.crs, "metrics": metrics,
+              "options": {k: v for k, v in dense_options.items() if v is not None},
+              "seconds": timings}
+    report["flying_height_m"] = setup.flying_height
+    return report
 
 
 def match_model_dense(project: Any, model: str, output_dir: PathLike,
@@ -127,29 +231,23 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     dict
         ``{"dsm", "count", "report", "points", "metrics"}``.
     """
-    from ..raster.io import open_image, scratch_folder, staged_folder
-    from .model_setup import prepare_model
-
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
     setup = prepare_model(project, model, spacing=spacing, spacing_gsd=1.0,
                           min_height=min_height, max_height=max_height,
                           disparity_margin=disparity_margin)
-    project, m, recs, pair = setup.project, setup.model, setup.records, setup.pair
-    grid, spacing, gsd, H = setup.grid, setup.spacing, setup.gsd, setup.flying_height
-    z_min, z_max, min_d, max_d = setup.z_min, setup.z_max, setup.min_d, setup.max_d
-    excl, bounds, lines = setup.exclusions, setup.boundaries, setup.breaklines
+    m, pair, grid, spacing = setup.model, setup.pair, setup.grid, setup.spacing
     max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
-    outlier_radius = 5.0 * spacing if outlier_radius is None else float(outlier_radius)
-    if outlier_threshold is None:
-        outlier_threshold = float(gsd) * H / pair.base  # 1 px of parallax in height
+    outliers = _Outliers(5.0 * spacing if outlier_radius is None else float(outlier_radius),
+                         # 1 px of parallax in height
+                         float(setup.gsd) * setup.flying_height / pair.base
+                         if outlier_threshold is None else outlier_threshold, outlier_k)
     for key, value in _DENSE_DEFAULTS.items():
         dense_options.setdefault(key, value)
-    feedback.info(f"Model {m.name}: heights {z_min:.1f}…{z_max:.1f} m → disparities "
-                  f"{min_d}…{max_d} px; DSM {grid.width}×{grid.height} cells at "
-                  f"{spacing:.3f} m.")
-
-    images = [project.read_image(rec, colour_only=True) for rec in recs]
+    feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
+                  f"disparities {setup.min_d}…{setup.max_d} px; DSM {grid.width}×{grid.height} "
+                  f"cells at {spacing:.3f} m.")
+    images = [setup.project.read_image(rec, colour_only=True) for rec in setup.records]
     out = Path(output_dir)
     timings: Dict[str, float] = {}
     with staged_folder(out, replace=True, product="match_model") as tmp, \
@@ -163,73 +261,21 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         timings["epipolar"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
-        n_left = n_valid = 0
-        t_match = 0.0
-        with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
-            left, shape_l = _window_source(src_l)
-            right, shape_r = _window_source(src_r)
-            tiles = iter_disparity_tiles(left, right, shape_l, shape_r, min_d, max_d,
-                                         max_memory_mb=memory_mb,
-                                         feedback=feedback.step(20, 85), **dense_options)
-            while True:
-                t1 = time.perf_counter()
-                try:
-                    r0, c0, block = next(tiles)
-                except StopIteration:
-                    break
-                t_match += time.perf_counter() - t1
-                n_left += int(np.isfinite(left(r0, r0 + block.shape[0], c0,
-                                               c0 + block.shape[1])).sum())
-                ok = np.isfinite(block)
-                n_valid += int(ok.sum())
-                if not ok.any():
-                    continue
-                rr, cc = np.nonzero(ok)
-                pts = pair.disparity_to_world(block[ok], cc + c0, rr + r0)
-                acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
-        timings["matching"] = t_match
-        timings["triangulation"] = time.perf_counter() - t0 - t_match
+        counts = _match_into(setup, grey, acc, memory_mb, dense_options, feedback)
+        timings["matching"] = counts.seconds
+        timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
-        zg, count = acc.reduce(feedback.step(85, 92))
-        res = finish_grid(zg, count, grid, max_gap, excl, bounds, lines,
-                          outlier_radius=outlier_radius, outlier_threshold=outlier_threshold,
-                          outlier_k=outlier_k)
-        feedback.check()
-        area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(excl, grid)
-        n_area = int(area.sum())
-        n_have = int((np.isfinite(res.z) & area).sum())
-        coverage = 100.0 * n_have / n_area if n_area else 0.0
-        write_grid(tmp / "dsm.tif", res.z, grid, crs=project.crs)
-        write_grid(tmp / "count.tif", np.minimum(res.count, 65535).astype(np.uint16), grid,
-                   crs=project.crs, overviews=False)
+        res = _grid_and_write(setup, acc, tmp, max_gap, outliers, feedback)
+        metrics = _metrics(setup, acc, res, counts, max_gap, outliers)
         timings["gridding"] = time.perf_counter() - t0
         timings["total"] = time.perf_counter() - t_start
-        metrics = {
-            "points": int(acc.points),
-            "coverage_pct": coverage,
-            "valid_disparity_pct": 100.0 * n_valid / n_left if n_left else 0.0,
-            "filled_pct": 100.0 * int(res.filled.sum()) / n_area if n_area else 0.0,
-            "spacing_m": spacing,
-            "cells": [grid.width, grid.height],
-            "disparity_range_px": [min_d, max_d],
-            "height_range_m": [z_min, z_max],
-            "max_gap_m": max_gap,
-            "outlier_radius_m": outlier_radius,
-            "outlier_threshold_m": outlier_threshold,
-            "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
-        }
-        report = {"model": m.name, "images": [recs[0].name, recs[1].name],
-                  "method": "dense", "crs": project.crs, "metrics": metrics,
-                  "options": {k: v for k, v in dense_options.items() if v is not None},
-                  "seconds": timings}
-        report["flying_height_m"] = H
-        from .model_report import write_model_report
-
-        write_model_report(tmp, report, dsm=tmp / "dsm.tif", count=tmp / "count.tif",
-                           exclusions=excl)
+        write_model_report(tmp, _report(setup, metrics, dense_options, timings),
+                           dsm=tmp / "dsm.tif", count=tmp / "count.tif",
+                           exclusions=setup.exclusions)
         feedback.progress(100.0)
     feedback.info(f"Model {m.name}: {metrics['points']} points, coverage "
-                  f"{coverage:.1f} %, valid disparities {metrics['valid_disparity_pct']:.1f} %.")
+                  f"{metrics['coverage_pct']:.1f} %, valid disparities "
+                  f"{metrics['valid_disparity_pct']:.1f} %.")
     return {"dsm": str(out / "dsm.tif"), "count": str(out / "count.tif"), "sigma": None,
             "report": str(out / "report.json"), "report_html": str(out / "report.html"),
             "points": None, "reduced": None, "metrics": metrics}

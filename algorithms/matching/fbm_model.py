@@ -32,42 +32,33 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import fields, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
+from affine import Affine
+from matplotlib.path import Path as MplPath
+from rasterio.features import rasterize
+from scipy import ndimage
+from shapely.geometry import LineString, Point, Polygon
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import SIDES
+from ..project.edits import read_layer
+from ..raster.io import staged_folder
+from ..surface.fe_grid import fe_interpolate
+from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
+from ..surface.groundel import reduce_groundels
+from ..surface.point_output import write_points
+from .hierarchy import EpipolarMatches, FbmLsmOptions, match_epipolar_fbm_lsm
+from .model_report import write_model_report
 from .model_setup import ModelSetup, footprint, prepare_model
+from .presets import DEFAULT_PRESET, POINT_FORMATS, PRESET_NAMES, PRESETS, SPACING_GSD
 
 PathLike = Union[str, Path]
 
-#: Strategy presets (seed-000 §3.1: empirical parameter sets per terrain type). Keys are
-#: fields of :class:`.hierarchy.FbmLsmOptions` or the surface options of
-#: :func:`match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``).
-PRESETS: Dict[str, Dict[str, Any]] = {
-    # open, gently undulating terrain: large windows and groundels, L1 planes, smooth surface
-    "flat": {"fbm_window": 32, "groundel_gsd": 40.0, "reduction": "l1", "smoothing": 1.0},
-    # hills: smaller windows follow the relief; medium groundels
-    "hilly": {"fbm_window": 24, "groundel_gsd": 24.0, "reduction": "l1", "smoothing": 0.3},
-    # buildings: small windows, tight bidirectional check, small groundels, median, little
-    # smoothing so that roofs and walls stay sharp
-    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "groundel_gsd": 10.0,
-              "reduction": "median", "smoothing": 0.05},
-    # vegetation: the lower envelope of the points of a groundel is taken as the terrain
-    "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
-               "smoothing": 0.3},
-}
-PRESET_NAMES = tuple(PRESETS)
-DEFAULT_PRESET = "flat"
-#: Default DSM spacing in GSD; the presets' ``smoothing`` refers to cells of this size, so a
-#: DSM asked for at another spacing gets the same surface, sampled differently.
-SPACING_GSD = 2.0
-
-POINT_FORMATS = ("gpkg", "las")
 
 
 def _grey(image: np.ndarray, pair: Any, side: str) -> np.ndarray:
@@ -90,8 +81,6 @@ def _to_epipolar(setup: ModelSetup, coords: np.ndarray, z: float) -> np.ndarray:
 
 
 def _epipolar_shapes(setup: ModelSetup, geoms: List[Any], z: float) -> List[Any]:
-    from shapely.geometry import LineString, Polygon
-
     out = []
     for g in geoms:
         for part in getattr(g, "geoms", [g]):
@@ -115,9 +104,6 @@ def epipolar_constraints(setup: ModelSetup, shape: Tuple[int, int]
     Polygons are projected at the model's mid height (the exact test is made in object space
     after the intersection); breaklines at their own heights.
     """
-    from affine import Affine
-    from rasterio.features import rasterize
-
     centre = Affine.translation(-0.5, -0.5)  # pixel centres at integer coordinates
     mask = None
     excl = _epipolar_shapes(setup, setup.exclusions, setup.z_mid)
@@ -145,8 +131,6 @@ def start_point_seeds(setup: ModelSetup) -> Optional[np.ndarray]:
     InputError
         A start point without a height, outside the model or inside an exclusion area.
     """
-    from ..project.edits import read_layer
-
     path = Path(setup.project.edits_path)
     if not path.is_file():
         return None
@@ -156,8 +140,6 @@ def start_point_seeds(setup: ModelSetup) -> Optional[np.ndarray]:
         return None
     if not feats:
         return None
-    from shapely.geometry import Point
-
     seeds = []
     for k, (geom, props) in enumerate(feats, start=1):
         h = props.get("height")
@@ -187,8 +169,6 @@ def start_point_seeds(setup: ModelSetup) -> Optional[np.ndarray]:
 
 def _options(preset: str, overrides: Dict[str, Any]) -> Tuple[Any, Dict[str, Any]]:
     """Hierarchy options and surface options from a preset and explicit values."""
-    from .hierarchy import FbmLsmOptions
-
     if preset not in PRESETS:
         raise InputError(f"Unknown preset '{preset}'; use one of {', '.join(PRESET_NAMES)}.")
     values = dict(PRESETS[preset])
@@ -235,8 +215,6 @@ def _on_surface(pair: Any, col: np.ndarray, row: np.ndarray, min_d: float, max_d
 
 def _inside_any(polygons: List[Any], x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Points strictly inside any of the (multi)polygons (holes honoured), vectorised."""
-    from matplotlib.path import Path as MplPath
-
     out = np.zeros(len(x), bool)
     xy = np.column_stack([x, y])
     for g in polygons:
@@ -278,6 +256,215 @@ def _sigma2_on(red: Any, grid: Any) -> np.ndarray:
     ok = (rr >= 0) & (cc >= 0)
     out[ok] = s2[rr[ok], cc[ok]]
     return out
+
+
+@dataclass
+class _ModelPoints:
+    """Raw points in object space that pass the object-space constraints.
+
+    Attributes
+    ----------
+    xyz : (n, 3) float64
+    sigma_z : (n,) float64
+        σ_Z = |Z(d + σ_d) − Z(d)|, m.
+    cell : (n,) int64
+        Flat DSM cell index of each point.
+    keep : (n,) int64
+        Index of each point in the matcher's arrays.
+    allowed : bool grid
+        DSM cells inside the measuring area and outside exclusions.
+    n_matched : int
+        Points of the matcher before the constraints.
+    """
+
+    xyz: np.ndarray
+    sigma_z: np.ndarray
+    cell: np.ndarray
+    keep: np.ndarray
+    allowed: np.ndarray
+    n_matched: int
+
+
+def _grey_epipolar(setup: ModelSetup, feedback: Feedback
+                   ) -> Tuple[Dict[str, np.ndarray], Optional[np.ndarray], Optional[np.ndarray]]:
+    """Grey epipolar images of both sides, and the constraints' mask and barriers."""
+    grey = {}
+    for side, rec in zip(SIDES, setup.records):
+        grey[side] = _grey(setup.project.read_image(rec, colour_only=True), setup.pair, side)
+        feedback.check()
+    mask, barriers = epipolar_constraints(setup, grey["left"].shape)
+    return grey, mask, barriers
+
+
+def _intersect(setup: ModelSetup, matches: EpipolarMatches) -> _ModelPoints:
+    """Object points of the matches, kept inside the measuring area and outside exclusions.
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 points remain.
+    """
+    pair, grid = setup.pair, setup.grid
+    col, row, d = matches.col, matches.row, matches.disparity
+    pts = pair.disparity_to_world(d, col, row)
+    pts_s = pair.disparity_to_world(d + np.maximum(matches.sigma_px, 1e-3), col, row)
+    sigma_z = np.abs(pts_s[:, 2] - pts[:, 2])
+    ok = np.isfinite(pts).all(axis=1)
+    # object-space constraints, exactly: inside the measuring area, outside exclusions
+    allowed = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions,
+                                                                              grid)
+    idx, on_grid = _cell_lookup(grid, pts[:, 0], pts[:, 1])
+    ok &= on_grid
+    ok[ok] = allowed.ravel()[idx[ok]]
+    # exactly: a point inside an exclusion area is dropped even where the cell centre is not
+    ok[ok] = ~_inside_any(setup.exclusions, pts[ok, 0], pts[ok, 1])
+    keep = np.nonzero(ok)[0]
+    if len(keep) < 3:
+        raise InputError(f"Model '{setup.model.name}': matching found {len(keep)} points; "
+                         "check the height range, the start points and the image texture.")
+    return _ModelPoints(pts[keep], sigma_z[keep], idx[keep], keep, allowed, len(d))
+
+
+def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, Any],
+             interpolation: str, max_gap: Optional[float], feedback: Feedback) -> np.ndarray:
+    """DSM heights (float32, NaN outside the allowed cells) from the inlier points."""
+    grid, inlier, pts = setup.grid, ~red.outlier, mp.xyz
+    if interpolation == "fe":
+        # a point's weight: its matching σ_Z and the scatter of the points about the local
+        # surface (σ1 of the groundels: texture, roughness, objects), which σ_Z of LSM
+        # (often a few cm) does not contain — else a few over-confident points bend the plate
+        # into ripples between them
+        s1 = red.summary().get("sigma1_m")
+        s1 = float(s1) if s1 is not None and math.isfinite(s1) else 0.0
+        w = 1.0 / (np.maximum(mp.sigma_z[inlier], 1e-3) ** 2 + s1 * s1)
+        z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
+                                   weights=w, smoothing=float(surface.get("smoothing", 1.0)),
+                                   reference_spacing=SPACING_GSD * setup.gsd,
+                                   breaklines=setup.breaklines, exclusions=setup.exclusions,
+                                   boundaries=setup.boundaries, max_gap=max_gap,
+                                   feedback=feedback.step(78, 92))
+    else:
+        acc = GridAccumulator(grid)
+        acc.add(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2])
+        zg, n_cell = acc.reduce()
+        z_grid = finish_grid(zg, n_cell, grid, math.inf if max_gap is None else max_gap,
+                             setup.exclusions, setup.boundaries,
+                             setup.breaklines).z
+    z_grid = np.asarray(z_grid, dtype=np.float32)
+    z_grid[~mp.allowed] = np.nan
+    return z_grid
+
+
+def _metrics(setup: ModelSetup, mp: _ModelPoints, red: Any, z_grid: np.ndarray,
+             count: np.ndarray, cell: float, seeds: Optional[np.ndarray],
+             matches: EpipolarMatches, max_gap: Optional[float]) -> Dict[str, Any]:
+    """Headline figures of the model: counts, coverage, measured share, σ1/σ2, geometry."""
+    grid, pair, allowed = setup.grid, setup.pair, mp.allowed
+    n_area = int(allowed.sum())
+    n_have = int((np.isfinite(z_grid) & allowed).sum())
+    coverage = 100.0 * n_have / n_area if n_area else 0.0
+    # measured: within half a groundel of a matched point (the rest is interpolated)
+    near = ndimage.distance_transform_edt(count == 0) * grid.spacing <= 0.5 * cell
+    measured = 100.0 * int((near & allowed).sum()) / n_area if n_area else 0.0
+    summary = red.summary()
+    H = setup.flying_height
+    return {
+        "points_matched": mp.n_matched,
+        "points_raw": len(mp.xyz),
+        "points_reduced": red.cells,
+        "outliers": red.n_outliers,
+        "coverage_pct": coverage,
+        "measured_pct": measured,
+        "sigma1_m": summary.get("sigma1_m"),
+        "sigma2_m": summary.get("sigma2_m"),
+        "sigma2_permille": (1000.0 * summary["sigma2_m"] / H
+                            if summary.get("sigma2_m") is not None else None),
+        "spacing_m": setup.spacing,
+        "groundel_m": cell,
+        "cells": [grid.width, grid.height],
+        "disparity_range_px": [setup.min_d, setup.max_d],
+        "height_range_m": [setup.z_min, setup.z_max],
+        "start_points": 0 if seeds is None else len(seeds),
+        "failed_windows": len(matches.failures),
+        "max_gap_m": max_gap,
+        "base_px": float(pair.base * pair.focal_px / H) if H > 0 else None,
+        "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
+    }
+
+
+def _write_points(tmp: Path, suffix: str, crs: Any, mp: _ModelPoints, red: Any,
+                  matches: EpipolarMatches) -> None:
+    """Raw points (σ_Z, σ_d, ρ, flags, level, outlier) and reduced points (one per groundel)."""
+    pts, keep = mp.xyz, mp.keep
+    write_points(tmp / f"points{suffix}", pts[:, 0], pts[:, 1], pts[:, 2], {
+        "sigma_z": mp.sigma_z.astype(np.float32),
+        "sigma_px": matches.sigma_px[keep].astype(np.float32),
+        "rho": matches.rho[keep].astype(np.float32),
+        "flags": matches.flags[keep].astype(np.int32),
+        "level": matches.level[keep].astype(np.int32),
+        "outlier": red.outlier.astype(np.int32),
+    }, crs=crs)
+    write_points(tmp / f"reduced{suffix}", red.x, red.y, red.z, {
+        "n": red.n.astype(np.int32), "sigma1": red.sigma1.astype(np.float32),
+        "sigma2": (red.F * red.sigma1 / np.sqrt(np.maximum(red.n, 1))).astype(np.float32),
+        "plane": red.plane.astype(np.int32)}, crs=crs)
+
+
+def _write_grids(tmp: Path, crs: Any, grid: Any, z_grid: np.ndarray, count: np.ndarray,
+                 sigma_grid: Optional[np.ndarray]) -> None:
+    """dsm.tif, count.tif (raw points per cell) and sigma.tif (σ2 per cell)."""
+    write_grid(tmp / "dsm.tif", z_grid, grid, crs=crs)
+    write_grid(tmp / "count.tif", np.minimum(count, 65535).astype(np.uint16), grid,
+               crs=crs, overviews=False)
+    if sigma_grid is not None:
+        write_grid(tmp / "sigma.tif", np.asarray(sigma_grid, np.float32), grid,
+                   crs=crs, overviews=False)
+
+
+def _check_choices(points_format: str, interpolation: str) -> None:
+    """Raise InputError for an unknown point format or interpolation."""
+    if points_format not in POINT_FORMATS:
+        raise InputError(f"Unknown point format '{points_format}'; use gpkg or las.")
+    if interpolation not in ("fe", "membrane"):
+        raise InputError(f"Unknown interpolation '{interpolation}'; use fe or membrane.")
+
+
+def _groundel_size(groundel: Optional[float], surface: Dict[str, Any],
+                   setup: ModelSetup) -> float:
+    """Groundel side (m): explicit, else the preset's multiple of the GSD."""
+    cell = float(groundel) if groundel else float(surface["groundel_gsd"]) * setup.gsd
+    if not cell > 0:
+        raise InputError(f"The groundel size must be positive, got {cell}.")
+    return cell
+
+
+def _timed(timings: Dict[str, float], key: str, t0: float) -> None:
+    """Record the seconds since ``t0`` under ``key``."""
+    timings[key] = time.perf_counter() - t0
+
+
+def _announce(setup: ModelSetup, seeds: Optional[np.ndarray], cell: float,
+              feedback: Feedback) -> None:
+    """Tell the operator the ranges, start points, DSM grid and groundel size."""
+    grid = setup.grid
+    feedback.info(f"Model {setup.model.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
+                  f"disparities {setup.min_d}…{setup.max_d} px; "
+                  f"{0 if seeds is None else len(seeds)} start point(s); DSM "
+                  f"{grid.width}×{grid.height} cells at {setup.spacing:.3f} m; groundels "
+                  f"{cell:.2f} m.")
+
+
+def _report(setup: ModelSetup, preset: str, metrics: Dict[str, Any],
+            matches: EpipolarMatches, red: Any, opts: FbmLsmOptions,
+            timings: Dict[str, float]) -> Dict[str, Any]:
+    """The content of report.json (keys in the order of the report)."""
+    return {"model": setup.model.name, "method": "fbm_lsm", "images": setup.names,
+            "crs": setup.project.crs, "flying_height_m": setup.flying_height,
+            "preset": preset, "metrics": metrics,
+            "levels": matches.stats.get("levels", []), "reduction": red.summary(),
+            "matching": {k: v for k, v in matches.stats.items() if k != "levels"},
+            "options": {f.name: getattr(opts, f.name) for f in fields(opts)},
+            "seconds": timings}
 
 
 def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
@@ -328,189 +515,67 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     dict
         ``{"dsm", "sigma", "count", "points", "reduced", "report", "report_html", "metrics"}``.
     """
-    from ..raster.io import staged_folder
-    from ..surface.gridding import polygon_mask, write_grid
-    from ..surface.groundel import reduce_groundels
-    from ..surface.point_output import write_points
-    from .hierarchy import match_epipolar_fbm_lsm
-    from .model_report import write_model_report
-
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
-    if points_format not in POINT_FORMATS:
-        raise InputError(f"Unknown point format '{points_format}'; use gpkg or las.")
-    if interpolation not in ("fe", "membrane"):
-        raise InputError(f"Unknown interpolation '{interpolation}'; use fe or membrane.")
+    _check_choices(points_format, interpolation)
     opts, surface = _options(preset, dict(options, groundel_gsd=None, reduction=reduction,
                                           smoothing=smoothing))
     setup = prepare_model(project, model, spacing=spacing, spacing_gsd=SPACING_GSD,
                           min_height=min_height, max_height=max_height)
-    project, m, pair, grid = setup.project, setup.model, setup.pair, setup.grid
-    cell = float(groundel) if groundel else float(surface["groundel_gsd"]) * setup.gsd
-    if not cell > 0:
-        raise InputError(f"The groundel size must be positive, got {cell}.")
+    project, m, grid = setup.project, setup.model, setup.grid
+    cell = _groundel_size(groundel, surface, setup)
     max_gap = None if max_gap is None or max_gap <= 0 else float(max_gap)
     seeds = start_point_seeds(setup) if use_start_points else None
-    feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
-                  f"disparities {setup.min_d}…{setup.max_d} px; "
-                  f"{0 if seeds is None else len(seeds)} start point(s); DSM "
-                  f"{grid.width}×{grid.height} cells at {setup.spacing:.3f} m; groundels "
-                  f"{cell:.2f} m.")
+    _announce(setup, seeds, cell, feedback)
     timings: Dict[str, float] = {}
     t0 = time.perf_counter()
-    grey = {}
-    for side, rec in zip(SIDES, setup.records):
-        grey[side] = _grey(project.read_image(rec, colour_only=True), pair, side)
-        feedback.check()
-    mask, barriers = epipolar_constraints(setup, grey["left"].shape)
-    timings["epipolar"] = time.perf_counter() - t0
+    grey, mask, barriers = _grey_epipolar(setup, feedback)
+    _timed(timings, "epipolar", t0)
     feedback.progress(5.0)
-
     t0 = time.perf_counter()
     matches = match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d, setup.max_d,
                                      seeds=seeds, mask=mask, barriers=barriers, options=opts,
                                      feedback=feedback.step(5, 70))
     del grey
-    timings["matching"] = time.perf_counter() - t0
-
+    _timed(timings, "matching", t0)
     t0 = time.perf_counter()
-    col, row, d = matches.col, matches.row, matches.disparity
-    pts = pair.disparity_to_world(d, col, row)
-    pts_s = pair.disparity_to_world(d + np.maximum(matches.sigma_px, 1e-3), col, row)
-    sigma_z = np.abs(pts_s[:, 2] - pts[:, 2])
-    ok = np.isfinite(pts).all(axis=1)
-    # object-space constraints, exactly: inside the measuring area, outside exclusions
-    allowed = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions,
-                                                                              grid)
-    idx, on_grid = _cell_lookup(grid, pts[:, 0], pts[:, 1])
-    ok &= on_grid
-    ok[ok] = allowed.ravel()[idx[ok]]
-    # exactly: a point inside an exclusion area is dropped even where the cell centre is not
-    ok[ok] = ~_inside_any(setup.exclusions, pts[ok, 0], pts[ok, 1])
-    n_raw_all = len(d)
-    keep = np.nonzero(ok)[0]
-    pts, sigma_z, idx = pts[keep], sigma_z[keep], idx[keep]
-    timings["intersection"] = time.perf_counter() - t0
+    mp = _intersect(setup, matches)
+    _timed(timings, "intersection", t0)
     feedback.progress(72.0)
-    if len(pts) < 3:
-        raise InputError(f"Model '{m.name}': matching found {len(pts)} points; check the "
-                         "height range, the start points and the image texture.")
-
     t0 = time.perf_counter()
-    mode = surface.get("reduction", "l1")
-    red = reduce_groundels(pts[:, 0], pts[:, 1], pts[:, 2], cell,
-                           origin=(grid.transform.c, grid.transform.f), mode=mode)
-    inlier = ~red.outlier
-    timings["reduction"] = time.perf_counter() - t0
+    red = reduce_groundels(mp.xyz[:, 0], mp.xyz[:, 1], mp.xyz[:, 2], cell,
+                           origin=(grid.transform.c, grid.transform.f),
+                           mode=surface.get("reduction", "l1"))
+    _timed(timings, "reduction", t0)
     feedback.progress(78.0)
-
     t0 = time.perf_counter()
-    from ..surface.gridding import GridAccumulator, finish_grid
-
-    if interpolation == "fe":
-        from ..surface.fe_grid import fe_interpolate
-
-        # a point's weight: its matching σ_Z and the scatter of the points about the local
-        # surface (σ1 of the groundels: texture, roughness, objects), which σ_Z of LSM
-        # (often a few cm) does not contain — else a few over-confident points bend the plate
-        # into ripples between them
-        s1 = red.summary().get("sigma1_m")
-        s1 = float(s1) if s1 is not None and math.isfinite(s1) else 0.0
-        w = 1.0 / (np.maximum(sigma_z[inlier], 1e-3) ** 2 + s1 * s1)
-        z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
-                                   weights=w, smoothing=float(surface.get("smoothing", 1.0)),
-                                   reference_spacing=SPACING_GSD * setup.gsd,
-                                   breaklines=setup.breaklines, exclusions=setup.exclusions,
-                                   boundaries=setup.boundaries, max_gap=max_gap,
-                                   feedback=feedback.step(78, 92))
-    else:
-        acc = GridAccumulator(grid)
-        acc.add(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2])
-        zg, n_cell = acc.reduce()
-        z_grid = finish_grid(zg, n_cell, grid, math.inf if max_gap is None else max_gap,
-                             setup.exclusions, setup.boundaries,
-                             setup.breaklines).z
-    z_grid = np.asarray(z_grid, dtype=np.float32)
-    z_grid[~allowed] = np.nan
-    count = np.bincount(idx, minlength=grid.width * grid.height).reshape(grid.shape)
+    z_grid = _surface(setup, mp, red, surface, interpolation, max_gap, feedback)
+    count = np.bincount(mp.cell, minlength=grid.width * grid.height).reshape(grid.shape)
     sigma_grid = _sigma2_on(red, grid)
-    timings["gridding"] = time.perf_counter() - t0
+    _timed(timings, "gridding", t0)
     feedback.check()
-
-    n_area = int(allowed.sum())
-    n_have = int((np.isfinite(z_grid) & allowed).sum())
-    coverage = 100.0 * n_have / n_area if n_area else 0.0
-    # measured: within half a groundel of a matched point (the rest is interpolated)
-    from scipy import ndimage
-
-    near = ndimage.distance_transform_edt(count == 0) * grid.spacing <= 0.5 * cell
-    measured = 100.0 * int((near & allowed).sum()) / n_area if n_area else 0.0
-    summary = red.summary()
-    H = setup.flying_height
-    metrics = {
-        "points_matched": n_raw_all,
-        "points_raw": len(pts),
-        "points_reduced": red.cells,
-        "outliers": red.n_outliers,
-        "coverage_pct": coverage,
-        "measured_pct": measured,
-        "sigma1_m": summary.get("sigma1_m"),
-        "sigma2_m": summary.get("sigma2_m"),
-        "sigma2_permille": (1000.0 * summary["sigma2_m"] / H
-                            if summary.get("sigma2_m") is not None else None),
-        "spacing_m": setup.spacing,
-        "groundel_m": cell,
-        "cells": [grid.width, grid.height],
-        "disparity_range_px": [setup.min_d, setup.max_d],
-        "height_range_m": [setup.z_min, setup.z_max],
-        "start_points": 0 if seeds is None else len(seeds),
-        "failed_windows": len(matches.failures),
-        "max_gap_m": max_gap,
-        "base_px": float(pair.base * pair.focal_px / H) if H > 0 else None,
-        "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
-    }
+    metrics = _metrics(setup, mp, red, z_grid, count, cell, seeds, matches, max_gap)
     out = Path(output_dir)
     suffix = "." + points_format
     with staged_folder(out, replace=True, product="match_model") as tmp:
-        write_grid(tmp / "dsm.tif", z_grid, grid, crs=project.crs)
-        write_grid(tmp / "count.tif", np.minimum(count, 65535).astype(np.uint16), grid,
-                   crs=project.crs, overviews=False)
-        if sigma_grid is not None:
-            write_grid(tmp / "sigma.tif", np.asarray(sigma_grid, np.float32), grid,
-                       crs=project.crs, overviews=False)
+        _write_grids(tmp, project.crs, grid, z_grid, count, sigma_grid)
         feedback.progress(94.0)
-        write_points(tmp / f"points{suffix}", pts[:, 0], pts[:, 1], pts[:, 2], {
-            "sigma_z": sigma_z.astype(np.float32),
-            "sigma_px": matches.sigma_px[keep].astype(np.float32),
-            "rho": matches.rho[keep].astype(np.float32),
-            "flags": matches.flags[keep].astype(np.int32),
-            "level": matches.level[keep].astype(np.int32),
-            "outlier": red.outlier.astype(np.int32),
-        }, crs=project.crs)
-        write_points(tmp / f"reduced{suffix}", red.x, red.y, red.z, {
-            "n": red.n.astype(np.int32), "sigma1": red.sigma1.astype(np.float32),
-            "sigma2": (red.F * red.sigma1 / np.sqrt(np.maximum(red.n, 1))).astype(np.float32),
-            "plane": red.plane.astype(np.int32)}, crs=project.crs)
+        _write_points(tmp, suffix, project.crs, mp, red, matches)
         feedback.progress(97.0)
         fails = matches.failures
         fail_xy = None
         if len(fails):
-            fail_xy = _on_surface(pair, fails[:, 0], fails[:, 1], setup.min_d, setup.max_d,
-                                  z_grid, grid)
-        timings["total"] = time.perf_counter() - t_start
-        report = {"model": m.name, "method": "fbm_lsm", "images": setup.names,
-                  "crs": project.crs, "flying_height_m": H, "preset": preset,
-                  "metrics": metrics, "levels": matches.stats.get("levels", []),
-                  "reduction": summary,
-                  "matching": {k: v for k, v in matches.stats.items() if k != "levels"},
-                  "options": {f.name: getattr(opts, f.name) for f in fields(opts)},
-                  "seconds": timings}
+            fail_xy = _on_surface(setup.pair, fails[:, 0], fails[:, 1], setup.min_d,
+                                  setup.max_d, z_grid, grid)
+        _timed(timings, "total", t_start)
+        report = _report(setup, preset, metrics, matches, red, opts, timings)
         write_model_report(tmp, report, dsm=tmp / "dsm.tif",
                            sigma=tmp / "sigma.tif" if sigma_grid is not None else None,
                            count=tmp / "count.tif", failures=fail_xy)
         feedback.progress(100.0)
     feedback.info(f"Model {m.name}: {metrics['points_raw']} points, "
-                  f"{metrics['points_reduced']} groundels, coverage {coverage:.1f} %.")
+                  f"{metrics['points_reduced']} groundels, coverage "
+                  f"{metrics['coverage_pct']:.1f} %.")
     return {"dsm": str(out / "dsm.tif"),
             "sigma": str(out / "sigma.tif") if sigma_grid is not None else None,
             "count": str(out / "count.tif"), "points": str(out / f"points{suffix}"),
@@ -518,5 +583,5 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
             "report_html": str(out / "report.html"), "metrics": metrics}
 
 
-__all__ = ["DEFAULT_PRESET", "PRESETS", "PRESET_NAMES", "epipolar_constraints",
-           "match_model_fbm_lsm", "start_point_seeds"]
+__all__ = ["DEFAULT_PRESET", "POINT_FORMATS", "PRESETS", "PRESET_NAMES", "SPACING_GSD",
+           "epipolar_constraints", "match_model_fbm_lsm", "start_point_seeds"]

@@ -78,6 +78,7 @@ Only accepted points are returned (bidirectional failures and outliers are count
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
@@ -95,13 +96,25 @@ from .fbm import (
     detect_features,
     fbm_level,
     fill_nodata,
-    group_weighted_median,
-    group_wls,
     window_components,
 )
 from .interest import InterestPoints
 from .lsm import lsm_match
 from .ncc import ncc_epipolar
+from .prediction import (
+    COARSE,
+    NEIGHBOURS,
+    NONE,
+    RANGE,
+    SEED,
+    ApproxGrid,
+    CoarsePlanes,
+    Predictor,
+    eval_planes,
+    fill_planes,
+    points_planes,
+    suspect_components,
+)
 from .pyramid import build_pyramid, from_level, levels_for_disparity, to_level
 
 FLAG_LSM = 1
@@ -114,7 +127,6 @@ __all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_GRI
            "FLAG_LSM_FAILED", "FLAG_RETRY", "EpipolarMatches", "FbmLsmOptions",
            "match_epipolar_fbm_lsm"]
 
-_NONE, _COARSE, _NEIGHBOURS, _RANGE, _SEED = 0, 1, 2, 3, 4
 
 
 @dataclass
@@ -286,112 +298,12 @@ def _reduce_any(mask: NDArray) -> NDArray:
 
 
 def _mask_pyramid(mask: Optional[NDArray], n: int) -> List[Optional[NDArray]]:
+    """``n`` levels of a boolean mask (2 × 2 'any' per level; None stays None)."""
     if mask is None:
         return [None] * n
     out = [np.asarray(mask, bool)]
     for _ in range(n - 1):
         out.append(_reduce_any(out[-1]))
-    return out
-
-
-def _eval_planes(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
-                 ) -> NDArray:
-    """Disparity of the groups' planes d = p0 + p1·u + p2·v at points (NaN for g < 0)."""
-    out = np.full(np.shape(cols), np.nan)
-    ok = g >= 0
-    if ok.any():
-        gg = g[ok]
-        u, v = grouping.uv(cols[ok], rows[ok], gg)
-        p = plane[gg]
-        out[ok] = p[:, 0] + p[:, 1] * u + p[:, 2] * v
-    return out
-
-
-def _point_neighbours(edges: NDArray, g: NDArray) -> Tuple[NDArray, NDArray, NDArray]:
-    """Every point's neighbour groups along ``edges`` (group → group).
-
-    Returns ``(point, neighbour, count)``: one (point index, neighbour group) pair per edge
-    leaving the point's group ``g`` (none for ``g < 0``), and the number of pairs per point.
-    """
-    order = np.argsort(edges[:, 0], kind="stable")
-    src, dst = edges[order, 0], edges[order, 1]
-    start = np.searchsorted(src, g, side="left")
-    stop = np.searchsorted(src, g, side="right")
-    cnt = np.where(g >= 0, stop - start, 0)
-    pi = np.repeat(np.arange(g.size), cnt)
-    first = np.cumsum(cnt) - cnt
-    return pi, dst[start[pi] + (np.arange(pi.size) - first[pi])], cnt
-
-
-def _plane_range(plane: NDArray, grouping: Grouping, g: NDArray, cols: NDArray, rows: NDArray
-                 ) -> Tuple[NDArray, NDArray]:
-    """Lowest and highest disparity of a group's own plane and its neighbours' planes at
-    each point (NaN for g < 0): where they disagree (a roof beside the ground) the point's
-    disparity is not known better than that."""
-    lo = _eval_planes(plane, grouping, g, cols, rows)
-    hi = lo.copy()
-    e = grouping.edges
-    if e.size == 0 or g.size == 0:
-        return lo, hi
-    pi, nb, cnt = _point_neighbours(e, g)
-    if cnt.sum() == 0:
-        return lo, hi
-    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
-    ok = np.isfinite(val)
-    np.fmin.at(lo, pi[ok], val[ok])
-    np.fmax.at(hi, pi[ok], val[ok])
-    return lo, hi
-
-
-def _neighbour_prediction(plane: NDArray, grouping: Grouping, matched: NDArray, g: NDArray,
-                          cols: NDArray, rows: NDArray) -> NDArray:
-    """Mean of the matched neighbour components' planes, evaluated at each point."""
-    out = np.full(np.shape(cols), np.nan)
-    e = grouping.edges
-    if e.size == 0 or g.size == 0:
-        return out
-    e = e[matched[e[:, 1]]]
-    if e.size == 0:
-        return out
-    pi, nb, cnt = _point_neighbours(e, g)
-    if cnt.sum() == 0:
-        return out
-    val = _eval_planes(plane, grouping, nb, cols[pi], rows[pi])
-    s = np.bincount(pi, val, g.size)
-    has = cnt > 0
-    out[has] = s[has] / cnt[has]
-    return out
-
-
-def _fill_planes(plane: NDArray, grouping: Grouping, matched: NDArray, masked: NDArray
-                 ) -> NDArray:
-    """Planes for unmatched, unmasked components from their neighbours (over the graph).
-
-    Wave by wave, each open component takes the mean of its filled neighbours' planes
-    evaluated at its centre (slopes averaged). The graph has no edges across barriers.
-    """
-    out = plane.copy()
-    have = matched.copy()
-    e = grouping.edges
-    c = grouping.centres
-    ws = grouping.window
-    while e.size:
-        sel = have[e[:, 1]] & ~have[e[:, 0]] & ~masked[e[:, 0]]
-        if not sel.any():
-            break
-        s, d = e[sel, 0], e[sel, 1]
-        u = (c[s, 0] - c[d, 0]) / ws
-        v = (c[s, 1] - c[d, 1]) / ws
-        p0 = out[d, 0] + out[d, 1] * u + out[d, 2] * v
-        n = np.bincount(s, minlength=len(out)).astype(float)
-        new = n > 0
-        acc = np.zeros_like(out)
-        acc[:, 0] = np.bincount(s, p0, len(out))
-        acc[:, 1] = np.bincount(s, out[d, 1], len(out))
-        acc[:, 2] = np.bincount(s, out[d, 2], len(out))
-        out[new] = acc[new] / n[new, None]
-        have |= new
-    out[~have] = np.nan
     return out
 
 
@@ -418,7 +330,17 @@ class _Collected:
         return tuple(np.concatenate(p) for p in zip(*self.parts))
 
 
-def _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx):
+def _check_inputs(left: NDArray, right: NDArray, min_d: float, max_d: float,
+                  mask: Optional[NDArray], barriers: Optional[NDArray],
+                  seeds: Optional[NDArray], approx: Optional[Tuple[NDArray, float]]
+                  ) -> Tuple[NDArray, NDArray]:
+    """The two images as float32 after checking shapes, range, seeds and approximation.
+
+    Raises
+    ------
+    InputError
+        Naming what is wrong and how to fix it.
+    """
     L = np.asarray(left, dtype=np.float32)
     R = np.asarray(right, dtype=np.float32)
     if L.ndim != 2 or R.ndim != 2:
@@ -441,6 +363,568 @@ def _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx):
         if np.ndim(grid) != 2 or not step > 0:
             raise InputError("approx must be (2-D disparity grid, positive step in px)")
     return L, R
+
+
+@dataclass
+class _Run:
+    """Constants of one matching run, shared by all levels."""
+
+    opt: FbmLsmOptions
+    min_d: float
+    max_d: float
+    shape0: Tuple[int, int]
+    ws: int
+    lsm_window: int
+    margin_coarse: int
+    margin0: int
+    pull_ref: float
+    pull_grow: float
+    level_kw: Dict[str, Any]
+
+    @property
+    def use_right_features(self) -> bool:
+        return self.opt.candidates == "features"
+
+
+def _run_constants(opt: FbmLsmOptions, min_d: float, max_d: float,
+                   shape0: Tuple[int, int]) -> _Run:
+    """Window sizes, margins, pull-ins and the keywords of :func:`.fbm.fbm_level`."""
+    ws = int(opt.fbm_window)
+    lsm_window = 2 * int(opt.lsm_half) + 1
+    margin_coarse = max(opt.ncc_window + 4, opt.refine_window) // 2 + 1
+    margin0 = max(margin_coarse, lsm_window // 2 + 1 if opt.lsm else 0)
+    # the coarser level's plane is off by its relief curvature, not by a share of the window:
+    # small windows keep ≥ 4 px (8 px when growing) with correlation candidates, whose search
+    # is not bound to the FBM convergence range of a window
+    floor = 4.0 if opt.candidates == "correlation" else 0.0
+    pull_ref = opt.pull_in if opt.pull_in is not None else max(ws / 8.0, floor)
+    pull_grow = opt.pull_in if opt.pull_in is not None else max(ws / 4.0, 2.0 * floor)
+    robust = {"huber_iterations": opt.huber_iterations,
+              "redescending_iterations": opt.redescending_iterations,
+              "huber_k": opt.huber_k, "redescending_c": opt.redescending_c,
+              "reject_k": opt.reject_k, "sigma_floor": opt.sigma_floor}
+    level_kw = {"rho_min": opt.rho_min, "row_tol": opt.row_tol, "bidir_tol": opt.bidir_tol,
+                "min_points": opt.min_points, "robust": robust,
+                "refine_window": opt.refine_window, "candidates": opt.candidates,
+                "max_peaks": int(opt.max_peaks)}
+    return _Run(opt, min_d, max_d, shape0, ws, lsm_window, margin_coarse, margin0, pull_ref,
+                pull_grow, level_kw)
+
+
+def _level_count(run: _Run, L0: NDArray, R0: NDArray, vL: NDArray, vR: NDArray) -> int:
+    """Pyramid depth: ``opt.levels`` or enough for the range, limited by the overlap."""
+    if run.opt.levels is not None:
+        return max(1, int(run.opt.levels))
+    ws = run.ws
+    n_levels = levels_for_disparity(run.max_d - run.min_d, pull_in=ws / 4.0, min_size=2 * ws,
+                                    shape=(min(L0.shape[0], R0.shape[0]),
+                                           min(L0.shape[1], R0.shape[1])))
+    # the top level must hold at least one whole matching window (plus the margins where
+    # no point can lie) across the stereo overlap, else nothing can be matched there
+    overlap0 = _overlap_width(vL, vR, run.min_d, run.max_d)
+    while n_levels > 1 and overlap0 / 2.0 ** (n_levels - 1) < ws + 2 * run.margin_coarse:
+        n_levels -= 1
+    return n_levels
+
+
+@dataclass
+class _Pyramids:
+    """Image, no-data, exclusion and barrier pyramids (index = level)."""
+
+    left: List[NDArray]
+    right: List[NDArray]
+    nodata_left: List[Optional[NDArray]]
+    nodata_right: List[Optional[NDArray]]
+    mask: List[Optional[NDArray]]
+    barriers: List[Optional[NDArray]]
+
+    @property
+    def n_levels(self) -> int:
+        return len(self.nodata_left)
+
+
+def _build_pyramids(Lf: NDArray, Rf: NDArray, vL: NDArray, vR: NDArray,
+                    mask: Optional[NDArray], barriers: Optional[NDArray],
+                    n_levels: int) -> _Pyramids:
+    """All pyramids, as deep as both image pyramids go."""
+    pl = build_pyramid(Lf, n_levels)
+    pr = build_pyramid(Rf, n_levels)
+    n = min(len(pl), len(pr))
+    return _Pyramids(pl, pr, _mask_pyramid(~vL, n), _mask_pyramid(~vR, n),
+                     _mask_pyramid(mask, n), _mask_pyramid(barriers, n))
+
+
+@dataclass
+class _Level:
+    """What one pyramid level matches on: images, exclusions, components, features."""
+
+    k: int
+    scale: float
+    left: NDArray
+    right: NDArray
+    valid_left: Optional[NDArray]
+    valid_right: Optional[NDArray]
+    barriers: Optional[NDArray]
+    margin: int
+    excl: Optional[NDArray]
+    grouping: Grouping
+    feature_kw: Dict[str, Any]
+    fl: InterestPoints
+    fr: InterestPoints
+    masked: NDArray
+    tiny: NDArray
+
+    @property
+    def ng(self) -> int:
+        return self.grouping.n_groups
+
+
+def _level_exclusion(run: _Run, pyr: _Pyramids, k: int, margin: int, valid_right,
+                     prev_matched: NDArray) -> Tuple[NDArray, Optional[NDArray]]:
+    """Left pixels without stereo overlap, and all excluded pixels of level ``k``.
+
+    Left pixels whose search range never reaches right-image data have nothing to match
+    (not a failure); below the top, the range is the coarser level's measured disparities.
+    """
+    scale = 2.0 ** k
+    Lk, Rk = pyr.left[k], pyr.right[k]
+    no_overlap = ~_overlap_mask(valid_right, Rk.shape, Lk.shape, run.min_d / scale - 1.0,
+                                run.max_d / scale + 1.0, margin)
+    pm = prev_matched[np.isfinite(prev_matched[:, 0])]
+    if pm.size:
+        # sharper: the disparities the coarser level measured (its planes at their window
+        # corners, ± the growing pull-in) instead of the a-priori range. Not per pixel: a
+        # wrong coarse window must stay open for the neighbour check, not be masked
+        corners = (pm[:, :1] + pm[:, 1:2] * np.array([-0.5, 0.5, -0.5, 0.5])
+                   + pm[:, 2:3] * np.array([-0.5, -0.5, 0.5, 0.5]))
+        lo_all = max(2.0 * float(corners.min()) - run.pull_grow, run.min_d / scale) - 1.0
+        hi_all = min(2.0 * float(corners.max()) + run.pull_grow, run.max_d / scale) + 1.0
+        no_overlap |= ~_overlap_mask(valid_right, Rk.shape, Lk.shape, lo_all, hi_all, margin)
+    excl = None
+    for m in (pyr.mask[k], pyr.barriers[k], no_overlap if no_overlap.any() else None):
+        if m is not None:
+            excl = m.copy() if excl is None else (excl | m)
+    return no_overlap, excl
+
+
+def _component_masks(grouping: Grouping, shape: Tuple[int, int], mask: Optional[NDArray],
+                     valid_left: Optional[NDArray], no_overlap: NDArray, margin: int,
+                     ws: int) -> Tuple[NDArray, NDArray]:
+    """Masked (≥ 90 % excluded or without data) and tiny (< ½ window usable) components.
+
+    Neither counts as a failure: tiny ones are e.g. cut by the image border, where no point
+    can lie.
+    """
+    ng = grouping.n_groups
+    lab = grouping.labels.ravel()
+    bad_px = np.zeros(shape, bool)
+    if mask is not None:
+        bad_px |= mask
+    if valid_left is not None:
+        bad_px |= ~valid_left
+    bad_px |= no_overlap
+    n_bad = np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
+    masked = n_bad >= 0.9 * np.maximum(grouping.area, 1)
+    bad_px[:margin + 1, :] = bad_px[-margin - 1:, :] = True
+    bad_px[:, :margin + 1] = bad_px[:, -margin - 1:] = True
+    usable = grouping.area - np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
+    tiny = usable < 0.5 * ws * ws
+    return masked, tiny
+
+
+def _setup_level(run: _Run, pyr: _Pyramids, k: int, prev_matched: NDArray) -> _Level:
+    """Exclusions, window components, Förstner features and component masks of level k."""
+    opt, ws = run.opt, run.ws
+    Lk, Rk = pyr.left[k], pyr.right[k]
+    validL = ~pyr.nodata_left[k] if pyr.nodata_left[k] is not None else None
+    validR = ~pyr.nodata_right[k] if pyr.nodata_right[k] is not None else None
+    margin = run.margin0 if k == 0 else run.margin_coarse
+    no_overlap, excl = _level_exclusion(run, pyr, k, margin, validR, prev_matched)
+    grouping = window_components(Lk.shape, ws, pyr.barriers[k])
+    fkw = {"window": opt.interest_window, "q_min": opt.q_min, "w_factor": opt.w_factor,
+           "nms_window": opt.nms_window, "margin": margin,
+           "local_cell": 2 * ws if opt.local_cell is None else int(opt.local_cell),
+           "local_floor": opt.local_floor}
+    fl = detect_features(Lk, validL, excl, **fkw)
+    fr = (detect_features(Rk, validR, None, **fkw) if run.use_right_features
+          else _no_points())
+    masked, tiny = _component_masks(grouping, Lk.shape, pyr.mask[k], validL, no_overlap,
+                                    margin, ws)
+    return _Level(k, 2.0 ** k, Lk, Rk, validL, validR, pyr.barriers[k], margin, excl,
+                  grouping, fkw, fl, fr, masked, tiny)
+
+
+def _seed_disparities(seeds: NDArray, run: _Run, lv: _Level, fb: Any
+                      ) -> Tuple[NDArray, NDArray, int]:
+    """Mean seed disparity per component (level px), the components with seeds, seeds used.
+
+    Raises
+    ------
+    InputError
+        When no start point lies inside the left epipolar image.
+    """
+    h0, w0 = run.shape0
+    s = np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
+    inside = ((s[:, 0] >= -0.5) & (s[:, 0] < w0 - 0.5)
+              & (s[:, 1] >= -0.5) & (s[:, 1] < h0 - 0.5)
+              & np.isfinite(s).all(axis=1))
+    if not inside.any():
+        raise InputError(f"none of the {len(s)} start point(s) lies inside the "
+                         f"left epipolar image ({w0} × {h0} px); "
+                         "check the start points of this model")
+    if not inside.all():
+        fb.warning(f"{int((~inside).sum())} start point(s) outside the left "
+                   "epipolar image are ignored")
+    s = s[inside]
+    ng = lv.ng
+    gs = lv.grouping.of(to_level(s[:, 0], lv.k), to_level(s[:, 1], lv.k), nearest=True)
+    ok = gs >= 0
+    cnt = np.bincount(gs[ok], minlength=ng)
+    sd = np.bincount(gs[ok], s[ok, 2] / lv.scale, ng)
+    has = cnt > 0
+    seed_d = np.full(ng, np.nan)
+    seed_d[has] = sd[has] / cnt[has]
+    return seed_d, has, int(ok.sum())
+
+
+def _initial_modes(run: _Run, lv: _Level, prev: Optional[CoarsePlanes],
+                   approx: Optional[Tuple[NDArray, float]], seeds: Optional[NDArray], fb: Any
+                   ) -> Tuple[NDArray, NDArray, Any, Optional[int]]:
+    """Prediction mode per component, seed disparities, coarse predictor, seeds used.
+
+    Below the top level every component is predicted from the coarser level, except those
+    it could not predict (nothing matched within reach there, e.g. a failed top level):
+    they search the whole range, never zero points silently. At the top: the ``approx``
+    grid, the seeds, else the range.
+    """
+    ng = lv.ng
+    mode = np.zeros(ng, np.int8)
+    seed_d = np.full(ng, np.nan)
+    n_seeds: Optional[int] = None
+    if prev is not None:
+        mode[:] = COARSE
+        c = lv.grouping.centres
+        mode[~np.isfinite(prev.predict(c[:, 0], c[:, 1]))] = RANGE
+        return mode, seed_d, prev, n_seeds
+    coarse = None
+    if approx is not None:
+        coarse = ApproxGrid(np.asarray(approx[0], dtype=np.float64), float(approx[1]),
+                             lv.k, lv.scale)
+        mode[:] = COARSE
+    if seeds is not None:
+        seed_d, has, n_seeds = _seed_disparities(seeds, run, lv, fb)
+        mode[has] = SEED
+    elif approx is None:
+        mode[:] = RANGE
+    return mode, seed_d, coarse, n_seeds
+
+
+@dataclass
+class _LevelState:
+    """The waves' bookkeeping of one level (per component unless noted)."""
+
+    mode: NDArray
+    seed_d: NDArray
+    coarse: Any
+    matched: NDArray
+    plane: NDArray
+    tried_nb: NDArray
+    cascaded: NDArray
+    suspect_done: NDArray
+    todo: NDArray
+    collected: _Collected
+    st: Dict[str, Any]
+    fallback_done: bool
+    wave: int = 0
+    big: Optional[Grouping] = None
+
+    def predictor(self, run: _Run, lv: _Level) -> Predictor:
+        """The predictor of the current wave (its own copy of the to-do set)."""
+        mid_k = 0.5 * (run.min_d + run.max_d) / lv.scale
+        half_k = 0.5 * (run.max_d - run.min_d) / lv.scale + 1.0
+        return Predictor(lv.grouping, self.mode, self.plane, self.matched, self.seed_d,
+                          self.coarse, mid_k, half_k, run.pull_ref, run.pull_grow,
+                          self.todo.copy())
+
+
+def _new_state(lv: _Level, mode: NDArray, seed_d: NDArray, coarse: Any,
+               top: int) -> _LevelState:
+    """Empty bookkeeping of a level; its statistics start with the feature counts."""
+    ng = lv.ng
+    st = {"features_left": int(lv.fl.cols.size), "features_right": int(lv.fr.cols.size),
+          "candidates": 0, "outliers": 0, "bidir_rejected": 0, "windows": int(ng),
+          "windows_masked": int(lv.masked.sum()), "enlarged_recovered": 0,
+          "densified_recovered": 0, "retry_recovered": 0, "waves": 0,
+          "range_fallback": 0}
+    return _LevelState(mode, seed_d, coarse, np.zeros(ng, bool), np.full((ng, 3), np.nan),
+                       np.full(ng, -1, np.int64), np.zeros(ng, bool), np.zeros(ng, bool),
+                       (mode != NONE) & ~lv.masked, _Collected(), st, lv.k != top)
+
+
+def _matched_neighbours(grouping: Grouping, matched: NDArray) -> NDArray:
+    """Number of matched neighbour components of every component (float)."""
+    if not grouping.edges.size:
+        return np.zeros(grouping.n_groups)
+    return np.bincount(grouping.edges[:, 0], matched[grouping.edges[:, 1]], grouping.n_groups)
+
+
+def _redo_suspects(run: _Run, lv: _Level, s: _LevelState) -> None:
+    """Consistency between windows: a component whose plane disagrees with the median of
+    (≥ 3) matched neighbours is redone from its neighbours, once."""
+    tol = max(float(run.opt.neighbour_tol), run.pull_ref / 2.0)
+    sus = suspect_components(s.plane, lv.grouping, s.matched & ~s.suspect_done, s.matched,
+                              tol)
+    if sus.any():
+        s.suspect_done |= sus
+        s.matched &= ~sus
+        s.plane[sus] = np.nan
+        s.collected.drop_groups(sus)
+        s.mode[sus] = NEIGHBOURS
+        s.tried_nb[sus] = -1
+        s.todo = sus
+        s.st["suspect_redone"] = s.st.get("suspect_redone", 0) + int(sus.sum())
+
+
+def _next_todo(run: _Run, lv: _Level, s: _LevelState) -> bool:
+    """Set the components of the next wave; False when the level is done.
+
+    With nothing left: the suspects of the neighbour check, then (once, at the top level)
+    the components never reached from the seeds/approximation, which search the range.
+    """
+    if not s.todo.any() and run.opt.neighbour_tol and run.opt.neighbour_tol > 0:
+        _redo_suspects(run, lv, s)
+    if s.todo.any():
+        return True
+    if s.fallback_done:
+        return False
+    s.fallback_done = True
+    s.todo = (s.tried_nb < 0) & ~s.matched & ~lv.masked
+    s.mode[s.todo] = RANGE
+    s.st["range_fallback"] = int(s.todo.sum())
+    return bool(s.todo.any())
+
+
+def _match_wave(run: _Run, lv: _Level, s: _LevelState, predict: Predictor) -> NDArray:
+    """One wave of :func:`.fbm.fbm_level` over the to-do set; returns its new failures."""
+    todo_now = predict.todo
+    retry = (s.mode == NEIGHBOURS) & (s.wave > 0)
+    nb_count = _matched_neighbours(lv.grouping, s.matched)
+    s.tried_nb[todo_now] = nb_count[todo_now].astype(np.int64)
+    res = fbm_level(lv.left, lv.right, lv.fl, lv.fr, lv.grouping, predict,
+                    ncc_window=run.opt.ncc_window, **run.level_kw)
+    for key in ("candidates", "outliers", "bidir_rejected"):
+        s.st[key] += res.stats[key]
+    ok = todo_now & (res.n_accepted >= run.opt.min_points)
+    sel = ok[np.maximum(res.group, 0)] & (res.group >= 0)
+    s.collected.add(res, sel & ~retry[res.group], 0)
+    s.collected.add(res, sel & retry[res.group], FLAG_RETRY)
+    s.st["retry_recovered"] += int((ok & retry).sum())
+    s.plane[ok] = res.plane[ok]
+    s.matched |= ok
+    return todo_now & ~ok & ~s.cascaded
+
+
+def _enlarge(run: _Run, lv: _Level, s: _LevelState, predict: Predictor,
+             failed: NDArray) -> None:
+    """Failure cascade, step 1: match the failed components in 2 × larger windows.
+
+    Matched components sharing a big window with a failed one give context (their own
+    plane). ``failed`` loses the recovered components (in place).
+    """
+    opt, grouping, fl, ng = run.opt, lv.grouping, lv.fl, lv.ng
+    s.cascaded |= failed
+    if s.big is None:
+        s.big = window_components(lv.left.shape, 2 * run.ws, lv.barriers)
+    big = s.big
+    gl_small = grouping.of(fl.cols, fl.rows)
+    in_failed = (gl_small >= 0) & failed[np.maximum(gl_small, 0)]
+    big_sel = np.zeros(big.n_groups, bool)
+    gb = big.of(fl.cols, fl.rows)
+    big_sel[gb[in_failed & (gb >= 0)]] = True
+    ctx = (gb >= 0) & big_sel[np.maximum(gb, 0)] & (gl_small >= 0)
+    context = np.zeros(ng, bool)
+    context[gl_small[ctx]] = True
+    context &= s.matched
+    predict_big = functools.partial(predict, active=failed, context=context)
+    res2 = fbm_level(lv.left, lv.right, fl, lv.fr, big, predict_big,
+                     ncc_window=opt.ncc_window + 4, **run.level_kw)
+    g2 = grouping.of(res2.col, res2.row)
+    keep = (g2 >= 0) & failed[np.maximum(g2, 0)]
+    cnt = np.bincount(g2[keep], minlength=ng)
+    ok2 = failed & (cnt >= opt.min_points)
+    if ok2.any():
+        keep &= ok2[np.maximum(g2, 0)]
+        res2.group = g2
+        s.collected.add(res2, keep, FLAG_ENLARGED)
+        s.plane[ok2] = points_planes(grouping, res2.col[keep], res2.row[keep],
+                                      res2.disparity[keep], g2[keep])[ok2]
+        s.matched |= ok2
+        s.st["enlarged_recovered"] += int(ok2.sum())
+    failed &= ~ok2
+
+
+def _densify(run: _Run, lv: _Level, s: _LevelState, predict: Predictor,
+             failed: NDArray) -> None:
+    """Failure cascade, step 2: reduce the step (denser Förstner points) in failed windows.
+
+    The points are detected only in the rows/columns of the failed windows (the thresholds
+    become local there, as the seed's sub-image thresholds).
+    """
+    opt, ws, Lk, Rk = run.opt, run.ws, lv.left, lv.right
+    s.cascaded |= failed
+    dkw = dict(lv.feature_kw, w_factor=opt.w_factor / 4.0, q_min=min(opt.q_min, 0.5),
+               nms_window=3)
+    wi = lv.grouping.window_index[failed]
+    nwx = -(-Lk.shape[1] // ws)
+    pad = lv.margin + 4
+    r0 = max(int(wi.min() // nwx) * ws - pad, 0)
+    r1 = min(int(wi.max() // nwx + 1) * ws + pad, Lk.shape[0])
+    c0 = max(int((wi % nwx).min()) * ws - pad, 0)
+    c1 = min(int((wi % nwx).max() + 1) * ws + pad, Lk.shape[1])
+    dfl = _detect_crop(Lk, lv.valid_left, lv.excl, r0, r1, c0, c1, dkw)
+    dfr = (_detect_crop(Rk, lv.valid_right, None, r0, min(r1, Rk.shape[0]), 0,
+                        Rk.shape[1], dkw) if run.use_right_features else _no_points())
+    gd = lv.grouping.of(dfl.cols, dfl.rows)
+    sub = (gd >= 0) & failed[np.maximum(gd, 0)]
+    dfl_sub = InterestPoints(*(a[sub] for a in dfl))
+    predict_dense = functools.partial(predict, active=failed)
+    res3 = fbm_level(Lk, Rk, dfl_sub, dfr, lv.grouping, predict_dense,
+                     ncc_window=opt.ncc_window, **run.level_kw)
+    ok3 = failed & (res3.n_accepted >= opt.min_points)
+    if ok3.any():
+        sel3 = (res3.group >= 0) & ok3[np.maximum(res3.group, 0)]
+        s.collected.add(res3, sel3, FLAG_DENSIFIED)
+        s.plane[ok3] = res3.plane[ok3]
+        s.matched |= ok3
+        s.st["densified_recovered"] += int(ok3.sum())
+
+
+@dataclass
+class _Progress:
+    """Progress over the levels, weighted by their pixel counts (4^-k)."""
+
+    fb: Any
+    cost: NDArray
+    done: float = 0.0
+
+    @property
+    def total(self) -> float:
+        return float(self.cost.sum())
+
+    def wave(self, k: int, wave: int) -> None:
+        self.fb.progress(100.0 * (self.done + self.cost[k] * min(0.9, 0.3 + 0.1 * wave))
+                         / self.total)
+
+    def level_done(self, k: int, lsm: bool) -> None:
+        self.done += self.cost[k]
+        self.fb.progress(100.0 * self.done / self.total * (0.9 if lsm else 1.0))
+
+
+def _match_level(run: _Run, lv: _Level, s: _LevelState, progress: _Progress) -> None:
+    """Waves until no component is left: match, failure cascade, come back from other
+    sides (components whose matched neighbours grew since they were last tried)."""
+    opt = run.opt
+    while _next_todo(run, lv, s):
+        predict = s.predictor(run, lv)
+        failed = _match_wave(run, lv, s, predict)
+        if failed.any() and opt.enlarge:
+            _enlarge(run, lv, s, predict, failed)
+        if failed.any() and opt.densify:
+            _densify(run, lv, s, predict, failed)
+        nb_count = _matched_neighbours(lv.grouping, s.matched)
+        s.todo = ~s.matched & ~lv.masked & (nb_count > 0) & (nb_count > s.tried_nb)
+        s.mode[s.todo] = NEIGHBOURS
+        s.wave += 1
+        progress.wave(lv.k, s.wave)
+    s.st["waves"] = s.wave
+
+
+def _level_points(lv: _Level, s: _LevelState, failures: List[NDArray]
+                  ) -> Tuple[NDArray, ...]:
+    """Accepted points of the level in level-0 px; statistics and failures recorded."""
+    k, st = lv.k, s.st
+    col, row, d, rho, sig, flags, _ = s.collected.arrays()
+    fail = ~s.matched & ~lv.masked & ~lv.tiny
+    st["failed_windows"] = int(fail.sum())
+    n_eval = int((~lv.masked & ~lv.tiny).sum())
+    st["failure_pct"] = round(100.0 * st["failed_windows"] / max(n_eval, 1), 3)
+    st["accepted"] = int(col.size)
+    if fail.any():
+        c = lv.grouping.centres[fail]
+        failures.append(np.stack([from_level(c[:, 0], k), from_level(c[:, 1], k),
+                                  np.full(len(c), k, float)], 1))
+    return (from_level(col, k), from_level(row, k), d * lv.scale,
+            (sig * lv.scale).astype(np.float32), rho.astype(np.float32), flags,
+            np.full(col.size, k, np.int8))
+
+
+def _lsm_refine(run: _Run, Lf: NDArray, Rf: NDArray, pts: Tuple[NDArray, ...],
+                total: Dict[str, Any]) -> Tuple[NDArray, ...]:
+    """Epipolar LSM of the level-0 points; failed ones flagged or (``lsm_reject``) dropped.
+
+    Seed §2.12: reject by the LSM thresholds — on real images nearly every gross FBM error
+    (> 2 px) is among these points.
+    """
+    opt = run.opt
+    col, row, disp, sig, rho, flags, level = pts
+    sel = np.flatnonzero(level == 0)
+    if not sel.size:
+        return pts
+    res = lsm_match(Lf, Rf, col[sel], row[sel], col[sel] - disp[sel], None,
+                    window=run.lsm_window, model="epipolar", max_iter=opt.lsm_max_iter,
+                    max_shift=opt.lsm_pull_in, min_corr=opt.lsm_min_rho,
+                    max_sigma=opt.lsm_max_sigma)
+    good = res.valid & np.isfinite(res.cols)
+    gi = sel[good]
+    disp[gi] = col[gi] - res.cols[good]
+    sig[gi] = res.sigma_col[good]
+    rho[gi] = res.corr[good]
+    flags[gi] |= FLAG_LSM
+    flags[sel[~good]] |= FLAG_LSM_FAILED
+    total["lsm_tried"] = int(sel.size)
+    total["lsm_failed"] = int((~good).sum())
+    if opt.lsm_reject and (~good).any():
+        keep = np.ones(col.size, bool)
+        keep[sel[~good]] = False
+        total["lsm_rejected"] = int((~keep).sum())
+        return tuple(a[keep] for a in pts)
+    return pts
+
+
+def _grid_densify(run: _Run, Lf: NDArray, Rf: NDArray, lv: _Level, s: _LevelState,
+                  pts: Tuple[NDArray, ...]) -> Tuple[Tuple[NDArray, ...], Dict[str, Any]]:
+    """Level-0 grid densification appended to the points (see :func:`_grid_points`).
+
+    Failed components are predicted from their neighbours' planes (wider search).
+    """
+    t_grid = time.perf_counter()
+    g_plane = fill_planes(s.plane, lv.grouping, s.matched, lv.masked)
+    g_pull = np.where(s.matched, run.pull_ref, run.pull_grow)
+    g_parts, g_stats = _grid_points(Lf, Rf, lv.grouping, g_plane, g_pull, lv.excl,
+                                    lv.valid_left, lv.margin, int(run.opt.grid_step), run.opt,
+                                    run.lsm_window)
+    if g_parts is not None:
+        pts = tuple(np.concatenate([a, b]) for a, b in zip(pts, g_parts))
+    g_stats["seconds"] = round(time.perf_counter() - t_grid, 3)
+    return pts, g_stats
+
+
+def _level0_finale(run: _Run, Lf: NDArray, Rf: NDArray, lv: _Level, s: _LevelState,
+                   pts: Tuple[NDArray, ...], total: Dict[str, Any],
+                   stats0: Dict[str, Any], fb: Any) -> Tuple[NDArray, ...]:
+    """LSM of the level-0 points, then the grid densification; statistics recorded."""
+    t_lsm = time.perf_counter()
+    pts = _lsm_refine(run, Lf, Rf, pts, total)
+    total["lsm_seconds"] = round(time.perf_counter() - t_lsm, 3)
+    stats0["lsm_tried"] = total["lsm_tried"]
+    if run.opt.grid_step and run.opt.grid_step > 0:
+        fb.check()
+        pts, g_stats = _grid_densify(run, Lf, Rf, lv, s, pts)
+        total["grid"] = g_stats
+        stats0["grid_points"] = g_stats["accepted"]
+    stats0["lsm_failed"] = total["lsm_failed"]
+    stats0["lsm_rejected"] = total.get("lsm_rejected", 0)
+    return pts
 
 
 def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: float, *,
@@ -482,49 +966,12 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     L0, R0 = _check_inputs(left, right, min_d, max_d, mask, barriers, seeds, approx)
     Lf, vL = fill_nodata(L0)
     Rf, vR = fill_nodata(R0)
-    ws = int(opt.fbm_window)
-    lsm_window = 2 * int(opt.lsm_half) + 1
-    margin_coarse = max(opt.ncc_window + 4, opt.refine_window) // 2 + 1
-    margin0 = max(margin_coarse, lsm_window // 2 + 1 if opt.lsm else 0)
-    if opt.levels is None:
-        n_levels = levels_for_disparity(max_d - min_d, pull_in=ws / 4.0, min_size=2 * ws,
-                                        shape=(min(L0.shape[0], R0.shape[0]),
-                                               min(L0.shape[1], R0.shape[1])))
-        # the top level must hold at least one whole matching window (plus the margins where
-        # no point can lie) across the stereo overlap, else nothing can be matched there
-        overlap0 = _overlap_width(vL, vR, min_d, max_d)
-        while n_levels > 1 and overlap0 / 2.0 ** (n_levels - 1) < ws + 2 * margin_coarse:
-            n_levels -= 1
-    else:
-        n_levels = max(1, int(opt.levels))
-    pl = build_pyramid(Lf, n_levels)
-    pr = build_pyramid(Rf, n_levels)
-    n_levels = min(len(pl), len(pr))
-    vLp = _mask_pyramid(~vL, n_levels)
-    vRp = _mask_pyramid(~vR, n_levels)
-    mp = _mask_pyramid(mask, n_levels)
-    bp = _mask_pyramid(barriers, n_levels)
+    run = _run_constants(opt, min_d, max_d, L0.shape)
+    pyr = _build_pyramids(Lf, Rf, vL, vR, mask, barriers, _level_count(run, L0, R0, vL, vR))
+    n_levels = pyr.n_levels
     top = n_levels - 1
-    # the coarser level's plane is off by its relief curvature, not by a share of the window:
-    # small windows keep ≥ 4 px (8 px when growing) with correlation candidates, whose search
-    # is not bound to the FBM convergence range of a window
-    floor = 4.0 if opt.candidates == "correlation" else 0.0
-    pull_ref = opt.pull_in if opt.pull_in is not None else max(ws / 8.0, floor)
-    pull_grow = opt.pull_in if opt.pull_in is not None else max(ws / 4.0, 2.0 * floor)
-    robust = {"huber_iterations": opt.huber_iterations,
-              "redescending_iterations": opt.redescending_iterations,
-              "huber_k": opt.huber_k, "redescending_c": opt.redescending_c,
-              "reject_k": opt.reject_k, "sigma_floor": opt.sigma_floor}
-    level_kw = {"rho_min": opt.rho_min, "row_tol": opt.row_tol, "bidir_tol": opt.bidir_tol,
-                "min_points": opt.min_points, "robust": robust,
-                "refine_window": opt.refine_window, "candidates": opt.candidates,
-                "max_peaks": int(opt.max_peaks)}
-    use_right_features = opt.candidates == "features"
-    cost = np.array([4.0 ** -k for k in range(n_levels)])
-    done_cost = 0.0
-    total_cost = float(cost.sum())
-
-    prev: Optional[Tuple[NDArray, Grouping]] = None  # filled planes of the coarser level
+    progress = _Progress(fb, np.array([4.0 ** -k for k in range(n_levels)]))
+    prev: Optional[CoarsePlanes] = None  # filled planes of the coarser level
     prev_matched = np.zeros((0, 3))
     stats_levels: Dict[str, Any] = {}
     failures: List[NDArray] = []
@@ -532,408 +979,37 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     n_seeds_used = 0
     for k in range(top, -1, -1):
         t_level = time.perf_counter()
-        scale = 2.0 ** k
-        Lk, Rk = pl[k], pr[k]
-        validL = ~vLp[k] if vLp[k] is not None else None
-        validR = ~vRp[k] if vRp[k] is not None else None
-        margin = margin0 if k == 0 else margin_coarse
-        # left pixels whose search range [min_d, max_d] never reaches right-image data: no
-        # stereo overlap, so nothing to match (not a failure)
-        no_overlap = ~_overlap_mask(validR, Rk.shape, Lk.shape, min_d / scale - 1.0,
-                                    max_d / scale + 1.0, margin)
-        pm = prev_matched[np.isfinite(prev_matched[:, 0])]
-        if pm.size:
-            # sharper: the disparities the coarser level measured (its planes at their window
-            # corners, ± the growing pull-in) instead of the a-priori range. Not per pixel: a
-            # wrong coarse window must stay open for the neighbour check, not be masked
-            corners = (pm[:, :1] + pm[:, 1:2] * np.array([-0.5, 0.5, -0.5, 0.5])
-                       + pm[:, 2:3] * np.array([-0.5, -0.5, 0.5, 0.5]))
-            lo_all = max(2.0 * float(corners.min()) - pull_grow, min_d / scale) - 1.0
-            hi_all = min(2.0 * float(corners.max()) + pull_grow, max_d / scale) + 1.0
-            no_overlap |= ~_overlap_mask(validR, Rk.shape, Lk.shape, lo_all, hi_all, margin)
-        excl = None
-        for m in (mp[k], bp[k], no_overlap if no_overlap.any() else None):
-            if m is not None:
-                excl = m.copy() if excl is None else (excl | m)
-        grouping = window_components(Lk.shape, ws, bp[k])
-        ng = grouping.n_groups
-        fkw = {"window": opt.interest_window, "q_min": opt.q_min, "w_factor": opt.w_factor,
-               "nms_window": opt.nms_window, "margin": margin,
-               "local_cell": 2 * ws if opt.local_cell is None else int(opt.local_cell),
-               "local_floor": opt.local_floor}
-        fl = detect_features(Lk, validL, excl, **fkw)
-        fr = (detect_features(Rk, validR, None, **fkw) if use_right_features
-              else _no_points())
-        # masked components: ≥ 90 % excluded or without data; tiny ones (< ½ window usable,
-        # e.g. cut by the image border, where no point can lie) are not failures
-        lab = grouping.labels.ravel()
-        bad_px = np.zeros(Lk.shape, bool)
-        if mp[k] is not None:
-            bad_px |= mp[k]
-        if validL is not None:
-            bad_px |= ~validL
-        bad_px |= no_overlap
-        n_bad = np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
-        masked = n_bad >= 0.9 * np.maximum(grouping.area, 1)
-        bad_px[:margin + 1, :] = bad_px[-margin - 1:, :] = True
-        bad_px[:, :margin + 1] = bad_px[:, -margin - 1:] = True
-        usable = grouping.area - np.bincount(lab, bad_px.ravel(), ng + 1)[1:]
-        tiny = usable < 0.5 * ws * ws
-
-        # ---- predictions -----------------------------------------------------------------
-        mode = np.zeros(ng, np.int8)
-        seed_d = np.full(ng, np.nan)
-        coarse = None
-        coarse_range = None
-        if prev is not None:
-            p_plane, p_group = prev
-
-            def coarse(cols, rows, p_plane=p_plane, p_group=p_group):
-                c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
-                g1 = p_group.of(c1, r1, nearest=True)
-                return 2.0 * _eval_planes(p_plane, p_group, g1, c1, r1)
-
-            def coarse_range(cols, rows, p_plane=p_plane, p_group=p_group):
-                c1, r1 = to_level(cols, 1) * 1.0, to_level(rows, 1) * 1.0
-                g1 = p_group.of(c1, r1, nearest=True)
-                lo, hi = _plane_range(p_plane, p_group, g1, c1, r1)
-                return 2.0 * lo, 2.0 * hi
-
-            mode[:] = _COARSE
-            # components the coarser level could not predict (nothing matched within reach
-            # there, e.g. a failed top level) search the whole range: never zero points
-            # silently
-            no_pred = ~np.isfinite(coarse(grouping.centres[:, 0], grouping.centres[:, 1]))
-            mode[no_pred] = _RANGE
-        else:
-            if approx is not None:
-                grid = np.asarray(approx[0], dtype=np.float64)
-                step = float(approx[1])
-
-                def coarse(cols, rows, grid=grid, step=step, k=k, scale=scale):
-                    i = np.floor((from_level(rows, k) + 0.5) / step).astype(np.int64)
-                    j = np.floor((from_level(cols, k) + 0.5) / step).astype(np.int64)
-                    ok = (i >= 0) & (i < grid.shape[0]) & (j >= 0) & (j < grid.shape[1])
-                    out = np.full(np.shape(cols), np.nan)
-                    out[ok] = grid[i[ok], j[ok]] / scale
-                    return out
-
-                mode[:] = _COARSE
-            if seeds is not None:
-                s = np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
-                inside = ((s[:, 0] >= -0.5) & (s[:, 0] < L0.shape[1] - 0.5)
-                          & (s[:, 1] >= -0.5) & (s[:, 1] < L0.shape[0] - 0.5)
-                          & np.isfinite(s).all(axis=1))
-                if not inside.any():
-                    raise InputError(f"none of the {len(s)} start point(s) lies inside the "
-                                     f"left epipolar image ({L0.shape[1]} × {L0.shape[0]} px); "
-                                     "check the start points of this model")
-                if not inside.all():
-                    fb.warning(f"{int((~inside).sum())} start point(s) outside the left "
-                               "epipolar image are ignored")
-                s = s[inside]
-                gs = grouping.of(to_level(s[:, 0], k), to_level(s[:, 1], k), nearest=True)
-                ok = gs >= 0
-                n_seeds_used = int(ok.sum())
-                cnt = np.bincount(gs[ok], minlength=ng)
-                sd = np.bincount(gs[ok], s[ok, 2] / scale, ng)
-                has = cnt > 0
-                seed_d[has] = sd[has] / cnt[has]
-                mode[has] = _SEED
-            elif approx is None:
-                mode[:] = _RANGE
-        mid_k = 0.5 * (min_d + max_d) / scale
-        half_k = 0.5 * (max_d - min_d) / scale + 1.0
-
-        matched = np.zeros(ng, bool)
-        plane = np.full((ng, 3), np.nan)
-        tried_nb = np.full(ng, -1, np.int64)
-        cascaded = np.zeros(ng, bool)
-        todo = (mode != _NONE) & ~masked
-        collected = _Collected()
-        st = {"features_left": int(fl.cols.size), "features_right": int(fr.cols.size),
-              "candidates": 0, "outliers": 0, "bidir_rejected": 0, "windows": int(ng),
-              "windows_masked": int(masked.sum()), "enlarged_recovered": 0,
-              "densified_recovered": 0, "retry_recovered": 0, "waves": 0,
-              "range_fallback": 0}
-        big: Optional[Grouping] = None
-        fallback_done = k != top
-        wave = 0
-        suspect_done = np.zeros(ng, bool)
-        while True:
-            if not todo.any() and opt.neighbour_tol and opt.neighbour_tol > 0:
-                # consistency between windows: a component whose plane disagrees with the
-                # median of (≥ 3) matched neighbours is redone from its neighbours, once
-                sus = _suspect_components(plane, grouping, matched & ~suspect_done,
-                                          matched, max(float(opt.neighbour_tol),
-                                                       pull_ref / 2.0))
-                if sus.any():
-                    suspect_done |= sus
-                    matched &= ~sus
-                    plane[sus] = np.nan
-                    collected.drop_groups(sus)
-                    mode[sus] = _NEIGHBOURS
-                    tried_nb[sus] = -1
-                    todo = sus
-                    st["suspect_redone"] = st.get("suspect_redone", 0) + int(sus.sum())
-            if not todo.any():
-                if fallback_done:
-                    break
-                fallback_done = True
-                # never reached from the seeds/approximation: search the whole range
-                todo = (tried_nb < 0) & ~matched & ~masked
-                mode[todo] = _RANGE
-                st["range_fallback"] = int(todo.sum())
-                if not todo.any():
-                    break
-            todo_now = todo.copy()
-            retry = (mode == _NEIGHBOURS) & (wave > 0)
-
-            def predict(cols, rows, active=None, context=None, todo_now=todo_now, mode=mode,
-                        plane=plane, matched=matched, coarse=coarse, seed_d=seed_d,
-                        coarse_range=coarse_range,
-                        grouping=grouping, mid_k=mid_k, half_k=half_k):
-                """(d_pred, pull_in) at left positions of this level; NaN = not matched now.
-
-                ``active`` (per component) replaces the wave's to-do set; ``context``
-                components predict from their own plane (enlarged windows).
-                """
-                g = grouping.of(cols, rows)
-                gg = np.maximum(g, 0)
-                d = np.full(np.shape(cols), np.nan)
-                p = np.full(np.shape(cols), np.nan)
-                act = (g >= 0) & (todo_now if active is None else active)[gg]
-                m = np.where(act, mode[gg], _NONE)
-                sel = m == _COARSE
-                if sel.any() and coarse is not None:
-                    if coarse_range is not None:
-                        # between disagreeing coarse planes (e.g. a window's roof plane
-                        # extrapolated over ground) search their whole span, up to 4 pull-ins
-                        lo, hi = coarse_range(cols[sel], rows[sel])
-                        d[sel] = 0.5 * (lo + hi)
-                        p[sel] = pull_ref + np.minimum(0.5 * (hi - lo), 3.0 * pull_ref)
-                    else:
-                        d[sel] = coarse(cols[sel], rows[sel])
-                        p[sel] = pull_ref
-                sel = m == _SEED
-                if sel.any():
-                    d[sel] = seed_d[g[sel]]
-                    p[sel] = pull_grow
-                sel = m == _RANGE
-                if sel.any():
-                    d[sel] = mid_k
-                    p[sel] = half_k
-                sel = m == _NEIGHBOURS
-                if sel.any():
-                    d[sel] = _neighbour_prediction(plane, grouping, matched, g[sel],
-                                                   cols[sel], rows[sel])
-                    p[sel] = pull_grow
-                if context is not None:
-                    own = (g >= 0) & context[gg] & ~act
-                    if own.any():
-                        d[own] = _eval_planes(plane, grouping, g[own], cols[own], rows[own])
-                        p[own] = pull_ref
-                return d, p
-
-            nb_count = np.bincount(grouping.edges[:, 0], matched[grouping.edges[:, 1]],
-                                   ng) if grouping.edges.size else np.zeros(ng)
-            tried_nb[todo_now] = nb_count[todo_now].astype(np.int64)
-            res = fbm_level(Lk, Rk, fl, fr, grouping, predict, ncc_window=opt.ncc_window,
-                            **level_kw)
-            for key in ("candidates", "outliers", "bidir_rejected"):
-                st[key] += res.stats[key]
-            ok = todo_now & (res.n_accepted >= opt.min_points)
-            sel = ok[np.maximum(res.group, 0)] & (res.group >= 0)
-            collected.add(res, sel & ~retry[res.group], 0)
-            collected.add(res, sel & retry[res.group], FLAG_RETRY)
-            st["retry_recovered"] += int((ok & retry).sum())
-            plane[ok] = res.plane[ok]
-            matched |= ok
-            failed = todo_now & ~ok & ~cascaded
-            # ---- failure cascade: enlarge the window, then reduce the step ----------------
-            if failed.any() and opt.enlarge:
-                cascaded |= failed
-                if big is None:
-                    big = window_components(Lk.shape, 2 * ws, bp[k])
-                gl_small = grouping.of(fl.cols, fl.rows)
-                in_failed = (gl_small >= 0) & failed[np.maximum(gl_small, 0)]
-                big_sel = np.zeros(big.n_groups, bool)
-                gb = big.of(fl.cols, fl.rows)
-                big_sel[gb[in_failed & (gb >= 0)]] = True
-                ctx = (gb >= 0) & big_sel[np.maximum(gb, 0)] & (gl_small >= 0)
-                # context: matched components sharing a big window with a failed one
-                context = np.zeros(ng, bool)
-                context[gl_small[ctx]] = True
-                context &= matched
-
-                def predict_big(cols, rows, predict=predict, failed=failed, context=context):
-                    return predict(cols, rows, active=failed, context=context)
-
-                res2 = fbm_level(Lk, Rk, fl, fr, big, predict_big,
-                                 ncc_window=opt.ncc_window + 4, **level_kw)
-                g2 = grouping.of(res2.col, res2.row)
-                keep = (g2 >= 0) & failed[np.maximum(g2, 0)]
-                cnt = np.bincount(g2[keep], minlength=ng)
-                ok2 = failed & (cnt >= opt.min_points)
-                if ok2.any():
-                    keep &= ok2[np.maximum(g2, 0)]
-                    res2.group = g2
-                    collected.add(res2, keep, FLAG_ENLARGED)
-                    plane[ok2] = _points_planes(grouping, res2.col[keep], res2.row[keep],
-                                                res2.disparity[keep], g2[keep])[ok2]
-                    matched |= ok2
-                    st["enlarged_recovered"] += int(ok2.sum())
-                failed &= ~ok2
-            if failed.any() and opt.densify:
-                cascaded |= failed
-                # denser points, detected only in the rows/columns of the failed windows (the
-                # thresholds become local there, as the seed's sub-image thresholds)
-                dkw = dict(fkw, w_factor=opt.w_factor / 4.0, q_min=min(opt.q_min, 0.5),
-                           nms_window=3)
-                wi = grouping.window_index[failed]
-                nwx = -(-Lk.shape[1] // ws)
-                pad = margin + 4
-                r0 = max(int(wi.min() // nwx) * ws - pad, 0)
-                r1 = min(int(wi.max() // nwx + 1) * ws + pad, Lk.shape[0])
-                c0 = max(int((wi % nwx).min()) * ws - pad, 0)
-                c1 = min(int((wi % nwx).max() + 1) * ws + pad, Lk.shape[1])
-                dfl = _detect_crop(Lk, validL, excl, r0, r1, c0, c1, dkw)
-                dfr = (_detect_crop(Rk, validR, None, r0, min(r1, Rk.shape[0]), 0,
-                                    Rk.shape[1], dkw) if use_right_features else _no_points())
-                gd = grouping.of(dfl.cols, dfl.rows)
-                sub = (gd >= 0) & failed[np.maximum(gd, 0)]
-                dfl_sub = InterestPoints(*(a[sub] for a in dfl))
-
-                def predict_dense(cols, rows, predict=predict, failed=failed):
-                    return predict(cols, rows, active=failed)
-
-                res3 = fbm_level(Lk, Rk, dfl_sub, dfr, grouping, predict_dense,
-                                 ncc_window=opt.ncc_window, **level_kw)
-                ok3 = failed & (res3.n_accepted >= opt.min_points)
-                if ok3.any():
-                    sel3 = (res3.group >= 0) & ok3[np.maximum(res3.group, 0)]
-                    collected.add(res3, sel3, FLAG_DENSIFIED)
-                    plane[ok3] = res3.plane[ok3]
-                    matched |= ok3
-                    st["densified_recovered"] += int(ok3.sum())
-            # ---- next wave: come back from other sides ----------------------------------
-            nb_count = np.bincount(grouping.edges[:, 0], matched[grouping.edges[:, 1]],
-                                   ng) if grouping.edges.size else np.zeros(ng)
-            todo = ~matched & ~masked & (nb_count > 0) & (nb_count > tried_nb)
-            mode[todo] = _NEIGHBOURS
-            wave += 1
-            fb.progress(100.0 * (done_cost + cost[k] * min(0.9, 0.3 + 0.1 * wave)) / total_cost)
-        st["waves"] = wave
-        # ---- level results ------------------------------------------------------------------
-        col, row, d, rho, sig, flags, _ = collected.arrays()
-        fail = ~matched & ~masked & ~tiny
-        st["failed_windows"] = int(fail.sum())
-        n_eval = int((~masked & ~tiny).sum())
-        st["failure_pct"] = round(100.0 * st["failed_windows"] / max(n_eval, 1), 3)
-        st["accepted"] = int(col.size)
-        if fail.any():
-            c = grouping.centres[fail]
-            failures.append(np.stack([from_level(c[:, 0], k), from_level(c[:, 1], k),
-                                      np.full(len(c), k, float)], 1))
+        lv = _setup_level(run, pyr, k, prev_matched)
+        mode, seed_d, coarse, n_seeds = _initial_modes(run, lv, prev, approx, seeds, fb)
+        n_seeds_used = n_seeds if n_seeds is not None else n_seeds_used
+        s = _new_state(lv, mode, seed_d, coarse, top)
+        _match_level(run, lv, s, progress)
+        pts = _level_points(lv, s, failures)
         # predictions for the next level everywhere (also into masked components, which
         # only sharpens the overlap there; nothing is matched in them)
-        prev = (_fill_planes(plane, grouping, matched, np.zeros(ng, bool)), grouping)
-        prev_matched = np.where(matched[:, None], plane, np.nan)  # measured planes only
+        prev = CoarsePlanes(fill_planes(s.plane, lv.grouping, s.matched,
+                                          np.zeros(lv.ng, bool)), lv.grouping)
+        prev_matched = np.where(s.matched[:, None], s.plane, np.nan)  # measured planes only
         if k == 0 or opt.keep_coarse:
-            out_parts.append((from_level(col, k), from_level(row, k), d * scale,
-                              (sig * scale).astype(np.float32), rho.astype(np.float32),
-                              flags, np.full(col.size, k, np.int8)))
-        st["seconds"] = round(time.perf_counter() - t_level, 3)
-        stats_levels[str(k)] = st
-        done_cost += cost[k]
-        fb.progress(100.0 * done_cost / total_cost * (0.9 if opt.lsm else 1.0))
-        fb.info(f"FBM level {k}: {st['accepted']} points, {st['failed_windows']} failed "
-                f"windows ({st['failure_pct']} %), {st['waves']} waves")
+            out_parts.append(pts)
+        s.st["seconds"] = round(time.perf_counter() - t_level, 3)
+        stats_levels[str(k)] = s.st
+        progress.level_done(k, opt.lsm)
+        fb.info(f"FBM level {k}: {s.st['accepted']} points, {s.st['failed_windows']} failed "
+                f"windows ({s.st['failure_pct']} %), {s.st['waves']} waves")
 
-    col, row, disp, sig, rho, flags, level = (np.concatenate(p) for p in zip(*out_parts))
+    pts = tuple(np.concatenate(p) for p in zip(*out_parts))
     total: Dict[str, Any] = {"levels": n_levels, "seeds_used": n_seeds_used,
                              "lsm_tried": 0, "lsm_failed": 0, "lsm_rejected": 0}
     if opt.lsm:
-        t_lsm = time.perf_counter()
-        sel = np.flatnonzero(level == 0)
-        if sel.size:
-            res = lsm_match(Lf, Rf, col[sel], row[sel], col[sel] - disp[sel], None,
-                            window=lsm_window, model="epipolar", max_iter=opt.lsm_max_iter,
-                            max_shift=opt.lsm_pull_in, min_corr=opt.lsm_min_rho,
-                            max_sigma=opt.lsm_max_sigma)
-            good = res.valid & np.isfinite(res.cols)
-            gi = sel[good]
-            disp[gi] = col[gi] - res.cols[good]
-            sig[gi] = res.sigma_col[good]
-            rho[gi] = res.corr[good]
-            flags[gi] |= FLAG_LSM
-            flags[sel[~good]] |= FLAG_LSM_FAILED
-            total["lsm_tried"] = int(sel.size)
-            total["lsm_failed"] = int((~good).sum())
-            if opt.lsm_reject and (~good).any():
-                # seed §2.12: reject by the LSM thresholds — on real images nearly every gross
-                # FBM error (> 2 px) is among these points
-                keep = np.ones(col.size, bool)
-                keep[sel[~good]] = False
-                col, row, disp, sig, rho, flags, level = (
-                    a[keep] for a in (col, row, disp, sig, rho, flags, level))
-                total["lsm_rejected"] = int((~keep).sum())
-        total["lsm_seconds"] = round(time.perf_counter() - t_lsm, 3)
-        stats_levels["0"]["lsm_tried"] = total["lsm_tried"]
-        if opt.grid_step and opt.grid_step > 0:
-            t_grid = time.perf_counter()
-            fb.check()
-            # failed components are predicted from their neighbours' planes (wider search)
-            g_plane = _fill_planes(plane, grouping, matched, masked)
-            g_pull = np.where(matched, pull_ref, pull_grow)
-            g_parts, g_stats = _grid_points(Lf, Rf, grouping, g_plane, g_pull, excl, validL,
-                                            margin, int(opt.grid_step), opt, lsm_window)
-            if g_parts is not None:
-                col, row, disp, sig, rho, flags, level = (
-                    np.concatenate([a, b]) for a, b in zip(
-                        (col, row, disp, sig, rho, flags, level), g_parts))
-            g_stats["seconds"] = round(time.perf_counter() - t_grid, 3)
-            total["grid"] = g_stats
-            stats_levels["0"]["grid_points"] = g_stats["accepted"]
-        stats_levels["0"]["lsm_failed"] = total["lsm_failed"]
-        stats_levels["0"]["lsm_rejected"] = total.get("lsm_rejected", 0)
+        pts = _level0_finale(run, Lf, Rf, lv, s, pts, total, stats_levels["0"], fb)
     fb.progress(100.0)
     fail_arr = np.concatenate(failures) if failures else np.zeros((0, 3))
-    total["points"] = int(col.size)
+    total["points"] = int(pts[0].size)
     total["failed_windows"] = len(fail_arr)
     total["failure_pct_level0"] = stats_levels["0"]["failure_pct"]
     total["seconds"] = round(time.perf_counter() - t_start, 3)
-    return EpipolarMatches(col, row, disp, sig, rho, flags, level,
-                           {"levels": stats_levels, "total": total}, fail_arr)
-
-
-def _suspect_components(plane: NDArray, grouping: Grouping, test: NDArray, matched: NDArray,
-                        tol: float) -> NDArray:
-    """Components (of ``test``) whose plane disagrees with their matched neighbours.
-
-    At the component's centre, the planes of its matched neighbours (over the barrier-free
-    graph) are evaluated; with at least 3 of them, the component is suspect when its own
-    plane differs from their median by more than ``tol`` px. A single wrong window (a
-    consistent but false set of correlation peaks, e.g. from a wrong coarse prediction)
-    is thus caught by the majority around it; real relief changes smoothly across windows.
-    """
-    ng = grouping.n_groups
-    out = np.zeros(ng, bool)
-    e = grouping.edges
-    if e.size == 0:
-        return out
-    e = e[test[e[:, 0]] & matched[e[:, 1]]]
-    if e.size == 0:
-        return out
-    c = grouping.centres
-    s, d = e[:, 0], e[:, 1]
-    u, v = grouping.uv(c[s, 0], c[s, 1], d)
-    val = plane[d, 0] + plane[d, 1] * u + plane[d, 2] * v
-    cnt = np.bincount(s, minlength=ng)
-    med = group_weighted_median(val, np.ones(val.size), s, ng)
-    own = plane[:, 0]  # the plane at its own centre (u = v = 0)
-    out = (cnt >= 3) & test & np.isfinite(med) & (np.abs(own - med) > tol)
-    return out
+    return EpipolarMatches(*pts, {"levels": stats_levels, "total": total}, fail_arr)
 
 
 def _overlap_width(valid_left: NDArray, valid_right: NDArray, min_d: float, max_d: float
@@ -1009,7 +1085,7 @@ def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
     sel = ok_px[rr, cc]
     rr, cc = rr[sel].astype(float), cc[sel].astype(float)
     g = grouping.of(cc, rr)
-    d = _eval_planes(plane, grouping, g, cc, rr)
+    d = eval_planes(plane, grouping, g, cc, rr)
     sel = np.isfinite(d)
     rr, cc, d, p = rr[sel], cc[sel], d[sel], pull[g[sel]]
     st["nodes"] = int(rr.size)
@@ -1063,15 +1139,3 @@ def _detect_crop(img: NDArray, valid: Optional[NDArray], excl: Optional[NDArray]
                         None if excl is None else excl[crop], **kw)
     return InterestPoints(f.cols + c0, f.rows + r0, f.w, f.q)
 
-
-def _points_planes(grouping: Grouping, col: NDArray, row: NDArray, d: NDArray, g: NDArray
-                   ) -> NDArray:
-    """Absolute plane d = p0 + p1·u + p2·v per group from accepted points (NaN where none)."""
-    ng = grouping.n_groups
-    out = np.full((ng, 3), np.nan)
-    if col.size:
-        u, v = grouping.uv(col, row, g)
-        a = group_wls(u, v, d, np.ones(col.size), g, ng, 1e-3)
-        has = np.bincount(g, minlength=ng) > 0
-        out[has] = a[has]
-    return out

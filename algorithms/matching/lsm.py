@@ -49,7 +49,8 @@ Failure flags (bits of ``LSMResult.flags``; 0 = a good match) — see the ``FLAG
 
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from dataclasses import dataclass
+from typing import NamedTuple, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -343,11 +344,11 @@ def lsm_match(template_image: NDArray, search_image: NDArray,
     }
     if chunk is None:
         chunk = max(16, 2**18 // (window + 2) ** 2)
+    cfg = _Settings(tuple(idx), half, max_iter, tol_shift, max_shift, min_corr, max_sigma,
+                    min_contrast, scale_range, contrast_range, jacobian)
     for start in range(0, n, int(chunk)):
         sl = slice(start, min(n, start + chunk))
-        _lsm_chunk(tpl, srch, cols[sl], rows[sl], p0[sl], idx, half, max_iter, tol_shift,
-                   max_shift, min_corr, max_sigma, min_contrast, scale_range, contrast_range,
-                   jacobian, out, sl)
+        _lsm_chunk(tpl, srch, cols[sl], rows[sl], p0[sl], cfg, out, sl)
     p = out["params"]
     if model == "epipolar":
         out["sig_r"] = np.where(np.isfinite(out["sig_c"]), 0.0, np.nan).astype(np.float32)
@@ -375,198 +376,289 @@ def _singular(Ns: NDArray, eps: float = 1e-7) -> NDArray:
         return ~(np.linalg.eigvalsh(safe)[:, 0] > eps) | ~np.isfinite(Ns).all(axis=(1, 2))
 
 
-def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_shift, min_corr,
-               max_sigma, min_contrast, scale_range, contrast_range, jacobian, out, sl):
-    """Gauss–Newton for one chunk of points; writes into ``out[...][sl]``.
+@dataclass(frozen=True)
+class _Settings:
+    """Model and thresholds of one :func:`lsm_match` call (see its parameters)."""
 
-    Per-point arrays (template, Jacobian, normal matrix) are kept compacted to the points still
-    iterating, so converged and failed points cost nothing in later iterations.
+    idx: Tuple[int, ...]
+    half: int
+    max_iter: int
+    tol_shift: float
+    max_shift: float
+    min_corr: float
+    max_sigma: float
+    min_contrast: float
+    scale_range: tuple
+    contrast_range: tuple
+    jacobian: str
+
+    @property
+    def u(self) -> int:
+        return len(self.idx)
+
+    @property
+    def m(self) -> int:
+        return (2 * self.half + 1) ** 2
+
+
+@dataclass
+class _Chunk:
+    """Per-point state of one chunk; the ``*c`` arrays and ``A0t``, ``N0`` are compacted
+    to the points still iterating (row k belongs to point ``loc[k]``)."""
+
+    p0: NDArray
+    p: NDArray
+    flags: NDArray
+    g1_mean: NDArray
+    g1_q: NDArray
+    iters: NDArray
+    converged: NDArray
+    last_normal: NDArray
+    last_vv: NDArray
+    last_corr: NDArray
+    active: NDArray
+    loc: NDArray
+    g1c: NDArray
+    A0t: Optional[NDArray] = None
+    N0: Optional[NDArray] = None
+
+    def compact(self) -> None:
+        """Drop the rows of points that stopped iterating."""
+        if len(self.active) < len(self.loc):
+            keep = np.searchsorted(self.loc, self.active)
+            self.g1c = self.g1c[keep]
+            if self.A0t is not None:
+                self.A0t, self.N0 = self.A0t[keep], self.N0[keep]
+            self.loc = self.active
+
+
+def _template_jacobian(ge1a: NDArray, g1c: NDArray, grid: NDArray,
+                       m: int) -> Tuple[NDArray, NDArray]:
+    """A0ᵀ (n, 8, m) from the template's own gradients, and N0 = A0ᵀA0 (float64).
+
+    The Jacobian at parameters p is A0·T(p), so only A0ᵀΔg has to be formed per iteration.
     """
-    n = cols.size
-    size = 2 * half + 1
-    m = size * size
-    u = len(idx)
-    height, width = srch.shape
-    flat = srch.ravel()
-    # template (fixed) with one extra pixel for the gradients, and the template-frame grids
+    xi, eta = grid
+    t_xi = (0.5 * (ge1a[:, 1:-1, 2:] - ge1a[:, 1:-1, :-2])).reshape(-1, m)
+    t_eta = (0.5 * (ge1a[:, 2:, 1:-1] - ge1a[:, :-2, 1:-1])).reshape(-1, m)
+    A0t = np.empty((len(g1c), 8, m), np.float32)  # (n, 8, m): Jacobian transposed
+    A0t[:, 0], A0t[:, 3] = t_xi, t_eta
+    np.multiply(t_xi, xi, out=A0t[:, 1])
+    np.multiply(t_xi, eta, out=A0t[:, 2])
+    np.multiply(t_eta, xi, out=A0t[:, 4])
+    np.multiply(t_eta, eta, out=A0t[:, 5])
+    A0t[:, 6] = 1.0
+    A0t[:, 7] = g1c
+    del t_xi, t_eta
+    N0 = np.matmul(A0t, A0t.transpose(0, 2, 1)).astype(np.float64)
+    return A0t, N0
+
+
+def _start_chunk(tpl: NDArray, cols: NDArray, rows: NDArray, p0: NDArray,
+                 cfg: _Settings) -> _Chunk:
+    """Template windows (flags: outside, textureless), their statistics for ρ and, in the
+    template mode, the fixed Jacobian."""
+    n, m, half = cols.size, cfg.m, cfg.half
+    # template (fixed) with one extra pixel for the gradients
     ge1, t_inside = extract_windows(tpl, cols, rows, half + 1)
     g1 = np.ascontiguousarray(ge1[:, 1:-1, 1:-1]).reshape(n, m)
-    grid_e = _grid(half + 1)
-    grid = _grid(half)
-    xi, eta = grid
-
-    p = p0.copy()
     flags = np.zeros(n, np.uint8)
     flags[~t_inside] |= FLAG_OUTSIDE
     # template statistics for the correlation coefficient: Σg1, Σ(g1 − ḡ1)²
     g1_mean = g1.mean(axis=1, dtype=np.float64)
     g1_q = np.einsum("ij,ij->i", g1, g1, dtype=np.float64) - m * g1_mean**2
-    flags[~(np.sqrt(np.maximum(g1_q, 0.0) / m) >= min_contrast)] |= FLAG_TEXTURELESS
-    iters = np.zeros(n, np.int16)
-    converged = np.zeros(n, bool)
-    last_N = np.zeros((n, u, u))
-    last_vv = np.full(n, np.nan)
-    last_corr = np.zeros(n)
+    flags[~(np.sqrt(np.maximum(g1_q, 0.0) / m) >= cfg.min_contrast)] |= FLAG_TEXTURELESS
     active = np.flatnonzero(flags == 0)
-    tol_lin = tol_shift / max(half, 1)
-    smin, smax = scale_range
-    cmin, cmax = contrast_range
+    ch = _Chunk(p0, p0.copy(), flags, g1_mean, g1_q, np.zeros(n, np.int16), np.zeros(n, bool),
+                np.zeros((n, cfg.u, cfg.u)), np.full(n, np.nan), np.zeros(n), active, active,
+                g1[active])
+    if cfg.jacobian == "template":
+        ch.A0t, ch.N0 = _template_jacobian(ge1[active], ch.g1c, _grid(half), m)
+    return ch
 
-    # compacted per-point arrays: row k belongs to point loc[k]
-    loc = active
-    g1c = g1[loc]
-    if jacobian == "template":
-        # A0: the Jacobian columns built from the template itself (fixed over the iterations);
-        # the current Jacobian is A0·T(p), so only A0ᵀΔg has to be formed per iteration.
-        ge1a = ge1[loc]
-        t_xi = (0.5 * (ge1a[:, 1:-1, 2:] - ge1a[:, 1:-1, :-2])).reshape(-1, m)
-        t_eta = (0.5 * (ge1a[:, 2:, 1:-1] - ge1a[:, :-2, 1:-1])).reshape(-1, m)
-        del ge1a
-        A0t = np.empty((len(loc), 8, m), np.float32)  # (n, 8, m): Jacobian transposed
-        A0t[:, 0], A0t[:, 3] = t_xi, t_eta
-        np.multiply(t_xi, xi, out=A0t[:, 1])
-        np.multiply(t_xi, eta, out=A0t[:, 2])
-        np.multiply(t_eta, xi, out=A0t[:, 4])
-        np.multiply(t_eta, eta, out=A0t[:, 5])
-        A0t[:, 6] = 1.0
-        A0t[:, 7] = g1c
-        del t_xi, t_eta
-        N0 = np.matmul(A0t, A0t.transpose(0, 2, 1)).astype(np.float64)
-    del ge1
 
-    for it in range(max_iter):
-        if active.size == 0:
-            break
-        if len(active) < len(loc):  # compact to the points still iterating
-            keep = np.searchsorted(loc, active)
-            g1c = g1c[keep]
-            if jacobian == "template":
-                A0t, N0 = A0t[keep], N0[keep]
-            loc = active
-        pa = p[active]
-        a1, a2 = pa[:, 1:2], pa[:, 2:3]
-        b1, b2 = pa[:, 4:5], pa[:, 5:6]
-        r0, r1 = pa[:, 6:7], pa[:, 7:8]
-        det = a1 * b2 - a2 * b1
-        inv_det = 1.0 / np.where(np.abs(det) > 1e-6, det, 1e-6)
-        if jacobian == "template":
-            g2, ins = _affine_sampler(flat, width, height, pa, grid, half)
-            outside = ~ins
-            resid = g2
-            resid *= -r1.astype(np.float32)
-            resid -= r0.astype(np.float32)
-            resid += g1c  # Δg = g1 − (r0 + r1·g2), in place of g2
-            bfull = np.matmul(A0t, resid[:, :, None])[:, :, 0].astype(np.float64)
-            s_res, s_g1res = bfull[:, 6], bfull[:, 7]  # Σ Δg, Σ g1·Δg (columns 1 and g1)
-            # r1·(gx, gy) ≈ J⁻ᵀ (∂g1/∂ξ, ∂g1/∂η) and g2 ≈ (g1 − r0)/r1  →  A = A0·T
-            c00, c01 = b2[:, 0] * inv_det[:, 0], -b1[:, 0] * inv_det[:, 0]
-            c10, c11 = -a2[:, 0] * inv_det[:, 0], a1[:, 0] * inv_det[:, 0]
-            T = np.zeros((len(active), 8, 8))
-            for j in range(3):  # geometric columns: a_j from (ξ-part j, η-part j+3)
-                T[:, j, j], T[:, j + 3, j] = c00, c01
-                T[:, j, j + 3], T[:, j + 3, j + 3] = c10, c11
-            T[:, 6, 6] = 1.0
-            T[:, 7, 7] = 1.0 / r1[:, 0]
-            T[:, 6, 7] = -r0[:, 0] / r1[:, 0]
-            T = T[:, :, idx]
-            N = np.matmul(T.transpose(0, 2, 1), np.matmul(N0, T))
-            b = np.matmul(bfull[:, None, :], T)[:, 0]
-        else:
-            # resample the extended search window (one extra pixel for the gradients)
-            ge, ins = _affine_sampler(flat, width, height, pa, grid_e, half + 1)
-            outside = ~ins
-            ge = ge.reshape(-1, size + 2, size + 2)
-            na = len(active)
-            At = np.empty((na, u, m), np.float32)  # Jacobian transposed, filled row by row
-            g2 = ge[:, 1:-1, 1:-1]
-            # window differences along ξ and η (central differences = half of these)
-            dxi = (ge[:, 1:-1, 2:] - ge[:, 1:-1, :-2]).reshape(na, m)
-            deta = (ge[:, 2:, 1:-1] - ge[:, :-2, 1:-1]).reshape(na, m)
-            # ∂g/∂ξ = gx·a1 + gy·b1, ∂g/∂η = gx·a2 + gy·b2  →  solve for (gx, gy), times r1
-            f = 0.5 * inv_det * r1
-            for j0, own, c_own, other, c_other in ((0, dxi, b2 * f, deta, -b1 * f),
-                                                   (3, deta, a1 * f, dxi, -a2 * f)):
-                if j0 not in idx:
-                    continue
-                k = idx.index(j0)
-                g = np.multiply(own, c_own.astype(np.float32), out=At[:, k])
-                if np.any(c_other != 0):  # zero for the rows of epipolar images
-                    g += other * c_other.astype(np.float32)
-                for j, w in ((j0 + 1, xi), (j0 + 2, eta)):
-                    if j in idx:
-                        np.multiply(g, w, out=At[:, idx.index(j)])
-            At[:, idx.index(6)] = 1.0
-            g2_rows = At[:, idx.index(7)]
-            g2_rows.reshape(na, size, size)[...] = g2
-            resid = np.multiply(g2_rows, -r1.astype(np.float32))
-            resid -= r0.astype(np.float32)
-            resid += g1c  # Δg = g1 − (r0 + r1·g2)
-            g2 = g2_rows
-            N = np.matmul(At, At.transpose(0, 2, 1)).astype(np.float64)
-            b = np.matmul(At, resid[:, :, None])[:, :, 0].astype(np.float64)
-            s_res = b[:, idx.index(6)]
-            s_g1res = np.einsum("ij,ij->i", g1c, resid).astype(np.float64)
-        # Jacobi-scaled normal matrix for a scale-free singularity test (first iteration only in
-        # the template mode, where N changes only by the small transformation T)
-        d = np.sqrt(np.maximum(np.einsum("nii->ni", N), 1e-30))
-        Ns = N / (d[:, :, None] * d[:, None, :])
-        if it == 0 or jacobian != "template":
-            singular = _singular(Ns)
-        else:
-            singular = np.zeros(len(active), bool)
-        Ns_safe = np.where(singular[:, None, None], np.eye(u), Ns)
-        dx = np.linalg.solve(Ns_safe, (b / d)[:, :, None])[:, :, 0] / d
-        dx[singular] = 0.0
+def _normals_template(ch: _Chunk, pa: NDArray, inv_det: NDArray, sampler: Tuple,
+                      cfg: _Settings) -> Tuple[NDArray, ...]:
+    """Normal equations N = TᵀN0T, b = Tᵀ(A0ᵀΔg) with the template's gradients.
 
-        # bookkeeping of the state *at* the current parameters (used if this is the last step)
-        last_N[active] = N
-        vv = np.einsum("ij,ij->i", resid, resid).astype(np.float64)
-        last_vv[active] = vv
-        # correlation of g1 and g2 from sums already at hand: g2 = (g1 − r0 − Δg)/r1, so with
-        # centred values (z) ρ = sign(r1)·(q − Σg1zΔg) / sqrt(q·(q − 2Σg1zΔg + Σ(Δg_z)²)),
-        # q = Σ g1z², Σg1zΔg = Σg1Δg − ḡ1ΣΔg, Σ(Δg_z)² = vv − (ΣΔg)²/m
-        q = g1_q[active]
-        s_zr = s_g1res - g1_mean[active] * s_res
-        den2 = q * (q - 2 * s_zr + (vv - s_res**2 / m))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            corr = np.sign(r1[:, 0]) * (q - s_zr) / np.sqrt(np.where(den2 > 0, den2, np.inf))
-        last_corr[active] = np.clip(corr, -1.0, 1.0)
+    r1·(gx, gy) ≈ J⁻ᵀ (∂g1/∂ξ, ∂g1/∂η) and g2 ≈ (g1 − r0)/r1  →  A = A0·T.
+    """
+    flat, width, height, grid, _ = sampler
+    a1, a2 = pa[:, 1:2], pa[:, 2:3]
+    b1, b2 = pa[:, 4:5], pa[:, 5:6]
+    r0, r1 = pa[:, 6:7], pa[:, 7:8]
+    g2, ins = _affine_sampler(flat, width, height, pa, grid, cfg.half)
+    resid = g2
+    resid *= -r1.astype(np.float32)
+    resid -= r0.astype(np.float32)
+    resid += ch.g1c  # Δg = g1 − (r0 + r1·g2), in place of g2
+    bfull = np.matmul(ch.A0t, resid[:, :, None])[:, :, 0].astype(np.float64)
+    s_res, s_g1res = bfull[:, 6], bfull[:, 7]  # Σ Δg, Σ g1·Δg (columns 1 and g1)
+    c00, c01 = b2[:, 0] * inv_det[:, 0], -b1[:, 0] * inv_det[:, 0]
+    c10, c11 = -a2[:, 0] * inv_det[:, 0], a1[:, 0] * inv_det[:, 0]
+    T = np.zeros((len(pa), 8, 8))
+    for j in range(3):  # geometric columns: a_j from (ξ-part j, η-part j+3)
+        T[:, j, j], T[:, j + 3, j] = c00, c01
+        T[:, j, j + 3], T[:, j + 3, j + 3] = c10, c11
+    T[:, 6, 6] = 1.0
+    T[:, 7, 7] = 1.0 / r1[:, 0]
+    T[:, 6, 7] = -r0[:, 0] / r1[:, 0]
+    T = T[:, :, cfg.idx]
+    N = np.matmul(T.transpose(0, 2, 1), np.matmul(ch.N0, T))
+    b = np.matmul(bfull[:, None, :], T)[:, 0]
+    return N, b, resid, ~ins, s_res, s_g1res
 
-        full = np.zeros((len(active), 8))
-        full[:, idx] = dx
-        pn = pa + full
-        iters[active] = it + 1
-        # failure tests
-        bad = np.zeros(len(active), np.uint8)
-        bad[outside] |= FLAG_OUTSIDE
-        bad[singular] |= FLAG_SINGULAR
-        drift = np.hypot(pn[:, 0] - p0[active, 0], pn[:, 3] - p0[active, 3])
-        det_n = pn[:, 1] * pn[:, 5] - pn[:, 2] * pn[:, 4]
-        fro = pn[:, 1] ** 2 + pn[:, 2] ** 2 + pn[:, 4] ** 2 + pn[:, 5] ** 2
-        # singular values of the 2×2 affine: s² = (fro ± sqrt(fro² − 4 det²)) / 2
-        disc = np.sqrt(np.maximum(fro * fro - 4 * det_n * det_n, 0.0))
-        s_hi = np.sqrt(0.5 * (fro + disc))
-        s_lo = np.sqrt(np.maximum(0.5 * (fro - disc), 0.0))
-        implausible = ((drift > max_shift) | (s_hi > smax) | (s_lo < smin) | (det_n <= 0)
-                       | (pn[:, 7] < cmin) | (pn[:, 7] > cmax) | ~np.isfinite(pn).all(axis=1))
-        bad[implausible & ~singular & ~outside] |= FLAG_DIVERGED
-        ok = bad == 0
-        p[active[ok]] = pn[ok]
-        flags[active] |= bad
-        done = ok & (np.abs(dx[:, 0]) < tol_shift)
-        done &= np.abs(full[:, 3]) < tol_shift
-        done &= (np.abs(full[:, [1, 2, 4, 5]]) < tol_lin).all(axis=1)
-        converged[active[done]] = True
-        active = active[ok & ~done]
 
-    flags[(flags == 0) & ~converged] |= FLAG_NOT_CONVERGED
-    # precision from the last normal matrix: Σ = σ0² N⁻¹
-    m_red = m - u
-    sigma0 = np.sqrt(last_vv / max(m_red, 1))
+def _normals_search(ch: _Chunk, pa: NDArray, inv_det: NDArray, sampler: Tuple,
+                    cfg: _Settings) -> Tuple[NDArray, ...]:
+    """Normal equations with the gradients of the resampled search window (classic form).
+
+    The extended search window (one extra pixel for the gradients) is resampled;
+    ∂g/∂ξ = gx·a1 + gy·b1, ∂g/∂η = gx·a2 + gy·b2 are solved for (gx, gy), times r1.
+    """
+    flat, width, height, grid, grid_e = sampler
+    idx, half, m, u = cfg.idx, cfg.half, cfg.m, cfg.u
+    size = 2 * half + 1
+    xi, eta = grid
+    a1, a2 = pa[:, 1:2], pa[:, 2:3]
+    b1, b2 = pa[:, 4:5], pa[:, 5:6]
+    r0, r1 = pa[:, 6:7], pa[:, 7:8]
+    ge, ins = _affine_sampler(flat, width, height, pa, grid_e, half + 1)
+    ge = ge.reshape(-1, size + 2, size + 2)
+    na = len(pa)
+    At = np.empty((na, u, m), np.float32)  # Jacobian transposed, filled row by row
+    g2 = ge[:, 1:-1, 1:-1]
+    # window differences along ξ and η (central differences = half of these)
+    dxi = (ge[:, 1:-1, 2:] - ge[:, 1:-1, :-2]).reshape(na, m)
+    deta = (ge[:, 2:, 1:-1] - ge[:, :-2, 1:-1]).reshape(na, m)
+    f = 0.5 * inv_det * r1
+    for j0, own, c_own, other, c_other in ((0, dxi, b2 * f, deta, -b1 * f),
+                                           (3, deta, a1 * f, dxi, -a2 * f)):
+        if j0 not in idx:
+            continue
+        k = idx.index(j0)
+        g = np.multiply(own, c_own.astype(np.float32), out=At[:, k])
+        if np.any(c_other != 0):  # zero for the rows of epipolar images
+            g += other * c_other.astype(np.float32)
+        for j, w in ((j0 + 1, xi), (j0 + 2, eta)):
+            if j in idx:
+                np.multiply(g, w, out=At[:, idx.index(j)])
+    At[:, idx.index(6)] = 1.0
+    g2_rows = At[:, idx.index(7)]
+    g2_rows.reshape(na, size, size)[...] = g2
+    resid = np.multiply(g2_rows, -r1.astype(np.float32))
+    resid -= r0.astype(np.float32)
+    resid += ch.g1c  # Δg = g1 − (r0 + r1·g2)
+    N = np.matmul(At, At.transpose(0, 2, 1)).astype(np.float64)
+    b = np.matmul(At, resid[:, :, None])[:, :, 0].astype(np.float64)
+    s_res = b[:, idx.index(6)]
+    s_g1res = np.einsum("ij,ij->i", ch.g1c, resid).astype(np.float64)
+    return N, b, resid, ~ins, s_res, s_g1res
+
+
+def _solve(N: NDArray, b: NDArray, test_singular: bool) -> Tuple[NDArray, NDArray]:
+    """Increments dx of the Jacobi-scaled normal equations and the singular systems.
+
+    The scaling makes the singularity test scale-free; in the template mode it runs in the
+    first iteration only, where N changes only by the small transformation T.
+    """
+    u = N.shape[-1]
+    d = np.sqrt(np.maximum(np.einsum("nii->ni", N), 1e-30))
+    Ns = N / (d[:, :, None] * d[:, None, :])
+    if test_singular:
+        singular = _singular(Ns)
+    else:
+        singular = np.zeros(len(N), bool)
+    Ns_safe = np.where(singular[:, None, None], np.eye(u), Ns)
+    dx = np.linalg.solve(Ns_safe, (b / d)[:, :, None])[:, :, 0] / d
+    dx[singular] = 0.0
+    return dx, singular
+
+
+def _correlation(ch: _Chunk, r1: NDArray, vv: NDArray, s_res: NDArray, s_g1res: NDArray,
+                 m: int) -> NDArray:
+    """ρ(g1, g2) from sums already at hand.
+
+    g2 = (g1 − r0 − Δg)/r1, so with centred values (z) ρ = sign(r1)·(q − Σg1zΔg) /
+    sqrt(q·(q − 2Σg1zΔg + Σ(Δg_z)²)), q = Σ g1z², Σg1zΔg = Σg1Δg − ḡ1ΣΔg,
+    Σ(Δg_z)² = vv − (ΣΔg)²/m.
+    """
+    q = ch.g1_q[ch.active]
+    s_zr = s_g1res - ch.g1_mean[ch.active] * s_res
+    den2 = q * (q - 2 * s_zr + (vv - s_res**2 / m))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.sign(r1[:, 0]) * (q - s_zr) / np.sqrt(np.where(den2 > 0, den2, np.inf))
+    return np.clip(corr, -1.0, 1.0)
+
+
+def _failures(ch: _Chunk, pn: NDArray, outside: NDArray, singular: NDArray,
+              cfg: _Settings) -> NDArray:
+    """Failure bits of the step to ``pn``: outside, singular, or diverged (drift beyond the
+    pull-in, implausible affine singular values or contrast, non-finite)."""
+    smin, smax = cfg.scale_range
+    cmin, cmax = cfg.contrast_range
+    active, p0 = ch.active, ch.p0
+    bad = np.zeros(len(active), np.uint8)
+    bad[outside] |= FLAG_OUTSIDE
+    bad[singular] |= FLAG_SINGULAR
+    drift = np.hypot(pn[:, 0] - p0[active, 0], pn[:, 3] - p0[active, 3])
+    det_n = pn[:, 1] * pn[:, 5] - pn[:, 2] * pn[:, 4]
+    fro = pn[:, 1] ** 2 + pn[:, 2] ** 2 + pn[:, 4] ** 2 + pn[:, 5] ** 2
+    # singular values of the 2×2 affine: s² = (fro ± sqrt(fro² − 4 det²)) / 2
+    disc = np.sqrt(np.maximum(fro * fro - 4 * det_n * det_n, 0.0))
+    s_hi = np.sqrt(0.5 * (fro + disc))
+    s_lo = np.sqrt(np.maximum(0.5 * (fro - disc), 0.0))
+    implausible = ((drift > cfg.max_shift) | (s_hi > smax) | (s_lo < smin) | (det_n <= 0)
+                   | (pn[:, 7] < cmin) | (pn[:, 7] > cmax) | ~np.isfinite(pn).all(axis=1))
+    bad[implausible & ~singular & ~outside] |= FLAG_DIVERGED
+    return bad
+
+
+def _iterate(ch: _Chunk, it: int, sampler: Tuple, cfg: _Settings) -> None:
+    """One Gauss–Newton step of the active points; records the state at the current
+    parameters (used if this is the last step), moves the good ones, retires the rest."""
+    ch.compact()
+    active = ch.active
+    pa = ch.p[active]
+    a1, a2 = pa[:, 1:2], pa[:, 2:3]
+    b1, b2 = pa[:, 4:5], pa[:, 5:6]
+    det = a1 * b2 - a2 * b1
+    inv_det = 1.0 / np.where(np.abs(det) > 1e-6, det, 1e-6)
+    template = cfg.jacobian == "template"
+    normals = _normals_template if template else _normals_search
+    N, b, resid, outside, s_res, s_g1res = normals(ch, pa, inv_det, sampler, cfg)
+    dx, singular = _solve(N, b, it == 0 or not template)
+    ch.last_normal[active] = N
+    vv = np.einsum("ij,ij->i", resid, resid).astype(np.float64)
+    ch.last_vv[active] = vv
+    ch.last_corr[active] = _correlation(ch, pa[:, 7:8], vv, s_res, s_g1res, cfg.m)
+    full = np.zeros((len(active), 8))
+    full[:, cfg.idx] = dx
+    pn = pa + full
+    ch.iters[active] = it + 1
+    bad = _failures(ch, pn, outside, singular, cfg)
+    ok = bad == 0
+    ch.p[active[ok]] = pn[ok]
+    ch.flags[active] |= bad
+    tol_lin = cfg.tol_shift / max(cfg.half, 1)
+    done = ok & (np.abs(dx[:, 0]) < cfg.tol_shift)
+    done &= np.abs(full[:, 3]) < cfg.tol_shift
+    done &= (np.abs(full[:, [1, 2, 4, 5]]) < tol_lin).all(axis=1)
+    ch.converged[active[done]] = True
+    ch.active = active[ok & ~done]
+
+
+def _finish_chunk(ch: _Chunk, cfg: _Settings, out: dict, sl: slice) -> None:
+    """Precision Σ = σ0² N⁻¹ from the last normal matrix, final flags; into ``out[sl]``."""
+    flags, idx, u = ch.flags, cfg.idx, cfg.u
+    n = flags.size
+    flags[(flags == 0) & ~ch.converged] |= FLAG_NOT_CONVERGED
+    m_red = cfg.m - u
+    sigma0 = np.sqrt(ch.last_vv / max(m_red, 1))
     have = np.isfinite(sigma0) & ((flags & (FLAG_SINGULAR | FLAG_OUTSIDE | FLAG_TEXTURELESS)) == 0)
     cov = np.full((n, u, u), np.nan)
     if have.any():
-        Nh = last_N[have]
+        Nh = ch.last_normal[have]
         d = np.sqrt(np.maximum(np.einsum("nii->ni", Nh), 1e-30))
         Qs = np.linalg.inv(Nh / (d[:, :, None] * d[:, None, :]))
         Q = Qs / (d[:, :, None] * d[:, None, :])
@@ -574,14 +666,31 @@ def _lsm_chunk(tpl, srch, cols, rows, p0, idx, half, max_iter, tol_shift, max_sh
     pos_c = idx.index(0)
     sig_c = np.sqrt(cov[:, pos_c, pos_c])
     sig_r = np.sqrt(cov[:, idx.index(3), idx.index(3)]) if 3 in idx else np.zeros(n)
-    flags[(flags == 0) & (last_corr < min_corr)] |= FLAG_LOW_CORRELATION
-    flags[(flags == 0) & ~(np.maximum(sig_c, sig_r) <= max_sigma)] |= FLAG_HIGH_SIGMA
-
-    out["params"][sl] = p
+    flags[(flags == 0) & (ch.last_corr < cfg.min_corr)] |= FLAG_LOW_CORRELATION
+    flags[(flags == 0) & ~(np.maximum(sig_c, sig_r) <= cfg.max_sigma)] |= FLAG_HIGH_SIGMA
+    out["params"][sl] = ch.p
     out["sigma0"][sl] = sigma0
     out["sig_c"][sl] = sig_c
     out["sig_r"][sl] = sig_r
     out["cov"][sl] = cov
-    out["corr"][sl] = last_corr
-    out["iters"][sl] = iters
+    out["corr"][sl] = ch.last_corr
+    out["iters"][sl] = ch.iters
     out["flags"][sl] = flags
+
+
+def _lsm_chunk(tpl: NDArray, srch: NDArray, cols: NDArray, rows: NDArray, p0: NDArray,
+               cfg: _Settings, out: dict, sl: slice) -> None:
+    """Gauss–Newton for one chunk of points; writes into ``out[...][sl]``.
+
+    Per-point arrays (template, Jacobian, normal matrix) are kept compacted to the points still
+    iterating, so converged and failed points cost nothing in later iterations.
+    """
+    height, width = srch.shape
+    # the image flattened for the sampler, the window grid and the one-pixel-larger grid
+    sampler = (srch.ravel(), width, height, _grid(cfg.half), _grid(cfg.half + 1))
+    ch = _start_chunk(tpl, cols, rows, p0, cfg)
+    for it in range(cfg.max_iter):
+        if ch.active.size == 0:
+            break
+        _iterate(ch, it, sampler, cfg)
+    _finish_chunk(ch, cfg, out, sl)

@@ -32,7 +32,10 @@ from pathlib import Path
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.patches import Patch
 from numpy.typing import NDArray
+from rasterio.features import rasterize
 
 from ..feedback import Feedback, ensure_feedback
 from ..jsonable import json_ready
@@ -274,8 +277,6 @@ def _excluded_mask(geoms: Optional[Sequence[Any]], transform: Any,
     shapes = [(g, 1) for g in (geoms or []) if g is not None and not g.is_empty]
     if not shapes:
         return None
-    from rasterio.features import rasterize
-
     return rasterize(shapes, out_shape=shape, transform=transform, fill=0,
                      dtype="uint8").astype(bool)
 
@@ -284,9 +285,6 @@ def figure_coverage(dsm: PathLike, count: Optional[PathLike] = None,
                     exclusions: Optional[Sequence[Any]] = None,
                     max_pixels: int = MAP_PIXELS) -> Tuple[Any, Dict[str, float]]:
     """Coverage map and the share (%) of each class."""
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    from matplotlib.patches import Patch
-
     z, transform, _ = read_decimated(dsm, max_pixels=max_pixels)
     cnt = None
     if count is not None and Path(count).is_file():

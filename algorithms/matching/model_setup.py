@@ -18,9 +18,14 @@ from pathlib import Path
 from typing import Any, List, Optional
 
 import numpy as np
+from shapely.geometry import Point, Polygon
+from shapely.ops import unary_union
 
 from ..errors import GeometryError, InputError
 from ..geometry.epipolar import EpipolarPair
+from ..geometry.projection import border_at_height
+from ..project.edits import read_constraints
+from ..project.model import Project
 from ..surface.gridding import Grid
 from .dense import check_disparity_range
 
@@ -55,8 +60,6 @@ class ModelSetup:
 
     def measuring_area(self) -> Any:
         """The stereo overlap at the mid height, inside the boundaries."""
-        from shapely.ops import unary_union
-
         area = self.overlap
         if self.boundaries:
             area = area.intersection(unary_union(self.boundaries))
@@ -65,10 +68,6 @@ class ModelSetup:
 
 def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
     """Image footprint polygon on the plane Z = ``height``."""
-    from shapely.geometry import Polygon
-
-    from ..geometry.projection import border_at_height
-
     pts = border_at_height(cam, eo, height, n)
     ok = np.isfinite(pts).all(axis=1)
     if ok.sum() < 3:
@@ -86,8 +85,6 @@ def check_breaklines(lines: List[Any]) -> None:
     InputError
         Naming the two lines (1-based, in the order of the layer) and the crossing point.
     """
-    from shapely.geometry import Point
-
     def ends(line: Any) -> List[Any]:
         return [Point(line.coords[0]), Point(line.coords[-1])]
 
@@ -135,11 +132,6 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     InputError, GeometryError
         Bad height range, spacing, boundaries, crossing breaklines; images that do not overlap.
     """
-    from shapely.ops import unary_union
-
-    from ..project.edits import read_constraints
-    from ..project.model import Project
-
     if not isinstance(project, Project):
         project = Project.load(project)
     m = project.model(model)

@@ -2,49 +2,18 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
-from typing import Any, Dict, Optional, Tuple
-
-import numpy as np
+from typing import Any, Dict, Optional
 
 from ...errors import InputError
 from ...feedback import Feedback
-from ...matching.dense import METHODS, GreySource, iter_disparity_tiles
-from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
-from ...raster.io import atomic_output, gtiff_profile, open_image
+from ...matching.dense import METHODS
+from ...matching.disparity_run import run_stereo_disparity
+from ...matching.presets import DEFAULT_PRESET, PRESET_NAMES
 from ..spec import Algorithm, Output, Parameter, model_product
 
 GROUP = "Matching"
 GROUP_ID = "matching"
-
-
-def _grey_source(src: Any) -> Tuple[GreySource, Tuple[int, int]]:
-    """Window reader of a rasterio dataset: mean of the colour bands, NaN where masked.
-
-    The mask is GDAL's (alpha band, nodata value or internal mask): 0 → no data.
-    """
-    from rasterio.enums import ColorInterp
-    from rasterio.windows import Window
-
-    interp = list(src.colorinterp)
-    bands = [i + 1 for i, c in enumerate(interp) if c != ColorInterp.alpha] or [1]
-    bands = bands[:3]
-    h, w = src.height, src.width
-
-    def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
-        out = np.full((r1 - r0, c1 - c0), np.nan, np.float32)
-        rr0, rr1, cc0, cc1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
-        if rr1 <= rr0 or cc1 <= cc0:
-            return out
-        win = Window(cc0, rr0, cc1 - cc0, rr1 - rr0)
-        grey = src.read(bands, window=win).astype(np.float32).mean(axis=0)
-        mask = src.read_masks(bands[0], window=win) == 0
-        grey[mask | ~np.isfinite(grey)] = np.nan
-        out[rr0 - r0:rr1 - r0, cc0 - c0:cc1 - c0] = grey
-        return out
-
-    return read, (h, w)
 
 
 class StereoDisparity(Algorithm):
@@ -99,52 +68,13 @@ class StereoDisparity(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        out_path = params["output"]
-        if not str(out_path).lower().endswith((".tif", ".tiff")):
-            raise InputError(f"The output '{out_path}' must be a GeoTIFF (.tif).")
-        if int(params["max_disparity"]) < int(params["min_disparity"]):
-            raise InputError("max_disparity must not be smaller than min_disparity.")
-        if params["block_size"] % 2 == 0:
-            raise InputError(f"Parameter 'block_size' = {params['block_size']} px must be odd "
-                             "(1, 3, 5 … 11): the window needs a centre pixel.")
-        with open_image(params["left"]) as src_l, open_image(params["right"]) as src_r:
-            if src_l.height != src_r.height:
-                feedback.warning(f"The images have {src_l.height} and {src_r.height} rows; "
-                                 "rows are matched by index (epipolar images share rows).")
-            left, shape_l = _grey_source(src_l)
-            right, shape_r = _grey_source(src_r)
-            h, w = shape_l
-            profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), predictor=3)
-            if src_l.crs is not None:  # keep a georeference if the left image has one
-                profile.update(crs=src_l.crs, transform=src_l.transform)
-            n_valid, d_min, d_max = 0, math.inf, -math.inf
-            with atomic_output(out_path) as tmp, open_image(tmp, "w", **profile) as dst:
-                from rasterio.windows import Window
-
-                tiles = iter_disparity_tiles(
-                    left, right, shape_l, shape_r, params["min_disparity"],
-                    params["max_disparity"], method=params["method"],
-                    block_size=params["block_size"], p1=params.get("p1"), p2=params.get("p2"),
-                    uniqueness=params["uniqueness"], lr_max_diff=params["lr_max_diff"],
-                    fill_max_width=params["fill_max_width"],
-                    max_memory_mb=params["memory_mb"], feedback=feedback)
-                for r0, c0, block in tiles:
-                    dst.write(block[None], window=Window(c0, r0, block.shape[1],
-                                                         block.shape[0]))
-                    ok = np.isfinite(block)
-                    if ok.any():
-                        n_valid += int(ok.sum())
-                        d_min = min(d_min, float(block[ok].min()))
-                        d_max = max(d_max, float(block[ok].max()))
-        share = n_valid / float(max(h * w, 1))
-        feedback.info(f"Disparity for {100.0 * share:.1f} % of the pixels.")
-        return {
-            "disparity": str(out_path),
-            "valid_share": share,
-            "min": d_min if n_valid else None,
-            "max": d_max if n_valid else None,
-        }
-
+        return run_stereo_disparity(
+            params["left"], params["right"], params["output"],
+            min_disparity=params["min_disparity"], max_disparity=params["max_disparity"],
+            method=params["method"], block_size=params["block_size"], p1=params.get("p1"),
+            p2=params.get("p2"), uniqueness=params["uniqueness"],
+            lr_max_diff=params["lr_max_diff"], fill_max_width=params["fill_max_width"],
+            memory_mb=params["memory_mb"], feedback=feedback)
 
 
 class MatchModel(Algorithm):

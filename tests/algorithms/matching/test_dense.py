@@ -15,6 +15,11 @@ from photodem.algorithms.matching.dense import (
     fill_holes_rows,
     sgm_disparity,
 )
+from photodem.algorithms.matching.disparity_run import (
+    DisparityStats,
+    grey_source,
+    run_stereo_disparity,
+)
 from photodem.algorithms.processing import registry
 from photodem.algorithms.raster.io import open_image, write_raster
 
@@ -237,6 +242,38 @@ def test_algorithm_through_registry(pair, tmp_path) -> None:
     assert 0.8 < res["valid_share"] <= 1.0
     assert 0.0 <= res["min"] < 10.0 and 16.0 < res["max"] <= 31.0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["disp.tif", "left.tif", "right.tif"]
+
+
+def test_domain_function_matches_the_declaration(pair, tmp_path) -> None:
+    """run_stereo_disparity is the orchestration; the declaration only passes parameters."""
+    left, right = _write_pair(tmp_path, pair)
+    small = tmp_path / "small.tif"
+    res = run_stereo_disparity(left, right, small, min_disparity=0, max_disparity=31,
+                               memory_mb=16.0)  # several tiles
+    via = registry.run("stereo_disparity", {"left": left, "right": right, "min_disparity": 0,
+                                            "max_disparity": 31, "memory_mb": 16.0,
+                                            "output": str(tmp_path / "via.tif")})
+    with open_image(small) as a, open_image(via["disparity"]) as b:
+        assert np.array_equal(a.read(1), b.read(1), equal_nan=True)
+    assert res["disparity"] == str(small)
+    assert {k: res[k] for k in ("valid_share", "min", "max")} == {
+        k: via[k] for k in ("valid_share", "min", "max")}
+    with open_image(left) as src:  # colour mean, NaN where the alpha band is 0
+        read, shape = grey_source(src)
+        win = read(-2, 3, 18, 23)
+    assert shape == (H, W) and win.shape == (5, 5)
+    assert np.isnan(win[:2]).all() and np.isnan(win[2:, :2]).all()
+    assert np.isfinite(win[2:, 2:]).all()
+    stats = DisparityStats()
+    stats.add(np.array([[np.nan, 2.5], [-1.0, np.nan]], np.float32))
+    assert (stats.n_valid, stats.d_min, stats.d_max) == (2, -1.0, 2.5)
+    for bad in ({"output": tmp_path / "x.png"}, {"min_disparity": 5, "max_disparity": 4},
+                {"block_size": 4}):
+        kw = dict({"output": tmp_path / "x.tif", "min_disparity": 0, "max_disparity": 31},
+                  **bad)
+        with pytest.raises(InputError):
+            run_stereo_disparity(left, right, **kw)
+    assert not (tmp_path / "x.tif").exists()
 
 
 def test_cancel_leaves_no_output(pair, tmp_path) -> None:

@@ -179,7 +179,7 @@ def test_surface_smoothing_refers_to_the_default_spacing(started, tmp_path,
                                                          monkeypatch) -> None:
     """A DSM asked for at another spacing gets the preset's smoothing for cells of the default
     spacing (2 GSD), so a coarser DSM is not also a smoother one."""
-    import photodem.algorithms.surface.fe_grid as fe_grid
+    import photodem.algorithms.matching.fbm_model as fbm_model
 
     seen = {}
 
@@ -190,7 +190,7 @@ def test_surface_smoothing_refers_to_the_default_spacing(started, tmp_path,
         seen.update(kwargs, spacing=args[3].spacing)
         raise Stop
 
-    monkeypatch.setattr(fe_grid, "fe_interpolate", capture)
+    monkeypatch.setattr(fbm_model, "fe_interpolate", capture)
     gsd = prepare_model(started, MODEL).gsd
     with pytest.raises(Stop):
         match_model_fbm_lsm(started, MODEL, tmp_path / "s", spacing=4.0 * gsd)

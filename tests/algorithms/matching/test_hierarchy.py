@@ -16,9 +16,9 @@ from photodem.algorithms.matching.hierarchy import (
     FLAG_LSM,
     FLAG_LSM_FAILED,
     FbmLsmOptions,
-    _suspect_components,
     match_epipolar_fbm_lsm,
 )
+from photodem.algorithms.matching.prediction import suspect_components
 
 H = W = 480
 
@@ -295,8 +295,8 @@ def test_suspect_components_majority_of_neighbours():
     plane[:, 1] = 0.05 * 32  # its slope in window units
     plane[12, 0] += 5.0  # the centre window is wrong by 5 px
     matched = np.ones(grp.n_groups, bool)
-    sus = _suspect_components(plane, grp, matched, matched, 2.0)
+    sus = suspect_components(plane, grp, matched, matched, 2.0)
     assert sus.tolist() == [k == 12 for k in range(grp.n_groups)]
     # a corner window with only 2 matched neighbours is never judged
     plane[0, 0] += 5.0
-    assert not _suspect_components(plane, grp, matched, matched, 2.0)[0]
+    assert not suspect_components(plane, grp, matched, matched, 2.0)[0]
