@@ -100,11 +100,22 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
+from rasterio.enums import ColorInterp
+from rasterio.windows import Window
+from scipy import ndimage, sparse
+from scipy.sparse.linalg import splu
 
+from ..crs_check import check_surface_crs
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, ensure_feedback
+from ..geometry.orientation import ExteriorOrientation
 from ..geometry.projection import world_to_pixel
+from ..linalg import CG_OBJECT_SPACE, dot_pairwise, jacobi, pcg
+from ..project.edits import read_constraints
+from ..project.model import Project
+from ..raster.io import gtiff_profile, open_image, staged_folder
+from ..raster.sample import bilinear_grid, world_to_grid
+from ..surface.gridding import Grid, polygon_mask
 from .pyramid import build_pyramid, to_level
 
 PathLike = Union[str, Path]
@@ -122,15 +133,12 @@ VIS_MARGIN = 2
 REJECT_K = 4.0
 #: Ridge on the grey-value unknowns, relative to the median grey diagonal of AᵀA.
 GREY_RIDGE = 1e-3
+#: Relative residual and iteration limit of the conjugate gradients per Gauss–Newton step.
+CG_TOL = 1e-6
+CG_MAX_ITER = 2000
 
 
 # -- small numerical helpers -------------------------------------------------------------------
-def _dot(a: Array, b: Array) -> float:
-    """Σ a·b by numpy's pairwise summation: bit-identical in every process (BLAS ``ddot``
-    kernels are not, and CG iteration counts would follow)."""
-    return float(np.sum(a * b))
-
-
 def _noblas(eo: Any) -> Any:
     """A copy of an orientation whose rotation matrix is a strided view.
 
@@ -139,40 +147,9 @@ def _noblas(eo: Any) -> Any:
     loaded first and sum in another order; the last-bit differences would flip convergence
     decisions, and the product must be the same in every face (Python, CLI, QGIS).
     """
-    from ..geometry.orientation import ExteriorOrientation
 
     rot = np.repeat(np.asarray(eo.rotation, dtype=float), 2, axis=1)[:, ::2]
     return ExteriorOrientation(np.array(eo.position, dtype=float), rot)
-
-
-def pcg(N: sparse.csr_matrix, b: Array, tol: float = 1e-6, max_iter: int = 2000
-        ) -> Tuple[Array, int]:
-    r"""Conjugate gradients with the Jacobi preconditioner :math:`M = \mathrm{diag}(N)`.
-
-    Stops when :math:`\|b - Nx\| \le \mathrm{tol}\,\|b\|`. Returns ``(x, iterations)``.
-    """
-    d = N.diagonal()
-    minv = np.where(d > 0, 1.0 / np.where(d > 0, d, 1.0), 1.0)
-    x = np.zeros_like(b)
-    r = b.copy()
-    limit = tol * tol * _dot(b, b)
-    if limit == 0.0:
-        return x, 0
-    z = minv * r
-    p = z.copy()
-    rz = _dot(r, z)
-    for it in range(1, max_iter + 1):
-        q = N @ p
-        alpha = rz / _dot(p, q)
-        x += alpha * p
-        r -= alpha * q
-        if _dot(r, r) <= limit:
-            return x, it
-        z = minv * r
-        rz_new = _dot(r, z)
-        p = z + (rz_new / rz) * p
-        rz = rz_new
-    return x, max_iter
 
 
 def _bilinear_index(u: Array, n: int) -> Tuple[Array, Array]:
@@ -210,15 +187,11 @@ def _sample_stack(stack: NDArray, col: Array, row: Array, margin: float = 1.0
 
 def _prolong(nodes: Array, r: Array, c: Array) -> Array:
     """Bilinear interpolation of a node grid at fractional (row, col) node coordinates."""
-    from scipy import ndimage
-
     return ndimage.map_coordinates(nodes, [r, c], order=1, mode="nearest")
 
 
 def _fill_nearest(z: NDArray) -> NDArray:
     """NaNs replaced by the nearest finite value (for internal use only)."""
-    from scipy import ndimage
-
     bad = ~np.isfinite(z)
     if not bad.any() or bad.all():
         return np.where(bad, 0.0, z)
@@ -262,11 +235,6 @@ class _ImageWindow:
 
 def _read_grey(path: Path, col0: int, row0: int, width: int, height: int) -> NDArray:
     """Grey (mean of the colour bands) of an image window, float32."""
-    from rasterio.enums import ColorInterp
-    from rasterio.windows import Window
-
-    from ..raster.io import open_image
-
     with open_image(path) as src:
         bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
         bands = (bands or [1])[:3]
@@ -428,7 +396,7 @@ def adjust_window(z_in: NDArray, valid: NDArray[np.bool_], x_first: float, y_fir
                                              ow, G, h0, h1, ref, nx * ny, nox * noy)
             n_z, n_unk = nx * ny, A.shape[1]
             in_system = cols_g >= 0
-            s0 = math.sqrt(_dot(obs, obs) / max(obs.size - n_unk, 1))
+            s0 = math.sqrt(dot_pairwise(obs, obs) / max(obs.size - n_unk, 1))
             last = {"A": A, "l": obs, "n_z": n_z, "ny": ny, "nx": nx,
                     "n_rad": 2 * len(rad_cols)}
             if not np.isfinite(s0) or (it > 0 and s0 > 3.0 * prev_s0):
@@ -457,7 +425,8 @@ def adjust_window(z_in: NDArray, valid: NDArray[np.bool_], x_first: float, y_fir
             ridge = np.zeros(n_unk)
             if dg.size:
                 ridge[n_z:n_z + dg.size] = GREY_RIDGE * float(np.median(dg))
-            x, k_cg = pcg((Nd + Nr + sparse.diags(ridge)).tocsr(), b)
+            N = (Nd + Nr + sparse.diags(ridge)).tocsr()
+            x, k_cg = pcg(N, b, jacobi(N), tol=CG_TOL, max_iter=CG_MAX_ITER, rule=CG_OBJECT_SPACE)
             cg_iters.append(k_cg)
             px_per_m = parallax_per_m / 2 ** level
             lim = min(0.2 * st * spacing, 1.0 / max(px_per_m, 1e-9))
@@ -546,8 +515,6 @@ def _erode_visibility(vis: NDArray[np.bool_], ny: int, nx: int, margin: int
     footprint, pyramid smoothing, the gradient stencil), so those samples are not used."""
     if margin <= 0:
         return vis
-    from scipy import ndimage
-
     st = ndimage.generate_binary_structure(2, 2)
     out = np.empty_like(vis)
     for i in range(vis.shape[0]):
@@ -712,8 +679,6 @@ def _precision(last: Dict[str, Any]) -> Tuple[Array, float, NDArray[np.bool_]]:
     .. math:: (N^{-1})_{mm} = (B^{-1})_{mm} + (Y S^{-1} Y^T)_{mm}, \qquad
               \hat x_B = B^{-1}(b_B - C\hat x_D),\; \hat x_D = S^{-1}(b_D - Y^Tb_B)
     """
-    from scipy.sparse.linalg import splu
-
     A, obs, n_z, ny, nx = last["A"], last["l"], last["n_z"], last["ny"], last["nx"]
     n_rad = last["n_rad"]
     N = (A.T @ A).tocsc()
@@ -749,7 +714,7 @@ def _precision(last: Dict[str, Any]) -> Tuple[Array, float, NDArray[np.bool_]]:
     else:
         x_d = np.zeros(0)
         x_b = lu.solve(b_b)
-    vtv = _dot(obs, obs) - _dot(b_b, x_b) - _dot(b_d, x_d)
+    vtv = dot_pairwise(obs, obs) - dot_pairwise(b_b, x_b) - dot_pairwise(b_d, x_d)
     n_obs, n_unk = obs.size, keep.size + n_rad
     sigma0 = math.sqrt(max(vtv, 0.0) / max(n_obs - n_unk, 1))
     node = np.flatnonzero(observed)  # the observed nodes come first in ``keep``
@@ -859,13 +824,6 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     dict
         ``{"dsm", "sigma", "report", "metrics"}``.
     """
-    from rasterio.windows import Window
-
-    from ..project.model import Project
-    from ..raster.io import gtiff_profile, open_image, staged_folder
-    from ..raster.sample import bilinear_grid, world_to_grid
-    from ..surface.gridding import Grid, polygon_mask
-
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
     if regularisation_mode not in MODES:
@@ -891,8 +849,6 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
             raise InputError(f"Image file '{p}' of image '{rec.name}' does not exist; fix its "
                              "path in project.toml.")
     with open_image(dsm) as src:
-        from ..crs_check import check_surface_crs
-
         check_surface_crs(dsm, src.crs, project.crs, "DSM")
         t = src.transform
         if t.b != 0 or t.d != 0 or abs(abs(t.a) - abs(t.e)) > 1e-9 * abs(t.a):
@@ -928,8 +884,6 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     tile = max(int(tile), unit)
     excl, bounds, _lines = ([], [], [])
     if Path(project.edits_path).is_file():
-        from ..project.edits import read_constraints
-
         excl, bounds, _lines = read_constraints(project.edits_path, project.crs or None)
     W, H = out_grid.width, out_grid.height
     tiles = [(r0, c0) for r0 in range(0, H, tile) for c0 in range(0, W, tile)]
@@ -1005,8 +959,6 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
                     rep["rejected_share"] = (round(res.rejected_share, 4)
                                              if np.isfinite(res.rejected_share) else None)
                     if res.ok:
-                        from scipy import ndimage
-
                         rr_, cc_ = np.mgrid[0:nr, 0:nc]
                         coords = [rr_ / stride, cc_ / stride]
                         dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
@@ -1132,4 +1084,4 @@ def _run_tile(recs: Sequence[Any], cams: Dict[str, Any], project: Any, z_in: Arr
                          feedback=feedback)
 
 
-__all__ = ["MODES", "WindowResult", "adjust_window", "pcg", "refine_object_space"]
+__all__ = ["MODES", "WindowResult", "adjust_window", "refine_object_space"]

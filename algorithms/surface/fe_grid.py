@@ -87,9 +87,12 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage, sparse
+from scipy.sparse.linalg import splu
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..linalg import CG_FE, jacobi, pcg
 from .gridding import Grid, polygon_mask
 
 Array = NDArray[Any]
@@ -254,8 +257,6 @@ class _Level:
 
     def normal(self, w: Array) -> Tuple[Any, Array]:
         """Normal matrix (CSR) and right-hand side for the weights ``w`` of the used points."""
-        from scipy import sparse
-
         n = self.n
         diags = {k: d.copy() for k, d in self.R.items()}
         for off, ka, kb in self._pairs:
@@ -277,39 +278,6 @@ class _Level:
         return np.einsum("ij,ij->i", self.vals, x[self.cols])
 
 
-def _dot(a: Array, b: Array) -> float:
-    # einsum, not BLAS: no thread start-up per call on a busy machine (4× faster here)
-    return float(np.einsum("i,i->", a, b))
-
-
-def _pcg(N: Any, b: Array, x: Array, tol: float, maxiter: int,
-         feedback: Feedback) -> Tuple[Array, int]:
-    """Jacobi-preconditioned conjugate gradients from ``x`` until ‖r‖ ≤ tol·‖b‖."""
-    dinv = 1.0 / N.diagonal()
-    r = b - N @ x
-    lim = (tol * tol) * max(_dot(b, b), 1e-300)
-    if _dot(r, r) <= lim:
-        return x, 0
-    zr = dinv * r
-    p = zr.copy()
-    rz = _dot(r, zr)
-    for k in range(1, maxiter + 1):
-        q = N @ p
-        alpha = rz / _dot(p, q)
-        x += alpha * p
-        r -= alpha * q
-        if _dot(r, r) <= lim:
-            return x, k
-        if k % 100 == 0:
-            feedback.check()
-        np.multiply(dinv, r, out=zr)
-        rz_new = _dot(r, zr)
-        p *= rz_new / rz
-        p += zr
-        rz = rz_new
-    return x, maxiter
-
-
 def _block_any(mask: Array) -> Array:
     h, w = mask.shape
     m = np.pad(mask, ((0, h % 2), (0, w % 2)))
@@ -324,8 +292,6 @@ def _block_mean(a: Array) -> Array:
 
 def _prolong(coarse: Array, shape: Tuple[int, int]) -> Array:
     """Bilinear interpolation of a coarse node grid (factor 2) at the fine nodes."""
-    from scipy import ndimage
-
     h, w = shape
     rr = (np.arange(h) + 0.5) / 2.0 - 0.5
     cc = (np.arange(w) + 0.5) / 2.0 - 0.5
@@ -357,8 +323,6 @@ class _TileProblem:
     def solve(self, w: Array, x0: Optional[Array], solver: str, tol: float, maxiter: int,
               feedback: Feedback) -> Tuple[Array, int]:
         """Node heights of level 0 (NaN where not unknown), CG iterations used."""
-        from scipy.sparse.linalg import splu
-
         its = 0
         if solver == "direct":
             lv = self.levels[0]
@@ -368,7 +332,8 @@ class _TileProblem:
         if x0 is not None:  # a warm start (robust iterations): only the finest level
             lv = self.levels[0]
             N, b = lv.normal(w[lv.used])
-            x, its = _pcg(N, b, _nan_nearest(x0).ravel().astype(float), tol, maxiter, feedback)
+            x, its = pcg(N, b, jacobi(N), _nan_nearest(x0).ravel().astype(float), tol=tol,
+                          max_iter=maxiter, rule=CG_FE, feedback=feedback)
             return self._grid(lv, x), its
         grid = None
         for lv in reversed(self.levels):
@@ -377,7 +342,8 @@ class _TileProblem:
                 x = splu(N.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(b)
             else:
                 start = _prolong(_nan_nearest(grid), lv.shape).ravel().astype(float)
-                x, k = _pcg(N, b, start, tol, maxiter, feedback)
+                x, k = pcg(N, b, jacobi(N), start, tol=tol, max_iter=maxiter, rule=CG_FE,
+                           feedback=feedback)
                 its += k
             grid = self._grid(lv, x)
         assert grid is not None
@@ -395,8 +361,6 @@ class _TileProblem:
 
 
 def _nan_nearest(a: Array) -> Array:
-    from scipy import ndimage
-
     bad = ~np.isfinite(a)
     if not bad.any() or bad.all():
         return np.where(bad, 0.0, a)
@@ -494,8 +458,6 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         (uint32 grid, points per cell), ``residuals`` (float32 per given point, NaN if unused),
         ``robust_weight`` (float32 per given point, NaN if unused; None unless robust).
     """
-    from scipy import ndimage
-
     t_start = time.perf_counter()
     feedback = ensure_feedback(feedback)
     if solver not in ("cg", "direct"):

@@ -15,8 +15,6 @@ import numpy as np
 import pytest
 import rasterio
 from affine import Affine
-from scipy import sparse
-from scipy.sparse.linalg import spsolve
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, InputError
@@ -28,7 +26,6 @@ from photodem.algorithms.matching.object_space import (
     _screen,
     _second_difference_rows,
     _visibility,
-    pcg,
     refine_object_space,
 )
 from photodem.algorithms.processing import registry
@@ -99,16 +96,6 @@ def _errors(scene, path):
 
 
 # -- numerics ---------------------------------------------------------------------------------
-def test_pcg_equals_direct_solution() -> None:
-    rng = np.random.default_rng(0)
-    A = sparse.random(400, 120, density=0.05, random_state=3, format="csr") \
-        + sparse.eye(400, 120, format="csr")
-    N = (A.T @ A).tocsr()
-    b = rng.standard_normal(120)
-    x, it = pcg(N, b, tol=1e-12)
-    assert np.allclose(x, spsolve(N.tocsc(), b), atol=1e-8) and 0 < it < 400
-
-
 def test_curvature_rows_vanish_on_planes() -> None:
     R = _second_difference_rows(5, 7)
     rr, cc = np.mgrid[0:5, 0:7]
