@@ -301,161 +301,281 @@ def adjust_window(z_in: NDArray, valid: NDArray[np.bool_], x_first: float, y_fir
     """
     feedback = ensure_feedback(feedback)
     rows, cols = z_in.shape
-    zf = _fill_nearest(np.asarray(z_in, dtype=float))
-    n_img = len(windows)
+    win = _Window(_fill_nearest(np.asarray(z_in, dtype=float)), valid, x_first, y_first,
+                  spacing, windows, parallax_per_m, feedback)
+    opts = _AdjustOptions(int(max_iter), float(regularisation), weight, mode, grey_px)
+    st = _WindowState(np.zeros(len(windows)), np.ones(len(windows)))
     names = [w.name for w in windows]
     dz_nodes: Optional[Array] = None
-    iters: List[int] = []
-    cg_iters: List[int] = []
-    h0 = np.zeros(n_img)
-    h1 = np.ones(n_img)
-    sigma0 = float("nan")
-    last: Dict[str, Any] = {}
-    reg_share = float("nan")
-    rej_share = float("nan")
-    share = float(regularisation)
-    ref = -1
-    first = True
     for level in range(levels - 1, -1, -1):
-        st = stride * 2 ** level  # output cells per node on this level
-        ny, nx = (rows - 1) // st + 1, (cols - 1) // st + 1
-        if min(ny, nx) < 3:
+        lat = _lattice(win, rows, cols, stride * 2 ** level, level, gsd, grey_px)
+        if lat is None:
             continue
         if dz_nodes is None:
-            dz = np.zeros((ny, nx))
+            dz = np.zeros((lat.ny, lat.nx))
         else:  # prolongation: bilinear, node spacing halves
-            pr, pc = np.mgrid[0:ny, 0:nx]
+            pr, pc = np.mgrid[0:lat.ny, 0:lat.nx]
             dz = _prolong(dz_nodes, pr / 2.0, pc / 2.0)
-        gsd_l = gsd * 2 ** level
-        # samples: one per ground pixel of the level, over the hull of the cell centres
-        ext_x = (cols - 1) * spacing
-        ext_y = (rows - 1) * spacing
-        ns_x = max(math.floor(ext_x / gsd_l), 1)
-        ns_y = max(math.floor(ext_y / gsd_l), 1)
-        su = (np.arange(ns_x) + 0.5) * (ext_x / ns_x)  # metres from the first cell centre
-        sv = (np.arange(ns_y) + 0.5) * (ext_y / ns_y)
-        SU, SV = np.meshgrid(su, sv)
-        SU, SV = SU.ravel(), SV.ravel()
-        # input heights and validity at the samples (output cells → bilinear)
-        cu, cv = SU / spacing, SV / spacing
-        zidx, zw = _bilinear_weights(cu, cv, cols, rows)
-        z_s = (zf.ravel()[zidx] * zw).sum(axis=1)
-        v_s = (valid.ravel()[zidx] | (zw == 0)).all(axis=1)
-        gidx, gw = _bilinear_weights(SU / (st * spacing), SV / (st * spacing), nx, ny)
-        # grey grid
-        dgo = grey_px * gsd_l
-        nox = math.ceil(ext_x / dgo) + 1
-        noy = math.ceil(ext_y / dgo) + 1
-        oidx, ow = _bilinear_weights(SU / dgo, SV / dgo, nox, noy)
-        Xs = x_first + SU
-        Ys = y_first - SV
-        delta = max(gsd_l, 0.05)
-        reg = _second_difference_rows(ny, nx)
-        zin_nodes = zf[::st, ::st][:ny, :nx]
-        G: Optional[Array] = None
-        lam = -1.0 if weight is None else float(weight)
-        prev_s0 = float("inf")
-        n_it = 0
-        done = False
-        # visibility once per level, on the start surface of the level (the corrections of
-        # one level are a fraction of a cell, far below what changes an occlusion)
-        rr_c, cc_c = np.mgrid[0:rows, 0:cols]
-        surf = zf + _prolong(dz, rr_c / st, cc_c / st)
-        zs = z_s + (dz.ravel()[gidx] * gw).sum(axis=1)
-        vis = _visibility(windows, Xs, Ys, zs, surf, x_first, y_first, spacing)
-        vis = _erode_visibility(vis, ns_y, ns_x, VIS_MARGIN) & v_s[None, :]
-        rejected = np.zeros(zs.size, bool)
-        in_system = np.zeros(nox * noy, bool)
-        for it in range(max_iter + 1):
-            feedback.check()
-            zs = z_s + (dz.ravel()[gidx] * gw).sum(axis=1)
-            g_all, k_all = _observe(windows, level, Xs, Ys, zs, vis, delta)
-            seen = np.isfinite(g_all)
-            use = (seen.sum(axis=0) >= 2) & ~rejected
-            if use.sum() < 16:
-                return _failed(names, iters, cg_iters, "no samples seen by two images")
-            if ref < 0:  # radiometric datum: the image that sees most samples
-                ref = int(np.argmax(seen[:, use].sum(axis=1)))
-            if G is None:
-                if first:  # start radiometry: mean and spread matched to the reference
-                    g_ref = g_all[ref, use & seen[ref]]
-                    for i in range(n_img):
-                        gi = g_all[i, use & seen[i]]
-                        if i != ref and gi.size >= 16:
-                            h1[i] = float(np.std(g_ref) / max(float(np.std(gi)), 1e-6))
-                            h0[i] = float(np.mean(g_ref) - h1[i] * np.mean(gi))
-                    first = False
-                G = _start_grey(g_all, seen, use, h0, h1, oidx, ow, noy, nox)
-            elif not in_system.all():
-                # grey nodes outside the last system (touched by rejected or new samples
-                # only) get the current mean of the images, not a stale value
-                fresh = _start_grey(g_all, seen, seen.sum(axis=0) >= 2, h0, h1, oidx, ow,
-                                    noy, nox)
-                G = np.where(in_system, G, fresh)
-            A, obs, cols_g, rad_cols = _design(g_all, k_all, seen & use[None, :], gidx, gw, oidx,
-                                             ow, G, h0, h1, ref, nx * ny, nox * noy)
-            n_z, n_unk = nx * ny, A.shape[1]
-            in_system = cols_g >= 0
-            s0 = math.sqrt(dot_pairwise(obs, obs) / max(obs.size - n_unk, 1))
-            last = {"A": A, "l": obs, "n_z": n_z, "ny": ny, "nx": nx,
-                    "n_rad": 2 * len(rad_cols)}
-            if not np.isfinite(s0) or (it > 0 and s0 > 3.0 * prev_s0):
-                return _failed(names, iters, cg_iters, "the adjustment diverged")
-            if done or it == max_iter or (it > 1 and abs(prev_s0 - s0) < 0.005 * prev_s0):
-                break
-            prev_s0 = s0
-            # normal equations: data + λ·curvature (7.2-5/6)
-            Nd = (A.T @ A).tocsr()
-            b = A.T @ obs
-            R = sparse.hstack([reg, sparse.csr_matrix((reg.shape[0], n_unk - n_z))]).tocsr()
-            RtR = (R.T @ R).tocsr()
-            if lam < 0:  # λ from the share, once per level: fixed within the Gauss-Newton loop
-                d_data = float(Nd.diagonal()[:n_z].mean())
-                d_reg = float(RtR.diagonal()[:n_z].mean())
-                lam = share * d_data / max(d_reg, 1e-30) if d_reg > 0 else 0.0
-            Nr = lam * RtR
-            reg_share = float(Nr.diagonal()[:n_z].mean()
-                              / max(float(Nd.diagonal()[:n_z].mean()), 1e-30))
-            z_node = dz if mode == "correction" else zin_nodes + dz
-            b = b - lam * (R.T @ (reg @ z_node.ravel()))
-            # determinability (seed-004 §5.3 f): a grey node at the edge of the used samples
-            # may carry only a corner of one sample's bilinear weights; a ridge of 1e-3 of
-            # the typical grey diagonal keeps it from running away (negligible elsewhere)
-            dg = Nd.diagonal()[n_z:n_z + int((cols_g >= 0).sum())]
-            ridge = np.zeros(n_unk)
-            if dg.size:
-                ridge[n_z:n_z + dg.size] = GREY_RIDGE * float(np.median(dg))
-            N = (Nd + Nr + sparse.diags(ridge)).tocsr()
-            x, k_cg = pcg(N, b, jacobi(N), tol=CG_TOL, max_iter=CG_MAX_ITER, rule=CG_OBJECT_SPACE)
-            cg_iters.append(k_cg)
-            px_per_m = parallax_per_m / 2 ** level
-            lim = min(0.2 * st * spacing, 1.0 / max(px_per_m, 1e-9))
-            dZ = np.clip(x[:n_z], -lim, lim)
-            dz = dz + dZ.reshape(ny, nx)
-            G = G.copy()
-            G[cols_g >= 0] += x[cols_g[cols_g >= 0]]
-            for i, (j0, j1) in rad_cols.items():
-                h0[i] += x[j0]
-                h1[i] += x[j1]
-            # gross-error screening on the image-to-image consistency after this step
-            rejected |= _screen(g_all, k_all, seen, h0, h1, (dZ[gidx] * gw).sum(axis=1),
-                                REJECT_K)
-            n_it += 1
-            # converged in height: one more linearisation gives the final residuals
-            # (over the nodes with image data; the others only follow the regularisation)
-            det = Nd.diagonal()[:n_z] > 0
-            done = (not det.any()
-                    or float(np.max(np.abs(dZ[det]))) < 0.01 / max(px_per_m, 1e-9))
-        iters.append(n_it)
-        sigma0 = s0
-        n_two = int((vis.sum(axis=0) >= 2).sum())
-        rej_share = float((rejected & (vis.sum(axis=0) >= 2)).sum()) / max(n_two, 1)
-        dz_nodes = dz
-    if dz_nodes is None or not last:
-        return _failed(names, iters, cg_iters, "the window is too small for the geometry facets")
-    sigma, sigma0, observed = _precision(last)
-    return WindowResult(dz_nodes, sigma, observed, sigma0, iters, cg_iters, names, True,
-                        reg_share=reg_share, rejected_share=rej_share)
+        out = _adjust_level(win, lat, dz, st, opts)
+        if isinstance(out, str):
+            return _failed(names, st.iters, st.cg_iters, out)
+        dz_nodes = out
+    if dz_nodes is None or not st.last:
+        return _failed(names, st.iters, st.cg_iters,
+                       "the window is too small for the geometry facets")
+    sigma, sigma0, observed = _precision(st.last)
+    return WindowResult(dz_nodes, sigma, observed, sigma0, st.iters, st.cg_iters, names, True,
+                        reg_share=st.reg_share, rejected_share=st.rej_share)
+
+
+@dataclass(frozen=True)
+class _AdjustOptions:
+    """Options of :func:`adjust_window` (see :func:`refine_object_space`)."""
+
+    max_iter: int
+    regularisation: float  # share of the curvature on the height diagonal
+    weight: Optional[float]  # fixed λ instead
+    mode: str
+    grey_px: float
+
+
+@dataclass
+class _Window:
+    """The data of one window that every level uses."""
+
+    zf: Array  # input heights, NaNs filled by the nearest value
+    valid: NDArray[np.bool_]
+    x_first: float
+    y_first: float
+    spacing: float
+    images: Sequence[_ImageWindow]
+    parallax_per_m: float
+    feedback: Feedback
+
+
+@dataclass
+class _WindowState:
+    """What carries over from level to level: radiometry, datum, counts, the last system."""
+
+    h0: Array
+    h1: Array
+    ref: int = -1  # radiometric reference image (−1: not chosen yet)
+    first: bool = True  # the start radiometry is still to be matched
+    iters: List[int] = field(default_factory=list)
+    cg_iters: List[int] = field(default_factory=list)
+    last: Dict[str, Any] = field(default_factory=dict)
+    reg_share: float = float("nan")
+    rej_share: float = float("nan")
+
+
+@dataclass
+class _Lattice:
+    """Samples, geometry nodes and grey nodes of one pyramid level of a window."""
+
+    level: int
+    st: int  # output cells per geometry node
+    ny: int
+    nx: int
+    ns_y: int
+    ns_x: int
+    Xs: Array
+    Ys: Array
+    z_s: Array  # input heights at the samples
+    v_s: NDArray[np.bool_]  # samples on refinable cells
+    gidx: NDArray
+    gw: Array
+    oidx: NDArray
+    ow: Array
+    noy: int
+    nox: int
+    delta: float  # metres of the ∂/∂Z differences
+    reg: sparse.csr_matrix
+    zin_nodes: Array
+
+
+def _lattice(win: _Window, rows: int, cols: int, st: int, level: int, gsd: float,
+             grey_px: float) -> Optional[_Lattice]:
+    """The lattices of ``level`` (None when the window has fewer than 3 nodes a side)."""
+    ny, nx = (rows - 1) // st + 1, (cols - 1) // st + 1
+    if min(ny, nx) < 3:
+        return None
+    spacing = win.spacing
+    gsd_l = gsd * 2 ** level
+    # samples: one per ground pixel of the level, over the hull of the cell centres
+    ext_x = (cols - 1) * spacing
+    ext_y = (rows - 1) * spacing
+    ns_x = max(math.floor(ext_x / gsd_l), 1)
+    ns_y = max(math.floor(ext_y / gsd_l), 1)
+    su = (np.arange(ns_x) + 0.5) * (ext_x / ns_x)  # metres from the first cell centre
+    sv = (np.arange(ns_y) + 0.5) * (ext_y / ns_y)
+    SU, SV = np.meshgrid(su, sv)
+    SU, SV = SU.ravel(), SV.ravel()
+    # input heights and validity at the samples (output cells → bilinear)
+    zidx, zw = _bilinear_weights(SU / spacing, SV / spacing, cols, rows)
+    z_s = (win.zf.ravel()[zidx] * zw).sum(axis=1)
+    v_s = (win.valid.ravel()[zidx] | (zw == 0)).all(axis=1)
+    gidx, gw = _bilinear_weights(SU / (st * spacing), SV / (st * spacing), nx, ny)
+    # grey grid
+    dgo = grey_px * gsd_l
+    nox = math.ceil(ext_x / dgo) + 1
+    noy = math.ceil(ext_y / dgo) + 1
+    oidx, ow = _bilinear_weights(SU / dgo, SV / dgo, nox, noy)
+    return _Lattice(level, st, ny, nx, ns_y, ns_x, win.x_first + SU, win.y_first - SV, z_s,
+                    v_s, gidx, gw, oidx, ow, noy, nox, max(gsd_l, 0.05),
+                    _second_difference_rows(ny, nx), win.zf[::st, ::st][:ny, :nx])
+
+
+def _level_visibility(win: _Window, lat: _Lattice, dz: Array) -> NDArray[np.bool_]:
+    """Samples each image sees on the start surface of the level, eroded by a margin.
+
+    Once per level: the corrections of one level are a fraction of a cell, far below what
+    changes an occlusion.
+    """
+    rows, cols = win.zf.shape
+    rr_c, cc_c = np.mgrid[0:rows, 0:cols]
+    surf = win.zf + _prolong(dz, rr_c / lat.st, cc_c / lat.st)
+    zs = lat.z_s + (dz.ravel()[lat.gidx] * lat.gw).sum(axis=1)
+    vis = _visibility(win.images, lat.Xs, lat.Ys, zs, surf, win.x_first, win.y_first,
+                      win.spacing)
+    return _erode_visibility(vis, lat.ns_y, lat.ns_x, VIS_MARGIN) & lat.v_s[None, :]
+
+
+@dataclass
+class _Observation:
+    """Grey values and height coefficients of one linearisation, with its sample masks."""
+
+    g_all: Array
+    k_all: Array
+    seen: NDArray[np.bool_]
+    use: NDArray[np.bool_]
+
+
+def _adjust_level(win: _Window, lat: _Lattice, dz: Array, st: _WindowState,
+                  opts: _AdjustOptions) -> Union[Array, str]:
+    """Gauss–Newton iterations of one level from the node corrections ``dz``.
+
+    Returns the corrections after the level, or the message of a failure. Updates the
+    radiometry, counts and the last system in ``st``.
+    """
+    vis = _level_visibility(win, lat, dz)
+    rejected = np.zeros(lat.z_s.size, bool)
+    in_system = np.zeros(lat.nox * lat.noy, bool)
+    G: Optional[Array] = None
+    lam = -1.0 if opts.weight is None else float(opts.weight)
+    prev_s0 = float("inf")
+    n_it = 0
+    done = False
+    for it in range(opts.max_iter + 1):
+        win.feedback.check()
+        zs = lat.z_s + (dz.ravel()[lat.gidx] * lat.gw).sum(axis=1)
+        g_all, k_all = _observe(win.images, lat.level, lat.Xs, lat.Ys, zs, vis, lat.delta)
+        seen = np.isfinite(g_all)
+        use = (seen.sum(axis=0) >= 2) & ~rejected
+        if use.sum() < 16:
+            return "no samples seen by two images"
+        ob = _Observation(g_all, k_all, seen, use)
+        if st.ref < 0:  # radiometric datum: the image that sees most samples
+            st.ref = int(np.argmax(seen[:, use].sum(axis=1)))
+        G = _grey_values(ob, G, in_system, st, lat)
+        A, obs, cols_g, rad_cols = _design(g_all, k_all, seen & use[None, :], lat.gidx, lat.gw,
+                                           lat.oidx, lat.ow, G, st.h0, st.h1, st.ref,
+                                           lat.nx * lat.ny, lat.nox * lat.noy)
+        n_z = lat.nx * lat.ny
+        in_system = cols_g >= 0
+        s0 = math.sqrt(dot_pairwise(obs, obs) / max(obs.size - A.shape[1], 1))
+        st.last = {"A": A, "l": obs, "n_z": n_z, "ny": lat.ny, "nx": lat.nx,
+                   "n_rad": 2 * len(rad_cols)}
+        if not np.isfinite(s0) or (it > 0 and s0 > 3.0 * prev_s0):
+            return "the adjustment diverged"
+        if done or it == opts.max_iter or (it > 1 and abs(prev_s0 - s0) < 0.005 * prev_s0):
+            break
+        prev_s0 = s0
+        x, lam, det = _solve_step(A, obs, cols_g, lat, dz, lam, st, opts)
+        # increments clipped to 0.2 geometry spacings and 1 px of parallax
+        px_per_m = win.parallax_per_m / 2 ** lat.level
+        lim = min(0.2 * lat.st * win.spacing, 1.0 / max(px_per_m, 1e-9))
+        dZ = np.clip(x[:n_z], -lim, lim)
+        dz = dz + dZ.reshape(lat.ny, lat.nx)
+        G = G.copy()
+        G[cols_g >= 0] += x[cols_g[cols_g >= 0]]
+        for i, (j0, j1) in rad_cols.items():
+            st.h0[i] += x[j0]
+            st.h1[i] += x[j1]
+        # gross-error screening on the image-to-image consistency after this step
+        dz_s = (dZ[lat.gidx] * lat.gw).sum(axis=1)
+        rejected |= _screen(g_all, k_all, seen, st.h0, st.h1, dz_s, REJECT_K)
+        n_it += 1
+        # converged in height: one more linearisation gives the final residuals
+        # (over the nodes with image data; the others only follow the regularisation)
+        done = (not det.any()
+                or float(np.max(np.abs(dZ[det]))) < 0.01 / max(px_per_m, 1e-9))
+    st.iters.append(n_it)
+    n_two = int((vis.sum(axis=0) >= 2).sum())
+    st.rej_share = float((rejected & (vis.sum(axis=0) >= 2)).sum()) / max(n_two, 1)
+    return dz
+
+
+def _grey_values(ob: _Observation, G: Optional[Array], in_system: NDArray[np.bool_],
+                 st: _WindowState, lat: _Lattice) -> Array:
+    """The object grey values to linearise at.
+
+    On the first linearisation of a level they start from the images' mean (after matching
+    the start radiometry to the reference, once per window); later, grey nodes outside the
+    last system (touched by rejected or new samples only) get the current mean of the
+    images, not a stale value.
+    """
+    g_all, seen, use = ob.g_all, ob.seen, ob.use
+    if G is None:
+        if st.first:  # start radiometry: mean and spread matched to the reference
+            g_ref = g_all[st.ref, use & seen[st.ref]]
+            for i in range(g_all.shape[0]):
+                gi = g_all[i, use & seen[i]]
+                if i != st.ref and gi.size >= 16:
+                    st.h1[i] = float(np.std(g_ref) / max(float(np.std(gi)), 1e-6))
+                    st.h0[i] = float(np.mean(g_ref) - st.h1[i] * np.mean(gi))
+            st.first = False
+        return _start_grey(g_all, seen, use, st.h0, st.h1, lat.oidx, lat.ow, lat.noy, lat.nox)
+    if in_system.all():
+        return G
+    fresh = _start_grey(g_all, seen, seen.sum(axis=0) >= 2, st.h0, st.h1, lat.oidx, lat.ow,
+                        lat.noy, lat.nox)
+    return np.where(in_system, G, fresh)
+
+
+def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice, dz: Array,
+                lam: float, st: _WindowState, opts: _AdjustOptions
+                ) -> Tuple[Array, float, NDArray[np.bool_]]:
+    """One Gauss–Newton solution: normal equations with the curvature regularisation
+    (7.2-5/6) and the grey ridge, solved by CG.
+
+    Returns the increments, λ (set from the share on the first step of a level, then kept
+    within the Gauss–Newton loop) and the height nodes with image data.
+    """
+    n_z, n_unk = lat.nx * lat.ny, A.shape[1]
+    Nd = (A.T @ A).tocsr()
+    b = A.T @ obs
+    R = sparse.hstack([lat.reg, sparse.csr_matrix((lat.reg.shape[0], n_unk - n_z))]).tocsr()
+    RtR = (R.T @ R).tocsr()
+    if lam < 0:  # λ from the share, once per level
+        d_data = float(Nd.diagonal()[:n_z].mean())
+        d_reg = float(RtR.diagonal()[:n_z].mean())
+        lam = opts.regularisation * d_data / max(d_reg, 1e-30) if d_reg > 0 else 0.0
+    Nr = lam * RtR
+    st.reg_share = float(Nr.diagonal()[:n_z].mean()
+                         / max(float(Nd.diagonal()[:n_z].mean()), 1e-30))
+    z_node = dz if opts.mode == "correction" else lat.zin_nodes + dz
+    b = b - lam * (R.T @ (lat.reg @ z_node.ravel()))
+    # determinability (seed-004 §5.3 f): a grey node at the edge of the used samples may
+    # carry only a corner of one sample's bilinear weights; a ridge of 1e-3 of the typical
+    # grey diagonal keeps it from running away (negligible elsewhere)
+    dg = Nd.diagonal()[n_z:n_z + int((cols_g >= 0).sum())]
+    ridge = np.zeros(n_unk)
+    if dg.size:
+        ridge[n_z:n_z + dg.size] = GREY_RIDGE * float(np.median(dg))
+    N = (Nd + Nr + sparse.diags(ridge)).tocsr()
+    x, k_cg = pcg(N, b, jacobi(N), tol=CG_TOL, max_iter=CG_MAX_ITER, rule=CG_OBJECT_SPACE)
+    st.cg_iters.append(k_cg)
+    return x, lam, Nd.diagonal()[:n_z] > 0
 
 
 def _failed(names: List[str], iters: List[int], cg_iters: List[int], message: str
