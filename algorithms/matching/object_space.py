@@ -946,17 +946,101 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     """
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
-    if regularisation_mode not in MODES:
-        raise InputError(f"Unknown regularisation mode '{regularisation_mode}'; use one of "
+    _check_options(regularisation_mode, regularisation, regularisation_weight, max_iter)
+    if not isinstance(project, Project):
+        project = Project.load(project)
+    plan = _plan(project, Path(dsm), images, spacing, levels, tile, overlap, facet_px)
+    settings = _TileSettings(min_cover, max_iter, regularisation, regularisation_weight,
+                             regularisation_mode, grey_px)
+    W, H = plan.out_grid.width, plan.out_grid.height
+    feedback.info(f"Object-space matching: {len(plan.recs)} images, GSD {plan.gsd:.3f} m, DSM "
+                  f"{W}×{H} cells at {plan.spacing:.3f} m, geometry nodes every {plan.stride} "
+                  f"cells, {plan.levels} levels, {len(plan.tiles)} tiles.")
+    out = Path(output_dir)
+    totals = _Totals()
+    with staged_folder(out, replace=True, product="refine_object_space") as tmp:
+        _write_tiles(plan, settings, tmp, totals, feedback)
+        feedback.check()
+        seconds = time.perf_counter() - t_start
+        metrics = _metrics(plan, totals)
+        report = {"dsm": str(plan.dsm), "crs": project.crs, "metrics": metrics,
+                  "options": {"max_iter": int(max_iter), "regularisation": regularisation,
+                              "regularisation_weight": regularisation_weight,
+                              "regularisation_mode": regularisation_mode,
+                              "facet_px": facet_px, "grey_px": grey_px, "tile": plan.tile,
+                              "overlap": plan.overlap, "min_cover": min_cover,
+                              "sigma": "probing of diag(N⁻¹), colour distance "
+                                       f"{PROBE_DISTANCE} nodes, without regularisation"},
+                  "tiles": totals.tile_reports, "seconds": {"total": seconds}}
+        (tmp / "report.json").write_text(json.dumps(report, indent=1), encoding="utf-8")
+        feedback.progress(100.0)
+    feedback.info(f"Refined {totals.n_refined} cells ({totals.n_nodes} geometry nodes), median "
+                  f"σ_Z {metrics['sigma_z_median_m'] or float('nan'):.3f} m, "
+                  f"{totals.failures} failed tiles.")
+    return {"dsm": str(out / "dsm.tif"), "sigma": str(out / "sigma.tif"),
+            "report": str(out / "report.json"), "metrics": metrics}
+
+
+def _check_options(mode: str, regularisation: float, weight: Optional[float],
+                   max_iter: int) -> None:
+    """Reject a mode, regularisation or iteration count that cannot be used."""
+    if mode not in MODES:
+        raise InputError(f"Unknown regularisation mode '{mode}'; use one of "
                          f"{', '.join(MODES)}.")
-    if not regularisation >= 0 or (regularisation_weight is not None
-                                    and not regularisation_weight >= 0):
+    if not regularisation >= 0 or (weight is not None and not weight >= 0):
         raise InputError("The regularisation must not be negative.")
     if int(max_iter) < 0:
         raise InputError("max_iter must not be negative (0 = no adjustment, only σ).")
-    if not isinstance(project, Project):
-        project = Project.load(project)
-    dsm = Path(dsm)
+
+
+@dataclass(frozen=True)
+class _TileSettings:
+    """Options of the adjustment of every tile (see :func:`refine_object_space`)."""
+
+    min_cover: float
+    max_iter: int
+    regularisation: float
+    weight: Optional[float]
+    mode: str
+    grey_px: float
+
+
+@dataclass
+class _Plan:
+    """The frame of a refinement: images, grids, lattice and tiles."""
+
+    project: Any
+    dsm: Path
+    recs: Sequence[Any]
+    cams: Dict[str, Any]
+    in_grid: Grid
+    out_grid: Grid
+    nodata: Optional[float]
+    spacing: float
+    gsd: float
+    levels: int
+    stride: int  # output cells per geometry node on level 0
+    unit: int  # node lattice of the top level, in cells
+    tile: int
+    overlap: int
+    excl: List[Any]
+    bounds: List[Any]
+    tiles: List[Tuple[int, int]]
+
+
+@dataclass
+class _Totals:
+    """What the tiles add up to: their reports, σ of the refined cells, counts."""
+
+    tile_reports: List[Dict[str, Any]] = field(default_factory=list)
+    sig_all: List[Array] = field(default_factory=list)
+    n_refined: int = 0
+    n_nodes: int = 0
+    failures: int = 0
+
+
+def _records(project: Any, dsm: Path, images: Optional[Sequence[str]]) -> List[Any]:
+    """The image records to use, after checking that the DSM and the image files exist."""
     if not dsm.is_file():
         raise InputError(f"The DSM '{dsm}' does not exist.")
     recs = project.images if images is None else [project.image(n) for n in images]
@@ -968,21 +1052,32 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
         if not p.is_file():
             raise InputError(f"Image file '{p}' of image '{rec.name}' does not exist; fix its "
                              "path in project.toml.")
+    return recs
+
+
+def _dsm_frame(dsm: Path, project: Any) -> Tuple[Grid, Optional[float], Any, Array]:
+    """Grid, nodata, bounds and a coarse overview of the heights (≤ 256 cells a side)."""
     with open_image(dsm) as src:
         check_surface_crs(dsm, src.crs, project.crs, "DSM")
         t = src.transform
         if t.b != 0 or t.d != 0 or abs(abs(t.a) - abs(t.e)) > 1e-9 * abs(t.a):
             raise InputError(f"The DSM '{dsm.name}' must be north-up with square cells.")
-        dsm_spacing = float(abs(t.a))
-        b = src.bounds
-        in_grid = Grid(t, src.width, src.height, dsm_spacing)
-        nodata = src.nodata
-        # a coarse overview of the heights: terrain height and height range
+        in_grid = Grid(t, src.width, src.height, float(abs(t.a)))
         step = max(1, max(src.width, src.height) // 256)
         ov = src.read(1, out_shape=(max(1, src.height // step), max(1, src.width // step)),
                       masked=True).astype(float).filled(np.nan)
+        frame = (in_grid, src.nodata, src.bounds, ov)
     if not np.isfinite(ov).any():
         raise InputError(f"The DSM '{dsm.name}' has no heights.")
+    return frame
+
+
+def _plan(project: Any, dsm: Path, images: Optional[Sequence[str]], spacing: Optional[float],
+          levels: Optional[int], tile: int, overlap: Optional[int], facet_px: float) -> _Plan:
+    """Check the inputs and fix grids, GSD, geometry stride, overlap and tiles."""
+    recs = _records(project, dsm, images)
+    in_grid, nodata, b, ov = _dsm_frame(dsm, project)
+    dsm_spacing = in_grid.spacing
     spacing = dsm_spacing if not spacing else float(spacing)
     if not spacing > 0:
         raise InputError(f"The spacing must be positive, got {spacing}.")
@@ -999,165 +1094,164 @@ def refine_object_space(project: Any, dsm: PathLike, output_dir: PathLike, *,
     if levels < 1:
         raise InputError("levels must be at least 1.")
     stride = max(1, round(facet_px * gsd / spacing))
-    unit = stride * 2 ** (levels - 1)  # node lattice of the top level, in cells
+    unit = stride * 2 ** (levels - 1)
     overlap = int(overlap) if overlap is not None else 3 * stride
     tile = max(int(tile), unit)
-    excl, bounds, _lines = ([], [], [])
+    excl, bounds = [], []
     if Path(project.edits_path).is_file():
         excl, bounds, _lines = read_constraints(project.edits_path, project.crs or None)
     W, H = out_grid.width, out_grid.height
     tiles = [(r0, c0) for r0 in range(0, H, tile) for c0 in range(0, W, tile)]
-    feedback.info(f"Object-space matching: {len(recs)} images, GSD {gsd:.3f} m, DSM "
-                  f"{W}×{H} cells at {spacing:.3f} m, geometry nodes every {stride} cells, "
-                  f"{levels} levels, {len(tiles)} tiles.")
-    out = Path(output_dir)
-    tile_reports: List[Dict[str, Any]] = []
-    sig_all: List[Array] = []
-    n_refined = 0
-    n_nodes = 0
-    failures = 0
-    with staged_folder(out, replace=True, product="refine_object_space") as tmp:
-        profile = gtiff_profile(W, H, 1, "float32", project.crs, nodata=float("nan"),
-                                predictor=3, transform=out_grid.transform)
-        with open_image(tmp / "dsm.tif", "w", **profile) as dst_z, \
-                open_image(tmp / "sigma.tif", "w", **profile) as dst_s, \
-                open_image(dsm) as src:
-            for t_i, (r0, c0) in enumerate(tiles):
-                feedback.progress(100.0 * t_i / len(tiles))
-                th, tw = min(tile, H - r0), min(tile, W - c0)
-                # window: core ± overlap, extended so that nodes of every level fit exactly
-                wr0, wc0 = r0 - overlap, c0 - overlap
-                nr = th + 2 * overlap
-                nc = tw + 2 * overlap
-                nr = ((nr - 1 + unit - 1) // unit) * unit + 1
-                nc = ((nc - 1 + unit - 1) // unit) * unit + 1
-                wgrid = Grid(out_grid.transform * out_grid.transform.translation(wc0, wr0),
-                             nc, nr, spacing)
-                x_first, y_first = wgrid.transform * (0.5, 0.5)
-                if out_grid is in_grid:
-                    z_in = src.read(1, window=Window(wc0, wr0, nc, nr), boundless=True,
-                                    fill_value=np.nan, masked=True)
-                    z_in = z_in.astype(float).filled(np.nan)
-                else:
-                    xs = x_first + spacing * np.arange(nc)
-                    ys = y_first - spacing * np.arange(nr)
-                    XX, YY = np.meshgrid(xs, ys)
-                    cc, rr = world_to_grid(src.transform, XX, YY)
-                    ic0 = max(int(np.floor(cc.min())) - 1, 0)
-                    ir0 = max(int(np.floor(rr.min())) - 1, 0)
-                    ic1 = min(int(np.ceil(cc.max())) + 2, src.width)
-                    ir1 = min(int(np.ceil(rr.max())) + 2, src.height)
-                    if ic1 > ic0 and ir1 > ir0:
-                        a = src.read(1, window=Window(ic0, ir0, ic1 - ic0, ir1 - ir0),
-                                     masked=True).astype(float).filled(np.nan)
-                        z_in = bilinear_grid(a, cc - ic0, rr - ir0)
-                    else:
-                        z_in = np.full((nr, nc), np.nan)
-                if nodata is not None and np.isfinite(nodata):
-                    z_in[z_in == nodata] = np.nan
-                valid = np.isfinite(z_in)
-                if excl:
-                    valid &= ~polygon_mask(excl, wgrid)
-                if bounds:
-                    valid &= polygon_mask(bounds, wgrid)
-                core = (slice(overlap, overlap + th), slice(overlap, overlap + tw))
-                z_out = np.full((th, tw), np.nan, np.float32)
-                s_out = np.full((th, tw), np.nan, np.float32)
-                rep: Dict[str, Any] = {"tile": [int(r0), int(c0)], "images": [],
-                                       "iterations": [], "sigma0": None, "failed": False}
-                if valid[core].any():
-                    res = _run_tile(recs, cams, project, z_in, valid, x_first, y_first,
-                                    spacing, stride, gsd, levels, min_cover, max_iter,
-                                    regularisation, regularisation_weight,
-                                    regularisation_mode, grey_px,
-                                    feedback)
-                    rep["images"] = res.images
-                    rep["iterations"] = res.iterations
-                    rep["cg_iterations"] = res.cg_iterations
-                    rep["regularisation_share"] = (round(res.reg_share, 4)
-                                                   if np.isfinite(res.reg_share) else None)
-                    rep["rejected_share"] = (round(res.rejected_share, 4)
-                                             if np.isfinite(res.rejected_share) else None)
-                    if res.ok:
-                        rr_, cc_ = np.mgrid[0:nr, 0:nc]
-                        coords = [rr_ / stride, cc_ / stride]
-                        dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
-                        sg = ndimage.map_coordinates(np.nan_to_num(res.sigma, nan=1e9),
-                                                     coords, order=1, mode="nearest")
-                        obs = ndimage.map_coordinates(res.observed.astype(float), coords,
-                                                      order=1, mode="nearest")
-                        good = valid & (obs > 0.5) & (sg < 1e8)
-                        zr = np.where(good, z_in + dz, np.nan)
-                        sr = np.where(good, sg, np.nan)
-                        z_out = zr[core].astype(np.float32)
-                        # σ to 0.1 mm: the sparse LU may differ in the last bits between
-                        # processes (BLAS builds), which must not show in the product
-                        s_out = np.round(sr[core], 4).astype(np.float32)
-                        rep["sigma0"] = round(res.sigma0, 4) if np.isfinite(res.sigma0) \
-                            else None
-                        k = np.isfinite(s_out)
-                        n_refined += int(k.sum())
-                        sig_all.append(s_out[k].astype(float))
-                        nodes_core = res.observed[overlap // stride:(overlap + th) // stride,
-                                                  overlap // stride:(overlap + tw) // stride]
-                        n_nodes += int(nodes_core.sum())
-                    else:
-                        failures += 1
-                        rep["failed"] = True
-                        rep["message"] = res.message
-                        feedback.warning(f"Tile at row {r0}, col {c0}: {res.message}; left "
-                                         "empty (NaN).")
-                tile_reports.append(rep)
-                dst_z.write(z_out[None], window=Window(c0, r0, tw, th))
-                dst_s.write(s_out[None], window=Window(c0, r0, tw, th))
-        feedback.check()
-        sig = np.concatenate(sig_all) if sig_all else np.zeros(0)
-        s0s = [r["sigma0"] for r in tile_reports if r.get("sigma0") is not None]
-        seconds = time.perf_counter() - t_start
-        metrics = {
-            "cells": [W, H],
-            "spacing_m": spacing,
-            "gsd_m": gsd,
-            "geometry_stride_cells": stride,
-            "levels": levels,
-            "tiles": len(tiles),
-            "refined_cells": n_refined,
-            "geometry_nodes": n_nodes,
-            "failures": failures,
-            "sigma0_grey_mean": float(np.mean(s0s)) if s0s else None,
-            "sigma0_grey_median": float(np.median(s0s)) if s0s else None,
-            # no mean: nodes on texture-free ground have σ of kilometres (no regularisation
-            # in the σ), which would swamp it; the share of such nodes is reported instead
-            "sigma_z_median_m": float(np.median(sig)) if sig.size else None,
-            "sigma_z_p95_m": float(np.percentile(sig, 95)) if sig.size else None,
-            "nodes_sigma_over_1m_pct": (round(100.0 * float(np.mean(sig > 1.0)), 3)
-                                        if sig.size else None),
-        }
-        report = {"dsm": str(dsm), "crs": project.crs, "metrics": metrics,
-                  "options": {"max_iter": int(max_iter), "regularisation": regularisation,
-                              "regularisation_weight": regularisation_weight,
-                              "regularisation_mode": regularisation_mode,
-                              "facet_px": facet_px, "grey_px": grey_px, "tile": tile,
-                              "overlap": overlap, "min_cover": min_cover,
-                              "sigma": "probing of diag(N⁻¹), colour distance "
-                                       f"{PROBE_DISTANCE} nodes, without regularisation"},
-                  "tiles": tile_reports, "seconds": {"total": seconds}}
-        (tmp / "report.json").write_text(json.dumps(report, indent=1), encoding="utf-8")
-        feedback.progress(100.0)
-    feedback.info(f"Refined {n_refined} cells ({n_nodes} geometry nodes), median σ_Z "
-                  f"{metrics['sigma_z_median_m'] or float('nan'):.3f} m, {failures} failed "
-                  "tiles.")
-    return {"dsm": str(out / "dsm.tif"), "sigma": str(out / "sigma.tif"),
-            "report": str(out / "report.json"), "metrics": metrics}
+    return _Plan(project, dsm, recs, cams, in_grid, out_grid, nodata, spacing, gsd, levels,
+                 stride, unit, tile, overlap, excl, bounds, tiles)
 
 
-def _run_tile(recs: Sequence[Any], cams: Dict[str, Any], project: Any, z_in: Array,
-              valid: NDArray[np.bool_], x_first: float, y_first: float, spacing: float,
-              stride: int, gsd: float, levels: int, min_cover: float, max_iter: int,
-              regularisation: float, weight: Optional[float], mode: str, grey_px: float,
-              feedback: Feedback
-              ) -> WindowResult:
+def _write_tiles(plan: _Plan, settings: _TileSettings, tmp: Path, totals: _Totals,
+                 feedback: Feedback) -> None:
+    """Refine tile by tile and write the cores into dsm.tif and sigma.tif of ``tmp``."""
+    W, H = plan.out_grid.width, plan.out_grid.height
+    profile = gtiff_profile(W, H, 1, "float32", plan.project.crs, nodata=float("nan"),
+                            predictor=3, transform=plan.out_grid.transform)
+    with open_image(tmp / "dsm.tif", "w", **profile) as dst_z, \
+            open_image(tmp / "sigma.tif", "w", **profile) as dst_s, \
+            open_image(plan.dsm) as src:
+        for t_i, (r0, c0) in enumerate(plan.tiles):
+            feedback.progress(100.0 * t_i / len(plan.tiles))
+            z_out, s_out, rep = _refine_tile(plan, settings, src, r0, c0, totals, feedback)
+            totals.tile_reports.append(rep)
+            th, tw = z_out.shape
+            dst_z.write(z_out[None], window=Window(c0, r0, tw, th))
+            dst_s.write(s_out[None], window=Window(c0, r0, tw, th))
+
+
+def _window_heights(plan: _Plan, src: Any, wr0: int, wc0: int, nr: int, nc: int,
+                    x_first: float, y_first: float) -> Array:
+    """Input heights (NaN = none) at the cell centres of a window of the output grid."""
+    spacing = plan.spacing
+    if plan.out_grid is plan.in_grid:
+        z_in = src.read(1, window=Window(wc0, wr0, nc, nr), boundless=True,
+                        fill_value=np.nan, masked=True)
+        z_in = z_in.astype(float).filled(np.nan)
+    else:
+        xs = x_first + spacing * np.arange(nc)
+        ys = y_first - spacing * np.arange(nr)
+        XX, YY = np.meshgrid(xs, ys)
+        cc, rr = world_to_grid(src.transform, XX, YY)
+        ic0 = max(int(np.floor(cc.min())) - 1, 0)
+        ir0 = max(int(np.floor(rr.min())) - 1, 0)
+        ic1 = min(int(np.ceil(cc.max())) + 2, src.width)
+        ir1 = min(int(np.ceil(rr.max())) + 2, src.height)
+        if ic1 > ic0 and ir1 > ir0:
+            a = src.read(1, window=Window(ic0, ir0, ic1 - ic0, ir1 - ir0),
+                         masked=True).astype(float).filled(np.nan)
+            z_in = bilinear_grid(a, cc - ic0, rr - ir0)
+        else:
+            z_in = np.full((nr, nc), np.nan)
+    if plan.nodata is not None and np.isfinite(plan.nodata):
+        z_in[z_in == plan.nodata] = np.nan
+    return z_in
+
+
+def _refine_tile(plan: _Plan, settings: _TileSettings, src: Any, r0: int, c0: int,
+                 totals: _Totals, feedback: Feedback) -> Tuple[Array, Array, Dict[str, Any]]:
+    """Heights and σ of the core of the tile at (r0, c0) (NaN where not refined), and its
+    report; adds to ``totals``."""
+    W, H = plan.out_grid.width, plan.out_grid.height
+    overlap, unit, spacing = plan.overlap, plan.unit, plan.spacing
+    th, tw = min(plan.tile, H - r0), min(plan.tile, W - c0)
+    # window: core ± overlap, extended so that nodes of every level fit exactly
+    wr0, wc0 = r0 - overlap, c0 - overlap
+    nr = ((th + 2 * overlap - 1 + unit - 1) // unit) * unit + 1
+    nc = ((tw + 2 * overlap - 1 + unit - 1) // unit) * unit + 1
+    wgrid = Grid(plan.out_grid.transform * plan.out_grid.transform.translation(wc0, wr0),
+                 nc, nr, spacing)
+    x_first, y_first = wgrid.transform * (0.5, 0.5)
+    z_in = _window_heights(plan, src, wr0, wc0, nr, nc, x_first, y_first)
+    valid = np.isfinite(z_in)
+    if plan.excl:
+        valid &= ~polygon_mask(plan.excl, wgrid)
+    if plan.bounds:
+        valid &= polygon_mask(plan.bounds, wgrid)
+    core = (slice(overlap, overlap + th), slice(overlap, overlap + tw))
+    z_out = np.full((th, tw), np.nan, np.float32)
+    s_out = np.full((th, tw), np.nan, np.float32)
+    rep: Dict[str, Any] = {"tile": [int(r0), int(c0)], "images": [], "iterations": [],
+                           "sigma0": None, "failed": False}
+    if not valid[core].any():
+        return z_out, s_out, rep
+    res = _run_tile(plan, z_in, valid, x_first, y_first, settings, feedback)
+    rep["images"] = res.images
+    rep["iterations"] = res.iterations
+    rep["cg_iterations"] = res.cg_iterations
+    rep["regularisation_share"] = (round(res.reg_share, 4)
+                                   if np.isfinite(res.reg_share) else None)
+    rep["rejected_share"] = (round(res.rejected_share, 4)
+                             if np.isfinite(res.rejected_share) else None)
+    if not res.ok:
+        totals.failures += 1
+        rep["failed"] = True
+        rep["message"] = res.message
+        feedback.warning(f"Tile at row {r0}, col {c0}: {res.message}; left empty (NaN).")
+        return z_out, s_out, rep
+    z_out, s_out = _tile_products(res, z_in, valid, core, plan.stride)
+    rep["sigma0"] = round(res.sigma0, 4) if np.isfinite(res.sigma0) else None
+    k = np.isfinite(s_out)
+    totals.n_refined += int(k.sum())
+    totals.sig_all.append(s_out[k].astype(float))
+    st = plan.stride
+    nodes_core = res.observed[overlap // st:(overlap + th) // st,
+                              overlap // st:(overlap + tw) // st]
+    totals.n_nodes += int(nodes_core.sum())
+    return z_out, s_out, rep
+
+
+def _tile_products(res: WindowResult, z_in: Array, valid: NDArray[np.bool_],
+                   core: Tuple[slice, slice], stride: int) -> Tuple[Array, Array]:
+    """Refined heights and σ (float32) of a tile's core from the node results (bilinear)."""
+    nr, nc = z_in.shape
+    rr_, cc_ = np.mgrid[0:nr, 0:nc]
+    coords = [rr_ / stride, cc_ / stride]
+    dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
+    sg = ndimage.map_coordinates(np.nan_to_num(res.sigma, nan=1e9), coords, order=1,
+                                 mode="nearest")
+    obs = ndimage.map_coordinates(res.observed.astype(float), coords, order=1, mode="nearest")
+    good = valid & (obs > 0.5) & (sg < 1e8)
+    zr = np.where(good, z_in + dz, np.nan)
+    sr = np.where(good, sg, np.nan)
+    # σ to 0.1 mm: the sparse LU may differ in the last bits between processes (BLAS
+    # builds), which must not show in the product
+    return zr[core].astype(np.float32), np.round(sr[core], 4).astype(np.float32)
+
+
+def _metrics(plan: _Plan, totals: _Totals) -> Dict[str, Any]:
+    """The figures of the report (σ0 per tile, σ_Z of the refined cells, counts)."""
+    sig = np.concatenate(totals.sig_all) if totals.sig_all else np.zeros(0)
+    s0s = [r["sigma0"] for r in totals.tile_reports if r.get("sigma0") is not None]
+    return {
+        "cells": [plan.out_grid.width, plan.out_grid.height],
+        "spacing_m": plan.spacing,
+        "gsd_m": plan.gsd,
+        "geometry_stride_cells": plan.stride,
+        "levels": plan.levels,
+        "tiles": len(plan.tiles),
+        "refined_cells": totals.n_refined,
+        "geometry_nodes": totals.n_nodes,
+        "failures": totals.failures,
+        "sigma0_grey_mean": float(np.mean(s0s)) if s0s else None,
+        "sigma0_grey_median": float(np.median(s0s)) if s0s else None,
+        # no mean: nodes on texture-free ground have σ of kilometres (no regularisation
+        # in the σ), which would swamp it; the share of such nodes is reported instead
+        "sigma_z_median_m": float(np.median(sig)) if sig.size else None,
+        "sigma_z_p95_m": float(np.percentile(sig, 95)) if sig.size else None,
+        "nodes_sigma_over_1m_pct": (round(100.0 * float(np.mean(sig > 1.0)), 3)
+                                    if sig.size else None),
+    }
+
+
+def _run_tile(plan: _Plan, z_in: Array, valid: NDArray[np.bool_], x_first: float,
+              y_first: float, settings: _TileSettings, feedback: Feedback) -> WindowResult:
     """Choose the images of a window, read their windows and pyramids, adjust."""
+    spacing, gsd, levels = plan.spacing, plan.gsd, plan.levels
     nr, nc = z_in.shape
     zf = z_in[valid]
     zlo, zhi = float(zf.min()), float(zf.max())
@@ -1173,15 +1267,15 @@ def _run_tile(recs: Sequence[Any], cams: Dict[str, Any], project: Any, z_in: Arr
     BY = y_first - border[:, 0] * spacing
     lim = 2.0 ** levels * 8.0
     wins: List[_ImageWindow] = []
-    for rec in recs:
-        cam = cams[rec.name]
-        if _footprint_cover(cam, rec.eo, X, Y, Z) < min_cover:
+    for rec in plan.recs:
+        cam = plan.cams[rec.name]
+        if _footprint_cover(cam, rec.eo, X, Y, Z) < settings.min_cover:
             continue
         box = _image_window(cam, rec.eo, np.concatenate([BX, X]), np.concatenate([BY, Y]),
                             zlo - 1.0, zhi + 1.0, int(lim), 2 ** (levels - 1))
         if box is None:
             continue
-        grey = _read_grey(project.image_path(rec), *box)
+        grey = _read_grey(plan.project.image_path(rec), *box)
         pyr = build_pyramid(grey, levels)
         if len(pyr) < levels:
             continue
@@ -1197,11 +1291,10 @@ def _run_tile(recs: Sequence[Any], cams: Dict[str, Any], project: Any, z_in: Arr
                for i in range(len(wins)) for j in range(i + 1, len(wins)))
     h = float(np.mean(P[:, 2]) - zm)
     parallax_per_m = max(base / h / gsd, 1e-6)
-    return adjust_window(z_in, valid, x_first, y_first, spacing, stride, wins, gsd,
-                         parallax_per_m, levels, max_iter=max_iter,
-                         regularisation=regularisation, weight=weight, mode=mode,
-                         grey_px=grey_px,
-                         feedback=feedback)
+    return adjust_window(z_in, valid, x_first, y_first, spacing, plan.stride, wins, gsd,
+                         parallax_per_m, levels, max_iter=settings.max_iter,
+                         regularisation=settings.regularisation, weight=settings.weight,
+                         mode=settings.mode, grey_px=settings.grey_px, feedback=feedback)
 
 
 __all__ = ["MODES", "WindowResult", "adjust_window", "refine_object_space"]
