@@ -21,12 +21,12 @@ from photodem.algorithms.errors import Cancelled, InputError
 from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
-from photodem.algorithms.matching.object_space import (
-    _ImageWindow,
+from photodem.algorithms.matching.object_space import refine_object_space
+from photodem.algorithms.matching.object_space_window import (
+    ImageWindow,
     _screen,
     _second_difference_rows,
     _visibility,
-    refine_object_space,
 )
 from photodem.algorithms.processing import registry
 from photodem.algorithms.project.edits import add_features, create_edits
@@ -119,7 +119,7 @@ def test_visibility_box_shadow_closed_form() -> None:
     Z = surf.ravel()
     far = ExteriorOrientation.from_opk([15.0 + 5000.0, 15.0, 10000.0], 0, 0, 0)
     nadir = ExteriorOrientation.from_opk([15.0, 15.0, 10000.0], 0, 0, 0)
-    wins = [_ImageWindow("far", None, far, 0, 0), _ImageWindow("nadir", None, nadir, 0, 0)]
+    wins = [ImageWindow("far", None, far, 0, 0), ImageWindow("nadir", None, nadir, 0, 0)]
     vis = _visibility(wins, X, Y, Z, surf, x_first, y_first, sp).reshape(2, n, n)
     west_wall = x_first + 20 * sp - 0.5 * sp  # X of the box's west face
     d = west_wall - (x_first + cc * sp)  # horizontal distance to the face (west of it > 0)
