@@ -158,7 +158,7 @@ def pcg(op: Operator, b: Array, minv: Array, x0: Optional[Array] = None, *, tol:
     tol : float
         Relative residual :math:`\|r\|/\|b\|` to reach.
     max_iter : int
-        Iterations at most.
+        Iterations at most (≥ 0).
     rule : CGRule
         Arithmetic choices; the default is :data:`CG_OBJECT_SPACE`.
     feedback : Feedback, optional
@@ -202,7 +202,7 @@ def _iterate(matvec: Callable[[Array], Array], x: Array, r: Array, minv: Array, 
             feedback.check()
         q = matvec(p)
         alpha = scalar(_ratio(rz, dot(p, q), floor))
-        x += alpha * p
+        x += alpha * p  # in place where possible: grids of 16 M cells
         q *= alpha
         r -= q
         if stop.reached(dot(r, r)):
