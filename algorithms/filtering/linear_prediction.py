@@ -106,6 +106,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..linalg import CG_LP, pcg
 from ..surface.gridding import Grid
 from .lp_pyramid import (
     BreaklineSides,
@@ -409,37 +410,9 @@ def covariance_apply(x: Array, c0: float, corr: float,
 
 def _pcg(matvec: Callable[[Array], Array], b: Array, x: Array, minv: Array, tol: float,
          maxiter: int, feedback: Feedback) -> Tuple[Array, int]:
-    """Jacobi-preconditioned conjugate gradients on grid vectors (float32, float64 dots)."""
-
-    def dot(u: Array, v: Array) -> float:
-        # float64 accumulation without BLAS: the same sum whatever the thread count, so every
-        # face (CLI, QGIS, qgis_process) gives bit-identical results
-        return float(np.einsum("i,i->", u.ravel(), v.ravel(), dtype=np.float64))
-
-    bnorm = math.sqrt(dot(b, b))
-    if bnorm == 0:
-        return np.zeros_like(b), 0
-    r = b - matvec(x)
-    z = minv * r
-    p = z.copy()
-    rz = dot(r, z)
-    it = 0
-    while it < maxiter:
-        it += 1
-        feedback.check()
-        ap = matvec(p)
-        alpha = np.float32(rz / max(dot(p, ap), 1e-300))
-        x += alpha * p  # in place where possible: grids of 16 M cells
-        ap *= alpha
-        r -= ap
-        if math.sqrt(dot(r, r)) <= tol * bnorm:
-            break
-        np.multiply(minv, r, out=z)
-        rz_new = dot(r, z)
-        p *= np.float32(rz_new / max(rz, 1e-300))
-        p += z
-        rz = rz_new
-    return x, it
+    """Jacobi-preconditioned conjugate gradients on grid vectors (float32, float64 dots):
+    :func:`..linalg.pcg` with the rule :data:`..linalg.CG_LP`."""
+    return pcg(matvec, b, minv, x, tol=tol, max_iter=maxiter, rule=CG_LP, feedback=feedback)
 
 
 def lp_solve(lz: Array, active: Array, cov: Covariance, noise_scale: Optional[Array] = None,

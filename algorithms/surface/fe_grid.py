@@ -83,13 +83,17 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage, sparse
+from scipy.sparse.linalg import splu
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..linalg import CG_FE, jacobi, pcg
 from .gridding import Grid, polygon_mask
 
 Array = NDArray[Any]
@@ -254,8 +258,6 @@ class _Level:
 
     def normal(self, w: Array) -> Tuple[Any, Array]:
         """Normal matrix (CSR) and right-hand side for the weights ``w`` of the used points."""
-        from scipy import sparse
-
         n = self.n
         diags = {k: d.copy() for k, d in self.R.items()}
         for off, ka, kb in self._pairs:
@@ -277,39 +279,6 @@ class _Level:
         return np.einsum("ij,ij->i", self.vals, x[self.cols])
 
 
-def _dot(a: Array, b: Array) -> float:
-    # einsum, not BLAS: no thread start-up per call on a busy machine (4× faster here)
-    return float(np.einsum("i,i->", a, b))
-
-
-def _pcg(N: Any, b: Array, x: Array, tol: float, maxiter: int,
-         feedback: Feedback) -> Tuple[Array, int]:
-    """Jacobi-preconditioned conjugate gradients from ``x`` until ‖r‖ ≤ tol·‖b‖."""
-    dinv = 1.0 / N.diagonal()
-    r = b - N @ x
-    lim = (tol * tol) * max(_dot(b, b), 1e-300)
-    if _dot(r, r) <= lim:
-        return x, 0
-    zr = dinv * r
-    p = zr.copy()
-    rz = _dot(r, zr)
-    for k in range(1, maxiter + 1):
-        q = N @ p
-        alpha = rz / _dot(p, q)
-        x += alpha * p
-        r -= alpha * q
-        if _dot(r, r) <= lim:
-            return x, k
-        if k % 100 == 0:
-            feedback.check()
-        np.multiply(dinv, r, out=zr)
-        rz_new = _dot(r, zr)
-        p *= rz_new / rz
-        p += zr
-        rz = rz_new
-    return x, maxiter
-
-
 def _block_any(mask: Array) -> Array:
     h, w = mask.shape
     m = np.pad(mask, ((0, h % 2), (0, w % 2)))
@@ -324,8 +293,6 @@ def _block_mean(a: Array) -> Array:
 
 def _prolong(coarse: Array, shape: Tuple[int, int]) -> Array:
     """Bilinear interpolation of a coarse node grid (factor 2) at the fine nodes."""
-    from scipy import ndimage
-
     h, w = shape
     rr = (np.arange(h) + 0.5) / 2.0 - 0.5
     cc = (np.arange(w) + 0.5) / 2.0 - 0.5
@@ -357,8 +324,6 @@ class _TileProblem:
     def solve(self, w: Array, x0: Optional[Array], solver: str, tol: float, maxiter: int,
               feedback: Feedback) -> Tuple[Array, int]:
         """Node heights of level 0 (NaN where not unknown), CG iterations used."""
-        from scipy.sparse.linalg import splu
-
         its = 0
         if solver == "direct":
             lv = self.levels[0]
@@ -368,7 +333,8 @@ class _TileProblem:
         if x0 is not None:  # a warm start (robust iterations): only the finest level
             lv = self.levels[0]
             N, b = lv.normal(w[lv.used])
-            x, its = _pcg(N, b, _nan_nearest(x0).ravel().astype(float), tol, maxiter, feedback)
+            x, its = pcg(N, b, jacobi(N), _nan_nearest(x0).ravel().astype(float), tol=tol,
+                          max_iter=maxiter, rule=CG_FE, feedback=feedback)
             return self._grid(lv, x), its
         grid = None
         for lv in reversed(self.levels):
@@ -377,7 +343,8 @@ class _TileProblem:
                 x = splu(N.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(b)
             else:
                 start = _prolong(_nan_nearest(grid), lv.shape).ravel().astype(float)
-                x, k = _pcg(N, b, start, tol, maxiter, feedback)
+                x, k = pcg(N, b, jacobi(N), start, tol=tol, max_iter=maxiter, rule=CG_FE,
+                           feedback=feedback)
                 its += k
             grid = self._grid(lv, x)
         assert grid is not None
@@ -395,8 +362,6 @@ class _TileProblem:
 
 
 def _nan_nearest(a: Array) -> Array:
-    from scipy import ndimage
-
     bad = ~np.isfinite(a)
     if not bad.any() or bad.all():
         return np.where(bad, 0.0, a)
@@ -494,27 +459,63 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         (uint32 grid, points per cell), ``residuals`` (float32 per given point, NaN if unused),
         ``robust_weight`` (float32 per given point, NaN if unused; None unless robust).
     """
-    from scipy import ndimage
-
     t_start = time.perf_counter()
     feedback = ensure_feedback(feedback)
     if solver not in ("cg", "direct"):
         raise InputError(f"Unknown FE solver '{solver}'; use 'cg' or 'direct'.")
     if not (smoothing > 0 and math.isfinite(smoothing)):
         raise InputError(f"The smoothing must be a positive number, got {smoothing}.")
-    tile, overlap = max(8, int(tile)), max(0, int(overlap))
     x = np.ravel(np.asarray(x, float))
     y = np.ravel(np.asarray(y, float))
     z = np.ravel(np.asarray(z, float))
-    n_in = z.size
-    w = (np.ones(n_in) if weights is None
+    w = (np.ones(z.size) if weights is None
          else np.ravel(np.broadcast_to(np.asarray(weights, float), z.shape)).copy())
-    h, wd = grid.shape
-    s = grid.spacing
-    x0, y0 = grid.transform.c, grid.transform.f
     domain = ~polygon_mask(exclusions, grid)
     if len(boundaries):
         domain &= polygon_mask(boundaries, grid)
+    obs = _observations(x, y, z, w, grid, domain, breaklines, breakline_weight)
+    lam = float(smoothing) * obs.wref * _spacing_factor(reference_spacing, grid.spacing)
+    active, unknown = _active_nodes(domain, obs, max_gap, grid.spacing)
+    zref = float(np.median(obs.pz))
+    opts = _SolveOptions(solver, tol, maxiter, robust, robust_iterations, robust_floor)
+    mosaic = _Mosaic(obs, active, unknown, _prior(obs, zref, grid.shape), lam, zref,
+                     max(8, int(tile)), max(0, int(overlap)), opts)
+    its_total = 0
+    for t in range(mosaic.n_tiles):
+        feedback.progress(100.0 * t / mosaic.n_tiles)
+        its_total += mosaic.add(t, feedback)
+    feedback.progress(100.0)
+    out = mosaic.surface()
+    run = {"lambda": lam, "smoothing": float(smoothing), "tiles": mosaic.n_tiles,
+           "cg_iterations": int(its_total), "solver": solver,
+           "seconds": time.perf_counter() - t_start}
+    return out.astype(np.float32), _summary(out, obs, z, mosaic, robust, run)
+
+
+@dataclass
+class _Observations:
+    """The observations of the grid: the given points in the domain, then the densified
+    vertices of 3-D breaklines (node coordinates ``pu, pv``, cells ``pr, pc``)."""
+
+    pid: Array  # indices of the given points that are used
+    n_bl: int  # breakline vertices, appended after the points
+    pu: Array
+    pv: Array
+    pz: Array
+    pw: Array
+    pr: Array
+    pc: Array
+    seg_uv: Array  # breakline segments u1, v1, u2, v2 in node coordinates
+    wref: float  # median weight of the used points
+    count: Array  # points per cell
+
+
+def _observations(x: Array, y: Array, z: Array, w: Array, grid: Grid, domain: Array,
+                  breaklines: Sequence[Any], breakline_weight: float) -> _Observations:
+    """Points in the domain and 3-D breakline vertices as observations (module notes)."""
+    h, wd = grid.shape
+    s = grid.spacing
+    x0, y0 = grid.transform.c, grid.transform.f
     row, col = grid.cell_of(x, y)
     ok = (row >= 0) & np.isfinite(z) & np.isfinite(w) & (w > 0)
     ok[ok] = domain[row[ok], col[ok]]
@@ -523,7 +524,6 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         raise InputError("No point lies in the grid's measuring area (outside the boundary or "
                          "in exclusion areas); check the points, polygons and CRS.")
     wref = float(np.median(w[pid]))
-    lam = float(smoothing) * wref * _spacing_factor(reference_spacing, s)
     count = np.bincount(row[pid] * wd + col[pid], minlength=h * wd).reshape(h, wd)
     # breaklines: segments in node coordinates, 3-D vertices as observations
     segs = _segments(breaklines)
@@ -537,126 +537,192 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         keep = br >= 0
         keep[keep] = domain[br[keep], bc[keep]]
         ox, oy, oz = bx[keep], by[keep], bz[keep]
-    n_bl = ox.size
     px = np.concatenate([x[pid], ox])
     py = np.concatenate([y[pid], oy])
     pz = np.concatenate([z[pid], oz])
-    pw = np.concatenate([w[pid], np.full(n_bl, breakline_weight * wref)])
-    pu, pv = (px - x0) / s - 0.5, (y0 - py) / s - 0.5
+    pw = np.concatenate([w[pid], np.full(ox.size, breakline_weight * wref)])
     pr, pc = grid.cell_of(px, py)
-    # cells with data, gaps, parts of the domain without data
-    measured = np.zeros((h, wd), bool)
-    measured[pr, pc] = True
+    return _Observations(pid, ox.size, (px - x0) / s - 0.5, (y0 - py) / s - 0.5, pz, pw, pr,
+                         pc, seg_uv, wref, count)
+
+
+def _active_nodes(domain: Array, obs: _Observations, max_gap: Optional[float],
+                  spacing: float) -> Tuple[Array, Array]:
+    """Nodes that get a height (``active``) and the unknowns (active nodes and their ring).
+
+    A node is active in the domain unless it lies farther than ``max_gap``/2 from data, or
+    in a connected part of the domain without data.
+    """
+    measured = np.zeros(domain.shape, bool)
+    measured[obs.pr, obs.pc] = True
     active = domain.copy()
     hole = domain & ~measured
     if max_gap is not None and math.isfinite(max_gap) and hole.any():
         # per node, not per connected gap: scattered points leave one connected "gap"
         # around all of them, which the per-gap rule of gridding.fill_gaps would drop whole
         dist = ndimage.distance_transform_edt(~measured)
-        active &= ~(2.0 * dist * s > max_gap + 1e-9)
+        active &= ~(2.0 * dist * spacing > max_gap + 1e-9)
     labels, n = ndimage.label(active)
     if n:
         has = np.concatenate([[False], np.asarray(ndimage.maximum(
             measured, labels, index=np.arange(1, n + 1))) > 0])
         active &= has[labels]
-    unknown = ndimage.binary_dilation(active, structure=np.ones((3, 3), bool))
-    # ridge target: the nearest measured cell's mean height (also the height offset)
-    zref = float(np.median(pz))
-    cell_sum = np.bincount(pr * wd + pc, weights=pz - zref, minlength=h * wd)
-    cell_n = np.bincount(pr * wd + pc, minlength=h * wd)
+    return active, ndimage.binary_dilation(active, structure=np.ones((3, 3), bool))
+
+
+def _prior(obs: _Observations, zref: float, shape: Tuple[int, int]) -> Array:
+    """Ridge target of every node: the nearest measured cell's mean height − ``zref``."""
+    h, wd = shape
+    cell = obs.pr * wd + obs.pc
+    cell_sum = np.bincount(cell, weights=obs.pz - zref, minlength=h * wd)
+    cell_n = np.bincount(cell, minlength=h * wd)
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = (cell_sum / cell_n).reshape(h, wd)
-    prior = _nan_nearest(mean)
-    # tiles: cores of tile × tile nodes, extended by the overlap, blended by linear ramps
-    acc = np.zeros((h, wd))
-    acc_w = np.zeros((h, wd))
-    rw_all = np.full(pz.size, np.nan)
-    ty, tx = math.ceil(h / tile), math.ceil(wd / tile)
-    tj = np.clip(np.floor(pu), 0, max(wd - 2, 0)).astype(np.int64)  # stencil base nodes
-    ti = np.clip(np.floor(pv), 0, max(h - 2, 0)).astype(np.int64)
-    its_total = 0
-    for t in range(ty * tx):
-        feedback.progress(100.0 * t / (ty * tx))
-        r_core, c_core = divmod(t, tx)
-        r0, c0 = max(0, r_core * tile - overlap), max(0, c_core * tile - overlap)
-        r1 = min(h, (r_core + 1) * tile + overlap)
-        c1 = min(wd, (c_core + 1) * tile + overlap)
-        un = unknown[r0:r1, c0:c1]
-        if not active[r0:r1, c0:c1].any():
-            continue
+    return _nan_nearest(mean)
+
+
+@dataclass(frozen=True)
+class _SolveOptions:
+    """Solver and robust-reweighting options of :func:`fe_interpolate`."""
+
+    solver: str
+    tol: float
+    maxiter: int
+    robust: bool
+    robust_iterations: int
+    robust_floor: float
+
+
+class _Mosaic:
+    """Tiles of ``tile`` × ``tile`` nodes, each solved with ``overlap`` nodes on every side
+    and blended into the grid by linear ramps (module notes)."""
+
+    def __init__(self, obs: _Observations, active: Array, unknown: Array, prior: Array,
+                 lam: float, zref: float, tile: int, overlap: int, opts: _SolveOptions) -> None:
+        self.obs, self.active, self.unknown, self.prior = obs, active, unknown, prior
+        self.lam, self.zref, self.tile, self.overlap, self.opts = lam, zref, tile, overlap, opts
+        h, wd = active.shape
+        self.acc = np.zeros((h, wd))
+        self.acc_w = np.zeros((h, wd))
+        self.rw_all = np.full(obs.pz.size, np.nan)
+        self.ty, self.tx = math.ceil(h / tile), math.ceil(wd / tile)
+        self.n_tiles = self.ty * self.tx
+        self.tj = np.clip(np.floor(obs.pu), 0, max(wd - 2, 0)).astype(np.int64)  # stencil base
+        self.ti = np.clip(np.floor(obs.pv), 0, max(h - 2, 0)).astype(np.int64)
+
+    def _window(self, t: int) -> Tuple[int, int, int, int, int, int]:
+        """Core tile (row, col) and the extended window r0, r1, c0, c1 of tile ``t``."""
+        h, wd = self.active.shape
+        r_core, c_core = divmod(t, self.tx)
+        r0 = max(0, r_core * self.tile - self.overlap)
+        c0 = max(0, c_core * self.tile - self.overlap)
+        r1 = min(h, (r_core + 1) * self.tile + self.overlap)
+        c1 = min(wd, (c_core + 1) * self.tile + self.overlap)
+        return r_core, c_core, r0, r1, c0, c1
+
+    def add(self, t: int, feedback: Feedback) -> int:
+        """Solve tile ``t`` and blend it into the grid; returns its CG iterations."""
+        h, wd = self.active.shape
+        r_core, c_core, r0, r1, c0, c1 = self._window(t)
+        if not self.active[r0:r1, c0:c1].any():
+            return 0
+        tj, ti, obs = self.tj, self.ti, self.obs
         # points whose bilinear stencil lies inside the window
         sel = np.flatnonzero((tj >= c0) & (np.minimum(tj + 1, wd - 1) < c1) & (ti >= r0)
                              & (np.minimum(ti + 1, h - 1) < r1))
         if sel.size == 0:
-            continue
-        lseg = seg_uv - np.array([c0, r0, c0, r0]) if len(seg_uv) else seg_uv
-        prob = _TileProblem((r1 - r0, c1 - c0), pu[sel] - c0, pv[sel] - r0, pz[sel] - zref,
-                            pw[sel], un, lseg, lam, wref, prior[r0:r1, c0:c1],
-                            cascade=solver == "cg")
-        lv0 = prob.levels[0]
-        is_pt = sel[lv0.used] < pid.size  # robust weights act on points, not breaklines
-        wt = pw[sel].copy()
-        sol, its = prob.solve(wt, None, solver, tol, maxiter, feedback)
-        its_total += its
-        rw = np.ones(int(lv0.used.sum()))
-        if robust:
-            wu = wt[lv0.used]
-            sig = 0.0
-            for it in range(max(1, int(robust_iterations))):
-                e = prob.residuals(sol)
-                en = np.abs(e) * np.sqrt(wu / wref)
-                if it <= 1:  # σ from the plain and the Huber solution, then kept: no collapse
-                    sig = 1.4826 * float(np.median(en[is_pt])) if is_pt.any() else 0.0
-                    sig = max(sig, float(robust_floor))
-                if not sig > 0:
-                    break
-                eb = en / sig
-                rw = (np.minimum(1.0, _HUBER / np.maximum(eb, 1e-12)) if it == 0
-                      else np.exp(-0.5 * (eb / _WELSCH) ** 2))
-                rw = np.where(is_pt, np.maximum(rw, 1e-6), 1.0)
-                wt_used = wu * rw
-                wt = pw[sel].copy()
-                wt[lv0.used] = wt_used
-                sol, its = prob.solve(wt, sol if solver == "cg" else None, solver, tol,
-                                      maxiter, feedback)
-                its_total += its
+            return 0
+        seg = obs.seg_uv
+        lseg = seg - np.array([c0, r0, c0, r0]) if len(seg) else seg
+        prob = _TileProblem((r1 - r0, c1 - c0), obs.pu[sel] - c0, obs.pv[sel] - r0,
+                            obs.pz[sel] - self.zref, obs.pw[sel], self.unknown[r0:r1, c0:c1],
+                            lseg, self.lam, obs.wref, self.prior[r0:r1, c0:c1],
+                            cascade=self.opts.solver == "cg")
+        sol, its, rw = self._solve(prob, sel, feedback)
+        if self.opts.robust:
             # robust weights of the points whose base node lies in the tile's core
-            g = sel[lv0.used]
-            core = ((tj[g] >= c_core * tile) & (tj[g] < (c_core + 1) * tile)
-                    & (ti[g] >= r_core * tile) & (ti[g] < (r_core + 1) * tile))
-            rw_all[g[core]] = rw[core]
-        ramp = np.outer(_ramp(r1 - r0, r0 == 0, r1 == h, overlap),
-                        _ramp(c1 - c0, c0 == 0, c1 == wd, overlap))
+            g = sel[prob.levels[0].used]
+            core = ((tj[g] >= c_core * self.tile) & (tj[g] < (c_core + 1) * self.tile)
+                    & (ti[g] >= r_core * self.tile) & (ti[g] < (r_core + 1) * self.tile))
+            self.rw_all[g[core]] = rw[core]
+        ramp = np.outer(_ramp(r1 - r0, r0 == 0, r1 == h, self.overlap),
+                        _ramp(c1 - c0, c0 == 0, c1 == wd, self.overlap))
         good = np.isfinite(sol)
-        acc[r0:r1, c0:c1] += np.where(good, sol, 0.0) * ramp * good
-        acc_w[r0:r1, c0:c1] += ramp * good
-    feedback.progress(100.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = np.where(active & (acc_w > 0), acc / acc_w + zref, np.nan)
-    # residuals of the given points against the blended grid
+        self.acc[r0:r1, c0:c1] += np.where(good, sol, 0.0) * ramp * good
+        self.acc_w[r0:r1, c0:c1] += ramp * good
+        return its
+
+    def _solve(self, prob: _TileProblem, sel: Array, feedback: Feedback
+               ) -> Tuple[Array, int, Array]:
+        """Plain solution of a tile, then the robust re-solutions (module notes).
+
+        Returns the node heights, the CG iterations and the robust weights of the tile's
+        used observations (ones without ``robust``).
+        """
+        o, pw, wref = self.opts, self.obs.pw, self.obs.wref
+        lv0 = prob.levels[0]
+        is_pt = sel[lv0.used] < self.obs.pid.size  # robust weights act on points only
+        wt = pw[sel].copy()
+        sol, its = prob.solve(wt, None, o.solver, o.tol, o.maxiter, feedback)
+        rw = np.ones(int(lv0.used.sum()))
+        if not o.robust:
+            return sol, its, rw
+        wu = wt[lv0.used]
+        sig = 0.0
+        for it in range(max(1, int(o.robust_iterations))):
+            en = np.abs(prob.residuals(sol)) * np.sqrt(wu / wref)
+            if it <= 1:  # σ from the plain and the Huber solution, then kept: no collapse
+                sig = 1.4826 * float(np.median(en[is_pt])) if is_pt.any() else 0.0
+                sig = max(sig, float(o.robust_floor))
+            if not sig > 0:
+                break
+            rw = _robust_weights(en / sig, it, is_pt)
+            wt = pw[sel].copy()
+            wt[lv0.used] = wu * rw
+            sol, k = prob.solve(wt, sol if o.solver == "cg" else None, o.solver, o.tol,
+                                o.maxiter, feedback)
+            its += k
+        return sol, its, rw
+
+    def surface(self) -> Array:
+        """The blended heights (float64), NaN where no node is active."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.active & (self.acc_w > 0), self.acc / self.acc_w + self.zref,
+                            np.nan)
+
+
+def _robust_weights(eb: Array, it: int, is_pt: Array) -> Array:
+    """Huber weights (first re-solution), then Welsch's; breakline vertices keep 1."""
+    rw = (np.minimum(1.0, _HUBER / np.maximum(eb, 1e-12)) if it == 0
+          else np.exp(-0.5 * (eb / _WELSCH) ** 2))
+    return np.where(is_pt, np.maximum(rw, 1e-6), 1.0)
+
+
+def _summary(out: Array, obs: _Observations, z: Array, mosaic: _Mosaic, robust: bool,
+             run: Dict[str, Any]) -> Dict[str, Any]:
+    """The info dict of :func:`fe_interpolate`: point statistics (residuals against the
+    blended grid, robust weights, counts) around the figures of the ``run``."""
+    n_in, pid = z.size, obs.pid
     res = np.full(n_in, np.nan)
-    zi = _bilinear(out, pu[:pid.size], pv[:pid.size])
-    res[pid] = z[pid] - zi
+    res[pid] = z[pid] - _bilinear(out, obs.pu[:pid.size], obs.pv[:pid.size])
     rwp = np.full(n_in, np.nan)
     if robust:
-        rwp[pid] = rw_all[:pid.size]
+        rwp[pid] = mosaic.rw_all[:pid.size]
     e = res[pid]
     fin = np.isfinite(e)
     kept = fin & ~(rwp[pid] < 0.5) if robust else fin
-    info: Dict[str, Any] = {
-        "points": int(n_in), "used": int(pid.size), "breakline_vertices": int(n_bl),
-        "rms": float(np.sqrt(np.mean(e[kept] ** 2))) if kept.any() else float("nan"),
+    nan = float("nan")
+    return {
+        "points": int(n_in), "used": int(pid.size), "breakline_vertices": int(obs.n_bl),
+        "rms": float(np.sqrt(np.mean(e[kept] ** 2))) if kept.any() else nan,
         "sigma_mad": (float(1.4826 * np.median(np.abs(e[kept] - np.median(e[kept]))))
-                      if kept.any() else float("nan")),
-        "max_abs": float(np.abs(e[kept]).max()) if kept.any() else float("nan"),
+                      if kept.any() else nan),
+        "max_abs": float(np.abs(e[kept]).max()) if kept.any() else nan,
         "downweighted": int(np.sum(rwp[pid] < 0.5)) if robust else 0,
-        "lambda": lam, "smoothing": float(smoothing), "tiles": ty * tx,
-        "cg_iterations": int(its_total), "solver": solver,
-        "seconds": time.perf_counter() - t_start,
-        "count": count.astype(np.uint32), "residuals": res.astype(np.float32),
+        **run,
+        "count": obs.count.astype(np.uint32), "residuals": res.astype(np.float32),
         "robust_weight": rwp.astype(np.float32) if robust else None,
     }
-    return out.astype(np.float32), info
 
 
 def _bilinear(g: Array, u: Array, v: Array) -> Array:

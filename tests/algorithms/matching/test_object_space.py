@@ -15,21 +15,18 @@ import numpy as np
 import pytest
 import rasterio
 from affine import Affine
-from scipy import sparse
-from scipy.sparse.linalg import spsolve
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, InputError
 from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
-from photodem.algorithms.matching.object_space import (
-    _ImageWindow,
+from photodem.algorithms.matching.object_space import refine_object_space
+from photodem.algorithms.matching.object_space_window import (
+    ImageWindow,
     _screen,
     _second_difference_rows,
     _visibility,
-    pcg,
-    refine_object_space,
 )
 from photodem.algorithms.processing import registry
 from photodem.algorithms.project.edits import add_features, create_edits
@@ -99,16 +96,6 @@ def _errors(scene, path):
 
 
 # -- numerics ---------------------------------------------------------------------------------
-def test_pcg_equals_direct_solution() -> None:
-    rng = np.random.default_rng(0)
-    A = sparse.random(400, 120, density=0.05, random_state=3, format="csr") \
-        + sparse.eye(400, 120, format="csr")
-    N = (A.T @ A).tocsr()
-    b = rng.standard_normal(120)
-    x, it = pcg(N, b, tol=1e-12)
-    assert np.allclose(x, spsolve(N.tocsc(), b), atol=1e-8) and 0 < it < 400
-
-
 def test_curvature_rows_vanish_on_planes() -> None:
     R = _second_difference_rows(5, 7)
     rr, cc = np.mgrid[0:5, 0:7]
@@ -132,7 +119,7 @@ def test_visibility_box_shadow_closed_form() -> None:
     Z = surf.ravel()
     far = ExteriorOrientation.from_opk([15.0 + 5000.0, 15.0, 10000.0], 0, 0, 0)
     nadir = ExteriorOrientation.from_opk([15.0, 15.0, 10000.0], 0, 0, 0)
-    wins = [_ImageWindow("far", None, far, 0, 0), _ImageWindow("nadir", None, nadir, 0, 0)]
+    wins = [ImageWindow("far", None, far, 0, 0), ImageWindow("nadir", None, nadir, 0, 0)]
     vis = _visibility(wins, X, Y, Z, surf, x_first, y_first, sp).reshape(2, n, n)
     west_wall = x_first + 20 * sp - 0.5 * sp  # X of the box's west face
     d = west_wall - (x_first + cc * sp)  # horizontal distance to the face (west of it > 0)
