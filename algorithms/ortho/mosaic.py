@@ -49,7 +49,7 @@ import json
 import math
 import time
 from contextlib import ExitStack
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
@@ -858,13 +858,95 @@ def mosaic_project(
     return result
 
 
+@dataclass
+class MosaicOptions:
+    """Seams, balancing and tiling of a mosaic (the keywords of :func:`mosaic_orthos`)."""
+
+    seamlines: str = "auto"
+    balance: str = "gain_offset"
+    feather: Optional[float] = None
+    reference: Optional[str] = None
+    corridor: Optional[float] = None
+    min_height: float = 2.0
+    tile: int = 1024
+    seam_cells: int = 1024
+
+
+@dataclass
+class MosaicSources:
+    """What a mosaic is made of: orthos, or the project's images rectified on a DEM.
+
+    Attributes
+    ----------
+    inputs : sequence of paths, optional
+        Orthos; they win over ``dem`` (with a warning when both are given).
+    project : Project, optional
+        Needed with ``dem`` and for ``seamlines="edits"``.
+    dem : path, optional
+        Surface to rectify every project image on (:func:`mosaic_project`).
+    dsm, dtm : path, optional
+        Surfaces of the seam cost (and of true orthos).
+    gsd : float, optional
+        Cell size (m).
+    resampling : str
+        Resampling of the rectification.
+    true_ortho : bool
+        Rectify on the DSM with the occlusion test.
+    """
+
+    inputs: Optional[Sequence[PathLike]] = None
+    project: Any = None
+    dem: Optional[PathLike] = None
+    dsm: Optional[PathLike] = None
+    dtm: Optional[PathLike] = None
+    gsd: Optional[float] = None
+    resampling: str = "bilinear"
+    true_ortho: bool = False
+
+
+def run_mosaic(output: PathLike, sources: MosaicSources, options: MosaicOptions,
+               feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """``mosaic``: mosaic the given orthos, or rectify the project's images first.
+
+    Returns
+    -------
+    dict
+        :func:`mosaic_orthos`'s (or :func:`mosaic_project`'s) result.
+
+    Raises
+    ------
+    InputError
+        Neither orthos nor a DEM, or a DEM without the project.
+    """
+    fb = ensure_feedback(feedback)
+    keywords = asdict(options)
+    if sources.inputs:
+        if sources.dem:
+            fb.warning("Both orthos and a DEM are given; the orthos are mosaicked "
+                       "and the DEM is not used.")
+        return mosaic_orthos(sources.inputs, output, gsd=sources.gsd, dsm=sources.dsm,
+                             dtm=sources.dtm, project=sources.project, feedback=fb, **keywords)
+    if sources.dem:
+        if sources.project is None:
+            raise InputError("Rectifying needs the project: give 'project' with 'dem' "
+                             "(or give the orthos as 'inputs').")
+        return mosaic_project(sources.project, sources.dem, output, gsd=sources.gsd,
+                              resampling=sources.resampling, dsm=sources.dsm,
+                              true_ortho=sources.true_ortho, dtm=sources.dtm, feedback=fb,
+                              **keywords)
+    raise InputError("Nothing to mosaic: give the orthos ('inputs'), or a project and "
+                     "a DEM ('dem') to rectify every image first.")
+
 __all__ = [
     "SEAMLINE_MODES",
+    "MosaicOptions",
+    "MosaicSources",
     "OrthoInfo",
     "check_inputs",
     "mosaic_grid",
     "mosaic_orthos",
     "mosaic_project",
     "read_ortho_info",
+    "run_mosaic",
     "sibling_paths",
 ]

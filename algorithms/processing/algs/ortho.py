@@ -257,7 +257,8 @@ class Mosaic(Algorithm):
         return [p for k, p in sibling_paths(path).items() if k != "mosaic"]
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...ortho.mosaic import mosaic_orthos, mosaic_project  # lazy: keeps photodem list fast
+        # lazy: keeps photodem list fast
+        from ...ortho.mosaic import MosaicOptions, MosaicSources, run_mosaic
 
         g = params.get
         project = Project.load(params["project"]) if g("project") else None
@@ -265,28 +266,17 @@ class Mosaic(Algorithm):
         if output is None:
             raise InputError("Give the output file of the mosaic (or a project, whose "
                              "products/mosaic/ folder is then used).")
-        options = {"seamlines": g("seamlines") or "auto",
-                   "balance": g("balance") or "gain_offset", "feather": g("feather"),
-                   "reference": g("reference") or None, "corridor": g("corridor") or None,
-                   "min_height": 2.0 if g("min_height") is None else params["min_height"],
-                   "tile": g("tile") or 1024, "seam_cells": g("seam_cells") or 1024}
-        if g("inputs"):
-            if g("dem"):
-                feedback.warning("Both orthos and a DEM are given; the orthos are mosaicked "
-                                 "and the DEM is not used.")
-            res = mosaic_orthos(params["inputs"], output, gsd=g("gsd") or None, dsm=g("dsm"),
-                                dtm=g("dtm"), project=project, feedback=feedback, **options)
-        elif g("dem"):
-            if project is None:
-                raise InputError("Rectifying needs the project: give 'project' with 'dem' "
-                                 "(or give the orthos as 'inputs').")
-            res = mosaic_project(project, params["dem"], output, gsd=g("gsd") or None,
-                                 resampling=g("resampling") or "bilinear", dsm=g("dsm"),
-                                 true_ortho=bool(g("true_ortho")), dtm=g("dtm"),
-                                 feedback=feedback, **options)
-        else:
-            raise InputError("Nothing to mosaic: give the orthos ('inputs'), or a project and "
-                             "a DEM ('dem') to rectify every image first.")
+        sources = MosaicSources(
+            inputs=g("inputs"), project=project, dem=g("dem"), dsm=g("dsm"), dtm=g("dtm"),
+            gsd=g("gsd") or None, resampling=g("resampling") or "bilinear",
+            true_ortho=bool(g("true_ortho")))
+        options = MosaicOptions(
+            seamlines=g("seamlines") or "auto", balance=g("balance") or "gain_offset",
+            feather=g("feather"), reference=g("reference") or None,
+            corridor=g("corridor") or None,
+            min_height=2.0 if g("min_height") is None else params["min_height"],
+            tile=g("tile") or 1024, seam_cells=g("seam_cells") or 1024)
+        res = run_mosaic(output, sources, options, feedback)
         return {k: res[k] for k in ("mosaic", "seamlines", "report", "gsd", "cells", "seams",
                                     "balance")}
 
