@@ -43,10 +43,21 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
+import rasterio
 from numpy.typing import ArrayLike, NDArray
+from rasterio.enums import ColorInterp
+from rasterio.warp import Resampling, reproject, transform_bounds
+from rasterio.windows import Window, from_bounds
+from scipy import ndimage
 
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, ensure_feedback
+from ..matching.lsm import lsm_match
+from ..matching.ncc import ncc_search_2d
+from ..project.model import Project
+from ..raster.io import atomic_output, gtiff_profile
+from ..raster.sample import bilinear
+from ..surface.point_output import write_points
 
 PathLike = Union[str, Path]
 Array = NDArray[np.float64]
@@ -104,8 +115,6 @@ def displacement_field(x: ArrayLike, y: ArrayLike, error: ArrayLike, z_ref: Arra
 
 
 def _grid_of(path: PathLike) -> Tuple[Any, Any, int, int]:
-    import rasterio
-
     p = Path(path)
     if not p.is_file():
         raise InputError(f"Raster '{p}' does not exist; check the path.")
@@ -121,10 +130,6 @@ def _read_on_grid(path: PathLike, transform: Any, crs: Any, width: int, height: 
     A raster on the same grid (same CRS, cell size and whole-cell offset) is read directly;
     anything else is resampled bilinearly (reprojected, with a warning once per file).
     """
-    import rasterio
-    from rasterio.warp import Resampling, reproject
-    from rasterio.windows import Window
-
     with rasterio.open(path) as src:
         same_crs = src.crs == crs or (src.crs is None or crs is None)
         t = src.transform
@@ -161,6 +166,138 @@ def _seen_by(camera: Any, eo: Any, x: Array, y: Array, z: Array) -> NDArray[np.b
     col, row = camera.camera_to_pixel(p)
     return ((col >= -0.5) & (col <= camera.width - 0.5) & (row >= -0.5)
             & (row <= camera.height - 0.5))
+
+
+@dataclass
+class _PredictionGrid:
+    """Output grid of a predicted displacement and where its heights come from.
+
+    ``z_const`` is the constant true height used when only the error raster is given.
+    """
+
+    transform: Any
+    crs: Any
+    width: int
+    height: int
+    error: Optional[PathLike]
+    dem: Optional[PathLike]
+    reference: Optional[PathLike]
+    z_const: Optional[float]
+
+    @property
+    def base(self) -> PathLike:
+        """The raster whose grid is the output grid."""
+        return self.error if self.error is not None else self.dem  # type: ignore[return-value]
+
+    def heights(self, row0: int, nrows: int, feedback: Feedback, warned: Dict[str, bool]
+                ) -> Tuple[Array, Array]:
+        """DEM error e and true height Z_ref on rows ``row0 … row0+nrows`` of the grid."""
+        block = (self.transform, self.crs, self.width, self.height, row0, nrows, feedback,
+                 warned)
+        if self.error is not None:
+            e = _read_on_grid(self.error, *block)
+            if self.reference is not None:
+                z_ref = _read_on_grid(self.reference, *block)
+            elif self.dem is not None:
+                z_ref = _read_on_grid(self.dem, *block) - e
+            else:
+                z_ref = np.full_like(e, float(self.z_const))  # type: ignore[arg-type]
+        else:
+            z_dem = _read_on_grid(self.dem, *block)  # type: ignore[arg-type]
+            z_ref = _read_on_grid(self.reference, *block)  # type: ignore[arg-type]
+            e = z_dem - z_ref
+        return e, z_ref
+
+
+def _prediction_grid(proj: Project, error: Optional[PathLike], dem: Optional[PathLike],
+                     reference: Optional[PathLike], terrain_height: Optional[float]
+                     ) -> _PredictionGrid:
+    """Check the height inputs and take the output grid from the error raster or the DEM."""
+    if error is None and (dem is None or reference is None):
+        raise InputError("Give the DEM-error raster (DEM − reference), or both the DEM and the "
+                         "reference DEM, to predict the ortho displacement.")
+    base = error if error is not None else dem
+    transform, crs, width, height = _grid_of(base)  # type: ignore[arg-type]
+    if crs is None and proj.crs:
+        crs = rasterio.crs.CRS.from_user_input(proj.crs)
+    z_const = None
+    if error is not None and dem is None and reference is None:
+        z_const = terrain_height if terrain_height is not None else proj.terrain_height
+        if z_const is None:
+            raise InputError("The flying height above the ground needs the true heights: give "
+                             "the reference DEM, the DEM, or a terrain height.")
+    return _PredictionGrid(transform, crs, width, height, error, dem, reference, z_const)
+
+
+@dataclass
+class _DisplacementStats:
+    """Running sums of the predicted |d| (float64, exact enough) and a histogram for p95."""
+
+    n: int = 0
+    s1: float = 0.0
+    s2: float = 0.0
+    s_h: float = 0.0
+    mx: float = 0.0
+    max_e: float = 0.0
+    edges: Optional[Array] = None
+    hist: Optional[NDArray[np.int64]] = None
+
+    def add(self, vals: Array, heights: Array, errors: Array) -> None:
+        """Add the |d| of seen cells, their flying heights Z0 − Z_ref and their errors."""
+        if not vals.size:
+            return
+        self.n += vals.size
+        self.s1 += float(vals.sum())
+        self.s2 += float(np.square(vals).sum())
+        self.s_h += float(heights.sum())
+        self.mx = max(self.mx, float(vals.max()))
+        self.max_e = max(self.max_e, float(np.abs(errors).max()))
+        if self.edges is None:  # 1 mm bins up to 1 km: exact enough for p95
+            self.edges = np.linspace(0.0, 1000.0, 1_000_001)
+            self.hist = np.zeros(self.edges.size - 1, np.int64)
+        self.hist += np.histogram(np.minimum(vals, 999.9995), bins=self.edges)[0]
+
+    def summary(self, camera: Any) -> Dict[str, Any]:
+        """The statistics of :func:`predict_displacement`'s result (rounded as reported)."""
+        n, mx = self.n, self.mx
+        h_mean = self.s_h / n
+        gsd = float(camera.gsd(h_mean))
+        cum = np.cumsum(self.hist)
+        p95 = float(self.edges[int(np.searchsorted(cum, 0.95 * n)) + 1])  # type: ignore[index]
+        above = 100.0 * float(n - cum[min(int(gsd * 1000.0), cum.size - 1)]) / n
+        return {
+            "flying_height_m": round(h_mean, 3),
+            "gsd_m": round(gsd, 5),
+            "cells": int(n),
+            "max_m": round(mx, 4),
+            "mean_m": round(self.s1 / n, 4),
+            "rms_m": round(math.sqrt(self.s2 / n), 4),
+            "p95_m": round(p95, 3),
+            "max_px": round(mx / gsd, 3),
+            "share_above_1gsd_pct": round(above, 3),
+            "max_error_m": round(self.max_e, 4),
+        }
+
+
+def _predict_block(grid: _PredictionGrid, camera: Any, eo: Any, row0: int, nrows: int,
+                   feedback: Feedback, warned: Dict[str, bool], stats: _DisplacementStats
+                   ) -> NDArray[np.float32]:
+    """The four bands of rows ``row0 … row0+nrows``; adds the seen cells to ``stats``."""
+    t, width = grid.transform, grid.width
+    rows, cols = np.mgrid[row0:row0 + nrows, 0:width].astype(np.float64)
+    x = t.a * (cols + 0.5) + t.b * (rows + 0.5) + t.c
+    y = t.d * (cols + 0.5) + t.e * (rows + 0.5) + t.f
+    e, z_ref = grid.heights(row0, nrows, feedback, warned)
+    dx, dy, radial = displacement_field(x, y, e, z_ref, eo.position)
+    ok = np.isfinite(radial) & _seen_by(camera, eo, x, y,
+                                        np.where(np.isfinite(z_ref), z_ref, 0.0))
+    mag = np.where(ok, np.abs(radial), np.nan)
+    out = np.stack([mag, np.where(ok, dx, np.nan), np.where(ok, dy, np.nan),
+                    np.where(ok, radial, np.nan)]).astype(np.float32)
+    vals = mag[ok]
+    if vals.size:
+        stats.add(vals, eo.position[2] - z_ref[ok], e[ok])
+    return out
 
 
 def predict_displacement(project: Any, image: str, output: PathLike, *,
@@ -205,40 +342,18 @@ def predict_displacement(project: Any, image: str, output: PathLike, *,
     GeometryError
         The image does not see any cell of the raster.
     """
-    import rasterio
-
-    from ..project.model import Project
-    from ..raster.io import atomic_output, gtiff_profile
-
     feedback = ensure_feedback(feedback)
     start = time.perf_counter()
     proj = project if isinstance(project, Project) else Project.load(project)
     rec = proj.image(image)
     camera = proj.camera_of(rec)
     eo = rec.eo
-    if error is None and (dem is None or reference is None):
-        raise InputError("Give the DEM-error raster (DEM − reference), or both the DEM and the "
-                         "reference DEM, to predict the ortho displacement.")
-    base = error if error is not None else dem
-    transform, crs, width, height = _grid_of(base)  # type: ignore[arg-type]
-    if crs is None and proj.crs:
-        crs = rasterio.crs.CRS.from_user_input(proj.crs)
-    z_const = None
-    if error is not None and dem is None and reference is None:
-        z_const = terrain_height if terrain_height is not None else proj.terrain_height
-        if z_const is None:
-            raise InputError("The flying height above the ground needs the true heights: give "
-                             "the reference DEM, the DEM, or a terrain height.")
+    grid = _prediction_grid(proj, error, dem, reference, terrain_height)
+    width, height = grid.width, grid.height
     profile = gtiff_profile(width, height, len(DISPLACEMENT_BANDS), "float32", nodata=float("nan"),
-                            transform=transform, crs=crs, predictor=3)
+                            transform=grid.transform, crs=grid.crs, predictor=3)
     warned: Dict[str, bool] = {}
-    # running sums for the statistics (float64, exact enough) and a histogram for p95
-    n = 0
-    s1 = s2 = s_h = 0.0
-    mx = 0.0
-    max_e = 0.0
-    edges = None
-    hist = None
+    stats = _DisplacementStats()
     with atomic_output(output) as tmp, rasterio.open(tmp, "w", **profile) as dst:
         for b, name in enumerate(DISPLACEMENT_BANDS, start=1):
             dst.set_band_description(b, name)
@@ -249,69 +364,25 @@ def predict_displacement(project: Any, image: str, output: PathLike, *,
         for row0 in range(0, height, BLOCK_ROWS):
             feedback.progress(100.0 * row0 / height)
             nrows = min(BLOCK_ROWS, height - row0)
-            rows, cols = np.mgrid[row0:row0 + nrows, 0:width].astype(np.float64)
-            x = transform.a * (cols + 0.5) + transform.b * (rows + 0.5) + transform.c
-            y = transform.d * (cols + 0.5) + transform.e * (rows + 0.5) + transform.f
-            block = (transform, crs, width, height, row0, nrows, feedback, warned)
-            if error is not None:
-                e = _read_on_grid(error, *block)
-                if reference is not None:
-                    z_ref = _read_on_grid(reference, *block)
-                elif dem is not None:
-                    z_ref = _read_on_grid(dem, *block) - e
-                else:
-                    z_ref = np.full_like(e, float(z_const))  # type: ignore[arg-type]
-            else:
-                z_dem = _read_on_grid(dem, *block)
-                z_ref = _read_on_grid(reference, *block)
-                e = z_dem - z_ref
-            dx, dy, radial = displacement_field(x, y, e, z_ref, eo.position)
-            ok = np.isfinite(radial) & _seen_by(camera, eo, x, y,
-                                                np.where(np.isfinite(z_ref), z_ref, 0.0))
-            mag = np.where(ok, np.abs(radial), np.nan)
-            out = np.stack([mag, np.where(ok, dx, np.nan), np.where(ok, dy, np.nan),
-                            np.where(ok, radial, np.nan)]).astype(np.float32)
-            dst.write(out, window=rasterio.windows.Window(0, row0, width, nrows))
-            vals = mag[ok]
-            if vals.size:
-                n += vals.size
-                s1 += float(vals.sum())
-                s2 += float(np.square(vals).sum())
-                s_h += float((eo.position[2] - z_ref[ok]).sum())
-                mx = max(mx, float(vals.max()))
-                max_e = max(max_e, float(np.abs(e[ok]).max()))
-                if edges is None:  # 1 mm bins up to 1 km: exact enough for p95
-                    edges = np.linspace(0.0, 1000.0, 1_000_001)
-                    hist = np.zeros(edges.size - 1, np.int64)
-                hist += np.histogram(np.minimum(vals, 999.9995), bins=edges)[0]
-        if n == 0:  # raised inside atomic_output: nothing is left behind
+            out = _predict_block(grid, camera, eo, row0, nrows, feedback, warned, stats)
+            dst.write(out, window=Window(0, row0, width, nrows))
+        if stats.n == 0:  # raised inside atomic_output: nothing is left behind
             raise GeometryError(
-                f"Image '{rec.name}' sees no cell of '{Path(str(base)).name}' with a height "
-                "error; check that the rasters cover the image's footprint.")
-    h_mean = s_h / n
-    gsd = float(camera.gsd(h_mean))
-    cum = np.cumsum(hist)
-    p95 = float(edges[int(np.searchsorted(cum, 0.95 * n)) + 1])  # type: ignore[index]
-    above = 100.0 * float(n - cum[min(int(gsd * 1000.0), cum.size - 1)]) / n
+                f"Image '{rec.name}' sees no cell of '{Path(str(grid.base)).name}' with a "
+                "height error; check that the rasters cover the image's footprint.")
+    summary = stats.summary(camera)
     feedback.progress(100.0)
     result = {
         "displacement": str(output),
         "image": rec.name,
         "nadir": [float(eo.position[0]), float(eo.position[1])],
-        "flying_height_m": round(h_mean, 3),
-        "gsd_m": round(gsd, 5),
-        "cells": int(n),
-        "max_m": round(mx, 4),
-        "mean_m": round(s1 / n, 4),
-        "rms_m": round(math.sqrt(s2 / n), 4),
-        "p95_m": round(p95, 3),
-        "max_px": round(mx / gsd, 3),
-        "share_above_1gsd_pct": round(above, 3),
-        "max_error_m": round(max_e, 4),
+        **summary,
         "seconds": round(time.perf_counter() - start, 3),
     }
+    mx, gsd = stats.mx, float(camera.gsd(stats.s_h / stats.n))
     feedback.info(f"Predicted displacement of {rec.name}: max {mx:.3f} m ({mx / gsd:.2f} px), "
-                  f"RMS {result['rms_m']:.3f} m over {n} cells (H = {h_mean:.1f} m).")
+                  f"RMS {result['rms_m']:.3f} m over {stats.n} cells "
+                  f"(H = {stats.s_h / stats.n:.1f} m).")
     return result
 
 
@@ -402,8 +473,6 @@ def _bands(src: Any) -> Tuple[List[int], Optional[int]]:
     The alpha band is the band flagged as alpha, else the last band of a 2- or 4-band raster
     (grey/RGB + alpha written without the flag).
     """
-    from rasterio.enums import ColorInterp
-
     interp = list(src.colorinterp)
     alpha = next((i + 1 for i, c in enumerate(interp) if c == ColorInterp.alpha), None)
     if alpha is None and src.count in (2, 4) and interp[-1] == ColorInterp.undefined:
@@ -415,9 +484,6 @@ def _bands(src: Any) -> Tuple[List[int], Optional[int]]:
 def _read_grey(src: Any, transform: Any, crs: Any, col0: int, row0: int, width: int,
                height: int, aligned: bool) -> Tuple[NDArray[np.float32], NDArray[np.bool_]]:
     """Mean of the colour bands and the validity mask on a window of the target grid."""
-    from rasterio.warp import Resampling, reproject
-    from rasterio.windows import Window
-
     bands, alpha = _bands(src)
     if aligned:
         t = src.transform
@@ -436,9 +502,6 @@ def _read_grey(src: Any, transform: Any, crs: Any, col0: int, row0: int, width: 
             inside[rr0:rr1, cc0:cc1] = True
         mask &= inside
     else:
-        from rasterio.warp import transform_bounds
-        from rasterio.windows import from_bounds
-
         win_t = transform * transform.translation(col0, row0)
         dst_crs = crs or src.crs
         # read only the source window that covers this strip (plus a margin of 2 cells)
@@ -469,8 +532,6 @@ def _read_grey(src: Any, transform: Any, crs: Any, col0: int, row0: int, width: 
                       dst_transform=win_t, dst_crs=dst_crs, resampling=Resampling.nearest,
                       src_nodata=None, dst_nodata=0)
         # a bilinear value next to invalid cells mixes in nodata: shrink the mask by one cell
-        from scipy import ndimage
-
         mask = ndimage.binary_erosion(m > 0, iterations=1, border_value=0)
     grey = data.mean(axis=0, dtype=np.float32) if data.shape[0] > 1 else data[0]
     return grey, mask
@@ -483,6 +544,141 @@ def _box_any(bad: NDArray[np.bool_], rows: NDArray, cols: NDArray, half: int) ->
     r0, r1 = rows - half, rows + half + 1
     c0, c1 = cols - half, cols + half + 1
     return (ii[r1, c1] - ii[r0, c1] - ii[r1, c0] + ii[r0, c0]) > 0
+
+
+def _check_shift_options(ortho: PathLike, reference: PathLike, spacing: Optional[int],
+                         window: int, radius: int) -> int:
+    """Refuse bad matching options and missing orthos; return the window spacing."""
+    if window < 5 or window % 2 == 0:
+        raise InputError(f"The matching window must be an odd number ≥ 5 px, not {window}.")
+    if radius < 1:
+        raise InputError("The search radius must be at least 1 px.")
+    spacing = int(spacing) if spacing else int(window)
+    if spacing < 1:
+        raise InputError("The window spacing must be at least 1 px.")
+    for p in (ortho, reference):
+        if not Path(p).is_file():
+            raise InputError(f"Ortho '{p}' does not exist; check the path.")
+    return spacing
+
+
+@dataclass
+class _ShiftArea:
+    """The reference grid and the area common to both orthos (reference pixels)."""
+
+    transform: Any
+    crs: Any
+    pixel_size: float
+    aligned: bool
+    col0: int
+    col1: int
+    row0: int
+    row1: int
+
+
+def _shift_area(ref: Any, oth: Any, ortho: PathLike, reference: PathLike,
+                feedback: Feedback) -> _ShiftArea:
+    """How the other ortho lies on the reference grid, and the area both cover."""
+    T, crs = ref.transform, ref.crs
+    if T.b != 0 or T.d != 0:
+        raise InputError(f"The reference ortho '{Path(reference).name}' is rotated; use a "
+                         "north-up ortho as the reference.")
+    px = float(abs(T.a))
+    t = oth.transform
+    same_crs = crs == oth.crs or crs is None or oth.crs is None
+    off_c = (T.c - t.c) / t.a
+    off_r = (T.f - t.f) / t.e if t.e else math.nan
+    aligned = (same_crs and t.b == 0 and t.d == 0 and abs(t.a - T.a) <= 1e-9 * px
+               and abs(t.e - T.e) <= 1e-9 * px and abs(off_c - round(off_c)) < 1e-6
+               and abs(off_r - round(off_r)) < 1e-6)
+    if not same_crs:
+        feedback.warning(f"'{Path(ortho).name}' is in another CRS than the reference "
+                         "ortho; it is reprojected (bilinear) onto the reference grid.")
+    elif not aligned:
+        feedback.info(f"'{Path(ortho).name}' is on another grid; it is resampled "
+                      "(bilinear) onto the reference grid.")
+    # the common area in reference pixels
+    ob = oth.bounds if same_crs else transform_bounds(oth.crs, crs, *oth.bounds)
+    rb = ref.bounds
+    left, right = max(rb.left, ob[0]), min(rb.right, ob[2])
+    bottom, top = max(rb.bottom, ob[1]), min(rb.top, ob[3])
+    inv = ~T
+    c_a, r_a = inv * (left, top)
+    c_b, r_b = inv * (right, bottom)
+    return _ShiftArea(T, crs, px, aligned,
+                      max(math.ceil(min(c_a, c_b) - 1e-9), 0),
+                      min(math.floor(max(c_a, c_b) + 1e-9), ref.width),
+                      max(math.ceil(min(r_a, r_b) - 1e-9), 0),
+                      min(math.floor(max(r_a, r_b) + 1e-9), ref.height))
+
+
+@dataclass
+class _MatchOptions:
+    """Window size, search radius and the acceptance limits of one shift measurement."""
+
+    window: int
+    radius: int
+    min_ncc: float
+    max_sigma: float
+
+
+def _match_strip(grey: Tuple[Array, Array, Array, Array], rr: NDArray, cc: NDArray,
+                 opt: _MatchOptions) -> Dict[str, NDArray]:
+    """NCC search and LSM refinement of the windows (rr, cc) of one strip.
+
+    ``grey`` is (reference grey, its mask, other grey, its mask). Returns the arrays
+    ``dc, dr, ncc, corr, sig, st`` (one entry per window, :data:`STATUS` codes in ``st``).
+    """
+    ga, ma, gb, mb = grey
+    half, radius, window = opt.window // 2, opt.radius, opt.window
+    status = np.zeros(rr.size, np.uint8)
+    out = _box_any(~ma, rr, cc, half + 1) | _box_any(~mb, rr, cc, half + radius + 1)
+    status[out] = 1
+    ncc = np.full(rr.size, np.nan, np.float32)
+    corr = np.full(rr.size, np.nan, np.float32)
+    sig = np.full(rr.size, np.nan, np.float32)
+    dc = np.full(rr.size, np.nan)
+    dr = np.full(rr.size, np.nan)
+    todo = np.flatnonzero(status == 0)
+    if todo.size:
+        a = np.where(ma, ga, 0.0).astype(np.float32)
+        b = np.where(mb, gb, 0.0).astype(np.float32)
+        c_t, r_t = cc[todo].astype(float), rr[todo].astype(float)
+        found = ncc_search_2d(a, b, c_t, r_t, c_t, r_t, radius=radius, window=window,
+                              min_ncc=opt.min_ncc, max_ratio=0.9)
+        ncc[todo] = found.ncc
+        flat = ~np.isfinite(found.ncc)
+        status[todo[flat]] = 2
+        status[todo[~flat & ~found.valid]] = 3
+        good = todo[found.valid]
+        if good.size:
+            sel = found.valid
+            lsm = lsm_match(a, b, c_t[sel], r_t[sel], found.cols[sel], found.rows[sel],
+                            window=window, model="shift", max_shift=1.5,
+                            min_corr=opt.min_ncc, max_sigma=opt.max_sigma)
+            corr[good] = lsm.corr
+            sig[good] = np.maximum(lsm.sigma_col, lsm.sigma_row)
+            ok = lsm.valid
+            status[good[~ok]] = 4
+            dc[good[ok]] = lsm.cols[ok] - c_t[sel][ok]
+            dr[good[ok]] = lsm.rows[ok] - r_t[sel][ok]
+    return {"dc": dc, "dr": dr, "ncc": ncc, "corr": corr, "sig": sig, "st": status}
+
+
+def _shift_result(res: Dict[str, List[NDArray]], area: _ShiftArea) -> ShiftResult:
+    """The windows of all strips as one :class:`ShiftResult` in map units."""
+    T = area.transform
+    cat = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in res.items()}
+    cols = cat["c"].astype(float)
+    rows = cat["r"].astype(float)
+    x = T.a * (cols + 0.5) + T.b * (rows + 0.5) + T.c
+    y = T.d * (cols + 0.5) + T.e * (rows + 0.5) + T.f
+    dcol, drow = cat["dc"], cat["dr"]
+    return ShiftResult(x=x, y=y, dx=T.a * dcol + T.b * drow, dy=T.d * dcol + T.e * drow,
+                       dcol=dcol, drow=drow, ncc=cat["ncc"].astype(np.float32),
+                       corr=cat["corr"].astype(np.float32), sigma=cat["sig"].astype(np.float32),
+                       status=cat["st"].astype(np.uint8), pixel_size=area.pixel_size,
+                       crs=area.crs)
 
 
 def measure_shift(ortho: PathLike, reference: PathLike, *, spacing: Optional[int] = None,
@@ -522,123 +718,39 @@ def measure_shift(ortho: PathLike, reference: PathLike, *, spacing: Optional[int
     InputError
         Bad parameters, or the orthos do not overlap by more than one window.
     """
-    import rasterio
-
-    from ..matching.lsm import lsm_match
-    from ..matching.ncc import ncc_search_2d
-
     feedback = ensure_feedback(feedback)
-    if window < 5 or window % 2 == 0:
-        raise InputError(f"The matching window must be an odd number ≥ 5 px, not {window}.")
-    if radius < 1:
-        raise InputError("The search radius must be at least 1 px.")
-    spacing = int(spacing) if spacing else int(window)
-    if spacing < 1:
-        raise InputError("The window spacing must be at least 1 px.")
-    for p in (ortho, reference):
-        if not Path(p).is_file():
-            raise InputError(f"Ortho '{p}' does not exist; check the path.")
-    half = window // 2
-    margin = half + radius + 2  # the search window plus the LSM's one-pixel bilinear border
+    spacing = _check_shift_options(ortho, reference, spacing, window, radius)
+    opt = _MatchOptions(window, radius, min_ncc, max_sigma)
+    margin = window // 2 + radius + 2  # the search window plus the LSM's bilinear border
     with rasterio.open(reference) as ref, rasterio.open(ortho) as oth:
-        T, crs = ref.transform, ref.crs
-        if T.b != 0 or T.d != 0:
-            raise InputError(f"The reference ortho '{Path(reference).name}' is rotated; use a "
-                             "north-up ortho as the reference.")
-        px = float(abs(T.a))
-        t = oth.transform
-        same_crs = crs == oth.crs or crs is None or oth.crs is None
-        off_c = (T.c - t.c) / t.a
-        off_r = (T.f - t.f) / t.e if t.e else math.nan
-        aligned = (same_crs and t.b == 0 and t.d == 0 and abs(t.a - T.a) <= 1e-9 * px
-                   and abs(t.e - T.e) <= 1e-9 * px and abs(off_c - round(off_c)) < 1e-6
-                   and abs(off_r - round(off_r)) < 1e-6)
-        if not same_crs:
-            feedback.warning(f"'{Path(ortho).name}' is in another CRS than the reference "
-                             "ortho; it is reprojected (bilinear) onto the reference grid.")
-        elif not aligned:
-            feedback.info(f"'{Path(ortho).name}' is on another grid; it is resampled "
-                          "(bilinear) onto the reference grid.")
-        # the common area in reference pixels
-        from rasterio.warp import transform_bounds
-
-        ob = oth.bounds if same_crs else transform_bounds(oth.crs, crs, *oth.bounds)
-        rb = ref.bounds
-        left, right = max(rb.left, ob[0]), min(rb.right, ob[2])
-        bottom, top = max(rb.bottom, ob[1]), min(rb.top, ob[3])
-        inv = ~T
-        c_a, r_a = inv * (left, top)
-        c_b, r_b = inv * (right, bottom)
-        col0 = max(math.ceil(min(c_a, c_b) - 1e-9), 0)
-        col1 = min(math.floor(max(c_a, c_b) + 1e-9), ref.width)
-        row0 = max(math.ceil(min(r_a, r_b) - 1e-9), 0)
-        row1 = min(math.floor(max(r_a, r_b) + 1e-9), ref.height)
-        if col1 - col0 < 2 * margin + 1 or row1 - row0 < 2 * margin + 1:
+        area = _shift_area(ref, oth, ortho, reference, feedback)
+        T, crs, col0, row0 = area.transform, area.crs, area.col0, area.row0
+        if area.col1 - col0 < 2 * margin + 1 or area.row1 - row0 < 2 * margin + 1:
             raise InputError(f"The orthos '{Path(ortho).name}' and '{Path(reference).name}' "
                              f"overlap by less than one window ({window} px + {radius} px "
                              "search radius each side); choose orthos of the same area.")
-        gcols = np.arange(col0 + margin, col1 - margin, spacing)
-        grows = np.arange(row0 + margin, row1 - margin, spacing)
+        gcols = np.arange(col0 + margin, area.col1 - margin, spacing)
+        grows = np.arange(row0 + margin, area.row1 - margin, spacing)
         per_strip = max(1, (max(int(strip_rows), spacing + 2 * margin) - 2 * margin) // spacing)
         res: Dict[str, List[NDArray]] = {k: [] for k in
                                          ("c", "r", "dc", "dr", "ncc", "corr", "sig", "st")}
-        width = col1 - col0
+        width = area.col1 - col0
         for s in range(0, grows.size, per_strip):
             feedback.progress(95.0 * s / max(grows.size, 1))
             srows = grows[s:s + per_strip]
             top_row = int(srows[0]) - margin
             nrows = int(srows[-1]) - top_row + margin + 1
             ga, ma = _read_grey(ref, T, crs, col0, top_row, width, nrows, True)
-            gb, mb = _read_grey(oth, T, crs, col0, top_row, width, nrows, aligned)
+            gb, mb = _read_grey(oth, T, crs, col0, top_row, width, nrows, area.aligned)
             rr, cc = np.meshgrid(srows - top_row, gcols - col0, indexing="ij")
             rr, cc = rr.ravel(), cc.ravel()
-            status = np.zeros(rr.size, np.uint8)
-            out = _box_any(~ma, rr, cc, half + 1) | _box_any(~mb, rr, cc, half + radius + 1)
-            status[out] = 1
-            ncc = np.full(rr.size, np.nan, np.float32)
-            corr = np.full(rr.size, np.nan, np.float32)
-            sig = np.full(rr.size, np.nan, np.float32)
-            dc = np.full(rr.size, np.nan)
-            dr = np.full(rr.size, np.nan)
-            todo = np.flatnonzero(status == 0)
-            if todo.size:
-                a = np.where(ma, ga, 0.0).astype(np.float32)
-                b = np.where(mb, gb, 0.0).astype(np.float32)
-                c_t, r_t = cc[todo].astype(float), rr[todo].astype(float)
-                found = ncc_search_2d(a, b, c_t, r_t, c_t, r_t, radius=radius, window=window,
-                                      min_ncc=min_ncc, max_ratio=0.9)
-                ncc[todo] = found.ncc
-                flat = ~np.isfinite(found.ncc)
-                status[todo[flat]] = 2
-                status[todo[~flat & ~found.valid]] = 3
-                good = todo[found.valid]
-                if good.size:
-                    sel = found.valid
-                    lsm = lsm_match(a, b, c_t[sel], r_t[sel], found.cols[sel], found.rows[sel],
-                                    window=window, model="shift", max_shift=1.5,
-                                    min_corr=min_ncc, max_sigma=max_sigma)
-                    corr[good] = lsm.corr
-                    sig[good] = np.maximum(lsm.sigma_col, lsm.sigma_row)
-                    ok = lsm.valid
-                    status[good[~ok]] = 4
-                    dc[good[ok]] = lsm.cols[ok] - c_t[sel][ok]
-                    dr[good[ok]] = lsm.rows[ok] - r_t[sel][ok]
+            found = _match_strip((ga, ma, gb, mb), rr, cc, opt)
             res["c"].append(cc + col0)
             res["r"].append(rr + top_row)
-            for key, val in (("dc", dc), ("dr", dr), ("ncc", ncc), ("corr", corr), ("sig", sig),
-                             ("st", status)):
+            for key, val in found.items():
                 res[key].append(val)
-    cat = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in res.items()}
-    cols = cat["c"].astype(float)
-    rows = cat["r"].astype(float)
-    x = T.a * (cols + 0.5) + T.b * (rows + 0.5) + T.c
-    y = T.d * (cols + 0.5) + T.e * (rows + 0.5) + T.f
-    dcol, drow = cat["dc"], cat["dr"]
     feedback.progress(100.0)
-    return ShiftResult(x=x, y=y, dx=T.a * dcol + T.b * drow, dy=T.d * dcol + T.e * drow,
-                       dcol=dcol, drow=drow, ncc=cat["ncc"].astype(np.float32),
-                       corr=cat["corr"].astype(np.float32), sigma=cat["sig"].astype(np.float32),
-                       status=cat["st"].astype(np.uint8), pixel_size=px, crs=crs)
+    return _shift_result(res, area)
 
 
 def _fields(result: ShiftResult, predicted: Optional[Dict[str, Array]]) -> Dict[str, NDArray]:
@@ -662,9 +774,6 @@ def write_shift_points(path: PathLike, result: ShiftResult,
     Fields: dx, dy, shift (map units), dx_px, dy_px (map axes, in reference pixels), ncc, corr,
     sigma_px, status (:data:`STATUS` names), and ``pred_*`` fields when a prediction is given.
     """
-    from ..raster.io import atomic_output
-    from ..surface.point_output import write_points
-
     path = Path(path)
     fields = _fields(result, predicted)
     if path.suffix.lower() == ".gpkg":
@@ -690,10 +799,6 @@ def write_shift_points(path: PathLike, result: ShiftResult,
 
 def sample_prediction(displacement: PathLike, x: ArrayLike, y: ArrayLike) -> Dict[str, Array]:
     """Predicted dx, dy and |d| (bilinear, NaN outside) of a displacement raster at points."""
-    import rasterio
-
-    from ..raster.sample import bilinear
-
     with rasterio.open(displacement) as src:
         dx = src.read(2).astype(np.float64)
         dy = src.read(3).astype(np.float64)

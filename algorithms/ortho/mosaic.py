@@ -49,17 +49,24 @@ import json
 import math
 import time
 from contextlib import ExitStack
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import rasterio
 from affine import Affine
 from numpy.typing import NDArray
+from rasterio.enums import ColorInterp, Resampling
+from rasterio.warp import reproject
+from rasterio.windows import Window
 from scipy import ndimage
+from shapely.geometry import box
+from shapely.ops import unary_union
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..project.model import Project
 from ..raster.io import (
     atomic_output,
     cog_output,
@@ -69,6 +76,7 @@ from ..raster.io import (
 )
 from . import balance as bal
 from . import seamlines as sl
+from .rectify import orthorectify_image
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -115,8 +123,6 @@ def read_ortho_info(path: PathLike) -> OrthoInfo:
     InputError
         Missing or unreadable file, rotated raster.
     """
-    import rasterio
-    from rasterio.enums import ColorInterp
 
     path = Path(path)
     if not path.is_file():
@@ -223,10 +229,6 @@ def _read_on_grid(src: Any, info: OrthoInfo, transform: Affine, r0: int, r1: int
     ``resampling`` is ``"full"`` (the mosaic grid: copied when aligned, else bilinear colour
     and nearest alpha) or ``"average"`` (block averages on a coarser grid).
     """
-    import rasterio
-    from rasterio.enums import Resampling
-    from rasterio.warp import reproject
-    from rasterio.windows import Window
 
     h, w = r1 - r0, c1 - c0
     colour = np.full((len(info.colour), h, w), np.nan, np.float32)
@@ -278,9 +280,6 @@ def _coverage(info: OrthoInfo, transform: Affine, r0: int, r1: int, c0: int, c1:
     From ``<stem>_visibility.tif`` (0 outside, 1 visible, 2 occluded; block minimum > 0);
     without it the valid fraction ``frac``.
     """
-    import rasterio
-    from rasterio.enums import Resampling
-    from rasterio.warp import reproject
 
     vis = info.path.with_name(f"{info.path.stem}_visibility.tif")
     if not vis.is_file():
@@ -298,9 +297,6 @@ def _coverage(info: OrthoInfo, transform: Affine, r0: int, r1: int, c0: int, c1:
 def _read_height(path: PathLike, transform: Affine, shape: Tuple[int, int], crs: Any,
                  how: str) -> Array:
     """A DSM/DTM block-aggregated (``max`` or ``average``) onto the seam grid, NaN = none."""
-    import rasterio
-    from rasterio.enums import Resampling
-    from rasterio.warp import reproject
 
     out = np.full(shape, np.nan, np.float32)
     try:
@@ -371,6 +367,290 @@ def _seam_sources(seamlines: str, project: Any) -> Optional[Path]:
     return Path(text)
 
 
+@dataclass
+class _SeamGrid:
+    """The mosaic grid reduced by an integer factor (module notes, step 1)."""
+
+    factor: int
+    cell: float
+    transform: Affine
+    width: int
+    height: int
+
+    @classmethod
+    def of(cls, transform: Affine, W: int, H: int, s: float, seam_cells: int) -> _SeamGrid:
+        """At most ``seam_cells`` cells a side (never fewer than 16) over the mosaic grid."""
+        f = max(1, math.ceil(max(W, H) / max(int(seam_cells), 16)))
+        cs = f * s
+        return cls(f, cs, Affine(cs, 0.0, transform.c, 0.0, -cs, transform.f),
+                   math.ceil(W / f), math.ceil(H / f))
+
+    @property
+    def shape(self) -> Tuple[int, int]:
+        return self.height, self.width
+
+
+@dataclass
+class _MosaicPlan:
+    """The checked inputs, the mosaic grid and the options of one mosaic."""
+
+    infos: List[OrthoInfo]
+    names: List[str]
+    crs: Any
+    transform: Affine
+    width: int
+    height: int
+    gsd: float
+    output: Path
+    ref_index: Optional[int]
+    seamlines: str
+    seam_file: Optional[Path]
+    feather_m: float
+    balance: str
+    dsm: Optional[PathLike]
+    dtm: Optional[PathLike]
+    corridor: Optional[float]
+    min_height: float
+    tile: int
+
+    @property
+    def feather_px(self) -> float:
+        return self.feather_m / self.gsd
+
+
+@dataclass
+class _Radiometry:
+    """Balancing of every image: gains, offsets and histogram look-up tables."""
+
+    gains: List[Array]
+    offsets: List[Array]
+    luts: List[Any]
+
+    def apply(self, k: int, colour: Array) -> Array:
+        """Colour bands of image ``k`` balanced."""
+        return bal.apply_balance(colour, self.gains[k], self.offsets[k], self.luts[k])
+
+    def grey(self, k: int, bands: Array) -> Array:
+        """Mean of the balanced bands of image ``k``."""
+        return apply_mean(bands, self.gains[k], self.offsets[k], self.luts[k])
+
+
+@dataclass
+class _Partition:
+    """Labels of the seam grid, the seams alone, their statistics and operator regions."""
+
+    labels: Array
+    partition: Array
+    stats: Dict[str, Any]
+    regions: List[Tuple[Any, int]]
+
+
+def _plan_mosaic(inputs: Sequence[PathLike], output: PathLike, gsd: Optional[float],
+                 options: Dict[str, Any], project: Any, fb: Feedback) -> _MosaicPlan:
+    """Read and check the inputs, fix the grid and resolve the options' defaults."""
+    if options["balance"] not in bal.BALANCE_MODES:
+        raise InputError(f"Balancing '{options['balance']}' is not one of "
+                         f"{', '.join(bal.BALANCE_MODES)}.")
+    infos = [read_ortho_info(p) for p in inputs]
+    check_inputs(infos)
+    for i in infos:
+        if not i.centre_from_tags:
+            fb.warning(f"{i.path.name} has no PHOTODEM_CAMERA_X/Y tags; its nadir point is "
+                       "taken as the raster centre.")
+    names = [i.name for i in infos]
+    transform, W, H, s = mosaic_grid(infos, gsd)
+    reference = options["reference"]
+    ref_index = None
+    if reference:
+        if reference not in names:
+            raise InputError(f"The reference image '{reference}' is not one of the inputs "
+                             f"({', '.join(names)}).")
+        ref_index = names.index(reference)
+    seamlines = options["seamlines"]
+    feather = options["feather"]
+    return _MosaicPlan(
+        infos, names, infos[0].crs, transform, W, H, s, Path(output), ref_index, seamlines,
+        _seam_sources(seamlines, project), 10.0 * s if feather is None else float(feather),
+        options["balance"], options["dsm"], options["dtm"], options["corridor"],
+        options["min_height"], options["tile"])
+
+
+def _sample_seam_grid(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, fb: Feedback
+                      ) -> Tuple[List[bal.BalanceImage], List[Array], List[Array]]:
+    """Every ortho block-averaged onto the seam grid: samples, valid fractions, coverage."""
+    infos = plan.infos
+    samples: List[bal.BalanceImage] = []
+    fracs: List[Array] = []
+    covers: List[Array] = []
+    for k, (info, src) in enumerate(zip(infos, srcs)):
+        fb.step(0, 15).progress(100.0 * k / len(infos))
+        win = _window_of(info, grid.transform, grid.width, grid.height)
+        if win is None:
+            samples.append(bal.BalanceImage(0, 0, np.zeros((len(info.colour), 0, 0),
+                                                           np.float32),
+                                            np.zeros((0, 0), bool)))
+            fracs.append(np.zeros((0, 0), np.float32))
+            covers.append(np.zeros((0, 0), np.float32))
+            continue
+        r0, r1, c0, c1 = win
+        colour, frac = _read_on_grid(src, info, grid.transform, r0, r1, c0, c1, "average")
+        full = frac >= 1.0 - 1e-6
+        colour[:, ~full] = np.nan
+        samples.append(bal.BalanceImage(r0, c0, colour, full))
+        fracs.append(frac)
+        covers.append(_coverage(info, grid.transform, r0, r1, c0, c1, frac))
+    return samples, fracs, covers
+
+
+def _operator_partition(plan: _MosaicPlan, grid: _SeamGrid, labels: Array,
+                        stats: Dict[str, Any]) -> Tuple[Array, List[Tuple[Any, int]]]:
+    """Labels with the operator's regions burnt in, and the regions (area, image index)."""
+    layers = ("seamlines",) if plan.seamlines.strip().lower() == "edits" else None
+    assigned, cuts = sl.read_operator_seamlines(plan.seam_file, plan.crs, plan.names, layers)
+    regions: List[Tuple[Any, int]] = []
+    if cuts:
+        regions.extend(sl.cut_regions(cuts, _bounds(plan.transform, plan.width, plan.height),
+                                      labels, grid.transform, len(plan.infos)))
+    regions.extend(assigned)  # assigned polygons win over cut regions
+    op = sl.rasterize_regions(regions, grid.shape, grid.transform)
+    labels = np.where(op >= 0, op, labels).astype(np.int32)
+    stats.update(regions=len(regions), assigned=len(assigned), cut_lines=len(cuts))
+    return labels, regions
+
+
+def _partition(plan: _MosaicPlan, grid: _SeamGrid, seam_imgs: List[sl.SeamImage],
+               fb: Feedback) -> _Partition:
+    """Step 3 of the module notes: nadir partition, then seams or the operator's regions."""
+    # the partition is built on the image footprints; occluded cells are filled later
+    labels = sl.nadir_labels(grid.shape, grid.transform, seam_imgs, geometric=True)
+    next_best = sl.nadir_labels(grid.shape, grid.transform, seam_imgs)
+    hag = None
+    margin = math.ceil(0.5 * plan.feather_m / grid.cell) + 1
+    if plan.dsm is not None and plan.dtm is not None:
+        hag = sl.object_height(
+            _read_height(plan.dsm, grid.transform, grid.shape, plan.crs, "max"),
+            _read_height(plan.dtm, grid.transform, grid.shape, plan.crs, "average"))
+    stats: Dict[str, Any] = {"mode": "auto" if plan.seam_file is None else "operator"}
+    regions: List[Tuple[Any, int]] = []
+    if plan.seam_file is not None:
+        labels, regions = _operator_partition(plan, grid, labels, stats)
+    elif plan.seamlines.strip().lower() == "auto" and len(plan.infos) > 1:
+        cor_m = sl.default_corridor([i.centre for i in plan.infos]) if plan.corridor is None \
+            else float(plan.corridor)
+        cor = max(round(cor_m / grid.cell), 2)
+        labels, st = sl.route_seams(labels, seam_imgs, hag, corridor=cor,
+                                    min_height=plan.min_height, margin=margin,
+                                    feedback=fb.step(15, 30))
+        stats.update(st, corridor_m=round(cor * grid.cell, 3))
+    else:
+        stats["mode"] = "nadir"
+    partition = labels  # footprint polygons: the seams, without occlusion fills
+    labels = sl.fill_invalid(labels, seam_imgs, next_best)
+    return _Partition(labels, partition, stats, regions)
+
+
+@dataclass
+class _TileCounts:
+    """Cells of the mosaic filled from another image than their partition's, and covered."""
+
+    filled: int = 0
+    covered: int = 0
+
+
+def _mosaic_tile(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, part: _Partition,
+                 radio: _Radiometry, bounds: Tuple[int, int, int, int], halo: int,
+                 counts: _TileCounts) -> Tuple[Array, Array]:
+    """Bands and alpha mask of the tile ``bounds`` = (r0, r1, c0, c1), halo cut off."""
+    infos, transform, f = plan.infos, plan.transform, grid.factor
+    r0, r1, c0, c1 = bounds
+    R0, R1 = max(r0 - halo, 0), min(r1 + halo, plan.height)
+    C0, C1 = max(c0 - halo, 0), min(c1 + halo, plan.width)
+    lab = part.labels[np.arange(R0, R1)[:, None] // f, np.arange(C0, C1)[None, :] // f]
+    if part.regions:
+        op = sl.rasterize_regions(part.regions, (R1 - R0, C1 - C0),
+                                  transform * Affine.translation(C0, R0))
+        lab = np.where(op >= 0, op, lab)
+    ids, vals, valids = [], [], []
+    for k, (info, src) in enumerate(zip(infos, srcs)):
+        wk = _window_of(info, transform, plan.width, plan.height)
+        if wk is None or wk[1] <= R0 or wk[0] >= R1 or wk[3] <= C0 or wk[2] >= C1:
+            continue
+        colour, valid = _read_on_grid(src, info, transform, R0, R1, C0, C1, "full")
+        if not valid.any():
+            continue
+        ids.append(k)
+        vals.append(radio.apply(k, colour))
+        valids.append(valid > 0)
+    final = _final_labels(lab, ids, valids, infos, transform, R0, R1, C0, C1)
+    inner = (slice(r0 - R0, r1 - R0), slice(c0 - C0, c1 - C0))
+    counts.filled += int(((final != lab) & (final >= 0))[inner].sum())
+    counts.covered += int((final >= 0)[inner].sum())
+    if ids:
+        data, alpha = _blend(vals, valids, final, ids, plan.feather_px)
+    else:
+        data = np.zeros((len(infos[0].colour), R1 - R0, C1 - C0), np.float32)
+        alpha = np.zeros((R1 - R0, C1 - C0), bool)
+    return data[:, inner[0], inner[1]], alpha[inner]
+
+
+def _write_mosaic(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, part: _Partition,
+                  radio: _Radiometry, fb: Feedback) -> _TileCounts:
+    """Step 4 of the module notes: the mosaic COG, tile by tile, with overviews and tags."""
+    infos, W, H = plan.infos, plan.width, plan.height
+    dtype = infos[0].dtype
+    lo, hi = _dtype_range(dtype)
+    nb = len(infos[0].colour)
+    halo = math.ceil(plan.feather_px / 2.0) + 1 if plan.feather_px >= 1.0 else 0
+    prof = gtiff_profile(W, H, nb + 1, dtype, plan.crs, transform=plan.transform, nodata=None)
+    tile = max(int(plan.tile), 64)
+    tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]
+    counts = _TileCounts()
+    tfb = fb.step(30, 95)
+    # a Cloud-Optimised GeoTIFF: the mosaic is the block's deliverable
+    with cog_output(plan.output, prof) as (tmp, scratch_prof), \
+            rasterio.open(tmp, "w", **scratch_prof) as dst:
+        for t_idx, (r0, c0) in enumerate(tiles):
+            tfb.progress(100.0 * t_idx / len(tiles))
+            r1, c1 = min(r0 + tile, H), min(c0 + tile, W)
+            data, alpha = _mosaic_tile(srcs, plan, grid, part, radio, (r0, r1, c0, c1), halo,
+                                       counts)
+            if np.issubdtype(np.dtype(dtype), np.integer):
+                data = np.clip(np.rint(data), lo, hi)
+            data = np.where(alpha[None], data, 0).astype(dtype)
+            a = np.where(alpha, _alpha_value(dtype), 0).astype(dtype)
+            win = Window(c0, r0, c1 - c0, r1 - r0)
+            dst.write(data, indexes=list(range(1, nb + 1)), window=win)
+            dst.write(a, nb + 1, window=win)
+        dst.colorinterp = [*infos[0].colorinterp, ColorInterp.alpha]
+        dst.update_tags(PHOTODEM_MOSAIC="1", PHOTODEM_IMAGES=",".join(plan.names),
+                        PHOTODEM_GSD=f"{plan.gsd:g}", PHOTODEM_SEAMLINES=part.stats["mode"],
+                        PHOTODEM_BALANCE=plan.balance)
+        fb.progress(95.0)
+        factors = overview_factors(W, H)
+        if factors:
+            dst.build_overviews(factors, Resampling.average)
+            dst.update_tags(ns="rio_overview", resampling="average")
+    return counts
+
+
+def _footprints(plan: _MosaicPlan, grid: _SeamGrid, part: _Partition) -> List[Any]:
+    """One polygon per image (None without one): the seams, operator regions exactly."""
+    n = len(plan.infos)
+    polys = sl.partition_polygons(part.partition, grid.transform, n)
+    if not part.regions:
+        return polys
+    # operator regions exactly, the rest from the seam grid
+    op_union = unary_union([g for g, _ in part.regions])
+    area = _box(plan.transform, plan.width, plan.height)
+    polys = [None if p is None else p.difference(op_union) for p in polys]
+    for k in range(n):
+        mine = [g for g, kk in part.regions if kk == k]
+        if mine:
+            piece = unary_union(mine).intersection(area)
+            polys[k] = piece if polys[k] is None else polys[k].union(piece)
+    return [None if p is None or p.is_empty else p for p in polys]
+
+
 def mosaic_orthos(
     inputs: Sequence[PathLike],
     output: PathLike,
@@ -431,203 +711,48 @@ def mosaic_orthos(
         ``filled_pct`` (% of mosaic cells filled from another than their partition image),
         ``seconds``.
     """
-    import rasterio
-    from rasterio.enums import ColorInterp, Resampling
-    from rasterio.windows import Window
-
     fb = ensure_feedback(feedback)
     start = time.perf_counter()
-    if balance not in bal.BALANCE_MODES:
-        raise InputError(f"Balancing '{balance}' is not one of {', '.join(bal.BALANCE_MODES)}.")
-    infos = [read_ortho_info(p) for p in inputs]
-    check_inputs(infos)
-    for i in infos:
-        if not i.centre_from_tags:
-            fb.warning(f"{i.path.name} has no PHOTODEM_CAMERA_X/Y tags; its nadir point is "
-                       "taken as the raster centre.")
-    names = [i.name for i in infos]
-    crs = infos[0].crs
-    transform, W, H, s = mosaic_grid(infos, gsd)
-    out = Path(output)
-    paths = sibling_paths(out)
-    ref_index = None
-    if reference:
-        if reference not in names:
-            raise InputError(f"The reference image '{reference}' is not one of the inputs "
-                             f"({', '.join(names)}).")
-        ref_index = names.index(reference)
-    seam_file = _seam_sources(seamlines, project)
-    feather_m = 10.0 * s if feather is None else float(feather)
-    feather_px = feather_m / s
-
-    # 1. seam grid ------------------------------------------------------------------------
-    f = max(1, math.ceil(max(W, H) / max(int(seam_cells), 16)))
-    cs = f * s
-    ctr = Affine(cs, 0.0, transform.c, 0.0, -cs, transform.f)
-    CW, CH = math.ceil(W / f), math.ceil(H / f)
-    fb.info(f"Mosaic of {len(infos)} orthos: {W} × {H} cells of {s:g} m, seam grid "
-            f"{CW} × {CH} (factor {f}).")
-    samples: List[bal.BalanceImage] = []
-    fracs: List[Array] = []
-    covers: List[Array] = []
+    plan = _plan_mosaic(inputs, output, gsd, {
+        "seamlines": seamlines, "balance": balance, "feather": feather, "reference": reference,
+        "dsm": dsm, "dtm": dtm, "corridor": corridor, "min_height": min_height, "tile": tile,
+    }, project, fb)
+    W, H, s, names = plan.width, plan.height, plan.gsd, plan.names
+    paths = sibling_paths(plan.output)
+    grid = _SeamGrid.of(plan.transform, W, H, s, seam_cells)
+    fb.info(f"Mosaic of {len(plan.infos)} orthos: {W} × {H} cells of {s:g} m, seam grid "
+            f"{grid.width} × {grid.height} (factor {grid.factor}).")
     with ExitStack() as stack:
-        srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
-        for k, (info, src) in enumerate(zip(infos, srcs)):
-            fb.step(0, 15).progress(100.0 * k / len(infos))
-            win = _window_of(info, ctr, CW, CH)
-            if win is None:
-                samples.append(bal.BalanceImage(0, 0, np.zeros((len(info.colour), 0, 0),
-                                                               np.float32),
-                                                np.zeros((0, 0), bool)))
-                fracs.append(np.zeros((0, 0), np.float32))
-                covers.append(np.zeros((0, 0), np.float32))
-                continue
-            r0, r1, c0, c1 = win
-            colour, frac = _read_on_grid(src, info, ctr, r0, r1, c0, c1, "average")
-            full = frac >= 1.0 - 1e-6
-            colour[:, ~full] = np.nan
-            samples.append(bal.BalanceImage(r0, c0, colour, full))
-            fracs.append(frac)
-            covers.append(_coverage(info, ctr, r0, r1, c0, c1, frac))
-
-        # 2. balancing ----------------------------------------------------------------------
-        gains, offsets, luts, report = bal.balance_images(samples, balance, ref_index, names)
+        srcs = [stack.enter_context(rasterio.open(i.path)) for i in plan.infos]
+        samples, fracs, covers = _sample_seam_grid(srcs, plan, grid, fb)
+        gains, offsets, luts, report = bal.balance_images(samples, balance, plan.ref_index,
+                                                          names)
+        radio = _Radiometry(gains, offsets, luts)
         fb.info(f"Balancing ({balance}): mean overlap difference "
                 f"{report['before']['mean_difference']} → {report['after']['mean_difference']} "
                 f"DN, mean |difference| {report['before']['mean_abs_difference']} → "
                 f"{report['after']['mean_abs_difference']} DN.")
-
-        # 3. partition ----------------------------------------------------------------------
-        seam_imgs = []
-        for k, smp in enumerate(samples):
-            frac = fracs[k]
-            grey = np.nan_to_num(apply_mean(smp.bands, gains[k], offsets[k], luts[k]), nan=0.0)
-            seam_imgs.append(sl.SeamImage(names[k], infos[k].centre, smp.row, smp.col,
-                                          frac, grey, covers[k]))
-        # the partition is built on the image footprints; occluded cells are filled later
-        labels = sl.nadir_labels((CH, CW), ctr, seam_imgs, geometric=True)
-        next_best = sl.nadir_labels((CH, CW), ctr, seam_imgs)
-        hag = None
-        margin = math.ceil(0.5 * feather_m / cs) + 1
-        if dsm is not None and dtm is not None:
-            hag = sl.object_height(_read_height(dsm, ctr, (CH, CW), crs, "max"),
-                                   _read_height(dtm, ctr, (CH, CW), crs, "average"))
-        seam_stats: Dict[str, Any] = {"mode": "auto" if seam_file is None else "operator"}
-        regions: List[Tuple[Any, int]] = []
-        if seam_file is not None:
-            layers = ("seamlines",) if seamlines.strip().lower() == "edits" else None
-            assigned, cuts = sl.read_operator_seamlines(seam_file, crs, names, layers)
-            if cuts:
-                regions.extend(sl.cut_regions(cuts, _bounds(transform, W, H), labels, ctr,
-                                              len(infos)))
-            regions.extend(assigned)  # assigned polygons win over cut regions
-            op = sl.rasterize_regions(regions, (CH, CW), ctr)
-            labels = np.where(op >= 0, op, labels).astype(np.int32)
-            seam_stats.update(regions=len(regions), assigned=len(assigned), cut_lines=len(cuts))
-        elif seamlines.strip().lower() == "auto" and len(infos) > 1:
-            cor_m = sl.default_corridor([i.centre for i in infos]) if corridor is None \
-                else float(corridor)
-            cor = max(round(cor_m / cs), 2)
-            labels, st = sl.route_seams(labels, seam_imgs, hag, corridor=cor,
-                                        min_height=min_height, margin=margin,
-                                        feedback=fb.step(15, 30))
-            seam_stats.update(st, corridor_m=round(cor * cs, 3))
-        else:
-            seam_stats["mode"] = "nadir"
-        partition = labels  # footprint polygons: the seams, without occlusion fills
-        labels = sl.fill_invalid(labels, seam_imgs, next_best)
-        del seam_imgs, samples, fracs, covers, next_best
-
-        # 4. mosaic, tile by tile -------------------------------------------------------------
-        dtype = infos[0].dtype
-        lo, hi = _dtype_range(dtype)
-        nb = len(infos[0].colour)
-        halo = math.ceil(feather_px / 2.0) + 1 if feather_px >= 1.0 else 0
-        img_wins = [_window_of(i, transform, W, H) for i in infos]
-        prof = gtiff_profile(W, H, nb + 1, dtype, crs, transform=transform,
-                             nodata=None)
-        tile = max(int(tile), 64)
-        tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]
-        filled = 0
-        covered = 0
-        tfb = fb.step(30, 95)
-        # a Cloud-Optimised GeoTIFF: the mosaic is the block's deliverable
-        with cog_output(out, prof) as (tmp, scratch_prof), \
-                rasterio.open(tmp, "w", **scratch_prof) as dst:
-            for t_idx, (r0, c0) in enumerate(tiles):
-                tfb.progress(100.0 * t_idx / len(tiles))
-                r1, c1 = min(r0 + tile, H), min(c0 + tile, W)
-                R0, R1 = max(r0 - halo, 0), min(r1 + halo, H)
-                C0, C1 = max(c0 - halo, 0), min(c1 + halo, W)
-                lab = labels[np.arange(R0, R1)[:, None] // f, np.arange(C0, C1)[None, :] // f]
-                if regions:
-                    op = sl.rasterize_regions(regions, (R1 - R0, C1 - C0),
-                                              transform * Affine.translation(C0, R0))
-                    lab = np.where(op >= 0, op, lab)
-                ids, vals, valids = [], [], []
-                for k, (info, src) in enumerate(zip(infos, srcs)):
-                    wk = img_wins[k]
-                    if wk is None or wk[1] <= R0 or wk[0] >= R1 or wk[3] <= C0 or wk[2] >= C1:
-                        continue
-                    colour, valid = _read_on_grid(src, info, transform, R0, R1, C0, C1, "full")
-                    if not valid.any():
-                        continue
-                    ids.append(k)
-                    vals.append(bal.apply_balance(colour, gains[k], offsets[k], luts[k]))
-                    valids.append(valid > 0)
-                final = _final_labels(lab, ids, valids, infos, transform, R0, R1, C0, C1)
-                inner = (slice(r0 - R0, r1 - R0), slice(c0 - C0, c1 - C0))
-                filled += int(((final != lab) & (final >= 0))[inner].sum())
-                covered += int((final >= 0)[inner].sum())
-                if ids:
-                    data, alpha = _blend(vals, valids, final, ids, feather_px)
-                else:
-                    data = np.zeros((nb, R1 - R0, C1 - C0), np.float32)
-                    alpha = np.zeros((R1 - R0, C1 - C0), bool)
-                data = data[:, inner[0], inner[1]]
-                alpha = alpha[inner]
-                if np.issubdtype(np.dtype(dtype), np.integer):
-                    data = np.clip(np.rint(data), lo, hi)
-                data = np.where(alpha[None], data, 0).astype(dtype)
-                a = np.where(alpha, _alpha_value(dtype), 0).astype(dtype)
-                win = Window(c0, r0, c1 - c0, r1 - r0)
-                dst.write(data, indexes=list(range(1, nb + 1)), window=win)
-                dst.write(a, nb + 1, window=win)
-            dst.colorinterp = [*infos[0].colorinterp, ColorInterp.alpha]
-            dst.update_tags(PHOTODEM_MOSAIC="1", PHOTODEM_IMAGES=",".join(names),
-                            PHOTODEM_GSD=f"{s:g}", PHOTODEM_SEAMLINES=seam_stats["mode"],
-                            PHOTODEM_BALANCE=balance)
-            fb.progress(95.0)
-            factors = overview_factors(W, H)
-            if factors:
-                dst.build_overviews(factors, Resampling.average)
-                dst.update_tags(ns="rio_overview", resampling="average")
+        seam_imgs = [
+            sl.SeamImage(names[k], plan.infos[k].centre, smp.row, smp.col, fracs[k],
+                         np.nan_to_num(radio.grey(k, smp.bands), nan=0.0), covers[k])
+            for k, smp in enumerate(samples)]
+        part = _partition(plan, grid, seam_imgs, fb)
+        del seam_imgs, samples, fracs, covers
+        counts = _write_mosaic(srcs, plan, grid, part, radio, fb)
 
     # 5. footprints / seamlines and the report -------------------------------------------------
-    polys = sl.partition_polygons(partition, ctr, len(infos))
-    if regions:  # operator regions exactly, the rest from the seam grid
-        from shapely.ops import unary_union
-
-        op_union = unary_union([g for g, _ in regions])
-        area = _box(transform, W, H)
-        polys = [None if p is None else p.difference(op_union) for p in polys]
-        for k in range(len(infos)):
-            mine = [g for g, kk in regions if kk == k]
-            if mine:
-                part = unary_union(mine).intersection(area)
-                polys[k] = part if polys[k] is None else polys[k].union(part)
-        polys = [None if p is None or p.is_empty else p for p in polys]
+    polys = _footprints(plan, grid, part)
     lines = sl.seam_lines(polys)
-    sl.write_seamlines(paths["seamlines"], polys, names, [i.path.name for i in infos], lines,
-                       crs)
-    report["seams"] = seam_stats
-    report["seam_factor"] = f
-    report["filled_pct"] = round(100.0 * filled / max(covered, 1), 3)
+    sl.write_seamlines(paths["seamlines"], polys, names, [i.path.name for i in plan.infos],
+                       lines, plan.crs)
+    report["seams"] = part.stats
+    report["seam_factor"] = grid.factor
+    report["filled_pct"] = round(100.0 * counts.filled / max(counts.covered, 1), 3)
     with atomic_output(paths["report"]) as tmp:
         tmp.write_text(json.dumps(report, indent=2), encoding="utf-8")
-    return {"mosaic": str(out), "seamlines": str(paths["seamlines"]),
+    return {"mosaic": str(plan.output), "seamlines": str(paths["seamlines"]),
             "report": str(paths["report"]), "gsd": s, "cells": [W, H], "images": names,
-            "seam_factor": f, "seams": seam_stats,
+            "seam_factor": grid.factor, "seams": part.stats,
             "balance": {"before": report["before"], "after": report["after"]},
             "filled_pct": report["filled_pct"],
             "seconds": round(time.perf_counter() - start, 2)}
@@ -670,8 +795,6 @@ def _bounds(transform: Affine, W: int, H: int) -> Tuple[float, float, float, flo
 
 
 def _box(transform: Affine, W: int, H: int) -> Any:
-    from shapely.geometry import box
-
     return box(*_bounds(transform, W, H))
 
 
@@ -708,9 +831,6 @@ def mosaic_project(
     dict
         :func:`mosaic_orthos`'s result plus ``orthos`` (per image: gsd, occluded_pct).
     """
-    from ..project.model import Project
-    from .rectify import orthorectify_image
-
     fb = ensure_feedback(feedback)
     proj = project if isinstance(project, Project) else Project.load(project)
     if true_ortho and not dsm:
@@ -738,13 +858,95 @@ def mosaic_project(
     return result
 
 
+@dataclass
+class MosaicOptions:
+    """Seams, balancing and tiling of a mosaic (the keywords of :func:`mosaic_orthos`)."""
+
+    seamlines: str = "auto"
+    balance: str = "gain_offset"
+    feather: Optional[float] = None
+    reference: Optional[str] = None
+    corridor: Optional[float] = None
+    min_height: float = 2.0
+    tile: int = 1024
+    seam_cells: int = 1024
+
+
+@dataclass
+class MosaicSources:
+    """What a mosaic is made of: orthos, or the project's images rectified on a DEM.
+
+    Attributes
+    ----------
+    inputs : sequence of paths, optional
+        Orthos; they win over ``dem`` (with a warning when both are given).
+    project : Project, optional
+        Needed with ``dem`` and for ``seamlines="edits"``.
+    dem : path, optional
+        Surface to rectify every project image on (:func:`mosaic_project`).
+    dsm, dtm : path, optional
+        Surfaces of the seam cost (and of true orthos).
+    gsd : float, optional
+        Cell size (m).
+    resampling : str
+        Resampling of the rectification.
+    true_ortho : bool
+        Rectify on the DSM with the occlusion test.
+    """
+
+    inputs: Optional[Sequence[PathLike]] = None
+    project: Any = None
+    dem: Optional[PathLike] = None
+    dsm: Optional[PathLike] = None
+    dtm: Optional[PathLike] = None
+    gsd: Optional[float] = None
+    resampling: str = "bilinear"
+    true_ortho: bool = False
+
+
+def run_mosaic(output: PathLike, sources: MosaicSources, options: MosaicOptions,
+               feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """``mosaic``: mosaic the given orthos, or rectify the project's images first.
+
+    Returns
+    -------
+    dict
+        :func:`mosaic_orthos`'s (or :func:`mosaic_project`'s) result.
+
+    Raises
+    ------
+    InputError
+        Neither orthos nor a DEM, or a DEM without the project.
+    """
+    fb = ensure_feedback(feedback)
+    keywords = asdict(options)
+    if sources.inputs:
+        if sources.dem:
+            fb.warning("Both orthos and a DEM are given; the orthos are mosaicked "
+                       "and the DEM is not used.")
+        return mosaic_orthos(sources.inputs, output, gsd=sources.gsd, dsm=sources.dsm,
+                             dtm=sources.dtm, project=sources.project, feedback=fb, **keywords)
+    if sources.dem:
+        if sources.project is None:
+            raise InputError("Rectifying needs the project: give 'project' with 'dem' "
+                             "(or give the orthos as 'inputs').")
+        return mosaic_project(sources.project, sources.dem, output, gsd=sources.gsd,
+                              resampling=sources.resampling, dsm=sources.dsm,
+                              true_ortho=sources.true_ortho, dtm=sources.dtm, feedback=fb,
+                              **keywords)
+    raise InputError("Nothing to mosaic: give the orthos ('inputs'), or a project and "
+                     "a DEM ('dem') to rectify every image first.")
+
 __all__ = [
     "SEAMLINE_MODES",
+    "MosaicOptions",
+    "MosaicSources",
     "OrthoInfo",
     "check_inputs",
     "mosaic_grid",
     "mosaic_orthos",
     "mosaic_project",
     "read_ortho_info",
+    "run_mosaic",
     "sibling_paths",
 ]

@@ -53,16 +53,25 @@ Operator seamlines
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
+import fiona
 import numpy as np
 from affine import Affine
 from numpy.typing import NDArray
+from rasterio.crs import CRS
+from rasterio.features import rasterize, shapes
+from rasterio.warp import transform_geom
 from scipy import ndimage
+from shapely.geometry import MultiLineString, MultiPolygon, box, mapping, shape
+from shapely.ops import linemerge, polygonize, unary_union
+from skimage.graph import MCP_Geometric
 
 from ..errors import InputError
+from ..raster.io import atomic_output
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -227,8 +236,6 @@ def _pair_cost(gi: Array, gj: Array, hag: Optional[Array], passable: Array,
 def _route_pair(labels: Array, i: int, j: int, images: Sequence[SeamImage],
                 hag: Optional[Array], corridor: int, min_height: float) -> Tuple[int, int]:
     """Route the seam between ``i`` and ``j`` in place; returns (routed, kept) component counts."""
-    from skimage.graph import MCP_Geometric
-
     H, W = labels.shape
     seam = boundary_cells(np.where((labels == i) | (labels == j), labels, -1))
     rows, cols = np.nonzero(seam)
@@ -440,11 +447,6 @@ def read_operator_seamlines(source: PathLike, crs: Any, names: Sequence[str],
     InputError
         Unreadable file, an ``image`` that is not a mosaic input, or no usable geometry.
     """
-    import fiona
-    from rasterio.crs import CRS
-    from rasterio.warp import transform_geom
-    from shapely.geometry import shape
-
     path = Path(source)
     if not path.is_file():
         raise InputError(f"Seamline file '{path}' does not exist; give a vector file, 'auto' "
@@ -499,10 +501,6 @@ def cut_regions(cuts: Sequence[Any], bounds: Tuple[float, float, float, float],
     Each region takes the label that ``labels`` (the nadir partition on the seam grid with
     ``transform``) gives most of its cells; regions without a labelled cell are dropped.
     """
-    from rasterio.features import rasterize
-    from shapely.geometry import box
-    from shapely.ops import polygonize, unary_union
-
     area = box(*bounds)
     lines = unary_union([*cuts, area.boundary])
     regions = [p for p in polygonize(lines) if p.representative_point().within(area)]
@@ -523,8 +521,6 @@ def cut_regions(cuts: Sequence[Any], bounds: Tuple[float, float, float, float],
 def rasterize_regions(regions: Sequence[Tuple[Any, int]], shape: Tuple[int, int],
                       transform: Affine) -> Array:
     """Image index per cell from ``(polygon, index)`` pairs (later pairs win), −1 elsewhere."""
-    from rasterio.features import rasterize
-
     if not regions:
         return np.full(shape, -1, np.int32)
     out = rasterize(((g, k + 1) for g, k in regions), out_shape=shape, transform=transform,
@@ -536,10 +532,6 @@ def rasterize_regions(regions: Sequence[Tuple[Any, int]], shape: Tuple[int, int]
 
 def partition_polygons(labels: Array, transform: Affine, n_images: int) -> List[Any]:
     """One (multi)polygon per image index (``None`` if it has no cell) from a label raster."""
-    from rasterio.features import shapes
-    from shapely.geometry import shape
-    from shapely.ops import unary_union
-
     parts: List[List[Any]] = [[] for _ in range(n_images)]
     lab = labels.astype(np.int32)
     for geom, value in shapes(lab, mask=lab >= 0, transform=transform, connectivity=4):
@@ -549,8 +541,6 @@ def partition_polygons(labels: Array, transform: Affine, n_images: int) -> List[
 
 def seam_lines(polygons: Sequence[Any]) -> List[Tuple[int, int, Any]]:
     """Shared boundaries ``(i, j, line)`` of neighbouring footprint polygons, ``i < j``."""
-    from shapely.ops import linemerge
-
     out = []
     for i in range(len(polygons)):
         for j in range(i + 1, len(polygons)):
@@ -573,17 +563,8 @@ def write_seamlines(path: PathLike, polygons: Sequence[Any], names: Sequence[str
 
     The ``footprints`` layer can be edited and given back to a mosaic as operator seamlines.
     """
-    from collections import OrderedDict
-
-    import fiona
-    from shapely.geometry import MultiLineString, MultiPolygon, mapping
-
-    from ..raster.io import atomic_output
-
     wkt = None
     if crs is not None:
-        from rasterio.crs import CRS
-
         wkt = CRS.from_user_input(crs).to_wkt()
     poly_schema = {"geometry": "MultiPolygon",
                    "properties": OrderedDict([("image", "str"), ("ortho", "str"),

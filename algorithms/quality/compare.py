@@ -27,13 +27,20 @@ import math
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import fiona
 import numpy as np
 import rasterio
+import shapely
 from affine import Affine
 from numpy.typing import NDArray
+from pyproj import CRS, Transformer
 from rasterio.enums import Resampling
+from rasterio.features import geometry_mask, rasterize
 from rasterio.vrt import WarpedVRT
-from rasterio.windows import Window
+from rasterio.warp import transform_bounds
+from rasterio.windows import Window, from_bounds
+from shapely.geometry import shape
+from shapely.ops import transform as shapely_transform
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
@@ -114,9 +121,6 @@ class _GridReader:
 
 def _common_grid(dem: Any, ref: Any) -> Tuple[Window, Affine]:
     """Window of the reference covering the common area (whole cells), and its transform."""
-    from rasterio.warp import transform_bounds
-    from rasterio.windows import from_bounds
-
     try:
         b = transform_bounds(dem.crs, ref.crs, *dem.bounds, densify_pts=21)
     except Exception as exc:
@@ -155,23 +159,15 @@ def _vector_kind(path: PathLike) -> bool:
 
 def _reproject_geometry(geom: Any, transformer: Any) -> Any:
     """``geom`` with its coordinates transformed (shapely 2 and 1.8)."""
-    import shapely
-
     if hasattr(shapely, "transform"):  # shapely ≥ 2: vectorised over all vertices
         return shapely.transform(geom, lambda xy: np.column_stack(
             transformer.transform(xy[:, 0], xy[:, 1])))
-    from shapely.ops import transform
-
-    return transform(transformer.transform, geom)
+    return shapely_transform(transformer.transform, geom)
 
 
 def _read_polygons(path: PathLike, crs: Any, field: Optional[str], what: str,
                    feedback: Feedback) -> Tuple[List[Any], List[Any]]:
     """Geometries (in ``crs``) and attribute values (or 1 when ``field`` is None)."""
-    import fiona
-    from pyproj import CRS, Transformer
-    from shapely.geometry import shape
-
     p = Path(path)
     if not p.exists():
         raise InputError(f"The {what} '{p}' does not exist; give an existing vector layer.")
@@ -216,8 +212,6 @@ class _PolygonRasteriser:
         self.bounds = np.array([g.bounds for g in geoms]).reshape(-1, 4)
 
     def labels(self, transform: Affine, h: int, w: int) -> Array:
-        from rasterio.features import rasterize
-
         x0, y1 = transform * (0, 0)
         x1, y0 = transform * (w, h)
         b = self.bounds
@@ -253,8 +247,6 @@ def _coregister(stack: contextlib.ExitStack, dem: Any, ref: Any, grid: Affine, w
     mask = None
     if stable is not None:
         if _vector_kind(stable):
-            from rasterio.features import geometry_mask
-
             geoms, _ = _read_polygons(stable, ref.crs, None, "stable-area layer", feedback)
             if not geoms:
                 raise InputError(f"The stable-area layer '{stable}' holds no polygons.")
@@ -275,6 +267,110 @@ def _coregister(stack: contextlib.ExitStack, dem: Any, ref: Any, grid: Affine, w
         feedback.warning("The co-registration did not converge; the shift may be unreliable.")
     return {"dx": r.dx, "dy": r.dy, "dz": r.dz, "iterations": r.iterations,
             "converged": r.converged, "residual_nmad": r.residual_nmad}
+
+
+class _ClassSource:
+    """Class labels window by window: from polygons (indices, with names) or a raster."""
+
+    def __init__(self, stack: contextlib.ExitStack, classes: Optional[PathLike],
+                 class_field: Optional[str], ref: Any, grid: Affine, width: int, height: int,
+                 feedback: Feedback) -> None:
+        self.names: Optional[Dict[str, str]] = None
+        self.polys: Optional[_PolygonRasteriser] = None
+        self.reader: Optional[_GridReader] = None
+        if classes is None:
+            return
+        if _vector_kind(classes):
+            geoms, values = _read_polygons(classes, ref.crs, class_field, "class layer",
+                                           feedback)
+            keys = sorted({_label_key(v) for v in values if v is not None})
+            index = {k: i for i, k in enumerate(keys)}
+            keep = [i for i, v in enumerate(values) if v is not None]
+            self.polys = _PolygonRasteriser([geoms[i] for i in keep],
+                                            [index[_label_key(values[i])] for i in keep])
+            self.names = {str(i): k for k, i in index.items()}
+        else:
+            csrc = _open_raster(stack, classes, "class raster")
+            self.reader = _GridReader(stack, csrc, ref.crs, grid, width, height,
+                                      Resampling.nearest)
+
+    def labels(self, wt: Affine, r: int, c: int, h: int, w: int) -> Optional[Array]:
+        """Class of every cell of the window (NaN = none), or None without classes."""
+        if self.polys is not None:
+            return self.polys.labels(wt, h, w)
+        if self.reader is not None:
+            return self.reader.read(r, c, h, w)
+        return None
+
+
+class _ComparisonGrid:
+    """The reference window both DEMs cover: its transform, size and offset in the reference."""
+
+    def __init__(self, src: Any, ref: Any) -> None:
+        gwin, self.transform = _common_grid(src, ref)
+        self.width, self.height = int(gwin.width), int(gwin.height)
+        self.r_off, self.c_off = int(gwin.row_off), int(gwin.col_off)
+
+    def windows(self, window_size: int) -> List[Tuple[int, int, int, int]]:
+        """(row, col, h, w) of the processing windows."""
+        step = max(16, int(window_size))
+        return [(r, c, min(step, self.height - r), min(step, self.width - c))
+                for r in range(0, self.height, step) for c in range(0, self.width, step)]
+
+
+def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], ref: Any,
+                       grid: _ComparisonGrid) -> Any:
+    """The open (staged) Δh raster, or None when no path is given."""
+    if path is None:
+        return None
+    tmp = stack.enter_context(atomic_output(path))
+    profile = gtiff_profile(grid.width, grid.height, 1, "float32", ref.crs, nodata=float("nan"),
+                            transform=grid.transform, predictor=3)
+    return stack.enter_context(rasterio.open(tmp, "w", **profile))
+
+
+def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
+                classes: _ClassSource, out_ds: Any, acc: DifferenceAccumulator,
+                window_size: int, progress: Tuple[float, Feedback]) -> Tuple[int, int]:
+    """Feed Δh of every window (with slope and class groups) to ``acc``; write Δh.
+
+    Returns the numbers of valid reference and DEM heights. ``progress`` is (the share
+    already done in %, the feedback).
+    """
+    base, fb = progress
+    t = grid.transform
+    wins = grid.windows(window_size)
+    n_ref = n_dem = 0
+    for i, (r, c, h, w) in enumerate(wins):
+        refp = _read_window(ref, grid.r_off + r - 1, grid.c_off + c - 1, h + 2, w + 2)
+        z_ref = refp[1:-1, 1:-1]
+        z_dem = dem_reader.read(r, c, h, w) + dz0
+        dz = z_dem - z_ref
+        n_ref += int(np.count_nonzero(np.isfinite(z_ref)))
+        n_dem += int(np.count_nonzero(np.isfinite(z_dem)))
+        groups = {"slope": slope_class_index(_slope_deg(refp, t.a, t.e))}
+        labels = classes.labels(t * Affine.translation(c, r), r, c, h, w)
+        if labels is not None:
+            groups["class"] = labels
+        acc.add(dz, groups)
+        if out_ds is not None:
+            out_ds.write(dz.astype(np.float32), 1, window=Window(c, r, w, h))
+        fb.progress(base + (100.0 - base) * (i + 1) / len(wins))
+    return n_ref, n_dem
+
+
+def _check_overlap_heights(n_ref: int, n_dem: int, acc: DifferenceAccumulator,
+                           dem: PathLike, reference: PathLike) -> None:
+    """One-line errors when a DEM or both together have no valid heights in common."""
+    if n_ref == 0:
+        raise InputError(f"The reference DEM '{reference}' has no valid heights in the area "
+                         "it shares with the DEM (all nodata).")
+    if n_dem == 0:
+        raise InputError(f"The DEM '{dem}' has no valid heights in the area it shares with "
+                         "the reference (all nodata).")
+    if acc.total.n == 0:
+        raise InputError("The DEM and the reference have no valid heights at the same "
+                         "cells; nothing to compare.")
 
 
 def compare_dems(
@@ -339,82 +435,29 @@ def compare_dems(
     with contextlib.ExitStack() as stack:
         ref = _open_raster(stack, reference, "reference DEM")
         src = _open_raster(stack, dem, "DEM")
-        gwin, grid = _common_grid(src, ref)
-        width, height = int(gwin.width), int(gwin.height)
-        r_off, c_off = int(gwin.row_off), int(gwin.col_off)
+        cg = _ComparisonGrid(src, ref)
+        grid, width, height = cg.transform, cg.width, cg.height
         fb.info(f"Comparison grid: {width} × {height} cells of the reference "
                 f"({abs(grid.a):g} × {abs(grid.e):g}), {ref.crs.to_string()}.")
-
         shift = None
         if coregister:
             shift = _coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
                                 fb.step(0, 10))
-        dz0 = shift["dz"] if shift else 0.0
         dem_reader = _GridReader(stack, src, ref.crs, grid, width, height, Resampling.bilinear,
                                  (shift["dx"], shift["dy"]) if shift else (0.0, 0.0))
-
-        class_names: Optional[Dict[str, str]] = None
-        polys: Optional[_PolygonRasteriser] = None
-        class_reader: Optional[_GridReader] = None
-        if classes is not None:
-            if _vector_kind(classes):
-                geoms, values = _read_polygons(classes, ref.crs, class_field, "class layer", fb)
-                keys = sorted({_label_key(v) for v in values if v is not None})
-                index = {k: i for i, k in enumerate(keys)}
-                keep = [i for i, v in enumerate(values) if v is not None]
-                polys = _PolygonRasteriser([geoms[i] for i in keep],
-                                           [index[_label_key(values[i])] for i in keep])
-                class_names = {str(i): k for k, i in index.items()}
-            else:
-                csrc = _open_raster(stack, classes, "class raster")
-                class_reader = _GridReader(stack, csrc, ref.crs, grid, width, height,
-                                           Resampling.nearest)
-
+        class_src = _ClassSource(stack, classes, class_field, ref, grid, width, height, fb)
         acc = DifferenceAccumulator(memory_budget=memory_budget)
-        out_ds = None
-        if difference_path is not None:
-            tmp = stack.enter_context(atomic_output(difference_path))
-            profile = gtiff_profile(width, height, 1, "float32", ref.crs, nodata=float("nan"),
-                                    transform=grid, predictor=3)
-            out_ds = stack.enter_context(rasterio.open(tmp, "w", **profile))
-
-        step = max(16, int(window_size))
-        wins = [(r, c, min(step, height - r), min(step, width - c))
-                for r in range(0, height, step) for c in range(0, width, step)]
-        n_ref = n_dem = 0
-        base = 10.0 if coregister else 0.0
-        for i, (r, c, h, w) in enumerate(wins):
-            refp = _read_window(ref, r_off + r - 1, c_off + c - 1, h + 2, w + 2)
-            z_ref = refp[1:-1, 1:-1]
-            z_dem = dem_reader.read(r, c, h, w) + dz0
-            dz = z_dem - z_ref
-            n_ref += int(np.count_nonzero(np.isfinite(z_ref)))
-            n_dem += int(np.count_nonzero(np.isfinite(z_dem)))
-            groups = {"slope": slope_class_index(_slope_deg(refp, grid.a, grid.e))}
-            wt = grid * Affine.translation(c, r)
-            if polys is not None:
-                groups["class"] = polys.labels(wt, h, w)
-            elif class_reader is not None:
-                groups["class"] = class_reader.read(r, c, h, w)
-            acc.add(dz, groups)
-            if out_ds is not None:
-                out_ds.write(dz.astype(np.float32), 1, window=Window(c, r, w, h))
-            fb.progress(base + (100.0 - base) * (i + 1) / len(wins))
-        if n_ref == 0:
-            raise InputError(f"The reference DEM '{reference}' has no valid heights in the area "
-                             "it shares with the DEM (all nodata).")
-        if n_dem == 0:
-            raise InputError(f"The DEM '{dem}' has no valid heights in the area it shares with "
-                             "the reference (all nodata).")
-        if acc.total.n == 0:
-            raise InputError("The DEM and the reference have no valid heights at the same "
-                             "cells; nothing to compare.")
+        out_ds = _difference_output(stack, difference_path, ref, cg)
+        n_ref, n_dem = _accumulate(ref, dem_reader, shift["dz"] if shift else 0.0, cg,
+                                   class_src, out_ds, acc, window_size,
+                                   (10.0 if coregister else 0.0, fb))
+        _check_overlap_heights(n_ref, n_dem, acc, dem, reference)
         res = acc.result(flying_height)
 
     per_slope = {SLOPE_LABELS[int(k)]: v for k, v in res.get("per_slope", {}).items()}
     per_class = res.get("per_class", {})
-    if class_names is not None:
-        per_class = {class_names[k]: v for k, v in per_class.items()}
+    if class_src.names is not None:
+        per_class = {class_src.names[k]: v for k, v in per_class.items()}
     return {
         "stats": res["stats"],
         "shift": shift,
@@ -425,4 +468,3 @@ def compare_dems(
         "difference": str(difference_path) if difference_path is not None else None,
         "precision": res["precision"],
     }
-

@@ -16,13 +16,18 @@ import math
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
+import fiona
 import numpy as np
+import rasterio
 from numpy.typing import NDArray
+from rasterio.crs import CRS
+from rasterio.warp import transform as warp_transform
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output
 from .points import sample_dem
+from .report import new_figure, png_bytes
 
 PathLike = Union[str, Path]
 
@@ -75,8 +80,6 @@ def read_line(path: PathLike) -> Tuple[NDArray[np.float64], Optional[str]]:
     InputError
         No line feature, or one with fewer than 2 vertices.
     """
-    import fiona
-
     path = Path(path)
     if not path.exists():
         raise InputError(f"Line file '{path}' does not exist.")
@@ -177,9 +180,6 @@ def dem_profile(dems: Sequence[PathLike], *, csv_path: PathLike, png_path: PathL
         No DEM, neither or a bad line, a line with < 2 vertices, a geographic first DEM, too
         many samples, or a DEM that does not cover the line at all.
     """
-    import rasterio
-    from rasterio.crs import CRS
-
     feedback = ensure_feedback(feedback)
     dems = [Path(d) for d in dems]
     if not dems:
@@ -203,9 +203,7 @@ def dem_profile(dems: Sequence[PathLike], *, csv_path: PathLike, png_path: PathL
         vertices, line_crs = read_line(line)
         if line_crs is not None and work_crs is not None and \
                 CRS.from_user_input(line_crs) != work_crs:
-            from rasterio.warp import transform
-
-            xs, ys = transform(CRS.from_user_input(line_crs), work_crs,
+            xs, ys = warp_transform(CRS.from_user_input(line_crs), work_crs,
                                vertices[:, 0].tolist(), vertices[:, 1].tolist())
             vertices = np.column_stack([xs, ys])
     else:
@@ -257,8 +255,6 @@ def _write_csv(path: PathLike, dist: NDArray[Any], x: NDArray[Any], y: NDArray[A
 
 def _write_plot(path: PathLike, dist: NDArray[Any], names: Sequence[str],
                 heights: Sequence[NDArray[Any]], spacing: float) -> None:
-    from .report import new_figure, png_bytes
-
     fig = new_figure(10.0, 4.5)
     ax = fig.add_subplot(1, 1, 1)
     for name, z in zip(names, heights):

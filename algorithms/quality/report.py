@@ -30,7 +30,14 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import rasterio
+from affine import Affine
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.figure import Figure
 from numpy.typing import NDArray
+from rasterio.warp import Resampling, reproject, transform_bounds
+from rasterio.windows import Window, from_bounds
 
 from ..feedback import Feedback, ensure_feedback
 from ..jsonable import json_ready
@@ -72,9 +79,6 @@ MAP_PIXELS = 900
 # -- matplotlib without pyplot --------------------------------------------------------------------
 def new_figure(width: float, height: float) -> Any:
     """A matplotlib Figure on an Agg canvas (inches); no global backend is touched."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
     fig = Figure(figsize=(width, height), dpi=100)
     FigureCanvasAgg(fig)
     return fig
@@ -168,9 +172,6 @@ def signed_histogram(difference: PathLike, limit: float, bins: int,
         ``edges`` (bins + 1 values from −limit to +limit), ``counts``, ``under`` and ``over``
         (cells beyond ±limit).
     """
-    import rasterio
-    from rasterio.windows import Window
-
     edges = np.linspace(-limit, limit, bins + 1)
     counts = np.zeros(bins, dtype=np.int64)
     under = over = 0
@@ -194,9 +195,6 @@ def read_decimated(path: PathLike, bounds: Optional[Tuple[float, float, float, f
     -------
     array (NaN = nodata), transform of the reduced grid, CRS
     """
-    import rasterio
-    from rasterio.windows import Window, from_bounds
-
     with rasterio.open(path) as src:
         if bounds is None:
             window = Window(0, 0, src.width, src.height)
@@ -208,8 +206,6 @@ def read_decimated(path: PathLike, bounds: Optional[Tuple[float, float, float, f
         data = src.read(1, window=window, out_shape=shape, masked=True,
                         boundless=bounds is not None)
         arr = np.ma.filled(data.astype(np.float64), np.nan)
-        from affine import Affine
-
         transform = src.window_transform(window) * Affine.scale(w / shape[1], h / shape[0])
         return arr, transform, src.crs
 
@@ -217,9 +213,6 @@ def read_decimated(path: PathLike, bounds: Optional[Tuple[float, float, float, f
 def _hillshade_on(hillshade: PathLike, transform: Any, crs: Any,
                   shape: Tuple[int, int]) -> Optional[NDArray[Any]]:
     """The hillshade resampled onto a small grid (decimated read, then reprojected)."""
-    import rasterio
-    from rasterio.warp import Resampling, reproject, transform_bounds
-
     h, w = shape
     left, top = transform * (0, 0)
     right, bottom = transform * (w, h)
@@ -304,8 +297,6 @@ def figure_histograms(stats: Dict[str, Any], signed: Optional[Dict[str, Any]]) -
 
 
 def _colormap() -> Tuple[Any, Any]:
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-
     colours = difference_colors()
     cmap = ListedColormap(colours[1:-1]).with_extremes(under=colours[0], over=colours[-1],
                                                        bad=(0, 0, 0, 0))

@@ -43,11 +43,16 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import rasterio
 from affine import Affine
 from numpy.typing import NDArray
+from rasterio.enums import Resampling
+from rasterio.warp import calculate_default_transform, reproject, transform_bounds
+from rasterio.windows import Window
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..quality.stats import DifferenceAccumulator
 from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
 
 PathLike = Union[str, Path]
@@ -84,9 +89,6 @@ def _sigma_source(path: Path, bands: int) -> Tuple[Optional[Path], bool]:
 
 
 def _open_inputs(paths: Sequence[PathLike]) -> Tuple[List[_Input], Any]:
-    import rasterio
-    from rasterio.warp import transform_bounds
-
     if not paths:
         raise InputError("No input DSMs given; give at least one raster.")
     infos = []
@@ -122,8 +124,6 @@ def _open_inputs(paths: Sequence[PathLike]) -> Tuple[List[_Input], Any]:
 def _grid(inputs: List[_Input], target: Any, spacing: Optional[float]
           ) -> Tuple[Affine, int, int, float]:
     """Transform, width, height, cell size of the output grid (see the module notes)."""
-    from rasterio.warp import calculate_default_transform
-
     res = []
     for i in inputs:
         if target is None or i.crs == target:
@@ -184,11 +184,6 @@ def _aligned_offset(i: _Input, target: Any, transform: Affine) -> Optional[Tuple
 def _read_window(src: Any, band: int, info: _Input, target: Any, win_transform: Affine,
                  shape: Tuple[int, int], r0: int, c0: int) -> Array:
     """Heights of one input on one output window (float32, NaN where it has none)."""
-    import rasterio
-    from rasterio.enums import Resampling
-    from rasterio.warp import reproject
-    from rasterio.windows import Window
-
     h, w = shape
     out = np.full(shape, np.nan, np.float32)
     if info.aligned is not None:
@@ -255,6 +250,134 @@ def sibling_paths(output: PathLike) -> Dict[str, Path]:
             "csv": output.with_name(f"{stem}_seams.csv")}
 
 
+def _overlap(a: Tuple[float, ...], b: Tuple[float, ...]) -> bool:
+    """Do two (xmin, ymin, xmax, ymax) extents overlap (with a positive area)?"""
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _checked_inputs(inputs: Sequence[PathLike], output: PathLike, mode: str,
+                    feedback: Feedback) -> Tuple[List[_Input], Any, Dict[str, Path]]:
+    """The opened inputs, the target CRS and the output files, after the up-front checks."""
+    if mode not in MODES:
+        raise InputError(f"Unknown merge mode '{mode}'; use one of {', '.join(MODES)}.")
+    out_paths = sibling_paths(output)
+    if out_paths["dsm"].suffix.lower() not in (".tif", ".tiff"):
+        raise InputError(f"The output '{output}' must be a GeoTIFF (.tif).")
+    infos, target = _open_inputs(inputs)
+    if len({i.path.resolve() for i in infos}) < len(infos):
+        feedback.warning("The same DSM is given more than once; it counts once per mention.")
+    if out_paths["dsm"].resolve() in {i.path.resolve() for i in infos}:
+        raise InputError("The output would overwrite an input; choose another output name.")
+    return infos, target, out_paths
+
+
+def _count_sigma(infos: List[_Input], mode: str, feedback: Feedback) -> int:
+    """Inputs with σ; warns when ``best_sigma`` lacks σ for some or all inputs."""
+    n_sigma = sum(1 for i in infos if i.sigma_band or i.sigma_path is not None)
+    if mode == "best_sigma" and n_sigma == 0:
+        feedback.warning("best_sigma: no input has σ (band 2 or a sibling sigma.tif); the "
+                         "median is used.")
+    elif mode == "best_sigma" and n_sigma < len(infos):
+        feedback.warning(f"best_sigma: {len(infos) - n_sigma} input(s) have no σ; they are used "
+                         "(as their median) only where no input with σ has a height.")
+    return n_sigma
+
+
+@dataclass
+class _MergeSources:
+    """The open inputs (and σ rasters) of a merge, with what the windows need of them."""
+
+    infos: List[_Input]
+    srcs: List[Any]
+    sig_srcs: List[Any]
+    target: Any
+    mode: str
+    n_sigma: int
+    pairs: List[Tuple[int, int]]
+
+    def window(self, transform: Affine, s: float, r0: int, c0: int, h: int, w: int,
+               accs: Dict[Tuple[int, int], Any]) -> Tuple[Array, Array]:
+        """Merged heights and input count of one output window; feeds the seam statistics."""
+        wt = transform * Affine.translation(c0, r0)
+        wb = (wt.c, wt.f - h * s, wt.c + w * s, wt.f)
+        idx = [j for j, i in enumerate(self.infos) if _overlap(i.bounds, wb)]
+        if not idx:
+            return np.full((h, w), np.nan, np.float32), np.zeros((h, w), np.uint16)
+        layers = np.stack([_read_window(self.srcs[j], 1, self.infos[j], self.target, wt,
+                                        (h, w), r0, c0) for j in idx])
+        sig = None
+        if self.mode == "best_sigma" and self.n_sigma:
+            sig = np.stack([self._sigma(j, wt, (h, w), r0, c0) for j in idx])
+        zc = _combine(layers, self.mode, sig)
+        cnt = np.isfinite(layers).sum(axis=0).astype(np.uint16)
+        pos = {j: n for n, j in enumerate(idx)}
+        for a, b in self.pairs:
+            if a in pos and b in pos:
+                accs[(a, b)].add(layers[pos[a]] - layers[pos[b]])
+        return zc, cnt
+
+    def _sigma(self, j: int, wt: Affine, shape: Tuple[int, int], r0: int, c0: int) -> Array:
+        """σ of input ``j`` on the window (NaN when it has none)."""
+        info = self.infos[j]
+        if info.sigma_band:
+            return _read_window(self.srcs[j], 2, info, self.target, wt, shape, r0, c0)
+        if self.sig_srcs[j] is not None:
+            return _read_window(self.sig_srcs[j], 1, info, self.target, wt, shape, r0, c0)
+        return np.full(shape, np.nan, np.float32)
+
+
+def _open_sources(stack: ExitStack, infos: List[_Input], target: Any, mode: str,
+                  n_sigma: int, pairs: List[Tuple[int, int]]) -> _MergeSources:
+    """Open every input and, for ``best_sigma``, its sibling σ raster (checked grid)."""
+    use_sigma = mode == "best_sigma"
+    srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
+    sig_srcs = [stack.enter_context(rasterio.open(i.sigma_path))
+                if (use_sigma and i.sigma_path is not None) else None for i in infos]
+    for i, ss in zip(infos, sig_srcs):  # a sibling σ must be on its DSM's grid
+        if ss is not None and (ss.transform != i.transform or ss.width != i.width
+                               or ss.height != i.height):
+            raise InputError(f"The σ raster '{i.sigma_path}' does not have the grid of "
+                             f"'{i.path.name}'; give σ on the DSM's grid.")
+    return _MergeSources(infos, srcs, sig_srcs, target, mode, n_sigma, pairs)
+
+
+def _seam_records(accs: Dict[Tuple[int, int], Any], infos: List[_Input]) -> List[Dict[str, Any]]:
+    """One dict per pair of inputs with common heights: names, indices, Δh statistics."""
+    seams = []
+    for (a, b), acc in accs.items():
+        full = acc.result()
+        st = full["stats"]
+        if not st["count"]:
+            continue  # extents overlap but no common heights
+        seams.append({"a": infos[a].path.name, "b": infos[b].path.name,
+                      "a_index": a, "b_index": b,
+                      **{key: st[key] for key in SEAM_KEYS},
+                      "exact": bool(full["precision"]["exact"])})
+    return seams
+
+
+def _write_seam_report(tmp_json: PathLike, tmp_csv: PathLike, result: Dict[str, Any],
+                       infos: List[_Input], crs_out: Any, transform: Affine,
+                       out_paths: Dict[str, Path]) -> None:
+    """``<stem>_seams.json`` (the result without paths, plus the grid) and the seam CSV."""
+    report = {**{k: v for k, v in result.items()
+                 if k not in ("dsm", "count", "report", "csv")},
+              "inputs": [i.path.name for i in infos],
+              "crs": crs_out.to_wkt() if crs_out is not None else None,
+              "transform": list(transform)[:6],
+              "files": {k: p.name for k, p in out_paths.items()},
+              "difference": "a − b (heights of input a minus input b)"}
+    Path(tmp_json).write_text(json.dumps(report, indent=2, allow_nan=False) + "\n",
+                              encoding="utf-8")
+    with open(tmp_csv, "w", newline="", encoding="utf-8") as fh:
+        wr = csv.writer(fh)
+        wr.writerow(["a", "b", *SEAM_KEYS])
+        for sm in result["seams"]:
+            wr.writerow([sm["a"], sm["b"], *("" if sm[key] is None else
+                                             (f"{sm[key]:.6f}" if key != "count"
+                                              else sm[key]) for key in SEAM_KEYS)])
+
+
 def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median",
                spacing: Optional[float] = None, tile: int = 512,
                feedback: Optional[Feedback] = None) -> Dict[str, Any]:
@@ -281,45 +404,19 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
         ``a, b`` input names, ``a_index, b_index`` and the statistics of ``Δh = z_a − z_b``),
         ``cells, covered, coverage, spacing, width, height, mode, sigma_inputs``.
     """
-    import rasterio
-    from rasterio.enums import Resampling
-    from rasterio.windows import Window
-
-    from ..quality.stats import DifferenceAccumulator
-
     feedback = ensure_feedback(feedback)
-    if mode not in MODES:
-        raise InputError(f"Unknown merge mode '{mode}'; use one of {', '.join(MODES)}.")
-    out_paths = sibling_paths(output)
-    if out_paths["dsm"].suffix.lower() not in (".tif", ".tiff"):
-        raise InputError(f"The output '{output}' must be a GeoTIFF (.tif).")
-    infos, target = _open_inputs(inputs)
-    if len({i.path.resolve() for i in infos}) < len(infos):
-        feedback.warning("The same DSM is given more than once; it counts once per mention.")
-    if out_paths["dsm"].resolve() in {i.path.resolve() for i in infos}:
-        raise InputError("The output would overwrite an input; choose another output name.")
+    infos, target, out_paths = _checked_inputs(inputs, output, mode, feedback)
     transform, width, height, s = _grid(infos, target, spacing)
     gx0, gy0 = transform.c, transform.f
     gbounds = (gx0, gy0 - height * s, gx0 + width * s, gy0)
     for i in infos:
         i.aligned = _aligned_offset(i, target, transform)
-    use_sigma = mode == "best_sigma"
-    n_sigma = sum(1 for i in infos if i.sigma_band or i.sigma_path is not None)
-    if use_sigma and n_sigma == 0:
-        feedback.warning("best_sigma: no input has σ (band 2 or a sibling sigma.tif); the "
-                         "median is used.")
-    elif use_sigma and n_sigma < len(infos):
-        feedback.warning(f"best_sigma: {len(infos) - n_sigma} input(s) have no σ; they are used "
-                         "(as their median) only where no input with σ has a height.")
-
-    def overlap(a: Tuple[float, ...], b: Tuple[float, ...]) -> bool:
-        return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
-
-    if not any(overlap(i.bounds, gbounds) for i in infos):
+    n_sigma = _count_sigma(infos, mode, feedback)
+    if not any(_overlap(i.bounds, gbounds) for i in infos):
         raise InputError("No input DSM overlaps the output grid; check the inputs' extents "
                          "and CRSs.")
     pairs = [(a, b) for a in range(len(infos)) for b in range(a + 1, len(infos))
-             if overlap(infos[a].bounds, infos[b].bounds)]
+             if _overlap(infos[a].bounds, infos[b].bounds)]
     # exact order statistics up to 64 MB of differences in all, then 0.5 mm histograms
     budget = max(2 ** 20, (64 * 2 ** 20) // max(len(pairs), 1))
     accs = {p: DifferenceAccumulator(memory_budget=budget) for p in pairs}
@@ -328,14 +425,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     covered = 0
     crs_out = target
     with ExitStack() as stack:
-        srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
-        sig_srcs = [stack.enter_context(rasterio.open(i.sigma_path))
-                    if (use_sigma and i.sigma_path is not None) else None for i in infos]
-        for i, ss in zip(infos, sig_srcs):  # a sibling σ must be on its DSM's grid
-            if ss is not None and (ss.transform != i.transform or ss.width != i.width
-                                   or ss.height != i.height):
-                raise InputError(f"The σ raster '{i.sigma_path}' does not have the grid of "
-                                 f"'{i.path.name}'; give σ on the DSM's grid.")
+        sources = _open_sources(stack, infos, target, mode, n_sigma, pairs)
         tmp_dsm, dsm_profile = stack.enter_context(cog_output(
             out_paths["dsm"], _profile(width, height, "float32", transform, crs_out,
                                        float("nan"))))
@@ -352,34 +442,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
                     k += 1
                     r0, c0 = tr * tile, tc * tile
                     h, w = min(tile, height - r0), min(tile, width - c0)
-                    wt = transform * Affine.translation(c0, r0)
-                    wb = (wt.c, wt.f - h * s, wt.c + w * s, wt.f)
-                    idx = [j for j, i in enumerate(infos) if overlap(i.bounds, wb)]
-                    if not idx:
-                        zc = np.full((h, w), np.nan, np.float32)
-                        cnt = np.zeros((h, w), np.uint16)
-                    else:
-                        layers = np.stack([_read_window(srcs[j], 1, infos[j], target, wt,
-                                                        (h, w), r0, c0) for j in idx])
-                        sig = None
-                        if use_sigma and n_sigma:
-                            sl = []
-                            for j in idx:
-                                if infos[j].sigma_band:
-                                    sl.append(_read_window(srcs[j], 2, infos[j], target, wt,
-                                                           (h, w), r0, c0))
-                                elif sig_srcs[j] is not None:
-                                    sl.append(_read_window(sig_srcs[j], 1, infos[j], target,
-                                                           wt, (h, w), r0, c0))
-                                else:
-                                    sl.append(np.full((h, w), np.nan, np.float32))
-                            sig = np.stack(sl)
-                        zc = _combine(layers, mode, sig)
-                        cnt = np.isfinite(layers).sum(axis=0).astype(np.uint16)
-                        pos = {j: n for n, j in enumerate(idx)}
-                        for a, b in pairs:
-                            if a in pos and b in pos:
-                                accs[(a, b)].add(layers[pos[a]] - layers[pos[b]])
+                    zc, cnt = sources.window(transform, s, r0, c0, h, w, accs)
                     covered += int(np.isfinite(zc).sum())
                     win = Window(c0, r0, w, h)
                     dst.write(zc[None], window=win)
@@ -390,16 +453,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
         if covered == 0:
             raise InputError("None of the input DSMs has a height (all cells are nodata); "
                              "check the inputs.")
-        seams = []
-        for (a, b), acc in accs.items():
-            full = acc.result()
-            st = full["stats"]
-            if not st["count"]:
-                continue  # extents overlap but no common heights
-            seams.append({"a": infos[a].path.name, "b": infos[b].path.name,
-                          "a_index": a, "b_index": b,
-                          **{key: st[key] for key in SEAM_KEYS},
-                          "exact": bool(full["precision"]["exact"])})
+        seams = _seam_records(accs, infos)
         cells = width * height
         result: Dict[str, Any] = {
             "dsm": str(out_paths["dsm"]), "count": str(out_paths["count"]),
@@ -408,22 +462,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
             "cells": cells, "covered": covered, "coverage": covered / float(cells),
             "sigma_inputs": n_sigma,
         }
-        report = {**{k: v for k, v in result.items()
-                     if k not in ("dsm", "count", "report", "csv")},
-                  "inputs": [i.path.name for i in infos],
-                  "crs": crs_out.to_wkt() if crs_out is not None else None,
-                  "transform": list(transform)[:6],
-                  "files": {k: p.name for k, p in out_paths.items()},
-                  "difference": "a − b (heights of input a minus input b)"}
-        Path(tmp_json).write_text(json.dumps(report, indent=2, allow_nan=False) + "\n",
-                                  encoding="utf-8")
-        with open(tmp_csv, "w", newline="", encoding="utf-8") as fh:
-            wr = csv.writer(fh)
-            wr.writerow(["a", "b", *SEAM_KEYS])
-            for sm in seams:
-                wr.writerow([sm["a"], sm["b"], *("" if sm[key] is None else
-                                                 (f"{sm[key]:.6f}" if key != "count"
-                                                  else sm[key]) for key in SEAM_KEYS)])
+        _write_seam_report(tmp_json, tmp_csv, result, infos, crs_out, transform, out_paths)
         feedback.progress(100.0)
     feedback.info(f"Merged {len(infos)} DSMs ({mode}): {width} × {height} cells of {s:g}, "
                   f"{100.0 * result['coverage']:.1f} % with a height, {len(seams)} seam(s).")

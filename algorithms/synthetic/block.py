@@ -42,13 +42,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import fiona
 import numpy as np
+import rasterio.crs
 from rasterio.errors import NotGeoreferencedWarning
+from shapely.geometry import LineString, Point, Polygon, mapping
+from shapely.ops import unary_union
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..project.edits import create_edits
 from ..project.model import ImageRecord, Project, StereoModel
 from ..raster.io import staged_folder, write_raster
+from ..project.stereo_models import detect_stereo_models
+from ..raster.sample import DemSampler, bilinear_grid
 from .flight import SIZES, STEEP_GSD_FACTOR, FlightPlan, footprint_points, plan_flight
 from .objects import LANDCOVER, SceneObjects, choose_checkpoints, flatten_sites, place_objects
 from .render import Renderer, render_image
@@ -112,8 +119,6 @@ class BlockResult:
 
 
 def _polygon(points: np.ndarray):
-    from shapely.geometry import Polygon
-
     return Polygon([tuple(p) for p in points]).buffer(0)
 
 
@@ -173,8 +178,6 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
     feedback.progress(6.0)
     footprints = [_polygon(footprint_points(plan.camera_of(im), im.eo, base))
                   for im in plan.images]
-    from shapely.ops import unary_union
-
     covered = unary_union(footprints)
     extent_core = float(np.sqrt(covered.area))
     dtm, dsm, landcover, objects = place_objects(grid, dtm, o_rng, extent_core)
@@ -206,8 +209,6 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
     The terrain height of an image is the mean DTM along its footprint outline (on the mean
     terrain plane) and at its nadir point; the footprint is then taken at that height.
     """
-    from ..raster.sample import bilinear_grid
-
     fps, heights = [], []
     for im in plan.images:
         cam = plan.camera_of(im)
@@ -237,15 +238,10 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
 
 # -- writing ---------------------------------------------------------------------------------------
 def _crs_wkt() -> str:
-    import rasterio.crs
-
     return rasterio.crs.CRS.from_string(CRS).to_wkt()
 
 
 def _write_vectors(scene: Scene, truth: Path) -> Dict[str, Path]:
-    import fiona
-    from shapely.geometry import LineString, Point, Polygon, mapping
-
     wkt = _crs_wkt()
     paths = {"buildings": truth / "buildings.gpkg", "breaklines": truth / "breaklines.gpkg",
              "checkpoints": truth / "checkpoints.gpkg"}
@@ -407,11 +403,6 @@ def _detected_models(project: Project, scene: Scene, feedback: Feedback) -> List
     all; else the planned pairs with our own figures and a warning. Further pairs the detection
     may accept (e.g. image 1 with image 3 over high mountains) are not added: the block's
     models are the consecutive in-strip pairs."""
-    try:
-        from ..project.stereo_models import detect_stereo_models
-        from ..raster.sample import DemSampler
-    except ImportError:  # pragma: no cover - stereo module not yet available
-        return list(scene.models)
     dem = DemSampler(scene.dtm, scene.grid.transform)
     found = {m.name: m for m in detect_stereo_models(project, dem=dem, in_strip_only=True)}
     planned = [m.name for m in scene.models]
@@ -424,10 +415,7 @@ def _detected_models(project: Project, scene: Scene, feedback: Feedback) -> List
 
 
 def _create_edits(root: Path) -> None:
-    try:
-        from ..project.edits import create_edits
-    except ImportError:  # pragma: no cover - edits module not yet available
-        return
+    """An empty ``edits.gpkg`` (all layers) in the project folder."""
     create_edits(root / "edits.gpkg", CRS)
 
 

@@ -63,6 +63,7 @@ import numpy as np
 from ..errors import GeometryError, InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation
+from ..geometry.projection import border_at_height, world_to_pixel
 
 #: along-track sensor format divided by the principal distance
 FORMAT_OVER_FOCAL = 0.9
@@ -269,8 +270,6 @@ def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float,
 def _window(frame: Camera, image: PlannedImage, centre: np.ndarray, spec: SizeSpec
             ) -> Tuple[Tuple[int, int], Camera]:
     """Window of ``spec.width`` × ``spec.height`` px of ``frame`` centred on ``centre``."""
-    from ..geometry.projection import world_to_pixel
-
     col, row = world_to_pixel(centre[None, :], frame, image.eo)
     # integer offsets keep the window pixels on the frame's pixel grid
     col0 = int(np.rint(float(col[0]) - (spec.width - 1) / 2.0))
@@ -285,6 +284,4 @@ def _window(frame: Camera, image: PlannedImage, centre: np.ndarray, spec: SizeSp
 def footprint_points(camera: Camera, eo: ExteriorOrientation, height: float,
                      per_edge: int = 8) -> np.ndarray:
     """Ground points (N, 2) of the image outline intersected with the plane Z = ``height``."""
-    from ..geometry.projection import border_at_height
-
     return border_at_height(camera, eo, height, per_edge)[:, :2]

@@ -26,7 +26,9 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 from scipy import ndimage
+from shapely.geometry import Point
 
+from ..raster.sample import bilinear_grid
 from .terrain import Grid
 
 #: Land-cover class codes of ``truth/landcover.tif``.
@@ -176,31 +178,14 @@ def parcel_type_map(grid: Grid, obj: SceneObjects) -> np.ndarray:
     return obj.parcel_types[iu, iv].astype(np.uint8)
 
 
-def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float
-                  ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, SceneObjects]:
-    """Modify the terrain, build the DSM and land cover, and return the object list.
+#: Distance (m) of placed objects from the edge of the grid.
+_EDGE_MARGIN = 8.0
 
-    Parameters
-    ----------
-    grid : Grid
-    dtm : ndarray (float64)
-        Natural terrain; a modified copy is returned.
-    rng : numpy.random.Generator
-    extent_core : float
-        Size (m) of the area covered by the images; object counts scale with its square.
 
-    Returns
-    -------
-    dtm, dsm : ndarray float64
-    landcover : ndarray uint8
-    objects : SceneObjects
-    """
-    dtm = dtm.copy()
-    X, Y = grid.xs, grid.ys
+def _linear_features(grid: Grid, rng: np.random.Generator, extent_core: float) -> SceneObjects:
+    """Draw the embankment, the ditch, the road and the parcels (no terrain change yet)."""
     xmin, ymin, xmax, ymax = grid.bounds
     cx, cy = (xmin + xmax) / 2.0, (ymin + ymax) / 2.0
-
-    # -- linear features ------------------------------------------------------------------------
     a_e = rng.uniform(np.radians(20), np.radians(70)) * rng.choice([-1.0, 1.0])
     n_e = np.array([-np.sin(a_e), np.cos(a_e)])
     off_e = rng.uniform(0.15, 0.25) * extent_core
@@ -221,55 +206,71 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
                cy - diag * (np.sin(a_e) + np.cos(a_e)) / 2.0 * 1.0)
     nu, nv = int(np.ceil(2 * diag / pu)) + 1, int(np.ceil(2 * diag / pv)) + 1
     ptypes = rng.choice(len(PARCEL_TYPES), size=(nu, nv), p=[0.35, 0.3, 0.2, 0.15])
-    obj = SceneObjects(emb, h_e, w_c, ditch, depth, top_w, bot_w, road, road_w, a_e, (pu, pv),
-                       ptypes, porigin)
+    return SceneObjects(emb, h_e, w_c, ditch, depth, top_w, bot_w, road, road_w, a_e, (pu, pv),
+                        ptypes, porigin)
 
-    d_e = emb.across(X, Y)
+
+def _shape_linear_features(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> np.ndarray:
+    """Raise the embankment and cut the ditch into ``dtm`` (in place); return the land cover."""
+    X, Y = grid.xs, grid.ys
+    h_e, w_c, toe = obj.embankment_height, obj.crest_width, obj.toe_half_width
+    top_w, bot_w, depth = obj.ditch_top, obj.ditch_bottom, obj.ditch_depth
+    d_e = obj.embankment.across(X, Y)
     dtm += np.clip(h_e - np.maximum(np.abs(d_e) - w_c / 2.0, 0.0) / 1.5, 0.0, None)
-    d_d = ditch.across(X, Y)
+    d_d = obj.ditch.across(X, Y)
     cut = np.clip((top_w / 2.0 - np.abs(d_d)) / ((top_w - bot_w) / 2.0), 0.0, 1.0) * depth
     dtm -= cut
 
     ptype = parcel_type_map(grid, obj)
     landcover = np.where(ptype == 0, OPEN, FIELD).astype(np.uint8)
     del ptype
-    landcover[np.abs(road.across(X, Y)) <= road_w / 2.0] = ROAD
+    landcover[np.abs(obj.road.across(X, Y)) <= obj.road_width / 2.0] = ROAD
     landcover[np.abs(d_e) <= toe] = EMBANKMENT
     landcover[np.abs(d_d) <= top_w / 2.0] = WATER
-    del d_e, d_d, cut
+    return landcover
 
-    def clear_of_lines(px: float, py: float, r: float) -> bool:
-        return (abs(float(emb.across(px, py))) > toe + r + 3.0
-                and abs(float(ditch.across(px, py))) > top_w / 2.0 + r + 3.0
-                and abs(float(road.across(px, py))) > road_w / 2.0 + r + 2.0)
 
-    area = extent_core ** 2
-    taken: List[Tuple[float, float, float]] = []  # x, y, keep-out radius
-    margin = 8.0
-    # -- forest patch (placed first: it needs the most room) ---------------------------------
+def _clear_of_lines(obj: SceneObjects, px: float, py: float, r: float) -> bool:
+    """Is a disc of radius ``r`` at (px, py) clear of the embankment, ditch and road?"""
+    return (abs(float(obj.embankment.across(px, py))) > obj.toe_half_width + r + 3.0
+            and abs(float(obj.ditch.across(px, py))) > obj.ditch_top / 2.0 + r + 3.0
+            and abs(float(obj.road.across(px, py))) > obj.road_width / 2.0 + r + 2.0)
+
+
+def _place_forest(grid: Grid, obj: SceneObjects, rng: np.random.Generator, extent_core: float,
+                  taken: List[Tuple[float, float, float]]
+                  ) -> List[Tuple[float, float, float, float]]:
+    """Trees (x, y, radius, height) of one forest patch, placed first: it needs the most room."""
+    xmin, ymin, xmax, ymax = grid.bounds
+    margin = _EDGE_MARGIN
     trees: List[Tuple[float, float, float, float]] = []
     radius_f = float(np.clip(0.1 * extent_core, 10.0, 60.0))
     for _ in range(500):
         fx = rng.uniform(xmin + radius_f + margin, xmax - radius_f - margin)
         fy = rng.uniform(ymin + radius_f + margin, ymax - radius_f - margin)
-        if clear_of_lines(fx, fy, radius_f) and all(
+        if _clear_of_lines(obj, fx, fy, radius_f) and all(
                 np.hypot(fx - tx, fy - ty) > radius_f + tr for tx, ty, tr in taken):
             break
     else:
-        fx = fy = None  # type: ignore[assignment]
-    if fx is not None:
-        taken.append((fx, fy, radius_f + 4.0))
-        spacing = 4.5
-        g = np.arange(-radius_f, radius_f + 1e-9, spacing)
-        gx, gy = np.meshgrid(g, g)
-        gx = gx + rng.uniform(-1.2, 1.2, gx.shape)
-        gy = gy + rng.uniform(-1.2, 1.2, gy.shape)
-        ecc = rng.uniform(0.7, 1.0)
-        keep = (gx / radius_f) ** 2 + (gy / (ecc * radius_f)) ** 2 <= 1.0
-        for tx, ty in zip(gx[keep], gy[keep]):
-            trees.append((fx + tx, fy + ty, rng.uniform(2.5, 4.0), rng.uniform(12.0, 20.0)))
+        return trees
+    taken.append((fx, fy, radius_f + 4.0))
+    spacing = 4.5
+    g = np.arange(-radius_f, radius_f + 1e-9, spacing)
+    gx, gy = np.meshgrid(g, g)
+    gx = gx + rng.uniform(-1.2, 1.2, gx.shape)
+    gy = gy + rng.uniform(-1.2, 1.2, gy.shape)
+    ecc = rng.uniform(0.7, 1.0)
+    keep = (gx / radius_f) ** 2 + (gy / (ecc * radius_f)) ** 2 <= 1.0
+    for tx, ty in zip(gx[keep], gy[keep]):
+        trees.append((fx + tx, fy + ty, rng.uniform(2.5, 4.0), rng.uniform(12.0, 20.0)))
+    return trees
 
-    # -- buildings on level platforms ------------------------------------------------------------
+
+def _place_buildings(grid: Grid, obj: SceneObjects, rng: np.random.Generator, area: float,
+                     taken: List[Tuple[float, float, float]]) -> None:
+    """Append buildings to ``obj`` (one per 2500 m², 4 … 400) where there is room."""
+    xmin, ymin, xmax, ymax = grid.bounds
+    margin = _EDGE_MARGIN
     n_buildings = int(np.clip(area / 2500.0, 4, 400))
     for _ in range(40 * n_buildings):
         if len(obj.buildings) >= n_buildings:
@@ -280,7 +281,7 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         px = rng.uniform(xmin + margin + length, xmax - margin - length)
         py = rng.uniform(ymin + margin + length, ymax - margin - length)
         r = 0.5 * float(np.hypot(length, width)) + 5.0
-        if not clear_of_lines(px, py, r):
+        if not _clear_of_lines(obj, px, py, r):
             continue
         if any(np.hypot(px - tx, py - ty) < r + tr for tx, ty, tr in taken):
             continue
@@ -291,13 +292,17 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
             ridge = eaves + 0.5 * width * np.tan(np.radians(rng.uniform(30.0, 45.0)))
         else:
             eaves = ridge = rng.uniform(4.0, 10.0)
-        angle = a_e + rng.choice([0.0, np.pi / 2]) + rng.normal(0.0, np.radians(3.0))
+        angle = obj.parcel_angle + rng.choice([0.0, np.pi / 2]) + rng.normal(0.0, np.radians(3.0))
         b = Building(len(obj.buildings) + 1, px, py, float(angle), length, width,
                      "gabled" if gabled else "flat", float(eaves), float(ridge))
         taken.append((px, py, r))
         obj.buildings.append(b)
 
-    for b in obj.buildings:  # platforms first (they change the DTM)
+
+def _level_platforms(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
+    """Level the ground under every building (in place), blended over 4 m; sets ``base_z``."""
+    X, Y = grid.xs, grid.ys
+    for b in obj.buildings:
         rows, cols = grid.window(b.x - b.radius - 6, b.y - b.radius - 6, b.x + b.radius + 6,
                                  b.y + b.radius + 6)
         u, v = b.local(X[:, cols], Y[rows, :])
@@ -309,7 +314,11 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         w = np.clip(1.0 - (dist - 1.0) / 4.0, 0.0, 1.0)
         dtm[rows, cols] = w * b.base_z + (1.0 - w) * sub
 
-    dsm = dtm.copy()
+
+def _burn_buildings(grid: Grid, dsm: np.ndarray, landcover: np.ndarray,
+                    obj: SceneObjects) -> None:
+    """Roofs into the DSM and BUILDING into the land cover (in place)."""
+    X, Y = grid.xs, grid.ys
     for b in obj.buildings:
         rows, cols = grid.window(b.x - b.radius, b.y - b.radius, b.x + b.radius, b.y + b.radius)
         u, v = b.local(X[:, cols], Y[rows, :])
@@ -319,7 +328,13 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         lc = landcover[rows, cols]
         lc[inside] = BUILDING
 
-    # -- isolated trees ------------------------------------------------------------------------
+
+def _place_isolated_trees(grid: Grid, obj: SceneObjects, rng: np.random.Generator,
+                          area: float, taken: List[Tuple[float, float, float]],
+                          trees: List[Tuple[float, float, float, float]]) -> None:
+    """Append isolated trees (one per 1500 m², 5 … 400) to ``trees`` where there is room."""
+    xmin, ymin, xmax, ymax = grid.bounds
+    margin = _EDGE_MARGIN
     n_trees = int(np.clip(area / 1500.0, 5, 400))
     n_isolated = 0
     for _ in range(30 * n_trees):
@@ -328,7 +343,7 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         r, h = rng.uniform(2.0, 5.0), rng.uniform(5.0, 15.0)
         tx = rng.uniform(xmin + margin, xmax - margin)
         ty = rng.uniform(ymin + margin, ymax - margin)
-        if not clear_of_lines(tx, ty, r - 2.0):
+        if not _clear_of_lines(obj, tx, ty, r - 2.0):
             continue
         if any(np.hypot(tx - bx, ty - by) < br + r - 3.0 for bx, by, br in taken):
             continue
@@ -336,7 +351,11 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         taken.append((tx, ty, r + 1.0))
         n_isolated += 1
 
-    obj.trees = np.array(trees, dtype=float).reshape(-1, 4)
+
+def _burn_trees(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndarray,
+                obj: SceneObjects) -> None:
+    """Tree crowns into the DSM (where higher) and TREE into the land cover (in place)."""
+    X, Y = grid.xs, grid.ys
     for tx, ty, r, h in obj.trees:
         rows, cols = grid.window(tx - r, ty - r, tx + r, ty + r)
         d2 = ((X[:, cols] - tx) ** 2 + (Y[rows, :] - ty) ** 2) / (r * r)
@@ -349,9 +368,11 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         lc = landcover[rows, cols]
         lc[(crown > 0.05) & (lc != BUILDING)] = TREE
 
-    # -- breaklines (3-D, heights from the final DTM) --------------------------------------------
-    from ..raster.sample import bilinear_grid
 
+def _add_breaklines(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
+    """3-D breaklines of the embankment and the ditch, heights from the final DTM."""
+    emb, ditch, toe = obj.embankment, obj.ditch, obj.toe_half_width
+    w_c, top_w, bot_w = obj.crest_width, obj.ditch_top, obj.ditch_bottom
     spacing = max(2.0, 4 * grid.cell)
     lines = [("embankment_crest", emb, -w_c / 2.0), ("embankment_crest", emb, w_c / 2.0),
              ("embankment_toe", emb, -toe), ("embankment_toe", emb, toe),
@@ -366,6 +387,44 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
         ok = np.isfinite(z)
         if ok.sum() >= 2:
             obj.breaklines.append((kind, np.column_stack([xy[ok], z[ok]])))
+
+
+def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float
+                  ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, SceneObjects]:
+    """Modify the terrain, build the DSM and land cover, and return the object list.
+
+    The random draws come in a fixed order (linear features and parcels, forest, buildings,
+    isolated trees), so a seed gives the same scene.
+
+    Parameters
+    ----------
+    grid : Grid
+    dtm : ndarray (float64)
+        Natural terrain; a modified copy is returned.
+    rng : numpy.random.Generator
+    extent_core : float
+        Size (m) of the area covered by the images; object counts scale with its square.
+
+    Returns
+    -------
+    dtm, dsm : ndarray float64
+    landcover : ndarray uint8
+    objects : SceneObjects
+    """
+    dtm = dtm.copy()
+    obj = _linear_features(grid, rng, extent_core)
+    landcover = _shape_linear_features(grid, dtm, obj)
+    area = extent_core ** 2
+    taken: List[Tuple[float, float, float]] = []  # x, y, keep-out radius
+    trees = _place_forest(grid, obj, rng, extent_core, taken)
+    _place_buildings(grid, obj, rng, area, taken)
+    _level_platforms(grid, dtm, obj)  # platforms first (they change the DTM)
+    dsm = dtm.copy()
+    _burn_buildings(grid, dsm, landcover, obj)
+    _place_isolated_trees(grid, obj, rng, area, taken, trees)
+    obj.trees = np.array(trees, dtype=float).reshape(-1, 4)
+    _burn_trees(grid, dtm, dsm, landcover, obj)
+    _add_breaklines(grid, dtm, obj)
     return dtm, dsm, landcover, obj
 
 
@@ -380,10 +439,6 @@ def choose_checkpoints(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: 
     the area seen by stereo models) and ``spacing`` to the other sites. Heights are the
     bilinear DTM (= DSM) at the site.
     """
-    from shapely.geometry import Point
-
-    from ..raster.sample import bilinear_grid
-
     f = max(1, round(1.0 / grid.cell))  # work on ~1 m blocks
     nr, nc = grid.nrows // f, grid.ncols // f
 
@@ -435,8 +490,6 @@ def flatten_sites(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, sites: np.ndarra
     disc would be bent by relief displacement; on a plane its centroid is the projection of its
     centre. The sites lie on open ground, so the DSM follows the DTM there.
     """
-    from ..raster.sample import bilinear_grid
-
     out = np.asarray(sites, dtype=float).reshape(-1, 3).copy()
     X, Y = grid.xs, grid.ys
     outer = radius + blend

@@ -15,8 +15,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import fiona
 import numpy as np
+from affine import Affine
 from numpy.typing import NDArray
+from rasterio import features
+from scipy import ndimage
+from shapely.affinity import affine_transform
+from shapely.geometry import LineString, Polygon, mapping
+from shapely.ops import split
+
+from ..raster.io import write_raster
 
 PathLike = Union[str, Path]
 
@@ -52,9 +61,6 @@ def make_scene(seed: int = 0, size: float = 3000.0, n_forest: int = 14, n_field:
                ) -> PolygonScene:
     """Random non-overlapping polygons in a ``size`` × ``size`` m square (``object_scale``
     scales their radii, e.g. to fit more of them)."""
-    from shapely.geometry import LineString, Polygon
-    from shapely.ops import split
-
     rng = np.random.default_rng(seed)
     x0, y0 = ORIGIN
     polys: List[Any] = []
@@ -103,9 +109,6 @@ def make_scene(seed: int = 0, size: float = 3000.0, n_forest: int = 14, n_field:
 
 def write_scene(scene: PolygonScene, path: PathLike) -> Path:
     """The map as a GeoPackage (layer ``polygons``, attributes ``class`` and ``id``)."""
-    import fiona
-    from shapely.geometry import mapping
-
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     schema = {"geometry": "Polygon", "properties": {"id": "int", "class": "str"}}
@@ -147,10 +150,6 @@ def render(scene: PolygonScene, T_img_to_map: NDArray[np.float64], width: int, h
            ) -> NDArray[np.uint8]:
     """Render the map into an image whose pixels map by ``T_img_to_map`` (pixel centres at
     integers); exact-coverage anti-aliasing by supersampling."""
-    from rasterio import features
-    from rasterio.transform import Affine
-    from shapely.affinity import affine_transform
-
     rng = np.random.default_rng(seed + 1000)
     Tinv = np.linalg.inv(T_img_to_map)
     # map → image corner coordinates (+0.5), then × supersample
@@ -178,8 +177,6 @@ def render(scene: PolygonScene, T_img_to_map: NDArray[np.float64], width: int, h
                              dtype="float32")
     img = big.reshape(height, ss, width, ss).mean(axis=(1, 3))
     # mild texture and sensor noise
-    from scipy import ndimage
-
     tex = ndimage.gaussian_filter(rng.normal(0, 1, (height, width)), 3.0)
     tex *= texture / max(float(tex.std()), 1e-9)
     img = img + tex + rng.normal(0, noise, img.shape)
@@ -189,8 +186,6 @@ def render(scene: PolygonScene, T_img_to_map: NDArray[np.float64], width: int, h
 def write_image(path: PathLike, img: NDArray[Any], transform: Any = None, crs: Any = None
                 ) -> Path:
     """Write a one- or multi-band byte image (no georeference unless given)."""
-    from ..raster.io import write_raster
-
     return write_raster(path, img, transform=transform, crs=crs)
 
 
@@ -220,8 +215,6 @@ def georef_case(folder: PathLike, seed: int = 0, width: int = 1000, height: int 
 def ortho_case(folder: PathLike, seed: int = 0, size_px: int = 1000, gsd: float = 3.0,
                scale: float = 1.3, angle_deg: float = 35.0) -> Dict[str, Any]:
     """A synthetic orthophoto (north-up GeoTIFF) and a rotated, rescaled image of it."""
-    from rasterio.transform import Affine
-
     folder = Path(folder)
     scene = make_scene(seed)
     x0, y0, x1, y1 = scene.extent

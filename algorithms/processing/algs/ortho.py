@@ -7,6 +7,7 @@ from typing import Any, Dict, List, Optional
 
 from ...errors import InputError
 from ...feedback import Feedback
+from ...project.model import Project
 from ..spec import Algorithm, Output, Parameter, project_product
 
 GROUP = "Orthophotos"
@@ -68,13 +69,12 @@ class Orthorectify(Algorithm):
 
     def sidecars(self, name: str, path: Path) -> List[Path]:
         """``<name>_visibility.tif`` beside the ortho."""
-        from ...ortho.rectify import visibility_path
+        from ...ortho.rectify import visibility_path  # lazy: keeps photodem list fast
 
         return [visibility_path(path)]
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...ortho.rectify import orthorectify_image
-        from ...project.model import Project
+        from ...ortho.rectify import orthorectify_image  # lazy: keeps photodem list fast
 
         dsm = params.get("dsm")
         if params.get("true_ortho") and not dsm:
@@ -149,68 +149,21 @@ class OrthoDisplacement(Algorithm):
     iterates_over = "image"
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        import json
-
-        from ...ortho.displacement import (
-            compare_shifts,
-            measure_shift,
-            predict_displacement,
-            sample_prediction,
-            write_shift_points,
+        # lazy: keeps photodem list fast
+        from ...ortho.displacement_run import (
+            DisplacementInputs,
+            MatchSettings,
+            run_ortho_displacement,
         )
-        from ...raster.io import staged_folder
 
         g = params.get
-        predict = bool(g("image") or g("error") or (g("dem") and g("reference")))
-        measure = bool(g("ortho") or g("reference_ortho"))
-        if not predict and not measure:
-            raise InputError("Nothing to do: give an image with a DEM error (or DEM and "
-                             "reference DEM) for the predicted displacement, and/or two orthos "
-                             "('ortho', 'reference_ortho') for the measured shift.")
-        if predict and not (g("project") and g("image")):
-            raise InputError("The predicted displacement needs the project and the image.")
-        if measure and not (g("ortho") and g("reference_ortho")):
-            raise InputError("The measured shift needs two orthos: 'ortho' and "
-                             "'reference_ortho'.")
-        out = Path(params["output"])
-        result: Dict[str, Any] = dict.fromkeys(
-            ("displacement", "predicted", "points", "csv", "measured", "comparison"))
-        with staged_folder(out, replace=True, product=self.id) as tmp:
-            summary: Dict[str, Any] = {}
-            if predict:
-                pred = predict_displacement(
-                    params["project"], params["image"], tmp / "displacement.tif",
-                    error=g("error"), dem=g("dem"), reference=g("reference"),
-                    terrain_height=g("terrain_height"),
-                    feedback=feedback.step(0.0, 40.0 if measure else 99.0))
-                pred.pop("seconds", None)
-                pred["displacement"] = "displacement.tif"
-                summary["predicted"] = pred
-                result["displacement"] = str(out / "displacement.tif")
-                result["predicted"] = pred
-            if measure:
-                shifts = measure_shift(params["ortho"], params["reference_ortho"],
-                                       spacing=g("spacing"), window=int(params["window"]),
-                                       radius=int(params["radius"]),
-                                       min_ncc=float(params["min_ncc"]),
-                                       feedback=feedback.step(40.0 if predict else 0.0, 95.0))
-                at = (sample_prediction(tmp / "displacement.tif", shifts.x, shifts.y)
-                      if predict else None)
-                write_shift_points(tmp / "shifts.gpkg", shifts, at)
-                write_shift_points(tmp / "shifts.csv", shifts, at)
-                summary["measured"] = shifts.summary()
-                result.update(points=str(out / "shifts.gpkg"), csv=str(out / "shifts.csv"),
-                              measured=summary["measured"])
-                if at is not None:
-                    summary["comparison"] = compare_shifts(shifts, at)
-                    result["comparison"] = summary["comparison"]
-            (tmp / "summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
-        result["json"] = str(out / "summary.json")
-        m = result["measured"]
-        if m and m.get("matched"):
-            feedback.info(f"Measured shift over {m['matched']} windows: mean {m['mean_shift_m']} "
-                          f"m ({m['mean_shift_px']} px), RMS {m['rms_shift_m']} m.")
-        return result
+        inputs = DisplacementInputs(
+            project=g("project"), image=g("image"), error=g("error"), dem=g("dem"),
+            reference=g("reference"), terrain_height=g("terrain_height"), ortho=g("ortho"),
+            reference_ortho=g("reference_ortho"))
+        match = MatchSettings(window=int(params["window"]), radius=int(params["radius"]),
+                              spacing=g("spacing"), min_ncc=float(params["min_ncc"]))
+        return run_ortho_displacement(params["output"], inputs, match, feedback=feedback)
 
 
 class Mosaic(Algorithm):
@@ -299,13 +252,13 @@ class Mosaic(Algorithm):
 
     def sidecars(self, name: str, path: Path) -> List[Path]:
         """``<name>_seamlines.gpkg`` and ``<name>_balance.json`` beside the mosaic."""
-        from ...ortho.mosaic import sibling_paths
+        from ...ortho.mosaic import sibling_paths  # lazy: keeps photodem list fast
 
         return [p for k, p in sibling_paths(path).items() if k != "mosaic"]
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...ortho.mosaic import mosaic_orthos, mosaic_project
-        from ...project.model import Project
+        # lazy: keeps photodem list fast
+        from ...ortho.mosaic import MosaicOptions, MosaicSources, run_mosaic
 
         g = params.get
         project = Project.load(params["project"]) if g("project") else None
@@ -313,28 +266,17 @@ class Mosaic(Algorithm):
         if output is None:
             raise InputError("Give the output file of the mosaic (or a project, whose "
                              "products/mosaic/ folder is then used).")
-        options = {"seamlines": g("seamlines") or "auto",
-                   "balance": g("balance") or "gain_offset", "feather": g("feather"),
-                   "reference": g("reference") or None, "corridor": g("corridor") or None,
-                   "min_height": 2.0 if g("min_height") is None else params["min_height"],
-                   "tile": g("tile") or 1024, "seam_cells": g("seam_cells") or 1024}
-        if g("inputs"):
-            if g("dem"):
-                feedback.warning("Both orthos and a DEM are given; the orthos are mosaicked "
-                                 "and the DEM is not used.")
-            res = mosaic_orthos(params["inputs"], output, gsd=g("gsd") or None, dsm=g("dsm"),
-                                dtm=g("dtm"), project=project, feedback=feedback, **options)
-        elif g("dem"):
-            if project is None:
-                raise InputError("Rectifying needs the project: give 'project' with 'dem' "
-                                 "(or give the orthos as 'inputs').")
-            res = mosaic_project(project, params["dem"], output, gsd=g("gsd") or None,
-                                 resampling=g("resampling") or "bilinear", dsm=g("dsm"),
-                                 true_ortho=bool(g("true_ortho")), dtm=g("dtm"),
-                                 feedback=feedback, **options)
-        else:
-            raise InputError("Nothing to mosaic: give the orthos ('inputs'), or a project and "
-                             "a DEM ('dem') to rectify every image first.")
+        sources = MosaicSources(
+            inputs=g("inputs"), project=project, dem=g("dem"), dsm=g("dsm"), dtm=g("dtm"),
+            gsd=g("gsd") or None, resampling=g("resampling") or "bilinear",
+            true_ortho=bool(g("true_ortho")))
+        options = MosaicOptions(
+            seamlines=g("seamlines") or "auto", balance=g("balance") or "gain_offset",
+            feather=g("feather"), reference=g("reference") or None,
+            corridor=g("corridor") or None,
+            min_height=2.0 if g("min_height") is None else params["min_height"],
+            tile=g("tile") or 1024, seam_cells=g("seam_cells") or 1024)
+        res = run_mosaic(output, sources, options, feedback)
         return {k: res[k] for k in ("mosaic", "seamlines", "report", "gsd", "cells", "seams",
                                     "balance")}
 

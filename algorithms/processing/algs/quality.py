@@ -62,49 +62,13 @@ class DemCompare(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...quality.compare import compare_dems
-        from ...quality.rasters import write_difference_style, write_hillshade, write_slope
-        from ...quality.report import write_csv, write_json, write_report
+        from ...quality.compare_run import run_dem_compare  # lazy: keeps photodem list fast
 
-        out = Path(params["output"])
-        height = params.get("flying_height")
-        names = {"difference": "difference.tif", "hillshade": "hillshade.tif",
-                 "slope": "slope.tif", "report": "report.html", "json": "stats.json",
-                 "csv": "stats.csv"}
-        with staged_folder(out, replace=True, product=self.id) as tmp:
-            result = compare_dems(
-                params["dem"], params["reference"], coregister=bool(params["coregister"]),
-                stable=params.get("stable"), classes=params.get("classes"),
-                class_field=params.get("class_field"), flying_height=height,
-                difference_path=tmp / names["difference"], feedback=feedback.step(0.0, 60.0))
-            write_difference_style(tmp / names["difference"])
-            write_hillshade(params["dem"], tmp / names["hillshade"],
-                            feedback=feedback.step(60.0, 68.0))
-            write_slope(params["dem"], tmp / names["slope"], feedback=feedback.step(68.0, 75.0))
-            summary = {
-                "dem": Path(params["dem"]).name,
-                "reference": Path(params["reference"]).name,
-                "flying_height": height,
-                **{k: v for k, v in result.items() if k != "difference"},
-                "files": {k: v for k, v in names.items() if k != "json"},
-            }
-            write_json(tmp / names["json"], summary)
-            write_csv(tmp / names["csv"], result, height)
-            write_report(tmp / names["report"], result, dem=Path(params["dem"]).name,
-                         reference=Path(params["reference"]).name,
-                         difference=tmp / names["difference"],
-                         hillshade=tmp / names["hillshade"], flying_height=height,
-                         feedback=feedback.step(75.0, 99.0))
-        stats = result.get("stats") or {}
-        feedback.info(f"Δh over {stats.get('count', 0)} cells: mean {stats.get('mean', 0):+.3f} "
-                      f"m, NMAD {stats.get('nmad', 0):.3f} m, RMS {stats.get('rms', 0):.3f} m.")
-        return {
-            "stats": result.get("stats"),
-            "shift": result.get("shift"),
-            "per_class": result.get("per_class"),
-            "per_slope": result.get("per_slope"),
-            **{k: str(out / v) for k, v in names.items()},
-        }
+        return run_dem_compare(
+            params["dem"], params["reference"], params["output"],
+            coregister=bool(params["coregister"]), stable=params.get("stable"),
+            classes=params.get("classes"), class_field=params.get("class_field"),
+            flying_height=params.get("flying_height"), feedback=feedback)
 
 
 class DemProfile(Algorithm):
@@ -137,7 +101,7 @@ class DemProfile(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...quality.profile import dem_profile
+        from ...quality.profile import dem_profile  # lazy: keeps photodem list fast
 
         out = Path(params["output"])
         with staged_folder(out, replace=True, product=self.id) as tmp:
@@ -182,27 +146,10 @@ class PointCompare(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...quality.points import point_compare
-        from ...quality.report import write_csv, write_json
+        from ...quality.compare_run import run_point_compare  # lazy: keeps photodem list fast
 
-        out = Path(params["output"])
-        height = params.get("flying_height")
-        with staged_folder(out, replace=True, product=self.id) as tmp:
-            result = point_compare(params["points"], params["dem"],
-                                   residuals_path=tmp / "residuals.csv", flying_height=height,
-                                   feedback=feedback)
-            summary = {"points_file": Path(params["points"]).name,
-                       "dem": Path(params["dem"]).name, "flying_height": height,
-                       **{k: v for k, v in result.items() if k != "residuals"},
-                       "files": {"residuals": "residuals.csv", "csv": "stats.csv"}}
-            write_json(tmp / "stats.json", summary)
-            write_csv(tmp / "stats.csv", {"stats": result["stats"]}, height)
-        stats = result["stats"]
-        feedback.info(f"{result['used']} of {result['points']} points on the DEM: mean Δz "
-                      f"{stats.get('mean', 0):+.3f} m, RMS {stats.get('rms', 0):.3f} m.")
-        return {"stats": stats, "points": result["points"], "used": result["used"],
-                "outside": result["outside"], "residuals": str(out / "residuals.csv"),
-                "json": str(out / "stats.json"), "csv": str(out / "stats.csv")}
+        return run_point_compare(params["points"], params["dem"], params["output"],
+                                 flying_height=params.get("flying_height"), feedback=feedback)
 
 
 ALGORITHMS: list = [DemCompare, DemProfile, PointCompare]

@@ -60,7 +60,7 @@ class SyntheticBlock(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...synthetic.block import generate_block
+        from ...synthetic.block import generate_block  # lazy: keeps photodem list fast
 
         result = generate_block(params["output"], size=params["size"],
                                 terrain=params["terrain"], seed=params["seed"],

@@ -1,0 +1,130 @@
+"""``dem_compare`` and ``point_compare``: the comparisons with all their files in one folder.
+
+Each run stages its folder and renames it into place only when every file is written, so a
+failed or cancelled run leaves nothing behind (and an earlier folder of the same algorithm
+stays until the new one is complete).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Dict, Optional, Union
+
+from ..feedback import Feedback, ensure_feedback
+from ..raster.io import staged_folder
+from .compare import compare_dems
+from .points import point_compare
+from .rasters import write_difference_style, write_hillshade, write_slope
+from .report import write_csv, write_json, write_report
+
+PathLike = Union[str, Path]
+
+#: Files of a ``dem_compare`` folder, by output name.
+DEM_COMPARE_FILES = {"difference": "difference.tif", "hillshade": "hillshade.tif",
+                     "slope": "slope.tif", "report": "report.html", "json": "stats.json",
+                     "csv": "stats.csv"}
+
+
+def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Dict[str, Any],
+                       flying_height: Optional[float], feedback: Feedback) -> None:
+    """Style, hillshade, slope, statistics (JSON, CSV) and the HTML report into ``tmp``."""
+    names = DEM_COMPARE_FILES
+    write_difference_style(tmp / names["difference"])
+    write_hillshade(dem, tmp / names["hillshade"], feedback=feedback.step(60.0, 68.0))
+    write_slope(dem, tmp / names["slope"], feedback=feedback.step(68.0, 75.0))
+    summary = {
+        "dem": Path(dem).name,
+        "reference": Path(reference).name,
+        "flying_height": flying_height,
+        **{k: v for k, v in result.items() if k != "difference"},
+        "files": {k: v for k, v in names.items() if k != "json"},
+    }
+    write_json(tmp / names["json"], summary)
+    write_csv(tmp / names["csv"], result, flying_height)
+    write_report(tmp / names["report"], result, dem=Path(dem).name,
+                 reference=Path(reference).name, difference=tmp / names["difference"],
+                 hillshade=tmp / names["hillshade"], flying_height=flying_height,
+                 feedback=feedback.step(75.0, 99.0))
+
+
+def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
+                    coregister: bool = False, stable: Optional[PathLike] = None,
+                    classes: Optional[PathLike] = None, class_field: Optional[str] = None,
+                    flying_height: Optional[float] = None,
+                    feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """Compare a DEM with a reference and write :data:`DEM_COMPARE_FILES` into ``output``.
+
+    Parameters
+    ----------
+    dem, reference, coregister, stable, classes, class_field, flying_height
+        As :func:`.compare.compare_dems`.
+    output : path
+        Output folder (an earlier ``dem_compare`` folder there is replaced).
+    feedback : Feedback, optional
+
+    Returns
+    -------
+    dict
+        ``stats``, ``shift``, ``per_class``, ``per_slope`` (as :func:`.compare.compare_dems`)
+        and the path of every file of :data:`DEM_COMPARE_FILES`.
+    """
+    feedback = ensure_feedback(feedback)
+    out = Path(output)
+    names = DEM_COMPARE_FILES
+    with staged_folder(out, replace=True, product="dem_compare") as tmp:
+        result = compare_dems(
+            dem, reference, coregister=coregister, stable=stable, classes=classes,
+            class_field=class_field, flying_height=flying_height,
+            difference_path=tmp / names["difference"], feedback=feedback.step(0.0, 60.0))
+        _dem_compare_files(tmp, dem, reference, result, flying_height, feedback)
+    stats = result.get("stats") or {}
+    feedback.info(f"Δh over {stats.get('count', 0)} cells: mean {stats.get('mean', 0):+.3f} "
+                  f"m, NMAD {stats.get('nmad', 0):.3f} m, RMS {stats.get('rms', 0):.3f} m.")
+    return {
+        "stats": result.get("stats"),
+        "shift": result.get("shift"),
+        "per_class": result.get("per_class"),
+        "per_slope": result.get("per_slope"),
+        **{k: str(out / v) for k, v in names.items()},
+    }
+
+
+def run_point_compare(points: PathLike, dem: PathLike, output: PathLike, *,
+                      flying_height: Optional[float] = None,
+                      feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """Compare points with a DEM; ``residuals.csv``, ``stats.json``, ``stats.csv`` in ``output``.
+
+    Parameters
+    ----------
+    points, dem, flying_height
+        As :func:`.points.point_compare`.
+    output : path
+        Output folder (an earlier ``point_compare`` folder there is replaced).
+    feedback : Feedback, optional
+
+    Returns
+    -------
+    dict
+        ``stats``, ``points``, ``used``, ``outside`` and the paths ``residuals``, ``json``,
+        ``csv``.
+    """
+    feedback = ensure_feedback(feedback)
+    out = Path(output)
+    with staged_folder(out, replace=True, product="point_compare") as tmp:
+        result = point_compare(points, dem, residuals_path=tmp / "residuals.csv",
+                               flying_height=flying_height, feedback=feedback)
+        summary = {"points_file": Path(points).name,
+                   "dem": Path(dem).name, "flying_height": flying_height,
+                   **{k: v for k, v in result.items() if k != "residuals"},
+                   "files": {"residuals": "residuals.csv", "csv": "stats.csv"}}
+        write_json(tmp / "stats.json", summary)
+        write_csv(tmp / "stats.csv", {"stats": result["stats"]}, flying_height)
+    stats = result["stats"]
+    feedback.info(f"{result['used']} of {result['points']} points on the DEM: mean Δz "
+                  f"{stats.get('mean', 0):+.3f} m, RMS {stats.get('rms', 0):.3f} m.")
+    return {"stats": stats, "points": result["points"], "used": result["used"],
+            "outside": result["outside"], "residuals": str(out / "residuals.csv"),
+            "json": str(out / "stats.json"), "csv": str(out / "stats.csv")}
+
+
+__all__ = ["DEM_COMPARE_FILES", "run_dem_compare", "run_point_compare"]
