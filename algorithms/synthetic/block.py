@@ -53,8 +53,8 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..project.edits import create_edits
 from ..project.model import ImageRecord, Project, StereoModel
-from ..raster.io import staged_folder, write_raster
 from ..project.stereo_models import detect_stereo_models
+from ..raster.io import staged_folder, write_raster
 from ..raster.sample import DemSampler, bilinear_grid
 from .flight import SIZES, STEEP_GSD_FACTOR, FlightPlan, footprint_points, plan_flight
 from .objects import LANDCOVER, SceneObjects, choose_checkpoints, flatten_sites, place_objects
