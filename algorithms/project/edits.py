@@ -253,10 +253,9 @@ def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
     if not path.is_file():
         raise InputError(f"Vector file '{path}' does not exist.")
     check_encodable(path, "vector file")
-    features = read_features(path, layers)  # an unreadable file fails here, as before
     out: List[Any] = []
     with reading(path, "vector file"):
-        for feat in features:
+        for feat in read_features(path, layers):
             if not any(k in feat.geometry["type"] for k in kinds):
                 continue
             checked, props = check_feature(path, feat.layer, feat.fid, shape(feat.geometry),

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, Iterator, Optional, Sequence, Union
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Union
 
 import fiona
 from rasterio.crs import CRS
@@ -33,8 +33,11 @@ class VectorFeature:
 
 
 def read_features(path: PathLike, layers: Optional[Sequence[str]] = None,
-                  what: str = "vector file") -> Iterator[VectorFeature]:
+                  what: str = "vector file") -> List[VectorFeature]:
     """The features with a geometry of every layer of ``path`` (or only of ``layers``).
+
+    Read completely before they are returned, so that every layer is closed again when a
+    caller stops at a feature it refuses.
 
     Parameters
     ----------
@@ -52,10 +55,10 @@ def read_features(path: PathLike, layers: Optional[Sequence[str]] = None,
     """
     path = Path(path)
     try:
-        names = fiona.listlayers(str(path))  # now, not when the features are first read
+        names = fiona.listlayers(str(path))
     except Exception as exc:  # driver-specific errors
         raise InputError(f"Cannot read the {what} '{path.name}': {exc}") from exc
-    return _features(path, names, layers)
+    return list(_features(path, names, layers))
 
 
 def _features(path: Path, names: Sequence[str],
