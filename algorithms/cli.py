@@ -30,6 +30,8 @@ which then removes its staged outputs; a second one aborts at once).
 
 from __future__ import annotations
 
+# Imports inside functions here are lazy on purpose: they keep ``photodem list`` fast (package
+# metadata, the demo chain) or load Qt only when the GUI starts.
 import argparse
 import contextlib
 import json

@@ -232,7 +232,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
 
     Every task's parameters and outputs are checked here, before the first task runs.
     """
-    from ..project.model import Project  # numpy and friends only when a batch is planned
+    from ..project.model import Project  # lazy: keeps photodem list fast (numpy and friends)
 
     unknown = set(config) - {"batch", "steps"}
     if unknown:
@@ -1342,7 +1342,7 @@ def _remove_stale_lock(path: Path, holder: Dict[str, Any]) -> bool:
 def _exclusive(folder: Path) -> Iterator[None]:
     """Hold an advisory lock on ``folder`` itself (POSIX ``flock``, no extra file; elsewhere
     no guard)."""
-    try:
+    try:  # a platform check, not a cycle: fcntl is POSIX only
         import fcntl
     except ImportError:  # Windows
         yield

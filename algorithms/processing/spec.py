@@ -460,7 +460,7 @@ _PROJECTS: Dict[Tuple[str, int, int], Tuple[Any, List[Path]]] = {}
 
 def _read_project(path: Any) -> Tuple[Any, List[Path]]:
     """The project at ``path`` and its resolved files, read again only when the file changed."""
-    from ..project.model import Project  # numpy and friends only when a project is used
+    from ..project.model import Project  # lazy: keeps photodem list fast (numpy and friends)
 
     file = Path(path) / PROJECT_FILE if Path(path).is_dir() else Path(path)
     try:

@@ -38,9 +38,11 @@ import fiona
 import pyproj
 from rasterio.crs import CRS
 from shapely.geometry import mapping, shape
+from shapely.ops import unary_union
+from shapely.validation import explain_validity
 
 from ..errors import InputError
-from ..input_errors import check_encodable, reading
+from ..input_errors import check_encodable, reading, warn_input
 from ..raster.io import atomic_output
 from .vector_io import read_features, to_crs
 
@@ -95,11 +97,8 @@ def repair_polygon(geom: Any, where: str) -> Any:
     """
     if geom.is_valid:
         return geom
-    from shapely.ops import unary_union
-    from shapely.validation import explain_validity
-
     reason = explain_validity(geom)
-    try:
+    try:  # a version check, not a cycle: make_valid came with shapely 1.8
         from shapely.validation import make_valid
 
         fixed = make_valid(geom)
@@ -111,8 +110,6 @@ def repair_polygon(geom: Any, where: str) -> Any:
     if fixed is None or fixed.is_empty or fixed.area <= 0:
         raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
                          "repairing it; redraw it in edits.gpkg.")
-    from ..input_errors import warn_input
-
     warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
                f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
     return fixed
@@ -138,8 +135,6 @@ def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
     if geom.geom_type in ("Polygon", "MultiPolygon"):
         geom = repair_polygon(geom, where)
     if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
-        from ..input_errors import warn_input
-
         warn_input(f"{where}: the breakline has no heights (2-D); it only separates the surface "
                    "and gives no heights. Digitise it with Z to use its heights.")
     return geom, props

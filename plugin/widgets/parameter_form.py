@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
 from ...algorithms.processing.spec import Algorithm, Parameter
+from ...algorithms.project.model import Project
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
@@ -349,8 +350,6 @@ class ParameterForm(QtWidgets.QWidget):
         if path and ((Path(path) / "project.toml").is_file()
                      or (path.endswith(".toml") and Path(path).is_file())):
             try:
-                from ...algorithms.project.model import Project
-
                 project = Project.load(path)
                 names = {"model": [m.name for m in project.models],
                          "image": [i.name for i in project.images]}

@@ -1,4 +1,7 @@
-"""Algorithm declarations: automatic georeferencing against GIS polygons."""
+"""Algorithm declarations: automatic georeferencing against GIS polygons.
+
+The domain modules are imported inside ``run`` (lazy: keeps ``photodem list`` fast).
+"""
 
 from __future__ import annotations
 
@@ -89,7 +92,6 @@ class GeoreferencePolygons(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        # lazy: keeps photodem list fast
         from ...georef.pipeline import GeorefOptions, run_georeference_polygons
 
         level = params.get("pyramid_level", -1)

@@ -1,4 +1,7 @@
-"""Algorithm declarations: project."""
+"""Algorithm declarations: project.
+
+The domain modules are imported inside ``run`` (lazy: keeps ``photodem list`` fast).
+"""
 
 from __future__ import annotations
 
