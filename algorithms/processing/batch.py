@@ -127,7 +127,6 @@ STATE_FILE = Path(".photodem") / "batch-state.json"
 LOCK_FILE = Path(".photodem") / "batch.lock"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
-_FILE_OUTPUT_KINDS = ("file", "folder", "raster", "vector")
 _PLACEHOLDER = re.compile(r"\{(project|run|step|model|image|file)\}")
 _BATCH_KEYS = {"project", "workers", "output"}
 _STEP_KEYS = {"algorithm", "name", "models", "images", "files", "params"}
@@ -601,7 +600,7 @@ def _output_paths(algorithm: str, outputs: Dict[str, Any]) -> List[str]:
     paths = []
     for out in alg.outputs:
         value = outputs.get(out.name)
-        if out.kind in _FILE_OUTPUT_KINDS and isinstance(value, str) and value:
+        if out.is_path and isinstance(value, str) and value:
             paths.append(value)
     return paths
 

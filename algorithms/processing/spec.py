@@ -83,7 +83,7 @@ class Parameter:
     def __post_init__(self) -> None:
         if self.kind not in PARAMETER_KINDS:
             raise ValueError(f"unknown parameter kind {self.kind!r} for {self.name!r}")
-        if self.kind == "enum" and not self.options:
+        if self.is_choice and not self.options:
             raise ValueError(f"enum parameter {self.name!r} needs options")
 
     @property
@@ -287,6 +287,11 @@ class Output:
     def __post_init__(self) -> None:
         if self.kind not in OUTPUT_VALUE_KINDS:
             raise ValueError(f"unknown output kind {self.kind!r} for {self.name!r}")
+
+    @property
+    def is_path(self) -> bool:
+        """The value is the path of a file or folder the run wrote."""
+        return self.kind in ("file", "folder", "raster", "vector")
 
 
 class Algorithm:

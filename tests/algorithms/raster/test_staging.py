@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rasterio
 
 from photodem.algorithms import output_policy
 from photodem.algorithms.errors import InputError
@@ -203,3 +204,29 @@ def test_product_tag_reader_on_bad_files(tmp_path):
     write_raster(tmp_path / "big.tif", np.zeros((3, 3), np.float32), BIGTIFF="YES")
     rio.tag_product(tmp_path / "big.tif", "bigtest")
     assert output_policy.file_product(tmp_path / "big.tif") == "bigtest"
+
+
+def test_product_tag_is_written_as_the_geotiff_is_created(tmp_path, monkeypatch):
+    # no reopening in r+ mode: open_image tags the staged file when it creates it
+    def no_reopen(path, product):
+        raise AssertionError(f"{path} reopened to tag it")
+
+    monkeypatch.setattr(rio, "tag_product", no_reopen)
+    targets = [output_policy.Target(tmp_path / name, "file", "output")
+               for name in ("a.tif", "c.tif")]
+    with output_policy.run_scope("test", None, targets):
+        write_raster(tmp_path / "a.tif", np.zeros((2, 2), np.float32))
+        write_raster(tmp_path / "c.tif", np.zeros((300, 300), np.float32), overviews=True)
+    assert output_policy.file_product(tmp_path / "a.tif") == "test"
+    assert output_policy.file_product(tmp_path / "c.tif") == "test"
+    assert not rio._TAG_ON_CREATE  # nothing pending is left behind
+
+
+def test_other_writers_are_tagged_after_writing(tmp_path):
+    target = output_policy.Target(tmp_path / "b.tif", "file", "output")
+    with output_policy.run_scope("test", None, [target]):
+        with rio.atomic_output(tmp_path / "b.tif") as tmp, rasterio.open(
+                tmp, "w", **rio.gtiff_profile(2, 2, crs="EPSG:25832")) as dst:
+            dst.write(np.zeros((1, 2, 2), np.float32))
+    assert output_policy.file_product(tmp_path / "b.tif") == "test"
+    assert not rio._TAG_ON_CREATE
