@@ -224,9 +224,10 @@ def test_product_tag_is_written_as_the_geotiff_is_created(tmp_path, monkeypatch)
 
 def test_other_writers_are_tagged_after_writing(tmp_path):
     target = output_policy.Target(tmp_path / "b.tif", "file", "output")
-    with output_policy.run_scope("test", None, [target]):
-        with rio.atomic_output(tmp_path / "b.tif") as tmp, rasterio.open(
-                tmp, "w", **rio.gtiff_profile(2, 2, crs="EPSG:25832")) as dst:
-            dst.write(np.zeros((1, 2, 2), np.float32))
+    profile = rio.gtiff_profile(2, 2, crs="EPSG:25832")
+    with output_policy.run_scope("test", None, [target]), \
+            rio.atomic_output(tmp_path / "b.tif") as tmp, \
+            rasterio.open(tmp, "w", **profile) as dst:
+        dst.write(np.zeros((1, 2, 2), np.float32))
     assert output_policy.file_product(tmp_path / "b.tif") == "test"
     assert not rio._TAG_ON_CREATE
