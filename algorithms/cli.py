@@ -30,6 +30,8 @@ which then removes its staged outputs; a second one aborts at once).
 
 from __future__ import annotations
 
+# Imports inside functions here are lazy on purpose: they keep ``photodem list`` fast (package
+# metadata, the demo chain) or load Qt only when the GUI starts.
 import argparse
 import contextlib
 import json
@@ -41,7 +43,6 @@ import traceback
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Sequence
 
-from . import output_policy
 from .cli_feedback import CliFeedback
 from .errors import Cancelled, PhotodemError
 from .feedback import Feedback
@@ -148,9 +149,9 @@ def algorithm_parser(alg: Algorithm) -> argparse.ArgumentParser:
             raise RuntimeError(f"{alg.id}: parameter name {p.name!r} is reserved by the CLI")
         kwargs: Dict[str, Any] = {"dest": p.name, "default": None, "help": _flag_help(p),
                                   "metavar": _metavar(p)}
-        if p.kind == "bool":
+        if p.is_bool:
             kwargs.update(nargs="?", const="true")
-        elif p.kind == "multiple_rasters":
+        elif p.is_list:
             kwargs.update(nargs="+")
         parser.add_argument(p.flag, **kwargs)
     parser.add_argument("--json", action="store_true", help="print the outputs as JSON")
@@ -159,9 +160,9 @@ def algorithm_parser(alg: Algorithm) -> argparse.ArgumentParser:
 
 
 def _metavar(p: Parameter) -> str:
-    if p.kind == "enum":
+    if p.is_choice:
         return "{" + ",".join(p.options) + "}"
-    if p.kind == "bool":
+    if p.is_bool:
         return "true|false"
     return p.kind.upper()
 
@@ -220,7 +221,7 @@ def describe(alg: Algorithm) -> str:
             details.append("one of " + "|".join(p.options))
         if p.extensions:
             details.append("files " + " ".join(p.extensions))
-        if p.kind == "bool":
+        if p.is_bool:
             details.append("true|false")
         details.append(status)
         lines.append(f"  {p.flag}  {p.description}")
@@ -372,13 +373,36 @@ def cmd_gui() -> int:
 
 
 # -- helpers -------------------------------------------------------------------------------------
+class _Stopped(Exception):
+    """A run ended by a cancellation (``interrupted``: by a second Ctrl-C), with the outputs
+    it had committed before (from its feedback), for the message."""
+
+    def __init__(self, interrupted: bool, committed: Sequence[Path]) -> None:
+        super().__init__()
+        self.interrupted = interrupted
+        self.committed = list(committed)
+
+
 @contextlib.contextmanager
 def _cancel_on_sigint(feedback: Feedback) -> Iterator[None]:
     """First Ctrl-C cancels ``feedback`` (the run cleans up); a second one interrupts.
 
     Once the run has committed an output it is no longer interrupted: it finishes its product
-    set, so that what is on disk is complete and matches the message.
+    set, so that what is on disk is complete and matches the message. A cancelled or
+    interrupted run ends as :class:`_Stopped` with the outputs ``feedback`` saw committed.
     """
+    try:
+        with _sigint_handler(feedback):
+            yield
+    except Cancelled:
+        raise _Stopped(False, feedback.committed) from None
+    except KeyboardInterrupt:
+        raise _Stopped(True, feedback.committed) from None
+
+
+@contextlib.contextmanager
+def _sigint_handler(feedback: Feedback) -> Iterator[None]:
+    """Install the Ctrl-C handler of :func:`_cancel_on_sigint` (main thread only)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -422,13 +446,12 @@ def _stdout_to_stderr() -> Iterator[None]:
             os.close(fd_saved)
 
 
-def _written_before_stop() -> str:
-    """What a stopped run left on disk, from its run scope (so the message matches it)."""
-    scope = output_policy.last_scope()
-    if scope is None or not scope.committed:
+def _written_before_stop(committed: Sequence[Path] = ()) -> str:
+    """What a stopped run left on disk, from the commits its feedback saw (so the message
+    matches it)."""
+    if not committed:
         return "no output was written."
-    return ("already complete before the stop: "
-            + ", ".join(str(p) for p in scope.committed) + ".")
+    return "already complete before the stop: " + ", ".join(str(p) for p in committed) + "."
 
 
 def _error(message: str) -> None:
@@ -464,6 +487,12 @@ def main(argv: Optional[List[str]] = None) -> int:
             return cmd_demo(args)
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    except _Stopped as stop:
+        interrupted = "\n" if stop.interrupted else ""
+        how = " (interrupted)" if stop.interrupted else ""
+        print(f"{interrupted}{PROG}: cancelled{how}; {_written_before_stop(stop.committed)}",
+              file=sys.stderr)
+        return EXIT_CANCELLED
     except Cancelled:
         print(f"{PROG}: cancelled; {_written_before_stop()}", file=sys.stderr)
         return EXIT_CANCELLED

@@ -9,6 +9,7 @@ tool a Qt signal, the CLI a progress line on stderr.
 from __future__ import annotations
 
 import threading
+from pathlib import Path
 from typing import Callable, List, Optional
 
 from .errors import Cancelled
@@ -34,6 +35,8 @@ class Feedback:
         self._on_log = on_log
         self._cancel = threading.Event()
         self._committed = threading.Event()
+        #: The outputs the run has renamed into place, in order (for the message after a stop).
+        self.committed: List[Path] = []
         self.percent = 0.0
         self.lines: List[str] = []
         self.warnings: List[str] = []
@@ -47,12 +50,15 @@ class Feedback:
         """True once :meth:`cancel` was called."""
         return self._cancel.is_set()
 
-    def mark_committed(self) -> None:
-        """The run has renamed an output into place: from now on it finishes, cancelled or not.
+    def mark_committed(self, path: Optional[Path] = None) -> None:
+        """The run has renamed an output (``path``) into place: from now on it finishes,
+        cancelled or not.
 
         Called by the run scope (:func:`..output_policy.commit`); a product set is never left
         half-replaced because an interrupt came late.
         """
+        if path is not None:
+            self.committed.append(Path(path))
         self._committed.set()
 
     def is_committed(self) -> bool:
@@ -104,8 +110,8 @@ class StepFeedback(Feedback):
     def is_canceled(self) -> bool:
         return self.parent.is_canceled()
 
-    def mark_committed(self) -> None:
-        self.parent.mark_committed()
+    def mark_committed(self, path: Optional[Path] = None) -> None:
+        self.parent.mark_committed(path)
 
     def is_committed(self) -> bool:
         return self.parent.is_committed()

@@ -434,7 +434,6 @@ def run_scope(product: str, on_commit: Optional[Callable[[Path], None]] = None,
         stack.pop()
         with _ACTIVE_LOCK:
             _ACTIVE.remove(scope)
-        _LOCAL.last = scope
 
 
 def _stack() -> List[RunScope]:
@@ -450,16 +449,6 @@ def current() -> Optional[RunScope]:
         return stack[-1]
     with _ACTIVE_LOCK:
         return _ACTIVE[0] if len(_ACTIVE) == 1 else None
-
-
-def last_scope() -> Optional[RunScope]:
-    """The scope of the run this thread ran last (for the message after an interrupt)."""
-    return getattr(_LOCAL, "last", None)
-
-
-def forget_last() -> None:
-    """Forget the last run's scope (a new run starts in this thread)."""
-    _LOCAL.last = None
 
 
 def current_product() -> str:
@@ -518,9 +507,7 @@ __all__ = [
     "file_mark",
     "file_product",
     "folder_product",
-    "forget_last",
     "is_tiff",
-    "last_scope",
     "pid_alive",
     "project_root",
     "remove_stale",

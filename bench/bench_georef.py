@@ -40,7 +40,7 @@ def _run(image: str, reference: str, **kw: Any):
         res = georeference(image, reference, **kw)
     except PhotodemError as exc:
         return None, time.perf_counter() - t0, str(exc), exc.counts
-    return res, time.perf_counter() - t0, "", res["counts"]
+    return res, time.perf_counter() - t0, "", res.counts
 
 
 def _synthetic(tmp: Path, n: int = 50) -> Dict[str, Any]:
@@ -57,7 +57,7 @@ def _synthetic(tmp: Path, n: int = 50) -> Dict[str, Any]:
             errs.append(float("inf"))
             fails.append(why.split("(")[0].strip())
             continue
-        errs.append(float(corner_error(res["fit"], case["truth"], case["width"],
+        errs.append(float(corner_error(res.fit, case["truth"], case["width"],
                                        case["height"]).max()))
     e = np.array(errs)
     ok = e <= 0.5
@@ -86,8 +86,8 @@ def _textured(tmp: Path, n: int = 10) -> Dict[str, Any]:
         if res is None:
             errs.append(float("inf"))
             continue
-        stages.append(res["stage"])
-        errs.append(float(corner_error(res["fit"], case["truth"], 600, 600).max()))
+        stages.append(res.stage)
+        errs.append(float(corner_error(res.fit, case["truth"], 600, 600).max()))
     e = np.array(errs)
     fin = e[np.isfinite(e)]
     return {"row": {"case": f"synthetic, textured objects, {n} maps (600 × 600 px, auto)",
@@ -186,8 +186,8 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
             errs.append(float("inf"))
             fails.append(why.split("(")[0].strip())
         else:
-            errs.append(float(corner_error(res["fit"], truth, W, H).max()))
-            stages.append(res["stage"])
+            errs.append(float(corner_error(res.fit, truth, W, H).max()))
+            stages.append(res.stage)
     e = np.array(errs)
     fin = e[np.isfinite(e)]
     res0, dt0, why0, _ = _run(str(image), str(ref))
@@ -256,7 +256,7 @@ def _ortho(tmp: Path) -> Dict[str, Any]:
     c = ortho_case(tmp / "ortho", seed=1)
     res, dt, _why, _ = _run(c["image"], c["reference"])
     rows = [{"case": "image vs orthophoto (rotated 35°, scale 1.3): PhotoDEM",
-             "corner_px": (float(corner_error(res["fit"], c["truth"], c["width"],
+             "corner_px": (float(corner_error(res.fit, c["truth"], c["width"],
                                               c["height"]).max()) if res else None),
              "seconds": dt, "goal_px": 0.5}]
     try:

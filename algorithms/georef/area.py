@@ -41,8 +41,14 @@ import math
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
+from rasterio.features import rasterize
+from scipy import fft as sfft
+from scipy import ndimage, optimize
+from scipy.signal import fftconvolve
+from shapely.geometry import Polygon
 
 from .correspondence import apply
 from .refinement import ControlPoint
@@ -94,9 +100,6 @@ def render_mask(rings: Sequence[Array], to_pixel: Array, shape: Tuple[int, int])
     ndarray of float64
         1 inside a polygon, 0 outside.
     """
-    from rasterio.features import rasterize
-    from shapely.geometry import Polygon
-
     geoms = []
     for r in rings:
         p = Polygon(apply(to_pixel, r) + 0.5)  # rasterio: pixel corners at integers
@@ -116,8 +119,6 @@ def edge_feature(a: Array, sigma: float, valid: Optional[NDArray[np.bool_]] = No
     zero within ~2σ of them, so the no-data border makes no edge. Gradients rather than
     grey values: the polygons' objects may be brighter or darker than their surroundings.
     """
-    from scipy import ndimage
-
     a = np.asarray(a, float)
     if valid is None:
         valid = np.isfinite(a)
@@ -131,8 +132,6 @@ def edge_feature(a: Array, sigma: float, valid: Optional[NDArray[np.bool_]] = No
 
 
 def _core(valid: NDArray[np.bool_], sigma: float) -> NDArray[np.bool_]:
-    from scipy import ndimage
-
     if valid.all():
         return valid
     return ndimage.binary_erosion(valid, iterations=max(1, math.ceil(2 * sigma)) + 1)
@@ -153,8 +152,6 @@ def log_polar_spectrum(a: Array, n: int, angles: int = 720, radii: int = 512) ->
     Rows are angles over 0–360° (the spectrum is point-symmetric, so half would do; the full
     circle keeps the phase correlation periodic), columns log radius from 1 to n/2.
     """
-    import cv2
-
     pad = np.zeros((n, n))
     h, w = a.shape
     pad[:h, :w] = (a - a.mean()) * _window(a.shape)
@@ -244,8 +241,6 @@ def masked_ncc(ref: Array, tmpl: Array, mask: NDArray[np.bool_]) -> Tuple[Array,
     h, w : int
         Template size.
     """
-    from scipy.signal import fftconvolve
-
     m = mask.astype(float)
     n = m.sum()
     t = np.where(mask, tmpl - tmpl[mask].mean(), 0.0)
@@ -279,8 +274,6 @@ def search_grid(rings: Sequence[Array], cells: int = SEARCH_CELLS) -> Tuple[Arra
 
 def downsample(grey: Array, factor: float) -> Tuple[Array, NDArray[np.bool_], Array]:
     """Image reduced by ``factor`` (area mean), its valid mask and the level-0 → level matrix."""
-    import cv2
-
     valid = np.isfinite(grey)
     h, w = grey.shape
     size = (max(8, round(w / factor)), max(8, round(h / factor)))
@@ -338,8 +331,6 @@ def refine_ecc(grey: Array, rings: Sequence[Array], T: Array, sigma: float = 1.5
     cc : float
         ECC correlation coefficient of the last (full-size) round; 0 when ECC failed.
     """
-    import cv2
-
     # a coarse level first widens ECC's capture range for the search's ~1° / 2 % steps
     factors = sorted({max(1.0, max(grey.shape) / c) for c in (cells // 4, cells)} | {1.0},
                      reverse=True)
@@ -497,8 +488,6 @@ def boundary_orientation_raster(rings: Sequence[Array], to_cell: Array, shape: T
     bilinearly into the four nearest cells; the raster is then Gaussian-smoothed (``sigma``
     cells), which tolerates the search's steps. Opposite normals give the same value.
     """
-    from scipy import ndimage
-
     c = abs(np.linalg.det(to_cell[:2, :2])) ** -0.5  # map units per cell
     pts, ang, wts = boundary_samples(rings, c / 4)
     out = np.zeros(shape, complex)
@@ -524,8 +513,6 @@ def gradient_orientation(a: Array, valid: Optional[NDArray[np.bool_]] = None,
                          sigma: float = 0.0) -> NDArray[np.complex128]:
     """Doubled-angle gradient field |g| e^{2iφ} of ``a`` (φ the gradient direction, x = column,
     y = row), after an optional Gaussian of ``sigma`` px; zero within two pixels of no data."""
-    from scipy import ndimage
-
     a = np.asarray(a, float)
     if valid is None:
         valid = np.isfinite(a)
@@ -548,8 +535,6 @@ def orientation_score(z: NDArray[np.complex128], T: Array, pts: Array, angles: A
     image pixel → map); the weights are outline length × gradient magnitude. 1: every edge
     runs along the outlines; 0: no relation.
     """
-    from scipy import ndimage
-
     Ti = np.linalg.inv(T)
     q = apply(Ti, pts)
     rows, cols = z.shape
@@ -619,10 +604,6 @@ def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = OR
         The best ``keep`` placements, best first, at least ~3 cells apart or at different
         rotations/scales.
     """
-    import cv2
-    from scipy import fft as sfft
-    from scipy import ndimage
-
     if not len(boundaries):
         return []
     to_cell, shape = search_grid(boundaries, cells)
@@ -722,8 +703,6 @@ def refine_orientation(grey: Array, boundaries: Sequence[Array], T: Array,
     score : float
         :func:`orientation_score` at the finest level.
     """
-    from scipy import optimize
-
     rows, cols = grey.shape
     px = math.sqrt(abs(np.linalg.det(T[:2, :2])))
     pts, ang, wts = boundary_samples(boundaries, px * spacing)

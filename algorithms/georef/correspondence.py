@@ -29,6 +29,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+from shapely.geometry import Polygon
 
 from .invariants import ObjectFeatures, d4_alternatives, pair_transform
 
@@ -86,8 +88,6 @@ def find_hypotheses(img: Sequence[ObjectFeatures], ref: Sequence[ObjectFeatures]
     list of Hypothesis
         Sorted largest reference object first, then largest image object, then ids.
     """
-    from scipy.spatial import cKDTree
-
     def usable(fs: Sequence[ObjectFeatures], amin: float) -> NDArray[np.int64]:
         return np.array([k for k, f in enumerate(fs)
                          if np.all(np.isfinite(f.invariants)) and np.all(f.invariants > 0)
@@ -153,8 +153,6 @@ def in_mbr(mbr: Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float
 
 def overlap(ring_a: NDArray[np.float64], ring_b: NDArray[np.float64]) -> float:
     """min(A(a∩b)/A(a), A(a∩b)/A(b)) (eq. 4.3), exact with shapely; 0 for invalid shapes."""
-    from shapely.geometry import Polygon
-
     try:
         a = Polygon(ring_a)
         b = Polygon(ring_b)
@@ -224,8 +222,6 @@ def consistent_interpretation(hyps: Sequence[Hypothesis], img: Sequence[ObjectFe
             if img[a].obj.run == img[b].obj.run:
                 conflict_cache[key] = False  # one run's regions never overlap
             else:
-                from shapely.geometry import Polygon
-
                 try:
                     pa, pb = Polygon(ra).buffer(0), Polygon(rb).buffer(0)
                     inter = pa.intersection(pb).area

@@ -17,6 +17,8 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 from numpy.typing import NDArray
 
+from .correspondence import apply
+
 KINDS = ("affine", "projective", "poly2")
 MIN_POINTS = {"affine": 3, "projective": 4, "poly2": 6}
 
@@ -90,8 +92,6 @@ class TransformFit:
         """Image (col, row) → map."""
         xy = np.asarray(xy, float)
         if self.matrix is not None:
-            from .correspondence import apply
-
             return apply(self.matrix, xy)
         Ns, Nd, coef = self.poly
         t = _poly_terms(_h(xy, Ns))
@@ -204,8 +204,6 @@ def corner_error(matrix_or_fit: Any, truth: NDArray[np.float64], width: int, hei
                  ) -> NDArray[np.float64]:
     """Distance (image pixels) between the image corners mapped by the recovered and by the
     true image → map transform, measured back in the image by the true one."""
-    from .correspondence import apply
-
     corners = np.array([[-0.5, -0.5], [width - 0.5, -0.5], [-0.5, height - 0.5],
                         [width - 0.5, height - 0.5]])
     if isinstance(matrix_or_fit, TransformFit):

@@ -21,6 +21,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import ConvexHull
 
 from .objects import PolygonObject
 
@@ -307,8 +308,6 @@ def min_bounding_rectangle(ring: NDArray[np.float64]
 
     Returns the centre, the unit axes as rows of a 2 × 2 matrix and the half side lengths.
     """
-    from scipy.spatial import ConvexHull
-
     pts = np.asarray(ring, float)
     c0 = pts.mean(axis=0)
     p = pts - c0

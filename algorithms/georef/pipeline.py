@@ -10,17 +10,21 @@ rotation and mirroring are all unknown.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, StepFeedback
+from ..output_policy import PRODUCT_MARKER
 from .area import area_search, boundary_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform, inverse_for_resampling
 from .invariants import object_features
+from .products import summary, write_outputs
 from .reference_layer import (
     is_raster,
     reference_objects_from_raster,
@@ -35,6 +39,7 @@ from .refinement import (
     trimmed_icp,
 )
 from .regions import DEFAULT_THRESHOLDS, image_objects, load_image
+from .result import GeorefResult
 
 PathLike = Union[str, Path]
 
@@ -73,23 +78,102 @@ def parse_thresholds(text: Union[str, Sequence[float], None]) -> List[float]:
     return vals
 
 
-def georeference(image: PathLike, reference: PathLike, class_field: Optional[str] = None,
-                 class_value: Optional[str] = None, transform: str = "affine",
-                 thresholds: Union[str, Sequence[float], None] = None,
-                 pyramid_level: Union[int, str] = "auto", rd: float = 0.03,
-                 max_depth: int = 6, min_overlap: float = 0.7, verify_overlap: float = 0.5,
-                 alpha_min: float = 30.0, sigma_np_px: float = 2.0, max_gcps: int = 500,
-                 smooth: float = 1.0, merge: bool = True, band: Optional[int] = None,
-                 gcp_mode: str = "outline", search: str = "auto",
-                 feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+@dataclass(frozen=True)
+class GeorefOptions:
+    """Options of :func:`georeference` (defaults: seed-001 Table 5.2 and the synthetic tests).
+
+    Attributes
+    ----------
+    class_field, class_value : str, optional
+        Attribute and value selecting the reference polygons (``None``: all polygons).
+    transform : {"affine", "projective", "poly2"}
+        The final image → map transform.
+    thresholds : str or sequence of float, optional
+        Region-growing thresholds in grey values of 8-bit data ("5,6,7,8"; ``None``: the
+        defaults of :data:`.regions.DEFAULT_THRESHOLDS`).
+    pyramid_level : int or "auto"
+        Pyramid level segmented (factor 2 each); ``"auto"``: the first with at most 4 Mpx.
+    rd : float
+        Relative difference allowed for each invariant (0.03 = 3 %).
+    max_depth : int
+        Depth of the consistency search (pairs).
+    min_overlap, verify_overlap : float
+        Smallest overlap share (0–1) of a consistent pair in the search / the verification.
+    alpha_min : float
+        Smallest angle (°) between the outline directions at a sharp control point.
+    sigma_np_px : float
+        Control point tolerance σ_NP (level-0 px): points are accepted (best first) while
+        the RMS of their outline distances stays below it.
+    max_gcps : int
+        Most control points.
+    smooth : float
+        Gaussian σ (px) of the smoothing before segmentation (0: none).
+    merge : bool
+        Merge similar adjacent regions after region growing.
+    band : int, optional
+        Image band used (1-based; ``None``: the mean of the bands).
+    gcp_mode : str
+        Where control points are taken (``"outline"``: along the outlines).
+    search : {"auto", "objects", "area"}
+        ``objects``: the object-based chain only; ``area``: the area-based global search
+        only (:mod:`.area`, polygon layers only); ``auto``: objects, and the area-based
+        search when the objects give no result.
+    """
+
+    class_field: Optional[str] = None
+    class_value: Optional[str] = None
+    transform: str = "affine"
+    thresholds: Union[str, Sequence[float], None] = None
+    pyramid_level: Union[int, str] = "auto"
+    rd: float = 0.03
+    max_depth: int = 6
+    min_overlap: float = 0.7
+    verify_overlap: float = 0.5
+    alpha_min: float = 30.0
+    sigma_np_px: float = 2.0
+    max_gcps: int = 500
+    smooth: float = 1.0
+    merge: bool = True
+    band: Optional[int] = None
+    gcp_mode: str = "outline"
+    search: str = "auto"
+
+    def check(self) -> List[float]:
+        """Refuse unknown transform and search names; returns the parsed thresholds."""
+        thr = parse_thresholds(self.thresholds)
+        if self.transform not in ("affine", "projective", "poly2"):
+            raise InputError(f"Unknown transform '{self.transform}'; use affine, projective "
+                             "or poly2.")
+        if self.search not in SEARCH_MODES:
+            raise InputError(f"Unknown search '{self.search}'; use {', '.join(SEARCH_MODES)}.")
+        return thr
+
+    def report(self, thresholds: List[float], pyramid_level: Optional[int]) -> Dict[str, Any]:
+        """The ``parameters`` of the report (this key order: report.json stays the same)."""
+        return {"thresholds": thresholds, "rd": self.rd, "max_depth": self.max_depth,
+                "min_overlap": self.min_overlap, "verify_overlap": self.verify_overlap,
+                "alpha_min": self.alpha_min, "sigma_np_px": self.sigma_np_px,
+                "max_gcps": self.max_gcps, "transform": self.transform,
+                "smooth": self.smooth, "merge": self.merge, "gcp_mode": self.gcp_mode,
+                "class_field": self.class_field, "class_value": self.class_value,
+                "search": self.search, "pyramid_level": pyramid_level}
+
+
+def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefOptions] = None,
+                 feedback: Optional[Feedback] = None, **overrides: Any) -> GeorefResult:
     """Georeference ``image`` against ``reference``; returns the result (no files written).
 
     Parameters
     ----------
-    search : {"auto", "objects", "area"}
-        ``objects``: the object-based chain only; ``area``: the area-based global search only
-        (:mod:`.area`, polygon layers only); ``auto``: objects, and the area-based search
-        when the objects give no result.
+    image, reference : path
+        The image; a polygon layer or a georeferenced raster.
+    options : GeorefOptions, optional
+        Default: ``GeorefOptions()``.
+    feedback : Feedback, optional
+        Progress, log and cancellation.
+    **overrides
+        Fields of :class:`GeorefOptions` that replace those of ``options``
+        (``georeference(img, ref, search="area")``).
 
     Raises
     ------
@@ -98,107 +182,158 @@ def georeference(image: PathLike, reference: PathLike, class_field: Optional[str
     GeometryError
         Too few objects match (the message says how many were found at each stage and why).
     """
+    opts = replace(options or GeorefOptions(), **overrides)
     fb = feedback or Feedback()
     t0 = time.perf_counter()
-    thr = parse_thresholds(thresholds)
-    if transform not in ("affine", "projective", "poly2"):
-        raise InputError(f"Unknown transform '{transform}'; use affine, projective or poly2.")
-    if search not in SEARCH_MODES:
-        raise InputError(f"Unknown search '{search}'; use {', '.join(SEARCH_MODES)}.")
-    grey, img_info = load_image(image, band)
+    thr = opts.check()
+    grey, img_info = load_image(image, opts.band)
     ref_kind = "raster" if is_raster(reference) else "vector"
-    if ref_kind == "raster" and search == "area":
+    if ref_kind == "raster" and opts.search == "area":
         raise InputError("The area-based search needs a polygon layer as reference, not a "
                          "raster; use search = objects or auto.")
+    ref = None
     if ref_kind == "vector":  # first: a bad layer or class fails before any work
-        ref_objs, crs, ref_info = reference_objects_from_vector(
-            reference, class_field, class_value, feedback=fb)
+        ref = reference_objects_from_vector(reference, opts.class_field, opts.class_value,
+                                            feedback=fb)
     fb.progress(5)
-    params = {"thresholds": thr, "rd": rd, "max_depth": max_depth, "min_overlap": min_overlap,
-              "verify_overlap": verify_overlap, "alpha_min": alpha_min,
-              "sigma_np_px": sigma_np_px, "max_gcps": max_gcps, "transform": transform,
-              "smooth": smooth, "merge": merge, "gcp_mode": gcp_mode,
-              "class_field": class_field, "class_value": class_value, "search": search}
-    if search == "area":
-        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, None)
+    run = _Run(opts, thr, grey, img_info, fb, t0)
+    if opts.search == "area":
+        return _area_stage(run, ref, None)
     try:
-        return _object_stage(grey, img_info, reference, ref_kind,
-                             (ref_objs, crs, ref_info) if ref_kind == "vector" else None,
-                             pyramid_level, params, fb, t0)
+        return _object_stage(run, reference, ref_kind, ref)
     except GeometryError as exc:
-        if search == "objects" or ref_kind == "raster":
+        if opts.search == "objects" or ref_kind == "raster":
             raise
         # the reason and counts only: the advice at the end is repeated by the area stage
         why = str(exc).replace("Georeferencing failed: ", "").split(". Check that")[0]
         fb.info(f"Object stage: {why} — trying the area-based search.")
-        return _area_stage(grey, img_info, ref_objs, crs, ref_info, params, fb, t0, why)
+        return _area_stage(run, ref, why)
 
 
-def _object_stage(grey: np.ndarray, img_info: Dict[str, Any], reference: PathLike,
-                  ref_kind: str, ref: Optional[tuple], pyramid_level: Union[int, str],
-                  params: Dict[str, Any], fb: Feedback, t0: float) -> Dict[str, Any]:
+@dataclass
+class _Run:
+    """What both stages share: the options, the parsed thresholds, the image, the feedback
+    and the start time."""
+
+    options: GeorefOptions
+    thresholds: List[float]
+    grey: np.ndarray
+    image_info: Dict[str, Any]
+    fb: Feedback
+    t0: float
+
+
+def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
+                  ref: Optional[tuple]) -> GeorefResult:
     """The object-based chain (seed-001): segmentation to the final fit."""
-    thr, rd, max_depth = params["thresholds"], params["rd"], params["max_depth"]
-    min_overlap, verify_overlap = params["min_overlap"], params["verify_overlap"]
-    alpha_min, sigma_np_px = params["alpha_min"], params["sigma_np_px"]
-    max_gcps, transform, smooth = params["max_gcps"], params["transform"], params["smooth"]
-    merge, gcp_mode = params["merge"], params["gcp_mode"]
-    if ref is not None:
-        ref_objs, crs, ref_info = ref
-    img_objs, seg = image_objects(grey, thr, pyramid_level=pyramid_level, smooth=smooth,
-                                  merge=merge, feedback=StepFeedback(fb, 5, 20))
+    opts, fb = run.options, run.fb
+    thr, pyramid_level = run.thresholds, opts.pyramid_level
+    img_objs, seg = image_objects(run.grey, thr, pyramid_level=pyramid_level,
+                                  smooth=opts.smooth, merge=opts.merge,
+                                  feedback=StepFeedback(fb, 5, 20))
     if ref_kind == "raster":  # segmented like the image
-        ref_objs, crs, ref_info = reference_objects_from_raster(
-            reference, thr, pyramid_level=pyramid_level, smooth=smooth, merge=merge,
+        ref = reference_objects_from_raster(
+            reference, thr, pyramid_level=pyramid_level, smooth=opts.smooth, merge=opts.merge,
             feedback=StepFeedback(fb, 20, 35))
+    ref_objs, crs, ref_info = ref  # type: ignore[misc]  # given for a vector reference
     fb.check()
     level = int(seg["level"])
     fi = object_features(img_objs)
     fr = object_features(ref_objs)
     fb.progress(40)
-    hyps = find_hypotheses(fi, fr, rd)
+    hyps = find_hypotheses(fi, fr, opts.rd)
     fb.info(f"{len(img_objs)} image objects, {len(ref_objs)} reference objects, "
-            f"{len(hyps)} hypotheses (invariants within {100 * rd:g} %).")
-    interp = consistent_interpretation(hyps, fi, fr, max_depth=max_depth,
-                                       min_overlap=min_overlap)
+            f"{len(hyps)} hypotheses (invariants within {100 * opts.rd:g} %).")
+    interp = consistent_interpretation(hyps, fi, fr, max_depth=opts.max_depth,
+                                       min_overlap=opts.min_overlap)
     fb.progress(55)
     counts = {"image_objects": len(img_objs), "reference_objects": len(ref_objs),
               "hypotheses": len(hyps), "consistent_pairs": len(interp.pairs),
               "search_nodes": interp.nodes, "depth_reached": interp.depth_reached}
     if interp.transform is None or len(interp.pairs) < 2:
         _fail(counts, "no two hypotheses are geometrically consistent")
-    ver = verify(hyps, fi, fr, interp.transform, min_overlap=verify_overlap)
+    ver = verify(hyps, fi, fr, interp.transform, min_overlap=opts.verify_overlap)
     counts.update(verified_stage1=ver.stage1, verified_pairs=len(ver.pairs),
                   reestimated=ver.reestimated)
     if len(ver.pairs) < MIN_PAIRS:
         _fail(counts, f"only {len(ver.pairs)} pair(s) verified (at least {MIN_PAIRS} needed)")
-    G = ver.transform
-    px = float(np.sqrt(abs(np.linalg.det(G[:2, :2]))))  # map units per level-0 pixel
+    matched = _Matched(fi, fr, ver.pairs, ver.overlaps, ver.transform, level)
+    refined, icp_stats = _pair_icp(matched, fb)
+    fb.progress(70)
+    T, joint_rms, offset_px = _joint_icp(matched, opts.transform, fb)
+    counts["joint_icp_rms_px"] = joint_rms / matched.px
+    counts["outline_offset_px"] = offset_px
+    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
+    fb.progress(75)
+    fit, inverse_fit, gcps, used_xy = _outline_fit(refined, matched.px, opts, counts)
+    fb.progress(85)
+    warnings = _object_warnings(used_xy, run.grey.shape, interp, opts.max_depth)
+    for w in warnings:
+        fb.warning(w)
+    fb.info(f"{len(ver.pairs)} verified pairs, {counts['gcps']} control points, "
+            f"RMSE {fit.rmse_px:.2f} px ({fit.rmse_map:.2f} m).")
+    return GeorefResult(
+        fit=fit, inverse_fit=inverse_fit, gcps=gcps, crs=crs, global_transform=ver.transform,
+        joint=T, search=interp.transform, pairs=ver.pairs, img_features=fi, ref_features=fr,
+        counts=counts, icp=icp_stats, segmentation=seg, reference=ref_info,
+        reference_kind=ref_kind, image_info=run.image_info, grey=run.grey, warnings=warnings,
+        seconds=time.perf_counter() - run.t0, stage="objects",
+        parameters=opts.report(thr, level))
+
+
+@dataclass
+class _Matched:
+    """The verified object pairs of the object stage and their common transform."""
+
+    fi: List[Any]  #: image object features
+    fr: List[Any]  #: reference object features
+    pairs: List[Any]  #: verified hypotheses (``h.i`` image, ``h.j`` reference object)
+    overlaps: List[float]  #: overlap share of each pair after the verification
+    G: np.ndarray  #: 3 × 3 image → map transform of the verification
+    level: int  #: pyramid level of the segmentation
+
+    @property
+    def px(self) -> float:
+        """Map units per level-0 pixel of ``G``."""
+        return float(np.sqrt(abs(np.linalg.det(self.G[:2, :2]))))
+
+
+def _pair_icp(m: _Matched, fb: Feedback) -> Tuple[List[tuple], List[Dict[str, Any]]]:
+    """Trimmed ICP of every verified pair on its own: the outlines with each pair's own
+    transform, and the per-pair figures of the report."""
+    px, level, fi, fr = m.px, m.level, m.fi, m.fr
     refined = []
     icp_stats = []
-    for k, h in enumerate(ver.pairs):
+    for k, h in enumerate(m.pairs):
         fb.check()
         ring_img = simplify_ring(fi[h.i].obj.ring, 0.5 * 2**level)
-        res = trimmed_icp(apply(G, ring_img), fr[h.j].obj.ring, spacing=px * 2**level,
+        res = trimmed_icp(apply(m.G, ring_img), fr[h.j].obj.ring, spacing=px * 2**level,
                           model="affine")
-        refined.append((fi[h.i].obj.ring, fr[h.j].obj.ring, res.transform @ G))
+        refined.append((fi[h.i].obj.ring, fr[h.j].obj.ring, res.transform @ m.G))
         icp_stats.append({"pair": k, "image_object": fi[h.i].obj.id,
                           "reference_object": fr[h.j].obj.id, "run": fi[h.i].obj.run,
-                          "threshold": fi[h.i].obj.threshold, "overlap": ver.overlaps[k],
+                          "threshold": fi[h.i].obj.threshold, "overlap": m.overlaps[k],
                           # µm/µpx: ICP that stops at its iteration limit differs below
                           # that between BLAS builds (these numbers only inform)
                           "icp_rms_m": round(res.rms, 6), "icp_rms_px": round(res.rms / px, 6),
                           "iterations": res.iterations, "converged": res.converged,
                           "kept": res.kept})
-    fb.progress(70)
-    # one transform for all verified outlines (see refinement.joint_icp); the segmentation
-    # shrinks or grows objects a little (boundary pixels form their own regions): that
-    # offset is estimated and the image outlines moved by it, alternating with the ICP
-    rings = [(simplify_ring(fi[h.i].obj.ring, 0.5 * 2**level), fr[h.j].obj.ring)
-             for h in ver.pairs]
+    return refined, icp_stats
+
+
+def _joint_icp(m: _Matched, transform: str, fb: Feedback) -> Tuple[np.ndarray, float, float]:
+    """One transform for all verified outlines (see :func:`.refinement.joint_icp`).
+
+    The segmentation shrinks or grows objects a little (boundary pixels form their own
+    regions): that offset is estimated and the image outlines moved by it, alternating with
+    the ICP. Returns the transform, the joint RMS (map units) and the offset (px).
+    """
+    level, px = m.level, m.px
+    rings = [(simplify_ring(m.fi[h.i].obj.ring, 0.5 * 2**level), m.fr[h.j].obj.ring)
+             for h in m.pairs]
     model = "projective" if transform == "projective" else "affine"
     offset_px = 0.0
-    T = G
+    T = m.G
     for _ in range(3):
         fb.check()
         moved = [(grow_ring(a, offset_px), b) for a, b in rings]
@@ -208,47 +343,47 @@ def _object_stage(grey: np.ndarray, img_info: Dict[str, Any], reference: PathLik
         offset_px += step
         if abs(step) < 0.02:
             break
-    counts["joint_icp_rms_px"] = joint.rms / px
-    counts["outline_offset_px"] = offset_px
-    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
-    fb.progress(75)
-    gcps = control_points(refined, alpha_min=alpha_min, sigma_np=sigma_np_px * px,
-                          max_count=max_gcps, spacing=px, mode=gcp_mode)
-    if len(gcps) < {"affine": 3, "projective": 4, "poly2": 6}[transform] + 2:
-        _fail(counts, f"only {len(gcps)} control points within σ_NP = {sigma_np_px:g} px")
+    return joint.transform, joint.rms, offset_px
+
+
+def _outline_fit(refined: List[tuple], px: float, opts: GeorefOptions,
+                 counts: Dict[str, Any]) -> tuple:
+    """Control points on the refined outlines and the final fit (``counts`` gets ``gcps``
+    and ``gcps_sharp``). Returns the fit, its inverse, the control points and the image
+    coordinates of the ones used."""
+    gcps = control_points(refined, alpha_min=opts.alpha_min, sigma_np=opts.sigma_np_px * px,
+                          max_count=opts.max_gcps, spacing=px, mode=opts.gcp_mode)
+    if len(gcps) < {"affine": 3, "projective": 4, "poly2": 6}[opts.transform] + 2:
+        _fail(counts, f"only {len(gcps)} control points within σ_NP = "
+                      f"{opts.sigma_np_px:g} px")
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
-    fit = fit_transform(img_xy, map_xy, transform)
+    fit = fit_transform(img_xy, map_xy, opts.transform)
     inverse_fit = inverse_for_resampling(fit, img_xy[fit.used], map_xy[fit.used])
-    fb.progress(85)
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = int(sum(g.sharp for g, u in zip(gcps, fit.used) if u))
+    return fit, inverse_fit, gcps, img_xy[fit.used]
+
+
+def _object_warnings(used_xy: np.ndarray, shape: Sequence[int], interp: Any,
+                     max_depth: int) -> List[str]:
+    """Warnings of the object stage: control points bunched together, a shallow search."""
     warnings = []
-    hull_share = _hull_share(img_xy[fit.used], grey.shape)
+    hull_share = _hull_share(used_xy, shape)
     if hull_share < 0.25:
         warnings.append(f"The control points cover only {100 * hull_share:.0f} % of the image "
                         "(convex hull): expect larger errors towards the image corners.")
     if not interp.depth_reached:
         warnings.append(f"The search did not reach depth {max_depth} "
                         f"({len(interp.pairs)} consistent pairs).")
-    for w in warnings:
-        fb.warning(w)
-    fb.info(f"{len(ver.pairs)} verified pairs, {counts['gcps']} control points, "
-            f"RMSE {fit.rmse_px:.2f} px ({fit.rmse_map:.2f} m).")
-    return {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps, "global": G,
-            "joint": joint.transform, "search": interp.transform,
-            "pairs": ver.pairs, "img_features": fi, "ref_features": fr, "crs": crs,
-            "counts": counts, "icp": icp_stats, "segmentation": seg, "reference": ref_info,
-            "reference_kind": ref_kind, "image_info": img_info, "grey": grey,
-            "warnings": warnings, "seconds": time.perf_counter() - t0, "stage": "objects",
-            "parameters": {**params, "pyramid_level": level}}
+    return warnings
 
 
-def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[Any],
-                crs: Any, ref_info: Dict[str, Any], params: Dict[str, Any], fb: Feedback,
-                t0: float, object_failure: Optional[str]) -> Dict[str, Any]:
+def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefResult:
     """The area-based global search (:mod:`.area`) and the same result layout as the object
     chain; its control points are a grid of image points through the refined affine."""
+    ref_objs, crs, ref_info = ref
+    grey, fb = run.grey, run.fb
     fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
     fb.progress(40)
     res = area_search(grey, [o.ring for o in ref_objs])
@@ -261,35 +396,12 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
                                  "mirrored": res.mirrored, "candidates": res.candidates}
     T = res.transform
     if res.ecc < MIN_ECC:
-        # the individual polygons' outlines against the image's edge directions
-        fb.info(f"ECC correlation {res.ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
-                "(individual outlines against edge directions).")
-        outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
-        bres = boundary_search(grey, outlines)
-        counts.update(boundary_outlines=len(outlines),
-                      boundary_score=round(bres.score, 4),
-                      boundary_screen=round(bres.screen, 4),
-                      boundary_runner_up=round(bres.runner_up, 4))
-        if bres.score < MIN_ORIENTATION or bres.gap < MIN_GAP:
-            why = (f"the area-based search found no alignment (ECC correlation {res.ecc:.2f} "
-                   f"< {MIN_ECC:g}; boundary-orientation score {bres.score:.2f}, needs "
-                   f"≥ {MIN_ORIENTATION:g}, ahead of the next placement by {bres.gap:.2f}, "
-                   f"needs ≥ {MIN_GAP:g})")
-            if object_failure:
-                why += f"; before it, the object stage: {object_failure}"
-            _fail(counts, why)
-        T = bres.transform
-        area_info = {"method": "boundary orientation", "score": bres.score,
-                     "screen": bres.screen, "search_score": bres.search_score,
-                     "runner_up": bres.runner_up,
-                     "mirrored": bres.mirrored, "candidates": bres.candidates,
-                     "ecc_before": res.ecc}
+        T, area_info = _boundary_stage(grey, ref_objs, res.ecc, counts, object_failure, fb)
     fb.progress(75)
     gcps = grid_control_points(T, np.isfinite(grey))
-    transform = params["transform"]
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
-    fit = fit_transform(img_xy, map_xy, transform)
+    fit = fit_transform(img_xy, map_xy, run.options.transform)
     inverse_fit = inverse_for_resampling(fit, img_xy, map_xy)
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = 0
@@ -302,15 +414,43 @@ def _area_stage(grey: np.ndarray, img_info: Dict[str, Any], ref_objs: Sequence[A
     for w in warnings:
         fb.warning(w)
     fb.progress(85)
-    return {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps, "global": T,
-            "joint": T, "search": T, "pairs": [],
-            "img_features": [], "ref_features": [], "crs": crs, "counts": counts, "icp": [],
-            "segmentation": {}, "reference": ref_info, "reference_kind": "vector",
-            "image_info": img_info, "grey": grey, "warnings": warnings,
-            "seconds": time.perf_counter() - t0, "stage": "area",
-            "area": area_info,
-            "reference_rings": [o.ring for o in ref_objs],
-            "parameters": {**params, "pyramid_level": None}}
+    return GeorefResult(
+        fit=fit, inverse_fit=inverse_fit, gcps=gcps, crs=crs, global_transform=T, joint=T,
+        search=T, counts=counts, reference=ref_info, reference_kind="vector",
+        image_info=run.image_info, grey=grey, warnings=warnings,
+        seconds=time.perf_counter() - run.t0, stage="area", area=area_info,
+        reference_rings=[o.ring for o in ref_objs],
+        parameters=run.options.report(run.thresholds, None))
+
+
+def _boundary_stage(grey: np.ndarray, ref_objs: Sequence[Any], ecc: float,
+                    counts: Dict[str, Any], object_failure: Optional[str],
+                    fb: Feedback) -> Tuple[np.ndarray, Dict[str, Any]]:
+    """The individual polygons' outlines against the image's edge directions, when the ECC
+    correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. Returns the
+    transform and the description of the search for the report."""
+    fb.info(f"ECC correlation {ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
+            "(individual outlines against edge directions).")
+    outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
+    bres = boundary_search(grey, outlines)
+    counts.update(boundary_outlines=len(outlines),
+                  boundary_score=round(bres.score, 4),
+                  boundary_screen=round(bres.screen, 4),
+                  boundary_runner_up=round(bres.runner_up, 4))
+    if bres.score < MIN_ORIENTATION or bres.gap < MIN_GAP:
+        why = (f"the area-based search found no alignment (ECC correlation {ecc:.2f} "
+               f"< {MIN_ECC:g}; boundary-orientation score {bres.score:.2f}, needs "
+               f"≥ {MIN_ORIENTATION:g}, ahead of the next placement by {bres.gap:.2f}, "
+               f"needs ≥ {MIN_GAP:g})")
+        if object_failure:
+            why += f"; before it, the object stage: {object_failure}"
+        _fail(counts, why)
+    info = {"method": "boundary orientation", "score": bres.score,
+            "screen": bres.screen, "search_score": bres.search_score,
+            "runner_up": bres.runner_up,
+            "mirrored": bres.mirrored, "candidates": bres.candidates,
+            "ecc_before": ecc}
+    return bres.transform, info
 
 
 def _fail(counts: Dict[str, Any], why: str) -> None:
@@ -323,11 +463,31 @@ def _fail(counts: Dict[str, Any], why: str) -> None:
 
 
 def _hull_share(xy: np.ndarray, shape: Sequence[int]) -> float:
-    from scipy.spatial import ConvexHull
-
+    """Share of the image area inside the convex hull of ``xy`` (0 for fewer than 3)."""
     if len(xy) < 3:
         return 0.0
     try:
         return float(ConvexHull(xy).volume / (shape[0] * shape[1]))
     except Exception:
         return 0.0
+
+
+def run_georeference_polygons(image: PathLike, reference: PathLike, output: PathLike,
+                              options: Optional[GeorefOptions] = None,
+                              feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """``georeference_polygons``: georeference ``image`` and write the products into the
+    folder ``output`` (see :func:`.products.write_outputs`); returns the outputs of the
+    algorithm (:func:`.products.summary`).
+
+    An output folder that holds files PhotoDEM did not write is refused before the work.
+    """
+    fb = feedback or Feedback()
+    out = Path(output)
+    if out.is_file() or (out.is_dir() and any(out.iterdir())
+                         and not (out / PRODUCT_MARKER).is_file()):
+        raise InputError(f"The output folder '{out}' holds files PhotoDEM did not "
+                         "write; choose an empty or new folder.")
+    result = georeference(image, reference, options, feedback=StepFeedback(fb, 0, 80))
+    paths = write_outputs(out, image, result, feedback=StepFeedback(fb, 80, 100),
+                          replace=True)
+    return summary(result, paths)

@@ -20,13 +20,23 @@ import json
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import fiona
 import numpy as np
+import rasterio
+from matplotlib.patches import Rectangle
+from rasterio.control import GroundControlPoint
+from rasterio.transform import Affine
+from rasterio.windows import Window
+from scipy import ndimage
+from scipy.spatial import ConvexHull, QhullError
 
 from ..feedback import Feedback
 from ..jsonable import json_ready
 from ..quality.report import new_figure
+from ..raster.io import atomic_output, gtiff_profile, open_image, overview_factors, staged_folder
 from .correspondence import apply
 from .fit import TransformFit, points_summary
+from .result import GeorefResult
 
 PathLike = Union[str, Path]
 
@@ -70,13 +80,13 @@ def points_crs(text: str) -> Optional[str]:
     return None
 
 
-def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
+def write_points_file(path: PathLike, result: GeorefResult) -> Path:
     """The QGIS Georeferencer ``.points`` file (see the module notes for the convention)."""
-    fit = result["fit"]
+    fit = result.fit
     rows = points_summary(fit)
-    lines = [f"#CRS: {result['crs'].to_wkt()}",
+    lines = [f"#CRS: {result.crs.to_wkt()}",
              "mapX,mapY,sourceX,sourceY,enable,dX,dY,residual"]
-    for g, r in zip(result["gcps"], rows):
+    for g, r in zip(result.gcps, rows):
         px = fit.pixel_size
         sx, sy = points_source(*g.image)
         lines.append(f"{g.map[0]:.6f},{g.map[1]:.6f},{sx:.6f},{sy:.6f},{1 if r['used'] else 0},"
@@ -85,18 +95,16 @@ def write_points_file(path: PathLike, result: Dict[str, Any]) -> Path:
     return Path(path)
 
 
-def write_gcps_gpkg(path: PathLike, result: Dict[str, Any]) -> Path:
+def write_gcps_gpkg(path: PathLike, result: GeorefResult) -> Path:
     """Control points as a point layer in the map CRS."""
-    import fiona
-
-    fit = result["fit"]
+    fit = result.fit
     schema = {"geometry": "Point",
               "properties": {"id": "int", "image_col": "float", "image_row": "float",
                              "residual_m": "float", "residual_px": "float", "loo_m": "float",
                              "enabled": "int", "pair": "int"}}
-    with fiona.open(path, "w", driver="GPKG", layer="gcps", crs_wkt=result["crs"].to_wkt(),
+    with fiona.open(path, "w", driver="GPKG", layer="gcps", crs_wkt=result.crs.to_wkt(),
                     schema=schema) as dst:
-        for k, (g, r) in enumerate(zip(result["gcps"], points_summary(fit))):
+        for k, (g, r) in enumerate(zip(result.gcps, points_summary(fit))):
             loo = r["loo_map"]
             dst.write({"geometry": {"type": "Point", "coordinates": g.map},
                        "properties": {"id": k, "image_col": g.image[0], "image_row": g.image[1],
@@ -107,27 +115,20 @@ def write_gcps_gpkg(path: PathLike, result: Dict[str, Any]) -> Path:
     return Path(path)
 
 
-def _inverse_points(result: Dict[str, Any], xy: np.ndarray) -> np.ndarray:
+def _inverse_points(result: GeorefResult, xy: np.ndarray) -> np.ndarray:
     """Map → image for the fitted transform (poly2: Newton steps on the forward model)."""
-    fit = result["fit"]
+    fit = result.fit
     if fit.matrix is not None:
         return apply(np.linalg.inv(fit.matrix), xy)
-    return result["inverse_fit"].forward(xy)  # poly2: its own map → image fit
+    return result.inverse_fit.forward(xy)  # poly2: its own map → image fit
 
 
-def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
+def write_georeferenced(path: PathLike, image: PathLike, result: GeorefResult,
                         gsd: Optional[float] = None, tile: int = 512,
                         feedback: Optional[Feedback] = None) -> Path:
     """The image resampled into the map CRS (bilinear, alpha band), tile by tile."""
-    import rasterio
-    from rasterio.transform import Affine
-    from rasterio.windows import Window
-    from scipy import ndimage
-
-    from ..raster.io import atomic_output, gtiff_profile, open_image, overview_factors
-
     fb = feedback or Feedback()
-    fit = result["fit"]
+    fit = result.fit
     with open_image(image) as src:
         W, H, count, dtype = src.width, src.height, src.count, src.dtypes[0]
         corners = np.array([[-0.5, -0.5], [W - 0.5, -0.5], [-0.5, H - 0.5], [W - 0.5, H - 0.5]])
@@ -139,7 +140,7 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
         ylo, yhi = float(min(y0, y1)), float(max(y0, y1))
         cols, rows = round((x1 - x0) / px), round((yhi - ylo) / px)
         transform = Affine(px, 0, x0, 0, -px, yhi)
-        profile = gtiff_profile(cols, rows, count + 1, dtype, result["crs"].to_wkt(),
+        profile = gtiff_profile(cols, rows, count + 1, dtype, result.crs.to_wkt(),
                                 transform=transform, nodata=None)
         amax = 255 if dtype == "uint8" else np.iinfo(dtype).max if np.issubdtype(
             np.dtype(dtype), np.integer) else 1.0
@@ -182,17 +183,12 @@ def write_georeferenced(path: PathLike, image: PathLike, result: Dict[str, Any],
     return Path(path)
 
 
-def write_with_gcps(path: PathLike, image: PathLike, result: Dict[str, Any]) -> Path:
+def write_with_gcps(path: PathLike, image: PathLike, result: GeorefResult) -> Path:
     """A copy of the image with the used control points embedded as GDAL GCPs."""
-    import rasterio
-    from rasterio.control import GroundControlPoint
-
-    from ..raster.io import atomic_output, open_image
-
-    fit = result["fit"]
+    fit = result.fit
     gcps = [GroundControlPoint(row=g.image[1] + 0.5, col=g.image[0] + 0.5, x=g.map[0],
                                y=g.map[1], id=str(k))
-            for k, (g, u) in enumerate(zip(result["gcps"], fit.used)) if u]
+            for k, (g, u) in enumerate(zip(result.gcps, fit.used)) if u]
     with open_image(image) as src:
         profile = src.profile.copy()
         profile.pop("transform", None)
@@ -201,78 +197,78 @@ def write_with_gcps(path: PathLike, image: PathLike, result: Dict[str, Any]) -> 
         with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
             for _, window in src.block_windows(1):
                 dst.write(src.read(window=window), window=window)
-            dst.gcps = (gcps, result["crs"].to_wkt())
+            dst.gcps = (gcps, result.crs.to_wkt())
     return Path(path)
 
 
-def overlay_png(path: PathLike, result: Dict[str, Any]) -> Path:
+def overlay_png(path: PathLike, result: GeorefResult) -> Path:
     """Matched image polygons (green) and reference polygons taken into the image (red)."""
-    grey = result["grey"]
-    fi, fr = result["img_features"], result["ref_features"]
+    grey = result.grey
+    fi, fr = result.img_features, result.ref_features
     H, W = grey.shape
     # no pyplot: the review saves from inside QGIS, whose backend must stay as it is
     fig = new_figure(8, 8 * H / max(W, 1))
     ax = fig.add_subplot()
     ax.imshow(grey, cmap="gray", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
-    outlines = [(fi[h.i].obj.ring, "lime") for h in result["pairs"]]
-    outlines += [(_inverse_points(result, fr[h.j].obj.ring), "red") for h in result["pairs"]]
+    outlines = [(fi[h.i].obj.ring, "lime") for h in result.pairs]
+    outlines += [(_inverse_points(result, fr[h.j].obj.ring), "red") for h in result.pairs]
     # the area-based stage matched the whole map: all reference outlines
-    outlines += [(_inverse_points(result, r), "red") for r in result.get("reference_rings", [])]
+    outlines += [(_inverse_points(result, r), "red") for r in result.reference_rings]
     for ring, colour in outlines:
         p = np.vstack([ring, ring[:1]])
         ax.plot(p[:, 0], p[:, 1], "-", color=colour, lw=0.8)
-    g = np.array([p.image for p in result["gcps"]]) if result["gcps"] else np.zeros((0, 2))
+    g = np.array([p.image for p in result.gcps]) if result.gcps else np.zeros((0, 2))
     if len(g):
         ax.plot(g[:, 0], g[:, 1], "+", color="yellow", ms=4)
     ax.set_xlim(-0.5, W - 0.5)
     ax.set_ylim(H - 0.5, -0.5)
     ax.set_title("reference polygons through the area-based transform (red); control points "
-                 "(+)" if result.get("stage") == "area" else
+                 "(+)" if result.stage == "area" else
                  "matched objects: image (green), reference (red); control points (+)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     return Path(path)
 
 
-def report_dict(result: Dict[str, Any]) -> Dict[str, Any]:
+def report_dict(result: GeorefResult) -> Dict[str, Any]:
     """Everything an operator checks, JSON-ready."""
-    fit = result["fit"]
-    fi, fr = result["img_features"], result["ref_features"]
+    fit = result.fit
+    fi, fr = result.img_features, result.ref_features
     return {
         "transform": transform_json(result),
         "rmse_px": fit.rmse_px, "rmse_m": fit.rmse_map, "sigma0_m": fit.sigma0,
-        "pixel_size_m": fit.pixel_size, "counts": result["counts"],
+        "pixel_size_m": fit.pixel_size, "counts": result.counts,
         "pairs": [{"image_object": fi[h.i].obj.id, "reference_object": fr[h.j].obj.id,
                    "run": fi[h.i].obj.run, "threshold": fi[h.i].obj.threshold,
                    "q": h.q, "d4_alternative": h.alternative,
                    "reference_features": fr[h.j].obj.attributes.get("features")}
-                  for h in result["pairs"]],
-        "icp": result["icp"],
+                  for h in result.pairs],
+        "icp": result.icp,
         "gcps": [{"image": list(g.image), "map": list(g.map), "pair": g.pair,
                   "sharp": bool(g.sharp), **r}
-                 for g, r in zip(result["gcps"], points_summary(fit))],
-        "segmentation": result["segmentation"], "reference": result["reference"],
-        "reference_kind": result["reference_kind"], "image": result["image_info"],
-        "parameters": result["parameters"], "warnings": result["warnings"],
-        "stage": result.get("stage", "objects"),
-        "area_search": result.get("area"),
-        "extensions": ["area-based global search" if result.get("stage") == "area" else None,
-                       "smoothing before segmentation" if result["parameters"]["smooth"]
+                 for g, r in zip(result.gcps, points_summary(fit))],
+        "segmentation": result.segmentation, "reference": result.reference,
+        "reference_kind": result.reference_kind, "image": result.image_info,
+        "parameters": result.parameters, "warnings": result.warnings,
+        "stage": result.stage,
+        "area_search": result.area,
+        "extensions": ["area-based global search" if result.stage == "area" else None,
+                       "smoothing before segmentation" if result.parameters["smooth"]
                        else None,
-                       "merging of similar adjacent regions" if result["parameters"]["merge"]
+                       "merging of similar adjacent regions" if result.parameters["merge"]
                        else None,
                        "D4 alternatives for ambiguous standard positions",
                        "least-squares re-estimate of the global affine after verification",
                        "joint ICP of all verified outlines with outline offset",
-                       "control points along outlines" if result["parameters"]["gcp_mode"]
+                       "control points along outlines" if result.parameters["gcp_mode"]
                        == "outline" else None],
     }
 
 
-def transform_json(result: Dict[str, Any]) -> Dict[str, Any]:
+def transform_json(result: GeorefResult) -> Dict[str, Any]:
     """The final transform: kind, 3 × 3 matrix (image col/row → map) or poly2 coefficients."""
-    fit = result["fit"]
-    out: Dict[str, Any] = {"kind": fit.kind, "crs": result["crs"].to_string()}
+    fit = result.fit
+    out: Dict[str, Any] = {"kind": fit.kind, "crs": result.crs.to_string()}
     if fit.matrix is not None:
         out["matrix"] = [[float(v) for v in row] for row in fit.matrix]
     else:
@@ -319,18 +315,16 @@ def draw_residuals(ax: Any, xy: np.ndarray, residuals: np.ndarray, scale: float,
             **marker_style)
 
 
-def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int,
+def residual_png(path: PathLike, result: GeorefResult, width: int, height: int,
                  check: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Path:
     """Control points over the image frame with their residual vectors (fitted − measured,
     exaggerated, as in the review dialog): points in the fit blue, the others (outliers,
     check points) orange; the convex hull of the points in the fit dashed — where the
     transform is interpolated, not extrapolated.
     ``check``: independent check points (image (n, 2), map (n, 2)), purple triangles."""
-    from matplotlib.patches import Rectangle
-
-    fit = result["fit"]
-    xy = np.array([g.image for g in result["gcps"]], float).reshape(-1, 2)
-    mp = np.array([g.map for g in result["gcps"]], float).reshape(-1, 2)
+    fit = result.fit
+    xy = np.array([g.image for g in result.gcps], float).reshape(-1, 2)
+    mp = np.array([g.map for g in result.gcps], float).reshape(-1, 2)
     # fitted − measured, in the image: the arrows of the review dialog
     res = image_residuals(fit, xy, fit.forward(xy) - mp)
     cxy = np.zeros((0, 2)) if check is None else np.asarray(check[0], float).reshape(-1, 2)
@@ -344,8 +338,6 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
         draw_residuals(ax, xy[used], res[used], scale, ROLE_COLOURS[role])
     draw_residuals(ax, cxy, cres, scale, INDEPENDENT_COLOUR, marker="^", size=5)
     if fit.used.sum() >= 3:
-        from scipy.spatial import ConvexHull, QhullError
-
         try:
             hull = ConvexHull(xy[fit.used])
             ring = xy[fit.used][np.append(hull.vertices, hull.vertices[0])]
@@ -365,7 +357,7 @@ def residual_png(path: PathLike, result: Dict[str, Any], width: int, height: int
     return Path(path)
 
 
-def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, Path]:
+def write_report(folder: Path, result: GeorefResult, name: str) -> Dict[str, Path]:
     """report.json, report.html, overlay.png and residuals.png in ``folder``."""
 
     rep = report_dict(result)
@@ -373,7 +365,7 @@ def write_report(folder: Path, result: Dict[str, Any], name: str) -> Dict[str, P
     (folder / "report.json").write_text(json.dumps(json_ready(rep), indent=1),
                                         encoding="utf-8")
     overlay_png(folder / "overlay.png", result)
-    info = result["image_info"]
+    info = result.image_info
     residual_png(folder / "residuals.png", result, info["width"], info["height"])
     (folder / "report.html").write_text(report_html(rep, name), encoding="utf-8")
     return {"report": folder / "report.json", "html": folder / "report.html",
@@ -449,12 +441,10 @@ def _independent_html(review: Dict[str, Any]) -> str:
             f"<th>residual px</th><th>residual m</th></tr>{rows}</table>")
 
 
-def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],
+def write_outputs(output: PathLike, image: PathLike, result: GeorefResult,
                   feedback: Optional[Feedback] = None, replace: bool = False
                   ) -> Dict[str, Any]:
     """All products into the folder ``output`` (staged: nothing half-written is left)."""
-    from ..raster.io import staged_folder
-
     name = Path(image).stem
     out = Path(output)
     with staged_folder(out, replace=replace, product="georeference_polygons") as tmp:
@@ -463,7 +453,7 @@ def write_outputs(output: PathLike, image: PathLike, result: Dict[str, Any],
     return product_paths(out, name)
 
 
-def write_transform_products(folder: Path, image: PathLike, result: Dict[str, Any], name: str,
+def write_transform_products(folder: Path, image: PathLike, result: GeorefResult, name: str,
                              feedback: Optional[Feedback] = None) -> None:
     """The products of the transform in ``folder``: the ``.points`` file, ``gcps.gpkg``, the
     georeferenced image and the image copy with GCPs (automatic run and review alike)."""
@@ -481,15 +471,15 @@ def product_paths(folder: Path, name: str) -> Dict[str, str]:
             "report": str(folder / "report.json"), "html": str(folder / "report.html")}
 
 
-def summary(result: Dict[str, Any], paths: Dict[str, Any]) -> Dict[str, Any]:
+def summary(result: GeorefResult, paths: Dict[str, Any]) -> Dict[str, Any]:
     """The algorithm's JSON result."""
-    fit = result["fit"]
+    fit = result.fit
     return {"transform": transform_json(result), "rmse_px": float(fit.rmse_px),
             "rmse_m": float(fit.rmse_map), "gcps": paths["points"],
             "gcps_gpkg": paths["gcps"], "image": paths["image"], "report": paths["report"],
-            "n_pairs": int(result["counts"]["verified_pairs"]),
-            "n_gcps": int(result["counts"]["gcps"])}
+            "n_pairs": int(result.counts["verified_pairs"]),
+            "n_gcps": int(result.counts["gcps"])}
 
 
-def points_list(result: Dict[str, Any]) -> List[Dict[str, Any]]:
+def points_list(result: GeorefResult) -> List[Dict[str, Any]]:
     return report_dict(result)["gcps"]

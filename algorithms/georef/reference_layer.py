@@ -15,13 +15,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
+import fiona
 import numpy as np
+import pyproj
+import rasterio
+from shapely.geometry import MultiPolygon, Polygon, shape
+from shapely.ops import unary_union
 
 from ..errors import InputError
 from ..feedback import Feedback
 from .correspondence import apply
 from .fit import centre_matrix
 from .objects import REFERENCE, PolygonObject, orient_ring
+from .regions import image_objects, load_image
 
 PathLike = Union[str, Path]
 
@@ -36,8 +42,6 @@ def is_raster(path: PathLike) -> bool:
     if p.suffix.lower() in (".gpkg", ".shp", ".geojson", ".json", ".gml", ".kml", ".fgb"):
         return False
     try:
-        import rasterio
-
         with rasterio.open(p):
             return True
     except Exception:
@@ -46,8 +50,6 @@ def is_raster(path: PathLike) -> bool:
 
 def matching_crs(crs: Any, lon: float, lat: float) -> Any:
     """The projected CRS to match in: ``crs`` when projected, else the UTM zone at lon/lat."""
-    import pyproj
-
     c = pyproj.CRS.from_user_input(crs)
     if c.is_projected:
         return c
@@ -68,8 +70,6 @@ def _match_value(value: Any, wanted: str) -> bool:
 
 def _transform_polygon(g: Any, tr: Any) -> Any:
     """A (multi)polygon through a pyproj transformer (rings rebuilt; shapely 1.8 and 2)."""
-    from shapely.geometry import MultiPolygon, Polygon
-
     def ring(coords: Any) -> np.ndarray:
         c = np.asarray(coords, float)
         x, y = tr.transform(c[:, 0], c[:, 1])
@@ -115,11 +115,6 @@ def reference_objects_from_vector(path: PathLike, class_field: Optional[str] = N
     InputError
         Unreadable layer, a class field it does not have, no polygon after the selection.
     """
-    import fiona
-    import pyproj
-    from shapely.geometry import shape
-    from shapely.ops import unary_union
-
     path = Path(path)
     if not path.exists():
         raise InputError(f"Reference layer '{path}' not found.")
@@ -213,11 +208,6 @@ def reference_objects_from_raster(path: PathLike, thresholds: Sequence[float],
     Regions are outlined in the raster's pixel frame and taken to map coordinates with its
     geotransform (pixel centres at integers: map = transform · (x + 0.5, y + 0.5)).
     """
-    import pyproj
-    import rasterio
-
-    from .regions import image_objects, load_image
-
     with rasterio.open(path) as src:
         if src.crs is None or src.transform.is_identity:
             raise InputError(f"The reference raster '{Path(path).name}' has no georeference; "

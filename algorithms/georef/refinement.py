@@ -21,15 +21,18 @@ from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
+from matplotlib.path import Path as MplPath
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+from shapely.geometry import Polygon
 
 from .correspondence import apply
+from .fit import fit_matrix
+from .objects import orient_ring
 
 
 def simplify_ring(ring: NDArray[np.float64], tolerance: float) -> NDArray[np.float64]:
     """Douglas–Peucker generalisation of a closed ring (shapely), unclosed output."""
-    from shapely.geometry import Polygon
-
     p = Polygon(ring).simplify(tolerance, preserve_topology=True)
     if p.is_empty or p.geom_type != "Polygon":
         return np.asarray(ring, float)
@@ -67,7 +70,6 @@ def closest_on_ring(points: NDArray[np.float64], ring: NDArray[np.float64],
     points = np.asarray(points, float)
     if len(points) * len(ring) <= 100_000:
         return _closest_brute(points, ring, chunk)
-    from scipy.spatial import cKDTree
 
     step = _spacing(points)
     dense = sample_ring(ring, step, keep_vertices=True)
@@ -119,8 +121,6 @@ def _closest_brute(points: NDArray[np.float64], ring: NDArray[np.float64], chunk
 def estimate(src: NDArray[np.float64], dst: NDArray[np.float64], model: str = "affine"
              ) -> Optional[NDArray[np.float64]]:
     """Least-squares 3 × 3 transform src → dst (affine, or projective by normalised DLT)."""
-    from .fit import fit_matrix
-
     try:
         return fit_matrix(src, dst, model)
     except (ValueError, np.linalg.LinAlgError):
@@ -288,8 +288,6 @@ def outline_offset(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
                    T: NDArray[np.float64], spacing: float) -> float:
     """Mean signed distance (map units) of the image outlines mapped by ``T`` from their
     partners' outlines: positive when the image objects are smaller (lie inside)."""
-    from matplotlib.path import Path as MplPath
-
     total, n = 0.0, 0
     for img_ring, ref_ring in pairs:
         cur = apply(T, sample_ring(img_ring, spacing))
@@ -305,13 +303,10 @@ def outline_offset(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
 
 def grow_ring(ring: NDArray[np.float64], distance: float) -> NDArray[np.float64]:
     """The ring moved outwards by ``distance`` (inwards when negative), mitred corners."""
-    from shapely.geometry import Polygon
-
     p = Polygon(ring).buffer(distance, join_style=2, mitre_limit=3.0)
     if p.is_empty:
         return np.asarray(ring, float)
     if p.geom_type != "Polygon":
         p = max(p.geoms, key=lambda g: g.area)
-    from .objects import orient_ring
 
     return orient_ring(np.asarray(p.exterior.coords, float))

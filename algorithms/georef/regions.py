@@ -18,14 +18,19 @@ integers).
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 from numpy.typing import NDArray
+from rasterio import features
+from rasterio.transform import Affine
+from scipy import ndimage
 
 from ..errors import InputError
 from ..feedback import Feedback
+from ..raster.io import open_image
 from .objects import IMAGE, PolygonObject, orient_ring
 
 #: Default thresholds (DN of 8-bit data), over- to under-segmentation (seed-001 §2.19).
@@ -304,9 +309,6 @@ def label_rings(labels: NDArray[Any], keep: Optional[NDArray[np.bool_]] = None
     positively oriented in that frame. ``keep`` (bool per label value, index = label) limits
     the regions traced.
     """
-    from rasterio import features
-    from rasterio.transform import Affine
-
     lab = np.asarray(labels, dtype=np.int32)
     mask = lab > 0
     if keep is not None:
@@ -358,8 +360,6 @@ def image_objects(image: NDArray[Any], thresholds: Sequence[float] = DEFAULT_THR
     info : dict
         Level used, regions per run before and after the size window.
     """
-    import time
-
     fb = feedback or Feedback()
     a = np.asarray(image, dtype=np.float64)
     rows0, cols0 = a.shape[-2:]
@@ -367,8 +367,6 @@ def image_objects(image: NDArray[Any], thresholds: Sequence[float] = DEFAULT_THR
         int(pyramid_level)
     small = reduce_level(a, level)
     if smooth > 0:
-        from scipy import ndimage
-
         sig = (0, smooth, smooth) if small.ndim == 3 else smooth
         nan = ~np.isfinite(small)
         small = ndimage.gaussian_filter(np.where(nan, np.nanmean(small), small), sig)
@@ -423,8 +421,6 @@ def load_image(path: Union[str, Path], band: Optional[int] = None
     Whole-image read: the images this method is for (satellite scenes, scanned photos at a
     pyramid level) are a few Mpx.
     """
-    from ..raster.io import open_image
-
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Image '{path}' not found.")

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Set, Tuple, Union
 
 import numpy as np
+import pyproj
 
 from ..errors import InputError
 from ..feedback import Feedback
@@ -37,6 +38,7 @@ from ..project.points_io import (
     parse_number,
     split_fields,
 )
+from ..raster.io import staged_folder
 from .fit import (
     KINDS,
     MIN_POINTS,
@@ -47,7 +49,18 @@ from .fit import (
     residual_fields,
     rmse,
 )
-from .products import image_from_points_source, image_residuals, points_crs
+from .products import (
+    image_from_points_source,
+    image_residuals,
+    points_crs,
+    product_paths,
+    report_html,
+    residual_png,
+    transform_json,
+    write_transform_products,
+)
+from .refinement import ControlPoint
+from .result import GeorefResult
 
 PathLike = Union[str, Path]
 #: Pair index of a control point the operator added by hand.
@@ -344,8 +357,6 @@ def _corner_to_image(name: str, col: np.ndarray, row: np.ndarray
 
 def _check_crs(name: str, crs_line: str, crs_wkt: str) -> None:
     """A ``.points`` file's CRS must be the result's (no reprojection of check points)."""
-    import pyproj
-
     try:
         same = pyproj.CRS.from_user_input(crs_line).equals(pyproj.CRS.from_wkt(crs_wkt),
                                                            ignore_axis_order=True)
@@ -424,18 +435,6 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
     InputError
         Too few active points (nothing is written then).
     """
-    import pyproj
-
-    from ..raster.io import staged_folder
-    from .products import (
-        product_paths,
-        report_html,
-        residual_png,
-        transform_json,
-        write_transform_products,
-    )
-    from .refinement import ControlPoint
-
     fb = feedback or Feedback()
     if fit is None:
         fit = review.fit()  # first: a bad state fails before anything is written
@@ -447,8 +446,8 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
     gcps = [ControlPoint(p.image, p.map, 0.0, p.pair, p.sharp) for p in review.points]
     inverse_fit = inverse_for_resampling(fit, review.image_xy()[fit.used],
                                          review.map_xy()[fit.used])
-    result = {"fit": fit, "inverse_fit": inverse_fit, "gcps": gcps,
-              "crs": pyproj.CRS.from_wkt(review.crs_wkt)}
+    result = GeorefResult(fit=fit, inverse_fit=inverse_fit, gcps=gcps,
+                          crs=pyproj.CRS.from_wkt(review.crs_wkt))
     rep = dict(review.report)
     auto = rep.pop("review", None) is None  # no review yet: report.json is the automatic one
     check_rmse, n_check = review.check_rmse(fit)

@@ -64,13 +64,13 @@ from affine import Affine
 from numpy.typing import NDArray
 from rasterio.crs import CRS
 from rasterio.features import rasterize, shapes
-from rasterio.warp import transform_geom
 from scipy import ndimage
 from shapely.geometry import MultiLineString, MultiPolygon, box, mapping, shape
 from shapely.ops import linemerge, polygonize, unary_union
 from skimage.graph import MCP_Geometric
 
 from ..errors import InputError
+from ..project.vector_io import read_features, to_crs
 from ..raster.io import atomic_output
 
 PathLike = Union[str, Path]
@@ -453,41 +453,27 @@ def read_operator_seamlines(source: PathLike, crs: Any, names: Sequence[str],
                          "or 'edits'.")
     target = None if crs is None else CRS.from_user_input(crs)
     lookup = {n.lower(): k for k, n in enumerate(names)}
-    try:
-        all_layers = fiona.listlayers(str(path))
-    except Exception as exc:  # driver-specific errors
-        raise InputError(f"Cannot read the seamline file '{path.name}': {exc}") from exc
     assigned: List[Tuple[Any, int]] = []
     cuts: List[Any] = []
-    for layer in all_layers:
-        if layers is not None and layer not in layers:
+    for feat in read_features(path, layers, "seamline file"):
+        layer = feat.layer
+        g = shape(to_crs(feat.geometry, feat.crs, target))
+        if g.is_empty:
             continue
-        with fiona.open(str(path), layer=layer) as src:
-            src_crs = CRS.from_wkt(src.crs_wkt) if src.crs_wkt else None
-            for feat in src:
-                geom = feat["geometry"]
-                if geom is None:
-                    continue
-                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-                if target is not None and src_crs is not None and src_crs != target:
-                    geom = transform_geom(src_crs, target, geom)
-                g = shape(geom)
-                if g.is_empty:
-                    continue
-                image = (dict(feat["properties"]).get("image") or "").strip()
-                if "Polygon" in g.geom_type and image:
-                    key = image.lower()
-                    k = lookup.get(key, lookup.get(Path(key).stem))
-                    if k is None:
-                        raise InputError(
-                            f"Seamline polygon of layer '{layer}' names the image '{image}', "
-                            f"which is not in the mosaic ({', '.join(names)}); correct its "
-                            "'image' attribute.")
-                    assigned.append((g.buffer(0), k))
-                elif "Polygon" in g.geom_type:
-                    cuts.append(g.boundary)
-                elif "LineString" in g.geom_type:
-                    cuts.append(g)
+        image = (feat.properties.get("image") or "").strip()
+        if "Polygon" in g.geom_type and image:
+            key = image.lower()
+            k = lookup.get(key, lookup.get(Path(key).stem))
+            if k is None:
+                raise InputError(
+                    f"Seamline polygon of layer '{layer}' names the image '{image}', "
+                    f"which is not in the mosaic ({', '.join(names)}); correct its "
+                    "'image' attribute.")
+            assigned.append((g.buffer(0), k))
+        elif "Polygon" in g.geom_type:
+            cuts.append(g.boundary)
+        elif "LineString" in g.geom_type:
+            cuts.append(g)
     if not assigned and not cuts:
         raise InputError(f"'{path.name}' holds no seamlines (lines, or polygons with an "
                          "'image' attribute); digitise some or use seamlines=auto.")

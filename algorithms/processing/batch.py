@@ -118,7 +118,7 @@ from ..errors import Cancelled, InputError, PhotodemError
 from ..feedback import Feedback, ensure_feedback
 from ..project import toml_io
 from . import registry
-from .spec import INPUT_PATH_KINDS, OUTPUT_KINDS, project_files
+from .spec import Parameter, project_files, split_list
 
 #: Environment variable with extra algorithm modules (comma-separated, importable names) that
 #: the CLI and batch workers register in addition to the built-in ones (tests, site extensions).
@@ -127,7 +127,6 @@ STATE_FILE = Path(".photodem") / "batch-state.json"
 LOCK_FILE = Path(".photodem") / "batch.lock"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
-_FILE_OUTPUT_KINDS = ("file", "folder", "raster", "vector")
 _PLACEHOLDER = re.compile(r"\{(project|run|step|model|image|file)\}")
 _BATCH_KEYS = {"project", "workers", "output"}
 _STEP_KEYS = {"algorithm", "name", "models", "images", "files", "params"}
@@ -232,7 +231,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
 
     Every task's parameters and outputs are checked here, before the first task runs.
     """
-    from ..project.model import Project  # numpy and friends only when a batch is planned
+    from ..project.model import Project  # lazy: keeps photodem list fast (numpy and friends)
 
     unknown = set(config) - {"batch", "steps"}
     if unknown:
@@ -328,7 +327,7 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         raise InputError(f"Batch file: params of step '{name}' must be a table.")
     params = dict(params)
     for p in alg.parameters:  # the batch project unless the step names another one
-        if p.kind == "project" and p.name not in params:
+        if p.is_project and p.name not in params:
             if project is None and p.required:
                 raise InputError(f"Batch file: step '{name}' ({alg.id}) needs a project; set "
                                  "project = \"<project folder>\" in [batch].")
@@ -338,10 +337,8 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
     iterate = alg.iterates_over
     item_kind: Optional[str] = None
     if iterate is not None:
-        item_kind = alg.parameter(iterate).kind
-        if item_kind in _FILE_ITEM_KINDS:
-            item_kind = "file"
-        elif item_kind not in ("model", "image"):
+        item_kind = _item_kind(alg.parameter(iterate))
+        if item_kind is None:
             raise InputError(f"{alg.id}: iterates_over names '{iterate}', which is not a "
                              "model, image, raster or file parameter.")
     for key in ("models", "images", "files"):
@@ -453,13 +450,8 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
 
 
 def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str) -> None:
-    """Check a task's outputs with the policy :func:`.registry.check_outputs` applies when
-    the task runs, but while planning: a forbidden output stops the batch before its first
-    task.
-
-    Inputs an earlier step makes need not exist yet. A ``project`` input that is no project
-    yet counts with its own path only (its files cannot be listed); an output derived from
-    such a project is left to the check when the task runs.
+    """Check a task's outputs while planning (:func:`.registry.check_outputs` with the run
+    folder): a forbidden output stops the batch before its first task.
 
     Parameters
     ----------
@@ -477,56 +469,18 @@ def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str)
     InputError
         One line: ``where`` and the policy's message.
     """
-    projects = [p.name for p in alg.parameters if p.kind == "project" and values.get(p.name)]
-    pending = [name for name in projects if not _is_project(values[name])]
     try:
-        targets = alg.output_targets(values)
-    except PhotodemError as exc:
-        if pending:  # derived from a project an earlier step makes: the run checks it
-            return
-        raise InputError(f"Batch file: {where}: {exc}") from None
-    if not targets:
-        return
-    try:
-        for target in targets:
-            out = target.path.resolve()
-            if out == run or out in run.parents:
-                raise InputError(f"Parameter '{target.name}': the output '{target.path}' is or "
-                                 f"contains the run folder '{run}', where the batch writes its "
-                                 "logs; choose another output.")
-        # The project files as Algorithm.input_paths lists them, but listed and resolved once
-        # per project, and only those an output is or contains (the only ones compared).
-        inputs, protected = alg.input_paths({**values, **dict.fromkeys(projects)})
-        outs = [t.path.resolve() for t in targets]
-        for name in projects:
-            inputs.append(Path(values[name]))
-            if name not in pending:
-                protected += _covered(project_files(values[name]), outs)
-        output_policy.check_targets(alg.id, targets, inputs, protected)
+        registry.check_outputs(alg, values, run_folder=run)
     except PhotodemError as exc:
         raise InputError(f"Batch file: {where}: {exc}") from None
 
 
-def _covered(paths: Sequence[Path], outs: Sequence[Path]) -> List[Path]:
-    """The resolved ``paths`` that one of the resolved ``outs`` is or contains (by name: no
-    file system calls, which matter for a project of a thousand images and tasks)."""
-    prefixes = []
-    for out in outs:
-        text = os.path.normcase(str(out))
-        prefixes.append((text, text if text.endswith(os.sep) else text + os.sep))
-    found = []
-    for path in paths:
-        text = os.path.normcase(str(path))
-        if any(text == same or text.startswith(below) for same, below in prefixes):
-            found.append(path)
-    return found
-
-
-def _is_project(value: Any) -> bool:
-    """True when ``value`` names a project folder (or its ``project.toml``) that exists."""
-    path = Path(value)
-    file = path / output_policy.PROJECT_FILE if path.is_dir() else path
-    return file.is_file()
+def _item_kind(p: Parameter) -> Optional[str]:
+    """What a step over parameter ``p`` iterates over: ``"model"``, ``"image"``, ``"file"``
+    (a raster or file parameter), or ``None`` when ``p`` cannot be iterated over."""
+    if p.is_item_name:
+        return p.kind
+    return "file" if p.kind in _FILE_ITEM_KINDS else None
 
 
 def _item_label(item: Optional[str], kind: Optional[str]) -> Optional[str]:
@@ -537,13 +491,13 @@ def _item_label(item: Optional[str], kind: Optional[str]) -> Optional[str]:
 def _anchored(alg: Any, name: str, value: Any, base_dir: Path) -> Any:
     """A relative path of a path parameter, taken relative to the batch file's folder."""
     try:
-        kind = alg.parameter(name).kind
+        p = alg.parameter(name)
     except KeyError:  # an unknown parameter: the algorithm's own check reports it
         return value
-    if kind not in (*INPUT_PATH_KINDS, *OUTPUT_KINDS, "multiple_rasters"):
+    if not p.is_path:
         return value
-    if kind == "multiple_rasters" and isinstance(value, str):
-        value = [v.strip() for v in value.split(",") if v.strip()]  # as Parameter.convert
+    if p.is_list and isinstance(value, str):
+        value = split_list(value)
     if isinstance(value, list):
         return [_anchored_path(v, base_dir) for v in value]
     return _anchored_path(value, base_dir)
@@ -646,7 +600,7 @@ def _output_paths(algorithm: str, outputs: Dict[str, Any]) -> List[str]:
     paths = []
     for out in alg.outputs:
         value = outputs.get(out.name)
-        if out.kind in _FILE_OUTPUT_KINDS and isinstance(value, str) and value:
+        if out.is_path and isinstance(value, str) and value:
             paths.append(value)
     return paths
 
@@ -1387,7 +1341,7 @@ def _remove_stale_lock(path: Path, holder: Dict[str, Any]) -> bool:
 def _exclusive(folder: Path) -> Iterator[None]:
     """Hold an advisory lock on ``folder`` itself (POSIX ``flock``, no extra file; elsewhere
     no guard)."""
-    try:
+    try:  # a platform check, not a cycle: fcntl is POSIX only
         import fcntl
     except ImportError:  # Windows
         yield
@@ -1441,13 +1395,13 @@ def batch_template(project: PathLike) -> str:
             lines.append(f"{kind}s = \"all\"   # or a list: [\"name1\", \"name2\"]")
         lines.append("[steps.params]")
         for p in alg.parameters:
-            if p.kind == "project" or p.name == alg.iterates_over:
+            if p.is_project or p.name == alg.iterates_over:
                 continue
             if p.is_output:
                 value = "{project}/products/{step}"
                 if alg.iterates_over:
                     value += "/{" + alg.parameter(alg.iterates_over).kind + "}"
-                if p.kind != "output_folder":
+                if not p.is_folder:
                     value += "/" + p.name + (p.extensions[0] if p.extensions else "")
                 lines.append(f"{p.name} = {_toml_string(value)}")
             elif p.required:

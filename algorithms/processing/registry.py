@@ -11,14 +11,14 @@ import importlib
 import os
 import time
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Optional
+from typing import Any, Dict, Iterable, List, Optional, Sequence
 
 from .. import output_policy
-from ..errors import InputError
+from ..errors import InputError, PhotodemError
 from ..feedback import Feedback, ensure_feedback
 from ..input_errors import check_raster_parameters, operator_errors
 from ..jsonable import json_ready
-from .spec import Algorithm, prepare_parameters
+from .spec import Algorithm, prepare_parameters, project_files
 
 #: Modules below ``algorithms/processing/algs`` that declare algorithms, in toolbox order.
 ALGORITHM_MODULES = (
@@ -117,7 +117,6 @@ def run(
     PhotodemError
         For anything the operator can fix (including :class:`~..errors.Cancelled`).
     """
-    output_policy.forget_last()
     alg = get(algorithm_id)
     feedback = ensure_feedback(feedback)
     with operator_errors(feedback):  # damaged inputs end as one-line operator errors
@@ -126,26 +125,96 @@ def run(
         targets = check_outputs(alg, prepared)
         output_policy.remove_stale(_folders_written(targets), feedback.info)
         start = time.perf_counter()
-        with output_policy.run_scope(alg.id, lambda path: feedback.mark_committed(), targets):
+        with output_policy.run_scope(alg.id, feedback.mark_committed, targets):
             result = alg.run(prepared, feedback)
             feedback.progress(100.0)
     feedback.info(f"{alg.id} finished in {time.perf_counter() - start:.1f} s.")
     return json_ready(result)
 
 
-def check_outputs(alg: Algorithm, prepared: Dict[str, Any]) -> List[output_policy.Target]:
+def check_outputs(alg: Algorithm, prepared: Dict[str, Any],
+                  run_folder: Optional[Path] = None) -> List[output_policy.Target]:
     """The outputs a run of ``alg`` with converted ``prepared`` values writes, once checked.
+
+    One check for a run (:func:`run`) and for a batch task while the batch is planned.
+
+    Parameters
+    ----------
+    alg : Algorithm
+        The algorithm.
+    prepared : dict
+        Its converted parameter values.
+    run_folder : Path, optional
+        Given while a batch is planned: the resolved run folder, where the batch writes its
+        logs; no output may be or contain it. Inputs an earlier step makes need not exist
+        then: a ``project`` input that is no project yet counts with its own path only, and an
+        output derived from such a project is left to the check when the task runs.
 
     Raises
     ------
     InputError
         When an output is forbidden (see :mod:`..output_policy`).
     """
-    targets = alg.output_targets(prepared)
-    if targets:
-        inputs, protected = alg.input_paths(prepared)
-        output_policy.check_targets(alg.id, targets, inputs, protected)
+    if run_folder is None:
+        targets = alg.output_targets(prepared)
+        if targets:
+            inputs, protected = alg.input_paths(prepared)
+            output_policy.check_targets(alg.id, targets, inputs, protected)
+        return targets
+    return _check_planned_outputs(alg, prepared, run_folder)
+
+
+def _check_planned_outputs(alg: Algorithm, values: Dict[str, Any],
+                           run_folder: Path) -> List[output_policy.Target]:
+    """:func:`check_outputs` of a batch task while the batch is planned."""
+    projects = [p.name for p in alg.parameters if p.is_project and values.get(p.name)]
+    pending = [name for name in projects if not _is_project(values[name])]
+    try:
+        targets = alg.output_targets(values)
+    except PhotodemError:
+        if pending:  # derived from a project an earlier step makes: the run checks it
+            return []
+        raise
+    if not targets:
+        return targets
+    for target in targets:
+        out = target.path.resolve()
+        if out == run_folder or out in run_folder.parents:
+            raise InputError(f"Parameter '{target.name}': the output '{target.path}' is or "
+                             f"contains the run folder '{run_folder}', where the batch writes "
+                             "its logs; choose another output.")
+    # The project files as Algorithm.input_paths lists them, but listed and resolved once
+    # per project, and only those an output is or contains (the only ones compared).
+    inputs, protected = alg.input_paths({**values, **dict.fromkeys(projects)})
+    outs = [t.path.resolve() for t in targets]
+    for name in projects:
+        inputs.append(Path(values[name]))
+        if name not in pending:
+            protected += _covered(project_files(values[name]), outs)
+    output_policy.check_targets(alg.id, targets, inputs, protected)
     return targets
+
+
+def _covered(paths: Sequence[Path], outs: Sequence[Path]) -> List[Path]:
+    """The resolved ``paths`` that one of the resolved ``outs`` is or contains (by name: no
+    file system calls, which matter for a project of a thousand images and tasks)."""
+    prefixes = []
+    for out in outs:
+        text = os.path.normcase(str(out))
+        prefixes.append((text, text if text.endswith(os.sep) else text + os.sep))
+    found = []
+    for path in paths:
+        text = os.path.normcase(str(path))
+        if any(text == same or text.startswith(below) for same, below in prefixes):
+            found.append(path)
+    return found
+
+
+def _is_project(value: Any) -> bool:
+    """True when ``value`` names a project folder (or its ``project.toml``) that exists."""
+    path = Path(value)
+    file = path / output_policy.PROJECT_FILE if path.is_dir() else path
+    return file.is_file()
 
 
 def _folders_written(targets: Iterable[output_policy.Target]) -> List[Path]:

@@ -83,7 +83,7 @@ class Parameter:
     def __post_init__(self) -> None:
         if self.kind not in PARAMETER_KINDS:
             raise ValueError(f"unknown parameter kind {self.kind!r} for {self.name!r}")
-        if self.kind == "enum" and not self.options:
+        if self.is_choice and not self.options:
             raise ValueError(f"enum parameter {self.name!r} needs options")
 
     @property
@@ -95,9 +95,72 @@ class Parameter:
     def required(self) -> bool:
         return not self.optional and self.default is None
 
+    # -- what the kind means (the faces switch on these, not on the kind strings) ------------
     @property
     def is_output(self) -> bool:
+        """A path the run writes (``output_*``)."""
         return self.kind in OUTPUT_KINDS
+
+    @property
+    def is_input_path(self) -> bool:
+        """One path the run reads (raster, vector, file, folder, project)."""
+        return self.kind in INPUT_PATH_KINDS
+
+    @property
+    def is_list(self) -> bool:
+        """A list of input paths (``multiple_rasters``; text: comma-separated)."""
+        return self.kind == "multiple_rasters"
+
+    @property
+    def is_path(self) -> bool:
+        """The value is a path or a list of paths, read or written."""
+        return self.is_input_path or self.is_output or self.is_list
+
+    @property
+    def is_folder(self) -> bool:
+        """The path names a folder (a project is a folder too)."""
+        return self.kind in ("folder", "project", "output_folder")
+
+    @property
+    def is_project(self) -> bool:
+        """A PhotoDEM project folder (or its ``project.toml``)."""
+        return self.kind == "project"
+
+    @property
+    def is_item_name(self) -> bool:
+        """The name of a stereo model or an image of the project."""
+        return self.kind in ("model", "image")
+
+    @property
+    def is_numeric(self) -> bool:
+        """A number (``number``) or a whole number (``integer``)."""
+        return self.kind in ("number", "integer")
+
+    @property
+    def is_integer(self) -> bool:
+        """A whole number."""
+        return self.kind == "integer"
+
+    @property
+    def is_choice(self) -> bool:
+        """One of :attr:`options` (``enum``)."""
+        return self.kind == "enum"
+
+    @property
+    def is_bool(self) -> bool:
+        """A yes/no value."""
+        return self.kind == "bool"
+
+    @property
+    def is_text(self) -> bool:
+        """Passed on as ``str`` unchanged: a name, a CRS or free text."""
+        return self.kind in ("model", "image", "string", "crs")
+
+    def paths(self, value: Any) -> List[str]:
+        """The paths of a converted value of a path parameter (``[]`` for ``None``)."""
+        if value is None:
+            return []
+        return list(value) if self.is_list else [value]
 
     # -- conversion ---------------------------------------------------------------------------
     def convert(self, value: Any) -> Any:
@@ -117,32 +180,21 @@ class Parameter:
                 return None
             else:
                 raise InputError(f"Parameter '{self.name}' ({self.description}) is required.")
-        kind = self.kind
         try:
-            if kind in INPUT_PATH_KINDS or kind in OUTPUT_KINDS:
+            if self.is_input_path or self.is_output:
                 return self._path_text(value)
-            if kind in ("model", "image", "string", "crs"):
+            if self.is_text:
                 return str(value)
-            if kind == "number":
-                number = float(value)
-                self._check_range(number)
-                return number
-            if kind == "integer":
-                number = float(value)
-                if number != int(number):
-                    raise ValueError
-                self._check_range(number)
-                return int(number)
-            if kind == "bool":
+            if self.is_numeric:
+                return self._to_number(value)
+            if self.is_bool:
                 return _to_bool(value)
-            if kind == "enum":
+            if self.is_choice:
                 return self._to_option(value)
-            if kind == "extent":
+            if self.kind == "extent":
                 return _to_extent(value)
-            if kind == "multiple_rasters":
-                items = [value] if isinstance(value, str) else list(value)
-                parts = [p for v in items for p in str(v).split(",")]  # "a.tif,b.tif" or a list
-                return [self._path_text(p.strip()) for p in parts if p.strip()]
+            if self.is_list:
+                return [self._path_text(part) for part in split_list(value)]
         except InputError:
             raise
         except (TypeError, ValueError, OverflowError):  # OverflowError: int(inf)
@@ -162,6 +214,17 @@ class Parameter:
                     f"Parameter '{self.name}': the path '{display_path(text)}' is not valid "
                     "UTF-8; rename it (GDAL reads and writes UTF-8 names only).") from None
         return text
+
+    def _to_number(self, value: Any) -> Any:
+        """A ``float`` (``number``) or an ``int`` (``integer``), checked against the range."""
+        number = float(value)
+        if self.is_integer:
+            if number != int(number):
+                raise ValueError(value)
+            self._check_range(number)
+            return int(number)
+        self._check_range(number)
+        return number
 
     def _check_range(self, number: float) -> None:
         if not math.isfinite(number):
@@ -225,6 +288,11 @@ class Output:
         if self.kind not in OUTPUT_VALUE_KINDS:
             raise ValueError(f"unknown output kind {self.kind!r} for {self.name!r}")
 
+    @property
+    def is_path(self) -> bool:
+        """The value is the path of a file or folder the run wrote."""
+        return self.kind in ("file", "folder", "raster", "vector")
+
 
 class Algorithm:
     """Base class of every PhotoDEM operation.
@@ -283,7 +351,7 @@ class Algorithm:
             path = self.output_path(params, p.name)
             if path is None:
                 continue
-            kind = "folder" if p.kind == "output_folder" else "file"
+            kind = "folder" if p.is_folder else "file"
             targets.append(Target(path, kind, p.name))
             if kind == "file" and path.name and not path.is_dir():  # else refused as a target
                 targets += [Target(side, "file", p.name, owner=path)
@@ -305,11 +373,9 @@ class Algorithm:
             value = params.get(p.name)
             if value is None:
                 continue
-            if p.kind == "multiple_rasters":
-                inputs += [Path(v) for v in value]
-            elif p.kind in INPUT_PATH_KINDS:
-                inputs.append(Path(value))
-            if p.kind == "project":
+            if p.is_list or p.is_input_path:
+                inputs += [Path(v) for v in p.paths(value)]
+            if p.is_project:
                 protected += project_files(Path(value))
         return inputs, protected
 
@@ -329,8 +395,9 @@ def prepare_parameters(algorithm: Algorithm, values: Dict[str, Any]) -> Dict[str
     """Check and convert raw parameter values for ``algorithm``.
 
     Unknown names are an error (a typo must not silently fall back to a default); missing
-    optional ones become their default or ``None``; input paths must exist; an output may not
-    be one of the inputs.
+    optional ones become their default or ``None``; input paths must exist. Where the outputs
+    may go (not onto an input, a project, a foreign file) is the output policy's matter,
+    checked next by :func:`.registry.check_outputs`.
 
     Raises
     ------
@@ -345,26 +412,20 @@ def prepare_parameters(algorithm: Algorithm, values: Dict[str, Any]) -> Dict[str
             f"known are {', '.join(sorted(known))}."
         )
     params = {p.name: p.convert(values.get(p.name)) for p in algorithm.parameters}
-    inputs = []
     for p in algorithm.parameters:
-        value = params[p.name]
-        if value is None:
-            continue
-        paths = value if p.kind == "multiple_rasters" else [value]
-        if p.kind in INPUT_PATH_KINDS or p.kind == "multiple_rasters":
-            for path in paths:
+        if p.is_input_path or p.is_list:
+            for path in p.paths(params[p.name]):
                 if not Path(path).exists():
                     raise InputError(f"Parameter '{p.name}': '{path}' does not exist.")
-                inputs.append(Path(path).resolve())
-    for p in algorithm.parameters:
-        if p.is_output and params[p.name] is not None:
-            out = Path(params[p.name]).resolve()
-            if out in inputs:
-                raise InputError(
-                    f"Parameter '{p.name}': the output '{out}' is also an input; "
-                    "PhotoDEM never overwrites its inputs. Choose another output."
-                )
     return params
+
+
+def split_list(value: Any) -> List[str]:
+    """The items of a list parameter: a list, or text with commas (``"a.tif,b.tif"``), or a
+    list of such texts; blanks around the items and empty items are dropped."""
+    items = [value] if isinstance(value, str) else list(value)
+    parts = [part for item in items for part in str(item).split(",")]
+    return [part.strip() for part in parts if part.strip()]
 
 
 def project_product(params: Dict[str, Any], step: str, name: str, what: str) -> Path:
@@ -404,7 +465,7 @@ _PROJECTS: Dict[Tuple[str, int, int], Tuple[Any, List[Path]]] = {}
 
 def _read_project(path: Any) -> Tuple[Any, List[Path]]:
     """The project at ``path`` and its resolved files, read again only when the file changed."""
-    from ..project.model import Project  # numpy and friends only when a project is used
+    from ..project.model import Project  # lazy: keeps photodem list fast (numpy and friends)
 
     file = Path(path) / PROJECT_FILE if Path(path).is_dir() else Path(path)
     try:
@@ -459,4 +520,5 @@ __all__ = [
     "model_product",
     "prepare_parameters",
     "project_product",
+    "split_list",
 ]

@@ -35,9 +35,16 @@ from pathlib import Path
 from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 
 import fiona
+import pyproj
+from rasterio.crs import CRS
 from shapely.geometry import mapping, shape
+from shapely.ops import unary_union
+from shapely.validation import explain_validity
 
 from ..errors import InputError
+from ..input_errors import check_encodable, reading, warn_input
+from ..raster.io import atomic_output
+from .vector_io import read_features, to_crs
 
 PathLike = Union[str, Path]
 
@@ -90,11 +97,8 @@ def repair_polygon(geom: Any, where: str) -> Any:
     """
     if geom.is_valid:
         return geom
-    from shapely.ops import unary_union
-    from shapely.validation import explain_validity
-
     reason = explain_validity(geom)
-    try:
+    try:  # a version check, not a cycle: make_valid came with shapely 1.8
         from shapely.validation import make_valid
 
         fixed = make_valid(geom)
@@ -106,8 +110,6 @@ def repair_polygon(geom: Any, where: str) -> Any:
     if fixed is None or fixed.is_empty or fixed.area <= 0:
         raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
                          "repairing it; redraw it in edits.gpkg.")
-    from ..input_errors import warn_input
-
     warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
                f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
     return fixed
@@ -133,16 +135,12 @@ def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
     if geom.geom_type in ("Polygon", "MultiPolygon"):
         geom = repair_polygon(geom, where)
     if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
-        from ..input_errors import warn_input
-
         warn_input(f"{where}: the breakline has no heights (2-D); it only separates the surface "
                    "and gives no heights. Digitise it with Z to use its heights.")
     return geom, props
 
 
 def _crs_wkt(crs: str) -> str:
-    import pyproj
-
     try:
         return pyproj.CRS.from_user_input(crs).to_wkt()
     except Exception as exc:  # pyproj.exceptions.CRSError
@@ -167,8 +165,6 @@ def create_edits(path: PathLike, crs: str) -> Path:
     InputError
         When ``path`` exists or the CRS is not understood.
     """
-    from ..raster.io import atomic_output
-
     path = Path(path)
     if path.exists():
         raise InputError(
@@ -223,21 +219,13 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Edits file '{path}' not found; create it with project_create.")
-    from ..input_errors import reading
-
     out: List[Tuple[Any, Dict[str, Any]]] = []
     with reading(path, "GeoPackage"):
         if layer not in fiona.listlayers(str(path)):
             raise InputError(f"'{path}' has no layer '{layer}'.")
-        with fiona.open(str(path), layer=layer) as src:
-            for feat in src:
-                geom = feat["geometry"]
-                if geom is None:
-                    continue
-                # fiona ≥ 1.10 returns Geometry objects, 1.9 dicts; shape() takes both
-                geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-                out.append(check_feature(path, layer, feat["id"], shape(geom),
-                                         dict(feat["properties"])))
+        for feat in read_features(path, (layer,), "GeoPackage"):
+            out.append(check_feature(path, layer, feat.fid, shape(feat.geometry),
+                                     feat.properties))
     return out
 
 
@@ -254,43 +242,24 @@ def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
     file has another CRS. ``skip_keep`` drops features whose ``action`` is ``keep`` (exclusion
     areas of edits.gpkg).
     """
-    from rasterio.crs import CRS
-    from rasterio.warp import transform_geom
-
     if crs is not None and not isinstance(crs, CRS):
         crs = CRS.from_user_input(crs)
-
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Vector file '{path}' does not exist.")
-    from ..input_errors import check_encodable, reading
-
     check_encodable(path, "vector file")
-    try:
-        names = fiona.listlayers(str(path))
-    except Exception as exc:  # driver-specific errors
-        raise InputError(f"Cannot read the vector file '{path.name}': {exc}") from exc
     out: List[Any] = []
     with reading(path, "vector file"):
-        for name in names:
-            if layers is not None and name not in layers:
+        for feat in read_features(path, layers):
+            if not any(k in feat.geometry["type"] for k in kinds):
                 continue
-            with fiona.open(str(path), layer=name) as src:
-                src_crs = CRS.from_wkt(src.crs_wkt) if src.crs_wkt else None
-                for feat in src:
-                    geom = feat["geometry"]
-                    if geom is None:
-                        continue
-                    geom = geom if isinstance(geom, dict) else geom.__geo_interface__
-                    if not any(k in geom["type"] for k in kinds):
-                        continue
-                    checked, props = check_feature(path, name, feat["id"], shape(geom),
-                                                   dict(feat["properties"]))
-                    if skip_keep and props.get("action") == "keep":
-                        continue
-                    if crs is not None and src_crs is not None and src_crs != crs:
-                        checked = shape(transform_geom(src_crs, crs, mapping(checked)))
-                    out.append(checked)
+            checked, props = check_feature(path, feat.layer, feat.fid, shape(feat.geometry),
+                                           feat.properties)
+            if skip_keep and props.get("action") == "keep":
+                continue
+            if crs is not None and feat.crs is not None and feat.crs != crs:
+                checked = shape(to_crs(mapping(checked), feat.crs, crs))
+            out.append(checked)
     return out
 
 

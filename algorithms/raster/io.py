@@ -22,8 +22,11 @@ import rasterio
 from affine import Affine
 from numpy.typing import NDArray
 from rasterio.enums import Resampling
+from rasterio.errors import NotGeoreferencedWarning
+from rasterio.shutil import copy as gdal_copy
 
 from .. import output_policy
+from ..errors import InputError
 from ..output_policy import PRODUCT_MARKER as PRODUCT_MARKER  # re-exported
 from ..output_policy import PRODUCT_TAG
 
@@ -76,10 +79,34 @@ def _product_of_file(path: Path) -> str:
     return scope.product
 
 
+#: Staged GeoTIFFs that get the :data:`PRODUCT_TAG` when :func:`open_image` creates them:
+#: staging path → algorithm id (set by :func:`atomic_output` and :func:`cog_output`).
+_TAG_ON_CREATE: Dict[str, str] = {}
+
+
 def tag_product(path: PathLike, product: str) -> None:
-    """Write the :data:`PRODUCT_TAG` into a finished (not Cloud-Optimised) GeoTIFF."""
+    """Write the :data:`PRODUCT_TAG` into a finished (not Cloud-Optimised) GeoTIFF.
+
+    Only for a staged GeoTIFF its writer did not create through :func:`open_image` (which
+    tags it as it creates it).
+    """
     with open_image(path, "r+") as dst:
         dst.update_tags(**{PRODUCT_TAG: product})
+
+
+@contextlib.contextmanager
+def _tagged_on_create(staged: Path, product: str) -> Iterator[None]:
+    """Tag ``staged`` with ``product`` when it is created (``""``: no tag), or at the end of
+    the block when its writer did not create it through :func:`open_image`."""
+    key = os.fspath(staged)
+    if product:
+        _TAG_ON_CREATE[key] = product
+    try:
+        yield
+        if _TAG_ON_CREATE.pop(key, None):  # written by another writer: tag it now
+            tag_product(staged, product)
+    finally:
+        _TAG_ON_CREATE.pop(key, None)
 
 
 @contextlib.contextmanager
@@ -90,18 +117,18 @@ def atomic_output(path: PathLike, tag: bool = True) -> Iterator[Path]:
     (including :class:`~photodem.algorithms.errors.Cancelled`) the temporary file is removed
     and ``path`` stays as it was. The rename is the commit point of the output: SIGINT is held
     back around it, and it is recorded in the run scope (:func:`..output_policy.commit`). A
-    GeoTIFF that is a main output of the run gets the product tag first (``tag=False``: the
-    caller tags it, see :func:`cog_output`).
+    GeoTIFF that is a main output of the run gets the product tag as :func:`open_image`
+    creates it (``tag=False``: the caller tags it, see :func:`cog_output`).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(output_policy.staging_name(path.stem, suffix=path.suffix))
+    product = _product_of_file(path) if tag else ""
+    tiff = output_policy.is_tiff(path)
     try:
-        yield tmp
-        product = _product_of_file(path) if tag else ""
-        if product and output_policy.is_tiff(path):
-            tag_product(tmp, product)
-        elif product:  # other files: a hidden mark beside them
+        with _tagged_on_create(tmp, product if tiff else ""):
+            yield tmp
+        if product and not tiff:  # other files: a hidden mark beside them
             output_policy.write_marker(output_policy.file_mark(path).parent, product,
                                        time.strftime("%Y-%m-%dT%H:%M:%S"),
                                        output_policy.file_mark(path).name)
@@ -142,15 +169,12 @@ def cog_output(path: PathLike, profile: Dict[str, Any]
     scratch_profile["compress"] = "none"
     with atomic_output(path, tag=False) as final:
         scratch = final.with_name(f"{final.stem}.scratch{final.suffix}")
+        # tagged before the copy (as it is created): rewriting a COG would spoil its layout
+        product = _product_of_file(Path(path))
         try:
-            yield scratch, scratch_profile
-            from rasterio.shutil import copy
-
-            product = _product_of_file(Path(path))
-            if product:  # tagged before the copy: rewriting a COG would spoil its layout
-                tag_product(scratch, product)
-
-            copy(str(scratch), str(final), driver="GTiff", copy_src_overviews=True, **creation)
+            with _tagged_on_create(scratch, product):
+                yield scratch, scratch_profile
+            gdal_copy(str(scratch), str(final), driver="GTiff", copy_src_overviews=True, **creation)
         finally:
             _remove_with_sidecars(scratch)
 
@@ -195,8 +219,6 @@ def staged_folder(path: PathLike, replace: bool = False, product: str = "") -> I
 
 def _check_staged_target(path: Path, replace: bool, product: str) -> None:
     """The second line of defence of :func:`staged_folder` (the first is the registry's)."""
-    from ..errors import InputError
-
     if path.exists() and not path.is_dir():
         raise InputError(f"The output '{path}' is a file, not a folder; choose a folder.")
     if not (path.exists() and any(path.iterdir())):
@@ -255,13 +277,16 @@ def open_image(path: PathLike, mode: str = "r", **profile: Any) -> Iterator[Any]
     """``rasterio.open`` for rasters in image space (aerial images, epipolar images).
 
     Such rasters have no georeference on purpose, so rasterio's ``NotGeoreferencedWarning`` is
-    noise there and is silenced; everything else is as ``rasterio.open``.
+    noise there and is silenced; everything else is as ``rasterio.open``. A staged main
+    GeoTIFF output of the run (see :func:`atomic_output`) gets its product tag as it is
+    created.
     """
-    from rasterio.errors import NotGeoreferencedWarning
-
+    product = _TAG_ON_CREATE.pop(os.fspath(path), "") if mode == "w" else ""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
         with rasterio.open(path, mode, **profile) as dataset:
+            if product:
+                dataset.update_tags(**{PRODUCT_TAG: product})
             yield dataset
 
 

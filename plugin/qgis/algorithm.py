@@ -135,7 +135,7 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
             name, desc, behavior=QgsProcessingParameterFile.File, defaultValue=default,
             optional=optional, fileFilter=_file_filter(p),
         )
-    elif kind in ("folder", "project"):
+    elif kind in ("folder", "project"):  # the two input folders
         q = QgsProcessingParameterFile(
             name, desc, behavior=QgsProcessingParameterFile.Folder, defaultValue=default,
             optional=optional,
@@ -156,9 +156,9 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
         q = QgsProcessingParameterVectorDestination(
             name, desc, defaultValue=default, optional=optional
         )
-    elif kind in ("number", "integer"):
+    elif p.is_numeric:
         number_type = (
-            QgsProcessingParameterNumber.Integer if kind == "integer"
+            QgsProcessingParameterNumber.Integer if p.is_integer
             else QgsProcessingParameterNumber.Double
         )
         q = QgsProcessingParameterNumber(
@@ -168,9 +168,9 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
             q.setMinimum(p.minimum)
         if p.maximum is not None:
             q.setMaximum(p.maximum)
-        if kind == "number":  # QGIS shows 6 decimals otherwise ("25.000000")
+        if not p.is_integer:  # QGIS shows 6 decimals otherwise ("25.000000")
             q.setMetadata({"widget_wrapper": {"decimals": 3}})
-    elif kind == "enum":
+    elif p.is_choice:
         index = None
         if default is not None:
             index = _option_index(p, default)
@@ -178,7 +178,7 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
             name, desc, options=[tr(o) for o in p.options], allowMultiple=False,
             defaultValue=index, optional=optional,
         )
-    elif kind == "bool":
+    elif p.is_bool:
         q = QgsProcessingParameterBoolean(
             name, desc, defaultValue=None if default is None else bool(default), optional=optional
         )
@@ -188,12 +188,12 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
         q = QgsProcessingParameterExtent(
             name, desc, defaultValue=_extent_to_qgis(default), optional=optional
         )
-    elif kind in ("model", "image", "string"):
+    elif p.is_item_name or kind == "string":
         q = QgsProcessingParameterString(
             name, desc, defaultValue=None if default is None else str(default),
             optional=optional,
         )
-    elif kind == "multiple_rasters":
+    elif p.is_list:
         q = QgsProcessingParameterMultipleLayers(
             name, desc, QgsProcessing.TypeRaster, defaultValue=default, optional=optional
         )
@@ -333,21 +333,21 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
             if isinstance(value, str) and _is_file(value.split("|")[0]):
                 return value.split("|")[0]
             return _layer_path(self.parameterAsVectorLayer(parameters, name, context))
-        if kind in ("file", "folder", "project"):
+        if kind == "file" or (p.is_folder and not p.is_output):
             return self.parameterAsFile(parameters, name, context) or None
         if kind in ("output_folder", "output_file"):
             return self.parameterAsFileOutput(parameters, name, context) or None
-        if kind in ("output_raster", "output_vector"):
+        if p.is_output:  # a raster or vector layer destination
             return self.parameterAsOutputLayer(parameters, name, context) or None
-        if kind == "number":
-            return self.parameterAsDouble(parameters, name, context)
-        if kind == "integer":
+        if p.is_integer:
             return self.parameterAsInt(parameters, name, context)
-        if kind == "enum":
+        if p.is_numeric:
+            return self.parameterAsDouble(parameters, name, context)
+        if p.is_choice:
             if isinstance(value, str) and not value.strip().lstrip("-").isdigit():
                 return value  # an option name (a batch file); the spec checks it
             return p.options[self.parameterAsEnum(parameters, name, context)]
-        if kind == "bool":
+        if p.is_bool:
             return self.parameterAsBoolean(parameters, name, context)
         if kind == "crs":
             crs = self.parameterAsCrs(parameters, name, context)
@@ -359,7 +359,7 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
             if rect.isNull():
                 return None
             return (rect.xMinimum(), rect.yMinimum(), rect.xMaximum(), rect.yMaximum())
-        if kind == "multiple_rasters":
+        if p.is_list:
             if isinstance(value, (list, tuple)) and all(
                 isinstance(v, str) and _is_file(v) for v in value
             ):

@@ -26,7 +26,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
-from ...algorithms.processing.spec import OUTPUT_KINDS, Algorithm, Parameter
+from ...algorithms.processing.spec import Algorithm, Parameter
+from ...algorithms.project.model import Project
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
@@ -110,96 +111,119 @@ def _text_value(text: str) -> Optional[str]:
 
 
 def _make_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
-    kind = p.kind
-    if kind in ("raster", "vector", "file", "project", "folder", "multiple_rasters") or \
-            kind in OUTPUT_KINDS:
-        if kind in ("folder", "project", "output_folder"):
-            mode = "folder"
-        elif kind in OUTPUT_KINDS:
-            mode = "save"
-        elif kind == "multiple_rasters":
-            mode = "open_many"
-        else:
-            mode = "open"
-        w = PathEdit(mode, p.extensions, parent)
-        if p.default is not None:
-            w.setText(str(p.default))
-        if kind == "project":
-            w.line_edit.setPlaceholderText(tr("project folder (with project.toml)"))
-        elif kind == "multiple_rasters":
-            w.line_edit.setPlaceholderText(tr("several files, separated by commas"))
-        return _Editor(w, lambda: _text_value(w.text()), lambda v: w.setText(_as_text(v)),
-                       w.text_changed)
-
-    if kind in ("number", "integer") and (p.default is not None or not p.optional):
-        if kind == "integer":
-            w = QtWidgets.QSpinBox(parent)
-            low = -_INT_LIMIT if p.minimum is None else int(max(p.minimum, -_INT_LIMIT))
-            high = _INT_LIMIT if p.maximum is None else int(min(p.maximum, _INT_LIMIT))
-        else:
-            w = QtWidgets.QDoubleSpinBox(parent)
-            low = -_FLOAT_LIMIT if p.minimum is None else p.minimum
-            high = _FLOAT_LIMIT if p.maximum is None else p.maximum
-            w.setDecimals(_decimals(p))
-            span = high - low
-            w.setSingleStep(0.1 if span <= 10 else 1.0)
-        w.setRange(low, high)
-        w.setAccelerated(True)
-        w.setKeyboardTracking(False)
-        if p.unit:
-            w.setSuffix(f" {p.unit}")
-        w.setValue(p.default if p.default is not None else max(low, min(0, high)))
-        w.setMinimumWidth(120)
-        return _Editor(w, w.value, lambda v: w.setValue(float(v) if kind == "number"
-                                                        else int(v)),
-                       w.valueChanged)
-
-    if kind in ("number", "integer"):  # optional without default: may stay empty
-        w = QtWidgets.QLineEdit(parent)
-        w.setPlaceholderText(tr("optional") + (f" [{p.unit}]" if p.unit else ""))
-        validator: QtGui.QValidator
-        if kind == "integer":
-            validator = QtGui.QIntValidator(w)
-        else:
-            validator = QtGui.QDoubleValidator(w)
-            validator.setLocale(QtCore.QLocale.c())
-        w.setValidator(validator)
-        return _Editor(w, lambda: _text_value(w.text()), lambda v: w.setText(_as_text(v)),
-                       w.textChanged)
-
-    if kind == "enum":
-        w = QtWidgets.QComboBox(parent)
-        if p.optional and p.default is None:
-            w.addItem("", None)
-        for option in p.options:
-            w.addItem(tr(option), option)
-        if p.default is not None:
-            w.setCurrentIndex(max(w.findData(p.default), 0))
-        return _Editor(w, lambda: w.currentData(),
-                       lambda v: w.setCurrentIndex(max(w.findData(v), 0)),
-                       w.currentIndexChanged)
-
-    if kind == "bool":
+    """The editor of ``p``, chosen by what its kind means (see the table above)."""
+    if p.is_path:
+        return _path_editor(p, parent)
+    if p.is_numeric and (p.default is not None or not p.optional):
+        return _number_editor(p, parent)
+    if p.is_numeric:  # optional without default: may stay empty
+        return _optional_number_editor(p, parent)
+    if p.is_choice:
+        return _choice_editor(p, parent)
+    if p.is_bool:
         w = QtWidgets.QCheckBox(parent)
         w.setChecked(bool(p.default))
         return _Editor(w, w.isChecked, lambda v: w.setChecked(bool(v)), w.toggled)
+    if p.is_item_name:
+        return _item_editor(p, parent)
+    return _text_editor(p, parent)
 
-    if kind in ("model", "image"):
-        w = QtWidgets.QComboBox(parent)
-        w.setEditable(True)
-        w.setInsertPolicy(QtWidgets.QComboBox.NoInsert)
-        w.lineEdit().setPlaceholderText(
-            tr("choose a project first") if kind == "model" else tr("image name"))
-        if p.default is not None:
-            w.setEditText(str(p.default))
-        return _Editor(w, lambda: _text_value(w.currentText()),
-                       lambda v: w.setEditText(_as_text(v)), w.currentTextChanged)
 
+def _path_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """A path with a browse button: a folder, a file to save, several files or one file."""
+    if p.is_folder:
+        mode = "folder"
+    elif p.is_output:
+        mode = "save"
+    elif p.is_list:
+        mode = "open_many"
+    else:
+        mode = "open"
+    w = PathEdit(mode, p.extensions, parent)
+    if p.default is not None:
+        w.setText(str(p.default))
+    if p.is_project:
+        w.line_edit.setPlaceholderText(tr("project folder (with project.toml)"))
+    elif p.is_list:
+        w.line_edit.setPlaceholderText(tr("several files, separated by commas"))
+    return _Editor(w, lambda: _text_value(w.text()), lambda v: w.setText(_as_text(v)),
+                   w.text_changed)
+
+
+def _number_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """A spin box within the parameter's range, with its unit."""
+    if p.is_integer:
+        w = QtWidgets.QSpinBox(parent)
+        low = -_INT_LIMIT if p.minimum is None else int(max(p.minimum, -_INT_LIMIT))
+        high = _INT_LIMIT if p.maximum is None else int(min(p.maximum, _INT_LIMIT))
+    else:
+        w = QtWidgets.QDoubleSpinBox(parent)
+        low = -_FLOAT_LIMIT if p.minimum is None else p.minimum
+        high = _FLOAT_LIMIT if p.maximum is None else p.maximum
+        w.setDecimals(_decimals(p))
+        span = high - low
+        w.setSingleStep(0.1 if span <= 10 else 1.0)
+    w.setRange(low, high)
+    w.setAccelerated(True)
+    w.setKeyboardTracking(False)
+    if p.unit:
+        w.setSuffix(f" {p.unit}")
+    w.setValue(p.default if p.default is not None else max(low, min(0, high)))
+    w.setMinimumWidth(120)
+    integer = p.is_integer
+    return _Editor(w, w.value, lambda v: w.setValue(int(v) if integer else float(v)),
+                   w.valueChanged)
+
+
+def _optional_number_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """A line edit that accepts numbers only and may stay empty."""
+    w = QtWidgets.QLineEdit(parent)
+    w.setPlaceholderText(tr("optional") + (f" [{p.unit}]" if p.unit else ""))
+    validator: QtGui.QValidator
+    if p.is_integer:
+        validator = QtGui.QIntValidator(w)
+    else:
+        validator = QtGui.QDoubleValidator(w)
+        validator.setLocale(QtCore.QLocale.c())
+    w.setValidator(validator)
+    return _Editor(w, lambda: _text_value(w.text()), lambda v: w.setText(_as_text(v)),
+                   w.textChanged)
+
+
+def _choice_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """A combo box of the options (translated labels, the option strings as data)."""
+    w = QtWidgets.QComboBox(parent)
+    if p.optional and p.default is None:
+        w.addItem("", None)
+    for option in p.options:
+        w.addItem(tr(option), option)
+    if p.default is not None:
+        w.setCurrentIndex(max(w.findData(p.default), 0))
+    return _Editor(w, lambda: w.currentData(),
+                   lambda v: w.setCurrentIndex(max(w.findData(v), 0)),
+                   w.currentIndexChanged)
+
+
+def _item_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """An editable combo box of the project's models or images (filled by the form)."""
+    w = QtWidgets.QComboBox(parent)
+    w.setEditable(True)
+    w.setInsertPolicy(QtWidgets.QComboBox.NoInsert)
+    w.lineEdit().setPlaceholderText(
+        tr("choose a project first") if p.kind == "model" else tr("image name"))
+    if p.default is not None:
+        w.setEditText(str(p.default))
+    return _Editor(w, lambda: _text_value(w.currentText()),
+                   lambda v: w.setEditText(_as_text(v)), w.currentTextChanged)
+
+
+def _text_editor(p: Parameter, parent: QtWidgets.QWidget) -> _Editor:
+    """A line edit: a CRS, an extent or free text."""
     w = QtWidgets.QLineEdit(parent)
     w.setPlaceholderText({
         "crs": tr("e.g. EPSG:25832"),
         "extent": tr("xmin,ymin,xmax,ymax"),
-    }.get(kind, tr("optional") if p.optional else ""))
+    }.get(p.kind, tr("optional") if p.optional else ""))
     if p.default is not None:
         w.setText(_as_text(p.default))
     return _Editor(w, lambda: _text_value(w.text()), lambda v: w.setText(_as_text(v)),
@@ -263,7 +287,7 @@ class ParameterForm(QtWidgets.QWidget):
             editor.changed.connect(self.changed)
             self._editors[p.name] = editor
             self._labels[p.name] = label
-        self._project_params = [p.name for p in algorithm.parameters if p.kind == "project"]
+        self._project_params = [p.name for p in algorithm.parameters if p.is_project]
         self._timer = QtCore.QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setInterval(300)
@@ -318,7 +342,7 @@ class ParameterForm(QtWidgets.QWidget):
     def update_from_project(self) -> None:
         """Fill the model/image combos from the project named in the form, if it loads."""
         combos = [(p, self._editors[p.name].widget) for p in self.algorithm.parameters
-                  if p.kind in ("model", "image")]
+                  if p.is_item_name]
         if not combos or not self._project_params:
             return
         path = self._editors[self._project_params[0]].get()
@@ -326,8 +350,6 @@ class ParameterForm(QtWidgets.QWidget):
         if path and ((Path(path) / "project.toml").is_file()
                      or (path.endswith(".toml") and Path(path).is_file())):
             try:
-                from ...algorithms.project.model import Project
-
                 project = Project.load(path)
                 names = {"model": [m.name for m in project.models],
                          "image": [i.name for i in project.images]}

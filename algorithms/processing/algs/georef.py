@@ -1,11 +1,13 @@
-"""Algorithm declarations: automatic georeferencing against GIS polygons."""
+"""Algorithm declarations: automatic georeferencing against GIS polygons.
+
+The domain modules are imported inside ``run`` (lazy: keeps ``photodem list`` fast).
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any, Dict
 
-from ...feedback import Feedback, StepFeedback
+from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
 GROUP = "Georeferencing"
@@ -90,31 +92,21 @@ class GeoreferencePolygons(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...errors import InputError
-        from ...georef.pipeline import georeference
-        from ...georef.products import summary, write_outputs
-        from ...raster.io import PRODUCT_MARKER
+        from ...georef.pipeline import GeorefOptions, run_georeference_polygons
 
         level = params.get("pyramid_level", -1)
-        output = Path(params["output"])
-        # refuse an operator's own folder before the work, not after it
-        if output.is_file() or (output.is_dir() and any(output.iterdir())
-                                and not (output / PRODUCT_MARKER).is_file()):
-            raise InputError(f"The output folder '{output}' holds files PhotoDEM did not "
-                             "write; choose an empty or new folder.")
-        result = georeference(
-            params["image"], params["reference"], params.get("class_field") or None,
-            params.get("class_value") or None, params.get("transform") or "affine",
+        options = GeorefOptions(
+            class_field=params.get("class_field") or None,
+            class_value=params.get("class_value") or None,
+            transform=params.get("transform") or "affine",
             thresholds=params.get("thresholds") or None,
             pyramid_level="auto" if level is None or int(level) < 0 else int(level),
             rd=float(params.get("relative_difference", 3.0)) / 100.0,
             max_depth=int(params.get("max_depth", 6)),
             sigma_np_px=float(params.get("sigma_np", 2.0)),
-            search=params.get("search") or "auto",
-            feedback=StepFeedback(feedback, 0, 80))
-        paths = write_outputs(output, params["image"], result,
-                              feedback=StepFeedback(feedback, 80, 100), replace=True)
-        return summary(result, paths)
+            search=params.get("search") or "auto")
+        return run_georeference_polygons(params["image"], params["reference"],
+                                         params["output"], options, feedback)
 
 
 ALGORITHMS = [GeoreferencePolygons]

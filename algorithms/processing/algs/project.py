@@ -1,9 +1,11 @@
-"""Algorithm declarations: project."""
+"""Algorithm declarations: project.
+
+The domain modules are imported inside ``run`` (lazy: keeps ``photodem list`` fast).
+"""
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any, Dict
 
 from ...errors import InputError
@@ -49,83 +51,12 @@ class ProjectCreate(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...geometry.stereo import load_dem, mean_terrain_height
-        from ...project.edits import create_edits
-        from ...project.importers import import_project
-        from ...project.stereo_models import (
-            block_bounds,
-            block_footprints,
-            detect_stereo_models,
-        )
-        from ...project.validate import validate_project
-        from ...raster.io import staged_folder
+        from ...project.create import create_project
 
-        out = Path(params["output"])
-        if out.exists() and any(out.iterdir()):
-            raise InputError(
-                f"The output folder '{out}' exists and is not empty; choose a new project folder."
-            )
-        feedback.progress(2)
-        project, warnings = import_project(
-            out, params["images"], params["exterior"], params.get("interior"),
-            crs=params.get("crs"), angle_unit=params["angle_unit"],
-        )
-        feedback.info(f"Read {len(project.images)} images and {len(project.cameras)} camera(s).")
-        feedback.progress(20)
-
-        # structural errors first: without them the geometry below is meaningful
-        report = validate_project(project, check_files=True, stereo_partners=False)
-        report.raise_if_errors()
-        feedback.progress(35)
-
-        dem = params.get("dem")
-        if dem is not None:
-            dem = load_dem(dem, block_bounds(project), crs=project.crs)
-            footprints = block_footprints(project, dem=dem)
-            project.terrain_height = round(mean_terrain_height(footprints), 3)
-            feedback.info(f"Mean terrain height under the footprints (DEM): "
-                          f"{project.terrain_height:.1f} m.")
-        else:
-            if params.get("terrain_height") is not None:
-                project.terrain_height = float(params["terrain_height"])
-            else:
-                project.terrain_height = 0.0
-                warnings.append("No DEM and no terrain height given: the terrain is assumed at "
-                                "0 m for footprints, overlaps and B/H.")
-            footprints = block_footprints(project)
-        feedback.progress(55)
-
-        report = validate_project(project, check_files=False, dem=dem, stereo_partners=False)
-        report.raise_if_errors()
-        project.models = detect_stereo_models(project, footprints=footprints)
-        paired = {m.left for m in project.models} | {m.right for m in project.models}
-        for rec in project.images:
-            if rec.name not in paired:
-                warnings.append(f"Image '{rec.name}' has no stereo partner (no other image "
-                                "overlaps it enough); it cannot be used for matching.")
-        warnings += report.warnings
-        for w in warnings:
-            feedback.warning(w)
-        kinds = [m.kind for m in project.models]
-        feedback.info(f"Stereo models: {kinds.count('in-strip')} in-strip, "
-                      f"{kinds.count('cross-strip')} cross-strip.")
-        feedback.progress(80)
-
-        with staged_folder(out, product=self.id) as tmp:
-            staged = Project(root=tmp, name=project.name, crs=project.crs,
-                             cameras=project.cameras, images=project.images,
-                             models=project.models, terrain_height=project.terrain_height,
-                             angle_unit=project.angle_unit)
-            staged.save()
-            create_edits(staged.edits_path, project.crs)
-            feedback.check()
-        return {
-            "project": str(out),
-            "images": len(project.images),
-            "cameras": len(project.cameras),
-            "models": [m.name for m in project.models],
-            "warnings": warnings,
-        }
+        return create_project(
+            params["output"], params["images"], params["exterior"], params.get("interior"),
+            crs=params.get("crs"), angle_unit=params["angle_unit"], dem=params.get("dem"),
+            terrain_height=params.get("terrain_height"), feedback=feedback)
 
 
 class ProjectInfo(Algorithm):
@@ -180,6 +111,7 @@ class ProjectInfo(Algorithm):
                         for k, v in m.items()} for m in models],
             "validation": report.to_dict(),
         }
+
 
 class StereoModels(Algorithm):
     id = "stereo_models"

@@ -67,9 +67,9 @@ def test_auto_falls_back_to_area_and_writes_outputs(tmp_path, plain):
     with pytest.raises(GeometryError):  # the objects are not homogeneous enough
         georeference(plain["image"], plain["reference"], search="objects")
     res = georeference(plain["image"], plain["reference"])
-    assert res["stage"] == "area"
-    assert corner_error(res["fit"], plain["truth"], SIZE, SIZE).max() < 0.5
-    assert any("object stage" in w for w in res["warnings"])
+    assert res.stage == "area"
+    assert corner_error(res.fit, plain["truth"], SIZE, SIZE).max() < 0.5
+    assert any("object stage" in w for w in res.warnings)
     paths = write_outputs(tmp_path / "out", plain["image"], res)
     for key in ("points", "gcps", "image", "report"):
         assert Path(paths[key]).is_file()
@@ -81,7 +81,7 @@ def test_auto_falls_back_to_area_and_writes_outputs(tmp_path, plain):
 
 def test_area_only_and_bad_modes(tmp_path, plain):
     res = georeference(plain["image"], plain["reference"], search="area")
-    assert res["stage"] == "area" and res["parameters"]["search"] == "area"
+    assert res.stage == "area" and res.parameters["search"] == "area"
     with pytest.raises(InputError, match="search"):
         georeference(plain["image"], plain["reference"], search="pixels")
     ortho = ortho_case(tmp_path / "ortho", seed=1)
@@ -112,4 +112,4 @@ def test_everest_area_search_never_wrong():
     except GeometryError as exc:
         assert "area-based search" in str(exc)
         return
-    assert corner_error(res["fit"], truth, W, H).max() <= 1.0
+    assert corner_error(res.fit, truth, W, H).max() <= 1.0

@@ -165,8 +165,8 @@ def test_pipeline_uses_the_boundaries_of_a_tiling(tmp_path, tiling) -> None:
     ref = _write_tiling(polys, tmp_path / "tiling.gpkg")
     path = write_image(tmp_path / "img.tif", np.clip(np.round(img), 1, 255).astype(np.uint8))
     res = georeference(path, ref, search="area")
-    assert res["area"]["method"] == "boundary orientation"
-    assert corner_error(res["fit"], T, SIZE, SIZE).max() < 0.5
+    assert res.area["method"] == "boundary orientation"
+    assert corner_error(res.fit, T, SIZE, SIZE).max() < 0.5
     other = _write_tiling(_tiling(11), tmp_path / "other.gpkg")
     with pytest.raises(GeometryError, match="boundary-orientation score"):
         georeference(path, other, search="area")
@@ -182,5 +182,5 @@ def test_everest_rgb_recovered_by_the_boundary_search() -> None:
         t, W, H = src.transform, src.width, src.height
     truth = centre_matrix(t)
     res = georeference(image, folder / "15_rgi60_glacier_outlines.gpkg", search="area")
-    assert res["area"]["method"] == "boundary orientation"
-    assert corner_error(res["fit"], truth, W, H).max() <= 1.0
+    assert res.area["method"] == "boundary orientation"
+    assert corner_error(res.fit, truth, W, H).max() <= 1.0

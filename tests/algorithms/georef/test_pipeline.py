@@ -30,16 +30,16 @@ def case(tmp_path_factory):
 
 def test_synthetic_case_recovered_to_half_a_pixel(case) -> None:
     res = georeference(case["image"], case["reference"])
-    err = corner_error(res["fit"], case["truth"], case["width"], case["height"])
+    err = corner_error(res.fit, case["truth"], case["width"], case["height"])
     assert err.max() <= 0.5
-    assert res["counts"]["verified_pairs"] >= 6 and res["counts"]["gcps"] >= 50
-    assert res["fit"].rmse_px < 0.5
+    assert res.counts["verified_pairs"] >= 6 and res.counts["gcps"] >= 50
+    assert res.fit.rmse_px < 0.5
 
 
 def test_image_against_orthophoto(tmp_path) -> None:
     c = ortho_case(tmp_path, seed=1, size_px=600)
     res = georeference(c["image"], c["reference"])
-    assert corner_error(res["fit"], c["truth"], c["width"], c["height"]).max() <= 1.0
+    assert corner_error(res.fit, c["truth"], c["width"], c["height"]).max() <= 1.0
 
 
 def test_outputs_of_the_algorithm(case, tmp_path) -> None:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rasterio
 
 from photodem.algorithms import output_policy
 from photodem.algorithms.errors import InputError
@@ -177,7 +178,6 @@ def test_commits_are_recorded_for_the_run_outputs_only(tmp_path):
         write_raster(tmp_path / "a.tif", np.zeros((2, 2), np.float32), overviews=True)
         assert output_policy.committed()
     assert scope.committed == [tmp_path / "a.tif"] and committed == [tmp_path / "a.tif"]
-    assert output_policy.last_scope() is scope
     assert output_policy.file_product(tmp_path / "a.tif") == "test"
     assert output_policy.file_product(tmp_path / "scratch.tif") is None
 
@@ -185,13 +185,14 @@ def test_commits_are_recorded_for_the_run_outputs_only(tmp_path):
 def test_a_committed_run_is_no_longer_cancelled(tmp_path):
     feedback = Feedback()
     target = output_policy.Target(tmp_path / "a.txt", "file", "output")
-    with output_policy.run_scope("test", lambda p: feedback.mark_committed(), [target]):
+    with output_policy.run_scope("test", feedback.mark_committed, [target]):
         with atomic_output(tmp_path / "a.txt") as tmp:
             tmp.write_text("a")
         feedback.cancel()
         feedback.check()  # no Cancelled: the product set is finished
         feedback.step(0, 50).progress(100)
     assert output_policy.file_product(tmp_path / "a.txt") == "test"
+    assert feedback.committed == [tmp_path / "a.txt"]  # what the CLI names after a stop
 
 
 def test_product_tag_reader_on_bad_files(tmp_path):
@@ -203,3 +204,30 @@ def test_product_tag_reader_on_bad_files(tmp_path):
     write_raster(tmp_path / "big.tif", np.zeros((3, 3), np.float32), BIGTIFF="YES")
     rio.tag_product(tmp_path / "big.tif", "bigtest")
     assert output_policy.file_product(tmp_path / "big.tif") == "bigtest"
+
+
+def test_product_tag_is_written_as_the_geotiff_is_created(tmp_path, monkeypatch):
+    # no reopening in r+ mode: open_image tags the staged file when it creates it
+    def no_reopen(path, product):
+        raise AssertionError(f"{path} reopened to tag it")
+
+    monkeypatch.setattr(rio, "tag_product", no_reopen)
+    targets = [output_policy.Target(tmp_path / name, "file", "output")
+               for name in ("a.tif", "c.tif")]
+    with output_policy.run_scope("test", None, targets):
+        write_raster(tmp_path / "a.tif", np.zeros((2, 2), np.float32))
+        write_raster(tmp_path / "c.tif", np.zeros((300, 300), np.float32), overviews=True)
+    assert output_policy.file_product(tmp_path / "a.tif") == "test"
+    assert output_policy.file_product(tmp_path / "c.tif") == "test"
+    assert not rio._TAG_ON_CREATE  # nothing pending is left behind
+
+
+def test_other_writers_are_tagged_after_writing(tmp_path):
+    target = output_policy.Target(tmp_path / "b.tif", "file", "output")
+    profile = rio.gtiff_profile(2, 2, crs="EPSG:25832")
+    with output_policy.run_scope("test", None, [target]), \
+            rio.atomic_output(tmp_path / "b.tif") as tmp, \
+            rasterio.open(tmp, "w", **profile) as dst:
+        dst.write(np.zeros((1, 2, 2), np.float32))
+    assert output_policy.file_product(tmp_path / "b.tif") == "test"
+    assert not rio._TAG_ON_CREATE
