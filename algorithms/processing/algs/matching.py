@@ -15,6 +15,8 @@ from ...matching.fbm_model import DEFAULT_PRESET, PRESET_NAMES
 from ...raster.io import atomic_output, gtiff_profile, open_image
 from ..spec import Algorithm, Output, Parameter, model_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Matching"
 GROUP_ID = "matching"
 

@@ -9,6 +9,8 @@ from ...errors import InputError
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, project_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Orthophotos"
 GROUP_ID = "ortho"
 
