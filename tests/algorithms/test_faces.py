@@ -19,6 +19,8 @@ import rasterio
 from photodem.algorithms.processing import registry
 from photodem.algorithms.raster.io import open_image
 
+pytestmark = pytest.mark.slow
+
 CLI = [sys.executable, "-m", "photodem.algorithms.cli"]
 
 
@@ -146,7 +148,6 @@ def _quality_inputs(block) -> Dict[str, str]:
             "checkpoints": str(truth / "checkpoints.gpkg"), "line": line}
 
 
-@pytest.mark.slow
 def test_dem_compare_python_equals_cli(block, tmp_path) -> None:
     q = _quality_inputs(block)
     params = {"dem": q["dsm"], "reference": q["dtm"], "classes": q["landcover"],
@@ -201,7 +202,6 @@ def test_stereo_disparity_python_equals_cli(block, tmp_path) -> None:
 
 
 @pytest.mark.parametrize("method", ["dense", "fbm_lsm"])
-@pytest.mark.slow
 def test_match_model_python_equals_cli(block, tmp_path, method) -> None:
     project = block["py"]["project"]
     model = registry.run("project_info", {"project": project})["models"][0]["name"]
@@ -309,7 +309,6 @@ def test_refine_object_space_python_equals_cli(block, tmp_path) -> None:
     assert py["metrics"]["refined_cells"] > 0.8 * 40 * 40 and py["metrics"]["failures"] == 0
 
 
-@pytest.mark.slow
 def test_filter_lowpass_python_equals_cli(block, tmp_path) -> None:
     q = _quality_inputs(block)
     params = {"input": q["dsm"], "project": block["py"]["project"], "preset": "urban",
@@ -321,7 +320,6 @@ def test_filter_lowpass_python_equals_cli(block, tmp_path) -> None:
     assert py["mask"] and py["labels"] is None and 0.0 < py["metrics"]["eliminated_share"] < 0.9
 
 
-@pytest.mark.slow
 def test_filter_linear_prediction_python_equals_cli(block, tmp_path) -> None:
     q = _quality_inputs(block)
     params = {"input": q["dsm"], "project": block["py"]["project"], "preset": "default",
@@ -378,7 +376,6 @@ def test_mosaic_python_equals_cli(block, tmp_path) -> None:
     assert py["balance"]["after"]["mean_difference"] <= 2.0 and py["gsd"] == 0.3
 
 
-@pytest.mark.slow
 def test_georeference_polygons_python_equals_cli(tmp_path) -> None:
     from photodem.algorithms.synthetic.polygon_scene import georef_case
 

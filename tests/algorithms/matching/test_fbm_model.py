@@ -25,6 +25,8 @@ from photodem.algorithms.project.edits import add_features
 from photodem.algorithms.project.model import Project
 from photodem.algorithms.synthetic.block import generate_block
 
+pytestmark = pytest.mark.slow
+
 MODEL = "0101_0102"
 OPEN = "1"  # land-cover class of open, textured ground
 
@@ -62,7 +64,6 @@ def result(started, tmp_path_factory):
                                         "method": "fbm_lsm", "output": str(out)})
 
 
-@pytest.mark.slow
 def test_outputs_and_report(result) -> None:
     for key in ("dsm", "sigma", "count", "points", "reduced", "report", "report_html"):
         assert result[key] and os.path.isfile(result[key]), key
@@ -101,7 +102,6 @@ def _measured_open_errors(result, block) -> np.ndarray:
     return (dsm - truth)[sel]
 
 
-@pytest.mark.slow
 def test_single_start_point_covers_the_model_within_0_1_permille(result, block) -> None:
     m = result["metrics"]
     assert m["start_points"] == 1
@@ -114,7 +114,6 @@ def test_single_start_point_covers_the_model_within_0_1_permille(result, block) 
     assert 1000.0 * rms / block.flying_height <= 0.1, rms
 
 
-@pytest.mark.slow
 def test_exclusion_area_is_nan_and_has_no_points(started, block, tmp_path) -> None:
     proj = tmp_path / "excl"
     shutil.copytree(started, proj)
