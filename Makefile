@@ -14,7 +14,7 @@ APT_PACKAGES := qgis python3-qgis qgis-providers python3-pyqt5 python3-rasterio 
 	python3-shapely python3-pyproj python3-skimage python3-scipy python3-matplotlib python3-yaml python3-opencv \
 	python3-pytest python3-pytestqt python3-venv qttools5-dev-tools pyqt5-dev-tools
 
-.PHONY: demo test test-a test-b gui bench lint zip venv venv-qgis apt clean
+.PHONY: demo test test-a test-b test-fast gui bench lint zip venv venv-qgis apt clean
 
 venv: $(STAMP_A)
 $(STAMP_A): pyproject.toml
@@ -46,6 +46,11 @@ test: test-a test-b
 test-a: venv
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/python -m pytest -q tests -m "not qgis" -p no:cacheprovider
+
+# While working: tier A without the tests marked slow (end-to-end runs); `make test` runs all.
+test-fast: venv
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/python -m pytest -q tests -m "not qgis and not slow" -p no:cacheprovider
 
 test-b: venv-qgis
 	bash tools/run_tier_b.sh $(VENV_QGIS)/bin/python

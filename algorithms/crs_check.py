@@ -16,6 +16,8 @@ import functools
 from pathlib import Path
 from typing import Any, Optional, Union
 
+import pyproj
+
 from .errors import InputError
 
 
@@ -37,7 +39,6 @@ def same_horizontal_crs(a: Any, b: Any) -> bool:
 def _wkt(crs: Any) -> str:
     if hasattr(crs, "to_wkt"):
         return str(crs.to_wkt())
-    import pyproj
 
     return str(pyproj.CRS.from_user_input(crs).to_wkt())
 
@@ -46,8 +47,6 @@ def _wkt(crs: Any) -> str:
 def _same_horizontal_wkt(wkt_a: str, wkt_b: str) -> bool:
     # cached: pyproj's parsing costs milliseconds, and every ortho of a block asks again
     try:
-        import pyproj
-
         pa, pb = pyproj.CRS.from_wkt(wkt_a), pyproj.CRS.from_wkt(wkt_b)
     except Exception:  # an unparsable CRS is never "the same"
         return False
@@ -61,8 +60,6 @@ def _same_horizontal_wkt(wkt_a: str, wkt_b: str) -> bool:
 def crs_label(crs: Any) -> str:
     """A short name of a CRS for messages (``EPSG:25832 (ETRS89 / UTM zone 32N)``)."""
     try:
-        import pyproj
-
         c = pyproj.CRS.from_user_input(_wkt(crs))
         code = c.to_epsg()
         return f"EPSG:{code} ({c.name})" if code else c.name

@@ -27,15 +27,23 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
+import rasterio
+from rasterio.features import shapes
+from scipy import ndimage
+from shapely.geometry import shape
 
 from .errors import PhotodemError
 from .feedback import Feedback, ensure_feedback
 from .geometry.epipolar import EpipolarPair
+from .georef.fit import corner_error
 from .processing import registry
 from .processing.batch import load_batch, run_batch
+from .project.edits import add_features
 from .project.model import Project
 from .quality.targets import target_centroids
 from .raster.io import PRODUCT_MARKER, open_image
+from .synthetic.objects import EMBANKMENT, TREE
+from .synthetic.polygon_scene import georef_case
 
 BATCH_FILE = """# PhotoDEM demo batch: epipolar pairs of every stereo model
 [batch]
@@ -237,14 +245,6 @@ def _operator_exclusions(project: Project, landcover: str, min_area: float = 400
     seed-002-003 A3.8: exclusion areas are part of the method). Drawn here from the truth land
     cover (single trees dropped by an opening).
     """
-    import rasterio
-    from rasterio.features import shapes
-    from scipy import ndimage
-    from shapely.geometry import shape
-
-    from .project.edits import add_features
-    from .synthetic.objects import EMBANKMENT, TREE
-
     with rasterio.open(landcover) as src:
         lc = src.read(1)
         transform = src.transform
@@ -266,9 +266,6 @@ def _operator_exclusions(project: Project, landcover: str, min_area: float = 400
 def _georef(out: Path, seed: int, feedback: Feedback) -> Dict[str, Any]:
     """Georeference a synthetic scene (a polygon map and an image of it under an unknown
     affine map, mirrored or not) and compare the result with the truth."""
-    from .georef.fit import corner_error
-    from .synthetic.polygon_scene import georef_case
-
     feedback.info("Georeferencing an image against polygons …")
     case = georef_case(out / "georef_scene", seed=seed + 4)
     res = registry.run("georeference_polygons", {

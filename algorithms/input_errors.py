@@ -22,12 +22,24 @@ import contextlib
 import csv
 import errno
 import os
+import sys
 import threading
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Iterator, List, Optional, Tuple, Type, Union
 
+import rasterio
+import rasterio.errors as rio
+from rasterio._err import CPLE_FileIOError, CPLE_OpenFailedError
+from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
+from rasterio.windows import Window
+
 from .errors import InputError, PhotodemError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.9/3.10 only
+    import tomli as tomllib
 
 PathLike = Union[str, Path]
 
@@ -72,16 +84,13 @@ def _library_errors() -> Tuple[Type[BaseException], ...]:
     Only classes raised while reading data are listed: a ``WindowError``, a ``SchemaError`` on
     writing or an ``InvalidArrayError`` is a programming error and stays one.
     """
-    import rasterio.errors as rio
-    from rasterio._err import CPLE_FileIOError, CPLE_OpenFailedError
-
     classes: List[Type[BaseException]] = [
         rio.RasterioIOError, rio.CRSError, rio.PathError, rio.FileError,
         CPLE_OpenFailedError, CPLE_FileIOError,
         UnicodeDecodeError, csv.Error,
     ]
     try:
-        import fiona.errors as fio
+        import fiona.errors as fio  # lazy: keeps photodem list fast
 
         names = ("DriverError", "DataIOError", "CRSError", "PathError",  # PathError: ≥ 1.10
                  "UnsupportedGeometryTypeError")
@@ -89,13 +98,11 @@ def _library_errors() -> Tuple[Type[BaseException], ...]:
     except ImportError:  # pragma: no cover - fiona is a dependency
         pass
     try:
-        import yaml
+        import yaml  # lazy: keeps photodem list fast
 
         classes.append(yaml.YAMLError)
     except ImportError:  # pragma: no cover
         pass
-    from .project.toml_io import tomllib
-
     classes.append(tomllib.TOMLDecodeError)
     return tuple(classes)
 
@@ -121,8 +128,6 @@ def _chain_messages(exc: BaseException) -> List[str]:
 
 def describe(exc: BaseException) -> str:
     """A one-line description of a library error, with a hint for damaged files."""
-    from .project.toml_io import tomllib
-
     if isinstance(exc, UnicodeDecodeError):
         return (f"it is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position "
                 f"{exc.start}); save it as UTF-8")
@@ -204,8 +209,6 @@ def operator_errors(feedback: Any = None) -> Iterator[None]:
     outer = getattr(_RUN, "feedback", None)
     _RUN.feedback = feedback if feedback is not None else outer
     try:
-        import rasterio
-
         # inside a rasterio environment GDAL's messages go to Python's logging, not as extra
         # "ERROR 1: …" lines to stderr beside the one-line error
         with rasterio.Env():
@@ -254,9 +257,6 @@ def check_raster(path: PathLike, what: str = "raster") -> None:
     if p.is_dir():
         return
     check_encodable(p, what)
-    import rasterio
-    from rasterio.errors import NotGeoreferencedWarning
-    from rasterio.windows import Window
 
     with reading(p, what), warnings.catch_warnings():
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -327,9 +327,6 @@ def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
 
 def _opens_as_raster(path: PathLike) -> bool:
     """True when GDAL recognises ``path`` as a raster (its blocks are not read)."""
-    import rasterio
-    from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
-
     try:
         check_encodable(path)
         with warnings.catch_warnings():

@@ -51,6 +51,8 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import pyproj
+import yaml
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
@@ -93,8 +95,6 @@ def normalise_crs(crs: Any) -> str:
     InputError
         When pyproj does not understand ``crs``.
     """
-    import pyproj
-
     try:
         c = pyproj.CRS.from_user_input(crs)
     except Exception as exc:  # pyproj.exceptions.CRSError
@@ -134,8 +134,6 @@ def _resolve_crs(path: PathLike, crs: Optional[str], warnings: List[str]) -> Opt
 
 
 def _same_crs(a: str, b: str) -> bool:
-    import pyproj
-
     return pyproj.CRS.from_user_input(a) == pyproj.CRS.from_user_input(b)
 
 
@@ -207,8 +205,6 @@ def read_interior_yaml(path: PathLike) -> Dict[str, Camera]:
     InputError
         When the file is not such a YAML or a camera is incomplete or unsupported.
     """
-    import yaml
-
     path = Path(path)
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8"))
@@ -384,8 +380,6 @@ def utm_crs_of(lat: float, lon: float) -> str:
 
 @functools.lru_cache(maxsize=16)
 def _ecef_transformer(crs: str, inverse: bool = False) -> Any:
-    import pyproj
-
     target = pyproj.CRS.from_user_input(crs)
     if not target.is_projected and not target.is_geographic:
         raise InputError(f"The target CRS '{target.name}' must be projected or geographic.")

@@ -29,10 +29,13 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
+from rasterio.enums import ColorInterp
 
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation, check_angle_unit
+from ..input_errors import check_encodable, reading
+from ..raster.io import open_image
 from . import toml_io
 
 PROJECT_FILE = "project.toml"
@@ -282,15 +285,12 @@ class Project:
         InputError
             When the file is missing or its size differs from the camera's.
         """
-        from ..raster.io import open_image
-
         rec = self.image(image) if isinstance(image, str) else image
         cam = self.camera_of(rec)
         path = self.image_path(rec)
         if not path.is_file():
             raise InputError(f"Image file '{path}' of image '{rec.name}' does not exist; "
                              "fix its path in project.toml.")
-        from ..input_errors import check_encodable, reading
 
         check_encodable(path, "image")
         with reading(path, "image"), open_image(path) as src:
@@ -299,7 +299,6 @@ class Project:
                                  f"'{cam.name}' is {cam.width}×{cam.height} px.")
             if not colour_only:
                 return src.read()
-            from rasterio.enums import ColorInterp
 
             bands = [i + 1 for i, c in enumerate(src.colorinterp) if c != ColorInterp.alpha]
             return src.read((bands or [1])[:3])

@@ -29,8 +29,10 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional
 
 import numpy as np
+import pyproj
 
 from ..errors import InputError
+from ..raster.io import open_image
 from .model import Project, identifier_errors
 
 #: Flying heights above ground (m) outside this range are reported as a warning.
@@ -74,8 +76,6 @@ def _count(errors: List[str]) -> str:
 
 def check_crs(crs: Optional[str]) -> Optional[str]:
     """An error message for an unusable project CRS, or ``None``."""
-    import pyproj
-
     if not crs:
         return ("The project has no CRS. Give the crs parameter or a .prj file beside the "
                 "exterior orientation.")
@@ -172,8 +172,6 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
 
 
 def _check_files(project: Project, records: List[Any], rep: ValidationReport) -> None:
-    from ..raster.io import open_image
-
     for rec in records:
         path = project.image_path(rec)
         if not path.is_file():

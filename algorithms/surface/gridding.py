@@ -53,9 +53,12 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from rasterio.features import rasterize
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
+from ..memory import check_allocation
+from ..raster.io import write_raster
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -74,8 +77,6 @@ def check_grid_memory(width: int, height: int, spacing: float) -> None:
     InputError
         Naming the grid size and the spacing to change.
     """
-    from ..memory import check_allocation
-
     check_allocation(float(width) * float(height) * GRID_BYTES_PER_CELL,
                      f"a grid of {width} × {height} cells at {spacing:g} m",
                      "the spacing (a coarser grid) or the extent")
@@ -266,8 +267,6 @@ def _median_per_cell(cell: Array, z: Array, w: Optional[Array], n_cells: int
 # -- masks -------------------------------------------------------------------------------------
 def polygon_mask(geoms: Iterable[Any], grid: Grid) -> Array:
     """Boolean mask of the cells whose centre lies in any of the (shapely) polygons."""
-    from rasterio.features import rasterize
-
     shapes = [(g, 1) for g in geoms if g is not None and not g.is_empty]
     if not shapes:
         return np.zeros(grid.shape, bool)
@@ -280,8 +279,6 @@ def line_barrier(lines: Iterable[Any], grid: Grid) -> Tuple[Array, Array]:
 
     Heights come from sampling each line every ¼ cell and taking the mean z per touched cell.
     """
-    from rasterio.features import rasterize
-
     lines = [g for g in lines if g is not None and not g.is_empty]
     barrier = np.zeros(grid.shape, bool)
     zline = np.full(grid.shape, np.nan, np.float32)
@@ -340,7 +337,7 @@ def reject_outliers(z: Array, spacing: float, radius: float, threshold: float,
     ndarray of bool
         True where a measured cell is an outlier.
     """
-    from scipy import ndimage
+    from scipy import ndimage  # lazy: keeps photodem list fast
 
     z = np.asarray(z, np.float32)
     valid = np.isfinite(z)
@@ -381,8 +378,8 @@ def fill_gaps(z: Array, spacing: float, max_gap: float, domain: Optional[Array] 
     -------
     (filled z float32, mask of the cells that were filled)
     """
-    from scipy import ndimage, sparse
-    from scipy.sparse.linalg import spsolve
+    from scipy import ndimage, sparse  # lazy: keeps photodem list fast
+    from scipy.sparse.linalg import spsolve  # lazy: keeps photodem list fast
 
     z = np.array(z, dtype=np.float64)
     h, w = z.shape
@@ -532,8 +529,6 @@ def grid_points(x: ArrayLike, y: ArrayLike, z: ArrayLike, spacing: float,
 def write_grid(path: PathLike, z: Array, grid: Grid, crs: Any = None,
                overviews: bool = True) -> Path:
     """Write a grid as a tiled, compressed GeoTIFF with overviews (float → NaN nodata)."""
-    from ..raster.io import write_raster
-
     return write_raster(path, z, transform=grid.transform, crs=crs, overviews=overviews)
 
 

@@ -31,8 +31,10 @@ import math
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import fiona
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from pyproj import CRS
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
@@ -63,7 +65,6 @@ def _crs(crs: Any) -> Any:
     """A pyproj CRS from anything pyproj or rasterio understands (None stays None)."""
     if crs is None or crs == "":
         return None
-    from pyproj import CRS
 
     try:
         if hasattr(crs, "to_wkt") and not isinstance(crs, CRS):
@@ -159,8 +160,6 @@ def _fiona_type(arr: Array) -> str:
 
 def _write_gpkg(path: Path, x: Array, y: Array, z: Array, cols: Dict[str, Array], crs: Any,
                 chunk: int, feedback: Feedback) -> Path:
-    import fiona
-
     schema = {"geometry": "3D Point",
               "properties": {k: _fiona_type(v) for k, v in cols.items()}}
     names = list(cols)

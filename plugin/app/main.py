@@ -22,7 +22,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     app.setApplicationName("PhotoDEM toolbox")
     install_translator()  # German when the system locale is German and i18n/*.qm exists
 
-    from .main_window import ToolboxWindow  # after the translator: labels are translated once
+    # lazy: imported after the translator is installed, so labels are translated once
+    from .main_window import ToolboxWindow
 
     window = ToolboxWindow()
     _windows.append(window)  # keep a reference when the caller runs the event loop

@@ -224,6 +224,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
     def open_georef_review(self, folder: Optional[str] = None) -> Optional[QtWidgets.QDialog]:
         """Open the review dialog of a georeferencing output folder (asks for it unless
         given; the last result of this session is offered first)."""
+        # lazy: the review dialog loads matplotlib and the georef package; opened on demand
         from ..widgets.georef_review import open_review
 
         def report(text: str) -> None:

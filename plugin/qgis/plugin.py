@@ -11,6 +11,7 @@ import importlib.util
 from typing import Any, List, Optional
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog
+from qgis.PyQt.QtWidgets import QDockWidget
 
 from ...algorithms.processing import registry
 from ..i18n import install_translator, remove_translator, tr
@@ -112,6 +113,7 @@ class PhotodemPlugin:
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
         the folder unless given); returns the dialog or ``None``."""
+        # lazy: the review dialog loads matplotlib and the georef package; opened on demand
         from ..widgets.georef_review import open_review
 
         def report(text: str) -> None:
@@ -126,14 +128,13 @@ class PhotodemPlugin:
 
     def open_dialog(self, algorithm_id: str) -> None:
         """Open the Processing dialog of ``photodem:<algorithm_id>``."""
-        import processing  # QGIS's processing plugin; only present in the desktop application
+        # lazy: QGIS's processing plugin exists only in the desktop application
+        import processing
 
         processing.execAlgorithmDialog(f"{PROVIDER_ID}:{algorithm_id}")
 
     def show_toolbox(self) -> None:
         """Show the Processing Toolbox filtered to PhotoDEM (best effort; UI only)."""
-        from qgis.PyQt.QtWidgets import QDockWidget
-
         dock = self.iface.mainWindow().findChild(QDockWidget, "ProcessingToolbox")
         if dock is None:
             return

@@ -15,6 +15,9 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
+import rasterio
+from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
+from matplotlib.figure import Figure
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.feedback import Feedback
@@ -27,6 +30,7 @@ from ...algorithms.georef.products import (
     skipped_ids_text,
 )
 from ...algorithms.georef.review import Review, load_review, save_review
+from ...algorithms.raster.io import open_image
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
@@ -134,8 +138,6 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         top.addStretch(1)
 
         # middle: residual map | tables
-        from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
-        from matplotlib.figure import Figure
 
         self.figure = Figure(figsize=(6, 6))
         self.canvas = FigureCanvasQTAgg(self.figure)
@@ -534,10 +536,6 @@ def _thumbnail(path: Path, max_side: int = 800) -> tuple:
     """The image's band mean at most ``max_side`` pixels wide/high, and its reduction
     factor (``None, 1`` when it cannot be read: the map then shows the points only)."""
     try:
-        import rasterio
-
-        from ...algorithms.raster.io import open_image
-
         with open_image(path) as src:
             f = max(1, int(np.ceil(max(src.width, src.height) / max_side)))
             shape = (src.count, max(1, src.height // f), max(1, src.width // f))

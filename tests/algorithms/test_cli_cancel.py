@@ -149,6 +149,7 @@ def project(tmp_path_factory):
 
 @pytest.mark.skipif(not PHOTODEM.exists(), reason="console script not installed")
 @pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.slow
 def test_sigint_at_a_random_moment_matches_the_disk(project, tmp_path, seed):
     delay = random.Random(seed).uniform(0.8, 3.0)  # start-up ≈ 1 s, the run ≈ 1–2 s
     out = tmp_path / "cmp"
@@ -178,6 +179,7 @@ def test_sigint_at_a_random_moment_matches_the_disk(project, tmp_path, seed):
 
 @pytest.mark.skipif(not PHOTODEM.exists(), reason="console script not installed")
 @pytest.mark.parametrize("seed", [4, 5])
+@pytest.mark.slow
 def test_a_killed_run_leaves_nothing_a_rerun_does_not_clean(project, tmp_path, seed):
     delay = random.Random(seed).uniform(1.0, 2.5)
     out = tmp_path / "cmp"

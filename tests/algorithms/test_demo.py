@@ -11,6 +11,7 @@ from photodem.algorithms.demo import run_demo
 from photodem.algorithms.errors import PhotodemError
 
 
+@pytest.mark.slow
 def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
     s = run_demo(tmp_path / "demo", size="tiny")
     surfaces = s["surfaces"]

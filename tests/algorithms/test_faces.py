@@ -19,6 +19,8 @@ import rasterio
 from photodem.algorithms.processing import registry
 from photodem.algorithms.raster.io import open_image
 
+pytestmark = pytest.mark.slow
+
 CLI = [sys.executable, "-m", "photodem.algorithms.cli"]
 
 

@@ -17,6 +17,8 @@ from photodem.plugin.app.main_window import ToolboxWindow
 from photodem.plugin.qt import QtCore
 from photodem.plugin.widgets.georef_review import GeorefReviewDialog
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def result_folder(tmp_path_factory):

@@ -7,6 +7,8 @@ from typing import Any, Dict
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "DTM filtering"
 GROUP_ID = "filtering"
 

@@ -15,6 +15,8 @@ from ...project.model import Project
 from ...raster.io import gtiff_profile, open_image, staged_folder
 from ..spec import Algorithm, Output, Parameter, model_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 #: Pixels per resampled row block (per band): bounds the memory of the resampling.
 _BLOCK_PIXELS = 1_000_000
 

@@ -12,6 +12,8 @@ from ...matching.disparity_run import run_stereo_disparity
 from ...matching.presets import DEFAULT_PRESET, PRESET_NAMES
 from ..spec import Algorithm, Output, Parameter, model_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Matching"
 GROUP_ID = "matching"
 

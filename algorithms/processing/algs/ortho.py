@@ -10,6 +10,8 @@ from ...feedback import Feedback
 from ...project.model import Project
 from ..spec import Algorithm, Output, Parameter, project_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Orthophotos"
 GROUP_ID = "ortho"
 

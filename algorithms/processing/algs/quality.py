@@ -9,6 +9,8 @@ from ...feedback import Feedback
 from ...raster.io import staged_folder
 from ..spec import Algorithm, Output, Parameter
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Quality control"
 GROUP_ID = "quality"
 

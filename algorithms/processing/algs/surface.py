@@ -8,6 +8,8 @@ from typing import Any, Dict, List, Optional
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, project_product
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 GROUP = "Surfaces"
 GROUP_ID = "surface"
 

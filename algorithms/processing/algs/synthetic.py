@@ -7,6 +7,8 @@ from typing import Any, Dict
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
 
+# Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
+
 
 class SyntheticBlock(Algorithm):
     id = "synthetic_block"

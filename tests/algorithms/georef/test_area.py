@@ -54,6 +54,7 @@ def test_fourier_mellin_finds_rotation_and_scale(plain):
 
 
 @pytest.mark.parametrize("seed", [0, 1])  # 1 is mirrored
+@pytest.mark.slow
 def test_area_search_recovers_textured_map(tmp_path, seed):
     case = _textured(tmp_path / "c", seed)
     grey, _ = load_image(case["image"])
@@ -63,6 +64,7 @@ def test_area_search_recovers_textured_map(tmp_path, seed):
     assert res.ecc > 0.5
 
 
+@pytest.mark.slow
 def test_auto_falls_back_to_area_and_writes_outputs(tmp_path, plain):
     with pytest.raises(GeometryError):  # the objects are not homogeneous enough
         georeference(plain["image"], plain["reference"], search="objects")
@@ -79,6 +81,7 @@ def test_auto_falls_back_to_area_and_writes_outputs(tmp_path, plain):
     assert "area-based global search" in rep["extensions"]
 
 
+@pytest.mark.slow
 def test_area_only_and_bad_modes(tmp_path, plain):
     res = georeference(plain["image"], plain["reference"], search="area")
     assert res.stage == "area" and res.parameters["search"] == "area"
@@ -89,6 +92,7 @@ def test_area_only_and_bad_modes(tmp_path, plain):
         georeference(ortho["image"], ortho["reference"], search="area")
 
 
+@pytest.mark.slow
 def test_area_search_rejects_unrelated_map(tmp_path, plain):
     """An image of another map: a failure message, not a wrong result."""
     other = _textured(tmp_path / "other", seed=7)
@@ -96,6 +100,7 @@ def test_area_search_rejects_unrelated_map(tmp_path, plain):
         georeference(plain["image"], other["reference"], search="area")
 
 
+@pytest.mark.slow
 def test_everest_area_search_never_wrong():
     """Landsat 7 B4 against the RGI glacier outlines, unperturbed: Fourier–Mellin + ECC does
     not find this scene, the boundary-orientation search does (docs/decisions.md); whatever

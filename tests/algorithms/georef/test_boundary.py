@@ -122,6 +122,7 @@ def test_orientation_score_peaks_at_the_truth(tiling) -> None:
     assert at > 0.8 and off < 0.4
 
 
+@pytest.mark.slow
 def test_search_and_refinement_recover_a_mirrored_rotated_tiling(tiling) -> None:
     _polys, rings, T, img = tiling
     cands = area.orientation_search(img, rings, cells=64, keep=3)
@@ -158,6 +159,7 @@ def test_reference_keeps_the_outlines_before_the_dissolve(tmp_path) -> None:
     assert len(objs[0].attributes["outlines"]) == 12
 
 
+@pytest.mark.slow
 def test_pipeline_uses_the_boundaries_of_a_tiling(tmp_path, tiling) -> None:
     """The dissolved tiling is one square without inner edges: only the boundary search
     can place the image; an unrelated tiling gives the failure message."""
@@ -172,6 +174,7 @@ def test_pipeline_uses_the_boundaries_of_a_tiling(tmp_path, tiling) -> None:
         georeference(path, other, search="area")
 
 
+@pytest.mark.slow
 def test_everest_rgb_recovered_by_the_boundary_search() -> None:
     """Landsat 7 RGB against the individual RGI outlines, unperturbed: within 1 px."""
     import rasterio

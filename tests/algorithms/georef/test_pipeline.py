@@ -28,6 +28,7 @@ def case(tmp_path_factory):
     return georef_case(tmp_path_factory.mktemp("georef") / "case", seed=5)
 
 
+@pytest.mark.slow
 def test_synthetic_case_recovered_to_half_a_pixel(case) -> None:
     res = georeference(case["image"], case["reference"])
     err = corner_error(res.fit, case["truth"], case["width"], case["height"])
@@ -36,12 +37,14 @@ def test_synthetic_case_recovered_to_half_a_pixel(case) -> None:
     assert res.fit.rmse_px < 0.5
 
 
+@pytest.mark.slow
 def test_image_against_orthophoto(tmp_path) -> None:
     c = ortho_case(tmp_path, seed=1, size_px=600)
     res = georeference(c["image"], c["reference"])
     assert corner_error(res.fit, c["truth"], c["width"], c["height"]).max() <= 1.0
 
 
+@pytest.mark.slow
 def test_outputs_of_the_algorithm(case, tmp_path) -> None:
     out = tmp_path / "out"
     res = registry.run("georeference_polygons", {
@@ -76,6 +79,7 @@ def test_outputs_of_the_algorithm(case, tmp_path) -> None:
         assert len(gcps) >= 50 and crs is not None
 
 
+@pytest.mark.slow
 def test_bad_inputs_write_nothing(case, tmp_path) -> None:
     out = tmp_path / "never"
     with pytest.raises(InputError, match="no attribute 'landuse'"):
@@ -126,6 +130,7 @@ def test_reference_dissolves_split_polygons_and_reprojects(tmp_path) -> None:
 
 
 @pytest.mark.parametrize("kind", ["projective", "poly2"])
+@pytest.mark.slow
 def test_other_transforms_write_an_aligned_image(case, tmp_path, kind) -> None:
     res = registry.run("georeference_polygons", {
         "image": case["image"], "reference": case["reference"], "transform": kind,
@@ -142,6 +147,7 @@ def test_other_transforms_write_an_aligned_image(case, tmp_path, kind) -> None:
     assert dark and all(dark)
 
 
+@pytest.mark.slow
 def test_batch_over_image_files_flags_failures_and_goes_on(case, tmp_path) -> None:
     """``photodem batch`` over a list of images against one reference (no project)."""
     import json

@@ -29,6 +29,8 @@ from photodem.algorithms.georef.review import (
 from photodem.algorithms.processing import registry
 from photodem.algorithms.synthetic.polygon_scene import georef_case
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def result(tmp_path_factory):

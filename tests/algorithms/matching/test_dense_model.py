@@ -16,6 +16,8 @@ from photodem.algorithms.matching.dense_model import match_model_dense
 from photodem.algorithms.processing import registry
 from photodem.algorithms.quality.compare import compare_dems
 
+pytestmark = pytest.mark.slow
+
 MODEL = "0102_0103"
 OPEN = (1, 7)  # open land and fields: textured, no occlusions
 

@@ -25,6 +25,8 @@ from photodem.algorithms.project.edits import add_features
 from photodem.algorithms.project.model import Project
 from photodem.algorithms.synthetic.block import generate_block
 
+pytestmark = pytest.mark.slow
+
 MODEL = "0101_0102"
 OPEN = "1"  # land-cover class of open, textured ground
 

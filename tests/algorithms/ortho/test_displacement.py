@@ -330,6 +330,7 @@ def tiny_block(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_shifts_follow_prediction_without_embankment(tiny_block: Path, tmp_path: Path) -> None:
     rectify = pytest.importorskip("photodem.algorithms.ortho.rectify",
                                   reason="orthorectify_image is being written in parallel")

@@ -101,6 +101,7 @@ def test_split_objects_go_whole_to_one_image() -> None:
     assert not (boundary_cells(out) & ndimage.binary_erosion(objects)).any()
 
 
+@pytest.mark.slow
 def test_auto_seamlines_cross_no_building_of_a_true_ortho_mosaic(tmp_path) -> None:
     """Acceptance (issue 6): automatic seamlines (vector output) cross no truth building
     footprint of a synthetic block (true-ortho mosaic with DSM and DTM); trees are avoided

@@ -439,6 +439,7 @@ def test_two_batches_taking_over_one_stale_lock_get_it_once(fake_algs, project4,
 @linux_only
 @pytest.mark.parametrize("moment", [round(random.Random(16 + i).uniform(1.0, 4.0), 2)
                                     for i in range(5)])
+@pytest.mark.slow
 def test_ctrl_c_at_a_random_moment_leaves_what_the_summary_says(fake_algs, project4, tmp_path,
                                                                 moment):
     run = tmp_path / "run"

@@ -131,6 +131,7 @@ def _project_with(block: Path, tmp_path: Path, layer: str, rows: list) -> Path:
     return p
 
 
+@pytest.mark.slow
 def test_repair_warning_reaches_the_feedback(block: Path, tmp_path: Path) -> None:
     x0, y0 = 402290.0, 5674690.0
     bow = Polygon([(x0, y0), (x0 + 10, y0 + 10), (x0 + 10, y0), (x0, y0 + 10)])
@@ -141,6 +142,7 @@ def test_repair_warning_reaches_the_feedback(block: Path, tmp_path: Path) -> Non
     assert any("invalid" in w and "exclusion_areas" in w for w in fb.warnings), fb.warnings
 
 
+@pytest.mark.slow
 def test_unknown_action_through_the_cli(block: Path, tmp_path: Path, capsys) -> None:
     x0, y0 = 402290.0, 5674690.0
     sq = Polygon([(x0, y0), (x0 + 10, y0), (x0 + 10, y0 + 10), (x0, y0 + 10)])

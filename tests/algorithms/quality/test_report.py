@@ -107,6 +107,7 @@ def truth(tmp_path_factory):
     return registry.run("synthetic_block", {"output": str(out), "size": "tiny"})
 
 
+@pytest.mark.slow
 def test_truth_dsm_against_dtm_per_class(truth, tmp_path: Path) -> None:
     import fiona
     from rasterio.features import rasterize
@@ -152,6 +153,7 @@ def test_truth_dsm_against_dtm_per_class(truth, tmp_path: Path) -> None:
     assert [row["name"] for row in rows if row["scope"] == "class"] == list(per)
 
 
+@pytest.mark.slow
 def test_dem_compare_bad_input_and_cancel(truth, tmp_path: Path) -> None:
     params = {"dem": truth["truth_dsm"], "reference": truth["truth_dtm"],
               "classes": truth["truth_buildings"], "class_field": "nope",

@@ -79,6 +79,7 @@ def test_registry_outputs_and_project(block: Path) -> None:
         assert min(abs(kappa), abs(abs(kappa) - 180.0)) < 3.0
 
 
+@pytest.mark.slow
 def test_determinism(block: Path, tmp_path: Path) -> None:
     again = generate_block(tmp_path / "again", size="tiny", terrain="gentle", seed=1,
                            texture_direction=30)
