@@ -4,7 +4,8 @@
   declarations → faces; the domains among themselves form no cycle.
 - No function in ``algorithms/`` or ``plugin/`` is longer than 120 lines, except the few listed
   in ``docs/architecture.md`` with their reason.
-- An import inside a function says why it is there (``# lazy: …`` or ``# optional: …``).
+- An import inside a function says why it is there (``# lazy: …``, ``# optional: …``, a
+  platform or version check); modules that ``photodem list`` loads may say it once at the top.
 """
 
 from __future__ import annotations
@@ -134,11 +135,25 @@ def test_functions_are_short() -> None:
     assert not long, "functions over 120 lines:\n" + "\n".join(long)
 
 
+#: Modules ``photodem list`` loads: they may say once, at the top, that their function-level
+#: imports are lazy (the declarations import their domain modules inside ``run``).
+LIST_MODULES = ("algorithms/cli.py", "algorithms/processing/")
+_REASON = re.compile(r"#.*\b(lazy|optional|platform|version)\b")
+_MODULE_REASON = re.compile(r"photodem list")
+
+
+def _header_says_lazy(path: Path, lines: List[str]) -> bool:
+    rel = path.relative_to(ROOT).as_posix()
+    return rel.startswith(LIST_MODULES) and any(_MODULE_REASON.search(ln) for ln in lines[:40])
+
+
 def test_imports_inside_functions_say_why() -> None:
     silent: List[str] = []
     for path in _modules():
         source = path.read_text(encoding="utf-8")
         lines = source.splitlines()
+        if _header_says_lazy(path, lines):
+            continue
         tree = ast.parse(source)
         for func in ast.walk(tree):
             if not isinstance(func, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -148,6 +163,6 @@ def test_imports_inside_functions_say_why() -> None:
                     continue
                 # The reason is on the import, or on a comment line just above the block.
                 above = lines[max(0, node.lineno - 6): node.end_lineno]
-                if not any(re.search(r"#\s*(lazy|optional)\b", ln) for ln in above):
+                if not any(_REASON.search(ln) for ln in above):
                     silent.append(f"{path.relative_to(ROOT)}:{node.lineno}")
     assert not silent, "imports inside functions without a reason:\n" + "\n".join(silent)

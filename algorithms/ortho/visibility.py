@@ -42,6 +42,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from scipy.ndimage import maximum_filter
 
 from ..raster.sample import bilinear_grid
 
@@ -72,8 +73,6 @@ def march_margin(z: ArrayLike, r: ArrayLike, centre_z: float, zmax: float) -> fl
 
 def _max_filters(dsm: Array, levels: Sequence[int]) -> Tuple[Tuple[int, Array], ...]:
     """Max filters of the DSM (NaN counts as −∞) for the skipping levels, largest first."""
-    from scipy.ndimage import maximum_filter
-
     filled = np.where(np.isfinite(dsm), dsm, -np.inf)
     out = []
     for k in sorted({int(k) for k in levels if int(k) >= 2}, reverse=True):

@@ -32,8 +32,10 @@ import numpy as np
 import pyproj
 
 from ..errors import InputError
+from ..geometry.stereo import footprint_and_height, load_dem
 from ..raster.io import open_image
 from .model import Project, identifier_errors
+from .stereo_models import block_bounds, detect_stereo_models
 
 #: Flying heights above ground (m) outside this range are reported as a warning.
 PLAUSIBLE_HEIGHT_M = (20.0, 15000.0)
@@ -153,8 +155,6 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
     if stereo_partners and not rep.errors and len(project.images) > 0:
         models = project.models
         if not models:
-            from .stereo_models import detect_stereo_models
-
             try:
                 models = detect_stereo_models(project, dem=dem)
             except Exception as exc:  # geometry failures are reported, not raised, here
@@ -195,9 +195,6 @@ def _check_files(project: Project, records: List[Any], rep: ValidationReport) ->
 
 def _check_heights(project: Project, records: List[Any], dem: Any,
                    rep: ValidationReport) -> None:
-    from ..geometry.stereo import footprint_and_height, load_dem
-    from .stereo_models import block_bounds
-
     sampler = None
     if dem is not None and records:
         try:

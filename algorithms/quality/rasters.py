@@ -36,7 +36,9 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
+import rasterio
 from numpy.typing import NDArray
+from rasterio.windows import Window
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
@@ -212,8 +214,6 @@ def _cell_metres(src: Any, row0: int, rows: int) -> Tuple[Union[float, NDArray[A
 
 def _read_with_margin(src: Any, row0: int, col0: int, rows: int, cols: int) -> NDArray[Any]:
     """Heights of a window plus a 1-cell margin; outside the raster the edge is repeated."""
-    from rasterio.windows import Window
-
     r0, c0 = max(row0 - 1, 0), max(col0 - 1, 0)
     r1, c1 = min(row0 + rows + 1, src.height), min(col0 + cols + 1, src.width)
     data = src.read(1, window=Window(c0, r0, c1 - c0, r1 - r0), masked=True)
@@ -228,9 +228,6 @@ def _map_windows(dem: PathLike, output: PathLike, dtype: str, nodata: float,
                  func: Callable[[NDArray[Any], Any, float], NDArray[Any]],
                  window_size: int, feedback: Optional[Feedback]) -> Path:
     """Apply ``func(z_with_margin, dx, dy)`` window by window and write ``output`` atomically."""
-    import rasterio
-    from rasterio.windows import Window
-
     feedback = ensure_feedback(feedback)
     dem = Path(dem)
     if not dem.is_file():
