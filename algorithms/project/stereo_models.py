@@ -37,7 +37,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Sequence, Set, Tuple
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,6 +46,7 @@ from scipy.spatial import cKDTree
 from shapely.geometry import Polygon
 
 from ..errors import GeometryError, InputError
+from ..feedback import Feedback, ensure_feedback
 from ..geometry.stereo import (
     DemLike,
     Footprints,
@@ -405,3 +407,83 @@ __all__ = [
     "model_geometry",
     "overlap_polygon",
 ]
+
+
+def _manual_pairs(text: Optional[str]) -> List[Tuple[str, str]]:
+    """Pairs ``'left,right; left,right'`` (newlines also separate pairs)."""
+    pairs = []
+    for pair in (text or "").replace("\n", ";").split(";"):
+        if not pair.strip():
+            continue
+        parts = [p.strip() for p in pair.split(",")]
+        if len(parts) != 2:
+            raise InputError(f"Manual pair '{pair.strip()}': give two image names "
+                             "separated by a comma, pairs separated by ';'.")
+        pairs.append((parts[0], parts[1]))
+    return pairs
+
+
+def run_stereo_models(project_path: Union[str, Path], *, detect: bool = True,
+                      min_overlap: float = 0.25, b_h_range: Tuple[float, float] = (0.2, 1.2),
+                      strip_angle_tolerance: float = 20.0, in_strip_only: bool = False,
+                      manual: Optional[str] = None, dem: Optional[Union[str, Path]] = None,
+                      feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+    """Set a project's stereo models (detected and/or manual) and save ``project.toml``.
+
+    Parameters
+    ----------
+    project_path : str or Path
+        Project folder or ``project.toml``.
+    detect : bool
+        Detect models from the footprints (:func:`detect_stereo_models`).
+    min_overlap : float
+        Minimum overlap as a share (0–1) of the smaller footprint.
+    b_h_range : (float, float)
+        Accepted base-to-height ratios.
+    strip_angle_tolerance : float
+        Degrees between a base and the strip direction for an in-strip pair.
+    in_strip_only : bool
+        Keep in-strip models only.
+    manual : str, optional
+        Pairs ``'left,right; left,right'`` by image name or short label, added as ``manual``.
+    dem : path, optional
+        DEM for terrain heights and footprints; default the project's terrain height.
+    feedback : Feedback, optional
+        Progress and messages.
+
+    Returns
+    -------
+    dict
+        ``models`` (as in ``project.toml``), ``count`` and ``unpaired`` image names.
+    """
+    feedback = ensure_feedback(feedback)
+    project = Project.load(project_path)
+    if b_h_range[0] >= b_h_range[1]:
+        raise InputError(f"Minimum B/H ({b_h_range[0]:g}) must be below the maximum "
+                         f"({b_h_range[1]:g}).")
+    surface = load_dem(dem, block_bounds(project), crs=project.crs) if dem else None
+    models: List[StereoModel] = []
+    if detect:
+        models = detect_stereo_models(
+            project, dem=surface, min_overlap=min_overlap, b_h_range=b_h_range,
+            strip_angle_tolerance=strip_angle_tolerance, in_strip_only=in_strip_only)
+    feedback.progress(60)
+    by_label = {label: name for name, label in
+                image_labels([r.name for r in project.images]).items()}
+    seen = {frozenset((m.left, m.right)) for m in models}
+    for left, right in _manual_pairs(manual):
+        left, right = by_label.get(left, left), by_label.get(right, right)
+        m = manual_model(project, project.image(left).name, project.image(right).name,
+                         dem=surface)
+        if frozenset((m.left, m.right)) not in seen:
+            seen.add(frozenset((m.left, m.right)))
+            models.append(m)
+    project.models = models
+    project.save()  # atomic: the old project.toml stays until the new one is complete
+    paired = {m.left for m in models} | {m.right for m in models}
+    unpaired = [r.name for r in project.images if r.name not in paired]
+    for name in unpaired:
+        feedback.warning(f"Image '{name}' has no stereo partner.")
+    feedback.info(f"{len(models)} stereo models written to {project.project_file}.")
+    return {"models": [m.to_dict() for m in models], "count": len(models),
+            "unpaired": unpaired}

@@ -5,12 +5,9 @@ The domain modules are imported inside ``run`` (lazy: keeps ``photodem list`` fa
 
 from __future__ import annotations
 
-import math
 from typing import Any, Dict
 
-from ...errors import InputError
 from ...feedback import Feedback
-from ...project.model import Project
 from ..spec import Algorithm, Output, Parameter
 
 
@@ -82,35 +79,9 @@ class ProjectInfo(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...project.validate import validate_project
+        from ...project.info import project_info
 
-        project = Project.load(params["project"])
-        images = []
-        for rec in project.images:
-            omega, phi, kappa = rec.eo.opk("degrees")
-            x, y, z = (float(v) for v in rec.eo.position)
-            images.append({
-                "name": rec.name, "camera": rec.camera, "path": rec.path,
-                "x": x, "y": y, "z": z, "omega": omega, "phi": phi, "kappa": kappa,
-                "exists": project.image_path(rec).is_file(),
-            })
-        cameras = {name: cam.to_dict() for name, cam in project.cameras.items()}
-        models = [m.to_dict() for m in project.models]
-        report = validate_project(project, check_files=True)
-        for w in report.warnings:
-            feedback.warning(w)
-        for e in report.errors:
-            feedback.warning("ERROR: " + e)
-        report.raise_first_error()  # every error is listed above; exit 2 with the first
-        return {
-            "name": project.name,
-            "crs": project.crs,
-            "images": images,
-            "cameras": cameras,
-            "models": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                        for k, v in m.items()} for m in models],
-            "validation": report.to_dict(),
-        }
+        return project_info(params["project"], feedback)
 
 
 class StereoModels(Algorithm):
@@ -149,53 +120,15 @@ class StereoModels(Algorithm):
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
-        from ...geometry.stereo import load_dem
-        from ...project.stereo_models import (
-            block_bounds,
-            detect_stereo_models,
-            image_labels,
-            manual_model,
-        )
+        from ...project.stereo_models import run_stereo_models
 
-        project = Project.load(params["project"])
-        if params["b_h_min"] >= params["b_h_max"]:
-            raise InputError(f"Minimum B/H ({params['b_h_min']:g}) must be below the maximum "
-                             f"({params['b_h_max']:g}).")
-        dem = (load_dem(params["dem"], block_bounds(project), crs=project.crs)
-               if params["dem"] else None)
-        models = []
-        if params["detect"]:
-            models = detect_stereo_models(
-                project, dem=dem, min_overlap=params["min_overlap"] / 100.0,
-                b_h_range=(params["b_h_min"], params["b_h_max"]),
-                strip_angle_tolerance=params["strip_angle_tolerance"],
-                in_strip_only=params["in_strip_only"])
-        feedback.progress(60)
-        by_label = {label: name for name, label in
-                    image_labels([r.name for r in project.images]).items()}
-        seen = {frozenset((m.left, m.right)) for m in models}
-        for pair in (params["manual"] or "").replace("\n", ";").split(";"):
-            if not pair.strip():
-                continue
-            parts = [p.strip() for p in pair.split(",")]
-            if len(parts) != 2:
-                raise InputError(f"Manual pair '{pair.strip()}': give two image names "
-                                 "separated by a comma, pairs separated by ';'.")
-            left, right = (by_label.get(p, p) for p in parts)
-            m = manual_model(project, project.image(left).name, project.image(right).name,
-                             dem=dem)
-            if frozenset((m.left, m.right)) not in seen:
-                seen.add(frozenset((m.left, m.right)))
-                models.append(m)
-        project.models = models
-        project.save()  # atomic: the old project.toml stays until the new one is complete
-        paired = {m.left for m in models} | {m.right for m in models}
-        unpaired = [r.name for r in project.images if r.name not in paired]
-        for name in unpaired:
-            feedback.warning(f"Image '{name}' has no stereo partner.")
-        feedback.info(f"{len(models)} stereo models written to {project.project_file}.")
-        return {"models": [m.to_dict() for m in models], "count": len(models),
-                "unpaired": unpaired}
+        return run_stereo_models(
+            params["project"], detect=params["detect"],
+            min_overlap=params["min_overlap"] / 100.0,
+            b_h_range=(params["b_h_min"], params["b_h_max"]),
+            strip_angle_tolerance=params["strip_angle_tolerance"],
+            in_strip_only=params["in_strip_only"], manual=params["manual"], dem=params["dem"],
+            feedback=feedback)
 
 
 ALGORITHMS: list = [ProjectCreate, ProjectInfo, StereoModels]
