@@ -144,7 +144,7 @@ def write_georeferenced(path: PathLike, image: PathLike, result: GeorefResult,
                                 transform=transform, nodata=None)
         amax = 255 if dtype == "uint8" else np.iinfo(dtype).max if np.issubdtype(
             np.dtype(dtype), np.integer) else 1.0
-        with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+        with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
             n_tiles = ((rows + tile - 1) // tile) * ((cols + tile - 1) // tile)
             done = 0
             for r0 in range(0, rows, tile):
@@ -194,7 +194,7 @@ def write_with_gcps(path: PathLike, image: PathLike, result: GeorefResult) -> Pa
         profile.pop("transform", None)
         profile.pop("crs", None)
         profile.update(driver="GTiff")
-        with atomic_output(path) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+        with atomic_output(path) as tmp, open_image(tmp, "w", **profile) as dst:
             for _, window in src.block_windows(1):
                 dst.write(src.read(window=window), window=window)
             dst.gcps = (gcps, result.crs.to_wkt())

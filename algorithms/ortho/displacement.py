@@ -55,7 +55,7 @@ from ..feedback import Feedback, ensure_feedback
 from ..matching.lsm import lsm_match
 from ..matching.ncc import ncc_search_2d
 from ..project.model import Project
-from ..raster.io import atomic_output, gtiff_profile
+from ..raster.io import atomic_output, gtiff_profile, open_image
 from ..raster.sample import bilinear
 from ..surface.point_output import write_points
 
@@ -354,7 +354,7 @@ def predict_displacement(project: Any, image: str, output: PathLike, *,
                             transform=grid.transform, crs=grid.crs, predictor=3)
     warned: Dict[str, bool] = {}
     stats = _DisplacementStats()
-    with atomic_output(output) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+    with atomic_output(output) as tmp, open_image(tmp, "w", **profile) as dst:
         for b, name in enumerate(DISPLACEMENT_BANDS, start=1):
             dst.set_band_description(b, name)
         dst.update_tags(PHOTODEM_IMAGE=rec.name, PHOTODEM_CAMERA_X=repr(eo.position[0]),

@@ -71,6 +71,7 @@ from ..raster.io import (
     atomic_output,
     cog_output,
     gtiff_profile,
+    open_image,
     overview_factors,
     scratch_folder,
 )
@@ -608,7 +609,7 @@ def _write_mosaic(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, part: _Pa
     tfb = fb.step(30, 95)
     # a Cloud-Optimised GeoTIFF: the mosaic is the block's deliverable
     with cog_output(plan.output, prof) as (tmp, scratch_prof), \
-            rasterio.open(tmp, "w", **scratch_prof) as dst:
+            open_image(tmp, "w", **scratch_prof) as dst:
         for t_idx, (r0, c0) in enumerate(tiles):
             tfb.progress(100.0 * t_idx / len(tiles))
             r1, c1 = min(r0 + tile, H), min(c0 + tile, W)

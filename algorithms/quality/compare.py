@@ -44,7 +44,7 @@ from shapely.ops import transform as shapely_transform
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from ..raster.io import atomic_output, gtiff_profile
+from ..raster.io import atomic_output, gtiff_profile, open_image
 from .coregister import nuth_kaab
 from .stats import SLOPE_LABELS, DifferenceAccumulator, _label_key, slope_class_index
 
@@ -326,7 +326,7 @@ def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], re
     tmp = stack.enter_context(atomic_output(path))
     profile = gtiff_profile(grid.width, grid.height, 1, "float32", ref.crs, nodata=float("nan"),
                             transform=grid.transform, predictor=3)
-    return stack.enter_context(rasterio.open(tmp, "w", **profile))
+    return stack.enter_context(open_image(tmp, "w", **profile))
 
 
 def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,

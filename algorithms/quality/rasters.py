@@ -42,7 +42,7 @@ from rasterio.windows import Window
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from ..raster.io import atomic_output, gtiff_profile
+from ..raster.io import atomic_output, gtiff_profile, open_image
 
 PathLike = Union[str, Path]
 
@@ -238,7 +238,7 @@ def _map_windows(dem: PathLike, output: PathLike, dtype: str, nodata: float,
         profile = _profile(src, dtype, nodata)
         windows = [(r, c, min(size, src.height - r), min(size, src.width - c))
                    for r in range(0, src.height, size) for c in range(0, src.width, size)]
-        with atomic_output(output) as tmp, rasterio.open(tmp, "w", **profile) as dst:
+        with atomic_output(output) as tmp, open_image(tmp, "w", **profile) as dst:
             for k, (r, c, h, w) in enumerate(windows):
                 z = _read_with_margin(src, r, c, h, w)
                 dx, dy = _cell_metres(src, r, h)

@@ -53,7 +53,7 @@ from rasterio.windows import Window
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..quality.stats import DifferenceAccumulator
-from ..raster.io import atomic_output, cog_output, gtiff_profile, overview_factors
+from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -433,8 +433,8 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
             out_paths["count"], _profile(width, height, "uint16", transform, crs_out, None)))
         tmp_json = stack.enter_context(atomic_output(out_paths["report"]))
         tmp_csv = stack.enter_context(atomic_output(out_paths["csv"]))
-        with rasterio.open(tmp_dsm, "w", **dsm_profile) as dst, \
-                rasterio.open(tmp_cnt, "w", **cnt_profile) as cnt_dst:
+        with open_image(tmp_dsm, "w", **dsm_profile) as dst, \
+                open_image(tmp_cnt, "w", **cnt_profile) as cnt_dst:
             k = 0
             for tr in range(n_tr):
                 for tc in range(n_tc):
