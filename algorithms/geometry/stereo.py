@@ -137,13 +137,13 @@ def footprint_and_height(camera: Camera, eo: ExteriorOrientation,
 
 
 def image_footprint(camera: Camera, eo: ExteriorOrientation, height: Optional[float] = None,
-                    dem: DemLike = None) -> Polygon:
+                    dem: DemLike = None, per_edge: int = 8) -> Polygon:
     """The image outline projected onto the terrain (plane at ``height`` or DEM mean height).
 
-    The one footprint polygon of the package; the ortho's rectangular extent on a DEM is
-    :func:`~..ortho.rectify.dem_footprint_box`.
+    The one footprint polygon of the package (``per_edge`` outline points per image edge);
+    the ortho's rectangular extent on a DEM is :func:`~..ortho.rectify.dem_footprint_box`.
     """
-    return footprint_and_height(camera, eo, height=height, dem=dem)[0]
+    return footprint_and_height(camera, eo, height=height, dem=dem, per_edge=per_edge)[0]
 
 
 def mean_terrain_height(footprints: Footprints) -> float:

@@ -23,7 +23,7 @@ from shapely.ops import unary_union
 
 from ..errors import GeometryError, InputError
 from ..geometry.epipolar import EpipolarPair
-from ..geometry.projection import border_at_height
+from ..geometry.stereo import image_footprint
 from ..project.edits import read_constraints
 from ..project.model import Project
 from ..surface.gridding import Grid
@@ -67,12 +67,12 @@ class ModelSetup:
 
 
 def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
-    """Image footprint polygon on the plane Z = ``height``."""
-    pts = border_at_height(cam, eo, height, n)
-    ok = np.isfinite(pts).all(axis=1)
-    if ok.sum() < 3:
+    """Image footprint polygon on the plane Z = ``height`` (:func:`image_footprint` with ``n``
+    points per edge, always normalised by ``buffer(0)``); empty where the rays miss the plane."""
+    try:
+        return image_footprint(cam, eo, height=height, per_edge=n).buffer(0)
+    except GeometryError:
         return Polygon()
-    return Polygon(pts[ok, :2]).buffer(0)
 
 
 def check_breaklines(lines: List[Any]) -> None:
