@@ -37,7 +37,7 @@ from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 import fiona
 import pyproj
 from rasterio.crs import CRS
-from shapely.geometry import mapping, shape
+from shapely.geometry import MultiPoint, Point, mapping, shape
 from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
@@ -84,20 +84,15 @@ def check_action(value: Any, where: str) -> Optional[str]:
     return text
 
 
-def repair_polygon(geom: Any, where: str) -> Any:
-    """``geom`` if it is a valid polygon, else its repaired form, with a warning.
+def repaired_polygon(geom: Any) -> Optional[Any]:
+    """The polygonal part of ``geom`` repaired, or ``None`` when nothing of it is left.
 
     ``shapely.validation.make_valid`` (shapely ≥ 1.8) keeps every part of a bow tie;
-    ``buffer(0)`` is the fallback. Only the polygonal parts of the result are kept.
-
-    Raises
-    ------
-    InputError
-        When nothing of the polygon is left after the repair.
+    ``buffer(0)`` is the fallback. Only the polygonal parts of the result are kept. A valid
+    polygon is returned as it is. Shared by the run-time reader and the editing tools.
     """
     if geom.is_valid:
         return geom
-    reason = explain_validity(geom)
     try:  # a version check, not a cycle: make_valid came with shapely 1.8
         from shapely.validation import make_valid
 
@@ -108,11 +103,37 @@ def repair_polygon(geom: Any, where: str) -> Any:
              if g.geom_type in ("Polygon", "MultiPolygon") and not g.is_empty]
     fixed = unary_union(parts) if parts else None
     if fixed is None or fixed.is_empty or fixed.area <= 0:
+        return None
+    return fixed
+
+
+def repair_polygon(geom: Any, where: str) -> Any:
+    """``geom`` if it is a valid polygon, else its repaired form (:func:`repaired_polygon`),
+    with a warning.
+
+    Raises
+    ------
+    InputError
+        When nothing of the polygon is left after the repair.
+    """
+    if geom.is_valid:
+        return geom
+    reason = explain_validity(geom)
+    fixed = repaired_polygon(geom)
+    if fixed is None:
         raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
                          "repairing it; redraw it in edits.gpkg.")
     warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
                f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
     return fixed
+
+
+def flat_breakline_message(layer: str, geom: Any, where: str) -> Optional[str]:
+    """The warning for a breakline without heights (2-D), or ``None``."""
+    if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
+        return (f"{where}: the breakline has no heights (2-D); it only separates the surface "
+                "and gives no heights. Digitise it with Z to use its heights.")
+    return None
 
 
 def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
@@ -134,9 +155,9 @@ def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
         props = {**props, "action": check_action(props.get("action"), where)}
     if geom.geom_type in ("Polygon", "MultiPolygon"):
         geom = repair_polygon(geom, where)
-    if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
-        warn_input(f"{where}: the breakline has no heights (2-D); it only separates the surface "
-                   "and gives no heights. Digitise it with Z to use its heights.")
+    flat = flat_breakline_message(layer, geom, where)
+    if flat:
+        warn_input(flat)
     return geom, props
 
 
@@ -181,6 +202,40 @@ def create_edits(path: PathLike, crs: str) -> Path:
     return path
 
 
+def check_layer(layer: str) -> str:
+    """``layer`` if it is a layer of ``edits.gpkg``.
+
+    Raises
+    ------
+    InputError
+        Naming the layer and the edit layers.
+    """
+    if layer not in EDIT_LAYERS:
+        raise InputError(f"'{layer}' is not an edit layer; use one of {', '.join(EDIT_LAYERS)}.")
+    return layer
+
+
+def check_fields(layer: str, props: Optional[Dict[str, Any]]) -> Dict[str, Any]:
+    """The attributes of one new feature of ``layer``, checked and normalised.
+
+    Unknown fields are an error; ``action`` of an exclusion area is normalised by
+    :func:`check_action`.
+
+    Raises
+    ------
+    InputError
+        Naming the layer and the offending field or value.
+    """
+    fields = EDIT_LAYERS[check_layer(layer)][1]
+    props = dict(props or {})
+    unknown = sorted(set(props) - set(fields))
+    if unknown:
+        raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
+    if layer == "exclusion_areas":
+        props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
+    return props
+
+
 def add_features(path: PathLike, layer: str,
                  features: Iterable[Tuple[Any, Dict[str, Any]]]) -> int:
     """Append ``(shapely geometry, properties)`` pairs to a layer of ``edits.gpkg``.
@@ -188,17 +243,10 @@ def add_features(path: PathLike, layer: str,
     Missing properties are written as empty; unknown ones are an error. Returns the number of
     features written.
     """
-    if layer not in EDIT_LAYERS:
-        raise InputError(f"'{layer}' is not an edit layer; use one of {', '.join(EDIT_LAYERS)}.")
-    fields = EDIT_LAYERS[layer][1]
+    fields = EDIT_LAYERS[check_layer(layer)][1]
     records = []
     for geom, props in features:
-        props = dict(props or {})
-        unknown = sorted(set(props) - set(fields))
-        if unknown:
-            raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
-        if layer == "exclusion_areas":
-            props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
+        props = check_fields(layer, props)
         records.append({"geometry": mapping(geom),
                         "properties": OrderedDict((k, props.get(k)) for k in fields)})
     with fiona.open(str(path), "a", driver="GPKG", layer=layer) as dst:
@@ -227,10 +275,6 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
             out.append(check_feature(path, layer, feat.fid, shape(feat.geometry),
                                      feat.properties))
     return out
-
-
-__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features", "check_action", "check_feature",
-           "create_edits", "read_layer", "repair_polygon"]
 
 
 def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
@@ -273,3 +317,83 @@ def read_constraints(path: PathLike, crs: Any = None) -> Tuple[List[Any], List[A
     return (read_geometries(path, ("Polygon",), crs, ("exclusion_areas",), skip_keep=True),
             read_geometries(path, ("Polygon",), crs, ("boundaries",)),
             read_geometries(path, ("LineString",), crs, ("breaklines",)))
+
+
+# -- breaklines must not cross (seed-000 §2.10) --------------------------------------------------
+#: Two points closer than this (m) are one point (shared end points of continuing lines).
+SAME_POINT_M = 1e-6
+
+
+def _ends(line: Any) -> List[Any]:
+    return [Point(line.coords[0]), Point(line.coords[-1])]
+
+
+def self_crossings(line: Any) -> List[Tuple[float, float]]:
+    """Points (x, y) where a line crosses or touches itself; empty for a simple line.
+
+    The line is noded (split where it meets itself); a node shared by more than two pieces is
+    a crossing. A closed line (first = last vertex) is not a crossing at its start.
+    """
+    if line.is_simple:
+        return []
+    noded = unary_union(line)
+    count: Dict[Tuple[float, float], int] = {}
+    for piece in getattr(noded, "geoms", [noded]):
+        for x, y in (piece.coords[0][:2], piece.coords[-1][:2]):
+            key = (round(x, 6), round(y, 6))
+            count[key] = count.get(key, 0) + 1
+    points = [p for p, n in count.items() if n > 2]
+    if not points:  # an overlap along a segment, or a degenerate line: still not simple
+        points = [line.representative_point().coords[0][:2]]
+    return points
+
+
+def line_crossing(a: Any, b: Any) -> Optional[Tuple[float, float]]:
+    """Where two lines cross or touch, or ``None`` when they are apart or one continues the
+    other (they meet only at end points of both)."""
+    if not a.intersects(b):
+        return None
+    cut = a.intersection(b)
+    points = list(getattr(cut, "geoms", [cut]))
+    shared = [e for e in _ends(a) if any(e.distance(f) < SAME_POINT_M for f in _ends(b))]
+    if all(isinstance(p, Point) and any(p.distance(e) < SAME_POINT_M for e in shared)
+           for p in points):
+        return None  # one line continues the other
+    if isinstance(cut, (Point, MultiPoint)):  # a true crossing: mark a point of it not shared
+        for p in points:
+            if not any(p.distance(e) < SAME_POINT_M for e in shared):
+                return p.x, p.y
+    x, y = cut.representative_point().coords[0][:2]
+    return x, y
+
+
+def check_breaklines(lines: List[Any]) -> None:
+    """Refuse breaklines that cross each other or themselves (seed-000 §2.10).
+
+    Touching at end points is allowed (lines that continue one another). The matcher calls this
+    before it matches; the editing tools use :func:`self_crossings` and :func:`line_crossing`.
+
+    Raises
+    ------
+    InputError
+        Naming the two lines (1-based, in the order of the layer) and the crossing point.
+    """
+    for i, a in enumerate(lines):
+        if not a.is_simple:
+            raise InputError(f"Breakline {i + 1} crosses itself; fix it in edits.gpkg "
+                             "(layer breaklines).")
+        for j in range(i + 1, len(lines)):
+            b = lines[j]
+            if not a.intersects(b):
+                continue
+            if line_crossing(a, b) is None:
+                continue
+            x, y = a.intersection(b).representative_point().coords[0][:2]
+            raise InputError(f"Breaklines {i + 1} and {j + 1} cross at ({x:.2f}, {y:.2f}); "
+                             "breaklines must not cross or touch — fix them in edits.gpkg.")
+
+
+__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "SAME_POINT_M", "add_features", "check_action",
+           "check_breaklines", "check_feature", "check_fields", "check_layer", "create_edits",
+           "flat_breakline_message", "line_crossing", "read_constraints", "read_geometries",
+           "read_layer", "repair_polygon", "repaired_polygon", "self_crossings"]
