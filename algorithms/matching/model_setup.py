@@ -24,7 +24,8 @@ from shapely.ops import unary_union
 from ..errors import GeometryError, InputError
 from ..geometry.epipolar import EpipolarPair
 from ..geometry.projection import border_at_height
-from ..project.edits import check_breaklines, read_constraints
+from ..project.breaklines import check_breaklines
+from ..project.edits import read_constraints
 from ..project.model import Project
 from ..surface.gridding import Grid
 from .dense import check_disparity_range

@@ -2,7 +2,7 @@
 
 The editing tools ask these functions; the rules are those applied when a run reads the edits
 (:mod:`.edits`: the action values, the polygon repair, 2-D breaklines; the matcher's crossing
-rule :func:`.edits.check_breaklines`), called here through the same functions, so an edit the
+rule :func:`.breaklines.check_breaklines`), called here through the same functions, so an edit the
 tools accept is not refused later, and the messages are the same.
 
 * :func:`check_new_breakline` — crossings with the existing breaklines and with itself (touching
@@ -29,14 +29,14 @@ from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
 from ..errors import InputError
+from .breaklines import line_crossing, self_crossings
 from .edits import (
     EDIT_LAYERS,
     check_fields,
     check_layer,
     flat_breakline_message,
-    line_crossing,
+    kind_message,
     repaired_polygon,
-    self_crossings,
 )
 from .model import Project, StereoModel
 from .stereo_models import block_footprints, overlap_polygon
@@ -81,7 +81,7 @@ def errors(problems: Sequence[Problem]) -> List[Problem]:
 def check_new_breakline(line: Any, existing: Sequence[Any]) -> List[Problem]:
     """Crossings of a new breakline with itself and with the existing ones.
 
-    The matcher's rule (:func:`.edits.check_breaklines`): breaklines must not cross or touch,
+    The matcher's rule (:func:`.breaklines.check_breaklines`): breaklines must not cross or touch,
     except at shared end points of lines that continue one another.
 
     Parameters
@@ -245,6 +245,9 @@ def _attribute_problems(layer: str, attributes: Optional[Dict[str, Any]],
         check_fields(layer, attributes)
     except InputError as exc:
         return [Problem(str(exc), where)]
+    kind = kind_message((attributes or {}).get("kind"), f"Layer '{layer}'")
+    if layer == "breaklines" and kind:
+        return [Problem(kind, where, "warning")]
     return []
 
 

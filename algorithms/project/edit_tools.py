@@ -39,6 +39,7 @@ from ..crs_check import crs_label, same_horizontal_crs
 from ..errors import InputError
 from ..input_errors import reading
 from ..raster.sample import bilinear_grid, world_to_grid
+from .edits import read_geometries
 
 PathLike = Union[str, Path]
 XY = Tuple[float, float]
@@ -338,5 +339,19 @@ def snap_to_lines(point: Sequence[float], lines: Sequence[Any],
     return best_vertex or best_edge
 
 
+def mosaic_seamlines(path: PathLike, crs: Any = None) -> List[Any]:
+    """The lines of a mosaic's seamline file (its ``seamlines`` layer), in ``crs``.
+
+    The snapping targets of :func:`snap_to_lines` for the standalone tool (QGIS snaps to the
+    loaded layer itself).
+
+    Raises
+    ------
+    InputError
+        A missing or unreadable file.
+    """
+    return read_geometries(path, ("LineString",), crs, ("seamlines",))
+
+
 __all__ = ["NODATA", "OUTSIDE", "DrapedLine", "HeightSample", "Snap", "drape_line",
-           "sample_height", "snap_to_lines", "surface_heights"]
+           "mosaic_seamlines", "sample_height", "snap_to_lines", "surface_heights"]

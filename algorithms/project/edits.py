@@ -37,7 +37,7 @@ from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 import fiona
 import pyproj
 from rasterio.crs import CRS
-from shapely.geometry import MultiPoint, Point, mapping, shape
+from shapely.geometry import mapping, shape
 from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
@@ -62,6 +62,10 @@ EDIT_LAYERS: Dict[str, Tuple[str, OrderedDict[str, str]]] = {
 #: Allowed values of ``exclusion_areas.action``.
 EXCLUSION_ACTIONS = ("keep", "remove", "exclude")
 
+#: The values the editing tools offer for ``breaklines.kind`` (seed-000 §2.10: breaklines and
+#: structure lines). Other texts are kept (the kind steers no algorithm yet), with a warning.
+BREAKLINE_KINDS = ("breakline", "structure_line")
+
 
 def _where(path: PathLike, layer: str, fid: Any) -> str:
     return f"'{Path(path).name}' layer {layer}, feature {fid}"
@@ -82,6 +86,17 @@ def check_action(value: Any, where: str) -> Optional[str]:
         raise InputError(f"{where}: action '{value}' is not one of {', '.join(EXCLUSION_ACTIONS)} "
                          "(empty = remove); fix it in edits.gpkg.")
     return text
+
+
+def kind_message(value: Any, where: str) -> Optional[str]:
+    """A warning for a breakline ``kind`` that is not one of :data:`BREAKLINE_KINDS`, or
+    ``None`` (empty = ``breakline``)."""
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    if str(value).strip().lower() in BREAKLINE_KINDS:
+        return None
+    return (f"{where}: kind '{value}' is not one of {', '.join(BREAKLINE_KINDS)}; it is kept "
+            "as a note.")
 
 
 def repaired_polygon(geom: Any) -> Optional[Any]:
@@ -319,81 +334,7 @@ def read_constraints(path: PathLike, crs: Any = None) -> Tuple[List[Any], List[A
             read_geometries(path, ("LineString",), crs, ("breaklines",)))
 
 
-# -- breaklines must not cross (seed-000 §2.10) --------------------------------------------------
-#: Two points closer than this (m) are one point (shared end points of continuing lines).
-SAME_POINT_M = 1e-6
-
-
-def _ends(line: Any) -> List[Any]:
-    return [Point(line.coords[0]), Point(line.coords[-1])]
-
-
-def self_crossings(line: Any) -> List[Tuple[float, float]]:
-    """Points (x, y) where a line crosses or touches itself; empty for a simple line.
-
-    The line is noded (split where it meets itself); a node shared by more than two pieces is
-    a crossing. A closed line (first = last vertex) is not a crossing at its start.
-    """
-    if line.is_simple:
-        return []
-    noded = unary_union(line)
-    count: Dict[Tuple[float, float], int] = {}
-    for piece in getattr(noded, "geoms", [noded]):
-        for x, y in (piece.coords[0][:2], piece.coords[-1][:2]):
-            key = (round(x, 6), round(y, 6))
-            count[key] = count.get(key, 0) + 1
-    points = [p for p, n in count.items() if n > 2]
-    if not points:  # an overlap along a segment, or a degenerate line: still not simple
-        points = [line.representative_point().coords[0][:2]]
-    return points
-
-
-def line_crossing(a: Any, b: Any) -> Optional[Tuple[float, float]]:
-    """Where two lines cross or touch, or ``None`` when they are apart or one continues the
-    other (they meet only at end points of both)."""
-    if not a.intersects(b):
-        return None
-    cut = a.intersection(b)
-    points = list(getattr(cut, "geoms", [cut]))
-    shared = [e for e in _ends(a) if any(e.distance(f) < SAME_POINT_M for f in _ends(b))]
-    if all(isinstance(p, Point) and any(p.distance(e) < SAME_POINT_M for e in shared)
-           for p in points):
-        return None  # one line continues the other
-    if isinstance(cut, (Point, MultiPoint)):  # a true crossing: mark a point of it not shared
-        for p in points:
-            if not any(p.distance(e) < SAME_POINT_M for e in shared):
-                return p.x, p.y
-    x, y = cut.representative_point().coords[0][:2]
-    return x, y
-
-
-def check_breaklines(lines: List[Any]) -> None:
-    """Refuse breaklines that cross each other or themselves (seed-000 §2.10).
-
-    Touching at end points is allowed (lines that continue one another). The matcher calls this
-    before it matches; the editing tools use :func:`self_crossings` and :func:`line_crossing`.
-
-    Raises
-    ------
-    InputError
-        Naming the two lines (1-based, in the order of the layer) and the crossing point.
-    """
-    for i, a in enumerate(lines):
-        if not a.is_simple:
-            raise InputError(f"Breakline {i + 1} crosses itself; fix it in edits.gpkg "
-                             "(layer breaklines).")
-        for j in range(i + 1, len(lines)):
-            b = lines[j]
-            if not a.intersects(b):
-                continue
-            if line_crossing(a, b) is None:
-                continue
-            x, y = a.intersection(b).representative_point().coords[0][:2]
-            raise InputError(f"Breaklines {i + 1} and {j + 1} cross at ({x:.2f}, {y:.2f}); "
-                             "breaklines must not cross or touch — fix them in edits.gpkg.")
-
-
-__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "SAME_POINT_M", "add_features", "check_action",
-           "check_breaklines", "check_feature", "check_fields", "check_layer", "create_edits",
-           "flat_breakline_message", "line_crossing", "read_constraints", "read_geometries",
-           "read_layer", "repair_polygon", "repaired_polygon", "self_crossings"]
+__all__ = ["BREAKLINE_KINDS", "EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features",
+           "check_action", "check_feature", "check_fields", "check_layer", "create_edits",
+           "flat_breakline_message", "kind_message", "read_constraints", "read_geometries",
+           "read_layer", "repair_polygon", "repaired_polygon"]

@@ -5,12 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import fiona
 import numpy as np
 import pyproj
 import pytest
 import rasterio
 from affine import Affine
-from shapely.geometry import LineString, MultiLineString, Point, Polygon
+from shapely.geometry import LineString, MultiLineString, Point, Polygon, mapping
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.geometry.camera import Camera
@@ -28,6 +29,7 @@ from photodem.algorithms.project.edit_tools import (
     NODATA,
     OUTSIDE,
     drape_line,
+    mosaic_seamlines,
     sample_height,
     snap_to_lines,
 )
@@ -233,6 +235,20 @@ def test_snap_to_multilines_and_bad_tolerance() -> None:
         snap_to_lines((0, 0), lines, 0)
 
 
+def test_mosaic_seamlines_are_snapping_targets(tmp_path: Path) -> None:
+    path = tmp_path / "seamlines.gpkg"
+    schema = {"geometry": "MultiLineString", "properties": {"image_a": "str"}}
+    with fiona.open(str(path), "w", driver="GPKG", layer="seamlines", schema=schema,
+                    crs="EPSG:25832") as dst:
+        dst.write({"geometry": mapping(MultiLineString([[(0, 0), (0, 100)]])),
+                   "properties": {"image_a": "a"}})
+    lines = mosaic_seamlines(path, "EPSG:25832")
+    assert len(lines) == 1
+    assert snap_to_lines((0.3, 50.0), lines, 1.0).point == pytest.approx((0.0, 50.0))
+    with pytest.raises(InputError, match="does not exist"):
+        mosaic_seamlines(tmp_path / "none.gpkg")
+
+
 # -- the block -----------------------------------------------------------------------------------
 CAM = Camera("c", 100, 80, 1.0, (0.01, 0.01))  # footprint 1000 m × 800 m at H = 1000 m
 
@@ -269,7 +285,7 @@ def test_valid_edits_have_no_problem(project: Project) -> None:
     square = Polygon([(0, 0), (50, 0), (50, 50), (0, 50)])
     edits = [("start_points", Point(400, 0), {"height": 102.5}),
              ("exclusion_areas", square, {"action": "Keep "}),
-             ("breaklines", LineString([(0, 0, 101), (30, 40, 103)]), {"kind": "hard"}),
+             ("breaklines", LineString([(0, 0, 101), (30, 40, 103)]), {"kind": "breakline"}),
              ("ground_points", Point(10, 10, 99.0), {}),
              ("check_points", Point(10, 10, 99.0), {"id": "CP1"}),
              ("seamlines", LineString([(400, -300), (400, 300)]), {}),
@@ -308,4 +324,10 @@ def test_warnings_do_not_refuse(project: Project) -> None:
                          project)
     assert [p.severity for p in half] == ["warning"] and "partly outside" in half[0].message
     assert half[0].location is not None
+    kind = validate_edit("breaklines", LineString([(0, 0, 100), (5, 5, 101)]), {"kind": "hedge"},
+                         project)
+    assert [p.severity for p in kind] == ["warning"]
+    assert "kind 'hedge' is not one of breakline, structure_line" in kind[0].message
+    assert validate_edit("breaklines", LineString([(0, 0, 100), (5, 5, 101)]),
+                         {"kind": "Structure_Line"}, project) == []
 
