@@ -29,6 +29,7 @@ from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
 from ..errors import InputError
+from ..geometry.stereo import Footprints
 from .breaklines import line_crossing, self_crossings
 from .edits import (
     EDIT_LAYERS,
@@ -150,9 +151,13 @@ def _first_xy(geom: Any) -> Optional[XY]:
 
 
 # -- the block: area, plausible heights, models ---------------------------------------------------
-def block_area(project: Project) -> Any:
-    """The project's block area: the union of its image footprints (terrain height)."""
-    return unary_union([poly for poly, _ in block_footprints(project).values()])
+def block_area(project: Project, footprints: Optional[Footprints] = None) -> Any:
+    """The project's block area: the union of its image footprints (terrain height).
+
+    ``footprints`` (:func:`.stereo_models.block_footprints`) may be passed to reuse them.
+    """
+    fp = block_footprints(project) if footprints is None else footprints
+    return unary_union([poly for poly, _ in fp.values()])
 
 
 def plausible_heights(project: Project) -> Tuple[float, float]:
@@ -181,7 +186,7 @@ def plausible_heights(project: Project) -> Tuple[float, float]:
 
 
 def models_at(project: Project, x: float, y: float,
-              footprints: Optional[Dict[str, Any]] = None) -> List[StereoModel]:
+              footprints: Optional[Footprints] = None) -> List[StereoModel]:
     """The stereo models of the project whose overlap contains the map point (x, y).
 
     ``footprints`` (:func:`.stereo_models.block_footprints`) may be passed to reuse them
@@ -202,7 +207,7 @@ _Z_LAYERS = ("breaklines", "ground_points", "check_points")
 
 
 def validate_edit(layer: str, geometry: Any, attributes: Optional[Dict[str, Any]],
-                  project: Project, area: Any = None) -> List[Problem]:
+                  project: Project, footprints: Optional[Footprints] = None) -> List[Problem]:
     """All problems of one edit before it is written to ``edits.gpkg``.
 
     Parameters
@@ -214,9 +219,10 @@ def validate_edit(layer: str, geometry: Any, attributes: Optional[Dict[str, Any]
     attributes : dict
         The feature's fields.
     project : Project
-        For the plausible heights and the block area.
-    area : shapely geometry, optional
-        :func:`block_area`, when the tool keeps it between edits.
+        For the plausible heights, the block area and the stereo models.
+    footprints : dict, optional
+        :func:`.stereo_models.block_footprints` of the project, when the tool keeps them
+        between edits (they cost a projection of every image's border).
 
     Returns
     -------
@@ -233,8 +239,12 @@ def validate_edit(layer: str, geometry: Any, attributes: Optional[Dict[str, Any]
         return problems + [Problem(f"Layer '{layer}': the feature has no geometry.")]
     problems += _geometry_problems(layer, geometry)
     problems += _height_problems(layer, geometry, attributes or {}, plausible_heights(project))
-    area = block_area(project) if area is None else area
-    problems += _area_problems(layer, geometry, area)
+    fp = block_footprints(project) if footprints is None else footprints
+    problems += _area_problems(layer, geometry, block_area(project, fp))
+    if layer == "start_points" and not errors(problems) and project.models \
+            and not models_at(project, geometry.x, geometry.y, fp):
+        problems.append(Problem(f"Layer '{layer}': the start point lies outside every stereo "
+                                "model; no model will use it.", _first_xy(geometry), "warning"))
     return problems
 
 

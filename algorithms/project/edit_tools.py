@@ -131,24 +131,31 @@ def _to_surface_crs(path: Path, surface_crs: Any, x: NDArray, y: NDArray,
     return np.asarray(sx, dtype=float), np.asarray(sy, dtype=float)
 
 
+#: Largest window (cells) read at once; points further apart are read one small window each
+#: (a long breakline on a fine DSM must not read most of the raster).
+MAX_WINDOW_CELLS = 1_000_000
+
+
+def _inside(col: NDArray, row: NDArray, width: int, height: int) -> NDArray:
+    """Fractional positions on the raster (cell centres at integers: edges at −0.5)."""
+    return (col >= -0.5) & (col <= width - 0.5) & (row >= -0.5) & (row <= height - 0.5)
+
+
 def _window_heights(src: Any, col: NDArray, row: NDArray) -> NDArray:
-    """Bilinear heights at fractional (col, row) of the open raster ``src``, NaN outside the
-    raster or next to nodata; only the window around the points is read."""
-    w, h = src.width, src.height
-    z = np.full(col.shape, np.nan)
-    inside = (col >= -0.5) & (col <= w - 0.5) & (row >= -0.5) & (row <= h - 0.5)
-    if not inside.any():
-        return z
-    c, r = col[inside], row[inside]
-    c0 = max(int(np.floor(c.min())), 0)
-    r0 = max(int(np.floor(r.min())), 0)
-    c1 = min(int(np.floor(c.max())) + 2, w)
-    r1 = min(int(np.floor(r.max())) + 2, h)
+    """Bilinear heights at fractional (col, row) of the open raster ``src``, all on the raster;
+    NaN next to nodata. Only the window around the points is read (one window around each
+    point when they lie far apart)."""
+    c0 = max(int(np.floor(col.min())), 0)
+    r0 = max(int(np.floor(row.min())), 0)
+    c1 = min(int(np.floor(col.max())) + 2, src.width)
+    r1 = min(int(np.floor(row.max())) + 2, src.height)
+    if len(col) > 1 and (c1 - c0) * (r1 - r0) > MAX_WINDOW_CELLS:
+        return np.concatenate([_window_heights(src, col[k:k + 1], row[k:k + 1])
+                               for k in range(len(col))])
     data = src.read(1, window=Window(c0, r0, c1 - c0, r1 - r0), masked=True)
     array = data.astype(float).filled(np.nan)
     # clamp: the outer half cells of the raster take the edge values (module notes)
-    z[inside] = bilinear_grid(array, c - c0, r - r0, edge="clamp")
-    return z
+    return bilinear_grid(array, col - c0, row - r0, edge="clamp")
 
 
 def surface_heights(surface: PathLike, x: Sequence[float], y: Sequence[float],
@@ -181,11 +188,14 @@ def surface_heights(surface: PathLike, x: Sequence[float], y: Sequence[float],
     y = np.atleast_1d(np.asarray(y, dtype=float))
     with reading(path, "surface"), rasterio.open(path) as src:
         sx, sy = _to_surface_crs(path, src.crs, x, y, crs)
+        bad = ~(np.isfinite(sx) & np.isfinite(sy))  # not representable in the surface's CRS
+        sx, sy = np.where(bad, np.nan, sx), np.where(bad, np.nan, sy)
         col, row = world_to_grid(src.transform, sx, sy)
-        z = _window_heights(src, col, row)
-        w, h = src.width, src.height
-    outside = ~((col >= -0.5) & (col <= w - 0.5) & (row >= -0.5) & (row <= h - 0.5))
-    return z, outside
+        on = _inside(col, row, src.width, src.height)
+        z = np.full(col.shape, np.nan)
+        if on.any():
+            z[on] = _window_heights(src, col[on], row[on])
+    return z, ~on
 
 
 def sample_height(surface: PathLike, x: float, y: float, crs: Any = None) -> HeightSample:

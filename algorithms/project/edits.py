@@ -95,8 +95,8 @@ def kind_message(value: Any, where: str) -> Optional[str]:
         return None
     if str(value).strip().lower() in BREAKLINE_KINDS:
         return None
-    return (f"{where}: kind '{value}' is not one of {', '.join(BREAKLINE_KINDS)}; it is kept "
-            "as a note.")
+    return (f"{where}: kind '{value}' is not one of {', '.join(BREAKLINE_KINDS)}; the line is "
+            "used as a breakline.")
 
 
 def repaired_polygon(geom: Any) -> Optional[Any]:

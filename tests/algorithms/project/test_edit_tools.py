@@ -3,6 +3,7 @@ and polygon checks, one edit's validation, snapping, the models at a point."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import fiona
@@ -16,6 +17,7 @@ from shapely.geometry import LineString, MultiLineString, Point, Polygon, mappin
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
+from photodem.algorithms.project import edit_tools
 from photodem.algorithms.project.edit_checks import (
     block_area,
     check_new_breakline,
@@ -34,7 +36,7 @@ from photodem.algorithms.project.edit_tools import (
     snap_to_lines,
 )
 from photodem.algorithms.project.model import ImageRecord, Project
-from photodem.algorithms.project.stereo_models import manual_model
+from photodem.algorithms.project.stereo_models import block_footprints, manual_model
 
 # -- an analytic DEM: z = A + B·x + C·y + D·x·y is reproduced exactly by bilinear interpolation
 A, B, C, D = 250.0, 0.03, -0.02, 1e-5
@@ -85,6 +87,10 @@ def test_sample_height_in_another_crs_is_reprojected(dem: Path) -> None:
     s = sample_height(dem, lon, lat, crs="EPSG:4326")
     assert s.z == pytest.approx(float(analytic(x, y)), abs=1e-6)
     assert sample_height(dem, x, y, crs="EPSG:25832").z == pytest.approx(s.z, abs=1e-6)
+    # metres taken for degrees: no position in the surface's CRS, outside, and no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sample_height(dem, x, y, crs="EPSG:4326").cause == OUTSIDE
 
 
 def test_outer_half_cell_takes_the_edge_value(dem: Path) -> None:
@@ -137,6 +143,32 @@ def test_only_a_window_is_read(dem: Path, monkeypatch) -> None:
     sample_height(dem, X0 + 30.3, Y0 - 20.2)
     assert len(seen) == 1 and seen[0] is not None
     assert seen[0].width <= 2 and seen[0].height <= 2
+
+
+def test_far_apart_points_are_read_one_small_window_each(dem: Path, monkeypatch) -> None:
+    seen = []
+    real = rasterio.io.DatasetReader.read
+
+    def spy(self, *args, **kwargs):
+        seen.append(kwargs.get("window"))
+        return real(self, *args, **kwargs)
+
+    coords = [(X0 + 3.3, Y0 - 3.3), (X0 + 61.7, Y0 - 41.1), (X0 + 117.5, Y0 - 77.7)]
+    whole = drape_line(dem, coords)
+    monkeypatch.setattr(rasterio.io.DatasetReader, "read", spy)
+    monkeypatch.setattr(edit_tools, "MAX_WINDOW_CELLS", 16)
+    split = drape_line(dem, coords)
+    assert len(seen) == 3 and all(w.width * w.height <= 4 for w in seen)
+    assert [c[2] for c in split.coords] == pytest.approx([c[2] for c in whole.coords], abs=1e-9)
+
+
+def test_unreadable_surface_and_unknown_crs(dem: Path, tmp_path: Path) -> None:
+    bad = tmp_path / "text.tif"
+    bad.write_text("not a raster")
+    with pytest.raises(InputError, match=r"text\.tif"):
+        sample_height(bad, 0, 0)
+    with pytest.raises(InputError, match="not understood"):
+        sample_height(dem, X0 + 5, Y0 - 5, crs="EPSG:999999")
 
 
 # -- drape_line ----------------------------------------------------------------------------------
@@ -280,7 +312,8 @@ def test_plausible_heights(project: Project) -> None:
 
 
 def test_valid_edits_have_no_problem(project: Project) -> None:
-    area = block_area(project)
+    fp = block_footprints(project)
+    area = block_area(project, fp)
     assert area.bounds == pytest.approx((-500.0, -400.0, 1300.0, 400.0))
     square = Polygon([(0, 0), (50, 0), (50, 50), (0, 50)])
     edits = [("start_points", Point(400, 0), {"height": 102.5}),
@@ -291,7 +324,7 @@ def test_valid_edits_have_no_problem(project: Project) -> None:
              ("seamlines", LineString([(400, -300), (400, 300)]), {}),
              ("boundaries", square, {"name": "b"})]
     for layer, geom, attrs in edits:
-        assert validate_edit(layer, geom, attrs, project, area=area) == [], layer
+        assert validate_edit(layer, geom, attrs, project, footprints=fp) == [], layer
 
 
 @pytest.mark.parametrize("layer, geom, attrs, words", [
@@ -324,6 +357,9 @@ def test_warnings_do_not_refuse(project: Project) -> None:
                          project)
     assert [p.severity for p in half] == ["warning"] and "partly outside" in half[0].message
     assert half[0].location is not None
+    alone = validate_edit("start_points", Point(-300, 0), {"height": 100.0}, project)
+    assert [p.severity for p in alone] == ["warning"]
+    assert "outside every stereo model" in alone[0].message
     kind = validate_edit("breaklines", LineString([(0, 0, 100), (5, 5, 101)]), {"kind": "hedge"},
                          project)
     assert [p.severity for p in kind] == ["warning"]
