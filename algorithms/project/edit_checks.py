@@ -312,6 +312,10 @@ def _height_problems(layer: str, geometry: Any, attributes: Dict[str, Any],
 
 def _area_problems(layer: str, geometry: Any, area: Any) -> List[Problem]:
     """Outside the block area: an error; partly outside: a warning."""
+    if "Polygon" in geometry.geom_type and not geometry.is_valid:
+        geometry = repaired_polygon(geometry)  # GEOS predicates want valid polygons
+        if geometry is None:
+            return []  # refused by the polygon check already
     if area is None or area.is_empty or area.covers(geometry):
         return []
     where = _first_xy(geometry)
