@@ -18,12 +18,13 @@ from pathlib import Path
 from typing import Any, List, Optional
 
 import numpy as np
-from shapely.geometry import Point, Polygon
+from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
 from ..errors import GeometryError, InputError
 from ..geometry.epipolar import EpipolarPair
 from ..geometry.stereo import image_footprint
+from ..project.breaklines import check_breaklines
 from ..project.edits import read_constraints
 from ..project.model import Project
 from ..surface.gridding import Grid
@@ -73,38 +74,6 @@ def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
         return image_footprint(cam, eo, height=height, per_edge=n).buffer(0)
     except GeometryError:
         return Polygon()
-
-
-def check_breaklines(lines: List[Any]) -> None:
-    """Refuse breaklines that cross each other or themselves (seed-000 §2.10).
-
-    Touching at end points is allowed (lines that continue one another).
-
-    Raises
-    ------
-    InputError
-        Naming the two lines (1-based, in the order of the layer) and the crossing point.
-    """
-    def ends(line: Any) -> List[Any]:
-        return [Point(line.coords[0]), Point(line.coords[-1])]
-
-    for i, a in enumerate(lines):
-        if not a.is_simple:
-            raise InputError(f"Breakline {i + 1} crosses itself; fix it in edits.gpkg "
-                             "(layer breaklines).")
-        for j in range(i + 1, len(lines)):
-            b = lines[j]
-            if not a.intersects(b):
-                continue
-            cut = a.intersection(b)
-            points = list(getattr(cut, "geoms", [cut]))
-            shared = [e for e in ends(a) if any(e.distance(f) < 1e-6 for f in ends(b))]
-            if all(isinstance(p, Point) and any(p.distance(e) < 1e-6 for e in shared)
-                   for p in points):
-                continue  # one line continues the other
-            x, y = cut.representative_point().coords[0][:2]
-            raise InputError(f"Breaklines {i + 1} and {j + 1} cross at ({x:.2f}, {y:.2f}); "
-                             "breaklines must not cross or touch — fix them in edits.gpkg.")
 
 
 def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
@@ -195,4 +164,4 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
                       boundaries=bounds, breaklines=lines)
 
 
-__all__ = ["ModelSetup", "check_breaklines", "footprint", "prepare_model"]
+__all__ = ["ModelSetup", "footprint", "prepare_model"]

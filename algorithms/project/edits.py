@@ -62,6 +62,10 @@ EDIT_LAYERS: Dict[str, Tuple[str, OrderedDict[str, str]]] = {
 #: Allowed values of ``exclusion_areas.action``.
 EXCLUSION_ACTIONS = ("keep", "remove", "exclude")
 
+#: The values the editing tools offer for ``breaklines.kind`` (seed-000 §2.10: breaklines and
+#: structure lines). Other texts are kept (the kind steers no algorithm yet), with a warning.
+BREAKLINE_KINDS = ("breakline", "structure_line")
+
 
 def _where(path: PathLike, layer: str, fid: Any) -> str:
     return f"'{Path(path).name}' layer {layer}, feature {fid}"
@@ -84,20 +88,26 @@ def check_action(value: Any, where: str) -> Optional[str]:
     return text
 
 
-def repair_polygon(geom: Any, where: str) -> Any:
-    """``geom`` if it is a valid polygon, else its repaired form, with a warning.
+def kind_message(value: Any, where: str) -> Optional[str]:
+    """A warning for a breakline ``kind`` that is not one of :data:`BREAKLINE_KINDS`, or
+    ``None`` (empty = ``breakline``)."""
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    if str(value).strip().lower() in BREAKLINE_KINDS:
+        return None
+    return (f"{where}: kind '{value}' is not one of {', '.join(BREAKLINE_KINDS)}; the line is "
+            "used as a breakline.")
+
+
+def repaired_polygon(geom: Any) -> Optional[Any]:
+    """The polygonal part of ``geom`` repaired, or ``None`` when nothing of it is left.
 
     ``shapely.validation.make_valid`` (shapely ≥ 1.8) keeps every part of a bow tie;
-    ``buffer(0)`` is the fallback. Only the polygonal parts of the result are kept.
-
-    Raises
-    ------
-    InputError
-        When nothing of the polygon is left after the repair.
+    ``buffer(0)`` is the fallback. Only the polygonal parts of the result are kept. A valid
+    polygon is returned as it is. Shared by the run-time reader and the editing tools.
     """
     if geom.is_valid:
         return geom
-    reason = explain_validity(geom)
     try:  # a version check, not a cycle: make_valid came with shapely 1.8
         from shapely.validation import make_valid
 
@@ -108,11 +118,37 @@ def repair_polygon(geom: Any, where: str) -> Any:
              if g.geom_type in ("Polygon", "MultiPolygon") and not g.is_empty]
     fixed = unary_union(parts) if parts else None
     if fixed is None or fixed.is_empty or fixed.area <= 0:
+        return None
+    return fixed
+
+
+def repair_polygon(geom: Any, where: str) -> Any:
+    """``geom`` if it is a valid polygon, else its repaired form (:func:`repaired_polygon`),
+    with a warning.
+
+    Raises
+    ------
+    InputError
+        When nothing of the polygon is left after the repair.
+    """
+    if geom.is_valid:
+        return geom
+    reason = explain_validity(geom)
+    fixed = repaired_polygon(geom)
+    if fixed is None:
         raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
                          "repairing it; redraw it in edits.gpkg.")
     warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
                f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
     return fixed
+
+
+def flat_breakline_message(layer: str, geom: Any, where: str) -> Optional[str]:
+    """The warning for a breakline without heights (2-D), or ``None``."""
+    if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
+        return (f"{where}: the breakline has no heights (2-D); it only separates the surface "
+                "and gives no heights. Digitise it with Z to use its heights.")
+    return None
 
 
 def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
@@ -134,9 +170,9 @@ def check_feature(path: PathLike, layer: str, fid: Any, geom: Any,
         props = {**props, "action": check_action(props.get("action"), where)}
     if geom.geom_type in ("Polygon", "MultiPolygon"):
         geom = repair_polygon(geom, where)
-    if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
-        warn_input(f"{where}: the breakline has no heights (2-D); it only separates the surface "
-                   "and gives no heights. Digitise it with Z to use its heights.")
+    flat = flat_breakline_message(layer, geom, where)
+    if flat:
+        warn_input(flat)
     return geom, props
 
 
@@ -181,6 +217,40 @@ def create_edits(path: PathLike, crs: str) -> Path:
     return path
 
 
+def check_layer(layer: str) -> str:
+    """``layer`` if it is a layer of ``edits.gpkg``.
+
+    Raises
+    ------
+    InputError
+        Naming the layer and the edit layers.
+    """
+    if layer not in EDIT_LAYERS:
+        raise InputError(f"'{layer}' is not an edit layer; use one of {', '.join(EDIT_LAYERS)}.")
+    return layer
+
+
+def check_fields(layer: str, props: Optional[Dict[str, Any]]) -> Dict[str, Any]:
+    """The attributes of one new feature of ``layer``, checked and normalised.
+
+    Unknown fields are an error; ``action`` of an exclusion area is normalised by
+    :func:`check_action`.
+
+    Raises
+    ------
+    InputError
+        Naming the layer and the offending field or value.
+    """
+    fields = EDIT_LAYERS[check_layer(layer)][1]
+    props = dict(props or {})
+    unknown = sorted(set(props) - set(fields))
+    if unknown:
+        raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
+    if layer == "exclusion_areas":
+        props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
+    return props
+
+
 def add_features(path: PathLike, layer: str,
                  features: Iterable[Tuple[Any, Dict[str, Any]]]) -> int:
     """Append ``(shapely geometry, properties)`` pairs to a layer of ``edits.gpkg``.
@@ -188,17 +258,10 @@ def add_features(path: PathLike, layer: str,
     Missing properties are written as empty; unknown ones are an error. Returns the number of
     features written.
     """
-    if layer not in EDIT_LAYERS:
-        raise InputError(f"'{layer}' is not an edit layer; use one of {', '.join(EDIT_LAYERS)}.")
-    fields = EDIT_LAYERS[layer][1]
+    fields = EDIT_LAYERS[check_layer(layer)][1]
     records = []
     for geom, props in features:
-        props = dict(props or {})
-        unknown = sorted(set(props) - set(fields))
-        if unknown:
-            raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
-        if layer == "exclusion_areas":
-            props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
+        props = check_fields(layer, props)
         records.append({"geometry": mapping(geom),
                         "properties": OrderedDict((k, props.get(k)) for k in fields)})
     with fiona.open(str(path), "a", driver="GPKG", layer=layer) as dst:
@@ -227,10 +290,6 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
             out.append(check_feature(path, layer, feat.fid, shape(feat.geometry),
                                      feat.properties))
     return out
-
-
-__all__ = ["EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features", "check_action", "check_feature",
-           "create_edits", "read_layer", "repair_polygon"]
 
 
 def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
@@ -273,3 +332,9 @@ def read_constraints(path: PathLike, crs: Any = None) -> Tuple[List[Any], List[A
     return (read_geometries(path, ("Polygon",), crs, ("exclusion_areas",), skip_keep=True),
             read_geometries(path, ("Polygon",), crs, ("boundaries",)),
             read_geometries(path, ("LineString",), crs, ("breaklines",)))
+
+
+__all__ = ["BREAKLINE_KINDS", "EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features",
+           "check_action", "check_feature", "check_fields", "check_layer", "create_edits",
+           "flat_breakline_message", "kind_message", "read_constraints", "read_geometries",
+           "read_layer", "repair_polygon", "repaired_polygon"]

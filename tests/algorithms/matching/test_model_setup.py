@@ -6,7 +6,7 @@ import pytest
 from shapely.geometry import LineString
 
 from photodem.algorithms.errors import InputError
-from photodem.algorithms.matching.model_setup import check_breaklines
+from photodem.algorithms.project.breaklines import check_breaklines
 
 
 def test_crossing_breaklines_are_refused() -> None:
