@@ -32,7 +32,7 @@ LAYERS: Dict[str, int] = {
     **dict.fromkeys(("quality", "surface", "filtering", "matching", "ortho", "georef",
                      "synthetic"), 4),
     "processing": 5,
-    **dict.fromkeys(("cli", "cli_feedback", "demo", "plugin"), 6),
+    **dict.fromkeys(("cli", "cli_entry", "cli_feedback", "demo", "plugin"), 6),
 }
 
 
