@@ -47,6 +47,9 @@ from .projection import border_pixels
 Array = NDArray[np.float64]
 SIDES = ("left", "right")
 
+#: Pixels per row block when writing resampled epipolar images (bounds the memory).
+RESAMPLE_BLOCK_PIXELS = 1_000_000
+
 
 def _side_index(side: str) -> int:
     if side not in SIDES:

@@ -37,7 +37,7 @@ import numpy as np
 from rasterio.windows import Window
 
 from ..feedback import Feedback, ensure_feedback
-from ..geometry.epipolar import SIDES, EpipolarPair
+from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from .dense import GreySource, iter_disparity_tiles
@@ -51,8 +51,6 @@ PathLike = Union[str, Path]
 #: fattening at occlusions and depth steps); the gridding fills the small gaps again.
 _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2}
 
-#: Pixels per resampled block of the scratch epipolar images.
-_BLOCK_PIXELS = 1_000_000
 
 
 def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
@@ -60,7 +58,7 @@ def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
     """Grey (band mean) epipolar image as float32, NaN outside the original image."""
     w, h = pair.sizes[SIDES.index(side)]
     profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), compress="none")
-    chunk = max(1, _BLOCK_PIXELS // max(w, 1))
+    chunk = max(1, RESAMPLE_BLOCK_PIXELS // max(w, 1))
     with open_image(path, "w", **profile) as dst:
         for r0, block, valid, _, _ in pair.iter_resample(image, side, chunk):
             grey = block.astype(np.float32).mean(axis=0)

@@ -15,15 +15,11 @@ import numpy as np
 from rasterio.windows import Window
 
 from ..feedback import Feedback
-from ..geometry.epipolar import SIDES, EpipolarPair
+from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..geometry.projection import ray_at_height, world_to_pixel
 from ..jsonable import json_ready
 from ..project.model import Project
 from ..raster.io import gtiff_profile, open_image, staged_folder
-
-#: Pixels per resampled row block (per band): bounds the memory of the resampling.
-_BLOCK_PIXELS = 1_000_000
-
 
 
 def _y_parallax_check(pair: EpipolarPair, height: float, n: int = 15) -> float:
@@ -49,7 +45,7 @@ def _write_side(pair: EpipolarPair, side: str, img: np.ndarray, folder: Path,
     Returns the updated count of rows written (for the progress of both sides).
     """
     w, h = pair.sizes[SIDES.index(side)]
-    chunk = max(1, _BLOCK_PIXELS // max(w, 1))
+    chunk = max(1, RESAMPLE_BLOCK_PIXELS // max(w, 1))
     bands = img.shape[0]
     photometric = "RGB" if bands == 3 else "MINISBLACK"
     img_profile = gtiff_profile(w, h, bands + 1, img.dtype.name, photometric=photometric,
