@@ -37,3 +37,17 @@ def test_the_command_runs_through_the_entry(monkeypatch, capsys) -> None:
     finally:
         signal.signal(signal.SIGINT, before)
     assert '"project_create"' in capsys.readouterr().out
+
+
+def test_ctrl_c_while_the_parser_is_built_is_a_quiet_cancel(monkeypatch, capsys) -> None:
+    from photodem.algorithms import cli
+
+    def interrupted() -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    monkeypatch.setattr(cli, "_IGNORE_LATE_SIGINT", cli._IGNORE_LATE_SIGINT)
+    monkeypatch.setattr(sys, "argv", ["photodem", "list"])
+    assert cli_entry.main() == 130
+    err = capsys.readouterr().err
+    assert "cancelled" in err and "Traceback" not in err
