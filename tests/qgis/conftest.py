@@ -76,12 +76,16 @@ def pytest_terminal_summary(terminalreporter) -> None:
 
 @pytest.fixture(scope="session")
 def qgis_app():
-    """The one QgsApplication (no GUI) with Processing initialised."""
+    """The one QgsApplication with Processing initialised.
+
+    GUI-enabled (offscreen): the workspace tests need real widgets — a ``QgsMapCanvas``, map
+    tools, docks — in the same process as the Processing tests.
+    """
     from qgis.core import QgsApplication
 
     start = time.perf_counter()
     QgsApplication.setPrefixPath(os.environ.get("QGIS_PREFIX_PATH", "/usr"), True)
-    app = QgsApplication([], False)
+    app = QgsApplication([], True)
     app.initQgis()
     plugins_dir = str(Path(QgsApplication.pkgDataPath()) / "python" / "plugins")
     if plugins_dir not in sys.path:
@@ -130,3 +134,19 @@ def fixture_alg(provider) -> Iterator[Any]:
     finally:
         registry.remove(FIXTURE_ID)
         provider.refreshAlgorithms()
+
+
+@pytest.fixture
+def qgis_iface(qgis_app, plugin):
+    """A desktop interface of real widgets (canvas, message bar, layer tree) for one test.
+
+    The project is cleared before and after, so each test starts from an empty map.
+    """
+    from _iface import WidgetIface
+    from qgis.core import QgsProject
+
+    QgsProject.instance().clear()
+    iface = WidgetIface()
+    yield iface
+    QgsProject.instance().clear()
+    iface.close()
