@@ -62,6 +62,7 @@ class PhotodemPlugin:
         self.provider: Optional[PhotodemProvider] = None
         self.actions: List[QAction] = []
         self.toolbox_action: Optional[QAction] = None
+        self.editing_toolbar: Any = None  # the "PhotoDEM editing" toolbar (section 2)
         self.translator = install_translator()
         self.missing = missing_dependencies()
 
@@ -109,6 +110,10 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
+        # -- editing toolbar (issue 18 §2): disabled until a workspace is set
+        from .editing_toolbar import EditingToolbar  # lazy: map tools only in the desktop GUI
+
+        self.editing_toolbar = EditingToolbar(self.iface)
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -146,6 +151,9 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if self.editing_toolbar is not None:  # editing toolbar (issue 18 §2)
+            self.editing_toolbar.unload()
+            self.editing_toolbar = None
         if self.iface is not None:
             for action in self.actions:
                 self.iface.removePluginRasterMenu(MENU_TITLE, action)

@@ -37,6 +37,21 @@ class FakeIface:
     def removePluginRasterMenu(self, menu, action):  # noqa: N802
         self.calls.append(("removePluginRasterMenu", menu, action.objectName()))
 
+    # the editing toolbar (issue 18 §2): a real canvas for its map tools, no CAD panel
+    def mapCanvas(self):  # noqa: N802
+        from qgis.gui import QgsMapCanvas
+
+        if "canvas" not in self.__dict__:
+            self.canvas = QgsMapCanvas(self.window)
+        return self.canvas
+
+    def cadDockWidget(self):  # noqa: N802
+        return None
+
+    def addToolBar(self, toolbar):  # noqa: N802
+        self.calls.append(("addToolBar", toolbar.objectName()))
+        self.window.addToolBar(toolbar)
+
     def __getattr__(self, name):  # anything else would be an unexpected use of iface
         raise AssertionError(f"the plugin used iface.{name}, which the fake does not provide")
 
@@ -106,6 +121,7 @@ def test_desktop_init_gui_and_unload(qgis_app, plugin):
         assert {f"photodem_{i}" for i in core_registry.algorithms()} <= names
         assert "photodemGeorefReview" in names
         assert ("addToolBarIcon", "photodemShowToolbox") in iface.calls
+        assert ("addToolBar", "photodemEditingToolbar") in iface.calls
         assert all(c[1] == "&PhotoDEM" for c in added)
         iface.calls.clear()
         desktop.unload()

@@ -1,0 +1,85 @@
+"""Clicks of the editing tools → the features they must write (plain data, no Qt).
+
+Shared by the QGIS tests (``tests/qgis/test_edit_tools.py``) and, later, the standalone tool's
+tests. Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block
+(``synthetic_block --size tiny``); heights come from the analytic surface :data:`SURFACE`
+(a plane, so bilinear sampling is exact to rounding: asserted to 1e-6 m).
+"""
+
+from __future__ import annotations
+
+from typing import Dict, List, Tuple
+
+XY = Tuple[float, float]
+
+#: The analytic surface z = z0 + gx·(x − x0) + gy·(y − y0) written as a GeoTIFF by the tests;
+#: ``bounds`` (xmin, ymin, xmax, ymax) cover the block, ``res`` is the cell size (m), and the
+#: cells inside ``nodata_box`` are nodata.
+SURFACE: Dict[str, object] = {
+    "z0": 50.0, "x0": 402300.0, "y0": 5674700.0, "gx": 0.01, "gy": 0.02,
+    "bounds": (402200.0, 5674600.0, 402400.0, 5674800.0), "res": 0.5,
+    "nodata_box": (402330.0, 5674735.0, 402345.0, 5674750.0), "crs": "EPSG:25832",
+}
+
+#: The canvas extent of the tests (the block with a margin).
+EXTENT = (402230.0, 5674615.0, 402370.0, 5674790.0)
+
+
+def surface_z(x: float, y: float) -> float:
+    """The analytic height of :data:`SURFACE` at (x, y)."""
+    s = SURFACE
+    return float(s["z0"]) + float(s["gx"]) * (x - float(s["x0"])) \
+        + float(s["gy"]) * (y - float(s["y0"]))
+
+
+#: One entry per tool: the layer, the left clicks (a right click finishes lines and polygons),
+#: what the form answers, and what must be in ``edits.gpkg`` after *Save layer edits*.
+#: ``z: "surface"`` — each vertex's Z (or the start point's ``height``) is :func:`surface_z` at
+#: the clicked pixel's map point.
+CLICKS: List[Dict[str, object]] = [
+    {"layer": "start_points", "clicks": [(402290.0, 5674660.0)],
+     "answer": {"text": "seed"}, "geometry": "Point", "z": "surface",
+     "attributes": {"note": "seed"}},
+    {"layer": "ground_points", "clicks": [(402300.0, 5674700.0)],
+     "answer": {"text": "road"}, "geometry": "Point", "z": "surface",
+     "attributes": {"note": "road"}},
+    {"layer": "check_points", "clicks": [(402315.0, 5674690.0)],
+     "answer": {"text": "CP1"}, "geometry": "Point", "z": "surface",
+     "attributes": {"id": "CP1"}},
+    {"layer": "exclusion_areas",
+     "clicks": [(402280.0, 5674650.0), (402300.0, 5674650.0), (402300.0, 5674670.0),
+                (402280.0, 5674670.0)],
+     "answer": {"action": "keep", "text": "lake"}, "geometry": "Polygon",
+     "attributes": {"action": "keep", "note": "lake"}},
+    {"layer": "boundaries",
+     "clicks": [(402270.0, 5674640.0), (402330.0, 5674640.0), (402330.0, 5674760.0),
+                (402270.0, 5674760.0)],
+     "answer": {"text": "area A"}, "geometry": "Polygon", "attributes": {"name": "area A"}},
+    {"layer": "breaklines",
+     "clicks": [(402270.0, 5674700.0), (402290.0, 5674710.0), (402320.0, 5674705.0)],
+     "answer": {"kind": "breakline"}, "geometry": "LineString", "z": "surface",
+     "attributes": {"kind": "breakline"}},
+    {"layer": "seamlines",
+     "clicks": [(402300.0, 5674630.0), (402300.0, 5674770.0)],
+     "answer": {}, "geometry": "LineString", "attributes": {}},
+]
+
+#: A breakline crossing the one of :data:`CLICKS` (near (402285, 5674707.5)): refused.
+CROSSING_BREAKLINE: List[XY] = [(402285.0, 5674690.0), (402285.0, 5674725.0)]
+
+#: A bow tie (self-intersecting at (402300, 5674700)): refused, or repaired with consent.
+BOW_TIE: List[XY] = [(402290.0, 5674690.0), (402310.0, 5674710.0), (402310.0, 5674690.0),
+                     (402290.0, 5674710.0)]
+
+#: Interpolated breakline: typed end heights, the inner vertex linear in the 2-D length.
+INTERPOLATED: Dict[str, object] = {
+    "clicks": [(402270.0, 5674740.0), (402290.0, 5674740.0), (402310.0, 5674740.0)],
+    "ends": (40.0, 44.0),
+}
+
+#: A click inside the block but outside every stereo model: the start point tool warns and the
+#: form asks for a typed height (no pre-filled value).
+OUTSIDE_MODELS: XY = (402250.0, 5674660.0)
+
+#: A click on the surface's nodata cells (a ground point: the form asks for a typed height).
+ON_NODATA: XY = (402337.0, 5674742.0)

@@ -1,0 +1,632 @@
+"""The "PhotoDEM editing" toolbar inside real QGIS: each tool driven by mouse events on the canvas
+viewport, the features read back from ``edits.gpkg`` with fiona after *Save layer edits*.
+
+The click table is ``tests/edit_clicks.py`` (shared with the standalone tool's tests). Heights
+are checked against an analytic plane at the clicked pixel's map point (bilinear on a plane is
+exact: 1e-6 m). The workspace is a stand-in with the contract's attributes (part W builds the
+real one).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import shutil
+import sys
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Tuple
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/: the shared click table
+from edit_clicks import (
+    BOW_TIE,
+    CLICKS,
+    CROSSING_BREAKLINE,
+    EXTENT,
+    INTERPOLATED,
+    ON_NODATA,
+    OUTSIDE_MODELS,
+    SURFACE,
+    surface_z,
+)
+
+pytestmark = pytest.mark.qgis
+
+SHOTS = Path("/tmp/e")
+
+
+# -- the block, the surface and the stand-in workspace ---------------------------------------------
+@pytest.fixture(scope="module")
+def block(tmp_path_factory, plugin) -> Path:
+    """A tiny synthetic block, made once (each test edits a copy)."""
+    from photodem.algorithms.processing import registry
+
+    out = tmp_path_factory.mktemp("edit-block") / "block"
+    result = registry.run("synthetic_block", {"output": str(out), "size": "tiny"})
+    return Path(result.get("project", out))
+
+
+def write_surface(path: Path, crs: Optional[str] = SURFACE["crs"]) -> Path:
+    """The analytic plane of :data:`SURFACE` as a float64 GeoTIFF (with its nodata box)."""
+    import numpy as np
+    import rasterio
+    from rasterio.transform import from_origin
+
+    xmin, ymin, xmax, ymax = SURFACE["bounds"]
+    res = SURFACE["res"]
+    cols, rows = int((xmax - xmin) / res), int((ymax - ymin) / res)
+    x = xmin + (np.arange(cols) + 0.5) * res
+    y = ymax - (np.arange(rows) + 0.5) * res
+    xx, yy = np.meshgrid(x, y)
+    z = surface_z(xx, yy)
+    bx0, by0, bx1, by1 = SURFACE["nodata_box"]
+    z[(xx > bx0) & (xx < bx1) & (yy > by0) & (yy < by1)] = -9999.0
+    profile = {"driver": "GTiff", "width": cols, "height": rows, "count": 1,
+               "dtype": "float64", "transform": from_origin(xmin, ymax, res, res),
+               "nodata": -9999.0}
+    if crs:
+        profile["crs"] = crs
+    with rasterio.open(path, "w", **profile) as dst:
+        dst.write(z, 1)
+    return path
+
+
+class StandIn:
+    """The contract's workspace: ``project``, ``root``, ``edit_layer``, ``surface_layers``."""
+
+    def __init__(self, root: Path, layers: Dict[str, Any], surfaces: List[Any]) -> None:
+        from photodem.algorithms.project.model import Project
+
+        self.root = root
+        self.project = Project.load(root)
+        self.layers = layers
+        self.surfaces = surfaces
+
+    def edit_layer(self, name: str) -> Any:
+        return self.layers.get(name)
+
+    def surface_layers(self) -> List[Any]:
+        return self.surfaces
+
+    def add_products(self, paths: Any) -> List[Any]:
+        return []
+
+
+class FakeAsk:
+    """The tools' questions answered from ``answer`` (no dialog); every call is recorded."""
+
+    def __init__(self) -> None:
+        self.answer: Dict[str, Any] = {}
+        self.calls: List[Tuple[Any, ...]] = []
+
+    def height(self, title, height, message="", text_label=""):
+        self.calls.append(("height", height, message))
+        value = self.answer.get("height", height)
+        return None if value is None else (value, self.answer.get("text", ""))
+
+    def action(self):
+        self.calls.append(("action",))
+        return self.answer.get("action", "remove"), self.answer.get("text", "")
+
+    def breakline(self, heights, editable, message=""):
+        self.calls.append(("breakline", list(heights), list(editable), message))
+        typed = self.answer.get("heights")
+        out = [typed[i] if (typed and free) else z
+               for i, (z, free) in enumerate(zip(heights, editable))]
+        return out, self.answer.get("kind", "breakline")
+
+    def text(self, title, label):
+        self.calls.append(("text", title))
+        return self.answer.get("text", "")
+
+    def repair(self, message):
+        self.calls.append(("repair", message))
+        return bool(self.answer.get("repair", False))
+
+
+@pytest.fixture
+def work(tmp_path, block, qgis_iface):
+    """A fresh copy of the block, its edit layers and the surface on the map, the toolbar."""
+    from qgis.core import (
+        QgsCoordinateReferenceSystem,
+        QgsProject,
+        QgsRasterLayer,
+        QgsRectangle,
+        QgsVectorLayer,
+    )
+
+    from photodem.algorithms.project.edits import EDIT_LAYERS
+    from photodem.plugin.qgis.editing_toolbar import EditingToolbar
+
+    root = tmp_path / "block"
+    shutil.copytree(block, root)
+    gpkg = root / "edits.gpkg"
+    layers = {}
+    for name in EDIT_LAYERS:
+        layer = QgsVectorLayer(f"{gpkg}|layername={name}", name, "ogr")
+        assert layer.isValid(), name
+        layer.setCustomProperty("photodem/kind", f"edit:{name}")
+        layers[name] = layer
+    surface = QgsRasterLayer(str(write_surface(tmp_path / "plane_dsm.tif")), "plane DSM")
+    assert surface.isValid()
+    QgsProject.instance().addMapLayer(surface)
+    QgsProject.instance().addMapLayers(list(layers.values()))
+    canvas = qgis_iface.mapCanvas()
+    canvas.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:25832"))
+    canvas.setExtent(QgsRectangle(*EXTENT))
+    canvas.refresh()
+    ask = FakeAsk()
+    bar = EditingToolbar(qgis_iface, ask=ask)
+    workspace = StandIn(root, layers, [surface])
+    bar.set_workspace(workspace)
+    state = {"root": root, "gpkg": gpkg, "layers": layers, "surface": surface, "bar": bar,
+             "ask": ask, "canvas": canvas, "iface": qgis_iface, "workspace": workspace}
+    yield state
+    done = state.pop("bar")
+    if done.toolbar in qgis_iface.toolbars:  # unload deletes it: not the iface's to delete
+        qgis_iface.toolbars.remove(done.toolbar)
+    done.unload()
+    del bar, done
+    for layer in layers.values():
+        if layer.isEditable():
+            layer.rollBack()
+    _flush()
+
+
+def _flush() -> None:
+    """Delete what ``deleteLater`` scheduled and collect the cycles now, while the application
+    lives (not at interpreter exit)."""
+    import gc
+
+    from qgis.PyQt.QtCore import QCoreApplication, QEvent
+
+    QCoreApplication.sendPostedEvents(None, QEvent.DeferredDelete)
+    gc.collect()
+
+
+# -- driving the canvas --------------------------------------------------------------------------
+def click(canvas, x: float, y: float, right: bool = False) -> Tuple[float, float]:
+    """A mouse click on the viewport at map (x, y); returns the map point of the clicked pixel."""
+    from qgis.core import QgsPointXY
+    from qgis.PyQt.QtCore import QPoint, Qt
+    from qgis.PyQt.QtTest import QTest
+
+    pixel = canvas.getCoordinateTransform().transform(QgsPointXY(x, y))
+    point = QPoint(round(pixel.x()), round(pixel.y()))
+    QTest.mouseMove(canvas.viewport(), point)
+    QTest.mouseClick(canvas.viewport(), Qt.RightButton if right else Qt.LeftButton,
+                     Qt.NoModifier, point)
+    hit = canvas.getCoordinateTransform().toMapCoordinates(point.x(), point.y())
+    return hit.x(), hit.y()
+
+
+def draw(work, layer: str, clicks, finish: bool = True) -> List[Tuple[float, float]]:
+    """Activate the tool of ``layer`` and click; lines and polygons end with a right click."""
+    tool = work["bar"].activate(layer)
+    assert tool is not None and work["canvas"].mapTool() is tool
+    hits = [click(work["canvas"], x, y) for x, y in clicks]
+    if finish and len(clicks) > 1:
+        click(work["canvas"], *clicks[-1], right=True)
+    return hits
+
+
+def saved(work, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
+    """Commit the layer (*Save layer edits*) and read it back from edits.gpkg with fiona."""
+    import fiona
+    from shapely.geometry import shape
+
+    qlayer = work["layers"][layer]
+    if qlayer.isEditable():
+        assert qlayer.commitChanges(), qlayer.commitErrors()
+    with fiona.open(work["gpkg"], layer=layer) as src:
+        return [(shape(f["geometry"]), dict(f["properties"])) for f in src]
+
+
+def digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def bar_text(iface) -> str:
+    """All texts in the message bar."""
+    return " ".join(item.text() for item in iface.messageBar().items())
+
+
+# -- every tool of the click table ---------------------------------------------------------------
+@pytest.mark.parametrize("case", CLICKS, ids=[c["layer"] for c in CLICKS])
+def test_tool_writes_the_feature_and_undo_removes_it(work, case):
+    layer_name = case["layer"]
+    work["ask"].answer = dict(case["answer"])
+    layer = work["layers"][layer_name]
+    hits = draw(work, layer_name, case["clicks"])
+    assert layer.featureCount() == 1, (bar_text(work["iface"]), work["ask"].calls, hits)
+    layer.undoStack().undo()
+    assert layer.featureCount() == 0  # QGIS's undo removes the edit
+    layer.undoStack().redo()
+    assert layer.featureCount() == 1
+    rows = saved(work, layer_name)
+    assert len(rows) == 1
+    geometry, props = rows[0]
+    assert case["geometry"] in geometry.geom_type
+    for key, value in case["attributes"].items():
+        assert props[key] == value
+    coords = (list(geometry.exterior.coords)[:-1] if "Polygon" in geometry.geom_type
+              else list(geometry.coords))
+    assert len(coords) == len(hits)
+    for (x, y, *_z), (hx, hy) in zip(coords, hits):
+        assert (x, y) == pytest.approx((hx, hy), abs=1e-6)
+    if case.get("z") == "surface":
+        if layer_name == "start_points":
+            assert props["height"] == pytest.approx(surface_z(*hits[0]), abs=1e-6)
+        else:
+            for x, y, z in coords:
+                assert z == pytest.approx(surface_z(x, y), abs=1e-6)
+    if layer_name == "exclusion_areas":
+        assert props["action"] in ("keep", "remove", "exclude")
+
+
+def test_start_point_in_the_real_form(work, qgis_app):
+    """The real height form: pre-filled with the sampled height, edited, accepted."""
+    from qgis.PyQt.QtCore import QTimer
+    from qgis.PyQt.QtWidgets import QApplication, QDialogButtonBox, QDoubleSpinBox, QLineEdit
+
+    from photodem.plugin.qgis.edit_forms import DialogAsker
+
+    work["bar"].controller.ask = DialogAsker(work["iface"].mainWindow())
+    seen: Dict[str, Any] = {}
+
+    def fill() -> None:
+        dialog = QApplication.activeModalWidget()
+        if dialog is None:
+            QTimer.singleShot(50, fill)
+            return
+        box = dialog.findChild(QDoubleSpinBox, "height")
+        seen["prefilled"] = box.value()
+        dialog.grab().save(str(SHOTS / "height_form.png"))
+        box.setValue(box.value() + 1.5)
+        dialog.findChild(QLineEdit, "text").setText("edited")
+        dialog.findChild(QDialogButtonBox).button(QDialogButtonBox.Ok).click()
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    QTimer.singleShot(0, fill)
+    (hx, hy), = draw(work, "start_points", [CLICKS[0]["clicks"][0]])
+    assert seen["prefilled"] == pytest.approx(surface_z(hx, hy), abs=1e-3)  # 3 decimals shown
+    (_, props), = saved(work, "start_points")
+    assert props["note"] == "edited"
+    assert props["height"] == pytest.approx(round(surface_z(hx, hy), 3) + 1.5, abs=1e-6)
+
+
+def test_real_action_form_offers_the_three_actions(work):
+    from qgis.PyQt.QtWidgets import QComboBox
+
+    from photodem.plugin.qgis.edit_forms import ActionDialog
+
+    dialog = ActionDialog(work["iface"].mainWindow())
+    box = dialog.findChild(QComboBox, "action")
+    assert [box.itemData(i) for i in range(box.count())] == ["keep", "remove", "exclude"]
+
+
+# -- refusals --------------------------------------------------------------------------------------
+def test_crossing_breakline_is_refused_and_marked(work):
+    first = next(c for c in CLICKS if c["layer"] == "breaklines")
+    layer = work["layers"]["breaklines"]
+    draw(work, "breaklines", first["clicks"])
+    assert layer.featureCount() == 1  # unsaved, in the edit buffer
+    before = digest(work["gpkg"])
+    draw(work, "breaklines", CROSSING_BREAKLINE)
+    assert layer.featureCount() == 1
+    assert digest(work["gpkg"]) == before
+    markers = work["bar"].controller.markers
+    assert len(markers) == 1
+    centre = markers[0].pos()  # scene position = canvas pixel
+    crossing = work["canvas"].getCoordinateTransform().toMapCoordinates(round(centre.x()),
+                                                                        round(centre.y()))
+    assert abs(crossing.x() - 402285.0) < 1.0 and abs(crossing.y() - 5674707.5) < 1.0
+    assert "refused" in bar_text(work["iface"])
+    assert len(saved(work, "breaklines")) == 1
+
+
+def test_self_intersecting_polygon_refused_or_repaired_with_consent(work):
+    layer = work["layers"]["exclusion_areas"]
+    work["ask"].answer = {"repair": False, "action": "exclude"}
+    draw(work, "exclusion_areas", BOW_TIE)
+    assert layer.featureCount() == 0
+    assert "refused" in bar_text(work["iface"]) and "Self-intersection" in bar_text(work["iface"])
+    assert saved(work, "exclusion_areas") == []
+    work["ask"].answer = {"repair": True, "action": "exclude"}
+    draw(work, "exclusion_areas", BOW_TIE)
+    rows = saved(work, "exclusion_areas")
+    assert len(rows) == 2  # the two triangles of the bow tie
+    assert all(g.is_valid and p["action"] == "exclude" for g, p in rows)
+
+
+def test_read_only_edits_are_refused(work):
+    gpkg = work["gpkg"]
+    gpkg.chmod(0o444)
+    try:
+        before = digest(gpkg)
+        assert work["bar"].activate("start_points") is None
+        assert "read-only" in bar_text(work["iface"])
+        assert not work["bar"].actions["start_points"].isChecked()
+        assert digest(gpkg) == before
+    finally:
+        gpkg.chmod(0o644)
+
+
+def test_missing_layer_and_no_project(work):
+    work["layers"].pop("seamlines")
+    assert work["bar"].activate("seamlines") is None
+    assert "missing" in bar_text(work["iface"])
+    work["bar"].set_workspace(None)
+    assert not work["bar"].actions["start_points"].isEnabled()
+    assert work["bar"].activate("start_points") is None
+    assert "Open a PhotoDEM project" in bar_text(work["iface"])
+
+
+def test_edit_outside_the_block_is_refused(work):
+    work["ask"].answer = {"height": 50.0}
+    draw(work, "ground_points", [(402232.0, 5674785.0)])  # canvas corner, outside the block
+    assert work["layers"]["ground_points"].featureCount() == 0
+    assert "outside the project's block" in bar_text(work["iface"])
+
+
+# -- heights without a surface value -------------------------------------------------------------
+def test_outside_models_asks_for_a_typed_height(work):
+    work["ask"].answer = {"height": 48.0, "text": ""}
+    draw(work, "start_points", [OUTSIDE_MODELS])
+    kind, prefilled, message = work["ask"].calls[-1]
+    assert kind == "height" and prefilled is None and "outside every stereo model" in message
+    assert "outside every stereo model" in bar_text(work["iface"])
+    (_, props), = saved(work, "start_points")
+    assert props["height"] == 48.0
+
+
+def test_nodata_asks_for_a_typed_height(work):
+    work["ask"].answer = {"height": 47.0}
+    draw(work, "ground_points", [ON_NODATA])
+    _, prefilled, message = work["ask"].calls[-1]
+    assert prefilled is None and "nodata" in message
+    (geometry, _), = saved(work, "ground_points")
+    assert geometry.z == 47.0
+
+
+def test_surface_in_another_crs_is_reprojected(work, tmp_path):
+    """The same plane warped to EPSG:4326 still gives the plane's height (to its resampling)."""
+    from osgeo import gdal
+    from qgis.core import QgsProject, QgsRasterLayer
+
+    path = str(tmp_path / "plane_4326.tif")
+    gdal.Warp(path, work["surface"].source(), dstSRS="EPSG:4326", resampleAlg="bilinear")
+    layer = QgsRasterLayer(path, "plane 4326")
+    QgsProject.instance().addMapLayer(layer)
+    work["bar"].surface_box.setLayer(layer)
+    work["ask"].answer = {}
+    (hx, hy), = draw(work, "ground_points", [(402300.0, 5674700.0)])
+    (geometry, _), = saved(work, "ground_points")
+    assert geometry.z == pytest.approx(surface_z(hx, hy), abs=0.01)
+
+
+def test_surface_without_crs_is_named(work, tmp_path):
+    from qgis.core import QgsCoordinateReferenceSystem, QgsProject, QgsRasterLayer
+
+    layer = QgsRasterLayer(str(write_surface(tmp_path / "no_crs.tif", crs=None)), "no crs")
+    layer.setCrs(QgsCoordinateReferenceSystem())
+    QgsProject.instance().addMapLayer(layer)
+    work["bar"].surface_box.setLayer(layer)
+    work["ask"].answer = {"height": None}  # the operator cancels the form
+    draw(work, "ground_points", [(402300.0, 5674700.0)])
+    assert "no CRS" in bar_text(work["iface"]) + str(work["ask"].calls)
+    assert work["layers"]["ground_points"].featureCount() == 0
+
+
+# -- breakline modes, seamline snapping, re-drape, validation ------------------------------------
+def test_interpolated_breakline(work):
+    work["bar"].set_z_mode("interpolate")
+    work["ask"].answer = {"heights": [INTERPOLATED["ends"][0], None, INTERPOLATED["ends"][1]]}
+    hits = draw(work, "breaklines", INTERPOLATED["clicks"])
+    _, _, editable, _ = work["ask"].calls[-1]
+    assert editable == [True, False, True]
+    (line, _), = saved(work, "breaklines")
+    z = [c[2] for c in line.coords]
+    lengths = [0.0, math.dist(hits[0], hits[1])]
+    lengths.append(lengths[1] + math.dist(hits[1], hits[2]))
+    z0, z1 = INTERPOLATED["ends"]
+    assert z == pytest.approx([z0 + (z1 - z0) * s / lengths[-1] for s in lengths], abs=1e-6)
+
+
+def test_seamline_snaps_to_the_mosaic_seamlines(work, tmp_path):
+    import fiona
+    from qgis.core import QgsProject, QgsVectorLayer
+
+    path = tmp_path / "mosaic_seamlines.gpkg"
+    schema = {"geometry": "LineString", "properties": {"id": "int"}}
+    with fiona.open(path, "w", driver="GPKG", layer="seamlines", schema=schema,
+                    crs="EPSG:25832") as dst:
+        dst.write({"geometry": {"type": "LineString",
+                                "coordinates": [(402301.0, 5674600.0), (402301.0, 5674800.0)]},
+                   "properties": {"id": 1}})
+    QgsProject.instance().addMapLayer(
+        QgsVectorLayer(f"{path}|layername=seamlines", "mosaic seamlines", "ogr"))
+    case = next(c for c in CLICKS if c["layer"] == "seamlines")
+    draw(work, "seamlines", case["clicks"])
+    (line, _), = saved(work, "seamlines")
+    assert [c[0] for c in line.coords] == pytest.approx([402301.0, 402301.0], abs=1e-6)
+
+
+def test_redrape_selected_points_is_one_undoable_command(work):
+    layer = work["layers"]["ground_points"]
+    work["ask"].answer = {"height": 30.0}
+    (hx, hy), = draw(work, "ground_points", [(402300.0, 5674700.0)])
+    feature = next(layer.getFeatures())
+    assert feature.geometry().constGet().z() == 30.0
+    layer.selectByIds([feature.id()])
+    work["iface"].setActiveLayer(layer)
+    assert work["bar"].controller.redrape() == 1
+    z = next(layer.getFeatures()).geometry().constGet().z()
+    assert z == pytest.approx(surface_z(hx, hy), abs=1e-6)
+    layer.undoStack().undo()
+    assert next(layer.getFeatures()).geometry().constGet().z() == 30.0
+
+
+def test_validate_lists_unsaved_problems_and_zooms(work):
+    from qgis.core import QgsFeature, QgsGeometry, QgsPointXY
+
+    layer = work["layers"]["start_points"]
+    layer.startEditing()
+    feature = QgsFeature(layer.fields())
+    feature.setGeometry(QgsGeometry.fromPointXY(QgsPointXY(402290.0, 5674660.0)))
+    feature["height"] = 900.0  # implausible: QGIS's own digitizing let it in
+    layer.addFeature(feature)
+    dock = work["bar"].validate()
+    assert dock is not None and dock.table.rowCount() >= 1
+    found = dock.found
+    assert any(f.layer == "start_points" and "plausible" in f.problem.message for f in found)
+    work["canvas"].setExtent(work["canvas"].fullExtent().buffered(5000))
+    row = next(k for k, f in enumerate(found) if "plausible" in f.problem.message)
+    dock.table.itemClicked.emit(dock.table.item(row, 0))
+    centre = work["canvas"].center()
+    assert abs(centre.x() - 402290.0) < 5 and abs(centre.y() - 5674660.0) < 5
+    assert work["canvas"].extent().width() < 100
+
+
+# -- screenshots -----------------------------------------------------------------------------------
+def _draw_everything(work) -> None:
+    for case in CLICKS:
+        if case["layer"] == "seamlines":
+            continue
+        work["ask"].answer = dict(case["answer"])
+        draw(work, case["layer"], case["clicks"])
+    work["ask"].answer = {"action": "remove"}
+    draw(work, "exclusion_areas", [(402305.0, 5674720.0), (402325.0, 5674720.0),
+                                   (402325.0, 5674735.0), (402305.0, 5674735.0)])
+    work["ask"].answer = {"action": "exclude"}
+    draw(work, "exclusion_areas", [(402275.0, 5674725.0), (402295.0, 5674725.0),
+                                   (402290.0, 5674745.0)])
+    draw(work, "breaklines", CROSSING_BREAKLINE)  # refused: its crossing stays marked
+
+
+def _preview_styles(work) -> None:
+    """Plain see-through styles for the screenshot (part W's QML styles replace them): the
+    exclusion actions in three colours with a light fill, outlines for boundaries."""
+    from qgis.core import (
+        QgsCategorizedSymbolRenderer,
+        QgsFillSymbol,
+        QgsLineSymbol,
+        QgsMarkerSymbol,
+        QgsRendererCategory,
+        QgsSingleSymbolRenderer,
+    )
+
+    def fill(colour: str) -> Any:
+        return QgsFillSymbol.createSimple({"color": colour + ",60", "outline_color": colour,
+                                           "outline_width": "0.8"})
+
+    layers = work["layers"]
+    layers["exclusion_areas"].setRenderer(QgsCategorizedSymbolRenderer("action", [
+        QgsRendererCategory(value, fill(colour), value)
+        for value, colour in (("keep", "40,160,60"), ("remove", "230,140,0"),
+                              ("exclude", "210,30,30"))]))
+    layers["boundaries"].setRenderer(QgsSingleSymbolRenderer(QgsFillSymbol.createSimple(
+        {"style": "no", "outline_color": "30,60,200", "outline_width": "0.8",
+         "outline_style": "dash"})))
+    layers["breaklines"].setRenderer(QgsSingleSymbolRenderer(QgsLineSymbol.createSimple(
+        {"line_color": "120,0,160", "line_width": "0.9"})))
+    for name, colour, shape in (("start_points", "0,120,255", "circle"),
+                                ("ground_points", "140,90,40", "triangle"),
+                                ("check_points", "0,0,0", "cross2")):
+        layers[name].setRenderer(QgsSingleSymbolRenderer(QgsMarkerSymbol.createSimple(
+            {"name": shape, "color": colour, "outline_color": "white", "size": "4"})))
+
+
+def _hillshade_under(work) -> None:
+    """The block's DSM as a hillshade at the bottom; the analytic plane (the toolbar's surface)
+    hidden."""
+    from qgis.core import QgsHillshadeRenderer, QgsProject, QgsRasterLayer
+
+    dsm = QgsRasterLayer(str(work["root"] / "truth" / "dsm.tif"), "DSM (hillshade)")
+    dsm.setRenderer(QgsHillshadeRenderer(dsm.dataProvider(), 1, 315, 45))
+    project = QgsProject.instance()
+    project.addMapLayer(dsm, False)
+    root = project.layerTreeRoot()
+    root.insertLayer(len(root.children()), dsm)
+    root.findLayer(work["surface"].id()).setItemVisibilityChecked(False)
+
+
+def _unsaved_problem(work) -> None:
+    """A start point with an implausible height, as QGIS's own digitizing could add it."""
+    from qgis.core import QgsFeature, QgsGeometry, QgsPointXY
+
+    layer = work["layers"]["start_points"]
+    feature = QgsFeature(layer.fields())
+    feature.setGeometry(QgsGeometry.fromPointXY(QgsPointXY(402320.0, 5674650.0)))
+    feature["height"] = 900.0
+    layer.addFeature(feature)
+
+
+@pytest.mark.parametrize("lang", ["en", "de"])
+def test_screenshot_toolbar_and_canvas(work, lang, qgis_app):
+    from qgis.PyQt.QtWidgets import QApplication
+
+    from photodem.plugin.i18n import install_translator
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    if lang == "de":
+        _install_preview_translation()
+        if work["bar"].toolbar in work["iface"].toolbars:
+            work["iface"].toolbars.remove(work["bar"].toolbar)
+        work["bar"].unload()
+        from photodem.plugin.qgis.editing_toolbar import EditingToolbar
+
+        work["bar"] = EditingToolbar(work["iface"], ask=work["ask"])
+        work["bar"].set_workspace(work["workspace"])
+    try:
+        _preview_styles(work)
+        _hillshade_under(work)
+        _draw_everything(work)
+        _unsaved_problem(work)
+        work["bar"].validate()
+        window = work["iface"].mainWindow()
+        window.resize(1900, 900)
+        canvas = work["canvas"]
+        for _ in range(3):
+            QApplication.processEvents()
+            canvas.refreshAllLayers()
+            canvas.waitWhileRendering()
+        assert window.grab().save(str(SHOTS / f"editing_{lang}.png"))
+    finally:
+        install_translator("en")
+
+
+def _install_preview_translation() -> None:
+    """German with this part's new strings (/work/prompts/de_e.tsv) merged into a temporary
+    .qm — the shared .ts is merged by the lead, so the screenshot previews the result."""
+    import subprocess
+    import tempfile
+    import xml.etree.ElementTree as ET
+
+    from qgis.PyQt.QtCore import QCoreApplication, QTranslator
+
+    from photodem.plugin import i18n
+
+    ts = Path(i18n.I18N_DIR) / "photodem_de.ts"
+    tsv = Path("/work/prompts/de_e.tsv")
+    if not ts.is_file() or not tsv.is_file() or shutil.which("lrelease") is None:
+        pytest.skip("no German sources or lrelease to preview the translation")
+    tree = ET.parse(ts)
+    context = tree.getroot().find("context")
+    for line in tsv.read_text(encoding="utf-8").splitlines():
+        if "\t" not in line:
+            continue
+        english, german = line.split("\t", 1)
+        message = ET.SubElement(context, "message")
+        ET.SubElement(message, "source").text = english
+        ET.SubElement(message, "translation").text = german
+    folder = Path(tempfile.mkdtemp(prefix="photodem-de-"))
+    tree.write(folder / "de.ts", encoding="utf-8", xml_declaration=True)
+    subprocess.run(["lrelease", "-silent", str(folder / "de.ts"), "-qm", str(folder / "de.qm")],
+                   check=True)
+    i18n.remove_translator()
+    translator = QTranslator()
+    assert translator.load(str(folder / "de.qm"))
+    QCoreApplication.installTranslator(translator)
+    i18n._installed = translator
