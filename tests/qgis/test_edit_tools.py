@@ -630,3 +630,107 @@ def _install_preview_translation() -> None:
     assert translator.load(str(folder / "de.qm"))
     QCoreApplication.installTranslator(translator)
     i18n._installed = translator
+
+
+# -- more bad input and modes --------------------------------------------------------------------
+def test_locked_edits_are_refused(work):
+    """Another program holds a write lock on edits.gpkg: the tool says so, nothing is written."""
+    import sqlite3
+
+    holder = sqlite3.connect(str(work["gpkg"]))
+    holder.execute("BEGIN IMMEDIATE")
+    try:
+        before = digest(work["gpkg"])
+        assert work["bar"].activate("breaklines") is None
+        assert "locked" in bar_text(work["iface"])
+        assert digest(work["gpkg"]) == before
+    finally:
+        holder.rollback()
+        holder.close()
+
+
+def test_typed_breakline_heights(work):
+    """Typed mode: every vertex is editable (pre-filled with the surface), the typed Z written."""
+    work["bar"].set_z_mode("typed")
+    case = next(c for c in CLICKS if c["layer"] == "breaklines")
+    work["ask"].answer = {"heights": [41.0, 42.0, 43.0], "kind": "structure_line"}
+    hits = draw(work, "breaklines", case["clicks"])
+    _, prefilled, editable, _ = work["ask"].calls[-1]
+    assert editable == [True, True, True]
+    assert prefilled == pytest.approx([surface_z(*h) for h in hits], abs=1e-6)
+    (line, props), = saved(work, "breaklines")
+    assert [c[2] for c in line.coords] == [41.0, 42.0, 43.0]
+    assert props["kind"] == "structure_line"
+
+
+def test_canvas_in_another_crs(work):
+    """Canvas in EPSG:3857: points and polygons land in the project CRS, heights at the point."""
+    from qgis.core import (
+        QgsCoordinateReferenceSystem,
+        QgsCoordinateTransform,
+        QgsPointXY,
+        QgsProject,
+        QgsRectangle,
+    )
+
+    canvas = work["canvas"]
+    web = QgsCoordinateReferenceSystem("EPSG:3857")
+    utm = QgsCoordinateReferenceSystem("EPSG:25832")
+    to_web = QgsCoordinateTransform(utm, web, QgsProject.instance())
+    canvas.setDestinationCrs(web)
+    canvas.setExtent(to_web.transformBoundingBox(QgsRectangle(*EXTENT)))
+    back = QgsCoordinateTransform(web, utm, QgsProject.instance())
+
+    def web_point(x: float, y: float) -> Tuple[float, float]:
+        p = to_web.transform(QgsPointXY(x, y))
+        return p.x(), p.y()
+
+    def utm_point(x: float, y: float) -> Tuple[float, float]:
+        p = back.transform(QgsPointXY(x, y))
+        return p.x(), p.y()
+
+    work["ask"].answer = {"text": "web"}
+    (hit,) = draw(work, "start_points", [web_point(402290.0, 5674660.0)])
+    (point, props), = saved(work, "start_points")
+    assert (point.x, point.y) == pytest.approx(utm_point(*hit), abs=1e-3)
+    assert props["height"] == pytest.approx(surface_z(point.x, point.y), abs=1e-6)
+    case = next(c for c in CLICKS if c["layer"] == "exclusion_areas")
+    work["ask"].answer = dict(case["answer"])
+    hits = draw(work, "exclusion_areas", [web_point(*xy) for xy in case["clicks"]])
+    (polygon, _), = saved(work, "exclusion_areas")
+    corners = list(polygon.exterior.coords)[:-1]
+    for (x, y), h in zip(corners, hits):
+        assert (x, y) == pytest.approx(utm_point(*h), abs=1e-3)
+
+
+def test_redrape_selected_breakline(work):
+    layer = work["layers"]["breaklines"]
+    work["bar"].set_z_mode("typed")
+    case = next(c for c in CLICKS if c["layer"] == "breaklines")
+    work["ask"].answer = {"heights": [30.0, 30.0, 30.0]}
+    draw(work, "breaklines", case["clicks"])
+    layer.selectAll()
+    work["iface"].setActiveLayer(layer)
+    assert work["bar"].controller.redrape() == 1
+    (line, _), = saved(work, "breaklines")
+    for x, y, z in line.coords:
+        assert z == pytest.approx(surface_z(x, y), abs=1e-6)
+
+
+def test_breakline_form_needs_the_free_heights(work):
+    """The real breakline form: OK only when every editable height is typed."""
+    from qgis.PyQt.QtWidgets import QDialogButtonBox
+
+    from photodem.plugin.qgis.edit_forms import BreaklineDialog
+
+    dialog = BreaklineDialog(work["iface"].mainWindow(), [None, 45.0, None],
+                             [True, False, True])
+    ok = dialog.buttons.button(QDialogButtonBox.Ok)
+    assert not ok.isEnabled()
+    dialog.boxes[0].setValue(40.0)
+    assert not ok.isEnabled()
+    dialog.boxes[2].setValue(44.0)
+    assert ok.isEnabled()
+    assert dialog.heights() == [40.0, 45.0, 44.0]
+    assert not dialog.boxes[1].isEnabled()
+    dialog.deleteLater()
