@@ -1470,7 +1470,7 @@
         </message>
         <message>
             <source>Iterations</source>
-            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:48</extracomment>
+            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:52</extracomment>
             <translation>Iterationen</translation>
         </message>
         <message>
@@ -2365,12 +2365,12 @@
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:105</extracomment>
+            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:107</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:107</extracomment>
+            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:109</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
@@ -2400,12 +2400,12 @@
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:244</extracomment>
+            <extracomment>plugin/app/main_window.py:245</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:245</extracomment>
+            <extracomment>plugin/app/main_window.py:246</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
@@ -2415,7 +2415,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:231; plugin/widgets/georef_review.py:326; plugin/widgets/georef_review.py:497; plugin/widgets/georef_review.py:502</extracomment>
+            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:232; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2429,18 +2429,323 @@
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
+            <source>keep (use only this area)</source>
+            <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
+            <translation>behalten (nur diese Fläche verwenden)</translation>
+        </message>
+        <message>
+            <source>remove (no matching here)</source>
+            <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
+            <translation>entfernen (hier keine Zuordnung)</translation>
+        </message>
+        <message>
+            <source>exclude (cut out of the products)</source>
+            <extracomment>plugin/qgis/edit_forms.py:35</extracomment>
+            <translation>ausschließen (aus den Produkten ausschneiden)</translation>
+        </message>
+        <message>
+            <source>breakline</source>
+            <extracomment>plugin/qgis/edit_forms.py:41</extracomment>
+            <translation>Bruchkante</translation>
+        </message>
+        <message>
+            <source>structure line</source>
+            <extracomment>plugin/qgis/edit_forms.py:41</extracomment>
+            <translation>Strukturlinie</translation>
+        </message>
+        <message>
+            <source>type a height</source>
+            <extracomment>plugin/qgis/edit_forms.py:51</extracomment>
+            <translation>Höhe eingeben</translation>
+        </message>
+        <message>
+            <source>Height</source>
+            <extracomment>plugin/qgis/edit_forms.py:90</extracomment>
+            <translation>Höhe</translation>
+        </message>
+        <message>
+            <source>Exclusion area</source>
+            <extracomment>plugin/qgis/edit_forms.py:105; plugin/qgis/edit_maptools.py:324; plugin/qgis/editing_toolbar.py:41</extracomment>
+            <translation>Ausschlussfläche</translation>
+        </message>
+        <message>
+            <source>What should happen inside the area?</source>
+            <extracomment>plugin/qgis/edit_forms.py:106</extracomment>
+            <translation>Was soll innerhalb der Fläche geschehen?</translation>
+        </message>
+        <message>
+            <source>Action</source>
+            <extracomment>plugin/qgis/edit_forms.py:112</extracomment>
+            <translation>Aktion</translation>
+        </message>
+        <message>
+            <source>Note</source>
+            <extracomment>plugin/qgis/edit_forms.py:114; plugin/qgis/edit_forms.py:93; plugin/qgis/edit_maptools.py:292</extracomment>
+            <translation>Notiz</translation>
+        </message>
+        <message>
+            <source>Breakline heights</source>
+            <extracomment>plugin/qgis/edit_forms.py:122</extracomment>
+            <translation>Höhen der Bruchkante</translation>
+        </message>
+        <message>
+            <source>Kind</source>
+            <extracomment>plugin/qgis/edit_forms.py:127</extracomment>
+            <translation>Art</translation>
+        </message>
+        <message>
+            <source>Invalid polygon</source>
+            <extracomment>plugin/qgis/edit_forms.py:191</extracomment>
+            <translation>Ungültiges Polygon</translation>
+        </message>
+        <message>
+            <source>Use the repaired polygon?</source>
+            <extracomment>plugin/qgis/edit_forms.py:192</extracomment>
+            <translation>Das reparierte Polygon verwenden?</translation>
+        </message>
+        <message>
+            <source>Vertex {0}</source>
+            <extracomment>plugin/qgis/edit_forms.py:134</extracomment>
+            <translation>Stützpunkt {0}</translation>
+        </message>
+        <message>
+            <source>Start point</source>
+            <extracomment>plugin/qgis/edit_maptools.py:290; plugin/qgis/editing_toolbar.py:41</extracomment>
+            <translation>Startpunkt</translation>
+        </message>
+        <message>
+            <source>Ground point</source>
+            <extracomment>plugin/qgis/edit_maptools.py:290; plugin/qgis/editing_toolbar.py:49</extracomment>
+            <translation>Bodenpunkt</translation>
+        </message>
+        <message>
+            <source>Check point</source>
+            <extracomment>plugin/qgis/edit_maptools.py:291; plugin/qgis/editing_toolbar.py:50</extracomment>
+            <translation>Kontrollpunkt</translation>
+        </message>
+        <message>
+            <source>Id</source>
+            <extracomment>plugin/qgis/edit_maptools.py:292</extracomment>
+            <translation>Kennung</translation>
+        </message>
+        <message>
+            <source>Breakline</source>
+            <extracomment>plugin/qgis/edit_maptools.py:368; plugin/qgis/editing_toolbar.py:49</extracomment>
+            <translation>Bruchkante</translation>
+        </message>
+        <message>
+            <source>Type the heights of the two ends; the others are interpolated.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:394</extracomment>
+            <translation>Geben Sie die Höhen der beiden Enden ein; die übrigen werden interpoliert.</translation>
+        </message>
+        <message>
+            <source>Re-drape</source>
+            <extracomment>plugin/qgis/edit_maptools.py:456; plugin/qgis/editing_toolbar.py:145</extracomment>
+            <translation>Neu abgreifen</translation>
+        </message>
+        <message>
+            <source>The edits file {0} does not exist.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:75</extracomment>
+            <translation>Die Bearbeitungsdatei {0} existiert nicht.</translation>
+        </message>
+        <message>
+            <source>The edits file {0} is read-only; make it writable to edit.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:78</extracomment>
+            <translation>Die Bearbeitungsdatei {0} ist schreibgeschützt; machen Sie sie beschreibbar, um zu bearbeiten.</translation>
+        </message>
+        <message>
+            <source>Open a PhotoDEM project first (PhotoDEM → Open project…).</source>
+            <extracomment>plugin/qgis/edit_maptools.py:161; plugin/qgis/editing_toolbar.py:229</extracomment>
+            <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt (PhotoDEM → Projekt öffnen…).</translation>
+        </message>
+        <message>
+            <source>No surface chosen; type the height.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:229</extracomment>
+            <translation>Keine Oberfläche gewählt; geben Sie die Höhe ein.</translation>
+        </message>
+        <message>
+            <source>The point lies outside every stereo model; no model will use it.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:285</extracomment>
+            <translation>Der Punkt liegt außerhalb aller Stereomodelle; kein Modell wird ihn verwenden.</translation>
+        </message>
+        <message>
+            <source>Boundary</source>
+            <extracomment>plugin/qgis/edit_maptools.py:326; plugin/qgis/edit_maptools.py:329; plugin/qgis/editing_toolbar.py:43</extracomment>
+            <translation>Begrenzung</translation>
+        </message>
+        <message>
+            <source>Name</source>
+            <extracomment>plugin/qgis/edit_maptools.py:326</extracomment>
+            <translation>Name</translation>
+        </message>
+        <message>
+            <source>Seamline</source>
+            <extracomment>plugin/qgis/edit_maptools.py:351; plugin/qgis/editing_toolbar.py:44</extracomment>
+            <translation>Schnittlinie</translation>
+        </message>
+        <message>
+            <source>Select breaklines or points in an edit layer of the project (breaklines, start, ground or check points) to re-drape them.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:443</extracomment>
+            <translation>Wählen Sie Bruchkanten oder Punkte in einem Bearbeitungslayer des Projekts (Bruchkanten, Start-, Boden- oder Kontrollpunkte), um ihre Höhen neu abzugreifen.</translation>
+        </message>
+        <message>
+            <source>The edits file {0} is locked or unreadable ({1}); close the program that holds it and try again.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:87</extracomment>
+            <translation>Die Bearbeitungsdatei {0} ist gesperrt oder nicht lesbar ({1}); schließen Sie das Programm, das sie geöffnet hält, und versuchen Sie es erneut.</translation>
+        </message>
+        <message>
+            <source>Choose a surface (DSM or DTM) in the editing toolbar.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:212</extracomment>
+            <translation>Wählen Sie in der Bearbeitungswerkzeugleiste eine Oberfläche (DOM oder DGM).</translation>
+        </message>
+        <message>
+            <source>{0} features re-draped on the surface.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:464</extracomment>
+            <translation>Höhen von {0} Objekten auf der Oberfläche neu abgegriffen.</translation>
+        </message>
+        <message>
+            <source>The layer '{0}' of edits.gpkg is not loaded or missing; add it to the project's edits first.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:165</extracomment>
+            <translation>Der Layer '{0}' von edits.gpkg ist nicht geladen oder fehlt; fügen Sie ihn zuerst den Bearbeitungen des Projekts hinzu.</translation>
+        </message>
+        <message>
+            <source>The surface '{0}' has no CRS; assign it its CRS (Layer Properties → Source) first.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:215</extracomment>
+            <translation>Die Oberfläche '{0}' hat kein KBS; weisen Sie ihr zuerst ihr KBS zu (Layereigenschaften → Quelle).</translation>
+        </message>
+        <message>
+            <source>The surface '{0}' is not a file ({1}).</source>
+            <extracomment>plugin/qgis/edit_maptools.py:220</extracomment>
+            <translation>Die Oberfläche '{0}' ist keine Datei ({1}).</translation>
+        </message>
+        <message>
+            <source>QGIS refused the new feature of '{0}'.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:266</extracomment>
+            <translation>QGIS hat das neue Objekt von '{0}' abgelehnt.</translation>
+        </message>
+        <message>
+            <source>Breakline refused, nothing written: {0}</source>
+            <extracomment>plugin/qgis/edit_maptools.py:356</extracomment>
+            <translation>Bruchkante abgelehnt, nichts geschrieben: {0}</translation>
+        </message>
+        <message>
+            <source>Nothing selected in '{0}'.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:448</extracomment>
+            <translation>Nichts ausgewählt in '{0}'.</translation>
+        </message>
+        <message>
+            <source>QGIS cannot edit the layer '{0}'.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:174</extracomment>
+            <translation>QGIS kann den Layer '{0}' nicht bearbeiten.</translation>
+        </message>
+        <message>
+            <source>Polygon refused, nothing written: {0}</source>
+            <extracomment>plugin/qgis/edit_maptools.py:315</extracomment>
+            <translation>Polygon abgelehnt, nichts geschrieben: {0}</translation>
+        </message>
+        <message>
+            <source>Feature {0}: {1}</source>
+            <extracomment>plugin/qgis/edit_maptools.py:488</extracomment>
+            <translation>Objekt {0}: {1}</translation>
+        </message>
+        <message>
+            <source>Breakline (3-D)</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:42</extracomment>
+            <translation>Bruchkante (3D)</translation>
+        </message>
+        <message>
+            <source>Ground point (3-D)</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:42</extracomment>
+            <translation>Bodenpunkt (3D)</translation>
+        </message>
+        <message>
+            <source>Check point (3-D)</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:43</extracomment>
+            <translation>Kontrollpunkt (3D)</translation>
+        </message>
+        <message>
+            <source>Z: drape</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:55</extracomment>
+            <translation>Z: von Oberfläche</translation>
+        </message>
+        <message>
+            <source>Each vertex gets the height of the surface</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:55</extracomment>
+            <translation>Jeder Stützpunkt erhält die Höhe der Oberfläche</translation>
+        </message>
+        <message>
+            <source>Z: typed</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:56</extracomment>
+            <translation>Z: eingegeben</translation>
+        </message>
+        <message>
+            <source>Type the height of each vertex</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:56</extracomment>
+            <translation>Geben Sie die Höhe jedes Stützpunkts ein</translation>
+        </message>
+        <message>
+            <source>Z: interpolate</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:57</extracomment>
+            <translation>Z: interpoliert</translation>
+        </message>
+        <message>
+            <source>Type the heights of the two ends; the vertices between are interpolated along the line</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:58</extracomment>
+            <translation>Geben Sie die Höhen der beiden Enden ein; die Stützpunkte dazwischen werden entlang der Linie interpoliert</translation>
+        </message>
+        <message>
+            <source>PhotoDEM editing</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:89</extracomment>
+            <translation>PhotoDEM-Bearbeitung</translation>
+        </message>
+        <message>
+            <source>The DSM or DTM the heights are taken from</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:133</extracomment>
+            <translation>Das DOM oder DGM, aus dem die Höhen entnommen werden</translation>
+        </message>
+        <message>
+            <source>How the breakline tool gives its vertices their heights</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:141</extracomment>
+            <translation>Wie das Bruchkantenwerkzeug die Höhen seiner Stützpunkte bestimmt</translation>
+        </message>
+        <message>
+            <source>Re-sample the heights of the selected breaklines and points on the surface</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:147</extracomment>
+            <translation>Die Höhen der gewählten Bruchkanten und Punkte neu von der Oberfläche abgreifen</translation>
+        </message>
+        <message>
+            <source>Validate</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:152</extracomment>
+            <translation>Prüfen</translation>
+        </message>
+        <message>
+            <source>Check the current edits, unsaved ones included</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:154</extracomment>
+            <translation>Die aktuellen Bearbeitungen prüfen, auch die nicht gespeicherten</translation>
+        </message>
+        <message>
+            <source>Surface</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:127</extracomment>
+            <translation>Oberfläche</translation>
+        </message>
+        <message>
+            <source>Validation: {0} problems.</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:238</extracomment>
+            <translation>Prüfung: {0} Probleme.</translation>
+        </message>
+        <message>
             <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
-            <extracomment>plugin/qgis/plugin.py:43</extracomment>
+            <extracomment>plugin/qgis/plugin.py:44</extracomment>
             <translation>PhotoDEM benötigt Python-Pakete, die QGIS nicht findet: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: mit dem OSGeo4W-Installer installieren.</translation>
         </message>
         <message>
             <source>PhotoDEM algorithms</source>
-            <extracomment>plugin/qgis/plugin.py:92</extracomment>
+            <extracomment>plugin/qgis/plugin.py:94</extracomment>
             <translation>PhotoDEM-Algorithmen</translation>
         </message>
         <message>
             <source>Show the PhotoDEM algorithms in the Processing Toolbox</source>
-            <extracomment>plugin/qgis/plugin.py:94</extracomment>
+            <extracomment>plugin/qgis/plugin.py:96</extracomment>
             <translation>Die PhotoDEM-Algorithmen im Verarbeitungswerkzeugkasten zeigen</translation>
         </message>
         <message>
@@ -2449,368 +2754,418 @@
             <translation>PhotoDEM Luftbildphotogrammetrie</translation>
         </message>
         <message>
+            <source>PhotoDEM validation</source>
+            <extracomment>plugin/qgis/validation_dock.py:107</extracomment>
+            <translation>PhotoDEM-Prüfung</translation>
+        </message>
+        <message>
+            <source>error</source>
+            <extracomment>plugin/qgis/validation_dock.py:132</extracomment>
+            <translation>Fehler</translation>
+        </message>
+        <message>
+            <source>warning</source>
+            <extracomment>plugin/qgis/validation_dock.py:132</extracomment>
+            <translation>Warnung</translation>
+        </message>
+        <message>
+            <source>Problem</source>
+            <extracomment>plugin/qgis/validation_dock.py:113</extracomment>
+            <translation>Problem</translation>
+        </message>
+        <message>
+            <source>Severity</source>
+            <extracomment>plugin/qgis/validation_dock.py:113</extracomment>
+            <translation>Schwere</translation>
+        </message>
+        <message>
+            <source>Layer</source>
+            <extracomment>plugin/qgis/validation_dock.py:113</extracomment>
+            <translation>Layer</translation>
+        </message>
+        <message>
+            <source>Feature</source>
+            <extracomment>plugin/qgis/validation_dock.py:114</extracomment>
+            <translation>Objekt</translation>
+        </message>
+        <message>
+            <source>unsaved</source>
+            <extracomment>plugin/qgis/validation_dock.py:138</extracomment>
+            <translation>ungespeichert</translation>
+        </message>
+        <message>
+            <source>No problems found.</source>
+            <extracomment>plugin/qgis/validation_dock.py:148</extracomment>
+            <translation>Keine Probleme gefunden.</translation>
+        </message>
+        <message>
+            <source>Breakline {0}</source>
+            <extracomment>plugin/qgis/validation_dock.py:96</extracomment>
+            <translation>Bruchkante {0}</translation>
+        </message>
+        <message>
             <source>Use</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
             <translation>Verwenden</translation>
         </message>
         <message>
             <source>Role</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
             <translation>Rolle</translation>
         </message>
         <message>
             <source>Pair</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
             <translation>Paar</translation>
         </message>
         <message>
             <source>Column</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
             <translation>Spalte</translation>
         </message>
         <message>
             <source>Row</source>
-            <extracomment>plugin/widgets/georef_review.py:39</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
             <translation>Zeile</translation>
         </message>
         <message>
             <source>dX [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>dX [px]</translation>
         </message>
         <message>
             <source>dY [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>dY [px]</translation>
         </message>
         <message>
             <source>Residual [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>Restfehler [px]</translation>
         </message>
         <message>
             <source>Residual [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:40</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
             <translation>Restfehler [m]</translation>
         </message>
         <message>
             <source>Leave-one-out [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:41</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
             <translation>Ohne diesen Punkt [m]</translation>
         </message>
         <message>
             <source>Reject</source>
-            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
             <translation>Verwerfen</translation>
         </message>
         <message>
             <source>Image object</source>
-            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
             <translation>Bildobjekt</translation>
         </message>
         <message>
             <source>Reference object</source>
-            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
             <translation>Referenzobjekt</translation>
         </message>
         <message>
             <source>Segmentation run</source>
-            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>Segmentierungslauf</translation>
         </message>
         <message>
             <source>Threshold [DN]</source>
-            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>Schwellwert [GW]</translation>
         </message>
         <message>
             <source>Overlap</source>
-            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>Überlappung</translation>
         </message>
         <message>
             <source>ICP RMS [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>ICP-RMS [px]</translation>
         </message>
         <message>
             <source>Converged</source>
-            <extracomment>plugin/widgets/georef_review.py:48</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
             <translation>Konvergiert</translation>
         </message>
         <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:63</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
             <source>Drop outliers (&gt; 3 σ0)</source>
-            <extracomment>plugin/widgets/georef_review.py:125</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:129</extracomment>
             <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:151</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:152</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:154</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:161</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:160</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:161</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:163</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:165</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:167</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/georef_review.py:166</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:167</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:169</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/georef_review.py:170</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:172</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:473</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:475</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:474; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:476; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:519</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:521</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:554</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:552</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:554</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:552</extracomment>
             <translation>nein</translation>
         </message>
         <message>
             <source>control point</source>
-            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:57</extracomment>
             <translation>Passpunkt</translation>
         </message>
         <message>
             <source>outlier (dropped)</source>
-            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:57</extracomment>
             <translation>Ausreißer (entfernt)</translation>
         </message>
         <message>
             <source>check point (off)</source>
-            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:58</extracomment>
             <translation>Kontrollpunkt (aus)</translation>
         </message>
         <message>
             <source>pair rejected</source>
-            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:58</extracomment>
             <translation>Paar verworfen</translation>
         </message>
         <message>
             <source>check (independent)</source>
-            <extracomment>plugin/widgets/georef_review.py:55</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:59</extracomment>
             <translation>Kontrollpunkt (unabhängig)</translation>
         </message>
         <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:66</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:70</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:71</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:68</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:72</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:69</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:73</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
             <source>Transform:</source>
-            <extracomment>plugin/widgets/georef_review.py:131</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:135</extracomment>
             <translation>Transformation:</translation>
         </message>
         <message>
             <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:337</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:339</extracomment>
             <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:392</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:502</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:504</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:75</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:79</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
             <source>Review georeferencing — {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:117</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:121</extracomment>
             <translation>Georeferenzierung prüfen — {0}</translation>
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:312</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:314</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:313</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:315</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
             <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:375</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:377</extracomment>
             <translation>manuell</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:396</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:398</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:398</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:400</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:402</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:404</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:435</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:437</extracomment>
             <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>
             <source>Browse</source>
-            <extracomment>plugin/widgets/parameter_form.py:59</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:60</extracomment>
             <translation>Durchsuchen</translation>
         </message>
         <message>
             <source>All files (*)</source>
-            <extracomment>plugin/widgets/parameter_form.py:76; plugin/widgets/parameter_form.py:78</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:77; plugin/widgets/parameter_form.py:79</extracomment>
             <translation>Alle Dateien (*)</translation>
         </message>
         <message>
-            <source>Supported files</source>
-            <extracomment>plugin/widgets/parameter_form.py:78</extracomment>
-            <translation>Unterstützte Dateien</translation>
-        </message>
-        <message>
-            <source>Choose a folder</source>
-            <extracomment>plugin/widgets/parameter_form.py:84</extracomment>
-            <translation>Ordner wählen</translation>
-        </message>
-        <message>
             <source>project folder (with project.toml)</source>
-            <extracomment>plugin/widgets/parameter_form.py:128</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:146</extracomment>
             <translation>Projektordner (mit project.toml)</translation>
         </message>
         <message>
             <source>optional</source>
-            <extracomment>plugin/widgets/parameter_form.py:159; plugin/widgets/parameter_form.py:202; plugin/widgets/parameter_form.py:292</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:181; plugin/widgets/parameter_form.py:226; plugin/widgets/parameter_form.py:316</extracomment>
             <translation>optional</translation>
         </message>
         <message>
             <source>choose a project first</source>
-            <extracomment>plugin/widgets/parameter_form.py:192</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:213</extracomment>
             <translation>zuerst ein Projekt wählen</translation>
         </message>
         <message>
             <source>image name</source>
-            <extracomment>plugin/widgets/parameter_form.py:192</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:213</extracomment>
             <translation>Bildname</translation>
         </message>
         <message>
-            <source>required</source>
-            <extracomment>plugin/widgets/parameter_form.py:292</extracomment>
-            <translation>erforderlich</translation>
+            <source>Supported files</source>
+            <extracomment>plugin/widgets/parameter_form.py:79</extracomment>
+            <translation>Unterstützte Dateien</translation>
+        </message>
+        <message>
+            <source>Choose a folder</source>
+            <extracomment>plugin/widgets/parameter_form.py:85</extracomment>
+            <translation>Ordner wählen</translation>
         </message>
         <message>
             <source>several files, separated by commas</source>
-            <extracomment>plugin/widgets/parameter_form.py:130</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:148</extracomment>
             <translation>mehrere Dateien, durch Kommas getrennt</translation>
         </message>
         <message>
+            <source>required</source>
+            <extracomment>plugin/widgets/parameter_form.py:316</extracomment>
+            <translation>erforderlich</translation>
+        </message>
+        <message>
             <source>e.g. EPSG:25832</source>
-            <extracomment>plugin/widgets/parameter_form.py:200</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:224</extracomment>
             <translation>z. B. EPSG:25832</translation>
         </message>
         <message>
             <source>xmin,ymin,xmax,ymax</source>
-            <extracomment>plugin/widgets/parameter_form.py:201</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:225</extracomment>
             <translation>xmin,ymin,xmax,ymax</translation>
         </message>
         <message>
             <source>type a name</source>
-            <extracomment>plugin/widgets/parameter_form.py:347</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:369</extracomment>
             <translation>Namen eingeben</translation>
         </message>
         <message>
             <source>no project found</source>
-            <extracomment>plugin/widgets/parameter_form.py:347</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:369</extracomment>
             <translation>kein Projekt gefunden</translation>
         </message>
         <message>
             <source>Save as</source>
-            <extracomment>plugin/widgets/parameter_form.py:86</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:87</extracomment>
             <translation>Speichern unter</translation>
         </message>
         <message>
             <source>Choose files</source>
-            <extracomment>plugin/widgets/parameter_form.py:88</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:89</extracomment>
             <translation>Dateien wählen</translation>
         </message>
         <message>
             <source>Choose a file</source>
-            <extracomment>plugin/widgets/parameter_form.py:91</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:92</extracomment>
             <translation>Datei wählen</translation>
         </message>
         <message>
