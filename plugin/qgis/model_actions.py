@@ -16,6 +16,7 @@ the selected feature, else picked from a list) and in the map canvas's context m
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from qgis.core import (
@@ -286,8 +287,7 @@ def _alive(task: Any) -> bool:
 
 
 def _disconnect(signal: Any, slot: Any) -> None:
-    try:
+    # TypeError: never connected; RuntimeError: the emitter is gone already
+    with contextlib.suppress(TypeError, RuntimeError):
         signal.disconnect(slot)
-    except (TypeError, RuntimeError):  # never connected, or the emitter is gone
-        pass
 

@@ -62,6 +62,7 @@ class PhotodemPlugin:
         self.provider: Optional[PhotodemProvider] = None
         self.actions: List[QAction] = []
         self.toolbox_action: Optional[QAction] = None
+        self.model_actions: Any = None  # run from the map (part R)
         self.translator = install_translator()
         self.missing = missing_dependencies()
 
@@ -109,6 +110,12 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
+        # -- run from the map: actions on stereo models (part R) --
+        # lazy: map-layer actions and dialogs exist only in the desktop, not under qgis_process
+        from .model_actions import ModelActions
+
+        self.model_actions = ModelActions(self.iface)
+        self.model_actions.register()
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -146,6 +153,9 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if self.model_actions is not None:  # run from the map (part R)
+            self.model_actions.unregister()
+            self.model_actions = None
         if self.iface is not None:
             for action in self.actions:
                 self.iface.removePluginRasterMenu(MENU_TITLE, action)

@@ -240,3 +240,39 @@ def test_right_click_on_the_map_offers_the_models_under_it(actions, tiny_project
     empty = QMenu()
     canvas.contextMenuAboutToShow.emit(empty, outside)
     assert empty.actions() == []
+
+
+def test_a_real_right_click_with_the_pan_tool_shows_the_model_menu(actions, tiny_project,
+                                                                    qgis_iface):
+    from qgis.core import QgsCoordinateReferenceSystem, QgsPointXY
+    from qgis.gui import QgsMapToolPan
+    from qgis.PyQt.QtCore import QPoint, Qt, QTimer
+    from qgis.PyQt.QtTest import QTest
+    from qgis.PyQt.QtWidgets import QApplication
+
+    layer = _block_layer(tiny_project, "stereo_models", "stereo_models")
+    canvas = qgis_iface.mapCanvas()
+    canvas.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:25832"))
+    canvas.setLayers([layer])
+    canvas.setExtent(layer.extent())
+    pan = QgsMapToolPan(canvas)
+    canvas.setMapTool(pan)
+    centre = _feature(layer, "0202_0203").geometry()
+    for f in layer.getFeatures():
+        if f["name"] != "0202_0203":
+            centre = centre.difference(f.geometry())
+    pixel = canvas.getCoordinateTransform().transform(
+        QgsPointXY(centre.pointOnSurface().asPoint()))
+    seen: List[str] = []
+
+    def read_and_close() -> None:  # the menu is modal: read it, then close it
+        popup = QApplication.activePopupWidget()
+        if popup is not None:
+            seen.extend(a.text() for a in popup.actions())
+            popup.close()
+
+    QTimer.singleShot(300, read_and_close)
+    QTest.mouseClick(canvas.viewport(), Qt.RightButton, Qt.NoModifier,
+                     QPoint(round(pixel.x()), round(pixel.y())))
+    QTest.qWait(400)
+    assert "Stereo model 0202_0203" in seen, seen
