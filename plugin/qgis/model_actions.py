@@ -150,7 +150,7 @@ class ModelActions(QObject):
         dsm = loaded.products_dir("dsm") / model / "dsm.tif"
         if not dsm.is_file():
             self.message(tr("Stereo model {0} has no DSM yet ({1}); match it first.").format(
-                model, dsm), Qgis.Warning)
+                model, loaded.relative_path(dsm)), Qgis.Warning)
             return None
         output = loaded.products_dir("dtm") / model
         return self.open_dialog("filter_lowpass", {"input": str(dsm), "project": project,

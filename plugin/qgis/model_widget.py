@@ -20,7 +20,7 @@ from qgis.core import (
     QgsProcessingParameterString,
     QgsSettings,
 )
-from qgis.PyQt.QtWidgets import QComboBox, QLabel, QVBoxLayout, QWidget
+from qgis.PyQt.QtWidgets import QComboBox, QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.project.model import Project
@@ -59,7 +59,8 @@ def project_models(path: Any) -> Tuple[List[str], str]:
     try:
         key = (str(toml.resolve()), toml.stat().st_mtime)
     except OSError:
-        return [], tr("Not a PhotoDEM project (no project.toml): {0}").format(text)
+        # no path in the text: it stands right above, in the project field
+        return [], tr("Not a PhotoDEM project: no project.toml in this folder.")
     if key not in _CACHE:
         try:
             _CACHE[key] = [m.name for m in Project.load(toml).models]
@@ -128,6 +129,8 @@ class ModelWidgetWrapper(WidgetWrapper):
         self.hint = QLabel()
         self.hint.setObjectName("photodemModelHint")
         self.hint.setWordWrap(True)
+        # a long path in a message must wrap, not widen the dialog
+        self.hint.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.hint.setStyleSheet("color: #a33;")
         self.hint.setVisible(False)
         layout.addWidget(self.hint)
