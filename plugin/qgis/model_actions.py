@@ -124,8 +124,15 @@ class ModelActions(QObject):
                 (tr("Filter its DSM…"), self.filter_dsm)]
 
     def match_model(self, project: str, model: str) -> Any:
-        """Open the ``match_model`` dialog with project and model filled in."""
-        return self.open_dialog("match_model", {"project": project, "model": model})
+        """Open the ``match_model`` dialog with project, model and output folder filled in.
+
+        The output is the spec's default folder ``products/dsm/<model>/`` written out: left
+        empty, the dialog would pass a temporary folder and the DSM would miss the project.
+        """
+        params: Dict[str, Any] = {"project": project, "model": model}
+        with contextlib.suppress(PhotodemError):  # unreadable: the dialog itself says so
+            params["output"] = str(Project.load(project).products_dir("dsm") / model)
+        return self.open_dialog("match_model", params)
 
     def epipolar_pair(self, project: str, model: str) -> Any:
         """Start ``epipolar_pair`` of the model as a background task."""

@@ -116,6 +116,12 @@ def _parameters(dialog) -> dict:
     return dialog.mainWidget().createProcessingParameters()
 
 
+def _static(value) -> str:
+    """A destination value of the dialog as a plain path."""
+    sink = getattr(value, "sink", None)
+    return str(sink.staticValue() if sink is not None else value)
+
+
 def test_map_layer_actions_only_on_stereo_model_layers(actions, tiny_project):
     from qgis.gui import QgsGui
 
@@ -141,6 +147,7 @@ def test_match_this_model_opens_the_dialog_with_project_and_model(actions, tiny_
     assert dialog.algorithm().id() == "photodem:match_model"
     params = _parameters(dialog)
     assert params["project"] == str(tiny_project) and params["model"] == "0201_0202"
+    assert _static(params["output"]) == str(tiny_project / "products" / "dsm" / "0201_0202")
     assert dialog.mainWidget().wrappers["model"].models() == MODELS
 
 
@@ -174,9 +181,7 @@ def test_filter_its_dsm_needs_a_dsm_then_fills_it_in(actions, tiny_project, qgis
         params = _parameters(dialog)
         assert params["input"] == str(dsm)
         assert params["project"] == str(tiny_project)
-        output = params["output"]
-        assert str(getattr(output, "sink", output).staticValue() if hasattr(output, "sink")
-                   else output) == str(tiny_project / "products" / "dtm" / model)
+        assert _static(params["output"]) == str(tiny_project / "products" / "dtm" / model)
     finally:
         shutil.rmtree(dsm.parent)
 
@@ -276,3 +281,19 @@ def test_a_real_right_click_with_the_pan_tool_shows_the_model_menu(actions, tiny
                      QPoint(round(pixel.x()), round(pixel.y())))
     QTest.qWait(400)
     assert "Stereo model 0202_0203" in seen, seen
+
+
+def test_the_dialog_opened_by_the_action_runs_match_model_as_a_task(actions, tiny_project,
+                                                                    qtbot):
+    from qgis.core import QgsApplication
+
+    layer = _block_layer(tiny_project, "stereo_models", "stereo_models")
+    model = "0202_0203"
+    actions.layer_actions[0].triggerForFeature(layer, _feature(layer, model))
+    dialog = actions.dialogs[-1]
+    before = len(QgsApplication.taskManager().tasks())
+    dialog.runAlgorithm()  # what the Run button does
+    assert len(QgsApplication.taskManager().tasks()) >= before  # 3.22: a background task
+    qtbot.waitUntil(lambda: bool(dialog.results()), timeout=120000)
+    dsm = tiny_project / "products" / "dsm" / model / "dsm.tif"
+    assert dialog.results()["dsm"] == str(dsm) and dsm.is_file()
