@@ -144,17 +144,33 @@ def test_the_batch_panel_gets_one_combo_per_row(qgis_iface, provider, tiny_proje
 
 def test_the_modeler_takes_a_static_name(qgis_iface, provider, fresh_settings):
     from processing.modeler.ModelerParametersDialog import ModelerParametersDialog
-    from qgis.core import QgsApplication, QgsProcessingModelAlgorithm
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingModelAlgorithm,
+        QgsProcessingModelChildParameterSource,
+        QgsProcessingModelParameter,
+        QgsProcessingParameterString,
+    )
 
     from photodem.plugin.qgis.model_widget import ModelWidgetWrapper
 
     alg = QgsApplication.processingRegistry().createAlgorithmById("photodem:match_model")
-    dialog = ModelerParametersDialog(alg, QgsProcessingModelAlgorithm())
+    graph = QgsProcessingModelAlgorithm()
+    name_input = QgsProcessingParameterString("which_model", "Which model")
+    graph.addModelParameter(name_input, QgsProcessingModelParameter("which_model"))
+    dialog = ModelerParametersDialog(alg, graph)
     wrappers = dialog.widget.widget.wrappers
     model = wrappers["model"]
     assert isinstance(model, ModelWidgetWrapper)
-    model.setValue("0101_0102")
+    model.setValue("0101_0102")  # a static name
     assert model.value() == "0101_0102"
+    # or a string input of the model, bound at run time
+    index = model.combo.findText("Which model")
+    assert index >= 0
+    model.combo.setCurrentIndex(index)
+    source = model.value()
+    assert source.source() == QgsProcessingModelChildParameterSource.ModelParameter
+    assert source.parameterName() == "which_model"
     dialog.close()
 
 
