@@ -101,7 +101,8 @@ def task_description(algorithm: Any, parameters: Dict[str, Any]) -> str:
     """The task manager's line: algorithm name and the stereo model if there is one."""
     model = parameters.get("model")
     name = algorithm.displayName()
-    return tr("PhotoDEM: {0} – {1}").format(name, model) if model else tr(
+    # the model first: the task manager cuts long lines at the right
+    return tr("PhotoDEM {1}: {0}").format(name, model) if model else tr(
         "PhotoDEM: {0}").format(name)
 
 
