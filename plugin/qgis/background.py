@@ -23,6 +23,7 @@ from qgis.core import (
     QgsTask,
     QgsVectorLayer,
 )
+from qgis.PyQt.QtCore import QTimer
 
 from ...algorithms.processing import registry
 from ..i18n import tr
@@ -149,6 +150,9 @@ def run_in_background(
         refs = _RUNNING.pop(key, {})
         _finish(algorithm_id, bool(ok), dict(results or {}), refs, iface)
 
+    if task.isCanceled():  # preparing the algorithm failed: the task will never run
+        QTimer.singleShot(0, lambda: executed(False, {}))
+        return task
     task.executed.connect(executed)
     QgsApplication.taskManager().addTask(task)
     return task

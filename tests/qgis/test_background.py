@@ -131,3 +131,26 @@ def test_product_paths_are_the_existing_raster_and_vector_outputs(tmp_path):
                                "report": str(dsm), "metrics": "{}"}
     assert product_paths("match_model", results) == [str(dsm)]
     assert product_paths("no_such_algorithm", results) == []
+
+
+def test_a_task_that_cannot_start_still_calls_back(qgis_iface, provider, tiny_project,
+                                                   workspace, qtbot, monkeypatch):
+    """QgsProcessingAlgRunnerTask cancels itself when preparing the algorithm fails."""
+    from qgis.core import QgsApplication, QgsProcessingAlgRunnerTask
+
+    from photodem.plugin.qgis import background
+
+    def failing_prepare(*args):
+        task = QgsProcessingAlgRunnerTask(*args)
+        task.cancel()
+        return task
+
+    monkeypatch.setattr(background, "QgsProcessingAlgRunnerTask", failing_prepare)
+    calls: List[Any] = []
+    task = background.run_in_background(
+        "match_model", {"project": str(tiny_project), "model": MODEL},
+        lambda ok, results: calls.append((ok, dict(results))), iface=qgis_iface)
+    assert task not in QgsApplication.taskManager().tasks()
+    _wait(qtbot, calls, 5000)
+    assert calls == [(False, {})] and workspace.added == []
+    assert not background.running_tasks()
