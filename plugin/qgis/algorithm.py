@@ -57,6 +57,9 @@ from ...algorithms.processing.spec import Algorithm, Output, Parameter
 from ..i18n import tr
 from ..qt import QIcon
 
+#: The widget wrapper of ``model`` parameters, by its dotted path (see ``model_widget``).
+MODEL_WIDGET_WRAPPER = f"{__package__}.model_widget.ModelWidgetWrapper"
+
 
 class QgisFeedback(Feedback):
     """PhotoDEM :class:`Feedback` on top of a ``QgsProcessingFeedback``.
@@ -193,6 +196,9 @@ def make_parameter(p: Parameter) -> QgsProcessingParameterDefinition:
             name, desc, defaultValue=None if default is None else str(default),
             optional=optional,
         )
+        if kind == "model":  # a drop-down of the project's models (a class path: imported
+            # only when a dialog is built, never under qgis_process)
+            q.setMetadata({"widget_wrapper": {"class": MODEL_WIDGET_WRAPPER}})
     elif p.is_list:
         q = QgsProcessingParameterMultipleLayers(
             name, desc, QgsProcessing.TypeRaster, defaultValue=default, optional=optional

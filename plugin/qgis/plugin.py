@@ -63,6 +63,7 @@ class PhotodemPlugin:
         self.actions: List[QAction] = []
         self.toolbox_action: Optional[QAction] = None
         self.editing_toolbar: Any = None  # the "PhotoDEM editing" toolbar (section 2)
+        self.model_actions: Any = None  # run from the map (part R)
         self.translator = install_translator()
         self.missing = missing_dependencies()
 
@@ -114,6 +115,12 @@ class PhotodemPlugin:
         from .editing_toolbar import EditingToolbar  # lazy: map tools only in the desktop GUI
 
         self.editing_toolbar = EditingToolbar(self.iface)
+        # -- run from the map: actions on stereo models (part R) --
+        # lazy: map-layer actions and dialogs exist only in the desktop, not under qgis_process
+        from .model_actions import ModelActions
+
+        self.model_actions = ModelActions(self.iface)
+        self.model_actions.register()
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -154,6 +161,9 @@ class PhotodemPlugin:
         if self.editing_toolbar is not None:  # editing toolbar (issue 18 §2)
             self.editing_toolbar.unload()
             self.editing_toolbar = None
+        if self.model_actions is not None:  # run from the map (part R)
+            self.model_actions.unregister()
+            self.model_actions = None
         if self.iface is not None:
             for action in self.actions:
                 self.iface.removePluginRasterMenu(MENU_TITLE, action)

@@ -42,6 +42,7 @@ class WidgetIface:
         self.menus: Dict[str, List[Any]] = {}
         self.toolbar_icons: List[Any] = []
         self.layer_actions: List[Any] = []
+        self.layer_action_layers: List[Any] = []  # (action, layer id) of addCustomActionForLayer
         self.window.show()
 
     # -- widgets ------------------------------------------------------------------------------
@@ -112,7 +113,7 @@ class WidgetIface:
         self.layer_actions.append(action)
 
     def addCustomActionForLayer(self, action, layer):  # noqa: N802
-        pass
+        self.layer_action_layers.append((action, layer.id()))
 
     def removeCustomActionForLayerType(self, action):  # noqa: N802
         if action in self.layer_actions:

@@ -52,6 +52,17 @@ class FakeIface:
         self.calls.append(("addToolBar", toolbar.objectName()))
         self.window.addToolBar(toolbar)
 
+    # -- actions on stereo models (model_actions): layer-tree entries, map context menu --
+    def addCustomActionForLayerType(self, action, menu, layer_type, all_layers):  # noqa: N802
+        self.calls.append(("addCustomActionForLayerType", menu, action.text()))
+
+    def addCustomActionForLayer(self, action, layer):  # noqa: N802
+        self.calls.append(("addCustomActionForLayer", action.text(), layer.id()))
+
+    def removeCustomActionForLayerType(self, action):  # noqa: N802
+        self.calls.append(("removeCustomActionForLayerType", action.text()))
+        return True
+
     def __getattr__(self, name):  # anything else would be an unexpected use of iface
         raise AssertionError(f"the plugin used iface.{name}, which the fake does not provide")
 
@@ -130,6 +141,9 @@ def test_desktop_init_gui_and_unload(qgis_app, plugin):
         assert ("removeToolBarIcon", "photodemShowToolbox") in iface.calls
         assert registry.providerById("photodem") is None
         assert desktop.actions == []
+        tree = {c[1] for c in iface.calls if c[0] == "removeCustomActionForLayerType"}
+        assert tree == {"Match this model…", "Epipolar pair", "Filter its DSM…"}
+        assert desktop.model_actions is None
     finally:
         plugin.initProcessing()
     assert registry.providerById("photodem") is plugin.provider
