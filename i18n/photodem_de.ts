@@ -365,7 +365,7 @@
         </message>
         <message>
             <source>Epipolar pair</source>
-            <extracomment>epipolar_pair: name</extracomment>
+            <extracomment>epipolar_pair: name; plugin/qgis/model_actions.py:123</extracomment>
             <translation>Epipolarbildpaar</translation>
         </message>
         <message>
@@ -385,7 +385,7 @@
         </message>
         <message>
             <source>Stereo model</source>
-            <extracomment>epipolar_pair.model: description; match_model.model: description</extracomment>
+            <extracomment>epipolar_pair.model: description; match_model.model: description; plugin/qgis/model_actions.py:251</extracomment>
             <translation>Stereomodell</translation>
         </message>
         <message>
@@ -2365,12 +2365,12 @@
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:107</extracomment>
+            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:108</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:109</extracomment>
+            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:110</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
@@ -2395,7 +2395,7 @@
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:213</extracomment>
+            <extracomment>plugin/app/main_window.py:213; plugin/qgis/background.py:173</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
@@ -2427,6 +2427,21 @@
             <source>Tools → Review georeferencing checks and edits its control points.</source>
             <extracomment>plugin/app/main_window.py:221</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
+        </message>
+        <message>
+            <source>PhotoDEM {1}: {0}</source>
+            <extracomment>plugin/qgis/background.py:106</extracomment>
+            <translation>PhotoDEM {1}: {0}</translation>
+        </message>
+        <message>
+            <source>PhotoDEM: {0}</source>
+            <extracomment>plugin/qgis/background.py:106</extracomment>
+            <translation>PhotoDEM: {0}</translation>
+        </message>
+        <message>
+            <source>{0} failed; see the log messages.</source>
+            <extracomment>plugin/qgis/background.py:175</extracomment>
+            <translation>{0} ist fehlgeschlagen; siehe Protokollmeldungen.</translation>
         </message>
         <message>
             <source>keep (use only this area)</source>
@@ -2734,18 +2749,78 @@
             <translation>Prüfung: {0} Probleme.</translation>
         </message>
         <message>
+            <source>Stereo model:</source>
+            <extracomment>plugin/qgis/model_actions.py:252</extracomment>
+            <translation>Stereomodell:</translation>
+        </message>
+        <message>
+            <source>Match this model…</source>
+            <extracomment>plugin/qgis/model_actions.py:122</extracomment>
+            <translation>Dieses Modell zuordnen…</translation>
+        </message>
+        <message>
+            <source>Filter its DSM…</source>
+            <extracomment>plugin/qgis/model_actions.py:124</extracomment>
+            <translation>Sein DOM filtern…</translation>
+        </message>
+        <message>
+            <source>Select the stereo-models layer of a PhotoDEM project first.</source>
+            <extracomment>plugin/qgis/model_actions.py:235</extracomment>
+            <translation>Wählen Sie zuerst den Stereomodell-Layer eines PhotoDEM-Projekts.</translation>
+        </message>
+        <message>
+            <source>The layer '{0}' names no PhotoDEM project.</source>
+            <extracomment>plugin/qgis/model_actions.py:95</extracomment>
+            <translation>Der Layer „{0}“ nennt kein PhotoDEM-Projekt.</translation>
+        </message>
+        <message>
+            <source>Stereo model {0} has no DSM yet ({1}); match it first.</source>
+            <extracomment>plugin/qgis/model_actions.py:159</extracomment>
+            <translation>Stereomodell {0} hat noch kein DOM ({1}); ordnen Sie es zuerst zu.</translation>
+        </message>
+        <message>
+            <source>Stereo model {0}</source>
+            <extracomment>plugin/qgis/model_actions.py:277</extracomment>
+            <translation>Stereomodell {0}</translation>
+        </message>
+        <message>
+            <source>Epipolar pair of {0} written to {1}.</source>
+            <extracomment>plugin/qgis/model_actions.py:142</extracomment>
+            <translation>Epipolarbildpaar von {0} nach {1} geschrieben.</translation>
+        </message>
+        <message>
+            <source>Stereo model name</source>
+            <extracomment>plugin/qgis/model_widget.py:113</extracomment>
+            <translation>Name des Stereomodells</translation>
+        </message>
+        <message>
+            <source>Not a PhotoDEM project: no project.toml in this folder.</source>
+            <extracomment>plugin/qgis/model_widget.py:63</extracomment>
+            <translation>Kein PhotoDEM-Projekt: keine project.toml in diesem Ordner.</translation>
+        </message>
+        <message>
+            <source>Stereo models of the project</source>
+            <extracomment>plugin/qgis/model_widget.py:196</extracomment>
+            <translation>Stereomodelle des Projekts</translation>
+        </message>
+        <message>
+            <source>The project cannot be read: {0}</source>
+            <extracomment>plugin/qgis/model_widget.py:68</extracomment>
+            <translation>Das Projekt ist nicht lesbar: {0}</translation>
+        </message>
+        <message>
             <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
             <extracomment>plugin/qgis/plugin.py:44</extracomment>
             <translation>PhotoDEM benötigt Python-Pakete, die QGIS nicht findet: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: mit dem OSGeo4W-Installer installieren.</translation>
         </message>
         <message>
             <source>PhotoDEM algorithms</source>
-            <extracomment>plugin/qgis/plugin.py:94</extracomment>
+            <extracomment>plugin/qgis/plugin.py:95</extracomment>
             <translation>PhotoDEM-Algorithmen</translation>
         </message>
         <message>
             <source>Show the PhotoDEM algorithms in the Processing Toolbox</source>
-            <extracomment>plugin/qgis/plugin.py:96</extracomment>
+            <extracomment>plugin/qgis/plugin.py:97</extracomment>
             <translation>Die PhotoDEM-Algorithmen im Verarbeitungswerkzeugkasten zeigen</translation>
         </message>
         <message>
