@@ -29,6 +29,7 @@ from qgis.core import (
     QgsProcessingFeedback,
     QgsProcessingOutputFile,
     QgsProcessingOutputFolder,
+    QgsProcessingOutputHtml,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
     QgsProcessingOutputString,
@@ -214,10 +215,12 @@ def _option_index(p: Parameter, value: Any) -> int:
 
 
 def make_output(o: Output):
-    """The QGIS output definition for a spec output (``json`` becomes a string output)."""
+    """The QGIS output definition for a spec output (``json`` becomes a string output,
+    ``html`` an HTML output that the Results Viewer lists)."""
     cls = {
         "folder": QgsProcessingOutputFolder,
         "file": QgsProcessingOutputFile,
+        "html": QgsProcessingOutputHtml,  # shown in the Results Viewer
         "raster": QgsProcessingOutputRasterLayer,
         "vector": QgsProcessingOutputVectorLayer,
         "number": QgsProcessingOutputNumber,

@@ -1,4 +1,4 @@
-"""The QGIS plugin class: Processing provider, Raster menu, toolbar button.
+"""The QGIS plugin class: Processing provider, Raster menu (with *Open project…*), toolbar button.
 
 QGIS desktop calls ``classFactory(iface)`` then :meth:`PhotodemPlugin.initGui`; ``qgis_process``
 calls ``classFactory(None)`` then only :meth:`PhotodemPlugin.initProcessing`. So
@@ -16,6 +16,7 @@ from qgis.PyQt.QtWidgets import QDockWidget
 from ...algorithms.processing import registry
 from ..i18n import install_translator, remove_translator, tr
 from ..qt import QAction, QIcon
+from .project_menu import ProjectMenu
 from .provider import ICON_PATH, PROVIDER_ID, PhotodemProvider
 
 MENU_TITLE = "&PhotoDEM"
@@ -62,6 +63,7 @@ class PhotodemPlugin:
         self.provider: Optional[PhotodemProvider] = None
         self.actions: List[QAction] = []
         self.toolbox_action: Optional[QAction] = None
+        self.project_menu: Optional[ProjectMenu] = None  # Open project… and recent projects
         self.translator = install_translator()
         self.missing = missing_dependencies()
 
@@ -90,6 +92,8 @@ class PhotodemPlugin:
             return
         parent = self.iface.mainWindow()
         icon = QIcon(str(ICON_PATH))
+        self.project_menu = ProjectMenu(self.iface, MENU_TITLE)
+        self.project_menu.register()
         self.toolbox_action = QAction(icon, tr("PhotoDEM algorithms"), parent)
         self.toolbox_action.setObjectName("photodemShowToolbox")
         self.toolbox_action.setToolTip(tr("Show the PhotoDEM algorithms in the Processing Toolbox"))
@@ -109,6 +113,10 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
+
+    def open_project(self, path: Optional[str] = None) -> Any:
+        """Open a PhotoDEM project as the workspace (asks for it without ``path``)."""
+        return self.project_menu.open_project(path) if self.project_menu is not None else None
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -146,6 +154,9 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if self.project_menu is not None:
+            self.project_menu.unregister()
+            self.project_menu = None
         if self.iface is not None:
             for action in self.actions:
                 self.iface.removePluginRasterMenu(MENU_TITLE, action)
