@@ -52,6 +52,15 @@ def value_labels() -> Dict[str, str]:
     return labels
 
 
+def constraint_descriptions() -> Dict[str, str]:
+    """Translated descriptions of the expression constraints in the QML files (shown when
+    a form refuses a value), by their English text."""
+    return {"keep, remove or exclude": tr("keep, remove or exclude"),
+            "breakline or structure_line": tr("breakline or structure_line"),
+            "height between -500 m and 9000 m": tr("height between -500 m and 9000 m"),
+            "a non-empty id": tr("a non-empty id")}
+
+
 def style_path(kind: str) -> Optional[Path]:
     """The QML file of a layer kind, or ``None`` when the kind has none."""
     name = KIND_STYLES.get(kind)
@@ -88,12 +97,12 @@ def translate_value_maps(layer: QgsVectorLayer) -> None:
     """Replace the labels of every value map of ``layer`` by their translation (the stored
     values stay), the category labels of a categorised renderer and the descriptions of the
     expression constraints (shown when the form refuses a value) alike."""
-    labels = value_labels()
+    labels, descriptions = value_labels(), constraint_descriptions()
     for index, field in enumerate(layer.fields()):
         expression = field.constraints().constraintExpression()
         if expression:
-            layer.setConstraintExpression(index, expression,
-                                          tr(field.constraints().constraintDescription()))
+            text = field.constraints().constraintDescription()
+            layer.setConstraintExpression(index, expression, descriptions.get(text, text))
         setup = field.editorWidgetSetup()
         if setup.type() != "ValueMap":
             continue

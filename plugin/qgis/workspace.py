@@ -282,11 +282,36 @@ class Workspace(QObject):
             self.iface.mapCanvas().refresh()
         return added
 
-    def remove_layers_of(self, path: Path) -> int:
-        """Remove every layer whose source is ``path`` (workspace or not); returns how many."""
+    def adopt(self, layer: QgsMapLayer, kind: str) -> None:
+        """Take a layer that Processing loaded for a run into the Products group (on top),
+        replacing older layers of the same file; a DEM gets its hillshade below it."""
+        path = Path(_source_path(layer))
+        self.remove_layers_of(path, keep=layer)
+        _tag(layer, kind, self.root)
+        group = self.subgroup(PRODUCTS)
+        tree = QgsProject.instance().layerTreeRoot()
+        node = tree.findLayer(layer.id())
+        if group is None or node is None:
+            return
+        if node.parent() is not group:
+            group.insertChildNode(0, node.clone())
+            node.parent().removeChildNode(node)
+        if kind in ELEVATION_KINDS:
+            shade = QgsRasterLayer(str(path), f"{layer.name()} ({tr('hillshade')})", "gdal")
+            if shade.isValid():
+                apply_style(shade, "hillshade")
+                _tag(shade, "hillshade", self.root)
+                QgsProject.instance().addMapLayer(shade, False)
+                index = group.children().index(group.findLayer(layer.id()))
+                group.insertLayer(index + 1, shade)
+
+    def remove_layers_of(self, path: Path, keep: Optional[QgsMapLayer] = None) -> int:
+        """Remove every PhotoDEM layer whose source is ``path`` (but ``keep``); returns how
+        many."""
         wanted = str(Path(path).resolve())
         ids = [layer.id() for layer in QgsProject.instance().mapLayers().values()
-               if _source_path(layer) == wanted and layer.customProperty(KIND)]
+               if _source_path(layer) == wanted and layer.customProperty(KIND)
+               and layer is not keep and (keep is None or layer.id() != keep.id())]
         QgsProject.instance().removeMapLayers(ids)
         return len(ids)
 
@@ -359,6 +384,26 @@ def _generic_product(path: Path) -> Optional[Product]:
     if suffix in _VECTOR_SUFFIXES:
         return Product("vector", path.stem, path)
     return None
+
+
+def product_label(product: Optional[Product], fallback: str = "") -> str:
+    """The layer name of a product (``fallback`` for ``None``)."""
+    return _product_label(product) if product is not None else fallback
+
+
+def place_output_layer(layer: QgsMapLayer, kind: Optional[str] = None) -> None:
+    """Style a layer that Processing loaded at the end of a run (``kind`` or what the file
+    is); a file under the open workspace's project goes into its Products group."""
+    path = Path(_source_path(layer))
+    if kind is None:
+        product = classify(path)
+        kind = product.kind if product is not None else None
+    if kind:
+        apply_style(layer, kind)
+        layer.setCustomProperty(KIND, kind)
+    workspace = current_workspace()
+    if workspace is not None and workspace.group is not None and is_inside(path, workspace.root):
+        workspace.adopt(layer, kind or "layer")
 
 
 # -- the current workspace -----------------------------------------------------------------------
@@ -437,4 +482,5 @@ def forget_workspace() -> None:
 
 __all__ = ["BLOCK", "EDITS", "GROUP_KIND", "KIND", "PRODUCTS", "PROJECT", "Workspace",
            "WorkspaceNotifier", "bind_workspace", "current_workspace", "forget_workspace",
-           "open_workspace", "workspace_groups", "workspace_notifier"]
+           "open_workspace", "place_output_layer", "product_label", "workspace_groups",
+           "workspace_notifier"]
