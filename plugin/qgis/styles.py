@@ -48,7 +48,8 @@ RAMP_CUT = (0.02, 0.98)
 def value_labels() -> Dict[str, str]:
     """Translated labels of the stored values of the value maps (English key → label)."""
     labels = {"keep": tr("keep"), "remove": tr("remove"), "exclude": tr("exclude"),
-              "breakline": tr("breakline"), "structure_line": tr("structure line")}
+              "breakline": tr("breakline"), "structure_line": tr("structure line"),
+              "": tr("other values")}  # the renderers' catch-all category
     return labels
 
 
