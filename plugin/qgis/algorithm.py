@@ -60,7 +60,7 @@ from ...algorithms.processing.spec import Algorithm, Output, Parameter
 from ...algorithms.project.products import Product, classify
 from ..i18n import tr
 from ..qt import QIcon
-from .workspace import place_output_layer, product_label
+from .workspace import layer_uri, place_output_layer, product_label
 
 
 class QgisFeedback(Feedback):
@@ -431,7 +431,7 @@ def load_on_completion(spec: Algorithm, result: Dict[str, Any], context) -> None
         return
     known = {_resolved(key): key for key in context.layersToLoadOnCompletion()}
     for output, path, product in main_outputs(spec, result):
-        key = known.get(_resolved(path), path)
+        key = known.get(_resolved(path), layer_uri(product) if product is not None else path)
         name = product_label(product, tr(output.description))
         details = QgsProcessingContext.LayerDetails(name, project, output.name)
         details.setPostProcessor(ProductPostProcessor(_kind(product)))

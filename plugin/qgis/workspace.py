@@ -146,7 +146,6 @@ class Workspace(QObject):
         self.load_block()
         for product in find_products(self.root):
             self._add_product(product, self.subgroup(PRODUCTS), at_top=False)
-        self.changed.emit()
 
     def _add_layer(self, layer: QgsMapLayer, kind: str, group: QgsLayerTreeGroup,
                    at_top: bool = False) -> QgsMapLayer:
@@ -245,7 +244,7 @@ class Workspace(QObject):
         or at the end; returns them top to bottom."""
         path, label = str(product.path), _product_label(product)
         if product.kind in ("seamlines", "vector"):
-            layer = QgsVectorLayer(path, label, "ogr")
+            layer = QgsVectorLayer(layer_uri(product), label, "ogr")
         else:
             layer = QgsRasterLayer(path, label, "gdal")
         if not layer.isValid():
@@ -376,6 +375,14 @@ def _product_label(product: Product) -> str:
     return f"{names.get(product.kind, product.kind)} {product.name}"
 
 
+def layer_uri(product: Product) -> str:
+    """The QGIS source of a product: the file, or its ``seamlines`` layer for the seamline
+    GeoPackage of a mosaic (which holds the footprints too)."""
+    if product.kind == "seamlines":
+        return f"{product.path}|layername=seamlines"
+    return str(product.path)
+
+
 def _generic_product(path: Path) -> Optional[Product]:
     """A file that is no known product, as a plain raster or vector layer (or ``None``)."""
     suffix = path.suffix.lower()
@@ -450,6 +457,7 @@ def open_workspace(iface: Any, path: Any) -> Workspace:
     workspace = Workspace(iface, project)
     workspace.build()
     _set_current(workspace)
+    workspace.changed.emit()
     return workspace
 
 
@@ -482,5 +490,5 @@ def forget_workspace() -> None:
 
 __all__ = ["BLOCK", "EDITS", "GROUP_KIND", "KIND", "PRODUCTS", "PROJECT", "Workspace",
            "WorkspaceNotifier", "bind_workspace", "current_workspace", "forget_workspace",
-           "open_workspace", "place_output_layer", "product_label", "workspace_groups",
+           "layer_uri", "open_workspace", "place_output_layer", "product_label", "workspace_groups",
            "workspace_notifier"]

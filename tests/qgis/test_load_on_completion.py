@@ -75,6 +75,22 @@ def test_run_and_load_results_adds_the_dtm_into_the_workspace(project, ws_iface)
     assert [n.layer().name() for n in ws.subgroup(PRODUCTS).findLayers()][:2] == names[:2]
 
 
+def test_mosaic_and_its_seamlines_are_loaded(project, ws_iface) -> None:
+    import processing
+
+    from photodem.plugin.qgis.workspace import PRODUCTS, open_workspace
+
+    ws = open_workspace(ws_iface, project)
+    processing.runAndLoadResults("photodem:mosaic", {
+        "project": str(project), "dem": str(project / "truth" / "dtm.tif")})
+    layers = {n.layer().name(): n.layer() for n in ws.subgroup(PRODUCTS).findLayers()}
+    assert set(layers) == {"Mosaic mosaic", "Seamlines mosaic"}
+    mosaic, seams = layers["Mosaic mosaic"], layers["Seamlines mosaic"]
+    assert mosaic.renderer().type() == "multibandcolor" and mosaic.renderer().alphaBand() == 4
+    assert seams.geometryType() == 1 and seams.source().endswith("|layername=seamlines")
+    assert seams.customProperty("photodem/kind") == "seamlines"
+
+
 def test_without_a_workspace_the_dtm_lands_at_the_root_styled(project, ws_iface,
                                                               tmp_path) -> None:
     import processing

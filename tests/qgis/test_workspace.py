@@ -26,6 +26,9 @@ def demo(tmp_path_factory) -> Path:
     registry.run("filter_lowpass", {"input": str(root / "products/dsm/0101_0102/dsm.tif"),
                                     "project": str(root),
                                     "output": str(root / "products/dtm/0101_0102")})
+    dtm = str(root / "truth" / "dtm.tif")
+    registry.run("orthorectify", {"project": str(root), "image": "0101", "dem": dtm})
+    registry.run("mosaic", {"project": str(root), "dem": dtm})
     return root
 
 
@@ -96,10 +99,14 @@ def test_open_gives_groups_and_styled_layers(project, ws_iface) -> None:
     assert block.findLayers()[1].layer().featureCount() == len(ws.project.images)
     products = [n.layer() for n in ws.subgroup(PRODUCTS).findLayers()]
     assert [p.name() for p in products] == ["DSM 0101_0102", "DSM 0101_0102 (hillshade)",
-                                            "DTM 0101_0102", "DTM 0101_0102 (hillshade)"]
-    assert all(p.providerType() == "gdal" for p in products)
-    assert [p.renderer().type() for p in products] == ["singlebandpseudocolor", "hillshade"] * 2
+                                            "DTM 0101_0102", "DTM 0101_0102 (hillshade)",
+                                            "Ortho 0101", "Mosaic mosaic", "Seamlines mosaic"]
+    assert [p.providerType() for p in products] == ["gdal"] * 6 + ["ogr"]
+    assert [p.renderer().type() for p in products[:6]] == (
+        ["singlebandpseudocolor", "hillshade"] * 2 + ["multibandcolor"] * 2)
     assert products[0].renderer().opacity() == pytest.approx(0.5)
+    assert [p.renderer().alphaBand() for p in products[4:6]] == [4, 4]  # RGB with alpha
+    assert products[6].geometryType() == 1 and "layername=seamlines" in products[6].source()
     assert [p.name() for p in ws.surface_layers()] == ["DSM 0101_0102", "DTM 0101_0102"]
 
 
@@ -141,6 +148,26 @@ def test_translated_labels_keep_english_values(project, ws_iface, monkeypatch) -
     pairs = [next(iter(e.items())) for e in setup.config()["map"]]
     assert pairs == [("behalten", "keep"), ("entfernen", "remove"), ("ausschließen", "exclude")]
     assert [c.label() for c in layer.renderer().categories()] == list(german.values())
+
+
+def test_changed_signals(project, ws_iface) -> None:
+    from photodem.plugin.qgis.workspace import (
+        current_workspace,
+        open_workspace,
+        workspace_notifier,
+    )
+
+    seen = []
+    workspace_notifier().changed.connect(seen.append)
+    try:
+        ws = open_workspace(ws_iface, project)
+        closed = []
+        ws.changed.connect(lambda: closed.append(current_workspace()))
+        ws.close()
+    finally:
+        workspace_notifier().changed.disconnect(seen.append)
+    assert seen == [ws, None] and closed == [None]
+    assert ws.group is None and current_workspace() is None
 
 
 def test_open_again_replaces_the_group(project, ws_iface) -> None:
@@ -309,3 +336,24 @@ def test_read_only_edits_load_read_only(project, ws_iface, monkeypatch) -> None:
     assert ws.read_only
     assert all(ws.edit_layer(n).readOnly() for n in EDIT_NAMES)
     assert any("read-only" in m for m in _messages(ws_iface))
+
+
+def test_plugin_menu_opens_projects(project, ws_iface, monkeypatch) -> None:
+    from photodem.plugin.qgis.plugin import MENU_TITLE, PhotodemPlugin
+    from photodem.plugin.qgis.project_menu import ProjectMenu
+    from photodem.plugin.qgis.workspace import current_workspace
+
+    monkeypatch.setattr(PhotodemPlugin, "initProcessing", lambda self: None)  # session's stays
+    plugin = PhotodemPlugin(ws_iface)
+    plugin.initGui()
+    try:
+        names = [a.objectName() for a in ws_iface.menus[MENU_TITLE]]
+        assert names[:1] == ["photodemOpenProject"]
+        assert plugin.project_menu.recent_menu.menuAction() in ws_iface.menus[MENU_TITLE]
+        monkeypatch.setattr(ProjectMenu, "ask_project", lambda self: str(project / "project.toml"))
+        plugin.project_menu.open_action.trigger()
+        assert current_workspace() is not None and current_workspace().root == project.resolve()
+    finally:
+        plugin.unload()
+    assert not any(a.objectName() == "photodemOpenProject"
+                   for a in ws_iface.menus.get(MENU_TITLE, []))
