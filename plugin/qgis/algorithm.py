@@ -390,6 +390,7 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
 #: Post-processors of layers still to be loaded: QGIS keeps no reference of its own, so without
 #: this list Python would delete them before the layers are loaded.
 _PENDING: List[QgsProcessingLayerPostProcessorInterface] = []
+_PENDING_MAX = 256
 
 
 class ProductPostProcessor(QgsProcessingLayerPostProcessorInterface):
@@ -401,6 +402,7 @@ class ProductPostProcessor(QgsProcessingLayerPostProcessorInterface):
         super().__init__()
         self.kind = kind
         _PENDING.append(self)
+        del _PENDING[:-_PENDING_MAX]  # runs whose layers were never loaded (processing.run)
 
     def postProcessLayer(self, layer, context, feedback) -> None:  # noqa: N802
         try:

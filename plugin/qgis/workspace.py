@@ -275,8 +275,13 @@ class Workspace(QObject):
             group = (self.subgroup(PRODUCTS) if inside and self.group is not None
                      else QgsProject.instance().layerTreeRoot())
             product = classify(path) or _generic_product(path)
-            if product is not None:
-                added += self._add_product(product, group, at_top=True)
+            if product is None:
+                continue
+            layers = self._add_product(product, group, at_top=True)
+            if not inside:  # not a product of this project
+                for layer in layers:
+                    layer.setCustomProperty(PROJECT, "")
+            added += layers
         if added:
             self.iface.mapCanvas().refresh()
         return added

@@ -201,6 +201,8 @@ def test_add_products_replaces_older_layer_of_the_same_file(project, ws_iface, t
     root = QgsProject.instance().layerTreeRoot()
     assert root.findLayer(layer.id()).parent() is root
     assert layer.renderer().type() == "singlebandpseudocolor"
+    assert layer.customProperty("photodem/kind") == "dsm"
+    assert layer.customProperty("photodem/project") == ""
 
 
 def test_qgz_round_trip_rebinds_the_group(project, ws_iface, tmp_path) -> None:
