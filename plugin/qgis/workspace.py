@@ -222,8 +222,12 @@ class Workspace(QObject):
 
     # -- block ---------------------------------------------------------------------------------
     def load_block(self) -> List[QgsVectorLayer]:
-        """Add footprints and stereo models (``.photodem/block.gpkg``) to the Block group."""
+        """Add footprints and stereo models (``.photodem/block.gpkg``, rewritten first when
+        ``project.toml`` is newer) to the Block group, replacing the layers it holds (they
+        are removed first: Windows cannot replace a file that is open)."""
         group = self.subgroup(BLOCK)
+        QgsProject.instance().removeMapLayers([n.layerId() for n in group.findLayers()])
+        group.removeAllChildren()
         try:
             path = write_block_layers(self.project)
         except (PhotodemError, OSError) as exc:

@@ -97,6 +97,8 @@ def test_open_gives_groups_and_styled_layers(project, ws_iface) -> None:
     assert models.customProperty("photodem/kind") == "stereo_models"
     assert models.featureCount() == len(ws.project.models) and models.labelsEnabled()
     assert block.findLayers()[1].layer().featureCount() == len(ws.project.images)
+    ws.load_block()  # again: replaced, not doubled
+    assert _names(ws.subgroup(BLOCK)) == ["Stereo models", "Image footprints"]
     products = [n.layer() for n in ws.subgroup(PRODUCTS).findLayers()]
     assert [p.name() for p in products] == ["DSM 0101_0102", "DSM 0101_0102 (hillshade)",
                                             "DTM 0101_0102", "DTM 0101_0102 (hillshade)",
