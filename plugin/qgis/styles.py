@@ -134,6 +134,10 @@ def stretch_ramp(layer: QgsRasterLayer) -> None:
                                               _height_label(low + item.value * (high - low)))
              for item in shader_fn.colorRampItemList()]
     shader_fn.setColorRampItemList(items)
+    if hasattr(shader_fn, "legendSettings"):  # version: QGIS ≥ 3.18; the legend lists "52.4 m"…
+        legend = shader_fn.legendSettings()
+        legend.setUseContinuousLegend(False)
+        shader_fn.setLegendSettings(legend)
     shader_fn.setMinimumValue(low)
     shader_fn.setMaximumValue(high)
     renderer.setClassificationMin(low)
