@@ -18,6 +18,7 @@ from ..i18n import install_translator, remove_translator, tr
 from ..qt import QAction, QIcon
 from .project_menu import ProjectMenu
 from .provider import ICON_PATH, PROVIDER_ID, PhotodemProvider
+from .workspace import workspace_notifier
 
 MENU_TITLE = "&PhotoDEM"
 #: Python packages the core needs (import name → Debian package).
@@ -94,6 +95,7 @@ class PhotodemPlugin:
         icon = QIcon(str(ICON_PATH))
         self.project_menu = ProjectMenu(self.iface, MENU_TITLE)
         self.project_menu.register()
+        workspace_notifier().changed.connect(self.workspace_changed)
         self.toolbox_action = QAction(icon, tr("PhotoDEM algorithms"), parent)
         self.toolbox_action.setObjectName("photodemShowToolbox")
         self.toolbox_action.setToolTip(tr("Show the PhotoDEM algorithms in the Processing Toolbox"))
@@ -117,6 +119,12 @@ class PhotodemPlugin:
     def open_project(self, path: Optional[str] = None) -> Any:
         """Open a PhotoDEM project as the workspace (asks for it without ``path``)."""
         return self.project_menu.open_project(path) if self.project_menu is not None else None
+
+    def workspace_changed(self, workspace: Any) -> None:
+        """A project was opened or closed: the editing toolbar (section 2) works on it."""
+        toolbar = getattr(self, "editing_toolbar", None)
+        if toolbar is not None:
+            toolbar.set_workspace(workspace)
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -155,6 +163,7 @@ class PhotodemPlugin:
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
         if self.project_menu is not None:
+            workspace_notifier().changed.disconnect(self.workspace_changed)
             self.project_menu.unregister()
             self.project_menu = None
         if self.iface is not None:

@@ -355,8 +355,12 @@ def test_plugin_menu_opens_projects(project, ws_iface, monkeypatch) -> None:
         assert names[:1] == ["photodemOpenProject"]
         assert plugin.project_menu.recent_menu.menuAction() in ws_iface.menus[MENU_TITLE]
         monkeypatch.setattr(ProjectMenu, "ask_project", lambda self: str(project / "project.toml"))
+        given = []
+        plugin.editing_toolbar = type("Toolbar", (), {"set_workspace": given.append,
+                                                      "unload": lambda self: None})()
         plugin.project_menu.open_action.trigger()
         assert current_workspace() is not None and current_workspace().root == project.resolve()
+        assert given == [current_workspace()]  # the editing toolbar works on the new project
     finally:
         plugin.unload()
     assert not any(a.objectName() == "photodemOpenProject"
