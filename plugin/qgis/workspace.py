@@ -148,15 +148,15 @@ class Workspace(QObject):
             self._add_product(product, self.subgroup(PRODUCTS), at_top=False)
 
     def _add_layer(self, layer: QgsMapLayer, kind: str, group: QgsLayerTreeGroup,
-                   at_top: bool = False) -> QgsMapLayer:
-        """Style, tag and add ``layer`` to ``group`` (at the end, or on top)."""
+                   index: int = -1) -> QgsMapLayer:
+        """Style, tag and add ``layer`` to ``group`` at ``index`` (-1: at the end)."""
         apply_style(layer, kind)
         _tag(layer, kind, self.root)
         QgsProject.instance().addMapLayer(layer, False)
-        if at_top:
-            group.insertLayer(0, layer)
-        else:
+        if index < 0:
             group.addLayer(layer)
+        else:
+            group.insertLayer(index, layer)
         return layer
 
     # -- edits ---------------------------------------------------------------------------------
@@ -187,8 +187,9 @@ class Workspace(QObject):
                         tr("Add them"), lambda: self.add_missing_layers(missing))
         return [layer for layer in layers if layer is not None]
 
-    def _edit_layer(self, path: Path, name: str,
-                    group: QgsLayerTreeGroup) -> Optional[QgsVectorLayer]:
+    def _edit_layer(self, path: Path, name: str, group: QgsLayerTreeGroup,
+                    index: int = -1) -> Optional[QgsVectorLayer]:
+        """One layer of ``edits.gpkg`` added to the Edits group (read-only when the file is)."""
         layer = QgsVectorLayer(f"{path}|layername={name}", name, "ogr")
         if not layer.isValid():
             self._message(tr("Cannot load the layer {0} of {1}.").format(name, path),
@@ -196,7 +197,7 @@ class Workspace(QObject):
             return None
         if self.read_only:
             layer.setReadOnly(True)
-        return self._add_layer(layer, f"edit:{name}", group)
+        return self._add_layer(layer, f"edit:{name}", group, index)
 
     def create_edits(self) -> None:
         """Create the missing ``edits.gpkg`` (all edit layers) and load it."""
@@ -208,13 +209,17 @@ class Workspace(QObject):
         self.load_edits()
 
     def add_missing_layers(self, names: Iterable[str]) -> None:
-        """Add the edit layers ``names`` to ``edits.gpkg`` (the others untouched), reload."""
+        """Add the edit layers ``names`` to ``edits.gpkg`` and to the Edits group in their
+        place; the other layers (and their unsaved edits) are not touched."""
+        path = self.project.edits_path
         try:
-            add_edit_layers(self.project.edits_path, self.project.crs, names)
+            added = add_edit_layers(path, self.project.crs, names)
         except PhotodemError as exc:
             self._message(str(exc), Qgis.Critical)
             return
-        self.load_edits()
+        group = self.subgroup(EDITS)
+        for name in added:
+            self._edit_layer(path, name, group, _edit_index(group, name))
 
     def edit_layer(self, name: str) -> Optional[QgsVectorLayer]:
         """The layer ``name`` of ``edits.gpkg`` in the Edits group, or ``None``."""
@@ -259,7 +264,7 @@ class Workspace(QObject):
             shade = QgsRasterLayer(path, f"{label} ({tr('hillshade')})", "gdal")
             layers.append((shade, "hillshade"))
         for item, kind in (reversed(layers) if at_top else layers):
-            self._add_layer(item, kind, group, at_top)
+            self._add_layer(item, kind, group, 0 if at_top else -1)
         return [item for item, _ in layers]
 
     def add_products(self, paths: Iterable[str]) -> List[QgsMapLayer]:
@@ -375,6 +380,15 @@ class Workspace(QObject):
         push.clicked.connect(run)
         item.layout().addWidget(push)
         bar.pushWidget(item, Qgis.Warning)
+
+
+def _edit_index(group: QgsLayerTreeGroup, name: str) -> int:
+    """Where the edit layer ``name`` goes in the Edits group: after the layers that come
+    before it in :data:`EDIT_LAYERS`."""
+    order = list(EDIT_LAYERS)
+    before = {f"edit:{other}" for other in order[:order.index(name)]}
+    return sum(1 for node in group.findLayers()
+               if node.layer() is not None and node.layer().customProperty(KIND) in before)
 
 
 def _product_label(product: Product) -> str:

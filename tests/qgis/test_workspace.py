@@ -309,9 +309,15 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
     ws = open_workspace(ws_iface, project)
     assert _names(ws.subgroup(EDITS)) == keep
     assert any("breaklines" in m for m in _messages(ws_iface))
+    points = ws.edit_layer("start_points")
+    points.startEditing()  # unsaved work of the operator survives the added layer
+    feature = next(points.getFeatures())
+    points.changeAttributeValue(feature.id(), points.fields().indexOf("height"), 13.0)
     _click_offer(ws_iface)
-    assert sorted(_names(ws.subgroup(EDITS))) == sorted(EDIT_NAMES)
+    assert _names(ws.subgroup(EDITS)) == EDIT_NAMES  # in its place
     assert ws.edit_layer("breaklines").isValid()
+    assert ws.edit_layer("start_points") is points and points.isModified()
+    points.rollBack()
     assert [p["height"] for _g, p in read_layer(edits, "start_points")] == [12.0]
 
 
