@@ -210,8 +210,17 @@ class Workspace(QObject):
 
     def add_missing_layers(self, names: Iterable[str]) -> None:
         """Add the edit layers ``names`` to ``edits.gpkg`` and to the Edits group in their
-        place; the other layers (and their unsaved edits) are not touched."""
+        place; the other layers are not touched. Refused while a layer of the file is being
+        edited: a second writer of the GeoPackage would break QGIS's open connections."""
+        names = list(names)
         path = self.project.edits_path
+        busy = [layer.name() for layer in self.layers_in(EDITS) if layer.isEditable()]
+        if busy:
+            self._message(tr("Save or discard the edits of {0} first; edits.gpkg was not "
+                             "changed.").format(", ".join(busy)), Qgis.Warning)
+            self._offer(tr("edits.gpkg lacks the layer(s) {0}.").format(", ".join(names)),
+                        tr("Add them"), lambda: self.add_missing_layers(names))
+            return
         try:
             added = add_edit_layers(path, self.project.crs, names)
         except PhotodemError as exc:
@@ -327,6 +336,13 @@ class Workspace(QObject):
                and layer is not keep and (keep is None or layer.id() != keep.id())]
         QgsProject.instance().removeMapLayers(ids)
         return len(ids)
+
+    def layers_in(self, subgroup: str) -> List[QgsMapLayer]:
+        """Every layer of a sub-group, in layer-tree order."""
+        group = self.subgroup(subgroup)
+        if group is None:
+            return []
+        return [n.layer() for n in group.findLayers() if n.layer() is not None]
 
     def layers(self, kind: str, subgroup: str = PRODUCTS) -> List[QgsMapLayer]:
         """The layers of one kind in a sub-group, in layer-tree order."""

@@ -294,7 +294,7 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
     import fiona
     from shapely.geometry import Point
 
-    from photodem.algorithms.project.edits import add_features, read_layer
+    from photodem.algorithms.project.edits import add_features, missing_edit_layers, read_layer
     from photodem.plugin.qgis.workspace import EDITS, open_workspace
 
     edits = project / "edits.gpkg"
@@ -310,14 +310,15 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
     assert _names(ws.subgroup(EDITS)) == keep
     assert any("breaklines" in m for m in _messages(ws_iface))
     points = ws.edit_layer("start_points")
-    points.startEditing()  # unsaved work of the operator survives the added layer
-    feature = next(points.getFeatures())
-    points.changeAttributeValue(feature.id(), points.fields().indexOf("height"), 13.0)
+    points.startEditing()  # while a layer is edited the file is not written
     _click_offer(ws_iface)
-    assert _names(ws.subgroup(EDITS)) == EDIT_NAMES  # in its place
-    assert ws.edit_layer("breaklines").isValid()
-    assert ws.edit_layer("start_points") is points and points.isModified()
+    assert missing_edit_layers(edits) == ["breaklines"]
+    assert any("Save or discard the edits of start_points" in m for m in _messages(ws_iface))
     points.rollBack()
+    _click_offer(ws_iface)  # offered again
+    assert _names(ws.subgroup(EDITS)) == EDIT_NAMES  # in its place
+    assert ws.edit_layer("breaklines").isValid() and ws.edit_layer("start_points") is points
+    assert [ws.edit_layer(n).featureCount() for n in EDIT_NAMES] == [1, 0, 0, 0, 0, 0, 0]
     assert [p["height"] for _g, p in read_layer(edits, "start_points")] == [12.0]
 
 
