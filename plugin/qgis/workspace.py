@@ -226,6 +226,9 @@ class Workspace(QObject):
         except PhotodemError as exc:
             self._message(str(exc), Qgis.Critical)
             return
+        for layer in self.layers_in(EDITS):  # their connections do not see the new table
+            layer.dataProvider().reloadData()
+            layer.reload()
         group = self.subgroup(EDITS)
         for name in added:
             self._edit_layer(path, name, group, _edit_index(group, name))
