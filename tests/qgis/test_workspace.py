@@ -29,6 +29,9 @@ def demo(tmp_path_factory) -> Path:
     dtm = str(root / "truth" / "dtm.tif")
     registry.run("orthorectify", {"project": str(root), "image": "0101", "dem": dtm})
     registry.run("mosaic", {"project": str(root), "dem": dtm})
+    registry.run("dem_compare", {"dem": str(root / "products/dsm/0101_0102/dsm.tif"),
+                                 "reference": str(root / "truth" / "dsm.tif"),
+                                 "output": str(root / "products/compare/0101_0102")})
     return root
 
 
@@ -102,13 +105,17 @@ def test_open_gives_groups_and_styled_layers(project, ws_iface) -> None:
     products = [n.layer() for n in ws.subgroup(PRODUCTS).findLayers()]
     assert [p.name() for p in products] == ["DSM 0101_0102", "DSM 0101_0102 (hillshade)",
                                             "DTM 0101_0102", "DTM 0101_0102 (hillshade)",
-                                            "Ortho 0101", "Mosaic mosaic", "Seamlines mosaic"]
-    assert [p.providerType() for p in products] == ["gdal"] * 6 + ["ogr"]
-    assert [p.renderer().type() for p in products[:6]] == (
-        ["singlebandpseudocolor", "hillshade"] * 2 + ["multibandcolor"] * 2)
+                                            "Difference 0101_0102", "Ortho 0101",
+                                            "Mosaic mosaic", "Seamlines mosaic"]
+    assert [p.providerType() for p in products] == ["gdal"] * 7 + ["ogr"]
+    assert [p.renderer().type() for p in products[:7]] == (
+        ["singlebandpseudocolor", "hillshade"] * 2 + ["singlebandpseudocolor"]
+        + ["multibandcolor"] * 2)
     assert products[0].renderer().opacity() == pytest.approx(0.5)
-    assert [p.renderer().alphaBand() for p in products[4:6]] == [4, 4]  # RGB with alpha
-    assert products[6].geometryType() == 1 and "layername=seamlines" in products[6].source()
+    shader = products[4].renderer().shader().rasterShaderFunction()  # dem_difference.qml
+    assert (shader.minimumValue(), shader.maximumValue()) == (-5.0, 5.0)
+    assert [p.renderer().alphaBand() for p in products[5:7]] == [4, 4]  # RGB with alpha
+    assert products[7].geometryType() == 1 and "layername=seamlines" in products[7].source()
     assert [p.name() for p in ws.surface_layers()] == ["DSM 0101_0102", "DTM 0101_0102"]
 
 
