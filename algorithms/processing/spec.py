@@ -37,7 +37,9 @@ PARAMETER_KINDS = (
     "string",
     "multiple_rasters",
 )
-OUTPUT_VALUE_KINDS = ("file", "folder", "raster", "vector", "number", "string", "json")
+#: ``html`` is a file the faces may show as a report (QGIS: the Results Viewer); the CLI treats it
+#: like ``file``.
+OUTPUT_VALUE_KINDS = ("file", "html", "folder", "raster", "vector", "number", "string", "json")
 
 
 @dataclass(frozen=True)
@@ -291,7 +293,7 @@ class Output:
     @property
     def is_path(self) -> bool:
         """The value is the path of a file or folder the run wrote."""
-        return self.kind in ("file", "folder", "raster", "vector")
+        return self.kind in ("file", "html", "folder", "raster", "vector")
 
 
 class Algorithm:

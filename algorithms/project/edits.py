@@ -217,6 +217,38 @@ def create_edits(path: PathLike, crs: str) -> Path:
     return path
 
 
+def missing_edit_layers(path: PathLike) -> List[str]:
+    """The layers of :data:`EDIT_LAYERS` that ``edits.gpkg`` lacks (in their order)."""
+    with reading(Path(path), "GeoPackage"):
+        present = set(fiona.listlayers(str(path)))
+    return [name for name in EDIT_LAYERS if name not in present]
+
+
+def add_edit_layers(path: PathLike, crs: str, names: Iterable[str]) -> List[str]:
+    """Add the empty edit layers ``names`` to an existing ``edits.gpkg``; the layers it holds
+    (the operator's work) are not touched. Layers that exist are skipped.
+
+    Returns the names of the layers added.
+
+    Raises
+    ------
+    InputError
+        For a name that is no edit layer or a CRS that is not understood.
+    """
+    wanted = [check_layer(name) for name in names]
+    wkt = _crs_wkt(crs)
+    added = []
+    for name in wanted:
+        if name not in missing_edit_layers(path):
+            continue
+        geom_type, fields = EDIT_LAYERS[name]
+        schema = {"geometry": geom_type, "properties": OrderedDict(fields)}
+        with fiona.open(str(path), "w", driver="GPKG", layer=name, schema=schema, crs_wkt=wkt):
+            pass
+        added.append(name)
+    return added
+
+
 def check_layer(layer: str) -> str:
     """``layer`` if it is a layer of ``edits.gpkg``.
 
@@ -334,7 +366,23 @@ def read_constraints(path: PathLike, crs: Any = None) -> Tuple[List[Any], List[A
             read_geometries(path, ("LineString",), crs, ("breaklines",)))
 
 
-__all__ = ["BREAKLINE_KINDS", "EDIT_LAYERS", "EXCLUSION_ACTIONS", "add_features",
-           "check_action", "check_feature", "check_fields", "check_layer", "create_edits",
-           "flat_breakline_message", "kind_message", "read_constraints", "read_geometries",
-           "read_layer", "repair_polygon", "repaired_polygon"]
+__all__ = [
+    "BREAKLINE_KINDS",
+    "EDIT_LAYERS",
+    "EXCLUSION_ACTIONS",
+    "add_edit_layers",
+    "add_features",
+    "check_action",
+    "check_feature",
+    "check_fields",
+    "check_layer",
+    "create_edits",
+    "flat_breakline_message",
+    "kind_message",
+    "missing_edit_layers",
+    "read_constraints",
+    "read_geometries",
+    "read_layer",
+    "repair_polygon",
+    "repaired_polygon",
+]

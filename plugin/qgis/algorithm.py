@@ -25,10 +25,13 @@ from qgis.core import (
     QgsCoordinateReferenceSystem,
     QgsProcessing,
     QgsProcessingAlgorithm,
+    QgsProcessingContext,
     QgsProcessingException,
     QgsProcessingFeedback,
+    QgsProcessingLayerPostProcessorInterface,
     QgsProcessingOutputFile,
     QgsProcessingOutputFolder,
+    QgsProcessingOutputHtml,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
     QgsProcessingOutputString,
@@ -54,8 +57,10 @@ from ...algorithms.errors import PhotodemError
 from ...algorithms.feedback import Feedback
 from ...algorithms.processing import registry
 from ...algorithms.processing.spec import Algorithm, Output, Parameter
+from ...algorithms.project.products import Product, classify
 from ..i18n import tr
 from ..qt import QIcon
+from .workspace import layer_uri, place_output_layer, product_label
 
 #: The widget wrapper of ``model`` parameters, by its dotted path (see ``model_widget``).
 MODEL_WIDGET_WRAPPER = f"{__package__}.model_widget.ModelWidgetWrapper"
@@ -220,10 +225,12 @@ def _option_index(p: Parameter, value: Any) -> int:
 
 
 def make_output(o: Output):
-    """The QGIS output definition for a spec output (``json`` becomes a string output)."""
+    """The QGIS output definition for a spec output (``json`` becomes a string output,
+    ``html`` an HTML output that the Results Viewer lists)."""
     cls = {
         "folder": QgsProcessingOutputFolder,
         "file": QgsProcessingOutputFile,
+        "html": QgsProcessingOutputHtml,  # shown in the Results Viewer
         "raster": QgsProcessingOutputRasterLayer,
         "vector": QgsProcessingOutputVectorLayer,
         "number": QgsProcessingOutputNumber,
@@ -378,9 +385,76 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
         raw = self.raw_parameters(parameters, context)
         adapter = QgisFeedback(feedback)
         try:
-            return registry.run(self.spec.id, raw, adapter)
+            result = registry.run(self.spec.id, raw, adapter)
         except PhotodemError as exc:  # operator errors: message only, no traceback
             raise QgsProcessingException(str(exc)) from exc
+        load_on_completion(self.spec, result, context)
+        return result
+
+
+# -- outputs on the map -------------------------------------------------------------------------
+#: Post-processors of layers still to be loaded: QGIS keeps no reference of its own, so without
+#: this list Python would delete them before the layers are loaded.
+_PENDING: List[QgsProcessingLayerPostProcessorInterface] = []
+_PENDING_MAX = 256
+
+
+class ProductPostProcessor(QgsProcessingLayerPostProcessorInterface):
+    """Styles a layer loaded at the end of a run and puts it into the open workspace's
+    Products group when the file lies under that project (see :func:`.workspace
+    .place_output_layer`)."""
+
+    def __init__(self, kind: Optional[str]) -> None:
+        super().__init__()
+        self.kind = kind
+        _PENDING.append(self)
+        del _PENDING[:-_PENDING_MAX]  # runs whose layers were never loaded (processing.run)
+
+    def postProcessLayer(self, layer, context, feedback) -> None:  # noqa: N802
+        try:
+            place_output_layer(layer, self.kind)
+        finally:
+            if self in _PENDING:
+                _PENDING.remove(self)
+
+
+def main_outputs(spec: Algorithm, result: Dict[str, Any]) -> List[tuple]:
+    """``(output, path, product)`` of the main raster/vector files of a run: every file that is a
+    known product (DSM, DTM, ortho…), else the first raster/vector file."""
+    files = []
+    for o in spec.outputs:
+        value = result.get(o.name)
+        if o.kind in ("raster", "vector") and isinstance(value, str) and _is_file(value):
+            files.append((o, value, classify(value)))
+    products = [f for f in files if f[2] is not None]
+    return products or files[:1]
+
+
+def load_on_completion(spec: Algorithm, result: Dict[str, Any], context) -> None:
+    """Register the main outputs of a run to be loaded when it ends (the toolbox dialog,
+    ``processing.runAndLoadResults``), styled by :class:`ProductPostProcessor`. A file that
+    QGIS already loads (a destination parameter) keeps its entry and gets the post-processor."""
+    project = context.project() if context is not None else None
+    if project is None:
+        return
+    known = {_resolved(key): key for key in context.layersToLoadOnCompletion()}
+    for output, path, product in main_outputs(spec, result):
+        key = known.get(_resolved(path), layer_uri(product) if product is not None else path)
+        name = product_label(product, tr(output.description))
+        details = QgsProcessingContext.LayerDetails(name, project, output.name)
+        details.setPostProcessor(ProductPostProcessor(_kind(product)))
+        context.addLayerToLoadOnCompletion(key, details)
+
+
+def _kind(product: Optional[Product]) -> Optional[str]:
+    return product.kind if product is not None else None
+
+
+def _resolved(path: str) -> str:
+    try:
+        return str(Path(path).resolve())
+    except (OSError, ValueError):
+        return path
 
 
 def _is_file(path: str) -> bool:

@@ -1,4 +1,4 @@
-"""The QGIS plugin class: Processing provider, Raster menu, toolbar button.
+"""The QGIS plugin class: Processing provider, Raster menu (with *Open project…*), toolbar button.
 
 QGIS desktop calls ``classFactory(iface)`` then :meth:`PhotodemPlugin.initGui`; ``qgis_process``
 calls ``classFactory(None)`` then only :meth:`PhotodemPlugin.initProcessing`. So
@@ -16,7 +16,9 @@ from qgis.PyQt.QtWidgets import QDockWidget
 from ...algorithms.processing import registry
 from ..i18n import install_translator, remove_translator, tr
 from ..qt import QAction, QIcon
+from .project_menu import ProjectMenu
 from .provider import ICON_PATH, PROVIDER_ID, PhotodemProvider
+from .workspace import current_workspace, workspace_notifier
 
 MENU_TITLE = "&PhotoDEM"
 #: Python packages the core needs (import name → Debian package).
@@ -62,8 +64,9 @@ class PhotodemPlugin:
         self.provider: Optional[PhotodemProvider] = None
         self.actions: List[QAction] = []
         self.toolbox_action: Optional[QAction] = None
-        self.editing_toolbar: Any = None  # the "PhotoDEM editing" toolbar (section 2)
-        self.model_actions: Any = None  # run from the map (part R)
+        self.editing_toolbar: Any = None  # the "PhotoDEM editing" toolbar
+        self.model_actions: Any = None  # actions on stereo models (run from the map)
+        self.project_menu: Optional[ProjectMenu] = None  # Open project… and recent projects
         self.translator = install_translator()
         self.missing = missing_dependencies()
 
@@ -92,6 +95,7 @@ class PhotodemPlugin:
             return
         parent = self.iface.mainWindow()
         icon = QIcon(str(ICON_PATH))
+        self._init_workspace()  # Open project… heads the menu
         self.toolbox_action = QAction(icon, tr("PhotoDEM algorithms"), parent)
         self.toolbox_action.setObjectName("photodemShowToolbox")
         self.toolbox_action.setToolTip(tr("Show the PhotoDEM algorithms in the Processing Toolbox"))
@@ -111,16 +115,31 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
-        # -- editing toolbar (issue 18 §2): disabled until a workspace is set
-        from .editing_toolbar import EditingToolbar  # lazy: map tools only in the desktop GUI
 
-        self.editing_toolbar = EditingToolbar(self.iface)
-        # -- run from the map: actions on stereo models (part R) --
-        # lazy: map-layer actions and dialogs exist only in the desktop, not under qgis_process
+    def _init_workspace(self) -> None:
+        """The project workspace: Open project… and recent projects, the editing toolbar
+        (disabled until a project is open) and the actions on stereo models."""
+        # lazy: map tools, map-layer actions and dialogs exist only in the desktop application
+        from .editing_toolbar import EditingToolbar
         from .model_actions import ModelActions
 
+        self.project_menu = ProjectMenu(self.iface, MENU_TITLE)
+        self.project_menu.register()
+        self.editing_toolbar = EditingToolbar(self.iface)
         self.model_actions = ModelActions(self.iface)
         self.model_actions.register()
+        workspace_notifier().changed.connect(self.workspace_changed)
+        self.workspace_changed(current_workspace())  # a .qgz read before the plugin loaded
+
+    def open_project(self, path: Optional[str] = None) -> Any:
+        """Open a PhotoDEM project as the workspace (asks for it without ``path``)."""
+        return self.project_menu.open_project(path) if self.project_menu is not None else None
+
+    def workspace_changed(self, workspace: Any) -> None:
+        """A project was opened or closed: the editing toolbar works on it."""
+        toolbar = getattr(self, "editing_toolbar", None)
+        if toolbar is not None:
+            toolbar.set_workspace(workspace)
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -158,12 +177,16 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
-        if self.editing_toolbar is not None:  # editing toolbar (issue 18 §2)
+        if self.editing_toolbar is not None:
             self.editing_toolbar.unload()
             self.editing_toolbar = None
-        if self.model_actions is not None:  # run from the map (part R)
+        if self.model_actions is not None:
             self.model_actions.unregister()
             self.model_actions = None
+        if self.project_menu is not None:
+            workspace_notifier().changed.disconnect(self.workspace_changed)
+            self.project_menu.unregister()
+            self.project_menu = None
         if self.iface is not None:
             for action in self.actions:
                 self.iface.removePluginRasterMenu(MENU_TITLE, action)

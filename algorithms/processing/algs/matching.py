@@ -155,7 +155,7 @@ class MatchModel(Algorithm):
         Output("points", "file", "Points"),
         Output("reduced", "file", "Reduced points"),
         Output("report", "file", "Report (JSON)"),
-        Output("report_html", "file", "Report (HTML)"),
+        Output("report_html", "html", "Report (HTML)"),
         Output("metrics", "json", "Metrics"),
     )
     iterates_over = "model"

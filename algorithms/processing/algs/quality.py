@@ -58,7 +58,7 @@ class DemCompare(Algorithm):
         Output("difference", "raster", "Difference model (DEM − reference)"),
         Output("hillshade", "raster", "Hillshade of the DEM"),
         Output("slope", "raster", "Slope of the DEM [°]"),
-        Output("report", "file", "HTML report"),
+        Output("report", "html", "HTML report"),
         Output("json", "file", "Statistics as JSON"),
         Output("csv", "file", "Statistics as CSV"),
     )
