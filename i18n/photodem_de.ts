@@ -140,7 +140,7 @@
         </message>
         <message>
             <source>Stereo models</source>
-            <extracomment>project_info output models; stereo_models output models; stereo_models: name</extracomment>
+            <extracomment>plugin/qgis/workspace.py:253; project_info output models; stereo_models output models; stereo_models: name</extracomment>
             <translation>Stereomodelle</translation>
         </message>
         <message>
@@ -1025,7 +1025,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm; mosaic.dsm: description</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:415</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1510,7 +1510,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:415</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -2030,7 +2030,7 @@
         </message>
         <message>
             <source>Seamlines</source>
-            <extracomment>mosaic.seamlines: description</extracomment>
+            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:416</extracomment>
             <translation>Schnittlinien</translation>
         </message>
         <message>
@@ -2115,7 +2115,7 @@
         </message>
         <message>
             <source>Mosaic</source>
-            <extracomment>mosaic output mosaic; mosaic.output: description</extracomment>
+            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:416</extracomment>
             <translation>Mosaik</translation>
         </message>
         <message>
@@ -2365,12 +2365,12 @@
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:108</extracomment>
+            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:112</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:110</extracomment>
+            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:114</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
@@ -2460,12 +2460,12 @@
         </message>
         <message>
             <source>breakline</source>
-            <extracomment>plugin/qgis/edit_forms.py:41</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:41; plugin/qgis/styles.py:51</extracomment>
             <translation>Bruchkante</translation>
         </message>
         <message>
             <source>structure line</source>
-            <extracomment>plugin/qgis/edit_forms.py:41</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:41; plugin/qgis/styles.py:51</extracomment>
             <translation>Strukturlinie</translation>
         </message>
         <message>
@@ -2810,23 +2810,98 @@
         </message>
         <message>
             <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
-            <extracomment>plugin/qgis/plugin.py:44</extracomment>
+            <extracomment>plugin/qgis/plugin.py:46</extracomment>
             <translation>PhotoDEM benötigt Python-Pakete, die QGIS nicht findet: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: mit dem OSGeo4W-Installer installieren.</translation>
         </message>
         <message>
             <source>PhotoDEM algorithms</source>
-            <extracomment>plugin/qgis/plugin.py:95</extracomment>
+            <extracomment>plugin/qgis/plugin.py:99</extracomment>
             <translation>PhotoDEM-Algorithmen</translation>
         </message>
         <message>
             <source>Show the PhotoDEM algorithms in the Processing Toolbox</source>
-            <extracomment>plugin/qgis/plugin.py:97</extracomment>
+            <extracomment>plugin/qgis/plugin.py:101</extracomment>
             <translation>Die PhotoDEM-Algorithmen im Verarbeitungswerkzeugkasten zeigen</translation>
+        </message>
+        <message>
+            <source>Open project…</source>
+            <extracomment>plugin/qgis/project_menu.py:77</extracomment>
+            <translation>Projekt öffnen…</translation>
+        </message>
+        <message>
+            <source>Show a PhotoDEM project on the map: edits, block and products</source>
+            <extracomment>plugin/qgis/project_menu.py:79</extracomment>
+            <translation>Ein PhotoDEM-Projekt in der Karte zeigen: Bearbeitungen, Block und Produkte</translation>
+        </message>
+        <message>
+            <source>Recent projects</source>
+            <extracomment>plugin/qgis/project_menu.py:82</extracomment>
+            <translation>Zuletzt geöffnete Projekte</translation>
+        </message>
+        <message>
+            <source>Open PhotoDEM project</source>
+            <extracomment>plugin/qgis/project_menu.py:133</extracomment>
+            <translation>PhotoDEM-Projekt öffnen</translation>
+        </message>
+        <message>
+            <source>PhotoDEM project</source>
+            <extracomment>plugin/qgis/project_menu.py:134</extracomment>
+            <translation>PhotoDEM-Projekt</translation>
+        </message>
+        <message>
+            <source>Project {0} opened.</source>
+            <extracomment>plugin/qgis/project_menu.py:152</extracomment>
+            <translation>Projekt {0} geöffnet.</translation>
+        </message>
+        <message>
+            <source>The project {0} is no longer there; it was removed from the recent projects.</source>
+            <extracomment>plugin/qgis/project_menu.py:124</extracomment>
+            <translation>Das Projekt {0} ist nicht mehr vorhanden; es wurde aus den zuletzt geöffneten Projekten entfernt.</translation>
         </message>
         <message>
             <source>PhotoDEM aerial photogrammetry</source>
             <extracomment>plugin/qgis/provider.py:34</extracomment>
             <translation>PhotoDEM Luftbildphotogrammetrie</translation>
+        </message>
+        <message>
+            <source>keep</source>
+            <extracomment>plugin/qgis/styles.py:50</extracomment>
+            <translation>behalten</translation>
+        </message>
+        <message>
+            <source>remove</source>
+            <extracomment>plugin/qgis/styles.py:50</extracomment>
+            <translation>entfernen</translation>
+        </message>
+        <message>
+            <source>exclude</source>
+            <extracomment>plugin/qgis/styles.py:50</extracomment>
+            <translation>ausschließen</translation>
+        </message>
+        <message>
+            <source>other values</source>
+            <extracomment>plugin/qgis/styles.py:52</extracomment>
+            <translation>andere Werte</translation>
+        </message>
+        <message>
+            <source>keep, remove or exclude</source>
+            <extracomment>plugin/qgis/styles.py:59</extracomment>
+            <translation>behalten, entfernen oder ausschließen</translation>
+        </message>
+        <message>
+            <source>breakline or structure_line</source>
+            <extracomment>plugin/qgis/styles.py:60</extracomment>
+            <translation>Bruchkante (breakline) oder Strukturlinie (structure_line)</translation>
+        </message>
+        <message>
+            <source>height between -500 m and 9000 m</source>
+            <extracomment>plugin/qgis/styles.py:61</extracomment>
+            <translation>Höhe zwischen -500 m und 9000 m</translation>
+        </message>
+        <message>
+            <source>a non-empty id</source>
+            <extracomment>plugin/qgis/styles.py:62</extracomment>
+            <translation>eine nicht leere Kennung</translation>
         </message>
         <message>
             <source>PhotoDEM validation</source>
@@ -2877,6 +2952,86 @@
             <source>Breakline {0}</source>
             <extracomment>plugin/qgis/validation_dock.py:96</extracomment>
             <translation>Bruchkante {0}</translation>
+        </message>
+        <message>
+            <source>Difference</source>
+            <extracomment>plugin/qgis/workspace.py:415</extracomment>
+            <translation>Differenz</translation>
+        </message>
+        <message>
+            <source>Ortho</source>
+            <extracomment>plugin/qgis/workspace.py:416</extracomment>
+            <translation>Ortho</translation>
+        </message>
+        <message>
+            <source>Image footprints</source>
+            <extracomment>plugin/qgis/workspace.py:253</extracomment>
+            <translation>Bildfußabdrücke</translation>
+        </message>
+        <message>
+            <source>Edits</source>
+            <extracomment>plugin/qgis/workspace.py:142</extracomment>
+            <translation>Bearbeitungen</translation>
+        </message>
+        <message>
+            <source>Block</source>
+            <extracomment>plugin/qgis/workspace.py:142</extracomment>
+            <translation>Block</translation>
+        </message>
+        <message>
+            <source>Products</source>
+            <extracomment>plugin/qgis/workspace.py:143</extracomment>
+            <translation>Produkte</translation>
+        </message>
+        <message>
+            <source>The project has no edits.gpkg: start points, exclusion areas and breaklines cannot be drawn.</source>
+            <extracomment>plugin/qgis/workspace.py:170</extracomment>
+            <translation>Das Projekt hat keine edits.gpkg: Startpunkte, Ausschlussflächen und Bruchkanten können nicht gezeichnet werden.</translation>
+        </message>
+        <message>
+            <source>Create edits.gpkg</source>
+            <extracomment>plugin/qgis/workspace.py:171</extracomment>
+            <translation>edits.gpkg anlegen</translation>
+        </message>
+        <message>
+            <source>Add them</source>
+            <extracomment>plugin/qgis/workspace.py:187; plugin/qgis/workspace.py:222</extracomment>
+            <translation>Hinzufügen</translation>
+        </message>
+        <message>
+            <source>{0} cannot be written: the edit layers are loaded read-only.</source>
+            <extracomment>plugin/qgis/workspace.py:176</extracomment>
+            <translation>{0} ist nicht beschreibbar: die Bearbeitungslayer werden schreibgeschützt geladen.</translation>
+        </message>
+        <message>
+            <source>edits.gpkg lacks the layer(s) {0}.</source>
+            <extracomment>plugin/qgis/workspace.py:186; plugin/qgis/workspace.py:221</extracomment>
+            <translation>In edits.gpkg fehlen die Layer {0}.</translation>
+        </message>
+        <message>
+            <source>Cannot load the layer {0} of {1}.</source>
+            <extracomment>plugin/qgis/workspace.py:195</extracomment>
+            <translation>Der Layer {0} von {1} kann nicht geladen werden.</translation>
+        </message>
+        <message>
+            <source>Save or discard the edits of {0} first; edits.gpkg was not changed.</source>
+            <extracomment>plugin/qgis/workspace.py:219</extracomment>
+            <translation>Speichern oder verwerfen Sie zuerst die Bearbeitungen von {0}; edits.gpkg wurde nicht geändert.</translation>
+        </message>
+        <message>
+            <source>Cannot load {0}.</source>
+            <extracomment>plugin/qgis/workspace.py:272</extracomment>
+            <translation>{0} kann nicht geladen werden.</translation>
+        </message>
+        <message>
+            <source>hillshade</source>
+            <extracomment>plugin/qgis/workspace.py:276; plugin/qgis/workspace.py:325</extracomment>
+            <translation>Schummerung</translation>
+        </message>
+        <message>
+            <source>The block layers cannot be made: {0}</source>
+            <extracomment>plugin/qgis/workspace.py:251</extracomment>
+            <translation>Die Block-Layer können nicht erstellt werden: {0}</translation>
         </message>
         <message>
             <source>Use</source>
