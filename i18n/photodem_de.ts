@@ -2444,19 +2444,19 @@
             <translation>{0} ist fehlgeschlagen; siehe Protokollmeldungen.</translation>
         </message>
         <message>
-            <source>keep (use only this area)</source>
+            <source>keep (surface stays as measured)</source>
             <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
-            <translation>behalten (nur diese Fläche verwenden)</translation>
+            <translation>behalten (Oberfläche bleibt wie gemessen)</translation>
         </message>
         <message>
-            <source>remove (no matching here)</source>
+            <source>remove (not matched; bridged in the DTM)</source>
             <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
-            <translation>entfernen (hier keine Zuordnung)</translation>
+            <translation>entfernen (nicht zugeordnet; im DGM überbrückt)</translation>
         </message>
         <message>
-            <source>exclude (cut out of the products)</source>
+            <source>exclude (as remove)</source>
             <extracomment>plugin/qgis/edit_forms.py:35</extracomment>
-            <translation>ausschließen (aus den Produkten ausschneiden)</translation>
+            <translation>ausschließen (wie entfernen)</translation>
         </message>
         <message>
             <source>breakline</source>

@@ -252,6 +252,14 @@ def _missing(value: Any) -> bool:
     return False
 
 
+def _is_temporary(value: Any) -> bool:
+    """True for QGIS's "temporary output" (a text or an output definition's sink)."""
+    sink = getattr(value, "sink", None)
+    if sink is not None:
+        value = sink.staticValue()
+    return isinstance(value, str) and value == QgsProcessing.TEMPORARY_OUTPUT
+
+
 def _layer_path(layer: Any) -> Optional[str]:
     """File path of a layer's source (OGR's ``|layername=…`` suffix removed)."""
     if layer is None:
@@ -326,12 +334,15 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
     def raw_parameters(self, parameters: Dict[str, Any], context) -> Dict[str, Any]:
         """Convert QGIS parameter values into the raw dict that ``registry.run`` takes.
 
-        Missing values stay missing, so the spec's own defaults apply exactly as in the CLI.
+        Missing values stay missing, so the spec's own defaults apply exactly as in the CLI. An
+        optional output left empty in the Processing dialog arrives as "temporary output"; it
+        counts as missing too, so e.g. a DSM goes to ``products/dsm/<model>/`` as its help says,
+        not into a temporary folder that is gone with the session.
         """
         raw: Dict[str, Any] = {}
         for p in self.spec.parameters:
             value = parameters.get(p.name)
-            if _missing(value):
+            if _missing(value) or (p.is_output and p.optional and _is_temporary(value)):
                 continue
             raw[p.name] = self._convert(p, value, parameters, context)
         return {k: v for k, v in raw.items() if v is not None}

@@ -31,8 +31,9 @@ HEIGHT_RANGE = (-1000.0, 9000.0)
 
 def action_labels() -> List[Tuple[str, str]]:
     """The exclusion actions with their translated labels, in the core's order."""
-    labels = {"keep": tr("keep (use only this area)"), "remove": tr("remove (no matching here)"),
-              "exclude": tr("exclude (cut out of the products)")}
+    labels = {"keep": tr("keep (surface stays as measured)"),
+              "remove": tr("remove (not matched; bridged in the DTM)"),
+              "exclude": tr("exclude (as remove)")}
     return [(value, labels[value]) for value in EXCLUSION_ACTIONS]
 
 

@@ -265,6 +265,9 @@ def test_missing_required_parameter_is_rejected_by_qgis(fixture_alg):
 
 
 def test_temporary_outputs(fixture_alg):
+    """A required output may be temporary; an optional one given as "temporary output" (what
+    the Processing dialog passes for an empty field) counts as not given: the core's default
+    applies (here: not written; in PhotoDEM's algorithms: the project's products folder)."""
     import processing
 
     got = processing.run("photodem:fixture_all_kinds", {
@@ -272,8 +275,23 @@ def test_temporary_outputs(fixture_alg):
         "output_raster": "TEMPORARY_OUTPUT",
     })
     assert Path(got["output_file"]).is_file()
-    assert (Path(got["output_folder"]) / "readme.txt").is_file()
-    assert got["output_raster"].endswith(".tif") and Path(got["output_raster"]).is_file()
+    assert not got.get("output_folder") and not got.get("output_raster")
+    assert got["summary"]["output_folder"] is None
+
+
+def test_empty_optional_output_of_the_dialog_goes_to_the_products(provider, tmp_path):
+    """The dialog's empty optional output folder lands in ``products/epipolar/<model>/``, not in
+    a temporary folder that is gone with the session."""
+    import processing
+
+    from photodem.algorithms.processing import registry
+
+    root = tmp_path / "tiny"
+    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    got = processing.run("photodem:epipolar_pair", {
+        "project": str(root), "model": "0101_0102", "output": "TEMPORARY_OUTPUT"})
+    assert Path(got["folder"]) == root / "products" / "epipolar" / "0101_0102"
+    assert Path(got["left"]).is_file()
 
 
 def test_project_parameter_accepts_project_toml(fixture_alg, tmp_path):
