@@ -406,6 +406,9 @@ class EditController:
                 self.message(str(exc), Qgis.Critical)
                 return None
             typed = [c[2] for c in line.coords]
+        if any(z is None for z in typed):  # a form that let a vertex without height through
+            self.message(tr("Every vertex of a breakline needs a height."), Qgis.Warning)
+            return None
         return [float(z) for z in typed], kind
 
     def seamline_sources(self) -> List[Any]:

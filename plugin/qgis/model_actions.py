@@ -126,8 +126,8 @@ class ModelActions(QObject):
     def match_model(self, project: str, model: str) -> Any:
         """Open the ``match_model`` dialog with project, model and output folder filled in.
 
-        The output is the spec's default folder ``products/dsm/<model>/`` written out: left
-        empty, the dialog would pass a temporary folder and the DSM would miss the project.
+        The output is the spec's default folder ``products/dsm/<model>/``, written out so the
+        operator sees where the DSM goes.
         """
         params: Dict[str, Any] = {"project": project, "model": model}
         with contextlib.suppress(PhotodemError):  # unreadable: the dialog itself says so
