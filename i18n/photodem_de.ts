@@ -1025,7 +1025,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:415</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:425</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1510,7 +1510,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:415</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:425</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -2030,7 +2030,7 @@
         </message>
         <message>
             <source>Seamlines</source>
-            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:416</extracomment>
+            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:409; plugin/qgis/workspace.py:426</extracomment>
             <translation>Schnittlinien</translation>
         </message>
         <message>
@@ -2115,7 +2115,7 @@
         </message>
         <message>
             <source>Mosaic</source>
-            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:416</extracomment>
+            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:426</extracomment>
             <translation>Mosaik</translation>
         </message>
         <message>
@@ -2450,77 +2450,77 @@
         </message>
         <message>
             <source>remove (not matched; bridged in the DTM)</source>
-            <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:35</extracomment>
             <translation>entfernen (nicht zugeordnet; im DGM überbrückt)</translation>
         </message>
         <message>
             <source>exclude (as remove)</source>
-            <extracomment>plugin/qgis/edit_forms.py:35</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:36</extracomment>
             <translation>ausschließen (wie entfernen)</translation>
         </message>
         <message>
             <source>breakline</source>
-            <extracomment>plugin/qgis/edit_forms.py:41; plugin/qgis/styles.py:51</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51</extracomment>
             <translation>Bruchkante</translation>
         </message>
         <message>
             <source>structure line</source>
-            <extracomment>plugin/qgis/edit_forms.py:41; plugin/qgis/styles.py:51</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51</extracomment>
             <translation>Strukturlinie</translation>
         </message>
         <message>
             <source>type a height</source>
-            <extracomment>plugin/qgis/edit_forms.py:51</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:52</extracomment>
             <translation>Höhe eingeben</translation>
         </message>
         <message>
             <source>Height</source>
-            <extracomment>plugin/qgis/edit_forms.py:90</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:91</extracomment>
             <translation>Höhe</translation>
         </message>
         <message>
             <source>Exclusion area</source>
-            <extracomment>plugin/qgis/edit_forms.py:105; plugin/qgis/edit_maptools.py:324; plugin/qgis/editing_toolbar.py:41</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:106; plugin/qgis/edit_maptools.py:324; plugin/qgis/editing_toolbar.py:41</extracomment>
             <translation>Ausschlussfläche</translation>
         </message>
         <message>
             <source>What should happen inside the area?</source>
-            <extracomment>plugin/qgis/edit_forms.py:106</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:107</extracomment>
             <translation>Was soll innerhalb der Fläche geschehen?</translation>
         </message>
         <message>
             <source>Action</source>
-            <extracomment>plugin/qgis/edit_forms.py:112</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:113</extracomment>
             <translation>Aktion</translation>
         </message>
         <message>
             <source>Note</source>
-            <extracomment>plugin/qgis/edit_forms.py:114; plugin/qgis/edit_forms.py:93; plugin/qgis/edit_maptools.py:292</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:115; plugin/qgis/edit_forms.py:94; plugin/qgis/edit_maptools.py:292</extracomment>
             <translation>Notiz</translation>
         </message>
         <message>
             <source>Breakline heights</source>
-            <extracomment>plugin/qgis/edit_forms.py:122</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:123</extracomment>
             <translation>Höhen der Bruchkante</translation>
         </message>
         <message>
             <source>Kind</source>
-            <extracomment>plugin/qgis/edit_forms.py:127</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:128</extracomment>
             <translation>Art</translation>
         </message>
         <message>
             <source>Invalid polygon</source>
-            <extracomment>plugin/qgis/edit_forms.py:191</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:192</extracomment>
             <translation>Ungültiges Polygon</translation>
         </message>
         <message>
             <source>Use the repaired polygon?</source>
-            <extracomment>plugin/qgis/edit_forms.py:192</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:193</extracomment>
             <translation>Das reparierte Polygon verwenden?</translation>
         </message>
         <message>
             <source>Vertex {0}</source>
-            <extracomment>plugin/qgis/edit_forms.py:134</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:135</extracomment>
             <translation>Stützpunkt {0}</translation>
         </message>
         <message>
@@ -2555,7 +2555,7 @@
         </message>
         <message>
             <source>Re-drape</source>
-            <extracomment>plugin/qgis/edit_maptools.py:456; plugin/qgis/editing_toolbar.py:145</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:459; plugin/qgis/editing_toolbar.py:145</extracomment>
             <translation>Neu abgreifen</translation>
         </message>
         <message>
@@ -2599,8 +2599,13 @@
             <translation>Schnittlinie</translation>
         </message>
         <message>
+            <source>Every vertex of a breakline needs a height.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:410</extracomment>
+            <translation>Jeder Stützpunkt einer Bruchkante braucht eine Höhe.</translation>
+        </message>
+        <message>
             <source>Select breaklines or points in an edit layer of the project (breaklines, start, ground or check points) to re-drape them.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:443</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:446</extracomment>
             <translation>Wählen Sie Bruchkanten oder Punkte in einem Bearbeitungslayer des Projekts (Bruchkanten, Start-, Boden- oder Kontrollpunkte), um ihre Höhen neu abzugreifen.</translation>
         </message>
         <message>
@@ -2615,7 +2620,7 @@
         </message>
         <message>
             <source>{0} features re-draped on the surface.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:464</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:467</extracomment>
             <translation>Höhen von {0} Objekten auf der Oberfläche neu abgegriffen.</translation>
         </message>
         <message>
@@ -2645,7 +2650,7 @@
         </message>
         <message>
             <source>Nothing selected in '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:448</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:451</extracomment>
             <translation>Nichts ausgewählt in '{0}'.</translation>
         </message>
         <message>
@@ -2660,7 +2665,7 @@
         </message>
         <message>
             <source>Feature {0}: {1}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:488</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:491</extracomment>
             <translation>Objekt {0}: {1}</translation>
         </message>
         <message>
@@ -2954,13 +2959,43 @@
             <translation>Bruchkante {0}</translation>
         </message>
         <message>
+            <source>Start points</source>
+            <extracomment>plugin/qgis/workspace.py:407</extracomment>
+            <translation>Startpunkte</translation>
+        </message>
+        <message>
+            <source>Exclusion areas</source>
+            <extracomment>plugin/qgis/workspace.py:407</extracomment>
+            <translation>Ausschlussflächen</translation>
+        </message>
+        <message>
+            <source>Boundaries</source>
+            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <translation>Begrenzungen</translation>
+        </message>
+        <message>
+            <source>Breaklines</source>
+            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <translation>Bruchkanten</translation>
+        </message>
+        <message>
+            <source>Ground points</source>
+            <extracomment>plugin/qgis/workspace.py:409</extracomment>
+            <translation>Bodenpunkte</translation>
+        </message>
+        <message>
+            <source>Check points</source>
+            <extracomment>plugin/qgis/workspace.py:410</extracomment>
+            <translation>Kontrollpunkte</translation>
+        </message>
+        <message>
             <source>Difference</source>
-            <extracomment>plugin/qgis/workspace.py:415</extracomment>
+            <extracomment>plugin/qgis/workspace.py:425</extracomment>
             <translation>Differenz</translation>
         </message>
         <message>
             <source>Ortho</source>
-            <extracomment>plugin/qgis/workspace.py:416</extracomment>
+            <extracomment>plugin/qgis/workspace.py:426</extracomment>
             <translation>Ortho</translation>
         </message>
         <message>

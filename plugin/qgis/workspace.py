@@ -190,7 +190,7 @@ class Workspace(QObject):
     def _edit_layer(self, path: Path, name: str, group: QgsLayerTreeGroup,
                     index: int = -1) -> Optional[QgsVectorLayer]:
         """One layer of ``edits.gpkg`` added to the Edits group (read-only when the file is)."""
-        layer = QgsVectorLayer(f"{path}|layername={name}", name, "ogr")
+        layer = QgsVectorLayer(f"{path}|layername={name}", edit_layer_title(name), "ogr")
         if not layer.isValid():
             self._message(tr("Cannot load the layer {0} of {1}.").format(name, path),
                           Qgis.Warning)
@@ -399,6 +399,16 @@ class Workspace(QObject):
         push.clicked.connect(run)
         item.layout().addWidget(push)
         bar.pushWidget(item, Qgis.Warning)
+
+
+def edit_layer_title(name: str) -> str:
+    """The name an edit layer of ``edits.gpkg`` shows in the layer tree (translated); the layer
+    is found by its kind ``edit:<name>``, never by this title."""
+    titles = {"start_points": tr("Start points"), "exclusion_areas": tr("Exclusion areas"),
+              "boundaries": tr("Boundaries"), "breaklines": tr("Breaklines"),
+              "ground_points": tr("Ground points"), "seamlines": tr("Seamlines"),
+              "check_points": tr("Check points")}
+    return titles.get(name, name)
 
 
 def _edit_index(group: QgsLayerTreeGroup, name: str) -> int:

@@ -13,6 +13,9 @@ pytestmark = pytest.mark.qgis
 
 EDIT_NAMES = ["start_points", "exclusion_areas", "boundaries", "breaklines", "ground_points",
               "seamlines", "check_points"]
+#: What the layer tree shows for them (English UI).
+EDIT_TITLES = ["Start points", "Exclusion areas", "Boundaries", "Breaklines", "Ground points",
+               "Seamlines", "Check points"]
 
 
 @pytest.fixture(scope="module")
@@ -77,11 +80,12 @@ def test_open_gives_groups_and_styled_layers(project, ws_iface) -> None:
     assert [g.name() for g in root.children()] == [f"PhotoDEM – {ws.project.name}"]
     assert _names(ws.group) == ["Edits", "Block", "Products"]
     edits = ws.subgroup(EDITS)
-    assert _names(edits) == EDIT_NAMES
-    for node in edits.findLayers():
+    assert _names(edits) == EDIT_TITLES
+    for name, node in zip(EDIT_NAMES, edits.findLayers()):
         layer = node.layer()
         assert layer.providerType() == "ogr" and not layer.readOnly()
-        assert layer.customProperty("photodem/kind") == f"edit:{layer.name()}"
+        assert layer.customProperty("photodem/kind") == f"edit:{name}"
+        assert layer.source().endswith(f"|layername={name}")
         assert layer.customProperty("photodem/project") == str(project.resolve())
     areas = ws.edit_layer("exclusion_areas")
     assert areas.renderer().type() == "categorizedSymbol"
@@ -314,7 +318,7 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
             dst.writerecords(src)
     saved.replace(edits)
     ws = open_workspace(ws_iface, project)
-    assert _names(ws.subgroup(EDITS)) == keep
+    assert _names(ws.subgroup(EDITS)) == [t for t in EDIT_TITLES if t != "Breaklines"]
     assert any("breaklines" in m for m in _messages(ws_iface))
     points = ws.edit_layer("start_points")
     points.startEditing()  # while a layer is edited the file is not written
@@ -323,7 +327,7 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
     assert any("Save or discard the edits of start_points" in m for m in _messages(ws_iface))
     points.rollBack()
     _click_offer(ws_iface)  # offered again
-    assert _names(ws.subgroup(EDITS)) == EDIT_NAMES  # in its place
+    assert _names(ws.subgroup(EDITS)) == EDIT_TITLES  # in its place
     assert ws.edit_layer("breaklines").isValid() and ws.edit_layer("start_points") is points
     assert [ws.edit_layer(n).featureCount() for n in EDIT_NAMES] == [1, 0, 0, 0, 0, 0, 0]
     assert [p["height"] for _g, p in read_layer(edits, "start_points")] == [12.0]
@@ -338,7 +342,7 @@ def test_missing_edits_file_is_offered(project, ws_iface) -> None:
     assert any("edits.gpkg" in m for m in _messages(ws_iface))
     _click_offer(ws_iface)
     assert (project / "edits.gpkg").is_file()
-    assert _names(ws.subgroup(EDITS)) == EDIT_NAMES
+    assert _names(ws.subgroup(EDITS)) == EDIT_TITLES
 
 
 def test_read_only_edits_load_read_only(project, ws_iface, monkeypatch) -> None:
