@@ -324,7 +324,7 @@ def test_missing_layer_is_offered_and_others_untouched(project, ws_iface) -> Non
     points.startEditing()  # while a layer is edited the file is not written
     _click_offer(ws_iface)
     assert missing_edit_layers(edits) == ["breaklines"]
-    assert any("Save or discard the edits of start_points" in m for m in _messages(ws_iface))
+    assert any("Save or discard the edits of Start points" in m for m in _messages(ws_iface))
     points.rollBack()
     _click_offer(ws_iface)  # offered again
     assert _names(ws.subgroup(EDITS)) == EDIT_TITLES  # in its place
