@@ -18,6 +18,15 @@ Per-class statistics use class polygons (any vector format fiona reads, any CRS,
 ``class_field``; rasterised per window, cell centres inside; later polygons win where they
 overlap) or a class raster (nearest neighbour); per-slope statistics use the slope of the
 reference (:data:`~.stats.SLOPE_CLASSES_DEG`).
+
+With the reference's terrain model (``dtm``, when the reference is a DSM) every cell gets an
+object class (:data:`~.objects.OBJECT_CLASSES`: object interior, object edge, open, other, from
+the nDSM reference − DTM and ``object_height``, see :mod:`.objects`; the reference is read with
+a margin of :func:`~.objects.mask_margin` cells so that the masks do not depend on the
+windows), with statistics per object class (``per_object``). With classes or a DTM, the
+**completeness** per class and per object class is counted too: of the cells with a valid
+reference, the shares where the DEM is within ±0.5 m and ±1 m and the share it measures at all
+(an empty DEM cell is a miss, unlike in the statistics, which only see cells both DEMs have).
 """
 
 from __future__ import annotations
@@ -46,6 +55,14 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile, open_image
 from .coregister import nuth_kaab
+from .objects import (
+    OBJECT_CLASSES,
+    OBJECT_HEIGHT,
+    CompletenessAccumulator,
+    mask_margin,
+    object_classes,
+    object_masks,
+)
 from .stats import SLOPE_LABELS, DifferenceAccumulator, _label_key, slope_class_index
 
 PathLike = Union[str, Path]
@@ -303,6 +320,37 @@ class _ClassSource:
         return None
 
 
+class _ObjectSource:
+    """Object classes of the reference cells, window by window (needs the reference's DTM)."""
+
+    def __init__(self, stack: contextlib.ExitStack, dtm: Optional[PathLike], ref: Any,
+                 grid: Affine, width: int, height: int, object_height: float) -> None:
+        self.reader: Optional[_GridReader] = None
+        self.object_height = float(object_height)
+        self.cell = abs(grid.a)
+        self.margin = mask_margin(self.cell)
+        if dtm is None:
+            return
+        if not object_height > 0:
+            raise InputError("The object height must be positive (metres above the DTM).")
+        src = _open_raster(stack, dtm, "terrain model (DTM)")
+        k = self.margin
+        self.reader = _GridReader(stack, src, ref.crs, grid * Affine.translation(-k, -k),
+                                  width + 2 * k, height + 2 * k, Resampling.bilinear)
+
+    def labels(self, ref: Any, grid: _ComparisonGrid, r: int, c: int, h: int, w: int
+               ) -> Optional[Array]:
+        """Object class codes of the window (NaN where the reference or DTM is empty)."""
+        if self.reader is None:
+            return None
+        k = self.margin
+        z = _read_window(ref, grid.r_off + r - k, grid.c_off + c - k, h + 2 * k, w + 2 * k)
+        t = self.reader.read(r, c, h + 2 * k, w + 2 * k)
+        m = object_masks(z, t, self.cell, object_height=self.object_height)
+        inner = (slice(k, k + h), slice(k, k + w))
+        return object_classes(m, np.isfinite(z - t))[inner]
+
+
 class _ComparisonGrid:
     """The reference window both DEMs cover: its transform, size and offset in the reference."""
 
@@ -330,13 +378,17 @@ def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], re
 
 
 def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
-                classes: _ClassSource, out_ds: Any, acc: DifferenceAccumulator,
+                sources: Tuple[_ClassSource, _ObjectSource], out_ds: Any,
+                accs: Tuple[DifferenceAccumulator, Dict[str, CompletenessAccumulator]],
                 window_size: int, progress: Tuple[float, Feedback]) -> Tuple[int, int]:
-    """Feed Δh of every window (with slope and class groups) to ``acc``; write Δh.
+    """Feed Δh of every window (with slope, class and object groups) to the accumulators.
 
-    Returns the numbers of valid reference and DEM heights. ``progress`` is (the share
-    already done in %, the feedback).
+    Writes Δh. Returns the numbers of valid reference and DEM heights. ``sources`` are the
+    class and object-class sources; ``accs`` the statistics and the completeness per grouping
+    (``"class"``, ``"object"``); ``progress`` is (the share already done in %, the feedback).
     """
+    classes, objects = sources
+    acc, comp = accs
     base, fb = progress
     t = grid.transform
     wins = grid.windows(window_size)
@@ -352,6 +404,13 @@ def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _Comparison
         labels = classes.labels(t * Affine.translation(c, r), r, c, h, w)
         if labels is not None:
             groups["class"] = labels
+        obj = objects.labels(ref, grid, r, c, h, w)
+        if obj is not None:
+            groups["object"] = obj
+        for name in ("class", "object"):
+            if name in groups:
+                comp[name].add_labels(dz, groups[name],
+                                      truth_valid=np.isfinite(z_ref))
         acc.add(dz, groups)
         if out_ds is not None:
             out_ds.write(dz.astype(np.float32), 1, window=Window(c, r, w, h))
@@ -386,6 +445,8 @@ def compare_dems(
     window_size: int = 1024,
     memory_budget: int = 512 * 2**20,
     coreg_max_cells: int = 4_000_000,
+    dtm: Optional[PathLike] = None,
+    object_height: float = OBJECT_HEIGHT,
     feedback: Optional[Feedback] = None,
 ) -> Dict[str, Any]:
     """Compare a DEM with a reference DEM on the reference grid, window by window.
@@ -412,6 +473,11 @@ def compare_dems(
         Bytes of differences kept for exact quantiles (beyond: 0.5 mm histograms).
     coreg_max_cells : int
         Cells of the (averaged) grid the co-registration sees.
+    dtm : path, optional
+        Terrain model of the reference (when the reference is a DSM): object classes from the
+        nDSM, statistics and completeness per object class.
+    object_height : float
+        Height above the DTM (m) from which a cell is an object.
     feedback : Feedback, optional
         Progress per window; cancelling raises Cancelled and leaves no difference raster.
 
@@ -421,7 +487,9 @@ def compare_dems(
         ``{"stats", "shift" (dx, dy, dz, iterations, converged, residual_nmad) or None,
         "per_class", "per_slope", "grid" {"crs", "transform", "width", "height",
         "resolution"}, "difference", "precision"}``; statistics as
-        :func:`~.stats.difference_stats`.
+        :func:`~.stats.difference_stats`. With ``dtm`` also ``"per_object"`` (statistics per
+        object class); with classes or ``dtm`` also ``"completeness"`` ``{"per_class",
+        "per_object"}`` (:meth:`~.objects.CompletenessAccumulator.result` per class).
 
     Raises
     ------
@@ -446,18 +514,24 @@ def compare_dems(
         dem_reader = _GridReader(stack, src, ref.crs, grid, width, height, Resampling.bilinear,
                                  (shift["dx"], shift["dy"]) if shift else (0.0, 0.0))
         class_src = _ClassSource(stack, classes, class_field, ref, grid, width, height, fb)
+        obj_src = _ObjectSource(stack, dtm, ref, grid, width, height, object_height)
         acc = DifferenceAccumulator(memory_budget=memory_budget)
+        comp = {"class": CompletenessAccumulator(), "object": CompletenessAccumulator()}
         out_ds = _difference_output(stack, difference_path, ref, cg)
         n_ref, n_dem = _accumulate(ref, dem_reader, shift["dz"] if shift else 0.0, cg,
-                                   class_src, out_ds, acc, window_size,
+                                   (class_src, obj_src), out_ds, (acc, comp), window_size,
                                    (10.0 if coregister else 0.0, fb))
         _check_overlap_heights(n_ref, n_dem, acc, dem, reference)
         res = acc.result(flying_height)
 
     per_slope = {SLOPE_LABELS[int(k)]: v for k, v in res.get("per_slope", {}).items()}
     per_class = res.get("per_class", {})
+    comp_class = comp["class"].result()
     if class_src.names is not None:
         per_class = {class_src.names[k]: v for k, v in per_class.items()}
+        comp_class = {class_src.names.get(k, k): v for k, v in comp_class.items()}
+    extra = _object_results(res, comp_class, comp["object"].result(), classes is not None,
+                            dtm is not None)
     return {
         "stats": res["stats"],
         "shift": shift,
@@ -467,4 +541,22 @@ def compare_dems(
                  "height": height, "resolution": [abs(grid.a), abs(grid.e)]},
         "difference": str(difference_path) if difference_path is not None else None,
         "precision": res["precision"],
+        **extra,
     }
+
+
+def _object_results(res: Dict[str, Any], comp_class: Dict[str, Any], comp_object: Dict[str, Any],
+                    with_classes: bool, with_objects: bool) -> Dict[str, Any]:
+    """``per_object`` and ``completeness`` of the result (only what was asked for)."""
+    names = {str(code): name for code, name in OBJECT_CLASSES}
+    order = [name for _, name in OBJECT_CLASSES]
+    out: Dict[str, Any] = {}
+    if with_objects:
+        per = {names.get(k, k): v for k, v in res.get("per_object", {}).items()}
+        out["per_object"] = {k: per[k] for k in order if k in per}
+    if with_classes or with_objects:
+        comp_o = {names.get(k, k): v for k, v in comp_object.items()}
+        out["completeness"] = {"per_class": comp_class if with_classes else None,
+                               "per_object": ({k: comp_o[k] for k in order if k in comp_o}
+                                              if with_objects else None)}
+    return out

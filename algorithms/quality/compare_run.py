@@ -13,9 +13,10 @@ from typing import Any, Dict, Optional, Union
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import staged_folder
 from .compare import compare_dems
+from .objects import OBJECT_HEIGHT
 from .points import point_compare
 from .rasters import write_difference_style, write_hillshade, write_slope
-from .report import write_csv, write_json, write_report
+from .report import write_completeness_csv, write_csv, write_json, write_report
 
 PathLike = Union[str, Path]
 
@@ -23,6 +24,8 @@ PathLike = Union[str, Path]
 DEM_COMPARE_FILES = {"difference": "difference.tif", "hillshade": "hillshade.tif",
                      "slope": "slope.tif", "report": "report.html", "json": "stats.json",
                      "csv": "stats.csv"}
+#: Completeness table of a ``dem_compare`` folder (with classes or a DTM only).
+COMPLETENESS_FILE = "completeness.csv"
 
 
 def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Dict[str, Any],
@@ -41,6 +44,8 @@ def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Di
     }
     write_json(tmp / names["json"], summary)
     write_csv(tmp / names["csv"], result, flying_height)
+    if result.get("completeness"):
+        write_completeness_csv(tmp / COMPLETENESS_FILE, result["completeness"])
     write_report(tmp / names["report"], result, dem=Path(dem).name,
                  reference=Path(reference).name, difference=tmp / names["difference"],
                  hillshade=tmp / names["hillshade"], flying_height=flying_height,
@@ -50,14 +55,19 @@ def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Di
 def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
                     coregister: bool = False, stable: Optional[PathLike] = None,
                     classes: Optional[PathLike] = None, class_field: Optional[str] = None,
-                    flying_height: Optional[float] = None,
+                    flying_height: Optional[float] = None, dtm: Optional[PathLike] = None,
+                    object_height: Optional[float] = None,
                     feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Compare a DEM with a reference and write :data:`DEM_COMPARE_FILES` into ``output``.
 
+    With classes or a DTM also :data:`COMPLETENESS_FILE`.
+
     Parameters
     ----------
-    dem, reference, coregister, stable, classes, class_field, flying_height
+    dem, reference, coregister, stable, classes, class_field, flying_height, dtm
         As :func:`.compare.compare_dems`.
+    object_height : float, optional
+        As :func:`.compare.compare_dems` (None: its default, 2.5 m).
     output : path
         Output folder (an earlier ``dem_compare`` folder there is replaced).
     feedback : Feedback, optional
@@ -75,17 +85,28 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
         result = compare_dems(
             dem, reference, coregister=coregister, stable=stable, classes=classes,
             class_field=class_field, flying_height=flying_height,
-            difference_path=tmp / names["difference"], feedback=feedback.step(0.0, 60.0))
+            difference_path=tmp / names["difference"], dtm=dtm,
+            object_height=OBJECT_HEIGHT if object_height is None else float(object_height),
+            feedback=feedback.step(0.0, 60.0))
         _dem_compare_files(tmp, dem, reference, result, flying_height, feedback)
     stats = result.get("stats") or {}
     feedback.info(f"Δh over {stats.get('count', 0)} cells: mean {stats.get('mean', 0):+.3f} "
                   f"m, NMAD {stats.get('nmad', 0):.3f} m, RMS {stats.get('rms', 0):.3f} m.")
+    comp = result.get("completeness")
+    if comp and comp.get("per_object"):
+        o = comp["per_object"].get("object interior") or {}
+        if o.get("cells"):
+            feedback.info(f"Object interior: {100 * o['within_0_5']:.1f} % within 0.5 m of the "
+                          f"reference, {100 * o['measured']:.1f} % measured.")
     return {
         "stats": result.get("stats"),
         "shift": result.get("shift"),
         "per_class": result.get("per_class"),
         "per_slope": result.get("per_slope"),
+        "per_object": result.get("per_object"),
+        "completeness": comp,
         **{k: str(out / v) for k, v in names.items()},
+        "completeness_csv": str(out / COMPLETENESS_FILE) if comp else None,
     }
 
 
@@ -127,4 +148,4 @@ def run_point_compare(points: PathLike, dem: PathLike, output: PathLike, *,
             "json": str(out / "stats.json"), "csv": str(out / "stats.csv")}
 
 
-__all__ = ["DEM_COMPARE_FILES", "run_dem_compare", "run_point_compare"]
+__all__ = ["COMPLETENESS_FILE", "DEM_COMPARE_FILES", "run_dem_compare", "run_point_compare"]

@@ -70,7 +70,7 @@ class ObjectMasks:
 
 def mask_margin(cell: float, inset: float = INSET, open_margin: float = OPEN_MARGIN) -> int:
     """Cells of margin a window needs so that its masks equal those of the whole grid."""
-    return int(math.ceil(max(inset, open_margin) / float(cell) + 0.5)) + 1
+    return math.ceil(max(inset, open_margin) / float(cell) + 0.5) + 1
 
 
 def _far_from(mask: Array, limit_m: float, cell: float) -> Array:
@@ -267,7 +267,7 @@ def outline_metrics(dsm: ArrayLike, dtm_true: ArrayLike, dsm_true: ArrayLike, la
     """
     z, t, s = (np.asarray(a, np.float64) for a in (dsm, dtm_true, dsm_true))
     lab = np.asarray(labels)
-    pad = int(math.ceil(margin / cell))
+    pad = math.ceil(margin / cell)
     objs = ndimage.find_objects(lab.astype(np.int64))
     rows: List[Dict[str, Any]] = []
     dist: List[Array] = []
@@ -301,7 +301,21 @@ def summarise_outlines(rows: List[Dict[str, Any]], dist: List[Array],
     }
 
 
-__all__ = ["COMPLETENESS_LIMITS", "CompletenessAccumulator", "INSET", "OBJECT_CLASSES",
-           "OBJECT_HEIGHT", "OPEN_HEIGHT", "OPEN_MARGIN", "ObjectMasks", "completeness",
-           "footprint_from_dsm", "mask_margin", "object_classes", "object_masks",
-           "outline_metrics", "summarise_outlines", "wall_distances"]
+__all__ = [
+    "COMPLETENESS_LIMITS",
+    "INSET",
+    "OBJECT_CLASSES",
+    "OBJECT_HEIGHT",
+    "OPEN_HEIGHT",
+    "OPEN_MARGIN",
+    "CompletenessAccumulator",
+    "ObjectMasks",
+    "completeness",
+    "footprint_from_dsm",
+    "mask_margin",
+    "object_classes",
+    "object_masks",
+    "outline_metrics",
+    "summarise_outlines",
+    "wall_distances",
+]

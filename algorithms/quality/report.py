@@ -483,7 +483,8 @@ def csv_rows(result: Dict[str, Any], flying_height: Optional[float] = None) -> L
     rows = [["scope", "name", *CSV_KEYS, *hist_cols, *per_cols]]
     groups = [("all", [("all", stats)]),
               ("class", stats_entries(result.get("per_class"))),
-              ("slope", stats_entries(result.get("per_slope")))]
+              ("slope", stats_entries(result.get("per_slope"))),
+              ("object", stats_entries(result.get("per_object")))]
     for scope, entries in groups:
         for name, s in entries:
             row = [scope, name.replace(",", ";")]
@@ -500,6 +501,34 @@ def csv_rows(result: Dict[str, Any], flying_height: Optional[float] = None) -> L
                 row.append("" if not math.isfinite(v) else f"{v:.6f}")
             rows.append(row)
     return rows
+
+
+def completeness_rows(completeness: Dict[str, Any]) -> List[List[str]]:
+    """Rows (scope, name, cells, measured, within_0_5, within_1) of a completeness result."""
+    rows = [["scope", "name", "cells", "measured", "within_0_5", "within_1"]]
+    for scope in ("class", "object"):
+        for name, c in (completeness.get(f"per_{scope}") or {}).items():
+            rows.append([scope, str(name).replace(",", ";"), str(int(c.get("cells") or 0))]
+                        + ["" if c.get(k) is None else f"{c[k]:.6f}"
+                           for k in ("measured", "within_0_5", "within_1")])
+    return rows
+
+
+def completeness_table(completeness: Dict[str, Any]) -> str:
+    """HTML table of the completeness per class and per object class."""
+    rows = [[("class " if r[0] == "class" else "") + r[1], _fmt(float(r[2]), "count")]
+            + [_fmt(float(v), "share") if v else "–" for v in r[3:]]
+            for r in completeness_rows(completeness)[1:]]
+    return _table(["class", "reference cells", "measured", "within ±0.5 m", "within ±1 m"],
+                  rows)
+
+
+def write_completeness_csv(path: PathLike, completeness: Dict[str, Any]) -> Path:
+    """The completeness as CSV (:func:`completeness_rows`), written atomically."""
+    text = "\n".join(",".join(row) for row in completeness_rows(completeness)) + "\n"
+    with atomic_output(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
 
 
 def write_csv(path: PathLike, result: Dict[str, Any],
@@ -600,6 +629,7 @@ def write_report(path: PathLike, result: Dict[str, Any], *, dem: str, reference:
                   "range of a symmetric distribution); whiskers: ∓ 95 % quantile of |Δh| "
                   "within min…max; dots: min and max; triangle: mean.</p>",
                   group_table(per_class, "class", flying_height)]
+    parts += _object_parts(result, flying_height)
     if per_slope:
         parts += ["<h2>By slope</h2>", _embed(figure_slope(per_slope), "error against slope"),
                   group_table(per_slope, "slope class [°]", flying_height)]
@@ -615,6 +645,25 @@ def write_report(path: PathLike, result: Dict[str, Any], *, dem: str, reference:
     return Path(path)
 
 
+def _object_parts(result: Dict[str, Any], flying_height: Optional[float]) -> List[str]:
+    """HTML of the statistics per object class and of the completeness (when computed)."""
+    parts: List[str] = []
+    per_object = stats_entries(result.get("per_object"))
+    if per_object:
+        parts += ["<h2>By object class</h2>", group_table(per_object, "object class",
+                                                          flying_height),
+                  '<p class="note">Object: reference ≥ the object height above the terrain '
+                  "model; interior: at least 1 m inside an object; open: less than 0.3 m "
+                  "above the terrain and at least 1 m from any object.</p>"]
+    comp = result.get("completeness")
+    if comp:
+        parts += ["<h2>Completeness</h2>", completeness_table(comp),
+                  '<p class="note">Of the cells with a reference height: the share the DEM '
+                  "measures at all, and the shares within ±0.5 m and ±1 m of the reference "
+                  "(cells the DEM leaves empty count as misses).</p>"]
+    return parts
+
+
 def _plain(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
@@ -625,6 +674,8 @@ def _plain(value: Any) -> str:
 
 __all__ = [
     "box_summary",
+    "completeness_rows",
+    "completeness_table",
     "csv_rows",
     "figure_boxplots",
     "figure_histograms",
@@ -635,6 +686,7 @@ __all__ = [
     "read_decimated",
     "signed_histogram",
     "stats_entries",
+    "write_completeness_csv",
     "write_csv",
     "write_json",
     "write_report",

@@ -27,14 +27,19 @@ class DemCompare(Algorithm):
         "estimated on stable terrain). Writes the difference model Δh = DEM − reference (with "
         "a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, "
         "std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope "
-        "class, in m and in ‰ of the flying height, and an HTML report with plots."
+        "class, in m and in ‰ of the flying height, and an HTML report with plots. With the "
+        "reference's terrain model (DTM) the cells are also classed into object interior, "
+        "object edge, open terrain and other by their height above the DTM; with classes or a "
+        "DTM the completeness per class is reported too: the share of the reference cells "
+        "the DEM measures, and the shares within ±0.5 m and ±1 m (empty cells count as misses)."
     )
     parameters = (
         Parameter("dem", "raster", "DEM to check"),
         Parameter("reference", "raster", "Reference DEM"),
         Parameter("output", "output_folder", "Output folder",
                   help="Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, "
-                       "report.html, stats.json and stats.csv."),
+                       "report.html, stats.json and stats.csv; with classes or a DTM also "
+                       "completeness.csv."),
         Parameter("coregister", "bool", "Co-register before comparing", default=False,
                   help="Estimate and remove a horizontal shift and a vertical bias (Nuth & "
                        "Kääb) on stable terrain first."),
@@ -49,18 +54,28 @@ class DemCompare(Algorithm):
         Parameter("flying_height", "number", "Flying height above ground [m]", optional=True,
                   minimum=1.0, unit="m",
                   help="For the statistics in ‰ of the flying height."),
+        Parameter("dtm", "raster", "Terrain model (DTM) of the reference", optional=True,
+                  help="When the reference is a DSM: its terrain model. Cells at least the "
+                       "object height above it are objects (buildings, trees); statistics and "
+                       "completeness per object class."),
+        Parameter("object_height", "number", "Object height [m]", default=2.5, minimum=0.1,
+                  unit="m", help="Height above the DTM from which a reference cell belongs to "
+                                 "an object."),
     )
     outputs = (
         Output("stats", "json", "Statistics of Δh [m]"),
         Output("shift", "json", "Co-registration shift dx, dy, dz [m]"),
         Output("per_class", "json", "Statistics per class"),
         Output("per_slope", "json", "Statistics per slope class"),
+        Output("per_object", "json", "Statistics per object class"),
+        Output("completeness", "json", "Completeness per class"),
         Output("difference", "raster", "Difference model (DEM − reference)"),
         Output("hillshade", "raster", "Hillshade of the DEM"),
         Output("slope", "raster", "Slope of the DEM [°]"),
         Output("report", "html", "HTML report"),
         Output("json", "file", "Statistics as JSON"),
         Output("csv", "file", "Statistics as CSV"),
+        Output("completeness_csv", "file", "Completeness as CSV"),
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
@@ -70,7 +85,8 @@ class DemCompare(Algorithm):
             params["dem"], params["reference"], params["output"],
             coregister=bool(params["coregister"]), stable=params.get("stable"),
             classes=params.get("classes"), class_field=params.get("class_field"),
-            flying_height=params.get("flying_height"), feedback=feedback)
+            flying_height=params.get("flying_height"), dtm=params.get("dtm"),
+            object_height=params.get("object_height"), feedback=feedback)
 
 
 class DemProfile(Algorithm):

@@ -240,3 +240,57 @@ def test_cancel_leaves_no_difference_raster(tmp_path, ref_plane):
         compare_dems(tmp_path / "dem.tif", ref_path, difference_path=out_dir / "dz.tif",
                      window_size=32, feedback=fb)
     assert not any(out_dir.iterdir())
+
+
+def _building_scene(tmp_path):
+    """A 0.5 m grid: flat DTM, a 40 × 40-cell box 8 m high; the DEM lost the building."""
+    t = Affine(0.5, 0, X0, 0, -0.5, Y0)
+    dtm = np.full((120, 120), 100.0)
+    dsm = dtm.copy()
+    dsm[40:80, 40:80] += 8.0
+    dem = dtm.copy()
+    dem[:, :10] = np.nan  # a strip the DEM does not measure (open terrain)
+    classes = np.where(dsm > dtm, 2.0, 1.0)
+    return (write(tmp_path / "ref.tif", dsm, t), write(tmp_path / "dtm.tif", dtm, t),
+            write(tmp_path / "dem.tif", dem, t), write(tmp_path / "cls.tif", classes, t))
+
+
+def test_object_classes_and_completeness(tmp_path):
+    ref, dtm, dem, cls = _building_scene(tmp_path)
+    plain = compare_dems(dem, ref, classes=cls)
+    res = compare_dems(dem, ref, classes=cls, dtm=dtm, window_size=16)
+    # the existing statistics do not change with the object classes
+    for key in ("stats", "per_class", "per_slope"):
+        assert json.dumps(res[key], sort_keys=True) == json.dumps(plain[key], sort_keys=True)
+    assert "per_object" not in plain and plain["completeness"]["per_object"] is None
+    comp = res["completeness"]["per_object"]
+    # 1 m inside = 2 cells of 0.5 m: a 36 × 36 interior; the edge is the 4·(40² − 36²) rest
+    assert comp["object interior"]["cells"] == 36 * 36
+    assert comp["object edge"]["cells"] == 40 * 40 - 36 * 36
+    assert comp["object interior"]["measured"] == 1.0
+    assert comp["object interior"]["within_1"] == 0.0
+    o = comp["open"]
+    assert o["measured"] == pytest.approx(o["within_0_5"]) and o["measured"] < 1.0
+    assert o["cells"] - round(o["measured"] * o["cells"]) == 120 * 10  # the empty strip
+    assert res["per_object"]["object interior"]["median"] == pytest.approx(-8.0)
+    by_class = res["completeness"]["per_class"]
+    assert by_class["2"]["within_0_5"] == 0.0 and by_class["1"]["within_0_5"] < 1.0
+    whole = compare_dems(dem, ref, dtm=dtm)  # one window: the same masks
+    assert whole["completeness"]["per_object"] == comp
+
+
+def test_dem_compare_writes_completeness(tmp_path):
+    from photodem.algorithms.processing import registry
+
+    ref, dtm, _dem, _ = _building_scene(tmp_path)
+    out = registry.run("dem_compare", {"dem": str(ref), "reference": str(ref), "dtm": str(dtm),
+                                       "output": str(tmp_path / "cmp")})
+    rows = (tmp_path / "cmp" / "completeness.csv").read_text().splitlines()
+    assert rows[0] == "scope,name,cells,measured,within_0_5,within_1"
+    assert "object,object interior,1296,1.000000,1.000000,1.000000" in rows
+    assert "Completeness" in (tmp_path / "cmp" / "report.html").read_text()
+    assert out["completeness"]["per_object"]["open"]["within_0_5"] == 1.0
+    plain = registry.run("dem_compare", {"dem": str(ref), "reference": str(ref),
+                                         "output": str(tmp_path / "cmp2")})
+    assert plain["completeness"] is None and plain["completeness_csv"] is None
+    assert not (tmp_path / "cmp2" / "completeness.csv").exists()

@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 
 from photodem.algorithms.quality.objects import (
-    CompletenessAccumulator, completeness, mask_margin, object_classes, object_masks,
-    outline_metrics, wall_distances)
+    CompletenessAccumulator,
+    completeness,
+    mask_margin,
+    object_classes,
+    object_masks,
+    outline_metrics,
+    wall_distances,
+)
 
 CELL = 0.1
 

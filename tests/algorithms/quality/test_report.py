@@ -143,8 +143,9 @@ def test_truth_dsm_against_dtm_per_class(truth, tmp_path: Path) -> None:
     assert t["min"] > 0.0 and t["max"] <= 20.0 + 1e-3
     # everything was written, and the style sits beside the difference model
     names = sorted(p.name for p in out.iterdir())
-    assert names == [".photodem-product.json", "difference.qml", "difference.tif",
-                     "hillshade.tif", "report.html", "slope.tif", "stats.csv", "stats.json"]
+    assert names == [".photodem-product.json", "completeness.csv", "difference.qml",
+                     "difference.tif", "hillshade.tif", "report.html", "slope.tif", "stats.csv",
+                     "stats.json"]
     saved = json.loads((out / "stats.json").read_text())
     assert saved["dem"] == "dsm.tif" and saved["files"]["difference"] == "difference.tif"
     assert saved["per_class"]["3"]["count"] == b["count"] and r["shift"] is None
