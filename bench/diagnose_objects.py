@@ -94,7 +94,7 @@ def _read(path: Path) -> Tuple[np.ndarray, Any, Any]:
 def load_truth(block: Path, setup: Any) -> Truth:
     """Truth DSM/DTM, masks, the measuring area and the building footprints inside it."""
     import fiona  # optional: only this script reads the footprints
-    from shapely.geometry import shape
+    from shapely.geometry import shape  # optional: with fiona, for the footprints only
 
     dsm, t, crs = _read(block / "truth" / "dsm.tif")
     dtm, _, _ = _read(block / "truth" / "dtm.tif")
