@@ -220,9 +220,13 @@ def footprint_from_dsm(dsm: ArrayLike, dtm_true: ArrayLike, true_fp: Array, heig
     return np.isin(lab, hit[hit > 0])
 
 
-def _one_building(dsm: Array, dtm: Array, dsm_true: Array, labels: Array, b: int,
-                  cell: float) -> Optional[Dict[str, Any]]:
-    """IoU and wall distances of building ``b`` inside a window around it."""
+def building_outline(dsm: Array, dtm: Array, dsm_true: Array, labels: Array, b: int,
+                     cell: float) -> Optional[Dict[str, Any]]:
+    """IoU and wall distances of building ``b`` inside a window around it.
+
+    Returns the row of :func:`outline_metrics` with the boundary distances (m) under ``"_d"``,
+    or None when the building has no cells or no positive height in the window.
+    """
     true_fp = labels == b
     if not true_fp.any():
         return None
@@ -277,7 +281,7 @@ def outline_metrics(dsm: ArrayLike, dtm_true: ArrayLike, dsm_true: ArrayLike, la
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, lab.shape[0])
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, lab.shape[1])
         w = (slice(r0, r1), slice(c0, c1))
-        one = _one_building(z[w], t[w], s[w], lab[w], i + 1, cell)
+        one = building_outline(z[w], t[w], s[w], lab[w], i + 1, cell)
         if one is not None:
             dist.append(one.pop("_d"))
             rows.append(one)
@@ -310,6 +314,7 @@ __all__ = [
     "OPEN_MARGIN",
     "CompletenessAccumulator",
     "ObjectMasks",
+    "building_outline",
     "completeness",
     "footprint_from_dsm",
     "mask_margin",

@@ -133,3 +133,60 @@ def test_outline_ignores_detached_trees_and_neighbours():
     b1 = r["buildings"][0]
     assert b1["found_cells"] == 1600 + 2 * 40  # the bridged gap, but not the neighbour
     assert r["count"] == 2
+
+
+def _files(tmp_path):
+    """Truth DSM/DTM (0.1 m grid) with the box building, its footprint, and DSMs on 0.2 m."""
+    import fiona
+    import rasterio
+    from affine import Affine
+    from shapely.geometry import box, mapping
+
+    dsm, dtm, _ = scene()
+    x0, y0 = 500000.0, 5400000.0
+    t = Affine(CELL, 0, x0, 0, -CELL, y0)
+
+    def write(name, arr, transform):
+        prof = {"driver": "GTiff", "width": arr.shape[1], "height": arr.shape[0], "count": 1,
+                "dtype": "float64", "transform": transform, "crs": "EPSG:25832",
+                "nodata": np.nan}
+        with rasterio.open(tmp_path / name, "w", **prof) as dst:
+            dst.write(arr, 1)
+        return tmp_path / name
+
+    fp = box(x0 + 3.0, y0 - 7.0, x0 + 7.0, y0 - 3.0)  # cells 30…69 of the 0.1 m grid
+    schema = {"geometry": "Polygon", "properties": {"id": "int"}}
+    with fiona.open(tmp_path / "b.gpkg", "w", driver="GPKG", schema=schema,
+                    crs="EPSG:25832") as dst:
+        dst.write({"geometry": mapping(fp), "properties": {"id": 1}})
+    coarse = Affine(2 * CELL, 0, x0, 0, -2 * CELL, y0)
+    good = dsm[::2, ::2] + 0.0  # the DSM on a 0.2 m grid (cell corners aligned)
+    lost = dtm[::2, ::2].copy()
+    lost[:, :5] = np.nan
+    return (write("t_dsm.tif", dsm, t), write("t_dtm.tif", dtm, t), tmp_path / "b.gpkg",
+            write("good.tif", good, coarse), write("lost.tif", lost, coarse))
+
+
+def test_object_metrics_of_files(tmp_path):
+    from shapely.geometry import box
+
+    from photodem.algorithms.quality.objects_run import object_metrics
+
+    t_dsm, t_dtm, b, good, lost = _files(tmp_path)
+    r = object_metrics(good, t_dsm, t_dtm, buildings=b, gsd=0.2, window_size=16)
+    c = r["completeness"]
+    assert c["interior"]["cells"] == 400
+    # bilinear 0.2 m → 0.1 m: the interior (1 m from the walls) is exact
+    assert c["interior"]["within_0_5"] == 1.0 and c["open"]["within_0_5"] == 1.0
+    o = r["outlines"]
+    assert o["count"] == 1 and o["iou_pooled"] > 0.9 and o["wall_median_gsd"] <= 1.0
+    r = object_metrics(lost, t_dsm, t_dtm, buildings=b, window_size=16)
+    assert r["completeness"]["interior"]["within_1"] == 0.0
+    assert r["outlines"]["iou_pooled"] == 0.0
+    assert r["completeness"]["open"]["measured"] < 1.0  # the empty strip is a miss
+    whole = object_metrics(lost, t_dsm, t_dtm, window_size=4096)
+    assert whole["completeness"] == r["completeness"] and whole["outlines"] is None
+    # an area that leaves the building out: no outline, no interior
+    area = box(500000.0 + 8.0, 5400000.0 - 12.0, 500000.0 + 12.0, 5400000.0 - 8.0)
+    r = object_metrics(good, t_dsm, t_dtm, buildings=b, area=area)
+    assert r["outlines"]["count"] == 0 and r["completeness"]["interior"]["cells"] == 0
