@@ -22,9 +22,10 @@ On a synthetic block with truth (default: the ``small`` block as ``make demo`` b
 
 Usage (from the repository root)::
 
-    .venv/bin/python -m bench.diagnose_objects [BLOCK_DIR] [--json OUT.json]
+    .venv/bin/python -m bench.diagnose_objects [BLOCK_DIR] [--seed N] [--json OUT.json]
 
-Without ``BLOCK_DIR`` a ``small`` block is generated in a temporary folder. Not part of
+Without ``BLOCK_DIR`` a ``small`` block (seed ``N``, default 1) is generated in a temporary
+folder. Not part of
 ``make bench`` (about 2 minutes); the numbers go to ``docs/decisions.md`` (issue 19).
 """
 
@@ -599,12 +600,15 @@ def main(argv: List[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("block", nargs="?", help="block folder (default: a new small block)")
     ap.add_argument("--json", help="write all numbers to this JSON file")
+    ap.add_argument("--seed", type=int, default=1, help="seed of a generated block (default 1, "
+                                                        "as make demo)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="diagnose-objects-") as tmp:
         block = Path(args.block) if args.block else None
         if block is None:
             block = Path(tmp) / "small"
-            registry.run("synthetic_block", {"size": "small", "output": str(block)})
+            registry.run("synthetic_block", {"size": "small", "seed": args.seed,
+                                             "output": str(block)})
         res = diagnose(block, Path(tmp))
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1, default=float))

@@ -333,6 +333,9 @@ class _ObjectSource:
             return
         if not object_height > 0:
             raise InputError("The object height must be positive (metres above the DTM).")
+        if ref.crs.is_geographic:
+            raise InputError("Object classes need a reference in a projected CRS (cells in "
+                             "metres); warp the reference DSM first (e.g. gdalwarp).")
         src = _open_raster(stack, dtm, "terrain model (DTM)")
         k = self.margin
         self.reader = _GridReader(stack, src, ref.crs, grid * Affine.translation(-k, -k),

@@ -294,3 +294,12 @@ def test_dem_compare_writes_completeness(tmp_path):
                                          "output": str(tmp_path / "cmp2")})
     assert plain["completeness"] is None and plain["completeness_csv"] is None
     assert not (tmp_path / "cmp2" / "completeness.csv").exists()
+
+
+def test_object_classes_need_a_projected_reference(tmp_path):
+    t = Affine(0.0001, 0, 10.0, 0, -0.0001, 50.0)
+    z = np.full((20, 20), 100.0)
+    ref = write(tmp_path / "ref.tif", z, t, crs="EPSG:4326")
+    dtm = write(tmp_path / "dtm.tif", z, t, crs="EPSG:4326")
+    with pytest.raises(InputError, match="projected CRS"):
+        compare_dems(ref, ref, dtm=dtm)
