@@ -335,8 +335,8 @@ def _level_platforms(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
 def _decorate_buildings(obj: SceneObjects, rng: np.random.Generator) -> None:
     """Roof style, texture seed and chimneys of every building (from the detail stream).
 
-    Styles cycle through :data:`ROOF_STYLES` from a random start, so every block with two or
-    more roofs of a type has the plain look and a textured one.
+    Styles cycle through :data:`ROOF_STYLES` from a random start, so every block with three or
+    more roofs of a type has the plain look and the textured ones.
     """
     start = {k: int(rng.integers(len(v))) for k, v in ROOF_STYLES.items()}
     count = dict.fromkeys(ROOF_STYLES, 0)
@@ -345,7 +345,8 @@ def _decorate_buildings(obj: SceneObjects, rng: np.random.Generator) -> None:
         b.style = styles[(start[b.roof] + count[b.roof]) % len(styles)]
         count[b.roof] += 1
         b.texture_seed = int(rng.integers(2 ** 31))
-        if b.roof != "gabled" or rng.uniform() < 0.35:
+        # two thirds of the gabled roofs carry chimneys, the first one always
+        if b.roof != "gabled" or (rng.uniform() < 0.35 and any(o.chimneys for o in obj.buildings)):
             continue
         half = b.width / 2.0
         for _ in range(int(rng.integers(1, 3))):
