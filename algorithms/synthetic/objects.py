@@ -435,8 +435,9 @@ def _burn_trees(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndar
                    grid.cell, d2.shape[0], d2.shape[1])
         relief, gaps = _crown_details(sub, rng, float(sparse))
         shape_ = np.clip(1.0 - d2, 0.0, None) ** 0.6
-        # clumps fade out towards the crown edge, so the outline stays the profile's
-        crown = h * shape_ + relief * np.minimum(shape_ * 3.0, 1.0)
+        # clumps fade out towards the crown edge, so the outline stays the profile's; the
+        # tree keeps its height h as the highest point
+        crown = np.minimum(h * shape_ + relief * np.minimum(shape_ * 3.0, 1.0), h)
         sub_dtm = dtm[rows, cols]
         sub_dsm = dsm[rows, cols]
         top = sub_dtm + crown
