@@ -520,6 +520,18 @@ def lowpass_parameters(preset: str = "default",
     return LowpassParameters.from_dict(par)
 
 
+def _reported_parameters(params: LowpassParameters, rows: List[Dict[str, Any]]
+                         ) -> Dict[str, Any]:
+    """The report's parameters, with the thresholds the iterations applied (the preset's
+    thresholds plus the slope allowance) right after the preset's."""
+    out: Dict[str, Any] = {}
+    for key, value in params.report().items():
+        out[key] = value
+        if key == "thresholds_m":
+            out["thresholds_applied_m"] = [r["threshold_m"] for r in rows if r["iteration"] >= 1]
+    return out
+
+
 def _filter_tiled(z: Array, spacing: float, params: LowpassParameters,
                   constraints: Optional[FilterConstraints], grid: Grid, limit: int,
                   feedback: Feedback, start: float) -> Dict[str, Any]:
@@ -873,7 +885,7 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
     report = {
         "algorithm": "filter_lowpass",
         "preset": params.preset,
-        "parameters": params.report(),
+        "parameters": _reported_parameters(params, res["iterations"]),
         "iterations": res["iterations"],
         "eliminated_share": res["eliminated_share"],
         "cells_valid": res["cells_valid"],

@@ -52,6 +52,7 @@ from ..input_errors import reading, warn_input
 from ..project.edits import read_layer
 from ..project.model import Project
 from ..project.points_io import check_distinct_points, read_points
+from ..quality.names import report_path
 from ..quality.report import _CSS, _embed, _table, new_figure, write_json
 from ..raster.io import staged_folder, write_raster
 from ..raster.sample import bilinear_grid
@@ -729,9 +730,47 @@ def _iteration_figure(rows: Sequence[Dict[str, Any]]) -> Any:
     return fig
 
 
-def _html_report(report: Dict[str, Any], title: str) -> str:
+#: How the report's parameter table names the parameters whose keys are not self-evident.
+PARAMETER_LABELS = {
+    "windows_m": "windows w_k [m]",
+    "thresholds_m": "thresholds t_k of the preset [m] (before the slope allowance)",
+    "thresholds_applied_m": "thresholds applied t_k + slope · w_k / 4 [m]",
+    "down_threshold_m": "threshold below the surface d [m] (+ slope · w_k / 4)",
+    "slope_pct": "slope allowance [%]",
+}
+
+
+def _elimination_figure(z: Array, ground: Array, max_side: int = 700) -> Any:
+    """The DSM in grey with the eliminated cells (not ground) in orange, decimated."""
+    step = max(1, math.ceil(max(z.shape) / max_side))
+    zs, gs = z[::step, ::step], ground[::step, ::step]
+    valid = np.isfinite(zs)
+    fig = new_figure(6.0, min(7.0, 6.0 * zs.shape[0] / max(zs.shape[1], 1) + 0.4))
+    ax = fig.add_subplot(111)
+    if valid.any():
+        lo, hi = np.nanpercentile(zs, [1, 99])
+        ax.imshow(np.where(valid, zs, np.nan), cmap="Greys_r", vmin=lo, vmax=max(hi, lo + 1e-6),
+                  interpolation="nearest")
+    ax.imshow(np.ma.masked_where(~(valid & ~gs), np.ones_like(zs)), cmap="autumn", alpha=0.75,
+              vmin=0, vmax=2, interpolation="nearest")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title("eliminated cells (orange) over the DSM", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def _parameter_rows(params: Dict[str, Any]) -> List[List[str]]:
+    def text(v: Any) -> str:
+        if isinstance(v, (list, tuple)):
+            return ", ".join(f"{x:g}" if isinstance(x, float) else str(x) for x in v)
+        return str(v)
+    return [[PARAMETER_LABELS.get(str(k), str(k)), text(v)] for k, v in params.items()]
+
+
+def _html_report(report: Dict[str, Any], title: str, figure: Optional[Any] = None) -> str:
     parts = [f"<h1>{html.escape(title)}</h1>",
-             f"<p>Input <b>{html.escape(Path(str(report.get('input', ''))).name)}</b> "
+             f"<p>Input <b>{html.escape(report_path(str(report.get('input', ''))))}</b> "
              f"({html.escape(str(report.get('source', '')))}), preset "
              f"<b>{html.escape(str(report.get('preset', '')))}</b>.</p>"]
     summary = [["cells with a height", str(report.get("cells_valid", ""))],
@@ -758,13 +797,14 @@ def _html_report(report: Dict[str, Any], title: str) -> str:
         parts += ["<h2>Elimination per iteration</h2>",
                   _embed(_iteration_figure(rows), "eliminated share per iteration"),
                   _table(["iteration", *keys], table_rows)]
+    if figure is not None:
+        parts += ["<h2>Eliminated cells</h2>", _embed(figure, "map of the eliminated cells"),
+                  '<p class="note">Drawn at reduced resolution; mask.tif holds every cell '
+                  "(0 ground, 1 eliminated).</p>"]
     params = report.get("parameters") or {}
     if params:
         parts += ["<h2>Parameters used</h2>",
-                  _table(["parameter", "value"],
-                         [[str(k), ", ".join(f"{x:g}" if isinstance(x, float) else str(x)
-                                             for x in v) if isinstance(v, (list, tuple))
-                           else str(v)] for k, v in params.items()])]
+                  _table(["parameter", "value"], _parameter_rows(params))]
     cons = report.get("constraints") or {}
     if cons:
         parts += ["<h2>Operator edits</h2>",
@@ -855,7 +895,10 @@ def write_filter_outputs(folder: PathLike, inp: FilterInput, dtm: Array, ground:
                          transform=inp.grid.transform, crs=crs)
         feedback.progress(70.0)
         write_json(tmp / "report.json", report)
-        (tmp / "report.html").write_text(_html_report(report, title), encoding="utf-8")
+        figure = (_elimination_figure(np.asarray(inp.z), ground)
+                  if inp.source == "raster" else None)
+        (tmp / "report.html").write_text(_html_report(report, title, figure),
+                                         encoding="utf-8")
     out["dtm"] = str(folder / "dtm.tif")
     out["ndsm"] = str(folder / "ndsm.tif")
     out["mask"] = str(folder / "mask.tif") if inp.source == "raster" else None

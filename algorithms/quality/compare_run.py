@@ -12,7 +12,9 @@ from typing import Any, Dict, Optional, Union
 
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import staged_folder
-from .compare import compare_dems
+from .class_legend import read_class_legend
+from .compare import _vector_kind, compare_dems
+from .names import report_path
 from .objects import OBJECT_HEIGHT
 from .points import point_compare
 from .rasters import write_difference_style, write_hillshade, write_slope
@@ -38,6 +40,8 @@ def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Di
     summary = {
         "dem": Path(dem).name,
         "reference": Path(reference).name,
+        "dem_path": str(Path(dem).absolute()),
+        "reference_path": str(Path(reference).absolute()),
         "flying_height": flying_height,
         **{k: v for k, v in result.items() if k != "difference"},
         "files": {k: v for k, v in names.items() if k != "json"},
@@ -46,8 +50,8 @@ def _dem_compare_files(tmp: Path, dem: PathLike, reference: PathLike, result: Di
     write_csv(tmp / names["csv"], result, flying_height)
     if result.get("completeness"):
         write_completeness_csv(tmp / COMPLETENESS_FILE, result["completeness"])
-    write_report(tmp / names["report"], result, dem=Path(dem).name,
-                 reference=Path(reference).name, difference=tmp / names["difference"],
+    write_report(tmp / names["report"], result, dem=report_path(dem),
+                 reference=report_path(reference), difference=tmp / names["difference"],
                  hillshade=tmp / names["hillshade"], flying_height=flying_height,
                  feedback=feedback.step(75.0, 99.0))
 
@@ -57,6 +61,7 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
                     classes: Optional[PathLike] = None, class_field: Optional[str] = None,
                     flying_height: Optional[float] = None, dtm: Optional[PathLike] = None,
                     object_height: Optional[float] = None,
+                    class_legend: Optional[PathLike] = None,
                     feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Compare a DEM with a reference and write :data:`DEM_COMPARE_FILES` into ``output``.
 
@@ -68,6 +73,10 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
         As :func:`.compare.compare_dems`.
     object_height : float, optional
         As :func:`.compare.compare_dems` (None: its default, 2.5 m).
+    class_legend : path, optional
+        Names of the codes of a class raster (:func:`.class_legend.read_class_legend`; by
+        default the QGIS style beside the raster). The report shows "name (code)"; the
+        statistics stay keyed by code, and ``class_names`` maps code → name.
     output : path
         Output folder (an earlier ``dem_compare`` folder there is replaced).
     feedback : Feedback, optional
@@ -81,6 +90,8 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
     feedback = ensure_feedback(feedback)
     out = Path(output)
     names = DEM_COMPARE_FILES
+    legend = (read_class_legend(classes, class_legend)
+              if classes is not None and not _vector_kind(classes) else {})
     with staged_folder(out, replace=True, product="dem_compare") as tmp:
         result = compare_dems(
             dem, reference, coregister=coregister, stable=stable, classes=classes,
@@ -88,6 +99,9 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
             difference_path=tmp / names["difference"], dtm=dtm,
             object_height=OBJECT_HEIGHT if object_height is None else float(object_height),
             feedback=feedback.step(0.0, 60.0))
+        if legend:
+            result["class_names"] = {k: legend[k] for k in result.get("per_class") or {}
+                                     if k in legend}
         _dem_compare_files(tmp, dem, reference, result, flying_height, feedback)
     stats = result.get("stats") or {}
     feedback.info(f"Δh over {stats.get('count', 0)} cells: mean {stats.get('mean', 0):+.3f} "
@@ -102,6 +116,7 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
         "stats": result.get("stats"),
         "shift": result.get("shift"),
         "per_class": result.get("per_class"),
+        "class_names": result.get("class_names"),
         "per_slope": result.get("per_slope"),
         "per_object": result.get("per_object"),
         "completeness": comp,

@@ -26,6 +26,7 @@ from rasterio.warp import transform as warp_transform
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output
+from .names import distinct_names
 from .points import sample_dem
 from .report import new_figure, png_bytes
 
@@ -137,18 +138,6 @@ def _cell_metres(src: Any) -> float:
     return cell
 
 
-def _names(paths: Sequence[PathLike]) -> List[str]:
-    """Column names: file stems, made unique."""
-    names: List[str] = []
-    for p in paths:
-        base = Path(p).stem or "dem"
-        name, k = base, 2
-        while name in names:
-            name, k = f"{base}_{k}", k + 1
-        names.append(name)
-    return names
-
-
 def dem_profile(dems: Sequence[PathLike], *, csv_path: PathLike, png_path: PathLike,
                 line: Optional[PathLike] = None, coordinates: Optional[str] = None,
                 spacing: Optional[float] = None,
@@ -160,7 +149,9 @@ def dem_profile(dems: Sequence[PathLike], *, csv_path: PathLike, png_path: PathL
     dems : sequence of path
         DEM rasters; the first one's CRS is the profile's CRS (must be projected, metres).
     csv_path, png_path : path
-        Outputs: ``distance,x,y,<one column per DEM>`` (empty = outside/nodata) and the plot.
+        Outputs: ``distance,x,y,<one column per DEM>`` (empty = outside/nodata; columns
+        named by :func:`.names.distinct_names`, ``m1/dtm`` and ``m2/dtm`` for two ``dtm.tif``)
+        and the plot.
     line : path, optional
         Vector file whose first line feature is the profile (any CRS; transformed).
     coordinates : str, optional
@@ -216,7 +207,7 @@ def dem_profile(dems: Sequence[PathLike], *, csv_path: PathLike, png_path: PathL
         raise InputError(f"The line is {length:.0f} m long: a spacing of {step:g} m gives more "
                          f"than {MAX_SAMPLES} samples; choose a larger spacing.")
     dist, x, y = sample_line(vertices, step)
-    names = _names(dems)
+    names = distinct_names(dems)
     heights: List[NDArray[np.float64]] = []
     for k, d in enumerate(dems):
         z = sample_dem(d, x, y, crs=work_crs)

@@ -42,6 +42,7 @@ from rasterio.windows import Window, from_bounds
 from ..feedback import Feedback, ensure_feedback
 from ..jsonable import json_ready
 from ..raster.io import atomic_output
+from .class_legend import class_label
 from .rasters import DIFFERENCE_CLASSES, difference_bounds, difference_colors
 
 PathLike = Union[str, Path]
@@ -514,9 +515,12 @@ def completeness_rows(completeness: Dict[str, Any]) -> List[List[str]]:
     return rows
 
 
-def completeness_table(completeness: Dict[str, Any]) -> str:
-    """HTML table of the completeness per class and per object class."""
-    rows = [[("class " if r[0] == "class" else "") + r[1], _fmt(float(r[2]), "count")]
+def completeness_table(completeness: Dict[str, Any],
+                       names: Optional[Dict[str, str]] = None) -> str:
+    """HTML table of the completeness per class (named by ``names``: code → name) and per
+    object class."""
+    rows = [[("class " + class_label(r[1], names or {}) if r[0] == "class" else r[1]),
+             _fmt(float(r[2]), "count")]
             + [_fmt(float(v), "share") if v else "–" for v in r[3:]]
             for r in completeness_rows(completeness)[1:]]
     return _table(["class", "reference cells", "measured", "within ±0.5 m", "within ±1 m"],
@@ -580,8 +584,8 @@ def write_report(path: PathLike, result: Dict[str, Any], *, dem: str, reference:
         What :func:`.compare.compare_dems` returns: ``stats``, ``shift`` (or None),
         ``per_class``, ``per_slope``, ``grid``.
     dem, reference : str
-        Names of the compared DEMs as shown in the report (file names, no folders: the report
-        does not depend on where it was written).
+        Names of the compared DEMs as shown in the report (:func:`.names.report_path`: the
+        project-relative or the absolute path, so that two ``dtm.tif`` can be told apart).
     difference, hillshade : path, optional
         The difference raster (map and signed histogram) and the DEM's hillshade (map
         background).
@@ -590,7 +594,8 @@ def write_report(path: PathLike, result: Dict[str, Any], *, dem: str, reference:
     """
     feedback = ensure_feedback(feedback)
     stats = result.get("stats") or {}
-    per_class = stats_entries(result.get("per_class"))
+    names = result.get("class_names") or {}
+    per_class = [(class_label(k, names), s) for k, s in stats_entries(result.get("per_class"))]
     per_slope = stats_entries(result.get("per_slope"))
     parts = [f"<h1>{html.escape(title)}</h1>",
              f"<p>DEM <b>{html.escape(dem)}</b> against reference <b>{html.escape(reference)}"
@@ -657,7 +662,8 @@ def _object_parts(result: Dict[str, Any], flying_height: Optional[float]) -> Lis
                   "above the terrain and at least 1 m from any object.</p>"]
     comp = result.get("completeness")
     if comp:
-        parts += ["<h2>Completeness</h2>", completeness_table(comp),
+        parts += ["<h2>Completeness</h2>",
+                  completeness_table(comp, result.get("class_names")),
                   '<p class="note">Of the cells with a reference height: the share the DEM '
                   "measures at all, and the shares within ±0.5 m and ±1 m of the reference "
                   "(cells the DEM leaves empty count as misses).</p>"]

@@ -55,10 +55,18 @@ from ..feedback import Feedback, ensure_feedback
 from ..project.edits import create_edits
 from ..project.model import ImageRecord, Project, StereoModel
 from ..project.stereo_models import detect_stereo_models
+from ..quality.class_legend import write_class_style
 from ..raster.io import staged_folder, write_raster
 from ..raster.sample import DemSampler, bilinear_grid
 from .flight import SIZES, STEEP_GSD_FACTOR, FlightPlan, footprint_points, plan_flight
-from .objects import LANDCOVER, SceneObjects, choose_checkpoints, flatten_sites, place_objects
+from .objects import (
+    LANDCOVER,
+    LANDCOVER_COLOURS,
+    SceneObjects,
+    choose_checkpoints,
+    flatten_sites,
+    place_objects,
+)
 from .render import Renderer, render_image
 from .terrain import TERRAIN_TYPES, Grid, make_terrain
 from .texture import PAD_FACTOR, make_albedo
@@ -388,6 +396,8 @@ def generate_block(output: Union[str, Path], size: str = "small", terrain: str =
         write_raster(truth / "dtm.tif", scene.dtm.astype(np.float32), g.transform, CRS)
         write_raster(truth / "dsm.tif", scene.dsm.astype(np.float32), g.transform, CRS)
         write_raster(truth / "landcover.tif", scene.landcover, g.transform, CRS, nodata=0)
+        write_class_style(truth / "landcover.tif", {code: (name, LANDCOVER_COLOURS[code])
+                                                    for code, name in LANDCOVER.items() if code})
         vec = _write_vectors(scene, truth)
         feedback.progress(99.0)
         names = {"dtm": "dtm.tif", "dsm": "dsm.tif", "landcover": "landcover.tif"}

@@ -51,6 +51,11 @@ class DemCompare(Algorithm):
                        "with a class attribute."),
         Parameter("class_field", "string", "Class attribute of the polygons", optional=True,
                   help="Attribute of the class polygons that names the class."),
+        Parameter("class_legend", "file", "Class names (legend of a class raster)",
+                  optional=True,
+                  help="Names of the codes of a class raster: a table with one 'value,name' "
+                       "per line, or a QGIS style (.qml). Default: the style beside the "
+                       "raster (landcover.qml for landcover.tif), else the codes."),
         Parameter("flying_height", "number", "Flying height above ground [m]", optional=True,
                   minimum=1.0, unit="m",
                   help="For the statistics in ‰ of the flying height."),
@@ -66,6 +71,7 @@ class DemCompare(Algorithm):
         Output("stats", "json", "Statistics of Δh [m]"),
         Output("shift", "json", "Co-registration shift dx, dy, dz [m]"),
         Output("per_class", "json", "Statistics per class"),
+        Output("class_names", "json", "Names of the class codes"),
         Output("per_slope", "json", "Statistics per slope class"),
         Output("per_object", "json", "Statistics per object class"),
         Output("completeness", "json", "Completeness per class"),
@@ -86,7 +92,8 @@ class DemCompare(Algorithm):
             coregister=bool(params["coregister"]), stable=params.get("stable"),
             classes=params.get("classes"), class_field=params.get("class_field"),
             flying_height=params.get("flying_height"), dtm=params.get("dtm"),
-            object_height=params.get("object_height"), feedback=feedback)
+            object_height=params.get("object_height"),
+            class_legend=params.get("class_legend"), feedback=feedback)
 
 
 class DemProfile(Algorithm):

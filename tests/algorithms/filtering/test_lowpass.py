@@ -245,6 +245,14 @@ def test_run_raster_writes_products_and_iterations(tmp_path) -> None:
         [f"diff_{i:02d}.tif" for i in range(1, n_it + 1)]
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     assert rep["preset"] == "default" and len(rep["iterations"]) == n_it + 1
+    # the report lists the thresholds the iterations applied, not only the preset's, and maps
+    # the eliminated cells
+    applied = rep["parameters"]["thresholds_applied_m"]
+    assert applied == [r["threshold_m"] for r in rep["iterations"][1:]]
+    assert applied[0] > rep["parameters"]["thresholds_m"][0]  # + slope · w / 4
+    page = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert "thresholds applied" in page and "Eliminated cells" in page
+    assert (tmp_path / "dsm.tif").absolute().as_posix() in page
 
 
 def test_run_points_labels_in_input_order(tmp_path) -> None:

@@ -76,6 +76,24 @@ def test_profile_heights_columns_and_plot(dems, tmp_path: Path) -> None:
     assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_two_files_of_the_same_name_get_distinct_columns(dems, tmp_path: Path) -> None:
+    fine, coarse = dems
+    (tmp_path / "m1").mkdir()
+    (tmp_path / "m2").mkdir()
+    a = Path(write_raster(tmp_path / "m1" / "dtm.tif", *_read(fine)))
+    b = Path(write_raster(tmp_path / "m2" / "dtm.tif", *_read(coarse)))
+    r = dem_profile([a, b], coordinates=f"{X0 + 10},{Y0 - 10};{X0 + 60},{Y0 - 40}",
+                    csv_path=tmp_path / "p.csv", png_path=tmp_path / "p.png")
+    assert r["columns"] == ["m1/dtm", "m2/dtm"]
+
+
+def _read(path):
+    import rasterio
+
+    with rasterio.open(path) as src:
+        return src.read(1), src.transform, src.crs
+
+
 def test_line_layer_in_another_crs_and_partial_cover(dems, tmp_path: Path) -> None:
     import fiona
     from rasterio.warp import transform

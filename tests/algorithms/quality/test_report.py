@@ -148,6 +148,13 @@ def test_truth_dsm_against_dtm_per_class(truth, tmp_path: Path) -> None:
                      "stats.json"]
     saved = json.loads((out / "stats.json").read_text())
     assert saved["dem"] == "dsm.tif" and saved["files"]["difference"] == "difference.tif"
+    # the legend style beside the land-cover raster names the codes; the report shows the
+    # project-relative paths of the compared files
+    assert r["class_names"]["3"] == "building" and saved["class_names"]["4"] == "tree / forest"
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "building (3)" in page and "road (2)" in page
+    project = Path(truth["project"]).name
+    assert f"{project}/truth/dsm.tif" in page and f"{project}/truth/dtm.tif" in page
     assert saved["per_class"]["3"]["count"] == b["count"] and r["shift"] is None
     with open(out / "stats.csv", newline="") as f:
         rows = list(csv.DictReader(f))
