@@ -514,6 +514,16 @@
             <translation>Attribut der Klassenpolygone, das die Klasse benennt.</translation>
         </message>
         <message>
+            <source>Class names (legend of a class raster)</source>
+            <extracomment>dem_compare.class_legend: description</extracomment>
+            <translation>Klassennamen (Legende eines Klassenrasters)</translation>
+        </message>
+        <message>
+            <source>Names of the codes of a class raster: a table with one 'value,name' per line, or a QGIS style (.qml). Default: the style beside the raster (landcover.qml for landcover.tif), else the codes.</source>
+            <extracomment>dem_compare.class_legend: help</extracomment>
+            <translation>Namen der Codes eines Klassenrasters: eine Tabelle mit einer Zeile 'Wert,Name' je Klasse oder ein QGIS-Stil (.qml). Vorgabe: der Stil neben dem Raster (landcover.qml zu landcover.tif), sonst die Codes.</translation>
+        </message>
+        <message>
             <source>Flying height above ground [m]</source>
             <extracomment>dem_compare.flying_height: description; point_compare.flying_height: description</extracomment>
             <translation>Flughöhe über Grund [m]</translation>
@@ -557,6 +567,11 @@
             <source>Statistics per class</source>
             <extracomment>dem_compare output per_class</extracomment>
             <translation>Statistik je Klasse</translation>
+        </message>
+        <message>
+            <source>Names of the class codes</source>
+            <extracomment>dem_compare output class_names</extracomment>
+            <translation>Namen der Klassencodes</translation>
         </message>
         <message>
             <source>Statistics per slope class</source>
