@@ -30,6 +30,9 @@ Every feature is checked when it is read (:func:`check_feature`, for :func:`read
 
 from __future__ import annotations
 
+import os
+import sqlite3
+import stat
 from collections import OrderedDict
 from pathlib import Path
 from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
@@ -217,6 +220,42 @@ def create_edits(path: PathLike, crs: str) -> Path:
     return path
 
 
+def edits_access(path: PathLike) -> Optional[Tuple[str, str]]:
+    """Why ``edits.gpkg`` cannot take edits now, or ``None`` when it can.
+
+    Returns
+    -------
+    tuple (kind, detail) or None
+        ``kind`` is ``"missing"``, ``"read-only"`` (the file or its folder, where SQLite
+        writes its journal, is not writable) or ``"locked"`` (another program holds a write
+        lock, or the file is not a database); ``detail`` says more in English.
+
+    Notes
+    -----
+    The lock test opens a write transaction and rolls it back at once: nothing is written.
+    The permission bits are checked as well as ``os.access``, which says yes to root for any
+    file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        return "missing", f"{path} does not exist"
+    bits = stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH
+    if not (os.access(path, os.W_OK) and path.stat().st_mode & bits):
+        return "read-only", f"{path} is read-only"
+    if not (os.access(path.parent, os.W_OK) and path.parent.stat().st_mode & bits):
+        return "read-only", f"the folder {path.parent} is read-only"
+    try:
+        con = sqlite3.connect(f"file:{path}?mode=rw", uri=True, timeout=0.2)
+        try:
+            con.execute("BEGIN IMMEDIATE")
+            con.rollback()
+        finally:
+            con.close()
+    except sqlite3.Error as exc:
+        return "locked", str(exc)
+    return None
+
+
 def missing_edit_layers(path: PathLike) -> List[str]:
     """The layers of :data:`EDIT_LAYERS` that ``edits.gpkg`` lacks (in their order)."""
     with reading(Path(path), "GeoPackage"):
@@ -377,6 +416,7 @@ __all__ = [
     "check_fields",
     "check_layer",
     "create_edits",
+    "edits_access",
     "flat_breakline_message",
     "kind_message",
     "missing_edit_layers",

@@ -19,9 +19,6 @@ All geometries handed to the core are in the project CRS (the CRS of ``edits.gpk
 
 from __future__ import annotations
 
-import os
-import sqlite3
-import stat
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
@@ -49,7 +46,7 @@ from shapely.geometry import LineString, Point
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.project import edit_checks, edit_tools
-from ...algorithms.project.edits import EDIT_LAYERS
+from ...algorithms.project.edits import EDIT_LAYERS, edits_access
 from ...algorithms.project.stereo_models import block_footprints
 from ..i18n import tr
 from .edit_forms import DialogAsker
@@ -66,27 +63,18 @@ SNAP_PIXELS = 12
 
 
 def edits_problem(path: Path) -> Optional[str]:
-    """Why ``edits.gpkg`` cannot take edits now (missing, read-only, locked), or ``None``.
-
-    The lock test opens a write transaction and rolls it back at once: nothing is written.
-    The write bits are checked too, since ``os.access`` says yes to root for any file.
-    """
-    if not path.is_file():
+    """Why ``edits.gpkg`` cannot take edits now (missing, read-only, locked), or ``None``
+    (:func:`~photodem.algorithms.project.edits.edits_access`, in the operator's language)."""
+    problem = edits_access(path)
+    if problem is None:
+        return None
+    kind, detail = problem
+    if kind == "missing":
         return tr("The edits file {0} does not exist.").format(path)
-    mode = path.stat().st_mode
-    if not os.access(path, os.W_OK) or not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
+    if kind == "read-only":
         return tr("The edits file {0} is read-only; make it writable to edit.").format(path)
-    try:
-        con = sqlite3.connect(f"file:{path}?mode=rw", uri=True, timeout=0.2)
-        try:
-            con.execute("BEGIN IMMEDIATE")
-            con.rollback()
-        finally:
-            con.close()
-    except sqlite3.Error as exc:
-        return tr("The edits file {0} is locked or unreadable ({1}); close the program that "
-                  "holds it and try again.").format(path, exc)
-    return None
+    return tr("The edits file {0} is locked or unreadable ({1}); close the program that "
+              "holds it and try again.").format(path, detail)
 
 
 def to_shapely(geometry: QgsGeometry) -> Any:

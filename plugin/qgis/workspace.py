@@ -20,7 +20,6 @@ current workspace (:func:`current_workspace`); opening the same project again re
 from __future__ import annotations
 
 import contextlib
-import os
 from pathlib import Path
 from typing import Any, Callable, Iterable, List, Optional, Tuple
 
@@ -41,6 +40,7 @@ from ...algorithms.project.edits import (
     EDIT_LAYERS,
     add_edit_layers,
     create_edits,
+    edits_access,
     missing_edit_layers,
 )
 from ...algorithms.project.model import Project
@@ -171,7 +171,8 @@ class Workspace(QObject):
                            "breaklines cannot be drawn."), tr("Create edits.gpkg"),
                         self.create_edits)
             return []
-        self.read_only = not (os.access(path, os.W_OK) and os.access(path.parent, os.W_OK))
+        problem = edits_access(path)
+        self.read_only = problem is not None and problem[0] == "read-only"
         if self.read_only:
             self._message(tr("{0} cannot be written: the edit layers are loaded read-only.")
                           .format(path), Qgis.Warning)

@@ -345,19 +345,18 @@ def test_missing_edits_file_is_offered(project, ws_iface) -> None:
     assert _names(ws.subgroup(EDITS)) == EDIT_TITLES
 
 
-def test_read_only_edits_load_read_only(project, ws_iface, monkeypatch) -> None:
-    import os
-
+def test_read_only_edits_load_read_only(project, ws_iface) -> None:
     from photodem.plugin.qgis import workspace
 
-    edits = str(project / "edits.gpkg")
-    real = os.access
-    monkeypatch.setattr(workspace.os, "access",
-                        lambda p, mode: False if str(p) == edits else real(p, mode))
-    ws = workspace.open_workspace(ws_iface, project)
-    assert ws.read_only
-    assert all(ws.edit_layer(n).readOnly() for n in EDIT_NAMES)
-    assert any("read-only" in m for m in _messages(ws_iface))
+    edits = project / "edits.gpkg"
+    edits.chmod(0o444)  # a real read-only file (the check reads the mode bits, even as root)
+    try:
+        ws = workspace.open_workspace(ws_iface, project)
+        assert ws.read_only
+        assert all(ws.edit_layer(n).readOnly() for n in EDIT_NAMES)
+        assert any("read-only" in m for m in _messages(ws_iface))
+    finally:
+        edits.chmod(0o644)
 
 
 class _StandInToolbar:
