@@ -337,20 +337,19 @@ def format_seconds(seconds: Optional[float]) -> str:
     """``1:05:09`` / ``5:09`` / ``–`` for unknown."""
     if seconds is None:
         return "–"
-    seconds = int(round(seconds))
-    hours, rest = divmod(seconds, 3600)
+    hours, rest = divmod(round(seconds), 3600)
     minutes, secs = divmod(rest, 60)
     return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
 
 
 __all__ = [
     "BATCH_FOLDER",
-    "BatchChoices",
     "FILTERS",
     "MODEL_STEPS",
-    "ModelRow",
     "ORTHO_STEPS",
     "STEP_ORDER",
+    "BatchChoices",
+    "ModelRow",
     "batch_config",
     "batch_text",
     "choice_default",

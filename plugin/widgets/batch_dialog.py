@@ -147,14 +147,9 @@ class BatchDialog(QtWidgets.QDialog):
 
         layout = QtWidgets.QVBoxLayout(self)
         layout.addLayout(top)
-        splitter = QtWidgets.QSplitter(Qt.Vertical, self)
-        splitter.addWidget(self.table)
-        splitter.addWidget(self._build_steps())
-        splitter.addWidget(self._build_run_view())
-        splitter.setStretchFactor(0, 3)
-        splitter.setStretchFactor(2, 2)
-        self.splitter = splitter
-        layout.addWidget(splitter, 1)
+        layout.addWidget(self.table, 3)
+        layout.addWidget(self._build_steps())  # its natural height: every choice visible
+        layout.addWidget(self._build_run_view(), 2)
         layout.addLayout(self._build_buttons())
         self.resize(980, 760)
         self.project_edit.text_changed.connect(self._on_project_text)
@@ -165,7 +160,8 @@ class BatchDialog(QtWidgets.QDialog):
         grid = QtWidgets.QGridLayout(box)
         self.step_checks: Dict[str, QtWidgets.QCheckBox] = {}
         labels = {"epipolar_pair": tr("Epipolar pair"), "match_model": tr("Matching"),
-                  "dsm_merge": tr("Merge DSMs"), "refine_object_space": tr("Refine in object space"),
+                  "dsm_merge": tr("Merge DSMs"),
+                  "refine_object_space": tr("Refine in object space"),
                   "filter": tr("DTM filter"), "ortho": tr("Orthophotos")}
         for row, step in enumerate(batch_setup.STEP_ORDER):
             check = QtWidgets.QCheckBox(labels[step], box)
@@ -399,9 +395,12 @@ class BatchDialog(QtWidgets.QDialog):
         self.project_edit.blockSignals(True)
         self.project_edit.setText(str(plan.project or ""))
         self.project_edit.blockSignals(False)
-        self.load_models() if plan.project is not None else self.table.setRowCount(0)
-        if plan.project is None:
+        if plan.project is not None:
+            self.load_models()
+        else:
+            self.table.setRowCount(0)
             self._rows = {}
+        self.workers_spin.setValue(plan.workers)
         self._rows_from_plan(plan, check=True)
         self.batch_file = Path(path).resolve()
         self.opened_file = True
@@ -417,7 +416,7 @@ class BatchDialog(QtWidgets.QDialog):
 
     def _show_file(self) -> None:
         if self.batch_file is not None:
-            self.file_label.setText(tr("Batch file: {0}  —  run it again with: photodem batch "
+            self.file_label.setText(tr("Batch file: {0}\nRun it again with: photodem batch "
                                        "{0}").format(self.batch_file))
 
     def write_batch_file(self) -> Path:
@@ -592,7 +591,10 @@ class BatchDialog(QtWidgets.QDialog):
             reason = str(failed[0].get("error") or "").strip().splitlines()
             self._set_state(row, "failed", reason[0] if reason else "")
         elif any(s is None for s in statuses):
-            self._set_state(row, "running" if self.is_running() else "cancelled")
+            if not self.is_running():
+                self._set_state(row, "cancelled")
+            else:  # its next task waits for the step before it
+                self._set_state(row, "waiting")
         elif "cancelled" in statuses:
             self._set_state(row, "cancelled")
         else:
@@ -703,7 +705,7 @@ class BatchDialog(QtWidgets.QDialog):
         return CLOSE_CANCEL if clicked is cancel else CLOSE_BACKGROUND if clicked is keep \
             else CLOSE_STAY
 
-    def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802
+    def closeEvent(self, event: QtGui.QCloseEvent) -> None:
         self._remember()
         if not self.is_running():
             super().closeEvent(event)
@@ -752,4 +754,4 @@ def _state_item(state: str) -> QtWidgets.QTableWidgetItem:
     return item
 
 
-__all__ = ["BatchDialog", "CLOSE_BACKGROUND", "CLOSE_CANCEL", "CLOSE_STAY", "state_text"]
+__all__ = ["CLOSE_BACKGROUND", "CLOSE_CANCEL", "CLOSE_STAY", "BatchDialog", "state_text"]

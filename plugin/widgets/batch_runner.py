@@ -22,7 +22,7 @@ from ..qt import QObject, Qt, QThread, pyqtSignal, pyqtSlot
 class _BatchFeedback(Feedback):
     """A feedback whose per-task hooks (called by the runner) emit the worker's signals."""
 
-    def __init__(self, worker: "BatchWorker") -> None:
+    def __init__(self, worker: BatchWorker) -> None:
         super().__init__(on_progress=worker.progress.emit, on_log=worker.log.emit)
         self._worker = worker
 
