@@ -28,10 +28,9 @@ from ...algorithms.project import toml_io
 from ..i18n import tr
 from ..qt import QSettings, Qt, QtCore, QtGui, QtWidgets, QUrl, pyqtSignal
 from .batch_runner import BatchWorker, start_batch_thread
-from .parameter_form import PathEdit
+from .parameter_form import SETTINGS_PROJECT, PathEdit
 
 #: Settings keys (``QSettings`` standalone, ``QgsSettings`` in QGIS: the same API).
-SETTINGS_PROJECT = "PhotoDEM/last_project"
 SETTINGS_PREFIX = "PhotoDEM/batch/"
 
 #: Table columns.
