@@ -292,14 +292,17 @@ def rerun_failed(config: Dict[str, Any], failed: Sequence[str]) -> Dict[str, Any
 # -- after a run ---------------------------------------------------------------------------------
 #: Output kinds that are products to open or add to a map.
 _PRODUCT_KINDS = ("raster", "vector")
+#: Algorithms whose outputs are intermediate (epipolar images are not georeferenced): not
+#: listed as products nor added to a map.
+_INTERMEDIATE = ("epipolar_pair",)
 
 
 def summary_products(summary: Dict[str, Any]) -> List[str]:
     """The raster and vector products of the done/skipped tasks of a batch summary, once each,
-    in task order (existing files only)."""
+    in task order (existing files only; not the epipolar images, which are intermediate)."""
     products: List[str] = []
     for task in summary.get("tasks", []):
-        if task.get("status") not in ("done", "skipped"):
+        if task.get("status") not in ("done", "skipped") or task.get("algorithm") in _INTERMEDIATE:
             continue
         try:
             alg = registry.get(task["algorithm"])

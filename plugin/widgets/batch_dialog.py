@@ -172,6 +172,12 @@ class BatchDialog(QtWidgets.QDialog):
         self.filter_combo = _combo(box, batch_setup.FILTERS, names=True)
         self.filter_preset = _combo(box, batch_setup.choice_options("filter_lowpass", "preset"))
         self.ortho_combo = _combo(box, batch_setup.ORTHO_STEPS, names=True)
+        for combo, tip in ((self.method_combo, tr("Matching method")),
+                           (self.match_preset, tr("Matching preset")),
+                           (self.filter_combo, tr("DTM filter")),
+                           (self.filter_preset, tr("Filter preset")),
+                           (self.ortho_combo, tr("Single orthophotos or a mosaic"))):
+            combo.setToolTip(tip)
         grid.addWidget(self.method_combo, 0, 4)  # beside Matching
         grid.addWidget(self.match_preset, 0, 5)
         grid.addWidget(self.filter_combo, 2, 1)

@@ -62,6 +62,10 @@ class RunPanel(QtWidgets.QWidget):
         self.result_view.setHeaderLabels([tr("Output"), tr("Value"), ""])
         self.result_view.setRootIsDecorated(True)
         self.result_view.setAlternatingRowColors(True)
+        header = self.result_view.header()
+        header.setStretchLastSection(False)
+        header.setSectionResizeMode(1, QtWidgets.QHeaderView.Stretch)
+        header.setSectionResizeMode(2, QtWidgets.QHeaderView.ResizeToContents)
         self.result_view.itemDoubleClicked.connect(
             lambda item, _col: self.open_path(item.data(1, PATH_ROLE) or ""))
         #: Opens a file or folder URL with the system's application; tests replace it.
@@ -198,6 +202,9 @@ class RunPanel(QtWidgets.QWidget):
         for key, value in result.items():
             self.result_view.addTopLevelItem(_tree_item(str(key), value))
         self.result_view.expandToDepth(0)
+        for i in range(self.result_view.topLevelItemCount()):
+            item = self.result_view.topLevelItem(i)
+            item.setExpanded(item.childCount() <= 6)  # long tables stay folded: files in view
         iterator = QtWidgets.QTreeWidgetItemIterator(self.result_view)
         while iterator.value():
             item = iterator.value()
