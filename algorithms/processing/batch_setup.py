@@ -26,7 +26,7 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -270,23 +270,21 @@ def write_batch(choices: BatchChoices, path: Optional[Path] = None) -> Path:
     return path
 
 
-def rerun_failed(config: Dict[str, Any], failed: Sequence[str]) -> Dict[str, Any]:
-    """The batch ``config`` restricted to the ``failed`` models/images (the other items'
-    steps are dropped); steps without items (merge, filter, mosaic) stay, as they depend on
-    them. Resume then skips whatever is complete."""
-    wanted = set(failed)
-    steps = []
-    for step in config.get("steps", []):
-        step = dict(step)
-        for key in ("models", "images", "files"):
-            if isinstance(step.get(key), list):
-                step[key] = [i for i in step[key] if Path(str(i)).stem in wanted
-                             or str(i) in wanted]
-                if not step[key]:
-                    break
-        else:
-            steps.append(step)
-    return {**config, "steps": steps}
+def only_items(tasks: Sequence[Any], items: Sequence[str]) -> List[Any]:
+    """The tasks of a plan for the models/images/files named in ``items`` (by name), and the
+    steps without items (merge, filter, mosaic), which depend on them; renumbered so that the
+    runner's records match (``Task.index``). Resume then skips whatever is complete.
+
+    Parameters
+    ----------
+    tasks : sequence of Task
+        ``BatchPlan.tasks`` of the batch file to run again.
+    items : sequence of str
+        Task names (a model or image name, a file name without suffix), e.g. the failed ones.
+    """
+    wanted = set(items)
+    kept = [t for t in tasks if t.item is None or t.name in wanted]
+    return [replace(t, index=i) for i, t in enumerate(kept)]
 
 
 # -- after a run ---------------------------------------------------------------------------------
@@ -362,8 +360,8 @@ __all__ = [
     "format_seconds",
     "model_rows",
     "new_batch_path",
+    "only_items",
     "remaining_seconds",
-    "rerun_failed",
     "step_states",
     "summary_products",
     "write_batch",

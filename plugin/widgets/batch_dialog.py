@@ -24,7 +24,6 @@ from typing import Any, Callable, Dict, List, Optional
 from ...algorithms.errors import PhotodemError
 from ...algorithms.processing import batch, batch_setup
 from ...algorithms.processing.batch_setup import BatchChoices
-from ...algorithms.project import toml_io
 from ..i18n import tr
 from ..qt import QSettings, Qt, QtCore, QtGui, QtWidgets, QUrl, pyqtSignal
 from .batch_runner import BatchWorker, start_batch_thread
@@ -455,25 +454,16 @@ class BatchDialog(QtWidgets.QDialog):
         return self._start(self.batch_file)
 
     def rerun_failed(self) -> bool:
-        """Run the current batch again for the failed models/images only (a new batch file
-        beside it; the rest is skipped by resume)."""
+        """Run the current batch file again for the failed models/images alone (and the steps
+        without items); the rest of the file is not run, complete tasks are skipped."""
         if self.is_running() or self.summary is None or self.batch_file is None:
             return False
         failed = batch_setup.failed_items(self.summary)
         if not failed:
             return False
-        config = toml_io.loads(self.batch_file.read_text(encoding="utf-8"))
-        config = batch_setup.rerun_failed(config, failed)
-        path = batch_setup.new_batch_path(self.batch_file.parent.parent.parent) \
-            if self.batch_file.parent.name == batch_setup.BATCH_FOLDER.name \
-            else self.batch_file.with_name(self.batch_file.stem + "-failed.toml")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(batch_setup.batch_text(config), encoding="utf-8")
-        self.batch_file, self.opened_file = path, True
-        self._show_file()
-        return self._start(path)
+        return self._start(self.batch_file, only=failed)
 
-    def _start(self, path: Optional[Path]) -> bool:
+    def _start(self, path: Optional[Path], only: Optional[List[str]] = None) -> bool:
         if path is None:
             return False
         self.summary, self.products = None, []
@@ -481,7 +471,7 @@ class BatchDialog(QtWidgets.QDialog):
         self.log_view.clear()
         self.tabs.setCurrentIndex(0)
         self.progress_bar.setValue(0)
-        worker = BatchWorker(path, workers=self.workers_spin.value())
+        worker = BatchWorker(path, workers=self.workers_spin.value(), only=only)
         worker.planned.connect(self._on_planned)
         worker.progress.connect(self._on_progress)
         worker.task_progress.connect(self._on_task_progress)

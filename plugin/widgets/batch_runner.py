@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import traceback
 from pathlib import Path
-from typing import Any, Dict, Optional
+from typing import Any, Dict, Optional, Sequence
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.feedback import Feedback
-from ...algorithms.processing import batch
+from ...algorithms.processing import batch, batch_setup
 from ..qt import QObject, Qt, QThread, pyqtSignal, pyqtSlot
 
 
@@ -66,9 +66,10 @@ class BatchWorker(QObject):
     done = pyqtSignal()
 
     def __init__(self, batch_file: Path, workers: Optional[int] = None, resume: bool = True,
-                 parent: Optional[QObject] = None) -> None:
+                 only: Optional[Sequence[str]] = None, parent: Optional[QObject] = None) -> None:
         super().__init__(parent)
         self.batch_file = Path(batch_file)
+        self.only = list(only) if only else None  # run these models/images/files alone
         self.workers = workers
         self.resume = resume
         self.feedback = _BatchFeedback(self)
@@ -84,6 +85,8 @@ class BatchWorker(QObject):
         (the message in :attr:`error` and the ``failed`` signal)."""
         try:
             plan = batch.load_batch(self.batch_file)
+            if self.only:
+                plan.tasks = batch_setup.only_items(plan.tasks, self.only)
             self.planned.emit(plan)
             self.summary = batch.run_batch(plan, self.feedback, workers=self.workers,
                                            resume=self.resume)

@@ -157,12 +157,12 @@ def test_failed_models_show_their_reason_and_run_again_alone(qtbot, dialog, chai
     assert state.startswith("failed: model b_c is broken")
     assert d.rerun_button.isEnabled()
     batch_file.write_text(batch_file.read_text().replace('fail = "b_c"', 'fail = ""'))
-    d.opened_file = True
-    d.batch_file = batch_file
     with qtbot.waitSignal(d.batch_finished, timeout=30000):
         assert d.rerun_failed()
     assert [t["item"] for t in d.summary["tasks"]] == ["b_c"]
     assert d.summary["status"] == "done"
+    assert d.table.item(d._rows["b_c"].row, bd.COL_STATE).text() == "done"
+    assert d.table.item(d._rows["a_b"].row, bd.COL_STATE).text() == "done"  # from before
 
 
 def test_image_list_batch_file(qtbot, dialog, tmp_path, monkeypatch):
@@ -230,3 +230,32 @@ def test_bad_input_is_reported(qtbot, dialog, tmp_path):
     assert not d.open_batch_file(str(bad))
     assert "no_such_algorithm" in dialog.messages[-1]
     assert Qt.Checked  # the module imports Qt for the check states
+
+
+def test_main_window_shows_a_batch_running_in_the_background(qtbot, settings, chain_project,
+                                                             monkeypatch):
+    from photodem.plugin.app.main_window import ToolboxWindow
+
+    _fake_algs.install(monkeypatch)
+    root = chain_project("abc")
+    file = root / "slow.toml"
+    file.write_text('[batch]\nproject = "."\nworkers = 1\n[[steps]]\n'
+                    'algorithm = "fake_sleep_write"\n[steps.params]\nseconds = 3\nsteps = 60\n'
+                    'output = "{project}/products/{step}/{model}.json"\n')
+    w = ToolboxWindow(message_boxes=False, settings=settings)
+    qtbot.addWidget(w)
+    w.show()
+    d = w.open_batch_dialog(str(root))
+    assert d.project_folder() == root.resolve() and d.open_batch_file(str(file))
+    d.run()
+    d.ask_close = lambda: bd.CLOSE_BACKGROUND
+    d.close()
+    assert w.batch_button.isVisible() and not d.isVisible()
+    w.batch_button.click()  # shows the running dialog again
+    assert d.isVisible() and w.open_batch_dialog() is d
+    d.hide()
+    with qtbot.waitSignal(d.batch_finished, timeout=30000):
+        d.cancel()
+    assert not w.batch_button.isVisible()
+    assert "cancelled" in w.statusBar().currentMessage()
+    d.wait(10000)

@@ -80,16 +80,14 @@ def test_step_states_come_from_the_state_and_the_summaries(fake_algs, project_di
     assert rows[0].states == {"epipolar_pair": "not run", "match_model": "not run"}
 
 
-def test_rerun_failed_keeps_only_the_failed_items():
-    config = {"batch": {"workers": 1}, "steps": [
-        {"algorithm": "epipolar_pair", "models": ["a", "b"]},
-        {"algorithm": "match_model", "models": ["a", "b"]},
-        {"algorithm": "dsm_merge", "params": {}},
-        {"algorithm": "georeference_polygons", "files": ["/x/s1.tif", "/x/s2.tif"]}]}
-    again = batch_setup.rerun_failed(config, ["b", "s2"])
-    assert [s.get("models") or s.get("files") for s in again["steps"]] == [
-        ["b"], ["b"], None, ["/x/s2.tif"]]
-    assert batch_setup.rerun_failed(config, ["zz"])["steps"] == [config["steps"][2]]
+def test_only_items_keeps_the_failed_items_and_the_steps_without_items(project_dir):
+    choices = BatchChoices(project_dir, ["a_b", "b_c", "c_d"],
+                           ["epipolar_pair", "match_model", "dsm_merge"])
+    plan = batch.load_batch(batch_setup.write_batch(choices))
+    kept = batch_setup.only_items(plan.tasks, ["b_c"])
+    assert [t.key for t in kept] == ["epipolar_pair/b_c", "match_model/b_c", "dsm_merge"]
+    assert [t.index for t in kept] == [0, 1, 2]
+    assert [t.key for t in batch_setup.only_items(plan.tasks, ["zz"])] == ["dsm_merge"]
 
 
 def test_time_helpers():
