@@ -41,8 +41,10 @@ class BatchTask(QgsTask):
         super().__init__(tr("PhotoDEM batch: {0}").format(worker.batch_file.name),
                          QgsTask.CanCancel)
         self.worker = worker
+        self.started_run = False
 
     def run(self) -> bool:
+        self.started_run = True
         self.worker.progress.connect(self.setProgress, Qt.DirectConnection)
         return self.worker.execute() is not None
 
@@ -51,7 +53,11 @@ class BatchTask(QgsTask):
         super().cancel()
 
     def finished(self, result: bool) -> None:
+        """In the main thread, after :meth:`run` (or instead of it: cancelled before it
+        began); ``result`` is not needed, the worker holds the summary."""
         _RUNNING.pop(id(self), None)
+        if not self.started_run:  # cancelled in the task manager before it began
+            self.worker.log.emit("warning", tr("The batch was cancelled before it started."))
         self.worker.done.emit()
 
     def wait(self, msecs: int = 60000) -> bool:

@@ -88,3 +88,53 @@ def test_batch_task_cancel_resume_products(qtbot, ws_iface, tiny_block, tmp_path
     by_cli = json.loads(Path(json.loads(cli.stdout)["summary"]).read_text())
     assert by_cli["status"] == "done" and _core(by_cli) == _core(final)
     menu.unregister()
+
+
+def test_task_manager_cancel_reaches_the_batch(qtbot, ws_iface, chain_project,
+                                               monkeypatch) -> None:
+    """The cancel button of QGIS's task manager (QgsTask.cancel) stops the batch."""
+    fakes = Path(__file__).resolve().parents[1] / "algorithms" / "processing"
+    monkeypatch.syspath_prepend(str(fakes))
+    import _fake_algs
+
+    from photodem.plugin.qgis import batch_actions
+
+    _fake_algs.install(monkeypatch)
+    root = chain_project("abc")
+    file = root / "slow.toml"
+    file.write_text('[batch]\nproject = "."\nworkers = 1\n[[steps]]\n'
+                    'algorithm = "fake_sleep_write"\n[steps.params]\nseconds = 3\nsteps = 60\n'
+                    'output = "{project}/products/{step}/{model}.json"\n')
+    d = batch_actions.open_batch_dialog(ws_iface, str(root))
+    qtbot.addWidget(d)
+    assert d.open_batch_file(str(file))
+    original = batch_actions.start_batch_task
+
+    def start(worker):
+        task = original(worker)
+        # the task manager's cancel button calls QgsTask.cancel: here once the first task runs
+        worker.task_progress.connect(lambda index, pct: task.cancel() if pct > 0 else None)
+        return task
+
+    d.start_worker = start
+    with qtbot.waitSignal(d.batch_finished, timeout=60000):
+        assert d.run()
+    assert d.summary["status"] == "cancelled"
+    assert [t["status"] for t in d.summary["tasks"]] == ["cancelled", "cancelled"]
+    assert not (root / "products").exists()  # the cancelled task left nothing behind
+
+    # cancelled right after it was queued: QGIS either skips run() (the dialog says so) or
+    # runs it with the cancel already set
+    def start_cancelled(worker):
+        task = original(worker)
+        task.cancel()
+        return task
+
+    d.start_worker = start_cancelled
+    with qtbot.waitSignal(d.batch_finished, timeout=60000):
+        assert d.resume()
+    assert not d.is_running()
+    if d.summary is None:
+        assert "cancelled before it started" in d.log_view.toPlainText()
+    else:
+        assert d.summary["counts"]["cancelled"] == 2
