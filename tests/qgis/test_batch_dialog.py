@@ -71,6 +71,11 @@ def test_batch_task_cancel_resume_products(qtbot, ws_iface, tiny_block, tmp_path
         assert d.resume()
         d.close()
         assert not d.isVisible() and d.is_running()
+    from qgis.core import QgsSettings
+
+    remembered = QgsSettings()  # what the dialog remembers, in QGIS's own settings
+    assert remembered.value("PhotoDEM/last_project") == str(root.resolve())
+    assert set(remembered.value("PhotoDEM/batch/steps")) == {"epipolar_pair", "match_model"}
     final = d.summary
     assert final["status"] == "done" and final["counts"] == {
         "done": 2, "skipped": 2, "failed": 0, "cancelled": 0}
