@@ -1000,7 +1000,9 @@ def run_batch(
         replaced by a new one (``…-2``), and the tasks' ``{run}`` values with it.
     feedback : Feedback, optional
         Receives the overall progress (share of tasks finished, including the running tasks'
-        own progress), one log line per task, and cancellation.
+        own progress), one log line per task, and cancellation. Optional per-task hooks of
+        the feedback are called in the batch's thread: ``task_progress(index, pct)`` (0 when a
+        task starts) and ``task_finished(index, record)`` (the batch dialog's rows).
     workers : int, optional
         Worker processes; default ``plan.workers``. ``1`` runs the tasks in this process.
     resume : bool
