@@ -347,6 +347,7 @@ class BatchDialog(QtWidgets.QDialog):
         bar.setRange(0, 1000)
         bar.setValue(0)
         bar.setFormat("%p %")
+        bar.setTextVisible(False)  # until the row is part of a run
         self.table.setCellWidget(row, COL_PROGRESS, bar)
         self.table.setItem(row, COL_STATE, QtWidgets.QTableWidgetItem(""))
         self._rows[name] = _Row(row)
@@ -532,6 +533,7 @@ class BatchDialog(QtWidgets.QDialog):
             names.append(name)
             self._set_state(row, "waiting")
             self._bar(row).setValue(0)
+            self._bar(row).setTextVisible(True)
         if check:
             self.set_checked_models(names)
 
