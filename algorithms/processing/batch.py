@@ -883,6 +883,7 @@ class _Pool:
                 worker.task = task
                 self.log(f"{task.key}: started on worker process {worker.process.pid}",
                          quiet=True)
+                self.progress.set(task.index, 0.0)  # started
                 _send(worker.conn, (task.index, task.algorithm, task.params, str(task.log)))
             busy = self._busy()
             mp_connection.wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
@@ -971,6 +972,15 @@ class _Progress:
         total = 100.0 * sum(self.fraction) / max(len(self.fraction), 1)
         with contextlib.suppress(Cancelled):  # the batch loop checks is_canceled() itself
             self.feedback.progress(total)
+        _notify(self.feedback, "task_progress", index, 100.0 * self.fraction[index])
+
+
+def _notify(feedback: Feedback, hook: str, *args: Any) -> None:
+    """Call an optional per-task hook of the feedback (``task_progress(index, pct)``: a task
+    started (0) or progressed; ``task_finished(index, record)``), e.g. for the batch dialog."""
+    method = getattr(feedback, hook, None)
+    if callable(method):
+        method(*args)
 
 
 def run_batch(
@@ -990,7 +1000,9 @@ def run_batch(
         replaced by a new one (``…-2``), and the tasks' ``{run}`` values with it.
     feedback : Feedback, optional
         Receives the overall progress (share of tasks finished, including the running tasks'
-        own progress), one log line per task, and cancellation.
+        own progress), one log line per task, and cancellation. Optional per-task hooks of
+        the feedback are called in the batch's thread: ``task_progress(index, pct)`` (0 when a
+        task starts) and ``task_finished(index, record)`` (the batch dialog's rows).
     workers : int, optional
         Worker processes; default ``plan.workers``. ``1`` runs the tasks in this process.
     resume : bool
@@ -1061,6 +1073,7 @@ def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: boo
             record["warnings"] = result["warnings"]
         if record["status"] != "cancelled":
             progress.set(task.index, 100.0)
+        _notify(feedback, "task_finished", task.index, dict(record))
         label = task.key
         if record["status"] == "done":
             state_all = read_state(plan.state_home)
@@ -1161,6 +1174,7 @@ def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
     for task in tasks:
         if feedback.is_canceled():
             return  # the records of the tasks not started say "cancelled"
+        progress.set(task.index, 0.0)  # started (per-task hooks show it as running)
         result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
                               lambda pct, i=task.index: progress.set(i, pct))
         finish(task, result)

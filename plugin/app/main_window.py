@@ -8,16 +8,18 @@ from __future__ import annotations
 
 import html
 from pathlib import Path
-from typing import Dict, Optional
+from typing import Any, Dict, Optional
 
 from ...algorithms.processing import registry
 from ...algorithms.processing.spec import Algorithm
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
-from ..widgets.parameter_form import ParameterForm
+from ..widgets.parameter_form import SETTINGS_PROJECT, ParameterForm
 from ..widgets.run_panel import RunPanel
 
 ALG_ROLE = QtCore.Qt.UserRole + 1
+#: Settings keys of the window's layout and the algorithm shown last.
+SETTINGS_WINDOW = "PhotoDEM/toolbox/"
 
 
 class ToolboxWindow(QtWidgets.QMainWindow):
@@ -27,14 +29,22 @@ class ToolboxWindow(QtWidgets.QMainWindow):
     ----------
     message_boxes : bool
         Show operator errors in a message box as well as in the log (tests switch it off).
+    settings : QSettings, optional
+        Where the window remembers its layout, the last algorithm, project and input of each
+        parameter; default ``QSettings()`` once the application has a name (``photodem gui``),
+        else nothing is remembered.
     """
 
     algorithm_selected = pyqtSignal(str)
 
     def __init__(self, parent: Optional[QtWidgets.QWidget] = None,
-                 message_boxes: bool = True) -> None:
+                 message_boxes: bool = True, settings: Any = None) -> None:
         super().__init__(parent)
         self.message_boxes = message_boxes
+        if settings is None and QtCore.QCoreApplication.organizationName():
+            settings = QtCore.QSettings()
+        self.settings = settings
+        self.batch_dialog: Optional[Any] = None  # the batch dialog (kept while it runs)
         self.setWindowTitle(tr("PhotoDEM toolbox"))
         self.resize(1200, 720)
         self.form: Optional[ParameterForm] = None
@@ -89,6 +99,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         right.setStretchFactor(0, 3)
         right.setStretchFactor(1, 2)
         right.setSizes([470, 230])
+        self.right_splitter = right
 
         splitter = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
         splitter.addWidget(left)
@@ -96,6 +107,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         splitter.setStretchFactor(0, 1)
         splitter.setStretchFactor(1, 3)
         splitter.setSizes([360, 840])
+        self.splitter = splitter
         self.setCentralWidget(splitter)
 
         self._build_menu()
@@ -106,6 +118,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.filter_edit.textChanged.connect(self._apply_filter)
         self.run_panel.run_requested.connect(self.run_current)
         self.run_panel.run_finished.connect(self._on_run_finished)
+        self._restore_layout()
 
     # -- building --------------------------------------------------------------------------------
     def _build_menu(self) -> None:
@@ -118,6 +131,10 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.review_action.setToolTip(tr("Check and edit the control points of a "
                                          "georeferencing result"))
         self.review_action.triggered.connect(lambda _checked=False: self.open_georef_review())
+        # the batch dialog over stereo models (issue 20)
+        self.batch_action = tools_menu.addAction(tr("Batch over stereo models…"))
+        self.batch_action.setToolTip(tr("Run steps over many stereo models, resumable"))
+        self.batch_action.triggered.connect(lambda _checked=False: self.open_batch_dialog())
         help_menu = self.menuBar().addMenu(tr("&Help"))
         about = help_menu.addAction(tr("&About PhotoDEM"))
         about.triggered.connect(self._about)
@@ -167,12 +184,22 @@ class ToolboxWindow(QtWidgets.QMainWindow):
     def select_algorithm(self, algorithm_id: str) -> ParameterForm:
         """Show the form of ``algorithm_id`` (also selects it in the tree)."""
         alg = registry.get(algorithm_id)
+        previous = self.form
+        if previous is not None:
+            previous.remember(self.settings)
         self.algorithm = alg
         self.title.setText(tr(alg.name))
         help_text = html.escape(tr(alg.help)) if alg.help else ""
         self.help_label.setText(
             f"{help_text}<br><span style='color:gray'>photodem run {alg.id}</span>")
         self.form = ParameterForm(alg)
+        self.form.restore(self.settings)  # the input of its last run
+        if previous is not None:
+            self.form.carry_over(previous)  # the project and input in view stay
+        if self.form._project_params and not self.form.project() and self.settings is not None:
+            last = self.settings.value(SETTINGS_PROJECT, "")
+            if last:
+                self.form.set_values({self.form._project_params[0]: last})
         container = QtWidgets.QWidget()
         layout = QtWidgets.QVBoxLayout(container)
         layout.addWidget(self.form)
@@ -203,6 +230,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.form.setEnabled(False)
         self.tree.setEnabled(False)
         self.statusBar().showMessage(tr("Running {0} …").format(self.algorithm.id))
+        self.form.remember(self.settings)
         self.run_panel.start(self.algorithm.id, self.form.values())
 
     def _on_run_finished(self, status: str, payload: object) -> None:
@@ -234,10 +262,84 @@ class ToolboxWindow(QtWidgets.QMainWindow):
 
         return open_review(self, folder, self.last_georef, self.message_boxes, report)
 
+    def open_batch_dialog(self, project: Optional[str] = None) -> QtWidgets.QDialog:
+        """Show the batch dialog (the one running in the background, or a new one on the
+        form's project)."""
+        # lazy: the batch dialog is opened on demand
+        from ..widgets.batch_dialog import BatchDialog
+
+        dialog = self.batch_dialog
+        if dialog is None or not dialog.is_running():
+            if dialog is not None:
+                dialog.deleteLater()
+            if project is None and self.form is not None:
+                project = self.form.project() or None
+            dialog = BatchDialog(project, self, settings=self.settings)
+            dialog.backgrounded.connect(self._batch_in_background)
+            dialog.batch_finished.connect(self._batch_finished)
+            self.batch_dialog = dialog
+        dialog.show()
+        dialog.raise_()
+        return dialog
+
+    def _batch_in_background(self) -> None:
+        """The batch dialog was closed while its batch runs: a button in the status bar
+        shows it again."""
+        if getattr(self, "batch_button", None) is None:
+            self.batch_button = QtWidgets.QPushButton(tr("Batch running – show"), self)
+            self.batch_button.setFlat(True)
+            self.batch_button.clicked.connect(lambda _c=False: self.open_batch_dialog())
+            self.statusBar().addPermanentWidget(self.batch_button)
+        self.batch_button.show()
+
+    def _batch_finished(self, summary: object) -> None:
+        button = getattr(self, "batch_button", None)
+        if button is not None:
+            button.hide()
+        if isinstance(summary, dict):
+            self.statusBar().showMessage(tr("Batch {0}: summary in {1}").format(
+                summary.get("status"), summary.get("summary")))
+
+    # -- remembering -----------------------------------------------------------------------------
+    def _restore_layout(self) -> None:
+        """The window's geometry, splitters and last algorithm from the settings."""
+        s = self.settings
+        if s is None:
+            return
+        for key, restore in ((SETTINGS_WINDOW + "geometry", self.restoreGeometry),
+                             (SETTINGS_WINDOW + "state", self.restoreState),
+                             (SETTINGS_WINDOW + "splitter", self.splitter.restoreState),
+                             (SETTINGS_WINDOW + "right", self.right_splitter.restoreState)):
+            value = s.value(key, None)
+            if isinstance(value, QtCore.QByteArray):
+                restore(value)
+        last = s.value(SETTINGS_WINDOW + "algorithm", "")
+        if last and last in registry.algorithms():
+            self.select_algorithm(str(last))
+
+    def save_layout(self) -> None:
+        """Remember the layout, the algorithm shown and its input."""
+        s = self.settings
+        if s is None:
+            return
+        s.setValue(SETTINGS_WINDOW + "geometry", self.saveGeometry())
+        s.setValue(SETTINGS_WINDOW + "state", self.saveState())
+        s.setValue(SETTINGS_WINDOW + "splitter", self.splitter.saveState())
+        s.setValue(SETTINGS_WINDOW + "right", self.right_splitter.saveState())
+        if self.algorithm is not None:
+            s.setValue(SETTINGS_WINDOW + "algorithm", self.algorithm.id)
+        if self.form is not None:
+            self.form.remember(s)
+        s.sync()
+
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
+        self.save_layout()
         if self.run_panel.is_running():
             self.run_panel.cancel()
             self.run_panel.wait(30000)
+        if self.batch_dialog is not None and self.batch_dialog.is_running():
+            self.batch_dialog.cancel()
+            self.batch_dialog.wait(30000)
         super().closeEvent(event)
 
     def _about(self) -> None:

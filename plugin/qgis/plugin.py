@@ -115,6 +115,11 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
+        # lazy: the batch dialog (Qt widgets, QgsTask) exists only in the desktop application
+        from .batch_actions import BatchMenu
+
+        self.batch_menu = BatchMenu(self.iface, MENU_TITLE, icon)  # Batch over stereo models…
+        self.batch_menu.register()
 
     def _init_workspace(self) -> None:
         """The project workspace: Open project… and recent projects, the editing toolbar
@@ -177,6 +182,9 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if getattr(self, "batch_menu", None) is not None:  # cancels a batch still running
+            self.batch_menu.unregister()
+            self.batch_menu = None
         if self.editing_toolbar is not None:
             self.editing_toolbar.unload()
             self.editing_toolbar = None

@@ -23,6 +23,7 @@ spec's defaults and "required" checks apply exactly as in the CLI and QGIS.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
@@ -31,6 +32,10 @@ from ...algorithms.project.model import Project
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
+#: Settings keys (``QSettings`` standalone, ``QgsSettings`` in QGIS): the last raw values of
+#: each algorithm (JSON) and the last project.
+SETTINGS_PARAMS = "PhotoDEM/params/"
+SETTINGS_PROJECT = "PhotoDEM/last_project"
 _INT_LIMIT = 2**31 - 1
 _FLOAT_LIMIT = 1e12
 
@@ -337,6 +342,53 @@ class ParameterForm(QtWidgets.QWidget):
             if name in self._editors:
                 self._editors[name].put(value)
         self.update_from_project()
+
+    # -- remembering -----------------------------------------------------------------------------
+    def remember(self, settings: Any) -> None:
+        """Store the current raw values under ``PhotoDEM/params/<algorithm>`` (JSON) in a
+        ``QSettings``-like object, and the project as the last project."""
+        if settings is None:
+            return
+        values = self.values()
+        settings.setValue(SETTINGS_PARAMS + self.algorithm.id, json.dumps(values, default=str))
+        project = self.project()
+        if project:
+            settings.setValue(SETTINGS_PROJECT, project)
+
+    def restore(self, settings: Any) -> bool:
+        """Fill the editors with the values remembered for this algorithm (if any)."""
+        if settings is None:
+            return False
+        text = settings.value(SETTINGS_PARAMS + self.algorithm.id, "")
+        try:
+            values = json.loads(text) if text else None
+        except (TypeError, ValueError):  # a damaged setting: start from the defaults
+            values = None
+        if not isinstance(values, dict):
+            return False
+        self.set_values(values)
+        return True
+
+    def carry_over(self, other: ParameterForm) -> None:
+        """Take the inputs of another algorithm's form that this one has too (same name and
+        kind; the project, models, images and input files, not outputs or options):
+        switching algorithms keeps the project and the input."""
+        mine = {p.name: p for p in self.algorithm.parameters}
+        values = other.values()
+        keep = {}
+        for p in other.algorithm.parameters:
+            twin = mine.get(p.name)
+            if twin is not None and twin.kind == p.kind and (p.is_path or p.is_item_name) \
+                    and not p.is_output and p.name in values:
+                keep[p.name] = values[p.name]
+        if keep:
+            self.set_values(keep)
+
+    def project(self) -> Optional[str]:
+        """The project folder of the form ('' / None when it has none)."""
+        if not self._project_params:
+            return None
+        return self._editors[self._project_params[0]].get()
 
     # -- project-driven combos ------------------------------------------------------------------
     def update_from_project(self) -> None:

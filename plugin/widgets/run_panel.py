@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import html
 import json
-from typing import Any, Dict, Optional
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Optional
 
 from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 from .worker import AlgorithmWorker, start_in_thread
 
+#: Item data role of a result row that names an existing file or folder.
+PATH_ROLE = QtCore.Qt.UserRole + 7
 _LEVEL_COLOURS = {"info": None, "warning": "#b35c00", "error": "#c0392b", "ok": "#1e7d32"}
 
 
@@ -55,14 +58,34 @@ class RunPanel(QtWidgets.QWidget):
         font = QtGui.QFontDatabase.systemFont(QtGui.QFontDatabase.FixedFont)
         self.log_view.setFont(font)
         self.result_view = QtWidgets.QTreeWidget(self)
-        self.result_view.setColumnCount(2)
-        self.result_view.setHeaderLabels([tr("Output"), tr("Value")])
+        self.result_view.setColumnCount(3)
+        self.result_view.setHeaderLabels([tr("Output"), tr("Value"), ""])
         self.result_view.setRootIsDecorated(True)
         self.result_view.setAlternatingRowColors(True)
+        header = self.result_view.header()
+        header.setStretchLastSection(False)
+        header.setSectionResizeMode(1, QtWidgets.QHeaderView.Stretch)
+        header.setSectionResizeMode(2, QtWidgets.QHeaderView.ResizeToContents)
+        self.result_view.itemDoubleClicked.connect(
+            lambda item, _col: self.open_path(item.data(1, PATH_ROLE) or ""))
+        #: Opens a file or folder URL with the system's application; tests replace it.
+        self.open_url: Callable[[QtCore.QUrl], Any] = QtGui.QDesktopServices.openUrl
+        self.report_button = QtWidgets.QPushButton(tr("Open report"), self)
+        self.report_button.setEnabled(False)
+        self.report_button.clicked.connect(lambda _c=False: self.open_report())
+        result_page = QtWidgets.QWidget(self)
+        result_layout = QtWidgets.QVBoxLayout(result_page)
+        result_layout.setContentsMargins(0, 0, 0, 0)
+        result_layout.addWidget(self.result_view, 1)
+        report_line = QtWidgets.QHBoxLayout()
+        report_line.addStretch(1)
+        report_line.addWidget(self.report_button)
+        result_layout.addLayout(report_line)
+        self.result_page = result_page
 
         self.tabs = QtWidgets.QTabWidget(self)
         self.tabs.addTab(self.log_view, tr("Log"))
-        self.tabs.addTab(self.result_view, tr("Result"))
+        self.tabs.addTab(result_page, tr("Result"))
 
         buttons = QtWidgets.QHBoxLayout()
         buttons.addWidget(self.progress_bar, 1)
@@ -173,13 +196,75 @@ class RunPanel(QtWidgets.QWidget):
         self.run_finished.emit(self._status, self._payload)
 
     def show_result(self, result: Dict[str, Any]) -> None:
-        """Show an output dict as a tree (nested dicts and lists expand)."""
+        """Show an output dict as a tree (nested dicts and lists expand); every output that is
+        an existing file or folder gets *Open* and *Show in folder*."""
         self.result_view.clear()
         for key, value in result.items():
             self.result_view.addTopLevelItem(_tree_item(str(key), value))
         self.result_view.expandToDepth(0)
+        for i in range(self.result_view.topLevelItemCount()):
+            item = self.result_view.topLevelItem(i)
+            item.setExpanded(item.childCount() <= 6)  # long tables stay folded: files in view
+        iterator = QtWidgets.QTreeWidgetItemIterator(self.result_view)
+        while iterator.value():
+            item = iterator.value()
+            path = item.data(1, PATH_ROLE)
+            if path:
+                self.result_view.setItemWidget(item, 2, self._path_buttons(path))
+            iterator += 1
         self.result_view.resizeColumnToContents(0)
-        self.tabs.setCurrentWidget(self.result_view)
+        self.report_button.setEnabled(self.report_path() is not None)
+        self.tabs.setCurrentWidget(self.result_page)
+
+    def _path_buttons(self, path: str) -> QtWidgets.QWidget:
+        box = QtWidgets.QWidget(self.result_view)
+        layout = QtWidgets.QHBoxLayout(box)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(2)
+        for text, folder in ((tr("Open"), False), (tr("Show in folder"), True)):
+            button = QtWidgets.QToolButton(box)
+            button.setText(text)
+            button.setAutoRaise(True)
+            button.clicked.connect(lambda _c=False, f=folder: self.open_path(path, f))
+            layout.addWidget(button)
+        layout.addStretch(1)
+        return box
+
+    # -- opening outputs -------------------------------------------------------------------------
+    def output_paths(self) -> List[str]:
+        """The outputs of the last result that are existing files or folders, in order."""
+        paths = []
+        iterator = QtWidgets.QTreeWidgetItemIterator(self.result_view)
+        while iterator.value():
+            path = iterator.value().data(1, PATH_ROLE)
+            if path:
+                paths.append(str(path))
+            iterator += 1
+        return paths
+
+    def report_path(self) -> Optional[str]:
+        """The run's report: an HTML output, else an output named ``report``."""
+        result = self._payload if isinstance(self._payload, dict) else {}
+        candidates = [v for k, v in result.items() if k in ("report_html", "report")]
+        candidates += [p for p in self.output_paths() if p.endswith((".html", ".htm"))]
+        for value in sorted(candidates, key=lambda v: not str(v).endswith((".html", ".htm"))):
+            if isinstance(value, str) and Path(value).is_file():
+                return value
+        return None
+
+    def open_path(self, path: str, folder: bool = False) -> bool:
+        """Open an output (or the folder that holds it) with the system's application."""
+        if not path:
+            return False
+        target = Path(path)
+        if folder and target.is_file():
+            target = target.parent
+        return bool(self.open_url(QtCore.QUrl.fromLocalFile(str(target))))
+
+    def open_report(self) -> bool:
+        """Open the run's report, if it has one."""
+        report = self.report_path()
+        return self.open_path(report) if report else False
 
 
 def _tree_item(key: str, value: Any) -> QtWidgets.QTreeWidgetItem:
@@ -195,4 +280,15 @@ def _tree_item(key: str, value: Any) -> QtWidgets.QTreeWidgetItem:
         text = json.dumps(value, ensure_ascii=False) if isinstance(value, list) else str(value)
         item = QtWidgets.QTreeWidgetItem([key, text])
         item.setToolTip(1, text)
+        if isinstance(value, str) and len(value) > 1 and _is_path(value):
+            item.setData(1, PATH_ROLE, value)
     return item
+
+
+def _is_path(text: str) -> bool:
+    """An absolute path that exists (an output file or folder)."""
+    try:
+        path = Path(text)
+        return path.is_absolute() and path.exists()
+    except (OSError, ValueError):
+        return False

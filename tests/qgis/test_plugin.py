@@ -131,6 +131,7 @@ def test_desktop_init_gui_and_unload(qgis_app, plugin):
         names = {c[2] for c in added}
         assert {f"photodem_{i}" for i in core_registry.algorithms()} <= names
         assert "photodemGeorefReview" in names
+        assert "photodemBatchDialog" in names  # Batch over stereo models…
         assert ("addToolBarIcon", "photodemShowToolbox") in iface.calls
         assert ("addToolBar", "photodemEditingToolbar") in iface.calls
         assert all(c[1] == "&PhotoDEM" for c in added)
