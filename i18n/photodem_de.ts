@@ -10,7 +10,7 @@
         </message>
         <message>
             <source>Project</source>
-            <extracomment>project_create: group; project_info: group; stereo_models: group</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:131; project_create: group; project_info: group; stereo_models: group</extracomment>
             <translation>Projekt</translation>
         </message>
         <message>
@@ -140,7 +140,7 @@
         </message>
         <message>
             <source>Stereo models</source>
-            <extracomment>plugin/qgis/workspace.py:253; project_info output models; stereo_models output models; stereo_models: name</extracomment>
+            <extracomment>plugin/qgis/workspace.py:254; project_info output models; stereo_models output models; stereo_models: name</extracomment>
             <translation>Stereomodelle</translation>
         </message>
         <message>
@@ -365,7 +365,7 @@
         </message>
         <message>
             <source>Epipolar pair</source>
-            <extracomment>epipolar_pair: name; plugin/qgis/model_actions.py:123</extracomment>
+            <extracomment>epipolar_pair: name; plugin/qgis/model_actions.py:123; plugin/widgets/batch_dialog.py:137; plugin/widgets/batch_dialog.py:160</extracomment>
             <translation>Epipolarbildpaar</translation>
         </message>
         <message>
@@ -735,7 +735,7 @@
         </message>
         <message>
             <source>Matching</source>
-            <extracomment>match_model: group; stereo_disparity: group</extracomment>
+            <extracomment>match_model: group; plugin/widgets/batch_dialog.py:138; plugin/widgets/batch_dialog.py:160; stereo_disparity: group</extracomment>
             <translation>Bildzuordnung</translation>
         </message>
         <message>
@@ -1075,7 +1075,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:425</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:426</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1115,7 +1115,7 @@
         </message>
         <message>
             <source>Merge DSMs</source>
-            <extracomment>dsm_merge: name</extracomment>
+            <extracomment>dsm_merge: name; plugin/widgets/batch_dialog.py:161</extracomment>
             <translation>DOMs zusammenführen</translation>
         </message>
         <message>
@@ -1560,7 +1560,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:425</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:426</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -1750,7 +1750,7 @@
         </message>
         <message>
             <source>Orthophotos</source>
-            <extracomment>mosaic: group; ortho_displacement: group; orthorectify: group</extracomment>
+            <extracomment>mosaic: group; ortho_displacement: group; orthorectify: group; plugin/widgets/batch_dialog.py:163</extracomment>
             <translation>Orthofotos</translation>
         </message>
         <message>
@@ -2080,7 +2080,7 @@
         </message>
         <message>
             <source>Seamlines</source>
-            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:409; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:410; plugin/qgis/workspace.py:427</extracomment>
             <translation>Schnittlinien</translation>
         </message>
         <message>
@@ -2160,7 +2160,7 @@
         </message>
         <message>
             <source>Mosaic</source>
-            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:427</extracomment>
             <translation>Mosaik</translation>
         </message>
         <message>
@@ -2380,98 +2380,118 @@
         </message>
         <message>
             <source>PhotoDEM toolbox</source>
-            <extracomment>plugin/app/main_window.py:38</extracomment>
+            <extracomment>plugin/app/main_window.py:48</extracomment>
             <translation>PhotoDEM-Werkzeugkasten</translation>
         </message>
         <message>
             <source>Search algorithms …</source>
-            <extracomment>plugin/app/main_window.py:46</extracomment>
+            <extracomment>plugin/app/main_window.py:56</extracomment>
             <translation>Algorithmen suchen …</translation>
         </message>
         <message>
             <source>Choose an algorithm on the left.</source>
-            <extracomment>plugin/app/main_window.py:102</extracomment>
+            <extracomment>plugin/app/main_window.py:114</extracomment>
             <translation>Links einen Algorithmus wählen.</translation>
         </message>
         <message>
             <source>&amp;File</source>
-            <extracomment>plugin/app/main_window.py:112</extracomment>
+            <extracomment>plugin/app/main_window.py:125</extracomment>
             <translation>&amp;Datei</translation>
         </message>
         <message>
             <source>&amp;Quit</source>
-            <extracomment>plugin/app/main_window.py:113</extracomment>
+            <extracomment>plugin/app/main_window.py:126</extracomment>
             <translation>&amp;Beenden</translation>
         </message>
         <message>
             <source>&amp;Tools</source>
-            <extracomment>plugin/app/main_window.py:116</extracomment>
+            <extracomment>plugin/app/main_window.py:129</extracomment>
             <translation>&amp;Werkzeuge</translation>
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:117; plugin/qgis/plugin.py:112</extracomment>
+            <extracomment>plugin/app/main_window.py:130; plugin/qgis/plugin.py:112</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:118; plugin/qgis/plugin.py:114</extracomment>
+            <extracomment>plugin/app/main_window.py:131; plugin/qgis/plugin.py:114</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
+            <source>Batch over stereo models…</source>
+            <extracomment>plugin/app/main_window.py:135; plugin/qgis/batch_actions.py:127</extracomment>
+            <translation>Batch über Stereomodelle…</translation>
+        </message>
+        <message>
+            <source>Run steps over many stereo models, resumable</source>
+            <extracomment>plugin/app/main_window.py:136; plugin/qgis/batch_actions.py:129</extracomment>
+            <translation>Schritte über viele Stereomodelle ausführen, fortsetzbar</translation>
+        </message>
+        <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:121</extracomment>
+            <extracomment>plugin/app/main_window.py:138</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:122</extracomment>
+            <extracomment>plugin/app/main_window.py:139</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:212</extracomment>
+            <extracomment>plugin/app/main_window.py:240</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:212</extracomment>
+            <extracomment>plugin/app/main_window.py:240</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:213; plugin/qgis/background.py:173</extracomment>
+            <extracomment>plugin/app/main_window.py:241; plugin/qgis/background.py:173</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:245</extracomment>
+            <extracomment>plugin/app/main_window.py:347</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:246</extracomment>
+            <extracomment>plugin/app/main_window.py:348</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:132</extracomment>
+            <extracomment>plugin/app/main_window.py:149</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:217; plugin/app/main_window.py:232; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/app/main_window.py:245; plugin/app/main_window.py:260; plugin/widgets/batch_dialog.py:726; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
+            <source>Batch running – show</source>
+            <extracomment>plugin/app/main_window.py:289</extracomment>
+            <translation>Batch läuft – anzeigen</translation>
+        </message>
+        <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:205; plugin/widgets/run_panel.py:101</extracomment>
+            <extracomment>plugin/app/main_window.py:232; plugin/widgets/run_panel.py:124</extracomment>
             <translation>{0} läuft …</translation>
         </message>
         <message>
             <source>Tools → Review georeferencing checks and edits its control points.</source>
-            <extracomment>plugin/app/main_window.py:221</extracomment>
+            <extracomment>plugin/app/main_window.py:249</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
+        </message>
+        <message>
+            <source>Batch {0}: summary in {1}</source>
+            <extracomment>plugin/app/main_window.py:300</extracomment>
+            <translation>Batch {0}: Zusammenfassung in {1}</translation>
         </message>
         <message>
             <source>PhotoDEM {1}: {0}</source>
@@ -2487,6 +2507,21 @@
             <source>{0} failed; see the log messages.</source>
             <extracomment>plugin/qgis/background.py:175</extracomment>
             <translation>{0} ist fehlgeschlagen; siehe Protokollmeldungen.</translation>
+        </message>
+        <message>
+            <source>The batch was cancelled before it started.</source>
+            <extracomment>plugin/qgis/batch_actions.py:60</extracomment>
+            <translation>Der Batch wurde abgebrochen, bevor er begann.</translation>
+        </message>
+        <message>
+            <source>Batch {0}: {1}; summary in {2}</source>
+            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:617</extracomment>
+            <translation>Batch {0}: {1}; Zusammenfassung in {2}</translation>
+        </message>
+        <message>
+            <source>PhotoDEM batch: {0}</source>
+            <extracomment>plugin/qgis/batch_actions.py:41</extracomment>
+            <translation>PhotoDEM-Batch: {0}</translation>
         </message>
         <message>
             <source>keep (surface stays as measured)</source>
@@ -2525,7 +2560,7 @@
         </message>
         <message>
             <source>Exclusion area</source>
-            <extracomment>plugin/qgis/edit_forms.py:106; plugin/qgis/edit_maptools.py:324; plugin/qgis/editing_toolbar.py:41</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:106; plugin/qgis/edit_maptools.py:312; plugin/qgis/editing_toolbar.py:41</extracomment>
             <translation>Ausschlussfläche</translation>
         </message>
         <message>
@@ -2540,7 +2575,7 @@
         </message>
         <message>
             <source>Note</source>
-            <extracomment>plugin/qgis/edit_forms.py:115; plugin/qgis/edit_forms.py:94; plugin/qgis/edit_maptools.py:292</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:115; plugin/qgis/edit_forms.py:94; plugin/qgis/edit_maptools.py:280</extracomment>
             <translation>Notiz</translation>
         </message>
         <message>
@@ -2550,7 +2585,7 @@
         </message>
         <message>
             <source>Kind</source>
-            <extracomment>plugin/qgis/edit_forms.py:128</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:128; plugin/widgets/batch_dialog.py:137</extracomment>
             <translation>Art</translation>
         </message>
         <message>
@@ -2569,148 +2604,148 @@
             <translation>Stützpunkt {0}</translation>
         </message>
         <message>
+            <source>The edits file {0} is locked or unreadable ({1}); close the program that holds it and try again.</source>
+            <extracomment>plugin/qgis/edit_maptools.py:76</extracomment>
+            <translation>Die Bearbeitungsdatei {0} ist gesperrt oder nicht lesbar ({1}); schließen Sie das Programm, das sie geöffnet hält, und versuchen Sie es erneut.</translation>
+        </message>
+        <message>
             <source>Start point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:290; plugin/qgis/editing_toolbar.py:41</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:278; plugin/qgis/editing_toolbar.py:41</extracomment>
             <translation>Startpunkt</translation>
         </message>
         <message>
             <source>Ground point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:290; plugin/qgis/editing_toolbar.py:49</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:278; plugin/qgis/editing_toolbar.py:49</extracomment>
             <translation>Bodenpunkt</translation>
         </message>
         <message>
             <source>Check point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:291; plugin/qgis/editing_toolbar.py:50</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:279; plugin/qgis/editing_toolbar.py:50</extracomment>
             <translation>Kontrollpunkt</translation>
         </message>
         <message>
             <source>Id</source>
-            <extracomment>plugin/qgis/edit_maptools.py:292</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:280</extracomment>
             <translation>Kennung</translation>
         </message>
         <message>
             <source>Breakline</source>
-            <extracomment>plugin/qgis/edit_maptools.py:368; plugin/qgis/editing_toolbar.py:49</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:356; plugin/qgis/editing_toolbar.py:49</extracomment>
             <translation>Bruchkante</translation>
         </message>
         <message>
             <source>Type the heights of the two ends; the others are interpolated.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:394</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:382</extracomment>
             <translation>Geben Sie die Höhen der beiden Enden ein; die übrigen werden interpoliert.</translation>
         </message>
         <message>
             <source>Re-drape</source>
-            <extracomment>plugin/qgis/edit_maptools.py:459; plugin/qgis/editing_toolbar.py:145</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:447; plugin/qgis/editing_toolbar.py:145</extracomment>
             <translation>Neu abgreifen</translation>
         </message>
         <message>
             <source>The edits file {0} does not exist.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:75</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:73</extracomment>
             <translation>Die Bearbeitungsdatei {0} existiert nicht.</translation>
         </message>
         <message>
             <source>The edits file {0} is read-only; make it writable to edit.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:78</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:75</extracomment>
             <translation>Die Bearbeitungsdatei {0} ist schreibgeschützt; machen Sie sie beschreibbar, um zu bearbeiten.</translation>
         </message>
         <message>
             <source>Open a PhotoDEM project first (PhotoDEM → Open project…).</source>
-            <extracomment>plugin/qgis/edit_maptools.py:161; plugin/qgis/editing_toolbar.py:229</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:149; plugin/qgis/editing_toolbar.py:229</extracomment>
             <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt (PhotoDEM → Projekt öffnen…).</translation>
         </message>
         <message>
             <source>No surface chosen; type the height.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:229</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:217</extracomment>
             <translation>Keine Oberfläche gewählt; geben Sie die Höhe ein.</translation>
         </message>
         <message>
             <source>The point lies outside every stereo model; no model will use it.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:285</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:273</extracomment>
             <translation>Der Punkt liegt außerhalb aller Stereomodelle; kein Modell wird ihn verwenden.</translation>
         </message>
         <message>
             <source>Boundary</source>
-            <extracomment>plugin/qgis/edit_maptools.py:326; plugin/qgis/edit_maptools.py:329; plugin/qgis/editing_toolbar.py:43</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:314; plugin/qgis/edit_maptools.py:317; plugin/qgis/editing_toolbar.py:43</extracomment>
             <translation>Begrenzung</translation>
         </message>
         <message>
             <source>Name</source>
-            <extracomment>plugin/qgis/edit_maptools.py:326</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:314</extracomment>
             <translation>Name</translation>
         </message>
         <message>
             <source>Seamline</source>
-            <extracomment>plugin/qgis/edit_maptools.py:351; plugin/qgis/editing_toolbar.py:44</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:339; plugin/qgis/editing_toolbar.py:44</extracomment>
             <translation>Schnittlinie</translation>
         </message>
         <message>
             <source>Every vertex of a breakline needs a height.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:410</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:398</extracomment>
             <translation>Jeder Stützpunkt einer Bruchkante braucht eine Höhe.</translation>
         </message>
         <message>
             <source>Select breaklines or points in an edit layer of the project (breaklines, start, ground or check points) to re-drape them.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:446</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:434</extracomment>
             <translation>Wählen Sie Bruchkanten oder Punkte in einem Bearbeitungslayer des Projekts (Bruchkanten, Start-, Boden- oder Kontrollpunkte), um ihre Höhen neu abzugreifen.</translation>
         </message>
         <message>
-            <source>The edits file {0} is locked or unreadable ({1}); close the program that holds it and try again.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:87</extracomment>
-            <translation>Die Bearbeitungsdatei {0} ist gesperrt oder nicht lesbar ({1}); schließen Sie das Programm, das sie geöffnet hält, und versuchen Sie es erneut.</translation>
-        </message>
-        <message>
             <source>Choose a surface (DSM or DTM) in the editing toolbar.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:212</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:200</extracomment>
             <translation>Wählen Sie in der Bearbeitungswerkzeugleiste eine Oberfläche (DOM oder DGM).</translation>
         </message>
         <message>
             <source>{0} features re-draped on the surface.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:467</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:455</extracomment>
             <translation>Höhen von {0} Objekten auf der Oberfläche neu abgegriffen.</translation>
         </message>
         <message>
             <source>The layer '{0}' of edits.gpkg is not loaded or missing; add it to the project's edits first.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:165</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:153</extracomment>
             <translation>Der Layer '{0}' von edits.gpkg ist nicht geladen oder fehlt; fügen Sie ihn zuerst den Bearbeitungen des Projekts hinzu.</translation>
         </message>
         <message>
             <source>The surface '{0}' has no CRS; assign it its CRS (Layer Properties → Source) first.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:215</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:203</extracomment>
             <translation>Die Oberfläche '{0}' hat kein KBS; weisen Sie ihr zuerst ihr KBS zu (Layereigenschaften → Quelle).</translation>
         </message>
         <message>
             <source>The surface '{0}' is not a file ({1}).</source>
-            <extracomment>plugin/qgis/edit_maptools.py:220</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:208</extracomment>
             <translation>Die Oberfläche '{0}' ist keine Datei ({1}).</translation>
         </message>
         <message>
             <source>QGIS refused the new feature of '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:266</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:254</extracomment>
             <translation>QGIS hat das neue Objekt von '{0}' abgelehnt.</translation>
         </message>
         <message>
             <source>Breakline refused, nothing written: {0}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:356</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:344</extracomment>
             <translation>Bruchkante abgelehnt, nichts geschrieben: {0}</translation>
         </message>
         <message>
             <source>Nothing selected in '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:451</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:439</extracomment>
             <translation>Nichts ausgewählt in '{0}'.</translation>
         </message>
         <message>
             <source>QGIS cannot edit the layer '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:174</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:162</extracomment>
             <translation>QGIS kann den Layer '{0}' nicht bearbeiten.</translation>
         </message>
         <message>
             <source>Polygon refused, nothing written: {0}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:315</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:303</extracomment>
             <translation>Polygon abgelehnt, nichts geschrieben: {0}</translation>
         </message>
         <message>
             <source>Feature {0}: {1}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:491</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:479</extracomment>
             <translation>Objekt {0}: {1}</translation>
         </message>
         <message>
@@ -2855,7 +2890,7 @@
         </message>
         <message>
             <source>The project cannot be read: {0}</source>
-            <extracomment>plugin/qgis/model_widget.py:68</extracomment>
+            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:320</extracomment>
             <translation>Das Projekt ist nicht lesbar: {0}</translation>
         </message>
         <message>
@@ -3005,47 +3040,47 @@
         </message>
         <message>
             <source>Start points</source>
-            <extracomment>plugin/qgis/workspace.py:407</extracomment>
+            <extracomment>plugin/qgis/workspace.py:408</extracomment>
             <translation>Startpunkte</translation>
         </message>
         <message>
             <source>Exclusion areas</source>
-            <extracomment>plugin/qgis/workspace.py:407</extracomment>
+            <extracomment>plugin/qgis/workspace.py:408</extracomment>
             <translation>Ausschlussflächen</translation>
         </message>
         <message>
             <source>Boundaries</source>
-            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <extracomment>plugin/qgis/workspace.py:409</extracomment>
             <translation>Begrenzungen</translation>
         </message>
         <message>
             <source>Breaklines</source>
-            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <extracomment>plugin/qgis/workspace.py:409</extracomment>
             <translation>Bruchkanten</translation>
         </message>
         <message>
             <source>Ground points</source>
-            <extracomment>plugin/qgis/workspace.py:409</extracomment>
+            <extracomment>plugin/qgis/workspace.py:410</extracomment>
             <translation>Bodenpunkte</translation>
         </message>
         <message>
             <source>Check points</source>
-            <extracomment>plugin/qgis/workspace.py:410</extracomment>
+            <extracomment>plugin/qgis/workspace.py:411</extracomment>
             <translation>Kontrollpunkte</translation>
         </message>
         <message>
             <source>Difference</source>
-            <extracomment>plugin/qgis/workspace.py:425</extracomment>
+            <extracomment>plugin/qgis/workspace.py:426</extracomment>
             <translation>Differenz</translation>
         </message>
         <message>
             <source>Ortho</source>
-            <extracomment>plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>plugin/qgis/workspace.py:427</extracomment>
             <translation>Ortho</translation>
         </message>
         <message>
             <source>Image footprints</source>
-            <extracomment>plugin/qgis/workspace.py:253</extracomment>
+            <extracomment>plugin/qgis/workspace.py:254</extracomment>
             <translation>Bildfußabdrücke</translation>
         </message>
         <message>
@@ -3060,7 +3095,7 @@
         </message>
         <message>
             <source>Products</source>
-            <extracomment>plugin/qgis/workspace.py:143</extracomment>
+            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:225</extracomment>
             <translation>Produkte</translation>
         </message>
         <message>
@@ -3075,43 +3110,315 @@
         </message>
         <message>
             <source>Add them</source>
-            <extracomment>plugin/qgis/workspace.py:187; plugin/qgis/workspace.py:222</extracomment>
+            <extracomment>plugin/qgis/workspace.py:188; plugin/qgis/workspace.py:223</extracomment>
             <translation>Hinzufügen</translation>
         </message>
         <message>
             <source>{0} cannot be written: the edit layers are loaded read-only.</source>
-            <extracomment>plugin/qgis/workspace.py:176</extracomment>
+            <extracomment>plugin/qgis/workspace.py:177</extracomment>
             <translation>{0} ist nicht beschreibbar: die Bearbeitungslayer werden schreibgeschützt geladen.</translation>
         </message>
         <message>
             <source>edits.gpkg lacks the layer(s) {0}.</source>
-            <extracomment>plugin/qgis/workspace.py:186; plugin/qgis/workspace.py:221</extracomment>
+            <extracomment>plugin/qgis/workspace.py:187; plugin/qgis/workspace.py:222</extracomment>
             <translation>In edits.gpkg fehlen die Layer {0}.</translation>
         </message>
         <message>
             <source>Cannot load the layer {0} of {1}.</source>
-            <extracomment>plugin/qgis/workspace.py:195</extracomment>
+            <extracomment>plugin/qgis/workspace.py:196</extracomment>
             <translation>Der Layer {0} von {1} kann nicht geladen werden.</translation>
         </message>
         <message>
             <source>Save or discard the edits of {0} first; edits.gpkg was not changed.</source>
-            <extracomment>plugin/qgis/workspace.py:219</extracomment>
+            <extracomment>plugin/qgis/workspace.py:220</extracomment>
             <translation>Speichern oder verwerfen Sie zuerst die Bearbeitungen von {0}; edits.gpkg wurde nicht geändert.</translation>
         </message>
         <message>
             <source>Cannot load {0}.</source>
-            <extracomment>plugin/qgis/workspace.py:272</extracomment>
+            <extracomment>plugin/qgis/workspace.py:273</extracomment>
             <translation>{0} kann nicht geladen werden.</translation>
         </message>
         <message>
             <source>hillshade</source>
-            <extracomment>plugin/qgis/workspace.py:276; plugin/qgis/workspace.py:325</extracomment>
+            <extracomment>plugin/qgis/workspace.py:277; plugin/qgis/workspace.py:326</extracomment>
             <translation>Schummerung</translation>
         </message>
         <message>
             <source>The block layers cannot be made: {0}</source>
-            <extracomment>plugin/qgis/workspace.py:251</extracomment>
+            <extracomment>plugin/qgis/workspace.py:252</extracomment>
             <translation>Die Block-Layer können nicht erstellt werden: {0}</translation>
+        </message>
+        <message>
+            <source>Batch over stereo models</source>
+            <extracomment>plugin/widgets/batch_dialog.py:94</extracomment>
+            <translation>Batch über Stereomodelle</translation>
+        </message>
+        <message>
+            <source>project folder (with project.toml)</source>
+            <extracomment>plugin/widgets/batch_dialog.py:128; plugin/widgets/parameter_form.py:151</extracomment>
+            <translation>Projektordner (mit project.toml)</translation>
+        </message>
+        <message>
+            <source>Open batch file…</source>
+            <extracomment>plugin/widgets/batch_dialog.py:129</extracomment>
+            <translation>Batch-Datei öffnen…</translation>
+        </message>
+        <message>
+            <source>Double-click a row to open its log.</source>
+            <extracomment>plugin/widgets/batch_dialog.py:143</extracomment>
+            <translation>Doppelklick auf eine Zeile öffnet ihr Protokoll.</translation>
+        </message>
+        <message>
+            <source>Steps</source>
+            <extracomment>plugin/widgets/batch_dialog.py:157</extracomment>
+            <translation>Schritte</translation>
+        </message>
+        <message>
+            <source>Refine in object space</source>
+            <extracomment>plugin/widgets/batch_dialog.py:162</extracomment>
+            <translation>Im Objektraum verfeinern</translation>
+        </message>
+        <message>
+            <source>DTM filter</source>
+            <extracomment>plugin/widgets/batch_dialog.py:163; plugin/widgets/batch_dialog.py:176</extracomment>
+            <translation>DGM-Filter</translation>
+        </message>
+        <message>
+            <source>Worker processes (default: cores − 1)</source>
+            <extracomment>plugin/widgets/batch_dialog.py:188</extracomment>
+            <translation>Worker-Prozesse (Vorgabe: Kerne − 1)</translation>
+        </message>
+        <message>
+            <source>The log of the batch appears here.</source>
+            <extracomment>plugin/widgets/batch_dialog.py:207</extracomment>
+            <translation>Hier erscheint das Protokoll des Batches.</translation>
+        </message>
+        <message>
+            <source>Open</source>
+            <extracomment>plugin/widgets/batch_dialog.py:210; plugin/widgets/run_panel.py:224</extracomment>
+            <translation>Öffnen</translation>
+        </message>
+        <message>
+            <source>Show in folder</source>
+            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
+            <translation>Im Ordner zeigen</translation>
+        </message>
+        <message>
+            <source>Log</source>
+            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:87</extracomment>
+            <translation>Protokoll</translation>
+        </message>
+        <message>
+            <source>Run</source>
+            <extracomment>plugin/widgets/batch_dialog.py:237; plugin/widgets/run_panel.py:42</extracomment>
+            <translation>Ausführen</translation>
+        </message>
+        <message>
+            <source>Write the batch file of these choices and run it</source>
+            <extracomment>plugin/widgets/batch_dialog.py:239</extracomment>
+            <translation>Die Batch-Datei dieser Auswahl schreiben und ausführen</translation>
+        </message>
+        <message>
+            <source>Resume</source>
+            <extracomment>plugin/widgets/batch_dialog.py:240</extracomment>
+            <translation>Fortsetzen</translation>
+        </message>
+        <message>
+            <source>Run the batch file again; finished tasks are skipped</source>
+            <extracomment>plugin/widgets/batch_dialog.py:241</extracomment>
+            <translation>Die Batch-Datei erneut ausführen; fertige Aufgaben werden übersprungen</translation>
+        </message>
+        <message>
+            <source>Re-run failed</source>
+            <extracomment>plugin/widgets/batch_dialog.py:242</extracomment>
+            <translation>Fehlgeschlagene erneut ausführen</translation>
+        </message>
+        <message>
+            <source>Cancel</source>
+            <extracomment>plugin/widgets/batch_dialog.py:243; plugin/widgets/georef_review.py:476; plugin/widgets/run_panel.py:45</extracomment>
+            <translation>Abbrechen</translation>
+        </message>
+        <message>
+            <source>Close</source>
+            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:172</extracomment>
+            <translation>Schließen</translation>
+        </message>
+        <message>
+            <source>Batch is running</source>
+            <extracomment>plugin/widgets/batch_dialog.py:693</extracomment>
+            <translation>Batch läuft</translation>
+        </message>
+        <message>
+            <source>The batch is still running. Cancel it, or keep it running in the background?</source>
+            <extracomment>plugin/widgets/batch_dialog.py:694</extracomment>
+            <translation>Der Batch läuft noch. Abbrechen oder im Hintergrund weiterlaufen lassen?</translation>
+        </message>
+        <message>
+            <source>Cancel the batch</source>
+            <extracomment>plugin/widgets/batch_dialog.py:696</extracomment>
+            <translation>Batch abbrechen</translation>
+        </message>
+        <message>
+            <source>Keep running</source>
+            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
+            <translation>Weiterlaufen lassen</translation>
+        </message>
+        <message>
+            <source>Back</source>
+            <extracomment>plugin/widgets/batch_dialog.py:698</extracomment>
+            <translation>Zurück</translation>
+        </message>
+        <message>
+            <source>done</source>
+            <extracomment>plugin/widgets/batch_dialog.py:45</extracomment>
+            <translation>fertig</translation>
+        </message>
+        <message>
+            <source>failed</source>
+            <extracomment>plugin/widgets/batch_dialog.py:45</extracomment>
+            <translation>fehlgeschlagen</translation>
+        </message>
+        <message>
+            <source>not run</source>
+            <extracomment>plugin/widgets/batch_dialog.py:45</extracomment>
+            <translation>nicht gelaufen</translation>
+        </message>
+        <message>
+            <source>skipped</source>
+            <extracomment>plugin/widgets/batch_dialog.py:46</extracomment>
+            <translation>übersprungen</translation>
+        </message>
+        <message>
+            <source>cancelled</source>
+            <extracomment>plugin/widgets/batch_dialog.py:46</extracomment>
+            <translation>abgebrochen</translation>
+        </message>
+        <message>
+            <source>running</source>
+            <extracomment>plugin/widgets/batch_dialog.py:46</extracomment>
+            <translation>läuft</translation>
+        </message>
+        <message>
+            <source>waiting</source>
+            <extracomment>plugin/widgets/batch_dialog.py:47</extracomment>
+            <translation>wartet</translation>
+        </message>
+        <message>
+            <source>Model</source>
+            <extracomment>plugin/widgets/batch_dialog.py:137</extracomment>
+            <translation>Modell</translation>
+        </message>
+        <message>
+            <source>B/H</source>
+            <extracomment>plugin/widgets/batch_dialog.py:137</extracomment>
+            <translation>B/H</translation>
+        </message>
+        <message>
+            <source>Overlap</source>
+            <extracomment>plugin/widgets/batch_dialog.py:137; plugin/widgets/georef_review.py:51</extracomment>
+            <translation>Überlappung</translation>
+        </message>
+        <message>
+            <source>Progress</source>
+            <extracomment>plugin/widgets/batch_dialog.py:138</extracomment>
+            <translation>Fortschritt</translation>
+        </message>
+        <message>
+            <source>State</source>
+            <extracomment>plugin/widgets/batch_dialog.py:138</extracomment>
+            <translation>Zustand</translation>
+        </message>
+        <message>
+            <source>Matching method</source>
+            <extracomment>plugin/widgets/batch_dialog.py:174</extracomment>
+            <translation>Zuordnungsverfahren</translation>
+        </message>
+        <message>
+            <source>Matching preset</source>
+            <extracomment>plugin/widgets/batch_dialog.py:175</extracomment>
+            <translation>Voreinstellung der Zuordnung</translation>
+        </message>
+        <message>
+            <source>Filter preset</source>
+            <extracomment>plugin/widgets/batch_dialog.py:177</extracomment>
+            <translation>Voreinstellung des Filters</translation>
+        </message>
+        <message>
+            <source>Single orthophotos or a mosaic</source>
+            <extracomment>plugin/widgets/batch_dialog.py:178</extracomment>
+            <translation>Einzelne Orthofotos oder ein Mosaik</translation>
+        </message>
+        <message>
+            <source>Workers</source>
+            <extracomment>plugin/widgets/batch_dialog.py:189</extracomment>
+            <translation>Worker</translation>
+        </message>
+        <message>
+            <source>Choose a project folder, or open a batch file.</source>
+            <extracomment>plugin/widgets/batch_dialog.py:314</extracomment>
+            <translation>Wählen Sie einen Projektordner oder öffnen Sie eine Batch-Datei.</translation>
+        </message>
+        <message>
+            <source>Choose a project folder (with project.toml) first.</source>
+            <extracomment>plugin/widgets/batch_dialog.py:375</extracomment>
+            <translation>Wählen Sie zuerst einen Projektordner (mit project.toml).</translation>
+        </message>
+        <message>
+            <source>Cancelling …</source>
+            <extracomment>plugin/widgets/batch_dialog.py:501; plugin/widgets/run_panel.py:149</extracomment>
+            <translation>Wird abgebrochen …</translation>
+        </message>
+        <message>
+            <source>No log yet: the task has not started.</source>
+            <extracomment>plugin/widgets/batch_dialog.py:674</extracomment>
+            <translation>Noch kein Protokoll: die Aufgabe hat noch nicht begonnen.</translation>
+        </message>
+        <message>
+            <source>Run writes the batch file into {0}</source>
+            <extracomment>plugin/widgets/batch_dialog.py:326</extracomment>
+            <translation>Ausführen schreibt die Batch-Datei nach {0}</translation>
+        </message>
+        <message>
+            <source>Open batch file</source>
+            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <translation>Batch-Datei öffnen</translation>
+        </message>
+        <message>
+            <source>Batch files (*.toml)</source>
+            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <translation>Batch-Dateien (*.toml)</translation>
+        </message>
+        <message>
+            <source>Running batch file {0} …</source>
+            <extracomment>plugin/widgets/batch_dialog.py:487</extracomment>
+            <translation>Batch-Datei {0} läuft …</translation>
+        </message>
+        <message>
+            <source>elapsed {0} · remaining {1}</source>
+            <extracomment>plugin/widgets/batch_dialog.py:603</extracomment>
+            <translation>vergangen {0} · verbleibend {1}</translation>
+        </message>
+        <message>
+            <source>Warning: </source>
+            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:169</extracomment>
+            <translation>Warnung: </translation>
+        </message>
+        <message>
+            <source>Error: </source>
+            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:183</extracomment>
+            <translation>Fehler: </translation>
+        </message>
+        <message>
+            <source>Batch file: {0}
+Run it again with: photodem batch {0}</source>
+            <extracomment>plugin/widgets/batch_dialog.py:424</extracomment>
+            <translation>Batch-Datei: {0}
+Erneut ausführen mit: photodem batch {0}</translation>
+        </message>
+        <message>
+            <source>The batch file cannot be used: {0}</source>
+            <extracomment>plugin/widgets/batch_dialog.py:398</extracomment>
+            <translation>Die Batch-Datei kann nicht verwendet werden: {0}</translation>
         </message>
         <message>
             <source>Use</source>
@@ -3189,11 +3496,6 @@
             <translation>Schwellwert [GW]</translation>
         </message>
         <message>
-            <source>Overlap</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
-            <translation>Überlappung</translation>
-        </message>
-        <message>
             <source>ICP RMS [px]</source>
             <extracomment>plugin/widgets/georef_review.py:51</extracomment>
             <translation>ICP-RMS [px]</translation>
@@ -3254,19 +3556,9 @@
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
-            <source>Close</source>
-            <extracomment>plugin/widgets/georef_review.py:172</extracomment>
-            <translation>Schließen</translation>
-        </message>
-        <message>
             <source>Writing the georeferenced image …</source>
             <extracomment>plugin/widgets/georef_review.py:475</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
-        </message>
-        <message>
-            <source>Cancel</source>
-            <extracomment>plugin/widgets/georef_review.py:476; plugin/widgets/run_panel.py:42</extracomment>
-            <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
@@ -3395,142 +3687,117 @@
         </message>
         <message>
             <source>Browse</source>
-            <extracomment>plugin/widgets/parameter_form.py:60</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:65</extracomment>
             <translation>Durchsuchen</translation>
         </message>
         <message>
             <source>All files (*)</source>
-            <extracomment>plugin/widgets/parameter_form.py:77; plugin/widgets/parameter_form.py:79</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:82; plugin/widgets/parameter_form.py:84</extracomment>
             <translation>Alle Dateien (*)</translation>
         </message>
         <message>
-            <source>project folder (with project.toml)</source>
-            <extracomment>plugin/widgets/parameter_form.py:146</extracomment>
-            <translation>Projektordner (mit project.toml)</translation>
-        </message>
-        <message>
             <source>optional</source>
-            <extracomment>plugin/widgets/parameter_form.py:181; plugin/widgets/parameter_form.py:226; plugin/widgets/parameter_form.py:316</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:186; plugin/widgets/parameter_form.py:231; plugin/widgets/parameter_form.py:321</extracomment>
             <translation>optional</translation>
         </message>
         <message>
             <source>choose a project first</source>
-            <extracomment>plugin/widgets/parameter_form.py:213</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:218</extracomment>
             <translation>zuerst ein Projekt wählen</translation>
         </message>
         <message>
             <source>image name</source>
-            <extracomment>plugin/widgets/parameter_form.py:213</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:218</extracomment>
             <translation>Bildname</translation>
         </message>
         <message>
             <source>Supported files</source>
-            <extracomment>plugin/widgets/parameter_form.py:79</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:84</extracomment>
             <translation>Unterstützte Dateien</translation>
         </message>
         <message>
             <source>Choose a folder</source>
-            <extracomment>plugin/widgets/parameter_form.py:85</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:90</extracomment>
             <translation>Ordner wählen</translation>
         </message>
         <message>
             <source>several files, separated by commas</source>
-            <extracomment>plugin/widgets/parameter_form.py:148</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:153</extracomment>
             <translation>mehrere Dateien, durch Kommas getrennt</translation>
         </message>
         <message>
             <source>required</source>
-            <extracomment>plugin/widgets/parameter_form.py:316</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:321</extracomment>
             <translation>erforderlich</translation>
         </message>
         <message>
             <source>e.g. EPSG:25832</source>
-            <extracomment>plugin/widgets/parameter_form.py:224</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:229</extracomment>
             <translation>z. B. EPSG:25832</translation>
         </message>
         <message>
             <source>xmin,ymin,xmax,ymax</source>
-            <extracomment>plugin/widgets/parameter_form.py:225</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:230</extracomment>
             <translation>xmin,ymin,xmax,ymax</translation>
         </message>
         <message>
             <source>type a name</source>
-            <extracomment>plugin/widgets/parameter_form.py:369</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:421</extracomment>
             <translation>Namen eingeben</translation>
         </message>
         <message>
             <source>no project found</source>
-            <extracomment>plugin/widgets/parameter_form.py:369</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:421</extracomment>
             <translation>kein Projekt gefunden</translation>
         </message>
         <message>
             <source>Save as</source>
-            <extracomment>plugin/widgets/parameter_form.py:87</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:92</extracomment>
             <translation>Speichern unter</translation>
         </message>
         <message>
             <source>Choose files</source>
-            <extracomment>plugin/widgets/parameter_form.py:89</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:94</extracomment>
             <translation>Dateien wählen</translation>
         </message>
         <message>
             <source>Choose a file</source>
-            <extracomment>plugin/widgets/parameter_form.py:92</extracomment>
+            <extracomment>plugin/widgets/parameter_form.py:97</extracomment>
             <translation>Datei wählen</translation>
         </message>
         <message>
-            <source>Run</source>
-            <extracomment>plugin/widgets/run_panel.py:39</extracomment>
-            <translation>Ausführen</translation>
-        </message>
-        <message>
             <source>The log of the run appears here.</source>
-            <extracomment>plugin/widgets/run_panel.py:54</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:57</extracomment>
             <translation>Hier erscheint das Protokoll des Laufs.</translation>
         </message>
         <message>
-            <source>Log</source>
-            <extracomment>plugin/widgets/run_panel.py:64</extracomment>
-            <translation>Protokoll</translation>
+            <source>Open report</source>
+            <extracomment>plugin/widgets/run_panel.py:73</extracomment>
+            <translation>Bericht öffnen</translation>
         </message>
         <message>
             <source>Result</source>
-            <extracomment>plugin/widgets/run_panel.py:65</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:88</extracomment>
             <translation>Ergebnis</translation>
         </message>
         <message>
             <source>Finished.</source>
-            <extracomment>plugin/widgets/run_panel.py:155</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:178</extracomment>
             <translation>Fertig.</translation>
         </message>
         <message>
             <source>Output</source>
-            <extracomment>plugin/widgets/run_panel.py:59</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:62</extracomment>
             <translation>Ausgabe</translation>
         </message>
         <message>
             <source>Value</source>
-            <extracomment>plugin/widgets/run_panel.py:59</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:62</extracomment>
             <translation>Wert</translation>
         </message>
         <message>
-            <source>Cancelling …</source>
-            <extracomment>plugin/widgets/run_panel.py:126</extracomment>
-            <translation>Wird abgebrochen …</translation>
-        </message>
-        <message>
-            <source>Warning: </source>
-            <extracomment>plugin/widgets/run_panel.py:146</extracomment>
-            <translation>Warnung: </translation>
-        </message>
-        <message>
-            <source>Error: </source>
-            <extracomment>plugin/widgets/run_panel.py:160</extracomment>
-            <translation>Fehler: </translation>
-        </message>
-        <message>
             <source>Unexpected error (please report it):</source>
-            <extracomment>plugin/widgets/run_panel.py:162</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:185</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
         </message>
         <message>
