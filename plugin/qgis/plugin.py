@@ -11,6 +11,7 @@ import importlib.util
 from typing import Any, List, Optional
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog
+from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtWidgets import QDockWidget
 
 from ...algorithms.processing import registry
@@ -115,6 +116,14 @@ class PhotodemPlugin:
         review.triggered.connect(lambda _checked=False: self.open_georef_review())
         self.iface.addPluginToRasterMenu(MENU_TITLE, review)
         self.actions.append(review)
+        # issue 20: the DEM quality dock (made on first use)
+        quality = QAction(icon, tr("DEM quality…"), parent)
+        quality.setObjectName("photodemQualityDock")
+        quality.setToolTip(tr("Statistics of an area, histogram, profiles, identify and "
+                              "blunders of a DEM against a reference"))
+        quality.triggered.connect(lambda _checked=False: self.show_quality_dock())
+        self.iface.addPluginToRasterMenu(MENU_TITLE, quality)
+        self.actions.append(quality)
 
     def _init_workspace(self) -> None:
         """The project workspace: Open project… and recent projects, the editing toolbar
@@ -157,6 +166,19 @@ class PhotodemPlugin:
             self._review = dialog  # keep a reference while it is open
         return dialog
 
+    def show_quality_dock(self) -> Any:
+        """Show the DEM quality dock (issue 20), made on first use; returns it."""
+        dock = getattr(self, "qc_dock", None)
+        if dock is None:
+            from .qc_dock import QcDock  # lazy: matplotlib and the map tools load on first use
+
+            dock = self.qc_dock = QcDock(self.iface, self.iface.mainWindow())
+            self.iface.addDockWidget(Qt.RightDockWidgetArea, dock)
+        dock.set_workspace(current_workspace())
+        dock.show()
+        dock.raise_()
+        return dock
+
     def open_dialog(self, algorithm_id: str) -> None:
         """Open the Processing dialog of ``photodem:<algorithm_id>``."""
         # lazy: QGIS's processing plugin exists only in the desktop application
@@ -177,6 +199,10 @@ class PhotodemPlugin:
 
     def unload(self) -> None:
         """Remove the menu entries, the toolbar button, the provider and the translator."""
+        if getattr(self, "qc_dock", None) is not None:  # issue 20: the DEM quality dock
+            self.iface.removeDockWidget(self.qc_dock)
+            self.qc_dock.deleteLater()
+            self.qc_dock = None
         if self.editing_toolbar is not None:
             self.editing_toolbar.unload()
             self.editing_toolbar = None
