@@ -24,12 +24,13 @@ from typing import Any, Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 from shapely import wkt as shapely_wkt
-from shapely.geometry import Point
+from shapely.geometry import Point, box
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.project.edits import EXCLUSION_ACTIONS, add_features
 from ...algorithms.quality import qc_blunders, qc_profile, qc_stats
 from ...algorithms.quality.names import distinct_names
+from ...algorithms.quality.profile import parse_coordinates
 from ..i18n import tr
 from ..qt import QtCore, QtWidgets, pyqtSignal, pyqtSlot
 from .qc_plots import (
@@ -73,9 +74,10 @@ class FunctionWorker(AlgorithmWorker):
             self.done.emit()
 
 
-def _path_row(parent: QtWidgets.QWidget, caption: str, filters: str
+def _path_row(parent: QtWidgets.QWidget, caption: str, filters: Optional[str]
               ) -> tuple:
-    """A line edit with a browse button (returns the row widget and the line edit)."""
+    """A line edit with a browse button (returns the row widget and the line edit); without
+    ``filters`` it browses for a folder."""
     row = QtWidgets.QWidget(parent)
     lay = QtWidgets.QHBoxLayout(row)
     lay.setContentsMargins(0, 0, 0, 0)
@@ -84,9 +86,14 @@ def _path_row(parent: QtWidgets.QWidget, caption: str, filters: str
     button.setText("…")
 
     def browse() -> None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(parent, caption, edit.text(), filters)
+        if filters is None:
+            path = QtWidgets.QFileDialog.getExistingDirectory(parent, caption, edit.text())
+        else:
+            path, _ = QtWidgets.QFileDialog.getOpenFileName(parent, caption, edit.text(),
+                                                            filters)
         if path:
             edit.setText(path)
+            edit.editingFinished.emit()
 
     button.clicked.connect(browse)
     lay.addWidget(edit, 1)
@@ -141,6 +148,11 @@ class QcPanel(QtWidgets.QWidget):
         self.inputs_box = QtWidgets.QGroupBox(tr("Surfaces"), self)
         form = QtWidgets.QFormLayout(self.inputs_box)
         rasters = tr("Rasters (*.tif *.tiff *.vrt *.img);;All files (*)")
+        row, self.project_edit = _path_row(self, tr("PhotoDEM project folder"), None)
+        self.project_edit.setPlaceholderText(tr("edits and comparisons go into this project"))
+        self.project_edit.editingFinished.connect(
+            lambda: self.set_project(self.project_edit.text().strip() or None))
+        form.addRow(tr("Project"), row)
         row, self.dem_edit = _path_row(self, tr("DEM to check"), rasters)
         form.addRow(tr("DEM"), row)
         row, self.reference_edit = _path_row(self, tr("Reference DEM"), rasters)
@@ -187,6 +199,18 @@ class QcPanel(QtWidgets.QWidget):
     def _build_stats_tab(self) -> QtWidgets.QWidget:
         tab = QtWidgets.QWidget(self)
         lay = QtWidgets.QVBoxLayout(tab)
+        row = QtWidgets.QHBoxLayout()
+        self.extent_edit = QtWidgets.QLineEdit(tab)
+        self.extent_edit.setPlaceholderText(tr("xmin, ymin, xmax, ymax (reference CRS)"))
+        button = QtWidgets.QPushButton(tr("Use extent"), tab)
+        button.clicked.connect(self._typed_extent)
+        whole = QtWidgets.QPushButton(tr("Whole model"), tab)
+        whole.clicked.connect(lambda: self.set_area(None))
+        row.addWidget(QtWidgets.QLabel(tr("Area"), tab))
+        row.addWidget(self.extent_edit, 1)
+        row.addWidget(button)
+        row.addWidget(whole)
+        lay.addLayout(row)
         split = QtWidgets.QSplitter(QtCore.Qt.Horizontal, tab)
         self.stats_table = QtWidgets.QTableWidget(split)
         self.stats_table.verticalHeader().setVisible(False)
@@ -204,6 +228,15 @@ class QcPanel(QtWidgets.QWidget):
     def _build_profile_tab(self) -> QtWidgets.QWidget:
         tab = QtWidgets.QWidget(self)
         lay = QtWidgets.QVBoxLayout(tab)
+        row = QtWidgets.QHBoxLayout()
+        self.line_edit = QtWidgets.QLineEdit(tab)
+        self.line_edit.setPlaceholderText(tr("x1,y1;x2,y2;… (DEM CRS), or draw a line on the "
+                                             "map"))
+        button = QtWidgets.QPushButton(tr("Profile"), tab)
+        button.clicked.connect(self._typed_line)
+        row.addWidget(self.line_edit, 1)
+        row.addWidget(button)
+        lay.addLayout(row)
         self.profile_plot = PlotCanvas(tab)
         self.profile_plot.clear(tr("Draw a line on the map"))
         lay.addWidget(self.profile_plot, 1)
@@ -276,6 +309,12 @@ class QcPanel(QtWidgets.QWidget):
     def set_project(self, root: Optional[Any]) -> None:
         """The project folder: edits go to its ``edits.gpkg``, *Compare* into its products."""
         self.project_root = Path(root) if root else None
+        if self.project_root is not None and not (self.project_root / "project.toml").is_file():
+            self._report("warning", tr("'{0}' is no PhotoDEM project (no project.toml); "
+                                       "choose the project folder.").format(root))
+            self.project_root = None
+        if self.project_edit.text() != str(root or ""):
+            self.project_edit.setText(str(root or ""))
 
     def set_inputs(self, dem: Optional[str] = None, reference: Optional[str] = None,
                    classes: Optional[str] = None,
@@ -334,6 +373,26 @@ class QcPanel(QtWidgets.QWidget):
         self._show_area()
         if run:
             self.compute_statistics()
+
+    def _typed_extent(self) -> None:
+        parts = [p for p in self.extent_edit.text().replace(";", ",").replace(" ", ",")
+                 .split(",") if p]
+        try:
+            bounds = [float(p) for p in parts]
+        except ValueError:
+            bounds = []
+        if len(bounds) != 4 or bounds[2] <= bounds[0] or bounds[3] <= bounds[1]:
+            self._report("warning", tr("Give the extent as 'xmin, ymin, xmax, ymax'."))
+            return
+        self.set_area(box(*bounds), tr("extent {0}").format(", ".join(parts)))
+
+    def _typed_line(self) -> None:
+        try:
+            coords = parse_coordinates(self.line_edit.text())
+        except PhotodemError as exc:
+            self._report("warning", str(exc))
+            return
+        self.set_line(coords)
 
     def _show_area(self) -> None:
         self.area_text.setText(tr("Area: {0}").format(self.area_label))
@@ -473,9 +532,11 @@ class QcPanel(QtWidgets.QWidget):
         return spots[row]
 
     def _write_to_gpkg(self, layer: str, geometry: Any, attributes: Dict[str, Any]) -> None:
-        if self.project_root is None:
-            raise PhotodemError(tr("Open a project first: edits go into its edits.gpkg."))
-        add_features(self.project_root / "edits.gpkg", layer, [(geometry, attributes)])
+        edits = self.project_root / "edits.gpkg" if self.project_root is not None else None
+        if edits is None or not edits.is_file():
+            raise PhotodemError(tr("Open a project with an edits.gpkg first: the edit goes "
+                                   "into it."))
+        add_features(edits, layer, [(geometry, attributes)])
 
     def _write_edit(self, layer: str, geometry: Any, attributes: Dict[str, Any]) -> bool:
         try:

@@ -117,3 +117,26 @@ def test_missing_inputs_are_reported(qtbot):
     with qtbot.waitSignal(w.message) as sig:
         assert not w.compute_statistics()
     assert sig.args[0] == "warning" and "DEM" in sig.args[1]
+
+
+def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
+    from photodem.plugin.app.main_window import ToolboxWindow
+
+    root, dem, ref = project
+    window = ToolboxWindow(message_boxes=False)
+    qtbot.addWidget(window)
+    panel = window.open_quality_panel()
+    assert window.open_quality_panel() is panel  # one dock, shown again
+    panel.project_edit.setText(str(root))
+    panel.project_edit.editingFinished.emit()
+    assert panel.project_root == root
+    panel.set_inputs(dem=dem, reference=ref)
+    panel.extent_edit.setText(f"{X0 + 5}, {Y0 - 15}, {X0 + 15}, {Y0 - 5}")
+    panel._typed_extent()
+    assert panel.wait()
+    assert panel.statistics["stats"]["count"] == 400
+    panel.line_edit.setText(f"{X0 + 1},{Y0 - 1};{X0 + 20},{Y0 - 20}")
+    panel._typed_line()
+    assert panel.profile is not None and panel.profile["length"] > 26
+    panel.set_project(root / "images")  # no project.toml: refused
+    assert panel.project_root is None and "no PhotoDEM project" in panel.status.text()
