@@ -480,7 +480,7 @@ class QcPanel(QtWidgets.QWidget):
             self._on_result(result)
 
     def _failed(self, text: str, operator_error: bool) -> None:
-        self._report("error", text if operator_error else tr("Internal error:\n{0}").format(text))
+        self._report("error", text if operator_error else tr("Internal error: {0}").format(text))
 
     def _done(self) -> None:
         self._worker, self._on_result = None, None

@@ -55,12 +55,16 @@ def fill_stats_table(table: QtWidgets.QTableWidget, stats: Optional[Dict[str, An
     """One row per statistic (label, value)."""
     rows = stat_rows()
     table.setColumnCount(2)
-    table.setHorizontalHeaderLabels([tr("Statistic"), tr("Value [m]")])
+    table.setHorizontalHeaderLabels([tr("Statistic"), tr("Value")])
     table.setRowCount(len(rows))
     for r, (key, label, unit) in enumerate(rows):
         table.setItem(r, 0, _item(label))
         table.setItem(r, 1, _item(format_value((stats or {}).get(key), unit)))
     table.resizeColumnsToContents()
+    table.setColumnWidth(1, max(table.columnWidth(1), table.fontMetrics().width("-00000.000")))
+    width = table.columnWidth(0) + table.columnWidth(1) + table.verticalScrollBar().sizeHint()\
+        .width() + 2 * table.frameWidth() + 4
+    table.setMinimumWidth(width)
 
 
 GROUP_KEYS = (("count", ""), ("mean", "m"), ("median", "m"), ("nmad", "m"), ("rms", "m"),
