@@ -37,6 +37,7 @@ from qgis.core import (
 )
 from qgis.gui import (
     QgsAdvancedDigitizingDockWidget,
+    QgsFieldComboBox,
     QgsMapLayerComboBox,
     QgsMapToolCapture,
     QgsMapToolDigitizeFeature,
@@ -69,7 +70,7 @@ NUDGE_KEYS = {Qt.Key_Left: 1, Qt.Key_Up: 1, Qt.Key_Right: -1, Qt.Key_Down: -1}
 
 
 def layer_path(layer: Optional[QgsMapLayer]) -> Optional[str]:
-    """The file behind a raster layer, or None."""
+    """The file behind a layer (an OGR layer name dropped), or None."""
     if layer is None:
         return None
     path = _source_path(layer)
@@ -181,9 +182,15 @@ class QcDock(QDockWidget):
         self.dem_combo = self._raster_combo(body, False)
         self.reference_combo = self._raster_combo(body, False)
         self.classes_combo = self._raster_combo(body, True)
+        self.classes_combo.setFilters(QgsMapLayerProxyModel.RasterLayer
+                                      | QgsMapLayerProxyModel.PolygonLayer)
+        self.class_field_combo = QgsFieldComboBox(body)
+        self.classes_combo.layerChanged.connect(self._classes_changed)
         form.addRow(tr("DEM"), self.dem_combo)
         form.addRow(tr("Reference"), self.reference_combo)
         form.addRow(tr("Classes (optional)"), self.classes_combo)
+        form.addRow(tr("Class attribute"), self.class_field_combo)
+        self._classes_changed(None)
         lay.addLayout(form)
         row = QHBoxLayout()
         self.buttons: Dict[str, QPushButton] = {}
@@ -208,6 +215,12 @@ class QcDock(QDockWidget):
         if optional:
             combo.setLayer(None)
         return combo
+
+    def _classes_changed(self, layer: Any) -> None:
+        """Class polygons need their class attribute; a class raster does not."""
+        vector = layer is not None and layer.type() == QgsMapLayer.VectorLayer
+        self.class_field_combo.setLayer(layer if vector else None)
+        self.class_field_combo.setEnabled(vector)
 
     def _band(self, kind: Any, colour: QColor) -> QgsRubberBand:
         band = QgsRubberBand(self.canvas, kind)
@@ -238,8 +251,11 @@ class QcDock(QDockWidget):
         if self.workspace is not None:
             others = [p for p in (layer_path(x) for x in self.workspace.surface_layers())
                       if p and p not in (dem, ref)]
-        return {"dem": dem, "reference": ref,
-                "classes": layer_path(self.classes_combo.currentLayer()), "surfaces": others}
+        classes = self.classes_combo.currentLayer()
+        field = self.class_field_combo.currentField() if self.class_field_combo.isEnabled() \
+            else None
+        return {"dem": dem, "reference": ref, "classes": layer_path(classes),
+                "class_field": field or None, "surfaces": others}
 
     def _crs_of(self, combo: QgsMapLayerComboBox) -> Optional[QgsCoordinateReferenceSystem]:
         layer = combo.currentLayer()

@@ -328,7 +328,8 @@ class QcPanel(QtWidgets.QWidget):
             self.surfaces_edit.setText(";".join(str(s) for s in surfaces))
 
     def inputs(self) -> Dict[str, Any]:
-        """``{"dem", "reference", "classes", "surfaces"}`` from the host or the path fields."""
+        """``{"dem", "reference", "classes", "surfaces"}`` (+ ``"class_field"`` of class
+        polygons) from the host or the path fields."""
         if self.input_provider is not None:
             return self.input_provider()
         extra = [s.strip() for s in self.surfaces_edit.text().split(";") if s.strip()]
@@ -403,7 +404,7 @@ class QcPanel(QtWidgets.QWidget):
         if given is None:
             return False
         kwargs = {"dem": given["dem"], "reference": given["reference"], "area": self.area,
-                  "classes": given.get("classes")}
+                  "classes": given.get("classes"), "class_field": given.get("class_field")}
         return self._start(FunctionWorker(qc_stats.area_statistics, kwargs),
                            self._statistics_done, tr("Computing statistics…"))
 
@@ -434,8 +435,9 @@ class QcPanel(QtWidgets.QWidget):
                                        "its products folder."))
             return False
         params = {"dem": given["dem"], "reference": given["reference"], "output": str(out)}
-        if given.get("classes"):
-            params["classes"] = given["classes"]
+        for key in ("classes", "class_field"):
+            if given.get(key):
+                params[key] = given[key]
         return self._start(AlgorithmWorker("dem_compare", params), self._compare_done,
                            tr("Comparing…"))
 

@@ -91,10 +91,25 @@ def _paths(work):
 
 
 def test_defaults_come_from_the_workspace(dock):
+    from qgis.core import QgsProject, QgsVectorLayer
+
     assert dock["dock"].dem_combo.currentLayer() is dock["dsm"]
     given = dock["dock"].inputs()
     assert given["dem"].endswith("products/dsm/0101_0102/dsm.tif")
     assert given["reference"].endswith("truth/dsm.tif")
+    assert given["classes"] is None and not dock["dock"].class_field_combo.isEnabled()
+    # class polygons with their attribute: per-class statistics by that attribute
+    buildings = QgsVectorLayer(str(dock["root"] / "truth" / "buildings.gpkg"), "buildings",
+                               "ogr")
+    QgsProject.instance().addMapLayer(buildings)
+    dock["dock"].classes_combo.setLayer(buildings)
+    dock["dock"].class_field_combo.setField("roof")
+    given = dock["dock"].inputs()
+    assert given["classes"].endswith("buildings.gpkg") and given["class_field"] == "roof"
+    dock["dock"].use_whole_model()
+    assert dock["dock"].panel.wait()
+    assert set(dock["dock"].panel.statistics["per_class"]) <= {"flat", "gabled"}
+    assert dock["dock"].panel.statistics["per_class"]
 
 
 def test_drawn_polygon_statistics_equal_dem_compare(dock):
