@@ -28,6 +28,7 @@ from qgis.core import (
     QgsGeometry,
     QgsMapLayer,
     QgsMapLayerProxyModel,
+    QgsPalettedRasterRenderer,
     QgsPointXY,
     QgsProject,
     QgsRasterLayer,
@@ -50,7 +51,7 @@ from qgis.PyQt.QtGui import QColor
 from qgis.PyQt.QtWidgets import (
     QDockWidget,
     QFormLayout,
-    QHBoxLayout,
+    QGridLayout,
     QPushButton,
     QVBoxLayout,
     QWidget,
@@ -162,6 +163,7 @@ class QcDock(QDockWidget):
         self.panel.zoomTo.connect(self.zoom_to)
         self.panel.difference_ready.connect(self.add_difference)
         self.panel.message.connect(self._message)
+        self.panel.filter_tab.dtm_changed.connect(self.reload_layers_of)
         self._build()
         self.area_band = self._band(QgsWkbTypes.PolygonGeometry, QColor(255, 0, 160, 50))
         self.line_band = self._band(QgsWkbTypes.LineGeometry, QColor(255, 0, 160, 220))
@@ -192,19 +194,22 @@ class QcDock(QDockWidget):
         form.addRow(tr("Class attribute"), self.class_field_combo)
         self._classes_changed(None)
         lay.addLayout(form)
-        row = QHBoxLayout()
+        grid = QGridLayout()
         self.buttons: Dict[str, QPushButton] = {}
-        for key, text, slot in (("area", tr("Draw area"), lambda: self.activate("area")),
-                                ("extent", tr("Visible extent"), self.use_visible_extent),
-                                ("whole", tr("Whole model"), self.use_whole_model),
-                                ("line", tr("Draw profile"), lambda: self.activate("line")),
-                                ("pick", tr("Profile of feature"), self.pick_line),
-                                ("identify", tr("Identify"), lambda: self.activate("identify"))):
-            button = QPushButton(text, body)
-            button.clicked.connect(slot)
-            row.addWidget(button)
-            self.buttons[key] = button
-        lay.addLayout(row)
+        rows = ((("area", tr("Draw area"), lambda: self.activate("area")),
+                 ("extent", tr("Visible extent"), self.use_visible_extent),
+                 ("whole", tr("Whole model"), self.use_whole_model),
+                 ("mask", tr("Show eliminated cells"), self.show_mask)),
+                (("line", tr("Draw profile"), lambda: self.activate("line")),
+                 ("pick", tr("Profile of feature"), self.pick_line),
+                 ("identify", tr("Identify"), lambda: self.activate("identify"))))
+        for r, buttons in enumerate(rows):
+            for c, (key, text, slot) in enumerate(buttons):
+                button = QPushButton(text, body)
+                button.clicked.connect(slot)
+                grid.addWidget(button, r, c)
+                self.buttons[key] = button
+        lay.addLayout(grid)
         lay.addWidget(self.panel, 1)
         self.setWidget(body)
 
@@ -242,6 +247,9 @@ class QcDock(QDockWidget):
             self.dem_combo.setLayer(surfaces[0])
         if len(surfaces) > 1:
             self.reference_combo.setLayer(surfaces[1])
+        dtms = [p for p in (layer_path(x) for x in workspace.layers("dtm")) if p]
+        if dtms and not self.panel.filter_tab.dtm_edit.text():
+            self.panel.filter_tab.dtm_edit.setText(dtms[0])
 
     def inputs(self) -> Dict[str, Any]:
         """The panel's inputs from the layer pickers (+ the workspace's other surfaces)."""
@@ -374,6 +382,38 @@ class QcDock(QDockWidget):
             rect.transform(QgsCoordinateTransform(crs, target, QgsProject.instance()))
         self.canvas.setExtent(rect.boundingBox())
         self.canvas.refresh()
+
+    # -- filter review ---------------------------------------------------------------------------
+    def show_mask(self) -> Optional[QgsRasterLayer]:
+        """The eliminated cells of the review's DTM (its ``mask.tif``) on top of the map:
+        objects red, half transparent; ground and no data clear."""
+        dtm = self.panel.filter_tab.dtm_edit.text().strip()
+        mask = Path(dtm).with_name("mask.tif") if dtm else None
+        if mask is None or not mask.is_file():
+            self._message("warning", tr("Choose a DTM of a PhotoDEM filter run (with its "
+                                        "mask.tif) in the Filter review tab."))
+            return None
+        layer = QgsRasterLayer(str(mask), tr("eliminated cells ({0})")
+                               .format(Path(dtm).parent.name), "gdal")
+        if not layer.isValid():
+            return None
+        classes = [QgsPalettedRasterRenderer.Class(1, QColor(215, 48, 31), tr("eliminated"))]
+        renderer = QgsPalettedRasterRenderer(layer.dataProvider(), 1, classes)
+        renderer.setOpacity(0.5)
+        layer.setRenderer(renderer)
+        QgsProject.instance().addMapLayer(layer)
+        return layer
+
+    def reload_layers_of(self, path: str) -> int:
+        """Redraw the layers of a file an *Accept* changed (and its mask); returns how many."""
+        wanted = {str(Path(path).resolve()), str(Path(path).with_name("mask.tif").resolve())}
+        count = 0
+        for layer in QgsProject.instance().mapLayers().values():
+            if _source_path(layer) in wanted:
+                layer.dataProvider().reloadData()
+                layer.triggerRepaint()
+                count += 1
+        return count
 
     # -- products and edits ----------------------------------------------------------------------
     def add_difference(self, path: str) -> List[QgsMapLayer]:

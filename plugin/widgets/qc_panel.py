@@ -18,7 +18,6 @@ default the core's :func:`~photodem.algorithms.project.edits.add_features` into 
 
 from __future__ import annotations
 
-import traceback
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence
 
@@ -26,13 +25,14 @@ import numpy as np
 from shapely import wkt as shapely_wkt
 from shapely.geometry import Point, box
 
-from ...algorithms.errors import Cancelled, PhotodemError
+from ...algorithms.errors import PhotodemError
 from ...algorithms.project.edits import EXCLUSION_ACTIONS, add_features
 from ...algorithms.quality import qc_blunders, qc_profile, qc_stats
 from ...algorithms.quality.names import distinct_names
 from ...algorithms.quality.profile import parse_coordinates
 from ..i18n import tr
-from ..qt import QtCore, QtWidgets, pyqtSignal, pyqtSlot
+from ..qt import QtCore, QtWidgets, pyqtSignal
+from .qc_filter import FilterReviewTab
 from .qc_plots import (
     PlotCanvas,
     draw_histogram,
@@ -41,37 +41,10 @@ from .qc_plots import (
     fill_group_table,
     fill_stats_table,
 )
+from .qc_worker import FunctionWorker
 from .worker import AlgorithmWorker, start_in_thread
 
 EditWriter = Callable[[str, Any, Dict[str, Any]], None]
-
-
-class FunctionWorker(AlgorithmWorker):
-    """An :class:`~.worker.AlgorithmWorker` that calls a core function instead of the registry.
-
-    ``function(**kwargs, feedback=…)``; the same signals, cancel and thread handling.
-    """
-
-    def __init__(self, function: Callable[..., Any], kwargs: Dict[str, Any],
-                 parent: Optional[QtCore.QObject] = None) -> None:
-        super().__init__(getattr(function, "__name__", "qc"), {}, parent)
-        self.function = function
-        self.kwargs = dict(kwargs)
-
-    @pyqtSlot()
-    def run(self) -> None:
-        try:
-            result = self.function(**self.kwargs, feedback=self.feedback)
-        except Cancelled as exc:
-            self.cancelled.emit(str(exc))
-        except PhotodemError as exc:
-            self.failed.emit(str(exc), True)
-        except Exception:  # a bug: show the traceback, keep the GUI alive
-            self.failed.emit(traceback.format_exc(), False)
-        else:
-            self.finished.emit(result)
-        finally:
-            self.done.emit()
 
 
 def _path_row(parent: QtWidgets.QWidget, caption: str, filters: Optional[str]
@@ -169,6 +142,8 @@ class QcPanel(QtWidgets.QWidget):
         self.tabs.addTab(self._build_profile_tab(), tr("Profile"))
         self.tabs.addTab(self._build_blunder_tab(), tr("Blunders"))
         self.tabs.addTab(self._build_identify_tab(), tr("Identify"))
+        self.filter_tab = FilterReviewTab(self)
+        self.tabs.addTab(self.filter_tab, tr("Filter review"))
         lay.addWidget(self.tabs, 1)
 
     def _build_actions(self) -> QtWidgets.QLayout:

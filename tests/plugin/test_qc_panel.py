@@ -140,3 +140,33 @@ def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
     assert panel.profile is not None and panel.profile["length"] > 26
     panel.set_project(root / "images")  # no project.toml: refused
     assert panel.project_root is None and "no PhotoDEM project" in panel.status.text()
+
+
+def test_filter_review_writes_only_on_accept(qtbot, tmp_path):
+    import hashlib
+
+    from photodem.algorithms.processing import registry
+
+    _, cols = np.mgrid[0:N, 0:N]
+    z = 100.0 + 0.02 * cols
+    z[40:56, 40:60] += 8.0  # a house
+    dsm = _write(tmp_path / "dsm.tif", z)
+    out = registry.run("filter_lowpass", {"input": dsm, "output": str(tmp_path / "dtm")})
+    w = QcPanel()
+    qtbot.addWidget(w)
+    w.set_inputs(dem=dsm)
+    w.filter_tab.dtm_edit.setText(out["dtm"])
+    assert not w.filter_tab.run()  # no area yet
+    w.set_area(box(X0 + 15, Y0 - 35, X0 + 35, Y0 - 15).wkt, run=False)
+    w.filter_tab.preset_combo.setCurrentIndex(w.filter_tab.preset_combo.findData("urban"))
+    digest = hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest()
+    assert w.filter_tab.run()
+    assert w.wait()
+    review = w.filter_tab.review
+    assert review is not None and review["preset"] == "urban"
+    assert review["inside"].sum() == 40 * 40 and "urban" in w.filter_tab.summary.text()
+    assert hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest() == digest
+    with qtbot.waitSignal(w.filter_tab.dtm_changed):
+        assert w.filter_tab.accept(confirm=False)
+    assert hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest() != digest or \
+        np.allclose(review["new"], review["old"], equal_nan=True)

@@ -40,6 +40,10 @@ def block(tmp_path_factory, tiny_block) -> Path:
     out.mkdir(parents=True)
     with rasterio.open(out / "dsm.tif", "w", **profile) as dst:
         dst.write(z.astype(profile["dtype"]), 1)
+    from photodem.algorithms.processing import registry
+
+    registry.run("filter_lowpass", {"input": str(out / "dsm.tif"),
+                                    "output": str(root / "products" / "dtm" / "0101_0102")})
     return root
 
 
@@ -172,7 +176,7 @@ def test_identify_click(dock):
     work.activate("identify")
     x, y = click(canvas, e.center().x(), e.center().y())
     values = work.panel.identify_table
-    assert values.rowCount() == 3  # DEM, reference, their difference
+    assert values.rowCount() == 6  # DEM, reference, the workspace DTM, three differences
     assert work.panel.identify_text.text() == f"At x = {x:.2f}, y = {y:.2f}"
 
 
@@ -208,3 +212,32 @@ def test_blunder_to_exclusion_area_through_the_edit_buffer(dock):
     # a row click zooms to the spot
     work.panel._blunder_clicked(1)
     assert dock["canvas"].extent().contains(QgsPointXY(*spots[1]["centroid"]))
+
+
+def test_filter_review_mask_refilter_and_accept(dock):
+    import hashlib
+
+    from qgis.core import QgsProject
+
+    work, canvas = dock["dock"], dock["canvas"]
+    tab = work.panel.filter_tab
+    dtm = dock["root"] / "products" / "dtm" / "0101_0102" / "dtm.tif"
+    assert Path(tab.dtm_edit.text()) == dtm.resolve()
+    mask = work.show_mask()
+    assert mask is not None and mask.renderer().type() == "paletted"
+    assert mask in QgsProject.instance().mapLayers().values()
+    e = dock["dsm"].extent()
+    x0, y0, w, h = e.xMinimum(), e.yMinimum(), e.width(), e.height()
+    work.activate("area")
+    for x, y in ((x0 + 0.3 * w, y0 + 0.3 * h), (x0 + 0.6 * w, y0 + 0.3 * h),
+                 (x0 + 0.5 * w, y0 + 0.6 * h)):
+        click(canvas, x, y)
+    click(canvas, x0 + 0.5 * w, y0 + 0.6 * h, right=True)
+    assert work.panel.wait()
+    before = hashlib.sha256(dtm.read_bytes()).hexdigest()
+    tab.preset_combo.setCurrentIndex(tab.preset_combo.findData("urban"))
+    assert tab.run() and work.panel.wait()
+    assert tab.review is not None and tab.review["inside"].sum() > 100
+    assert hashlib.sha256(dtm.read_bytes()).hexdigest() == before  # nothing written yet
+    assert tab.accept(confirm=False)
+    assert work.reload_layers_of(str(dtm)) >= 2  # the DTM layer and the mask layer
