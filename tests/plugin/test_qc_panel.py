@@ -144,6 +144,7 @@ def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
 
 def test_filter_review_writes_only_on_accept(qtbot, tmp_path):
     import hashlib
+    from pathlib import Path
 
     from photodem.algorithms.processing import registry
 
@@ -159,14 +160,14 @@ def test_filter_review_writes_only_on_accept(qtbot, tmp_path):
     assert not w.filter_tab.run()  # no area yet
     w.set_area(box(X0 + 15, Y0 - 35, X0 + 35, Y0 - 15).wkt, run=False)
     w.filter_tab.preset_combo.setCurrentIndex(w.filter_tab.preset_combo.findData("urban"))
-    digest = hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest()
+    digest = hashlib.sha256(Path(out["dtm"]).read_bytes()).hexdigest()
     assert w.filter_tab.run()
     assert w.wait()
     review = w.filter_tab.review
     assert review is not None and review["preset"] == "urban"
     assert review["inside"].sum() == 40 * 40 and "urban" in w.filter_tab.summary.text()
-    assert hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest() == digest
+    assert hashlib.sha256(Path(out["dtm"]).read_bytes()).hexdigest() == digest
     with qtbot.waitSignal(w.filter_tab.dtm_changed):
         assert w.filter_tab.accept(confirm=False)
-    assert hashlib.sha256(open(out["dtm"], "rb").read()).hexdigest() != digest or \
+    assert hashlib.sha256(Path(out["dtm"]).read_bytes()).hexdigest() != digest or \
         np.allclose(review["new"], review["old"], equal_nan=True)
