@@ -241,3 +241,23 @@ def test_filter_review_mask_refilter_and_accept(dock):
     assert hashlib.sha256(dtm.read_bytes()).hexdigest() == before  # nothing written yet
     assert tab.accept(confirm=False)
     assert work.reload_layers_of(str(dtm)) >= 2  # the DTM layer and the mask layer
+
+
+def test_profile_of_a_picked_line_z_feature(dock, qgis_iface):
+    from qgis.core import QgsFeature, QgsGeometry, QgsProject, QgsVectorLayer
+
+    work, canvas = dock["dock"], dock["canvas"]
+    e = dock["dsm"].extent()
+    y = e.center().y()
+    x0, x1 = e.xMinimum() + 0.2 * e.width(), e.xMinimum() + 0.8 * e.width()
+    lines = QgsVectorLayer("LineStringZ?crs=EPSG:25832", "lines", "memory")
+    feature = QgsFeature()
+    feature.setGeometry(QgsGeometry.fromWkt(f"LineStringZ({x0} {y} 50, {x1} {y} 55)"))
+    lines.dataProvider().addFeatures([feature])
+    QgsProject.instance().addMapLayer(lines)
+    qgis_iface.setActiveLayer(lines)
+    assert work.pick_line() is canvas.mapTool()
+    click(canvas, 0.5 * (x0 + x1), y)
+    prof = work.panel.profile
+    assert prof is not None and prof["vertices"]["z"].tolist() == [50.0, 55.0]
+    assert prof["length"] == pytest.approx(x1 - x0)
