@@ -417,10 +417,12 @@ class QcDock(QDockWidget):
 
     # -- products and edits ----------------------------------------------------------------------
     def add_difference(self, path: str) -> List[QgsMapLayer]:
-        """The difference model on the map: in the Products group (styled) with a workspace,
-        else on top with its ``.qml`` style."""
+        """The difference model on the map (and the DEM's hillshade the comparison wrote below
+        it): in the Products group (styled) with a workspace, else on top with its ``.qml``
+        style."""
         if self.workspace is not None:
-            return self.workspace.add_products([path])
+            shade = Path(path).with_name("hillshade.tif")
+            return self.workspace.add_products([str(shade), path] if shade.is_file() else [path])
         layer = QgsRasterLayer(path, Path(path).parent.name + " Δh", "gdal")
         if not layer.isValid():
             return []

@@ -261,3 +261,18 @@ def test_profile_of_a_picked_line_z_feature(dock, qgis_iface):
     prof = work.panel.profile
     assert prof is not None and prof["vertices"]["z"].tolist() == [50.0, 55.0]
     assert prof["length"] == pytest.approx(x1 - x0)
+
+
+def test_compare_adds_the_styled_difference_to_products(dock):
+    from photodem.plugin.qgis.workspace import PRODUCTS
+
+    work = dock["dock"]
+    assert work.panel.compare()
+    assert work.panel.wait()
+    products = dock["ws"].layers_in(PRODUCTS)
+    diff = [p for p in products if p.source().endswith("difference.tif")]
+    assert len(diff) == 1 and diff[0].renderer().type() == "singlebandpseudocolor"
+    assert "products/quality/" in diff[0].source()
+    shade = [p for p in products if p.source().endswith("hillshade.tif")]
+    assert shade and products.index(diff[0]) < products.index(shade[0])  # above its hillshade
+    assert work.panel.statistics["stats"]["count"] > 1000
