@@ -276,3 +276,24 @@ def test_compare_adds_the_styled_difference_to_products(dock):
     shade = [p for p in products if p.source().endswith("hillshade.tif")]
     assert shade and products.index(diff[0]) < products.index(shade[0])  # above its hillshade
     assert work.panel.statistics["stats"]["count"] > 1000
+
+
+def test_raster_menu_entry_shows_the_dock(qgis_iface, monkeypatch):
+    from photodem.plugin.qgis.plugin import MENU_TITLE, PhotodemPlugin
+    from photodem.plugin.qgis.qc_dock import QcDock
+
+    monkeypatch.setattr(PhotodemPlugin, "initProcessing", lambda self: None)  # session's stays
+    plugin = PhotodemPlugin(qgis_iface)
+    plugin.initGui()
+    try:
+        entry = [a for a in qgis_iface.menus[MENU_TITLE]
+                 if a.objectName() == "photodemQualityDock"]
+        assert len(entry) == 1
+        entry[0].trigger()
+        dock = plugin.qc_dock
+        assert isinstance(dock, QcDock) and dock in qgis_iface.docks and dock.isVisible()
+        entry[0].trigger()
+        assert plugin.qc_dock is dock  # shown again, not made twice
+    finally:
+        plugin.unload()
+    assert plugin.qc_dock is None and dock not in qgis_iface.docks
