@@ -135,8 +135,8 @@ def draw_histogram(canvas: PlotCanvas, result: Dict[str, Any]) -> None:
     for s in (-1, 1):
         ax.axvline(med + s * nmad, color="#b2182b", linewidth=0.8, linestyle="--")
     outside = int(stats["count"] - counts.sum())
-    ax.set_title(tr("Δh histogram: {0} cells, NMAD {1:.3f} m, {2} outside the plot")
-                 .format(stats["count"], nmad, outside), fontsize=9)
+    ax.set_title(tr("Δh histogram: {0} cells, NMAD {1:.3f} m").format(stats["count"], nmad)
+                 + "\n" + tr("{0} cells outside the plot").format(outside), fontsize=9)
     ax.set_xlabel(tr("Δh = DEM − reference [m]"))
     ax.set_ylabel(tr("Cells"))
     ax.legend(loc="upper right", fontsize=8)
