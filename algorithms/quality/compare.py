@@ -34,12 +34,14 @@ from __future__ import annotations
 import contextlib
 import math
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import fiona
 import numpy as np
 import rasterio
 import shapely
+import shapely.geometry
+import shapely.wkt
 from affine import Affine
 from numpy.typing import NDArray
 from pyproj import CRS, Transformer
@@ -70,6 +72,9 @@ Array = NDArray[np.float64]
 
 VECTOR_SUFFIXES = {".gpkg", ".shp", ".geojson", ".json", ".kml", ".gml", ".fgb", ".sqlite"}
 RASTER_SUFFIXES = {".tif", ".tiff", ".vrt", ".img", ".asc", ".nc", ".jp2", ".png"}
+
+#: Called with (row, col, Δh) of every processing window of the comparison grid.
+WindowHook = Callable[[int, int, Array], None]
 
 
 # -- inputs ---------------------------------------------------------------------------------------
@@ -362,11 +367,56 @@ class _ComparisonGrid:
         self.width, self.height = int(gwin.width), int(gwin.height)
         self.r_off, self.c_off = int(gwin.row_off), int(gwin.col_off)
 
-    def windows(self, window_size: int) -> List[Tuple[int, int, int, int]]:
-        """(row, col, h, w) of the processing windows."""
+    def windows(self, window_size: int, within: Optional[Window] = None
+                ) -> List[Tuple[int, int, int, int]]:
+        """(row, col, h, w) of the processing windows (only those of ``within`` when given)."""
         step = max(16, int(window_size))
-        return [(r, c, min(step, self.height - r), min(step, self.width - c))
-                for r in range(0, self.height, step) for c in range(0, self.width, step)]
+        r0, c0, r1, c1 = 0, 0, self.height, self.width
+        if within is not None:
+            r0, c0 = int(within.row_off), int(within.col_off)
+            r1, c1 = r0 + int(within.height), c0 + int(within.width)
+        return [(r, c, min(step, r1 - r), min(step, c1 - c))
+                for r in range(r0, r1, step) for c in range(c0, c1, step)]
+
+
+class _Area:
+    """The cells of the comparison grid whose centres lie in an area (polygon or extent).
+
+    Only the area's bounding window of the grid is processed, so an area statistic reads no
+    more than the area; cells outside the polygon are masked out window by window.
+    """
+
+    def __init__(self, area: Any, grid: _ComparisonGrid) -> None:
+        if isinstance(area, str):
+            area = shapely.wkt.loads(area)
+        elif isinstance(area, (tuple, list)) and len(area) == 4:
+            area = shapely.geometry.box(*[float(v) for v in area])
+        if area is None or area.is_empty or area.geom_type not in ("Polygon", "MultiPolygon"):
+            raise InputError("The area must be a polygon or an extent (xmin, ymin, xmax, ymax) "
+                             "in the reference CRS.")
+        self.geom = area if area.is_valid else area.buffer(0)
+        t = grid.transform
+        win = from_bounds(*self.geom.bounds, transform=t)
+        c0 = max(math.floor(win.col_off), 0)
+        r0 = max(math.floor(win.row_off), 0)
+        c1 = min(math.ceil(win.col_off + win.width), grid.width)
+        r1 = min(math.ceil(win.row_off + win.height), grid.height)
+        if c1 <= c0 or r1 <= r0:
+            raise InputError("The area lies outside the common area of the DEM and the "
+                             "reference; draw it where both have heights.")
+        self.window = Window(c0, r0, c1 - c0, r1 - r0)
+        self.transform = t
+
+    def result(self) -> Dict[str, Any]:
+        """``{"area": {"row", "col", "height", "width"}}``: the area's window of the grid."""
+        w = self.window
+        return {"area": {"row": int(w.row_off), "col": int(w.col_off), "height": int(w.height),
+                         "width": int(w.width)}}
+
+    def inside(self, r: int, c: int, h: int, w: int) -> NDArray[np.bool_]:
+        """True for the cells of the window whose centres lie in the area."""
+        return geometry_mask([self.geom], out_shape=(h, w), invert=True,
+                             transform=self.transform * Affine.translation(c, r))
 
 
 def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], ref: Any,
@@ -383,23 +433,31 @@ def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], re
 def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
                 sources: Tuple[_ClassSource, _ObjectSource], out_ds: Any,
                 accs: Tuple[DifferenceAccumulator, Dict[str, CompletenessAccumulator]],
-                window_size: int, progress: Tuple[float, Feedback]) -> Tuple[int, int]:
+                window_size: int, progress: Tuple[float, Feedback],
+                area: Optional[_Area] = None,
+                on_window: Optional[WindowHook] = None) -> Tuple[int, int]:
     """Feed Δh of every window (with slope, class and object groups) to the accumulators.
 
     Writes Δh. Returns the numbers of valid reference and DEM heights. ``sources`` are the
     class and object-class sources; ``accs`` the statistics and the completeness per grouping
     (``"class"``, ``"object"``); ``progress`` is (the share already done in %, the feedback).
+    With ``area`` only its windows are read and cells outside it are empty; ``on_window``
+    receives ``(row, col, dz)`` of every window (grid rows/columns).
     """
     classes, objects = sources
     acc, comp = accs
     base, fb = progress
     t = grid.transform
-    wins = grid.windows(window_size)
+    wins = grid.windows(window_size, area.window if area is not None else None)
     n_ref = n_dem = 0
     for i, (r, c, h, w) in enumerate(wins):
         refp = _read_window(ref, grid.r_off + r - 1, grid.c_off + c - 1, h + 2, w + 2)
         z_ref = refp[1:-1, 1:-1]
         z_dem = dem_reader.read(r, c, h, w) + dz0
+        if area is not None:  # outside the area: as if neither DEM had a height there
+            outside = ~area.inside(r, c, h, w)
+            z_ref = np.where(outside, np.nan, z_ref)
+            z_dem[outside] = np.nan
         dz = z_dem - z_ref
         n_ref += int(np.count_nonzero(np.isfinite(z_ref)))
         n_dem += int(np.count_nonzero(np.isfinite(z_dem)))
@@ -415,6 +473,8 @@ def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _Comparison
                 comp[name].add_labels(dz, groups[name],
                                       truth_valid=np.isfinite(z_ref))
         acc.add(dz, groups)
+        if on_window is not None:
+            on_window(r, c, dz)
         if out_ds is not None:
             out_ds.write(dz.astype(np.float32), 1, window=Window(c, r, w, h))
         fb.progress(base + (100.0 - base) * (i + 1) / len(wins))
@@ -450,6 +510,8 @@ def compare_dems(
     coreg_max_cells: int = 4_000_000,
     dtm: Optional[PathLike] = None,
     object_height: float = OBJECT_HEIGHT,
+    area: Any = None,
+    on_window: Optional[WindowHook] = None,
     feedback: Optional[Feedback] = None,
 ) -> Dict[str, Any]:
     """Compare a DEM with a reference DEM on the reference grid, window by window.
@@ -481,6 +543,10 @@ def compare_dems(
         nDSM, statistics and completeness per object class.
     object_height : float
         Height above the DTM (m) from which a cell is an object.
+    area : shapely polygon, WKT or (xmin, ymin, xmax, ymax), optional
+        Only the cells whose centres lie in it (reference CRS); only its window is read.
+    on_window : callable, optional
+        ``on_window(row, col, dz)`` per window (grid rows/cols; NaN outside ``area``).
     feedback : Feedback, optional
         Progress per window; cancelling raises Cancelled and leaves no difference raster.
 
@@ -521,9 +587,10 @@ def compare_dems(
         acc = DifferenceAccumulator(memory_budget=memory_budget)
         comp = {"class": CompletenessAccumulator(), "object": CompletenessAccumulator()}
         out_ds = _difference_output(stack, difference_path, ref, cg)
+        zone = _Area(area, cg) if area is not None else None
         n_ref, n_dem = _accumulate(ref, dem_reader, shift["dz"] if shift else 0.0, cg,
                                    (class_src, obj_src), out_ds, (acc, comp), window_size,
-                                   (10.0 if coregister else 0.0, fb))
+                                   (10.0 if coregister else 0.0, fb), zone, on_window)
         _check_overlap_heights(n_ref, n_dem, acc, dem, reference)
         res = acc.result(flying_height)
 
@@ -544,6 +611,7 @@ def compare_dems(
                  "height": height, "resolution": [abs(grid.a), abs(grid.e)]},
         "difference": str(difference_path) if difference_path is not None else None,
         "precision": res["precision"],
+        **(zone.result() if zone is not None else {}),
         **extra,
     }
 

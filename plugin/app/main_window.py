@@ -135,6 +135,11 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.batch_action = tools_menu.addAction(tr("Batch over stereo models…"))
         self.batch_action.setToolTip(tr("Run steps over many stereo models, resumable"))
         self.batch_action.triggered.connect(lambda _checked=False: self.open_batch_dialog())
+        # issue 20: the DEM quality panel, docked in this window
+        self.quality_action = tools_menu.addAction(tr("DEM quality…"))
+        self.quality_action.setToolTip(tr("Statistics, histogram, profiles, identify and "
+                                          "blunders of a DEM against a reference"))
+        self.quality_action.triggered.connect(lambda _checked=False: self.open_quality_panel())
         help_menu = self.menuBar().addMenu(tr("&Help"))
         about = help_menu.addAction(tr("&About PhotoDEM"))
         about.triggered.connect(self._about)
@@ -331,6 +336,19 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         if self.form is not None:
             self.form.remember(s)
         s.sync()
+    def open_quality_panel(self) -> QtWidgets.QWidget:
+        """Show the DEM quality panel (issue 20) in a dock of this window; returns the panel."""
+        dock = self.findChild(QtWidgets.QDockWidget, "photodemQuality")
+        if dock is None:
+            from ..widgets.qc_panel import QcPanel  # lazy: matplotlib loads on first use
+
+            dock = QtWidgets.QDockWidget(tr("DEM quality"), self)
+            dock.setObjectName("photodemQuality")
+            dock.setWidget(QcPanel(dock))
+            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, dock)
+        dock.show()
+        dock.raise_()
+        return dock.widget()
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
         self.save_layout()
@@ -340,6 +358,10 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         if self.batch_dialog is not None and self.batch_dialog.is_running():
             self.batch_dialog.cancel()
             self.batch_dialog.wait(30000)
+        quality = self.findChild(QtWidgets.QDockWidget, "photodemQuality")
+        if quality is not None and quality.widget().is_running():  # issue 20
+            quality.widget().cancel()
+            quality.widget().wait(30000)
         super().closeEvent(event)
 
     def _about(self) -> None:

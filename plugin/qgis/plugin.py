@@ -11,6 +11,7 @@ import importlib.util
 from typing import Any, List, Optional
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog
+from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtWidgets import QDockWidget
 
 from ...algorithms.processing import registry
@@ -120,6 +121,14 @@ class PhotodemPlugin:
 
         self.batch_menu = BatchMenu(self.iface, MENU_TITLE, icon)  # Batch over stereo models…
         self.batch_menu.register()
+        # issue 20: the DEM quality dock (made on first use)
+        quality = QAction(icon, tr("DEM quality…"), parent)
+        quality.setObjectName("photodemQualityDock")
+        quality.setToolTip(tr("Statistics of an area, histogram, profiles, identify and "
+                              "blunders of a DEM against a reference"))
+        quality.triggered.connect(lambda _checked=False: self.show_quality_dock())
+        self.iface.addPluginToRasterMenu(MENU_TITLE, quality)
+        self.actions.append(quality)
 
     def _init_workspace(self) -> None:
         """The project workspace: Open project… and recent projects, the editing toolbar
@@ -145,6 +154,9 @@ class PhotodemPlugin:
         toolbar = getattr(self, "editing_toolbar", None)
         if toolbar is not None:
             toolbar.set_workspace(workspace)
+        dock = getattr(self, "qc_dock", None)
+        if dock is not None:  # the quality dock's defaults follow the project
+            dock.set_workspace(workspace)
 
     def open_georef_review(self, folder: Optional[str] = None) -> Any:
         """Open the review dialog of a ``georeference_polygons`` output folder (asks for
@@ -161,6 +173,19 @@ class PhotodemPlugin:
         if dialog is not None:
             self._review = dialog  # keep a reference while it is open
         return dialog
+
+    def show_quality_dock(self) -> Any:
+        """Show the DEM quality dock (issue 20), made on first use; returns it."""
+        dock = getattr(self, "qc_dock", None)
+        if dock is None:
+            from .qc_dock import QcDock  # lazy: matplotlib and the map tools load on first use
+
+            dock = self.qc_dock = QcDock(self.iface, self.iface.mainWindow())
+            self.iface.addDockWidget(Qt.RightDockWidgetArea, dock)
+        dock.set_workspace(current_workspace())
+        dock.show()
+        dock.raise_()
+        return dock
 
     def open_dialog(self, algorithm_id: str) -> None:
         """Open the Processing dialog of ``photodem:<algorithm_id>``."""
@@ -185,6 +210,10 @@ class PhotodemPlugin:
         if getattr(self, "batch_menu", None) is not None:  # cancels a batch still running
             self.batch_menu.unregister()
             self.batch_menu = None
+        if getattr(self, "qc_dock", None) is not None:  # issue 20: the DEM quality dock
+            self.iface.removeDockWidget(self.qc_dock)
+            self.qc_dock.deleteLater()
+            self.qc_dock = None
         if self.editing_toolbar is not None:
             self.editing_toolbar.unload()
             self.editing_toolbar = None
