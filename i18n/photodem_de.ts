@@ -10,7 +10,7 @@
         </message>
         <message>
             <source>Project</source>
-            <extracomment>plugin/widgets/batch_dialog.py:131; project_create: group; project_info: group; stereo_models: group</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:131; plugin/widgets/qc_panel.py:128; project_create: group; project_info: group; stereo_models: group</extracomment>
             <translation>Projekt</translation>
         </message>
         <message>
@@ -460,12 +460,12 @@
         </message>
         <message>
             <source>DEM to check</source>
-            <extracomment>dem_compare.dem: description; point_compare.dem: description</extracomment>
+            <extracomment>dem_compare.dem: description; plugin/widgets/qc_panel.py:129; point_compare.dem: description</extracomment>
             <translation>Zu prüfendes Höhenmodell</translation>
         </message>
         <message>
             <source>Reference DEM</source>
-            <extracomment>dem_compare.reference: description</extracomment>
+            <extracomment>dem_compare.reference: description; plugin/widgets/qc_panel.py:131</extracomment>
             <translation>Referenzmodell</translation>
         </message>
         <message>
@@ -1120,7 +1120,7 @@
         </message>
         <message>
             <source>Surfaces</source>
-            <extracomment>dsm_merge: group; interpolate_dem: group; refine_object_space: group</extracomment>
+            <extracomment>dsm_merge: group; interpolate_dem: group; plugin/widgets/qc_panel.py:121; refine_object_space: group</extracomment>
             <translation>Oberflächen</translation>
         </message>
         <message>
@@ -1215,7 +1215,7 @@
         </message>
         <message>
             <source>DEM</source>
-            <extracomment>interpolate_dem output dem; interpolate_dem.output: description</extracomment>
+            <extracomment>interpolate_dem output dem; interpolate_dem.output: description; plugin/qgis/qc_dock.py:191; plugin/widgets/qc_panel.py:130</extracomment>
             <translation>DHM</translation>
         </message>
         <message>
@@ -1560,7 +1560,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:426; plugin/widgets/qc_filter.py:50</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -2225,7 +2225,7 @@
         </message>
         <message>
             <source>Class attribute</source>
-            <extracomment>georeference_polygons.class_field: description</extracomment>
+            <extracomment>georeference_polygons.class_field: description; plugin/qgis/qc_dock.py:194</extracomment>
             <translation>Klassenattribut</translation>
         </message>
         <message>
@@ -2410,12 +2410,12 @@
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:130; plugin/qgis/plugin.py:112</extracomment>
+            <extracomment>plugin/app/main_window.py:130; plugin/qgis/plugin.py:113</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:131; plugin/qgis/plugin.py:114</extracomment>
+            <extracomment>plugin/app/main_window.py:131; plugin/qgis/plugin.py:115</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
@@ -2429,68 +2429,83 @@
             <translation>Schritte über viele Stereomodelle ausführen, fortsetzbar</translation>
         </message>
         <message>
+            <source>DEM quality…</source>
+            <extracomment>plugin/app/main_window.py:139; plugin/qgis/plugin.py:125</extracomment>
+            <translation>DHM-Qualität…</translation>
+        </message>
+        <message>
+            <source>Statistics, histogram, profiles, identify and blunders of a DEM against a reference</source>
+            <extracomment>plugin/app/main_window.py:140</extracomment>
+            <translation>Statistik, Histogramm, Profile, Abfrage und grobe Fehler eines DHM gegenüber einer Referenz</translation>
+        </message>
+        <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:138</extracomment>
+            <extracomment>plugin/app/main_window.py:143</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:139</extracomment>
+            <extracomment>plugin/app/main_window.py:144</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:240</extracomment>
+            <extracomment>plugin/app/main_window.py:245</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:240</extracomment>
+            <extracomment>plugin/app/main_window.py:245</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:241; plugin/qgis/background.py:173</extracomment>
+            <extracomment>plugin/app/main_window.py:246; plugin/qgis/background.py:173</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:347</extracomment>
+            <extracomment>plugin/app/main_window.py:369</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:348</extracomment>
+            <extracomment>plugin/app/main_window.py:370</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:149</extracomment>
+            <extracomment>plugin/app/main_window.py:154</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:245; plugin/app/main_window.py:260; plugin/widgets/batch_dialog.py:726; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:726; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
             <source>Batch running – show</source>
-            <extracomment>plugin/app/main_window.py:289</extracomment>
+            <extracomment>plugin/app/main_window.py:294</extracomment>
             <translation>Batch läuft – anzeigen</translation>
         </message>
         <message>
+            <source>DEM quality</source>
+            <extracomment>plugin/app/main_window.py:345</extracomment>
+            <translation>DHM-Qualität</translation>
+        </message>
+        <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:232; plugin/widgets/run_panel.py:124</extracomment>
+            <extracomment>plugin/app/main_window.py:237; plugin/widgets/run_panel.py:124</extracomment>
             <translation>{0} läuft …</translation>
         </message>
         <message>
             <source>Tools → Review georeferencing checks and edits its control points.</source>
-            <extracomment>plugin/app/main_window.py:249</extracomment>
+            <extracomment>plugin/app/main_window.py:254</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
             <source>Batch {0}: summary in {1}</source>
-            <extracomment>plugin/app/main_window.py:300</extracomment>
+            <extracomment>plugin/app/main_window.py:305</extracomment>
             <translation>Batch {0}: Zusammenfassung in {1}</translation>
         </message>
         <message>
@@ -2540,7 +2555,7 @@
         </message>
         <message>
             <source>breakline</source>
-            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51; plugin/widgets/qc_plots.py:156</extracomment>
             <translation>Bruchkante</translation>
         </message>
         <message>
@@ -2570,7 +2585,7 @@
         </message>
         <message>
             <source>Action</source>
-            <extracomment>plugin/qgis/edit_forms.py:113</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:113; plugin/widgets/qc_panel.py:264</extracomment>
             <translation>Aktion</translation>
         </message>
         <message>
@@ -2720,7 +2735,7 @@
         </message>
         <message>
             <source>QGIS refused the new feature of '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:254</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:254; plugin/qgis/qc_dock.py:454</extracomment>
             <translation>QGIS hat das neue Objekt von '{0}' abgelehnt.</translation>
         </message>
         <message>
@@ -2825,7 +2840,7 @@
         </message>
         <message>
             <source>Surface</source>
-            <extracomment>plugin/qgis/editing_toolbar.py:127</extracomment>
+            <extracomment>plugin/qgis/editing_toolbar.py:127; plugin/widgets/qc_panel.py:614</extracomment>
             <translation>Oberfläche</translation>
         </message>
         <message>
@@ -2895,18 +2910,23 @@
         </message>
         <message>
             <source>PhotoDEM needs Python packages that QGIS cannot find: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: install them with the OSGeo4W installer.</source>
-            <extracomment>plugin/qgis/plugin.py:46</extracomment>
+            <extracomment>plugin/qgis/plugin.py:47</extracomment>
             <translation>PhotoDEM benötigt Python-Pakete, die QGIS nicht findet: {0}. Debian/Ubuntu: sudo apt install {1}; Windows: mit dem OSGeo4W-Installer installieren.</translation>
         </message>
         <message>
             <source>PhotoDEM algorithms</source>
-            <extracomment>plugin/qgis/plugin.py:99</extracomment>
+            <extracomment>plugin/qgis/plugin.py:100</extracomment>
             <translation>PhotoDEM-Algorithmen</translation>
         </message>
         <message>
             <source>Show the PhotoDEM algorithms in the Processing Toolbox</source>
-            <extracomment>plugin/qgis/plugin.py:101</extracomment>
+            <extracomment>plugin/qgis/plugin.py:102</extracomment>
             <translation>Die PhotoDEM-Algorithmen im Verarbeitungswerkzeugkasten zeigen</translation>
+        </message>
+        <message>
+            <source>Statistics of an area, histogram, profiles, identify and blunders of a DEM against a reference</source>
+            <extracomment>plugin/qgis/plugin.py:127</extracomment>
+            <translation>Statistik eines Gebiets, Histogramm, Profile, Abfrage und grobe Fehler eines DHM gegenüber einer Referenz</translation>
         </message>
         <message>
             <source>Open project…</source>
@@ -2947,6 +2967,101 @@
             <source>PhotoDEM aerial photogrammetry</source>
             <extracomment>plugin/qgis/provider.py:34</extracomment>
             <translation>PhotoDEM Luftbildphotogrammetrie</translation>
+        </message>
+        <message>
+            <source>PhotoDEM – DEM quality</source>
+            <extracomment>plugin/qgis/qc_dock.py:154</extracomment>
+            <translation>PhotoDEM – DHM-Qualität</translation>
+        </message>
+        <message>
+            <source>Reference</source>
+            <extracomment>plugin/qgis/qc_dock.py:192; plugin/widgets/qc_panel.py:132</extracomment>
+            <translation>Referenz</translation>
+        </message>
+        <message>
+            <source>Classes (optional)</source>
+            <extracomment>plugin/qgis/qc_dock.py:193; plugin/widgets/qc_panel.py:134</extracomment>
+            <translation>Klassen (optional)</translation>
+        </message>
+        <message>
+            <source>visible extent</source>
+            <extracomment>plugin/qgis/qc_dock.py:315</extracomment>
+            <translation>sichtbare Ausdehnung</translation>
+        </message>
+        <message>
+            <source>whole model</source>
+            <extracomment>plugin/qgis/qc_dock.py:319; plugin/widgets/qc_panel.py:107; plugin/widgets/qc_panel.py:348; plugin/widgets/qc_panel.py:422</extracomment>
+            <translation>ganzes Modell</translation>
+        </message>
+        <message>
+            <source>Select a line layer in the layer tree first.</source>
+            <extracomment>plugin/qgis/qc_dock.py:334</extracomment>
+            <translation>Wählen Sie zuerst einen Linienlayer im Layerbaum.</translation>
+        </message>
+        <message>
+            <source>Choose a DTM of a PhotoDEM filter run (with its mask.tif) in the Filter review tab.</source>
+            <extracomment>plugin/qgis/qc_dock.py:393</extracomment>
+            <translation>Wählen Sie im Reiter Filterprüfung ein DGM eines PhotoDEM-Filterlaufs (mit mask.tif).</translation>
+        </message>
+        <message>
+            <source>eliminated</source>
+            <extracomment>plugin/qgis/qc_dock.py:400</extracomment>
+            <translation>eliminiert</translation>
+        </message>
+        <message>
+            <source>Draw area</source>
+            <extracomment>plugin/qgis/qc_dock.py:199</extracomment>
+            <translation>Gebiet zeichnen</translation>
+        </message>
+        <message>
+            <source>Visible extent</source>
+            <extracomment>plugin/qgis/qc_dock.py:200</extracomment>
+            <translation>Sichtbare Ausdehnung</translation>
+        </message>
+        <message>
+            <source>Whole model</source>
+            <extracomment>plugin/qgis/qc_dock.py:201; plugin/widgets/qc_panel.py:182</extracomment>
+            <translation>Ganzes Modell</translation>
+        </message>
+        <message>
+            <source>Show eliminated cells</source>
+            <extracomment>plugin/qgis/qc_dock.py:202</extracomment>
+            <translation>Eliminierte Zellen zeigen</translation>
+        </message>
+        <message>
+            <source>Draw profile</source>
+            <extracomment>plugin/qgis/qc_dock.py:203</extracomment>
+            <translation>Profil zeichnen</translation>
+        </message>
+        <message>
+            <source>Profile of feature</source>
+            <extracomment>plugin/qgis/qc_dock.py:204</extracomment>
+            <translation>Profil eines Objekts</translation>
+        </message>
+        <message>
+            <source>Identify</source>
+            <extracomment>plugin/qgis/qc_dock.py:205; plugin/widgets/qc_panel.py:144</extracomment>
+            <translation>Abfragen</translation>
+        </message>
+        <message>
+            <source>drawn polygon ({0:.0f} m²)</source>
+            <extracomment>plugin/qgis/qc_dock.py:309</extracomment>
+            <translation>gezeichnetes Polygon ({0:.0f} m²)</translation>
+        </message>
+        <message>
+            <source>eliminated cells ({0})</source>
+            <extracomment>plugin/qgis/qc_dock.py:396</extracomment>
+            <translation>eliminierte Zellen ({0})</translation>
+        </message>
+        <message>
+            <source>Blunder to {0}</source>
+            <extracomment>plugin/qgis/qc_dock.py:451</extracomment>
+            <translation>Grober Fehler nach {0}</translation>
+        </message>
+        <message>
+            <source>Open a PhotoDEM project first: the edit goes into its layer '{0}'.</source>
+            <extracomment>plugin/qgis/qc_dock.py:439</extracomment>
+            <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt: Die Bearbeitung kommt in dessen Layer „{0}“.</translation>
         </message>
         <message>
             <source>keep</source>
@@ -3235,7 +3350,7 @@
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:243; plugin/widgets/georef_review.py:476; plugin/widgets/run_panel.py:45</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:243; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
@@ -3766,6 +3881,526 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Datei wählen</translation>
         </message>
         <message>
+            <source>dtm.tif of a PhotoDEM filter run (its mask.tif beside it)</source>
+            <extracomment>plugin/widgets/qc_filter.py:48</extracomment>
+            <translation>dtm.tif eines PhotoDEM-Filterlaufs (mit mask.tif daneben)</translation>
+        </message>
+        <message>
+            <source>preset</source>
+            <extracomment>plugin/widgets/qc_filter.py:60</extracomment>
+            <translation>Voreinstellung</translation>
+        </message>
+        <message>
+            <source>Re-filter area</source>
+            <extracomment>plugin/widgets/qc_filter.py:64</extracomment>
+            <translation>Gebiet neu filtern</translation>
+        </message>
+        <message>
+            <source>Draw an area, choose a preset and press 'Re-filter area'</source>
+            <extracomment>plugin/widgets/qc_filter.py:69</extracomment>
+            <translation>Zeichnen Sie ein Gebiet, wählen Sie eine Voreinstellung und drücken Sie „Gebiet neu filtern“</translation>
+        </message>
+        <message>
+            <source>Accept into the DTM</source>
+            <extracomment>plugin/widgets/qc_filter.py:151; plugin/widgets/qc_filter.py:75</extracomment>
+            <translation>In das DGM übernehmen</translation>
+        </message>
+        <message>
+            <source>Re-filtering the area…</source>
+            <extracomment>plugin/widgets/qc_filter.py:97</extracomment>
+            <translation>Gebiet wird neu gefiltert…</translation>
+        </message>
+        <message>
+            <source>new − old DTM [m]</source>
+            <extracomment>plugin/widgets/qc_filter.py:138</extracomment>
+            <translation>neues − altes DGM [m]</translation>
+        </message>
+        <message>
+            <source>Preset</source>
+            <extracomment>plugin/widgets/qc_filter.py:55</extracomment>
+            <translation>Voreinstellung</translation>
+        </message>
+        <message>
+            <source>Final threshold</source>
+            <extracomment>plugin/widgets/qc_filter.py:62</extracomment>
+            <translation>Letzte Schwelle</translation>
+        </message>
+        <message>
+            <source>Draw the area to re-filter first.</source>
+            <extracomment>plugin/widgets/qc_filter.py:86</extracomment>
+            <translation>Zeichnen Sie zuerst das neu zu filternde Gebiet.</translation>
+        </message>
+        <message>
+            <source>Choose the DSM (as DEM) and the DTM it was filtered into.</source>
+            <extracomment>plugin/widgets/qc_filter.py:89</extracomment>
+            <translation>Wählen Sie das DOM (als DHM) und das daraus gefilterte DGM.</translation>
+        </message>
+        <message>
+            <source>eliminated before</source>
+            <extracomment>plugin/widgets/qc_filter.py:124</extracomment>
+            <translation>eliminiert vorher</translation>
+        </message>
+        <message>
+            <source>eliminated after</source>
+            <extracomment>plugin/widgets/qc_filter.py:125</extracomment>
+            <translation>eliminiert nachher</translation>
+        </message>
+        <message>
+            <source>Eliminated in the area: {0} before, {1} with '{2}'; new − old DTM: median {3:+.3f} m, max |Δh| {4:.2f} m. Nothing is written until you accept.</source>
+            <extracomment>plugin/widgets/qc_filter.py:107</extracomment>
+            <translation>Im Gebiet eliminiert: {0} vorher, {1} mit „{2}“; neues − altes DGM: Median {3:+.3f} m, max. |Δh| {4:.2f} m. Geschrieben wird erst, wenn Sie übernehmen.</translation>
+        </message>
+        <message>
+            <source>The area was written into {0}.</source>
+            <extracomment>plugin/widgets/qc_filter.py:161</extracomment>
+            <translation>Das Gebiet wurde in {0} geschrieben.</translation>
+        </message>
+        <message>
+            <source>Write the re-filtered area into '{0}' (and its mask)? The cells outside the area stay as they are.</source>
+            <extracomment>plugin/widgets/qc_filter.py:152</extracomment>
+            <translation>Das neu gefilterte Gebiet in „{0}“ (und seine Maske) schreiben? Die Zellen außerhalb des Gebiets bleiben unverändert.</translation>
+        </message>
+        <message>
+            <source>Rasters (*.tif *.tiff *.vrt *.img);;All files (*)</source>
+            <extracomment>plugin/widgets/qc_panel.py:123</extracomment>
+            <translation>Raster (*.tif *.tiff *.vrt *.img);;Alle Dateien (*)</translation>
+        </message>
+        <message>
+            <source>PhotoDEM project folder</source>
+            <extracomment>plugin/widgets/qc_panel.py:124</extracomment>
+            <translation>PhotoDEM-Projektordner</translation>
+        </message>
+        <message>
+            <source>edits and comparisons go into this project</source>
+            <extracomment>plugin/widgets/qc_panel.py:125</extracomment>
+            <translation>Edits und Vergleiche werden in dieses Projekt geschrieben</translation>
+        </message>
+        <message>
+            <source>Class raster</source>
+            <extracomment>plugin/widgets/qc_panel.py:133</extracomment>
+            <translation>Klassenraster</translation>
+        </message>
+        <message>
+            <source>further surfaces for profiles, separated by ;</source>
+            <extracomment>plugin/widgets/qc_panel.py:136</extracomment>
+            <translation>weitere Oberflächen für Profile, getrennt durch ;</translation>
+        </message>
+        <message>
+            <source>Profile also</source>
+            <extracomment>plugin/widgets/qc_panel.py:137</extracomment>
+            <translation>Im Profil auch</translation>
+        </message>
+        <message>
+            <source>Statistics</source>
+            <extracomment>plugin/widgets/qc_panel.py:141</extracomment>
+            <translation>Statistik</translation>
+        </message>
+        <message>
+            <source>Profile</source>
+            <extracomment>plugin/widgets/qc_panel.py:142; plugin/widgets/qc_panel.py:210</extracomment>
+            <translation>Profil</translation>
+        </message>
+        <message>
+            <source>Blunders</source>
+            <extracomment>plugin/widgets/qc_panel.py:143</extracomment>
+            <translation>Grobe Fehler</translation>
+        </message>
+        <message>
+            <source>Filter review</source>
+            <extracomment>plugin/widgets/qc_panel.py:146</extracomment>
+            <translation>Filterprüfung</translation>
+        </message>
+        <message>
+            <source>Compare</source>
+            <extracomment>plugin/widgets/qc_panel.py:153</extracomment>
+            <translation>Vergleichen</translation>
+        </message>
+        <message>
+            <source>Run dem_compare on the whole model and add the difference model to the map</source>
+            <extracomment>plugin/widgets/qc_panel.py:154</extracomment>
+            <translation>dem_compare für das ganze Modell ausführen und das Differenzmodell zur Karte hinzufügen</translation>
+        </message>
+        <message>
+            <source>Statistics of the area</source>
+            <extracomment>plugin/widgets/qc_panel.py:157</extracomment>
+            <translation>Statistik des Gebiets</translation>
+        </message>
+        <message>
+            <source>xmin, ymin, xmax, ymax (reference CRS)</source>
+            <extracomment>plugin/widgets/qc_panel.py:179</extracomment>
+            <translation>xmin, ymin, xmax, ymax (KBS der Referenz)</translation>
+        </message>
+        <message>
+            <source>Use extent</source>
+            <extracomment>plugin/widgets/qc_panel.py:180</extracomment>
+            <translation>Ausdehnung verwenden</translation>
+        </message>
+        <message>
+            <source>Draw an area or press 'Statistics of the area'</source>
+            <extracomment>plugin/widgets/qc_panel.py:194</extracomment>
+            <translation>Zeichnen Sie ein Gebiet oder drücken Sie „Statistik des Gebiets“</translation>
+        </message>
+        <message>
+            <source>x1,y1;x2,y2;… (DEM CRS), or draw a line on the map</source>
+            <extracomment>plugin/widgets/qc_panel.py:208</extracomment>
+            <translation>x1,y1;x2,y2;… (KBS des DHM) oder eine Linie in der Karte zeichnen</translation>
+        </message>
+        <message>
+            <source>Draw a line on the map</source>
+            <extracomment>plugin/widgets/qc_panel.py:216</extracomment>
+            <translation>Zeichnen Sie eine Linie in der Karte</translation>
+        </message>
+        <message>
+            <source>Export CSV…</source>
+            <extracomment>plugin/widgets/qc_panel.py:221</extracomment>
+            <translation>CSV exportieren…</translation>
+        </message>
+        <message>
+            <source>Export PNG…</source>
+            <extracomment>plugin/widgets/qc_panel.py:223</extracomment>
+            <translation>PNG exportieren…</translation>
+        </message>
+        <message>
+            <source>Find blunders</source>
+            <extracomment>plugin/widgets/qc_panel.py:241</extracomment>
+            <translation>Grobe Fehler suchen</translation>
+        </message>
+        <message>
+            <source>To exclusion area</source>
+            <extracomment>plugin/widgets/qc_panel.py:258</extracomment>
+            <translation>Als Ausschlussfläche</translation>
+        </message>
+        <message>
+            <source>To ground point</source>
+            <extracomment>plugin/widgets/qc_panel.py:260</extracomment>
+            <translation>Als Bodenpunkt</translation>
+        </message>
+        <message>
+            <source>A ground point at the spot's centre with the reference height</source>
+            <extracomment>plugin/widgets/qc_panel.py:261</extracomment>
+            <translation>Ein Bodenpunkt in der Mitte der Stelle mit der Höhe der Referenz</translation>
+        </message>
+        <message>
+            <source>Click on the map to see every surface's height there.</source>
+            <extracomment>plugin/widgets/qc_panel.py:275</extracomment>
+            <translation>Klicken Sie in die Karte, um dort die Höhe jeder Oberfläche zu sehen.</translation>
+        </message>
+        <message>
+            <source>Computing statistics…</source>
+            <extracomment>plugin/widgets/qc_panel.py:384</extracomment>
+            <translation>Statistik wird berechnet…</translation>
+        </message>
+        <message>
+            <source>Comparing…</source>
+            <extracomment>plugin/widgets/qc_panel.py:417</extracomment>
+            <translation>Vergleiche…</translation>
+        </message>
+        <message>
+            <source>Done.</source>
+            <extracomment>plugin/widgets/qc_panel.py:455</extracomment>
+            <translation>Fertig.</translation>
+        </message>
+        <message>
+            <source>Searching blunders…</source>
+            <extracomment>plugin/widgets/qc_panel.py:488</extracomment>
+            <translation>Suche grobe Fehler…</translation>
+        </message>
+        <message>
+            <source>CSV (*.csv)</source>
+            <extracomment>plugin/widgets/qc_panel.py:597</extracomment>
+            <translation>CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>PNG image (*.png)</source>
+            <extracomment>plugin/widgets/qc_panel.py:597</extracomment>
+            <translation>PNG-Bild (*.png)</translation>
+        </message>
+        <message>
+            <source>Export profile</source>
+            <extracomment>plugin/widgets/qc_panel.py:598</extracomment>
+            <translation>Profil exportieren</translation>
+        </message>
+        <message>
+            <source>Area</source>
+            <extracomment>plugin/widgets/qc_panel.py:184</extracomment>
+            <translation>Gebiet</translation>
+        </message>
+        <message>
+            <source>|Δh − median| above k × NMAD, k =</source>
+            <extracomment>plugin/widgets/qc_panel.py:235</extracomment>
+            <translation>|Δh − Median| über k × NMAD, k =</translation>
+        </message>
+        <message>
+            <source>the DEM</source>
+            <extracomment>plugin/widgets/qc_panel.py:317</extracomment>
+            <translation>das Höhenmodell</translation>
+        </message>
+        <message>
+            <source>the reference</source>
+            <extracomment>plugin/widgets/qc_panel.py:317</extracomment>
+            <translation>die Referenz</translation>
+        </message>
+        <message>
+            <source>drawn area</source>
+            <extracomment>plugin/widgets/qc_panel.py:348</extracomment>
+            <translation>gezeichnetes Gebiet</translation>
+        </message>
+        <message>
+            <source>Give the extent as 'xmin, ymin, xmax, ymax'.</source>
+            <extracomment>plugin/widgets/qc_panel.py:361</extracomment>
+            <translation>Geben Sie die Ausdehnung als „xmin, ymin, xmax, ymax“ an.</translation>
+        </message>
+        <message>
+            <source>Open a project first: the comparison is written into its products folder.</source>
+            <extracomment>plugin/widgets/qc_panel.py:409</extracomment>
+            <translation>Öffnen Sie zuerst ein Projekt: Der Vergleich wird in seinen Produktordner geschrieben.</translation>
+        </message>
+        <message>
+            <source>A computation is running; wait or cancel it.</source>
+            <extracomment>plugin/widgets/qc_panel.py:435</extracomment>
+            <translation>Eine Berechnung läuft; warten Sie oder brechen Sie sie ab.</translation>
+        </message>
+        <message>
+            <source>Select a blunder in the list first.</source>
+            <extracomment>plugin/widgets/qc_panel.py:507</extracomment>
+            <translation>Wählen Sie zuerst einen groben Fehler in der Liste.</translation>
+        </message>
+        <message>
+            <source>Open a project with an edits.gpkg first: the edit goes into it.</source>
+            <extracomment>plugin/widgets/qc_panel.py:514</extracomment>
+            <translation>Öffnen Sie zuerst ein Projekt mit edits.gpkg: Die Bearbeitung wird dort gespeichert.</translation>
+        </message>
+        <message>
+            <source>The reference has no height at the spot's centre.</source>
+            <extracomment>plugin/widgets/qc_panel.py:552</extracomment>
+            <translation>Die Referenz hat in der Mitte der Stelle keine Höhe.</translation>
+        </message>
+        <message>
+            <source>Choose the surfaces first.</source>
+            <extracomment>plugin/widgets/qc_panel.py:562; plugin/widgets/qc_panel.py:608</extracomment>
+            <translation>Wählen Sie zuerst die Oberflächen.</translation>
+        </message>
+        <message>
+            <source>Height [m]</source>
+            <extracomment>plugin/widgets/qc_panel.py:614; plugin/widgets/qc_plots.py:170</extracomment>
+            <translation>Höhe [m]</translation>
+        </message>
+        <message>
+            <source>extent {0}</source>
+            <extracomment>plugin/widgets/qc_panel.py:363</extracomment>
+            <translation>Ausdehnung {0}</translation>
+        </message>
+        <message>
+            <source>Area: {0}</source>
+            <extracomment>plugin/widgets/qc_panel.py:374</extracomment>
+            <translation>Gebiet: {0}</translation>
+        </message>
+        <message>
+            <source>Cancelled.</source>
+            <extracomment>plugin/widgets/qc_panel.py:441</extracomment>
+            <translation>Abgebrochen.</translation>
+        </message>
+        <message>
+            <source>{0} blunder spots (|Δh − median| &gt; {1:.2f} m).</source>
+            <extracomment>plugin/widgets/qc_panel.py:493</extracomment>
+            <translation>{0} Stellen mit groben Fehlern (|Δh − Median| &gt; {1:.2f} m).</translation>
+        </message>
+        <message>
+            <source>Written to {0}.</source>
+            <extracomment>plugin/widgets/qc_panel.py:525</extracomment>
+            <translation>In {0} geschrieben.</translation>
+        </message>
+        <message>
+            <source>{0} stations, {1} breakline crossings, {2} check points</source>
+            <extracomment>plugin/widgets/qc_panel.py:576</extracomment>
+            <translation>{0} Stationen, {1} Kreuzungen mit Bruchkanten, {2} Kontrollpunkte</translation>
+        </message>
+        <message>
+            <source>At x = {0:.2f}, y = {1:.2f}</source>
+            <extracomment>plugin/widgets/qc_panel.py:621</extracomment>
+            <translation>Bei x = {0:.2f}, y = {1:.2f}</translation>
+        </message>
+        <message>
+            <source>'{0}' is no PhotoDEM project (no project.toml); choose the project folder.</source>
+            <extracomment>plugin/widgets/qc_panel.py:288</extracomment>
+            <translation>„{0}“ ist kein PhotoDEM-Projekt (keine project.toml); wählen Sie den Projektordner.</translation>
+        </message>
+        <message>
+            <source>Internal error: {0}</source>
+            <extracomment>plugin/widgets/qc_panel.py:460</extracomment>
+            <translation>Interner Fehler: {0}</translation>
+        </message>
+        <message>
+            <source>Profile written to {0}.</source>
+            <extracomment>plugin/widgets/qc_panel.py:602</extracomment>
+            <translation>Profil nach {0} geschrieben.</translation>
+        </message>
+        <message>
+            <source>Choose {0}: '{1}' is not a raster file.</source>
+            <extracomment>plugin/widgets/qc_panel.py:320</extracomment>
+            <translation>Wählen Sie {0}: „{1}“ ist keine Rasterdatei.</translation>
+        </message>
+        <message>
+            <source>Δh = DEM − reference [m]</source>
+            <extracomment>plugin/widgets/qc_plots.py:140</extracomment>
+            <translation>Δh = DHM − Referenz [m]</translation>
+        </message>
+        <message>
+            <source>Cells</source>
+            <extracomment>plugin/widgets/qc_plots.py:141; plugin/widgets/qc_plots.py:181</extracomment>
+            <translation>Zellen</translation>
+        </message>
+        <message>
+            <source>Distance along the line [m]</source>
+            <extracomment>plugin/widgets/qc_plots.py:169</extracomment>
+            <translation>Abstand entlang der Linie [m]</translation>
+        </message>
+        <message>
+            <source>Area [m²]</source>
+            <extracomment>plugin/widgets/qc_plots.py:181</extracomment>
+            <translation>Fläche [m²]</translation>
+        </message>
+        <message>
+            <source>Max. Δh [m]</source>
+            <extracomment>plugin/widgets/qc_plots.py:181</extracomment>
+            <translation>Max. Δh [m]</translation>
+        </message>
+        <message>
+            <source>Mean Δh [m]</source>
+            <extracomment>plugin/widgets/qc_plots.py:181</extracomment>
+            <translation>Mittleres Δh [m]</translation>
+        </message>
+        <message>
+            <source>Count</source>
+            <extracomment>plugin/widgets/qc_plots.py:27; plugin/widgets/qc_plots.py:81</extracomment>
+            <translation>Anzahl</translation>
+        </message>
+        <message>
+            <source>Mean</source>
+            <extracomment>plugin/widgets/qc_plots.py:27; plugin/widgets/qc_plots.py:81</extracomment>
+            <translation>Mittelwert</translation>
+        </message>
+        <message>
+            <source>Median</source>
+            <extracomment>plugin/widgets/qc_plots.py:28; plugin/widgets/qc_plots.py:82</extracomment>
+            <translation>Median</translation>
+        </message>
+        <message>
+            <source>Std. deviation</source>
+            <extracomment>plugin/widgets/qc_plots.py:28</extracomment>
+            <translation>Standardabweichung</translation>
+        </message>
+        <message>
+            <source>Minimum</source>
+            <extracomment>plugin/widgets/qc_plots.py:29</extracomment>
+            <translation>Minimum</translation>
+        </message>
+        <message>
+            <source>Maximum</source>
+            <extracomment>plugin/widgets/qc_plots.py:30</extracomment>
+            <translation>Maximum</translation>
+        </message>
+        <message>
+            <source>68 % quantile of |Δh|</source>
+            <extracomment>plugin/widgets/qc_plots.py:30</extracomment>
+            <translation>68-%-Quantil von |Δh|</translation>
+        </message>
+        <message>
+            <source>90 % quantile of |Δh|</source>
+            <extracomment>plugin/widgets/qc_plots.py:31</extracomment>
+            <translation>90-%-Quantil von |Δh|</translation>
+        </message>
+        <message>
+            <source>95 % quantile of |Δh|</source>
+            <extracomment>plugin/widgets/qc_plots.py:31</extracomment>
+            <translation>95-%-Quantil von |Δh|</translation>
+        </message>
+        <message>
+            <source>99 % quantile of |Δh|</source>
+            <extracomment>plugin/widgets/qc_plots.py:32</extracomment>
+            <translation>99-%-Quantil von |Δh|</translation>
+        </message>
+        <message>
+            <source>Within ±0.25 m</source>
+            <extracomment>plugin/widgets/qc_plots.py:33</extracomment>
+            <translation>Innerhalb ±0,25 m</translation>
+        </message>
+        <message>
+            <source>Within ±0.5 m</source>
+            <extracomment>plugin/widgets/qc_plots.py:33; plugin/widgets/qc_plots.py:82</extracomment>
+            <translation>Innerhalb ±0,5 m</translation>
+        </message>
+        <message>
+            <source>Within ±1 m</source>
+            <extracomment>plugin/widgets/qc_plots.py:34</extracomment>
+            <translation>Innerhalb ±1 m</translation>
+        </message>
+        <message>
+            <source>Statistic</source>
+            <extracomment>plugin/widgets/qc_plots.py:58</extracomment>
+            <translation>Kennzahl</translation>
+        </message>
+        <message>
+            <source>Value</source>
+            <extracomment>plugin/widgets/qc_plots.py:58; plugin/widgets/run_panel.py:62</extracomment>
+            <translation>Wert</translation>
+        </message>
+        <message>
+            <source>Class</source>
+            <extracomment>plugin/widgets/qc_plots.py:78</extracomment>
+            <translation>Klasse</translation>
+        </message>
+        <message>
+            <source>Slope</source>
+            <extracomment>plugin/widgets/qc_plots.py:79</extracomment>
+            <translation>Neigung</translation>
+        </message>
+        <message>
+            <source>Grouping</source>
+            <extracomment>plugin/widgets/qc_plots.py:81</extracomment>
+            <translation>Gruppierung</translation>
+        </message>
+        <message>
+            <source>Group</source>
+            <extracomment>plugin/widgets/qc_plots.py:81</extracomment>
+            <translation>Gruppe</translation>
+        </message>
+        <message>
+            <source>No differences in this area</source>
+            <extracomment>plugin/widgets/qc_plots.py:124</extracomment>
+            <translation>Keine Differenzen in diesem Gebiet</translation>
+        </message>
+        <message>
+            <source>check point</source>
+            <extracomment>plugin/widgets/qc_plots.py:163</extracomment>
+            <translation>Kontrollpunkt</translation>
+        </message>
+        <message>
+            <source>line vertices (Z)</source>
+            <extracomment>plugin/widgets/qc_plots.py:167</extracomment>
+            <translation>Stützpunkte der Linie (Z)</translation>
+        </message>
+        <message>
+            <source>Profile: {0:.1f} m, spacing {1:g} m</source>
+            <extracomment>plugin/widgets/qc_plots.py:171</extracomment>
+            <translation>Profil: {0:.1f} m, Abstand {1:g} m</translation>
+        </message>
+        <message>
+            <source>median {0:.3f} m</source>
+            <extracomment>plugin/widgets/qc_plots.py:134</extracomment>
+            <translation>Median {0:.3f} m</translation>
+        </message>
+        <message>
+            <source>{0} cells outside the plot</source>
+            <extracomment>plugin/widgets/qc_plots.py:139</extracomment>
+            <translation>{0} Zellen außerhalb der Grafik</translation>
+        </message>
+        <message>
+            <source>Δh histogram: {0} cells, NMAD {1:.3f} m</source>
+            <extracomment>plugin/widgets/qc_plots.py:138</extracomment>
+            <translation>Δh-Histogramm: {0} Zellen, NMAD {1:.3f} m</translation>
+        </message>
+        <message>
             <source>The log of the run appears here.</source>
             <extracomment>plugin/widgets/run_panel.py:57</extracomment>
             <translation>Hier erscheint das Protokoll des Laufs.</translation>
@@ -3789,11 +4424,6 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Output</source>
             <extracomment>plugin/widgets/run_panel.py:62</extracomment>
             <translation>Ausgabe</translation>
-        </message>
-        <message>
-            <source>Value</source>
-            <extracomment>plugin/widgets/run_panel.py:62</extracomment>
-            <translation>Wert</translation>
         </message>
         <message>
             <source>Unexpected error (please report it):</source>
