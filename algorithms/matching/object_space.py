@@ -107,7 +107,6 @@ import numpy as np
 from numpy.typing import NDArray
 from rasterio.enums import ColorInterp
 from rasterio.windows import Window
-from scipy import ndimage
 
 from ..crs_check import check_surface_crs
 from ..errors import GeometryError, InputError
@@ -123,8 +122,11 @@ from .object_space_window import (
     PROBE_DISTANCE,
     ImageWindow,
     WindowResult,
+    _bilinear_weights,
+    _fill_nearest,
     adjust_window,
     noblas,
+    same_side_weights,
 )
 from .pyramid import build_pyramid
 
@@ -490,7 +492,7 @@ def _refine_tile(plan: _Plan, settings: _TileSettings, src: Any, r0: int, c0: in
         rep["message"] = res.message
         feedback.warning(f"Tile at row {r0}, col {c0}: {res.message}; left empty (NaN).")
         return z_out, s_out, rep
-    z_out, s_out = _tile_products(res, z_in, valid, core, plan.stride)
+    z_out, s_out = _tile_products(res, z_in, valid, core, plan.stride, plan.spacing)
     rep["sigma0"] = round(res.sigma0, 4) if np.isfinite(res.sigma0) else None
     k = np.isfinite(s_out)
     totals.n_refined += int(k.sum())
@@ -503,17 +505,32 @@ def _refine_tile(plan: _Plan, settings: _TileSettings, src: Any, r0: int, c0: in
 
 
 def _tile_products(res: WindowResult, z_in: Array, valid: NDArray[np.bool_],
-                   core: Tuple[slice, slice], stride: int) -> Tuple[Array, Array]:
-    """Refined heights and σ (float32) of a tile's core from the node results (bilinear)."""
+                   core: Tuple[slice, slice], stride: int, spacing: float
+                   ) -> Tuple[Array, Array]:
+    """Refined heights and σ (float32) of a tile's core from the node results.
+
+    Bilinear from the nodes on the same side of a wall as the cell
+    (:func:`.object_space_window.same_side_weights`): a roof's correction does not leak to
+    the ground beside it. A cell with no node on its side (on the wall itself) keeps its
+    input height, without σ.
+    """
     nr, nc = z_in.shape
     rr_, cc_ = np.mgrid[0:nr, 0:nc]
-    coords = [rr_ / stride, cc_ / stride]
-    dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
-    sg = ndimage.map_coordinates(np.nan_to_num(res.sigma, nan=1e9), coords, order=1,
-                                 mode="nearest")
-    obs = ndimage.map_coordinates(res.observed.astype(float), coords, order=1, mode="nearest")
+    ny, nx = res.dz.shape
+    idx, w = _bilinear_weights(cc_.ravel() / stride, rr_.ravel() / stride, nx, ny)
+    zf = _fill_nearest(np.asarray(z_in, dtype=float))
+    w = same_side_weights(idx, w, zf[::stride, ::stride][:ny, :nx].ravel(), zf.ravel(),
+                          stride * spacing)
+    wall = (w.sum(axis=1) == 0).reshape(nr, nc)
+
+    def interp(nodes: Array) -> Array:
+        return (nodes.ravel()[idx] * w).sum(axis=1).reshape(nr, nc)
+
+    dz = interp(res.dz)
+    sg = interp(np.nan_to_num(res.sigma, nan=1e9))
+    obs = interp(res.observed.astype(float))
     good = valid & (obs > 0.5) & (sg < 1e8)
-    zr = np.where(good, z_in + dz, np.nan)
+    zr = np.where(good, z_in + dz, np.where(valid & wall, z_in, np.nan))
     sr = np.where(good, sg, np.nan)
     # σ to 0.1 mm: the sparse LU may differ in the last bits between processes (BLAS
     # builds), which must not show in the product
