@@ -512,25 +512,30 @@ def _tile_products(res: WindowResult, z_in: Array, valid: NDArray[np.bool_],
     Bilinear from the nodes on the same side of a wall as the cell
     (:func:`.object_space_window.same_side_weights`): a roof's correction does not leak to
     the ground beside it. A cell with no node on its side (on the wall itself) keeps its
-    input height, without σ.
+    input height, without σ, and so does a cell whose observed nodes are all across a wall.
+    Cells without observed nodes around them are NaN (as without the walls rule).
     """
     nr, nc = z_in.shape
     rr_, cc_ = np.mgrid[0:nr, 0:nc]
     ny, nx = res.dz.shape
-    idx, w = _bilinear_weights(cc_.ravel() / stride, rr_.ravel() / stride, nx, ny)
+    idx, w_all = _bilinear_weights(cc_.ravel() / stride, rr_.ravel() / stride, nx, ny)
     zf = _fill_nearest(np.asarray(z_in, dtype=float))
-    w = same_side_weights(idx, w, zf[::stride, ::stride][:ny, :nx].ravel(), zf.ravel(),
+    w = same_side_weights(idx, w_all, zf[::stride, ::stride][:ny, :nx].ravel(), zf.ravel(),
                           stride * spacing)
     wall = (w.sum(axis=1) == 0).reshape(nr, nc)
 
-    def interp(nodes: Array) -> Array:
-        return (nodes.ravel()[idx] * w).sum(axis=1).reshape(nr, nc)
+    def interp(nodes: Array, weights: Array = w) -> Array:
+        return (nodes.ravel()[idx] * weights).sum(axis=1).reshape(nr, nc)
 
     dz = interp(res.dz)
     sg = interp(np.nan_to_num(res.sigma, nan=1e9))
-    obs = interp(res.observed.astype(float))
-    good = valid & (obs > 0.5) & (sg < 1e8)
-    zr = np.where(good, z_in + dz, np.where(valid & wall, z_in, np.nan))
+    # refined where the nodes around the cell are observed, on its side and in all; where
+    # only those across a wall are, or on the wall itself, the input height is kept (the
+    # cells the refinement leaves empty stay what they were without the walls rule)
+    obs_all = interp(res.observed.astype(float), w_all)
+    good = valid & (obs_all > 0.5) & (interp(res.observed.astype(float)) > 0.5) & (sg < 1e8)
+    keep = valid & ~good & (wall | (obs_all > 0.5))
+    zr = np.where(good, z_in + dz, np.where(keep, z_in, np.nan))
     sr = np.where(good, sg, np.nan)
     # σ to 0.1 mm: the sparse LU may differ in the last bits between processes (BLAS
     # builds), which must not show in the product

@@ -188,6 +188,28 @@ def _second_difference_rows(ny: int, nx: int, z_nodes: Optional[Array] = None,
     return sparse.csr_matrix((vals, (rows, cols)), shape=(n, ny * nx))
 
 
+def _hold_rows(ny: int, nx: int, z_nodes: Array, step: Optional[float] = None
+               ) -> sparse.csr_matrix:
+    """Rows ``2·dZ_c = 0`` for the centre of every curvature row cut at a wall.
+
+    The cut keeps the roof's correction off the ground, but leaves the nodes next to a wall
+    (on weakly textured roofs often all nodes of a small roof) without the regularisation
+    that held them; this holds them at the input height instead, with the weight a
+    curvature row gives its centre. On the correction ΔZ in both modes.
+    """
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    zf = np.asarray(z_nodes, dtype=float).ravel()
+    lim = BREAK_M if step is None else step
+    cut = []
+    for centre, lo, hi in ((idx[:, 1:-1], idx[:, :-2], idx[:, 2:]),
+                           (idx[1:-1, :], idx[:-2, :], idx[2:, :])):
+        c, a, b = centre.ravel(), lo.ravel(), hi.ravel()
+        cut.append(c[~(np.abs(zf[a] - 2.0 * zf[c] + zf[b]) <= lim)])
+    c = np.concatenate(cut) if cut else np.zeros(0, int)
+    return sparse.csr_matrix((np.full(c.size, 2.0), (np.arange(c.size), c)),
+                             shape=(c.size, ny * nx))
+
+
 # -- image windows -----------------------------------------------------------------------------
 @dataclass
 class ImageWindow:
@@ -345,6 +367,7 @@ class _Lattice:
     nox: int
     delta: float  # metres of the ∂/∂Z differences
     reg: sparse.csr_matrix
+    hold: sparse.csr_matrix  # rows holding the nodes at cut curvature rows (on ΔZ)
     zin_nodes: Array
 
 
@@ -379,7 +402,8 @@ def _lattice(win: _Window, rows: int, cols: int, st: int, level: int, gsd: float
     oidx, ow = _bilinear_weights(SU / dgo, SV / dgo, nox, noy)
     return _Lattice(level, st, ny, nx, ns_y, ns_x, win.x_first + SU, win.y_first - SV, z_s,
                     v_s, gidx, gw, oidx, ow, noy, nox, max(gsd_l, 0.05),
-                    _second_difference_rows(ny, nx, zin_nodes), zin_nodes)
+                    _second_difference_rows(ny, nx, zin_nodes), _hold_rows(ny, nx, zin_nodes),
+                    zin_nodes)
 
 
 def _level_visibility(win: _Window, lat: _Lattice, dz: Array) -> NDArray[np.bool_]:
@@ -511,7 +535,8 @@ def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice
     n_z, n_unk = lat.nx * lat.ny, A.shape[1]
     Nd = (A.T @ A).tocsr()
     b = A.T @ obs
-    R = sparse.hstack([lat.reg, sparse.csr_matrix((lat.reg.shape[0], n_unk - n_z))]).tocsr()
+    Rz = sparse.vstack([lat.reg, lat.hold]).tocsr()
+    R = sparse.hstack([Rz, sparse.csr_matrix((Rz.shape[0], n_unk - n_z))]).tocsr()
     RtR = (R.T @ R).tocsr()
     if lam < 0:  # λ from the share, once per level
         d_data = float(Nd.diagonal()[:n_z].mean())
@@ -521,7 +546,7 @@ def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice
     st.reg_share = float(Nr.diagonal()[:n_z].mean()
                          / max(float(Nd.diagonal()[:n_z].mean()), 1e-30))
     z_node = dz if opts.mode == "correction" else lat.zin_nodes + dz
-    b = b - lam * (R.T @ (lat.reg @ z_node.ravel()))
+    b = b - lam * (R.T @ np.concatenate([lat.reg @ z_node.ravel(), lat.hold @ dz.ravel()]))
     # determinability (seed-004 §5.3 f): a grey node at the edge of the used samples may
     # carry only a corner of one sample's bilinear weights; a ridge of 1e-3 of the typical
     # grey diagonal keeps it from running away (negligible elsewhere)
