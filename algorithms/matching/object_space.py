@@ -86,9 +86,20 @@ Windows
     NaN. A window whose adjustment diverges is written as NaN and counted as a failure; the run
     goes on.
 
-Not modelled: breaklines in the regularisation, robust reweighting (off in the thesis as well;
-the screening above only removes gross errors), walls (the 2.5D limit: their samples are
-dropped, the input heights there are kept up to the smooth correction).
+Walls (issue 19)
+    Discontinuities come from the input DSM. Curvature rows whose input second difference
+    exceeds :data:`.object_space_window.BREAK_M` (1 m: a wall, not a slope) are left out and
+    their centre nodes held at the input height (``2·ΔZ = 0``, weight λ) instead; samples,
+    the prolongation between levels and the output cells take their correction only from
+    nodes on the same side (:func:`.object_space_window.same_side_weights`: a node more than
+    1 m + 0.5 × distance off in input height is across a wall). A cell without a node on its
+    side (the wall itself), or whose observed nodes are all across a wall, keeps its input
+    height without σ. So a roof's correction does not leak onto the ground beside it, and the
+    walls stay where the input has them (measured in ``docs/decisions.md``).
+
+Not modelled: robust reweighting (off in the thesis as well; the screening above only removes
+gross errors), moving walls (the 2.5D limit: their samples are dropped, the input's wall
+position is kept).
 
 The adjustment of one window is in :mod:`.object_space_window`; the conjugate gradients are
 :func:`..linalg.pcg`.
