@@ -1124,9 +1124,9 @@
             <translation>Oberflächen</translation>
         </message>
         <message>
-            <source>Merges model DSMs into one DSM on a common grid: the union of their extents at the finest input cell size (or at the given spacing), in the CRS of the first input; inputs with another grid or CRS are resampled bilinearly, window by window. Modes: median or mean of the heights per cell; best_sigma takes the height of the input with the smallest σ, where σ is a second band of the input or a raster &lt;name&gt;_sigma.tif or sigma.tif beside it — inputs without σ are used only where no input with σ has a height (as their median), so without any σ best_sigma is the median. Writes the DSM, &lt;name&gt;_count.tif (inputs per cell) and the seam statistics of every overlapping pair (Δh = a − b: count, mean, median, std, RMS, NMAD) as &lt;name&gt;_seams.json and .csv.</source>
+            <source>Merges model DSMs into one DSM on a common grid: the union of their extents at the finest input cell size (or at the given spacing), in the CRS of the first input; inputs with another grid or CRS are resampled bilinearly, window by window. Modes: median or mean of the heights per cell; best_sigma takes the height of the input with the smallest σ, where σ is a second band of the input or a raster &lt;name&gt;_sigma.tif or sigma.tif beside it — inputs without σ are used only where no input with σ has a height (as their median), so without any σ best_sigma is the median. Writes the DSM, &lt;name&gt;_count.tif (inputs per cell) and the seam statistics of every overlapping pair (Δh = a − b: count, mean, median, std, RMS, NMAD) as &lt;name&gt;_seams.json and .csv. Walls are kept: where the inputs of a cell differ by more than the step threshold (one has the roof, another the ground), the largest consistent group of heights is used instead of averaging them, and resampled inputs take the nearest cell at steps.</source>
             <extracomment>dsm_merge: help</extracomment>
-            <translation>Führt Modell-DOMs auf einem gemeinsamen Raster zu einem DOM zusammen: die Vereinigung ihrer Ausdehnungen mit der feinsten Zellgröße der Eingaben (oder der angegebenen Zellgröße), im KBS der ersten Eingabe; Eingaben mit anderem Raster oder KBS werden fensterweise bilinear umgetastet. Modi: Median oder Mittel der Höhen je Zelle; best_sigma nimmt die Höhe der Eingabe mit dem kleinsten σ, wobei σ ein zweiter Kanal der Eingabe oder ein Raster &lt;Name&gt;_sigma.tif oder sigma.tif daneben ist — Eingaben ohne σ werden nur dort verwendet, wo keine Eingabe mit σ eine Höhe hat (als ihr Median), ohne jedes σ ist best_sigma also der Median. Schreibt das DOM, &lt;Name&gt;_count.tif (Eingaben je Zelle) und die Nahtstatistik jedes überlappenden Paars (Δh = a − b: Anzahl, Mittel, Median, Standardabweichung, RMS, NMAD) als &lt;Name&gt;_seams.json und .csv.</translation>
+            <translation>Führt Modell-DOMs auf einem gemeinsamen Raster zu einem DOM zusammen: die Vereinigung ihrer Ausdehnungen mit der feinsten Zellgröße der Eingaben (oder der angegebenen Zellgröße), im KBS der ersten Eingabe; Eingaben mit anderem Raster oder KBS werden fensterweise bilinear umgetastet. Modi: Median oder Mittel der Höhen je Zelle; best_sigma nimmt die Höhe der Eingabe mit dem kleinsten σ, wobei σ ein zweiter Kanal der Eingabe oder ein Raster &lt;Name&gt;_sigma.tif oder sigma.tif daneben ist — Eingaben ohne σ werden nur dort verwendet, wo keine Eingabe mit σ eine Höhe hat (als ihr Median), ohne jedes σ ist best_sigma also der Median. Schreibt das DOM, &lt;Name&gt;_count.tif (Eingaben je Zelle) und die Nahtstatistik jedes überlappenden Paars (Δh = a − b: Anzahl, Mittel, Median, Standardabweichung, RMS, NMAD) als &lt;Name&gt;_seams.json und .csv. Wände bleiben erhalten: wo die Eingaben einer Zelle um mehr als die Stufenschwelle voneinander abweichen (eine hat das Dach, eine andere den Boden), wird die größte in sich stimmige Gruppe von Höhen verwendet statt sie zu mitteln, und umgetastete Eingaben nehmen an Stufen die nächste Zelle.</translation>
         </message>
         <message>
             <source>Input DSMs</source>
@@ -1177,6 +1177,16 @@
             <source>Default: the finest cell size of the inputs.</source>
             <extracomment>dsm_merge.spacing: help</extracomment>
             <translation>Standard: die feinste Zellgröße der Eingaben.</translation>
+        </message>
+        <message>
+            <source>Step threshold [m]</source>
+            <extracomment>dsm_merge.step: description</extracomment>
+            <translation>Stufenschwelle [m]</translation>
+        </message>
+        <message>
+            <source>Inputs of a cell that differ by more than this see different surfaces (a wall): they are not averaged. 0 = plain median / mean.</source>
+            <extracomment>dsm_merge.step: help</extracomment>
+            <translation>Eingaben einer Zelle, die um mehr als diesen Wert voneinander abweichen, sehen verschiedene Oberflächen (eine Wand): sie werden nicht gemittelt. 0 = einfacher Median / Mittelwert.</translation>
         </message>
         <message>
             <source>Inputs per cell</source>

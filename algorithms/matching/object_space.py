@@ -86,9 +86,20 @@ Windows
     NaN. A window whose adjustment diverges is written as NaN and counted as a failure; the run
     goes on.
 
-Not modelled: breaklines in the regularisation, robust reweighting (off in the thesis as well;
-the screening above only removes gross errors), walls (the 2.5D limit: their samples are
-dropped, the input heights there are kept up to the smooth correction).
+Walls (issue 19)
+    Discontinuities come from the input DSM. Curvature rows whose input second difference
+    exceeds :data:`.object_space_window.BREAK_M` (1 m: a wall, not a slope) are left out and
+    their centre nodes held at the input height (``2·ΔZ = 0``, weight λ) instead; samples,
+    the prolongation between levels and the output cells take their correction only from
+    nodes on the same side (:func:`.object_space_window.same_side_weights`: a node more than
+    1 m + 0.5 × distance off in input height is across a wall). A cell without a node on its
+    side (the wall itself), or whose observed nodes are all across a wall, keeps its input
+    height without σ. So a roof's correction does not leak onto the ground beside it, and the
+    walls stay where the input has them (measured in ``docs/decisions.md``).
+
+Not modelled: robust reweighting (off in the thesis as well; the screening above only removes
+gross errors), moving walls (the 2.5D limit: their samples are dropped, the input's wall
+position is kept).
 
 The adjustment of one window is in :mod:`.object_space_window`; the conjugate gradients are
 :func:`..linalg.pcg`.
@@ -107,7 +118,6 @@ import numpy as np
 from numpy.typing import NDArray
 from rasterio.enums import ColorInterp
 from rasterio.windows import Window
-from scipy import ndimage
 
 from ..crs_check import check_surface_crs
 from ..errors import GeometryError, InputError
@@ -123,8 +133,11 @@ from .object_space_window import (
     PROBE_DISTANCE,
     ImageWindow,
     WindowResult,
+    _bilinear_weights,
+    _fill_nearest,
     adjust_window,
     noblas,
+    same_side_weights,
 )
 from .pyramid import build_pyramid
 
@@ -490,7 +503,7 @@ def _refine_tile(plan: _Plan, settings: _TileSettings, src: Any, r0: int, c0: in
         rep["message"] = res.message
         feedback.warning(f"Tile at row {r0}, col {c0}: {res.message}; left empty (NaN).")
         return z_out, s_out, rep
-    z_out, s_out = _tile_products(res, z_in, valid, core, plan.stride)
+    z_out, s_out = _tile_products(res, z_in, valid, core, plan.stride, plan.spacing)
     rep["sigma0"] = round(res.sigma0, 4) if np.isfinite(res.sigma0) else None
     k = np.isfinite(s_out)
     totals.n_refined += int(k.sum())
@@ -503,17 +516,37 @@ def _refine_tile(plan: _Plan, settings: _TileSettings, src: Any, r0: int, c0: in
 
 
 def _tile_products(res: WindowResult, z_in: Array, valid: NDArray[np.bool_],
-                   core: Tuple[slice, slice], stride: int) -> Tuple[Array, Array]:
-    """Refined heights and σ (float32) of a tile's core from the node results (bilinear)."""
+                   core: Tuple[slice, slice], stride: int, spacing: float
+                   ) -> Tuple[Array, Array]:
+    """Refined heights and σ (float32) of a tile's core from the node results.
+
+    Bilinear from the nodes on the same side of a wall as the cell
+    (:func:`.object_space_window.same_side_weights`): a roof's correction does not leak to
+    the ground beside it. A cell with no node on its side (on the wall itself) keeps its
+    input height, without σ, and so does a cell whose observed nodes are all across a wall.
+    Cells without observed nodes around them are NaN (as without the walls rule).
+    """
     nr, nc = z_in.shape
     rr_, cc_ = np.mgrid[0:nr, 0:nc]
-    coords = [rr_ / stride, cc_ / stride]
-    dz = ndimage.map_coordinates(res.dz, coords, order=1, mode="nearest")
-    sg = ndimage.map_coordinates(np.nan_to_num(res.sigma, nan=1e9), coords, order=1,
-                                 mode="nearest")
-    obs = ndimage.map_coordinates(res.observed.astype(float), coords, order=1, mode="nearest")
-    good = valid & (obs > 0.5) & (sg < 1e8)
-    zr = np.where(good, z_in + dz, np.nan)
+    ny, nx = res.dz.shape
+    idx, w_all = _bilinear_weights(cc_.ravel() / stride, rr_.ravel() / stride, nx, ny)
+    zf = _fill_nearest(np.asarray(z_in, dtype=float))
+    w = same_side_weights(idx, w_all, zf[::stride, ::stride][:ny, :nx].ravel(), zf.ravel(),
+                          stride * spacing)
+    wall = (w.sum(axis=1) == 0).reshape(nr, nc)
+
+    def interp(nodes: Array, weights: Array = w) -> Array:
+        return (nodes.ravel()[idx] * weights).sum(axis=1).reshape(nr, nc)
+
+    dz = interp(res.dz)
+    sg = interp(np.nan_to_num(res.sigma, nan=1e9))
+    # refined where the nodes around the cell are observed, on its side and in all; where
+    # only those across a wall are, or on the wall itself, the input height is kept (the
+    # cells the refinement leaves empty stay what they were without the walls rule)
+    obs_all = interp(res.observed.astype(float), w_all)
+    good = valid & (obs_all > 0.5) & (interp(res.observed.astype(float)) > 0.5) & (sg < 1e8)
+    keep = valid & ~good & (wall | (obs_all > 0.5))
+    zr = np.where(good, z_in + dz, np.where(keep, z_in, np.nan))
     sr = np.where(good, sg, np.nan)
     # σ to 0.1 mm: the sparse LU may differ in the last bits between processes (BLAS
     # builds), which must not show in the product

@@ -36,6 +36,14 @@ VIS_MARGIN = 2
 REJECT_K = 4.0
 #: Ridge on the grey-value unknowns, relative to the median grey diagonal of AᵀA.
 GREY_RIDGE = 1e-3
+#: Height jump (m) of the input DSM that counts as a discontinuity (a wall): the curvature
+#: regularisation is cut there and heights are interpolated only from nodes on the same side.
+BREAK_M = 1.0
+#: Slope (m per m) that never counts as a wall between a node and a point.
+SLOPE_TOL = 0.5
+#: Ridge on height nodes that neither data nor regularisation determine (relative to the
+#: median height diagonal): they keep their start correction.
+HEIGHT_RIDGE = 1e-6
 #: Relative residual and iteration limit of the conjugate gradients per Gauss–Newton step.
 CG_TOL = 1e-6
 CG_MAX_ITER = 2000
@@ -93,6 +101,18 @@ def _prolong(nodes: Array, r: Array, c: Array) -> Array:
     return ndimage.map_coordinates(nodes, [r, c], order=1, mode="nearest")
 
 
+def _prolong_same_side(dz_coarse: Array, z_coarse: Array, z_fine: Array, node_m: float
+                       ) -> Array:
+    """Node corrections of the next finer level (half the spacing): bilinear from the coarse
+    nodes on the same side of a wall (:func:`same_side_weights`), 0 where there is none."""
+    ny, nx = z_fine.shape
+    pr, pc = np.mgrid[0:ny, 0:nx]
+    cy, cx = dz_coarse.shape
+    idx, w = _bilinear_weights(pc.ravel() / 2.0, pr.ravel() / 2.0, cx, cy)
+    w = same_side_weights(idx, w, z_coarse.ravel(), z_fine.ravel(), node_m)
+    return (dz_coarse.ravel()[idx] * w).sum(axis=1).reshape(ny, nx)
+
+
 def _fill_nearest(z: NDArray) -> NDArray:
     """NaNs replaced by the nearest finite value (for internal use only)."""
     bad = ~np.isfinite(z)
@@ -102,8 +122,49 @@ def _fill_nearest(z: NDArray) -> NDArray:
     return z[tuple(idx)]
 
 
-def _second_difference_rows(ny: int, nx: int) -> sparse.csr_matrix:
-    """Rows of the discrete curvature (7.2-5/6) on an ny × nx node grid: [1, −2, 1] X and Y."""
+def same_side_weights(idx: NDArray, w: Array, z_nodes: Array, z_points: Array,
+                      node_m: float, step: Optional[float] = None) -> Array:
+    """Bilinear weights (n, 4) restricted to the nodes on the same side of a discontinuity.
+
+    A node whose input height differs from the point's input height by more than
+    ``step + SLOPE_TOL · d`` (``d`` the horizontal distance in m, so slopes up to
+    :data:`SLOPE_TOL` never count) lies across a wall (a roof node for a ground point or the
+    reverse): its weight is set to 0 and the others are renormalised, so a correction never
+    leaks from the roof to the ground. Points without any such node (on a wall, between roof
+    and ground) get all-zero weights: they keep their input height.
+
+    Parameters
+    ----------
+    idx, w : ndarray (n, 4)
+        Node indices and bilinear weights (:func:`_bilinear_weights` order).
+    z_nodes : ndarray
+        Input heights of the nodes (flat).
+    z_points : ndarray (n,)
+        Input heights of the points.
+    node_m : float
+        Node spacing (m).
+    step : float, optional
+        Height jump (m) that counts as a wall; default :data:`BREAK_M`.
+    """
+    step = BREAK_M if step is None else step
+    fu = w[:, 1] + w[:, 3]  # fractions within the node cell, recovered from the weights
+    fv = w[:, 2] + w[:, 3]
+    d = node_m * np.stack([np.hypot(fu, fv), np.hypot(1 - fu, fv), np.hypot(fu, 1 - fv),
+                           np.hypot(1 - fu, 1 - fv)], axis=1)
+    same = np.abs(z_nodes[idx] - z_points[:, None]) <= step + SLOPE_TOL * d
+    ws = np.where(same, w, 0.0)
+    tot = ws.sum(axis=1, keepdims=True)
+    return np.where(tot > 0, ws / np.where(tot > 0, tot, 1.0), 0.0)
+
+
+def _second_difference_rows(ny: int, nx: int, z_nodes: Optional[Array] = None,
+                            step: Optional[float] = None) -> sparse.csr_matrix:
+    """Rows of the discrete curvature (7.2-5/6) on an ny × nx node grid: [1, −2, 1] X and Y.
+
+    With the input heights of the nodes ``z_nodes``, rows whose three nodes straddle a
+    discontinuity (input second difference > ``step``: a wall, not a slope) are left out, so
+    the regularisation does not tie the roof's correction to the ground's.
+    """
     idx = np.arange(ny * nx).reshape(ny, nx)
     blocks = []
     for centre, lo, hi in ((idx[:, 1:-1], idx[:, :-2], idx[:, 2:]),
@@ -116,11 +177,37 @@ def _second_difference_rows(ny: int, nx: int) -> sparse.csr_matrix:
     lo = np.concatenate([b[0] for b in blocks])
     c = np.concatenate([b[1] for b in blocks])
     hi = np.concatenate([b[2] for b in blocks])
+    if z_nodes is not None:
+        zf = np.asarray(z_nodes, dtype=float).ravel()
+        keep = np.abs(zf[lo] - 2.0 * zf[c] + zf[hi]) <= (BREAK_M if step is None else step)
+        lo, c, hi = lo[keep], c[keep], hi[keep]
     n = c.size
     rows = np.repeat(np.arange(n), 3)
     cols = np.stack([lo, c, hi], axis=1).ravel()
     vals = np.tile([1.0, -2.0, 1.0], n)
     return sparse.csr_matrix((vals, (rows, cols)), shape=(n, ny * nx))
+
+
+def _hold_rows(ny: int, nx: int, z_nodes: Array, step: Optional[float] = None
+               ) -> sparse.csr_matrix:
+    """Rows ``2·dZ_c = 0`` for the centre of every curvature row cut at a wall.
+
+    The cut keeps the roof's correction off the ground, but leaves the nodes next to a wall
+    (on weakly textured roofs often all nodes of a small roof) without the regularisation
+    that held them; this holds them at the input height instead, with the weight a
+    curvature row gives its centre. On the correction ΔZ in both modes.
+    """
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    zf = np.asarray(z_nodes, dtype=float).ravel()
+    lim = BREAK_M if step is None else step
+    cut = []
+    for centre, lo, hi in ((idx[:, 1:-1], idx[:, :-2], idx[:, 2:]),
+                           (idx[1:-1, :], idx[:-2, :], idx[2:, :])):
+        c, a, b = centre.ravel(), lo.ravel(), hi.ravel()
+        cut.append(c[~(np.abs(zf[a] - 2.0 * zf[c] + zf[b]) <= lim)])
+    c = np.concatenate(cut) if cut else np.zeros(0, int)
+    return sparse.csr_matrix((np.full(c.size, 2.0), (np.arange(c.size), c)),
+                             shape=(c.size, ny * nx))
 
 
 # -- image windows -----------------------------------------------------------------------------
@@ -196,15 +283,16 @@ def adjust_window(z_in: NDArray, valid: NDArray[np.bool_], x_first: float, y_fir
     st = _WindowState(np.zeros(len(windows)), np.ones(len(windows)))
     names = [w.name for w in windows]
     dz_nodes: Optional[Array] = None
+    z_coarse: Optional[Array] = None
     for level in range(levels - 1, -1, -1):
         lat = _lattice(win, rows, cols, stride * 2 ** level, level, gsd, grey_px)
         if lat is None:
             continue
-        if dz_nodes is None:
+        if dz_nodes is None or z_coarse is None:
             dz = np.zeros((lat.ny, lat.nx))
-        else:  # prolongation: bilinear, node spacing halves
-            pr, pc = np.mgrid[0:lat.ny, 0:lat.nx]
-            dz = _prolong(dz_nodes, pr / 2.0, pc / 2.0)
+        else:  # prolongation: bilinear from the same side of walls, node spacing halves
+            dz = _prolong_same_side(dz_nodes, z_coarse, lat.zin_nodes, 2 * lat.st * spacing)
+        z_coarse = lat.zin_nodes
         out = _adjust_level(win, lat, dz, st, opts)
         if isinstance(out, str):
             return _failed(names, st.iters, st.cg_iters, out)
@@ -279,6 +367,7 @@ class _Lattice:
     nox: int
     delta: float  # metres of the ∂/∂Z differences
     reg: sparse.csr_matrix
+    hold: sparse.csr_matrix  # rows holding the nodes at cut curvature rows (on ΔZ)
     zin_nodes: Array
 
 
@@ -304,6 +393,8 @@ def _lattice(win: _Window, rows: int, cols: int, st: int, level: int, gsd: float
     z_s = (win.zf.ravel()[zidx] * zw).sum(axis=1)
     v_s = (win.valid.ravel()[zidx] | (zw == 0)).all(axis=1)
     gidx, gw = _bilinear_weights(SU / (st * spacing), SV / (st * spacing), nx, ny)
+    zin_nodes = win.zf[::st, ::st][:ny, :nx]
+    gw = same_side_weights(gidx, gw, zin_nodes.ravel(), z_s, st * spacing)  # not across walls
     # grey grid
     dgo = grey_px * gsd_l
     nox = math.ceil(ext_x / dgo) + 1
@@ -311,7 +402,8 @@ def _lattice(win: _Window, rows: int, cols: int, st: int, level: int, gsd: float
     oidx, ow = _bilinear_weights(SU / dgo, SV / dgo, nox, noy)
     return _Lattice(level, st, ny, nx, ns_y, ns_x, win.x_first + SU, win.y_first - SV, z_s,
                     v_s, gidx, gw, oidx, ow, noy, nox, max(gsd_l, 0.05),
-                    _second_difference_rows(ny, nx), win.zf[::st, ::st][:ny, :nx])
+                    _second_difference_rows(ny, nx, zin_nodes), _hold_rows(ny, nx, zin_nodes),
+                    zin_nodes)
 
 
 def _level_visibility(win: _Window, lat: _Lattice, dz: Array) -> NDArray[np.bool_]:
@@ -443,7 +535,8 @@ def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice
     n_z, n_unk = lat.nx * lat.ny, A.shape[1]
     Nd = (A.T @ A).tocsr()
     b = A.T @ obs
-    R = sparse.hstack([lat.reg, sparse.csr_matrix((lat.reg.shape[0], n_unk - n_z))]).tocsr()
+    Rz = sparse.vstack([lat.reg, lat.hold]).tocsr()
+    R = sparse.hstack([Rz, sparse.csr_matrix((Rz.shape[0], n_unk - n_z))]).tocsr()
     RtR = (R.T @ R).tocsr()
     if lam < 0:  # λ from the share, once per level
         d_data = float(Nd.diagonal()[:n_z].mean())
@@ -453,7 +546,7 @@ def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice
     st.reg_share = float(Nr.diagonal()[:n_z].mean()
                          / max(float(Nd.diagonal()[:n_z].mean()), 1e-30))
     z_node = dz if opts.mode == "correction" else lat.zin_nodes + dz
-    b = b - lam * (R.T @ (lat.reg @ z_node.ravel()))
+    b = b - lam * (R.T @ np.concatenate([lat.reg @ z_node.ravel(), lat.hold @ dz.ravel()]))
     # determinability (seed-004 §5.3 f): a grey node at the edge of the used samples may
     # carry only a corner of one sample's bilinear weights; a ridge of 1e-3 of the typical
     # grey diagonal keeps it from running away (negligible elsewhere)
@@ -461,6 +554,11 @@ def _solve_step(A: sparse.csr_matrix, obs: Array, cols_g: NDArray, lat: _Lattice
     ridge = np.zeros(n_unk)
     if dg.size:
         ridge[n_z:n_z + dg.size] = GREY_RIDGE * float(np.median(dg))
+    # a height node cut off by walls from the regularisation and without data (a small roof
+    # nobody sees) would be singular: a tiny ridge keeps its start correction
+    dzz = (Nd + Nr).diagonal()[:n_z]
+    if (dzz <= 0).any() and (dzz > 0).any():
+        ridge[:n_z] = np.where(dzz > 0, 0.0, HEIGHT_RIDGE * float(np.median(dzz[dzz > 0])))
     N = (Nd + Nr + sparse.diags(ridge)).tocsr()
     x, k_cg = pcg(N, b, jacobi(N), tol=CG_TOL, max_iter=CG_MAX_ITER, rule=CG_OBJECT_SPACE)
     st.cg_iters.append(k_cg)

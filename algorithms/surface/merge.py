@@ -5,7 +5,10 @@ Grid
     the union of the inputs' extents (transformed to that CRS) at the finest input cell size,
     or at ``spacing`` when given. Without ``spacing`` the grid is aligned to the finest input's
     cell corners, so inputs on that grid are copied without resampling; otherwise (other
-    cell size, origin or CRS) an input is resampled bilinearly (GDAL warper, NaN ignored).
+    cell size, origin or CRS) an input is resampled bilinearly (GDAL warper, NaN ignored),
+    except on cells that straddle a step of more than ``step`` (a wall), which take the
+    nearest input cell (:func:`.merge_steps.step_aware`): bilinear weights would put them
+    between roof and ground.
 
 Merge per cell, over the inputs :math:`k` with a height :math:`z_k` there
     * ``median``: :math:`\mathrm{median}_k\, z_k` (mean of the two middle values for an even
@@ -15,6 +18,15 @@ Merge per cell, over the inputs :math:`k` with a height :math:`z_k` there
       σ comes from a second band of the input, or from a sibling raster ``<name>_sigma.tif``
       or ``sigma.tif`` in the input's folder. Cells where no input with σ has a height take the
       median of the inputs without σ (so without any σ at all this is the median).
+
+Walls (issue 19)
+    Where the heights of a cell spread over more than ``step`` (default 1 m), the inputs see
+    different surfaces there (roof and ground at a wall placed differently, a blunder). The
+    median of two and the mean of any number would put the cell between them; instead the
+    candidates are split into populations at gaps > ``step`` and the largest population is
+    combined (ties: the one closest to the pooled median of the 5 × 5 neighbourhood, then the
+    upper one): :func:`.merge_steps.combine_keeping_steps`. Cells whose inputs agree within
+    ``step`` are merged as above; ``step = 0`` turns this off (plain median / mean).
 
 Seams
     For every pair of inputs :math:`(a, b)`, :math:`a < b` in input order, whose extents
@@ -54,6 +66,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..quality.stats import DifferenceAccumulator
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
+from .merge_steps import REF_RADIUS, STEP_M, combine_keeping_steps, step_aware
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -182,8 +195,12 @@ def _aligned_offset(i: _Input, target: Any, transform: Affine) -> Optional[Tuple
 
 
 def _read_window(src: Any, band: int, info: _Input, target: Any, win_transform: Affine,
-                 shape: Tuple[int, int], r0: int, c0: int) -> Array:
-    """Heights of one input on one output window (float32, NaN where it has none)."""
+                 shape: Tuple[int, int], r0: int, c0: int, step: float = 0.0) -> Array:
+    """Heights of one input on one output window (float32, NaN where it has none).
+
+    A resampled input takes the nearest cell where bilinear weights straddle a step of more
+    than ``step`` (:func:`.merge_steps.step_aware`; 0 = bilinear everywhere).
+    """
     h, w = shape
     out = np.full(shape, np.nan, np.float32)
     if info.aligned is not None:
@@ -197,34 +214,55 @@ def _read_window(src: Any, band: int, info: _Input, target: Any, win_transform: 
         vals = np.ma.filled(data.astype(np.float32), np.nan)
         out[rr0 - r0:rr1 - r0, cc0 - c0:cc1 - c0] = vals
     else:
-        nodata = src.nodatavals[band - 1]
-        reproject(
-            source=rasterio.band(src, band), destination=out,
-            src_transform=src.transform, src_crs=src.crs or target,
-            src_nodata=nodata if nodata is not None else np.nan,
-            dst_transform=win_transform, dst_crs=target or src.crs, dst_nodata=np.nan,
-            resampling=Resampling.bilinear, init_dest_nodata=True)
+        out = _resampled(src, band, target, win_transform, shape, Resampling.bilinear)
+        if step > 0:
+            near = _resampled(src, band, target, win_transform, shape, Resampling.nearest)
+            out = step_aware(out, near, step)
     out[~np.isfinite(out)] = np.nan
     return out
 
 
-def _combine(stack: Array, mode: str, sigma: Optional[Array]) -> Array:
-    """Merged heights of a (k, h, w) stack (NaN = no height); see the module notes."""
+def _resampled(src: Any, band: int, target: Any, win_transform: Affine,
+               shape: Tuple[int, int], how: Any) -> Array:
+    """One band of ``src`` warped onto a window of the output grid (float32, NaN = none)."""
+    out = np.full(shape, np.nan, np.float32)
+    nodata = src.nodatavals[band - 1]
+    reproject(
+        source=rasterio.band(src, band), destination=out,
+        src_transform=src.transform, src_crs=src.crs or target,
+        src_nodata=nodata if nodata is not None else np.nan,
+        dst_transform=win_transform, dst_crs=target or src.crs, dst_nodata=np.nan,
+        resampling=how, init_dest_nodata=True)
+    return out
+
+
+def _combine(stack: Array, mode: str, sigma: Optional[Array], step: float = 0.0,
+             halo: int = 0) -> Array:
+    """Merged heights of a (k, h, w) stack (NaN = no height); see the module notes.
+
+    ``stack`` and ``sigma`` cover the window plus ``halo`` cells on every side (context of
+    the step rule); the result is the window's core.
+    """
+    h, w = stack.shape[1] - 2 * halo, stack.shape[2] - 2 * halo
+    core = (slice(None), slice(halo, halo + h), slice(halo, halo + w))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN cells stay NaN
         if mode == "mean":
-            return np.nanmean(stack, axis=0).astype(np.float32)
-        med = np.nanmedian(stack, axis=0).astype(np.float32)
+            plain = np.nanmean(stack[core], axis=0).astype(np.float32)
+            return combine_keeping_steps(stack, "mean", plain, step, halo)
+        med = np.nanmedian(stack[core], axis=0).astype(np.float32)
         if mode == "median" or sigma is None:
-            return med
-        has_sigma = np.isfinite(sigma) & np.isfinite(stack)
-        s = np.where(has_sigma, sigma, np.inf)
+            return combine_keeping_steps(stack, "median", med, step, halo)
+        st, sg = stack[core], sigma[core]
+        has_sigma = np.isfinite(sg) & np.isfinite(st)
+        s = np.where(has_sigma, sg, np.inf)
         best = np.argmin(s, axis=0)
-        zbest = np.take_along_axis(stack, best[None], axis=0)[0]
+        zbest = np.take_along_axis(st, best[None], axis=0)[0]
         any_sigma = has_sigma.any(axis=0)
-        # inputs without σ: median of those
+        # inputs without σ: median of those (walls kept as for the median)
         rest = np.where(np.isfinite(sigma), np.nan, stack)
-        med_rest = np.nanmedian(rest, axis=0).astype(np.float32)
+        med_rest = np.nanmedian(rest[core], axis=0).astype(np.float32)
+        med_rest = combine_keeping_steps(rest, "median", med_rest, step, halo)
         return np.where(any_sigma, zbest, med_rest).astype(np.float32)
 
 
@@ -294,21 +332,29 @@ class _MergeSources:
     mode: str
     n_sigma: int
     pairs: List[Tuple[int, int]]
+    step: float = STEP_M
 
     def window(self, transform: Affine, s: float, r0: int, c0: int, h: int, w: int,
                accs: Dict[Tuple[int, int], Any]) -> Tuple[Array, Array]:
-        """Merged heights and input count of one output window; feeds the seam statistics."""
-        wt = transform * Affine.translation(c0, r0)
-        wb = (wt.c, wt.f - h * s, wt.c + w * s, wt.f)
+        """Merged heights and input count of one output window; feeds the seam statistics.
+
+        The inputs are read with a halo of :data:`.merge_steps.REF_RADIUS` cells (context
+        of the step rule at the window's border), so windows join without seams.
+        """
+        g = REF_RADIUS if self.step > 0 else 0
+        rh, ch, hh, wh = r0 - g, c0 - g, h + 2 * g, w + 2 * g
+        wt = transform * Affine.translation(ch, rh)
+        wb = (wt.c, wt.f - hh * s, wt.c + wh * s, wt.f)
         idx = [j for j, i in enumerate(self.infos) if _overlap(i.bounds, wb)]
         if not idx:
             return np.full((h, w), np.nan, np.float32), np.zeros((h, w), np.uint16)
         layers = np.stack([_read_window(self.srcs[j], 1, self.infos[j], self.target, wt,
-                                        (h, w), r0, c0) for j in idx])
+                                        (hh, wh), rh, ch, self.step) for j in idx])
         sig = None
         if self.mode == "best_sigma" and self.n_sigma:
-            sig = np.stack([self._sigma(j, wt, (h, w), r0, c0) for j in idx])
-        zc = _combine(layers, self.mode, sig)
+            sig = np.stack([self._sigma(j, wt, (hh, wh), rh, ch) for j in idx])
+        zc = _combine(layers, self.mode, sig, self.step, g)
+        layers = layers[:, g:g + h, g:g + w]
         cnt = np.isfinite(layers).sum(axis=0).astype(np.uint16)
         pos = {j: n for n, j in enumerate(idx)}
         for a, b in self.pairs:
@@ -327,7 +373,7 @@ class _MergeSources:
 
 
 def _open_sources(stack: ExitStack, infos: List[_Input], target: Any, mode: str,
-                  n_sigma: int, pairs: List[Tuple[int, int]]) -> _MergeSources:
+                  n_sigma: int, pairs: List[Tuple[int, int]], step: float) -> _MergeSources:
     """Open every input and, for ``best_sigma``, its sibling σ raster (checked grid)."""
     use_sigma = mode == "best_sigma"
     srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
@@ -338,7 +384,7 @@ def _open_sources(stack: ExitStack, infos: List[_Input], target: Any, mode: str,
                                or ss.height != i.height):
             raise InputError(f"The σ raster '{i.sigma_path}' does not have the grid of "
                              f"'{i.path.name}'; give σ on the DSM's grid.")
-    return _MergeSources(infos, srcs, sig_srcs, target, mode, n_sigma, pairs)
+    return _MergeSources(infos, srcs, sig_srcs, target, mode, n_sigma, pairs, step)
 
 
 def _seam_records(accs: Dict[Tuple[int, int], Any], infos: List[_Input]) -> List[Dict[str, Any]]:
@@ -380,7 +426,7 @@ def _write_seam_report(tmp_json: PathLike, tmp_csv: PathLike, result: Dict[str, 
 
 def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median",
                spacing: Optional[float] = None, tile: int = 512,
-               feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+               feedback: Optional[Feedback] = None, step: float = STEP_M) -> Dict[str, Any]:
     """Merge DSMs onto a common grid (see the module notes).
 
     Parameters
@@ -396,6 +442,9 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     tile : int
         Side (cells) of the processing windows; bounds the memory.
     feedback : Feedback, optional
+    step : float
+        Height spread (m) of a cell's inputs above which they are treated as different
+        surfaces (a wall) and not averaged (module notes "Walls"); 0 = plain median / mean.
 
     Returns
     -------
@@ -406,6 +455,8 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     """
     feedback = ensure_feedback(feedback)
     infos, target, out_paths = _checked_inputs(inputs, output, mode, feedback)
+    if not step >= 0:
+        raise InputError(f"The step threshold must not be negative, got {step}.")
     transform, width, height, s = _grid(infos, target, spacing)
     gx0, gy0 = transform.c, transform.f
     gbounds = (gx0, gy0 - height * s, gx0 + width * s, gy0)
@@ -425,7 +476,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     covered = 0
     crs_out = target
     with ExitStack() as stack:
-        sources = _open_sources(stack, infos, target, mode, n_sigma, pairs)
+        sources = _open_sources(stack, infos, target, mode, n_sigma, pairs, step)
         tmp_dsm, dsm_profile = stack.enter_context(cog_output(
             out_paths["dsm"], _profile(width, height, "float32", transform, crs_out,
                                        float("nan"))))
@@ -460,7 +511,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
             "report": str(out_paths["report"]), "csv": str(out_paths["csv"]),
             "seams": seams, "mode": mode, "spacing": s, "width": width, "height": height,
             "cells": cells, "covered": covered, "coverage": covered / float(cells),
-            "sigma_inputs": n_sigma,
+            "sigma_inputs": n_sigma, "step": float(step),
         }
         _write_seam_report(tmp_json, tmp_csv, result, infos, crs_out, transform, out_paths)
         feedback.progress(100.0)

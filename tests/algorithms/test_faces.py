@@ -236,7 +236,9 @@ def test_dsm_merge_python_equals_cli(block, tmp_path) -> None:
     assert _swap(cli, str(tmp_path / "cli"), "<out>") == _swap(py, str(tmp_path / "py"), "<out>")
     _same_files(tmp_path / "py", tmp_path / "cli")
     seam = py["seams"][0]  # DSM − DTM: objects are above the terrain
-    assert seam["count"] > 0 and seam["mean"] > 0 and seam["min"] >= -0.01
+    # (−0.02: beside a wall the DSM takes its nearest cell instead of bilinear weights across
+    # the wall, so the ground there is off by the terrain slope over up to half a cell)
+    assert seam["count"] > 0 and seam["mean"] > 0 and seam["min"] >= -0.02
 
 
 def test_interpolate_dem_python_equals_cli(block, tmp_path) -> None:

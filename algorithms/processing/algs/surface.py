@@ -28,7 +28,10 @@ class DsmMerge(Algorithm):
         "sigma.tif beside it — inputs without σ are used only where no input with σ has a "
         "height (as their median), so without any σ best_sigma is the median. Writes the DSM, "
         "<name>_count.tif (inputs per cell) and the seam statistics of every overlapping pair "
-        "(Δh = a − b: count, mean, median, std, RMS, NMAD) as <name>_seams.json and .csv."
+        "(Δh = a − b: count, mean, median, std, RMS, NMAD) as <name>_seams.json and .csv. "
+        "Walls are kept: where the inputs of a cell differ by more than the step threshold "
+        "(one has the roof, another the ground), the largest consistent group of heights is "
+        "used instead of averaging them, and resampled inputs take the nearest cell at steps."
     )
     parameters = (
         Parameter("inputs", "multiple_rasters", "Input DSMs",
@@ -41,6 +44,9 @@ class DsmMerge(Algorithm):
                        "mean: average; best_sigma: the height with the smallest σ."),
         Parameter("spacing", "number", "Cell size [m]", optional=True, minimum=0.0, unit="m",
                   help="Default: the finest cell size of the inputs."),
+        Parameter("step", "number", "Step threshold [m]", default=1.0, minimum=0.0, unit="m",
+                  help="Inputs of a cell that differ by more than this see different surfaces "
+                       "(a wall): they are not averaged. 0 = plain median / mean."),
     )
     outputs = (
         Output("dsm", "raster", "Merged DSM"),
@@ -61,7 +67,8 @@ class DsmMerge(Algorithm):
         from ...surface.merge import merge_dsms
 
         res = merge_dsms(params["inputs"], params["output"], mode=params.get("mode", "median"),
-                         spacing=params.get("spacing") or None, feedback=feedback)
+                         spacing=params.get("spacing") or None, feedback=feedback,
+                         step=float(params.get("step", 1.0)))
         return {k: res[k] for k in ("dsm", "count", "seams", "report", "csv", "coverage")}
 
 

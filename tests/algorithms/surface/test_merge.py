@@ -75,9 +75,12 @@ def test_median_and_mean_exact(tmp_path) -> None:
         write_raster(paths[-1], np.full((20, 30), v, np.float32),
                      transform=Affine(0.5, 0, 0, 0, -0.5, 100), crs=CRS)
     med = merge_dsms(paths, tmp_path / "med.tif", "median")
-    mean = merge_dsms(paths, tmp_path / "mean.tif", "mean")
+    mean = merge_dsms(paths, tmp_path / "mean.tif", "mean", step=0.0)
     assert np.all(_read(med["dsm"]) == 2.0)
     assert np.allclose(_read(mean["dsm"]), 13.0 / 3.0, rtol=1e-6)
+    # with the step rule (default), 10 is another surface: the mean of the majority {1, 2}
+    robust = merge_dsms(paths, tmp_path / "robust.tif", "mean")
+    assert np.all(_read(robust["dsm"]) == 1.5)
     assert np.all(_read(med["count"]) == 3)
     assert [(s["a_index"], s["b_index"], s["mean"]) for s in med["seams"]] == \
         [(0, 1, -1.0), (0, 2, -9.0), (1, 2, -8.0)]
@@ -200,3 +203,68 @@ def test_registry_run(tmp_path) -> None:
     assert set(res) == {"dsm", "count", "seams", "report", "csv", "coverage"}
     assert res["seams"][0]["mean"] == -0.25
     assert all(Path(p).is_file() for p in sibling_paths(out).values())
+
+
+# -- walls (issue 19): no averaging of a roof and the ground -----------------------------------
+ROOF = 8.0  # building height above the ground (m)
+
+
+def _box_dsm(path: Path, wall_col: int, s: float = 0.2, x0: float = 0.0, hole=None,
+             n: int = 100) -> str:
+    """Sloped ground (1 %) with a flat-roofed building over cols ≥ ``wall_col``, rows 30–69."""
+    cols, rows = np.meshgrid(np.arange(n), np.arange(n))
+    x = x0 + (cols + 0.5) * s
+    z = 100.0 + 0.01 * x
+    z = np.where((cols >= wall_col) & (cols < 80) & (rows >= 30) & (rows < 70), z + ROOF, z)
+    if hole is not None:
+        z[hole] = np.nan
+    write_raster(path, z.astype(np.float32), transform=Affine(s, 0, x0, 0, -s, 20.0), crs=CRS)
+    return str(path)
+
+
+def _wall_col(row: np.ndarray, x0: float = 0.0, s: float = 0.2) -> int:
+    """First column of a row whose height is at least half the building above the ground."""
+    ground = 100.0 + 0.01 * (x0 + (np.arange(row.size) + 0.5) * s)
+    return int(np.argmax(row - ground >= 0.5 * ROOF))
+
+
+def _between(z: np.ndarray, s: float = 0.2) -> int:
+    """Cells neither on the ground nor on the roof (more than 0.5 m from both)."""
+    cols = np.arange(z.shape[1])
+    ground = 100.0 + 0.01 * (cols + 0.5) * s
+    d = z - ground[None, :]
+    return int((np.isfinite(d) & (np.abs(d) > 0.5) & (np.abs(d - ROOF) > 0.5)).sum())
+
+
+def test_two_dsms_with_a_shifted_wall_keep_a_step(tmp_path) -> None:
+    a = _box_dsm(tmp_path / "a.tif", 40)
+    b = _box_dsm(tmp_path / "b.tif", 42)  # the same wall two cells (0.4 m) further in
+    plain = _read(merge_dsms([a, b], tmp_path / "plain.tif", "median", step=0.0)["dsm"])
+    assert _between(plain) == 2 * 40  # the old rule: half height on the disputed cells
+    for mode in ("median", "mean"):
+        z = _read(merge_dsms([a, b], tmp_path / f"{mode}.tif", mode, tile=32)["dsm"])
+        assert _between(z) == 0
+        walls = [_wall_col(z[r]) for r in range(32, 68)]
+        assert all(40 <= c <= 42 for c in walls) and max(walls) - min(walls) <= 1
+        assert np.allclose(z[50, 50:78] - (100.0 + 0.01 * (np.arange(50, 78) + 0.5) * 0.2),
+                           ROOF, atol=1e-4)  # the roof keeps its height
+
+
+def test_majority_wall_and_roof_hole_on_another_grid(tmp_path) -> None:
+    a = _box_dsm(tmp_path / "a.tif", 40)
+    hole = (slice(40, 60), slice(50, 70))
+    b = _box_dsm(tmp_path / "b.tif", 40, hole=hole)
+    c = _box_dsm(tmp_path / "c.tif", 45)  # one input with the wall 1 m off
+    z = _read(merge_dsms([a, b, c], tmp_path / "m.tif", "mean")["dsm"])
+    assert _between(z) == 0
+    assert all(_wall_col(z[r]) == 40 for r in range(31, 69))  # the majority's wall
+    # b half a cell off the grid: resampled, but the cells at the wall take the nearest cell
+    b2 = _box_dsm(tmp_path / "b2.tif", 40, x0=0.1, hole=hole)
+    m2 = merge_dsms([a, b2], tmp_path / "m2.tif", "median")
+    z2 = _read(m2["dsm"])
+    assert _between(z2[:, 1:-1]) == 0
+    assert all(abs(_wall_col(z2[r]) - 40) <= 1 for r in range(32, 68))
+    ground = 100.0 + 0.01 * (np.arange(50, 70) + 0.5) * 0.2
+    assert np.allclose(z2[40:60, 50:70] - ground[None, :], ROOF, atol=0.01)  # hole: a's roof
+    plain = _read(merge_dsms([a, b2], tmp_path / "p2.tif", "median", step=0.0)["dsm"])
+    assert _between(plain[:, 1:-1]) > 0  # bilinear across the wall without the rule
