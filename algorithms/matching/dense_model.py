@@ -49,7 +49,7 @@ PathLike = Union[str, Path]
 #: Matching options of the DSM path that differ from :func:`.dense.iter_disparity_tiles`:
 #: disparities within 2 px of a hole, of a mask or of the image border are dropped (foreground
 #: fattening at occlusions and depth steps); the gridding fills the small gaps again.
-_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2}
+_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0}
 
 
 

@@ -1,0 +1,184 @@
+"""Disparity filters of dense matching that keep objects: one-sided edge erosion and
+plane fill of holes within segments bounded by discontinuities (issue 19).
+
+One-sided edge erosion
+----------------------
+At a depth step SGM drags the foreground (larger) disparity over the background ("foreground
+fattening"), and the left–right check leaves holes along the step. Eroding every valid pixel
+near a hole removes the roof edges as well, which were right. Here a valid pixel within ``k`` px
+(chessboard) of an invalid pixel is removed only if it lies on the *lower* side of a
+discontinuity — some valid disparity within the same ``(2k+1)²`` window exceeds it by more than
+``jump`` px — or within ``k`` px of a masked pixel or the image edge (half windows there).
+
+Plane fill
+----------
+Each 8-connected hole (invalid, not masked, inscribed diameter ≤ ``max_size`` px) is bordered
+by valid pixels (its 1-px ring). Their disparities are split at the largest gap of their sorted
+values if that gap exceeds ``jump`` px: an *upper* population (the roof) and a *lower* one (the
+ground). A plane ``d = a + b·x + c·y`` is fitted to each population (least squares, then once
+more without residuals > 1 px; fewer than 6 pixels or a degenerate fit: their median). A hole
+with one population takes its plane. A mixed hole is split where the wall is: each pixel takes
+the population of its nearest border pixel, except in the left image's occlusions — a run
+whose left border along the row is lower and its right border higher is background seen by the
+left camera only, and takes the lower plane. A filled value outside the disparities of its
+population's border (±``jump``) is not trusted (the plane extrapolates a steep slope) and is
+clipped to that range.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Tuple
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+
+Array = NDArray[Any]
+_RING = np.ones((3, 3), bool)
+
+
+def erode_lower_side(disp: Array, masked: Array, k: int, jump: float) -> Array:
+    """Remove valid disparities near holes that lie on the lower side of a depth step.
+
+    Parameters
+    ----------
+    disp : array
+        Disparities (NaN invalid); not changed.
+    masked : array of bool
+        Pixels without image data (frame outside the image, masks).
+    k : int
+        Erosion radius (px, chessboard).
+    jump : float
+        Disparity step (px) that makes a discontinuity.
+
+    Returns
+    -------
+    array
+        A copy with the eroded pixels NaN.
+    """
+    out = disp.copy()
+    if k <= 0:
+        return out
+    valid = np.isfinite(disp)
+    size = 2 * int(k) + 1
+    near_hole = ndimage.maximum_filter(~valid & ~masked, size=size, mode="constant", cval=False)
+    near_mask = ndimage.maximum_filter(masked, size=size, mode="constant", cval=True)
+    upper = ndimage.maximum_filter(np.where(valid, disp, -np.inf), size=size, mode="nearest")
+    lower_side = upper - np.where(valid, disp, np.inf) > jump
+    out[valid & (near_mask | (near_hole & lower_side))] = np.nan
+    return out
+
+
+def _fit_plane(x: Array, y: Array, d: Array) -> Tuple[float, float, float]:
+    """Plane ``d = a + b·x + c·y`` (robust: one refit without residuals > 1 px); the median as
+    a constant where the points are too few or collinear."""
+    med = float(np.median(d))
+    if d.size < 6 or np.ptp(x) < 2 or np.ptp(y) < 2:
+        return med, 0.0, 0.0
+    a = np.column_stack([np.ones_like(x), x, y]).astype(np.float64)
+    keep = np.abs(d - med) <= max(3.0, 3.0 * 1.4826 * float(np.median(np.abs(d - med))))
+    for _ in range(2):
+        if keep.sum() < 6:
+            return med, 0.0, 0.0
+        coef, *_ = np.linalg.lstsq(a[keep], d[keep], rcond=None)
+        keep = np.abs(a @ coef - d) <= 1.0
+    return float(coef[0]), float(coef[1]), float(coef[2])
+
+
+def _split(values: Array, jump: float) -> Optional[float]:
+    """Threshold between the lower and upper population (largest gap > ``jump``), or None."""
+    v = np.sort(values)
+    if v.size < 2:
+        return None
+    gaps = np.diff(v)
+    i = int(np.argmax(gaps))
+    return float(v[i] + gaps[i] / 2.0) if gaps[i] > jump else None
+
+
+def _occluded(hole: Array, disp: Array, split: float) -> Array:
+    """Hole pixels whose row run has a lower left and an upper right border (left occlusion)."""
+    h, w = hole.shape
+    cols = np.arange(w)[None, :]
+    stop = ~hole
+    li = np.maximum.accumulate(np.where(stop, cols, -1), axis=1)
+    ri = np.flip(np.minimum.accumulate(np.flip(np.where(stop, cols, w), axis=1), axis=1), axis=1)
+    rows = np.arange(h)[:, None]
+    lv = np.where(li >= 0, disp[rows, np.clip(li, 0, w - 1)], np.nan)
+    rv = np.where(ri < w, disp[rows, np.clip(ri, 0, w - 1)], np.nan)
+    with np.errstate(invalid="ignore"):
+        return hole & (lv < split) & (rv > split)
+
+
+def _fill_one(disp: Array, hole: Array, ring: Array, jump: float) -> Array:
+    """Fill values of one hole (``hole``, ``ring`` are masks of a small window of ``disp``)."""
+    ry, rx = np.nonzero(ring)
+    rd = disp[ring].astype(np.float64)
+    hy, hx = np.nonzero(hole)
+    split = _split(rd, jump)
+    groups = [np.ones(rd.size, bool)] if split is None else [rd < split, rd >= split]
+    planes = [_fit_plane(rx[g], ry[g], rd[g]) for g in groups]
+    lims = [(rd[g].min() - jump, rd[g].max() + jump) for g in groups]
+    if split is None:
+        which = np.zeros(hy.size, int)
+    else:
+        upper_ring = np.zeros(hole.shape, bool)
+        upper_ring[ry[groups[1]], rx[groups[1]]] = True
+        lower_ring = ring & ~upper_ring
+        # nearest border pixel of each population
+        d_up = ndimage.distance_transform_edt(~upper_ring)[hole]
+        d_lo = ndimage.distance_transform_edt(~lower_ring)[hole]
+        which = (d_up < d_lo).astype(int)
+        occ = _occluded(hole, np.where(ring, disp, np.nan), split)[hole]
+        which[occ] = 0
+    out = np.empty(hy.size, np.float32)
+    for g, (a, b, c) in enumerate(planes):
+        sel = which == g
+        out[sel] = np.clip(a + b * hx[sel] + c * hy[sel], *lims[g])
+    return out
+
+
+def plane_fill(disp: Array, masked: Array, max_size: float, jump: float) -> Array:
+    """Fill holes of a disparity map from planes of their bordering surfaces (module notes).
+
+    Parameters
+    ----------
+    disp : array
+        Disparities (NaN invalid); not changed.
+    masked : array of bool
+        Pixels never filled and not counted as border (no image data).
+    max_size : float
+        Largest inscribed hole diameter (px) that is filled; 0 = no filling.
+    jump : float
+        Disparity step (px) that separates an upper from a lower surface.
+
+    Returns
+    -------
+    array
+        A copy with the holes filled.
+    """
+    out = disp.copy()
+    if max_size <= 0:
+        return out
+    valid = np.isfinite(disp)
+    holes = ~valid & ~masked
+    if not holes.any() or not valid.any():
+        return out
+    radius = ndimage.distance_transform_edt(holes)
+    labels, n = ndimage.label(holes, structure=_RING)
+    big = ndimage.maximum(radius, labels, np.arange(1, n + 1))
+    for i, sl in enumerate(ndimage.find_objects(labels)):
+        if sl is None or 2.0 * big[i] > max_size:
+            continue
+        # the hole's window grown by 1 px so that its ring is inside
+        r0, c0 = max(sl[0].start - 1, 0), max(sl[1].start - 1, 0)
+        win = (slice(r0, sl[0].stop + 1), slice(c0, sl[1].stop + 1))
+        hole = labels[win] == i + 1
+        ring = ndimage.binary_dilation(hole, _RING) & valid[win]
+        if ring.sum() < 1:
+            continue
+        sub = out[win]
+        sub[hole] = _fill_one(disp[win], hole, ring, jump)
+    return out
+
+
+__all__ = ["erode_lower_side", "plane_fill"]
