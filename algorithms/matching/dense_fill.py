@@ -96,7 +96,9 @@ def _split(values: Array, jump: float) -> Optional[float]:
 
 
 def _occluded(hole: Array, disp: Array, split: float) -> Array:
-    """Hole pixels whose row run has a lower left and an upper right border (left occlusion)."""
+    """Hole pixels the right camera cannot see: in a row run with a lower left and an upper
+    right border, the first ``d_right − d_left`` px from the left border (the width the step
+    hides); the rest of the run is the step's own invalid band."""
     h, w = hole.shape
     cols = np.arange(w)[None, :]
     stop = ~hole
@@ -106,10 +108,11 @@ def _occluded(hole: Array, disp: Array, split: float) -> Array:
     lv = np.where(li >= 0, disp[rows, np.clip(li, 0, w - 1)], np.nan)
     rv = np.where(ri < w, disp[rows, np.clip(ri, 0, w - 1)], np.nan)
     with np.errstate(invalid="ignore"):
-        return hole & (lv < split) & (rv > split)
+        return hole & (lv < split) & (rv > split) & (cols - li <= rv - lv)
 
 
-def _fill_one(disp: Array, hole: Array, ring: Array, jump: float) -> Array:
+def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional[Array] = None,
+              tone: float = 0.0) -> Array:
     """Fill values of one hole (``hole``, ``ring`` are masks of a small window of ``disp``)."""
     ry, rx = np.nonzero(ring)
     rd = disp[ring].astype(np.float64)
@@ -128,6 +131,13 @@ def _fill_one(disp: Array, hole: Array, ring: Array, jump: float) -> Array:
         d_up = ndimage.distance_transform_edt(~upper_ring)[hole]
         d_lo = ndimage.distance_transform_edt(~lower_ring)[hole]
         which = (d_up < d_lo).astype(int)
+        if grey is not None:
+            # the surface whose border looks like the pixel (roof and ground differ in tone)
+            g = grey[hole]
+            g_up = float(np.median(grey[upper_ring]))
+            g_lo = float(np.median(grey[lower_ring]))
+            if abs(g_up - g_lo) > tone:
+                which = (np.abs(g - g_up) < np.abs(g - g_lo)).astype(int)
         occ = _occluded(hole, np.where(ring, disp, np.nan), split)[hole]
         which[occ] = 0
     out = np.empty(hy.size, np.float32)
@@ -137,7 +147,8 @@ def _fill_one(disp: Array, hole: Array, ring: Array, jump: float) -> Array:
     return out
 
 
-def plane_fill(disp: Array, masked: Array, max_size: float, jump: float) -> Array:
+def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
+               grey: Optional[Array] = None) -> Array:
     """Fill holes of a disparity map from planes of their bordering surfaces (module notes).
 
     Parameters
@@ -150,6 +161,9 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float) -> Arra
         Largest inscribed hole diameter (px) that is filled; 0 = no filling.
     jump : float
         Disparity step (px) that separates an upper from a lower surface.
+    grey : array, optional
+        Grey values of the left image (smoothed): a pixel of a mixed hole takes the surface
+        whose border has the nearer tone where the two tones differ.
 
     Returns
     -------
@@ -163,6 +177,10 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float) -> Arra
     holes = ~valid & ~masked
     if not holes.any() or not valid.any():
         return out
+    tone = 0.0
+    if grey is not None:
+        grey = ndimage.uniform_filter(np.nan_to_num(grey, nan=0.0).astype(np.float32), 3)
+        tone = 0.5 * float(np.std(grey[valid]))  # tones closer than this are not told apart
     radius = ndimage.distance_transform_edt(holes)
     labels, n = ndimage.label(holes, structure=_RING)
     big = ndimage.maximum(radius, labels, np.arange(1, n + 1))
@@ -177,7 +195,8 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float) -> Arra
         if ring.sum() < 1:
             continue
         sub = out[win]
-        sub[hole] = _fill_one(disp[win], hole, ring, jump)
+        sub[hole] = _fill_one(disp[win], hole, ring, jump,
+                              None if grey is None else grey[win], tone)
     return out
 
 
