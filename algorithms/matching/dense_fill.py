@@ -16,13 +16,18 @@ Each 8-connected hole (invalid, not masked, inscribed diameter ≤ ``max_size`` 
 by valid pixels (its 1-px ring). Their disparities are split at the largest gap of their sorted
 values if that gap exceeds ``jump`` px: an *upper* population (the roof) and a *lower* one (the
 ground). A plane ``d = a + b·x + c·y`` is fitted to each population (least squares, then once
-more without residuals > 1 px; fewer than 6 pixels or a degenerate fit: their median). A hole
-with one population takes its plane. A mixed hole is split where the wall is: each pixel takes
-the population of its nearest border pixel, except in the left image's occlusions — a run
-whose left border along the row is lower and its right border higher is background seen by the
-left camera only, and takes the lower plane. A filled value outside the disparities of its
-population's border (±``jump``) is not trusted (the plane extrapolates a steep slope) and is
-clipped to that range.
+more without residuals > 1 px; fewer than 6 pixels or a degenerate fit: their median). A mixed hole is split where the wall is: a pixel takes the
+upper surface if its nearest border pixel is upper and (where the tones of the two borders
+differ by more than half the image's spread) its grey value is nearer to the upper border's —
+except in the left image's occlusions: in a row run whose left border is lower and its right
+border higher, the first ``d_upper − d_lower`` px from the left border (the width the step hides
+from the right camera) are ground. A filled value outside the disparities of its population's
+border (±``jump``) is clipped to that range (a plane extrapolating a steep slope).
+
+In the DSM path only the upper (object) part of a mixed hole is filled: holes without a step
+and the ground part are left to the gridding's gap interpolation as before, because filling
+them from planes made open terrain worse (synthetic ``aerial`` block, terrain RMS 0.10 against
+0.05 m) while roofs gained nothing from it (``fill_lower`` fills them too).
 """
 
 from __future__ import annotations
@@ -85,14 +90,26 @@ def _fit_plane(x: Array, y: Array, d: Array) -> Tuple[float, float, float]:
     return float(coef[0]), float(coef[1]), float(coef[2])
 
 
-def _split(values: Array, jump: float) -> Optional[float]:
-    """Threshold between the lower and upper population (largest gap > ``jump``), or None."""
+def _split(values: Array, jump: float, least: float = 0.1) -> Tuple[Optional[float], Array]:
+    """Threshold between the lower and upper population (largest gap > ``jump``), or None,
+    and the border values to use. A population of fewer than ``least`` of the border pixels
+    (or 5) is a handful of blunders, not a surface: it is dropped instead."""
     v = np.sort(values)
+    keep = np.ones(values.size, bool)
     if v.size < 2:
-        return None
+        return None, keep
     gaps = np.diff(v)
     i = int(np.argmax(gaps))
-    return float(v[i] + gaps[i] / 2.0) if gaps[i] > jump else None
+    if gaps[i] <= jump:
+        return None, keep
+    split = float(v[i] + gaps[i] / 2.0)
+    n_lo = i + 1
+    n_hi = v.size - n_lo
+    small = max(5.0, least * v.size)
+    if n_lo < small or n_hi < small:
+        keep = values >= split if n_lo < n_hi else values < split
+        return None, keep
+    return split, keep
 
 
 def _occluded(hole: Array, disp: Array, split: float) -> Array:
@@ -112,13 +129,13 @@ def _occluded(hole: Array, disp: Array, split: float) -> Array:
 
 
 def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional[Array] = None,
-              tone: float = 0.0) -> Array:
+              tone: float = 0.0, fill_lower: bool = False) -> Array:
     """Fill values of one hole (``hole``, ``ring`` are masks of a small window of ``disp``)."""
     ry, rx = np.nonzero(ring)
     rd = disp[ring].astype(np.float64)
     hy, hx = np.nonzero(hole)
-    split = _split(rd, jump)
-    groups = [np.ones(rd.size, bool)] if split is None else [rd < split, rd >= split]
+    split, keep = _split(rd, jump)
+    groups = [keep] if split is None else [rd < split, rd >= split]
     planes = [_fit_plane(rx[g], ry[g], rd[g]) for g in groups]
     lims = [(rd[g].min() - jump, rd[g].max() + jump) for g in groups]
     if split is None:
@@ -137,10 +154,12 @@ def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional
             g_up = float(np.median(grey[upper_ring]))
             g_lo = float(np.median(grey[lower_ring]))
             if abs(g_up - g_lo) > tone:
-                which = (np.abs(g - g_up) < np.abs(g - g_lo)).astype(int)
+                which = which * (np.abs(g - g_up) < np.abs(g - g_lo))
         occ = _occluded(hole, np.where(ring, disp, np.nan), split)[hole]
         which[occ] = 0
     out = np.empty(hy.size, np.float32)
+    if not fill_lower:
+        planes[0] = (np.nan, 0.0, 0.0)  # the lower surface is left to the gridding
     for g, (a, b, c) in enumerate(planes):
         sel = which == g
         out[sel] = np.clip(a + b * hx[sel] + c * hy[sel], *lims[g])
@@ -148,7 +167,7 @@ def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional
 
 
 def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
-               grey: Optional[Array] = None) -> Array:
+               grey: Optional[Array] = None, fill_lower: bool = False) -> Array:
     """Fill holes of a disparity map from planes of their bordering surfaces (module notes).
 
     Parameters
@@ -164,6 +183,10 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
     grey : array, optional
         Grey values of the left image (smoothed): a pixel of a mixed hole takes the surface
         whose border has the nearer tone where the two tones differ.
+    fill_lower : bool
+        Fill holes without a step and the lower part of holes with one as well; by default
+        only the upper (object) part of a hole with a step is filled — the ground is left to
+        the gridding's gap interpolation, which keeps open terrain as accurate as before.
 
     Returns
     -------
@@ -196,7 +219,7 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
             continue
         sub = out[win]
         sub[hole] = _fill_one(disp[win], hole, ring, jump,
-                              None if grey is None else grey[win], tone)
+                              None if grey is None else grey[win], tone, fill_lower)
     return out
 
 

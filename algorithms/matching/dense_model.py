@@ -49,7 +49,10 @@ PathLike = Union[str, Path]
 #: Matching options of the DSM path that differ from :func:`.dense.iter_disparity_tiles`:
 #: disparities within 2 px of a hole, of a mask or of the image border are dropped (foreground
 #: fattening at occlusions and depth steps); the gridding fills the small gaps again.
-_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0}
+_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0}
+#: Height step (m) that separates an object from its ground for the one-sided erosion and the
+#: plane fill (objects count from 2.5 m; ground slopes within a hole stay below it).
+_JUMP_M = 1.5
 
 
 
@@ -242,6 +245,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                          if outlier_threshold is None else outlier_threshold, outlier_k)
     for key, value in _DENSE_DEFAULTS.items():
         dense_options.setdefault(key, value)
+    # the step in px of this model's parallax (1 px = GSD·H/B m)
+    dense_options.setdefault("edge_jump", _JUMP_M * pair.base
+                             / (float(setup.gsd) * setup.flying_height))
     feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
                   f"disparities {setup.min_d}…{setup.max_d} px; DSM {grid.width}×{grid.height} "
                   f"cells at {spacing:.3f} m.")

@@ -96,15 +96,18 @@ def _metrics(disp: np.ndarray, s: Dict[str, np.ndarray], k: int) -> Tuple[float,
 def test_roofs_filled_and_walls_in_place(scene) -> None:
     new = sgm_disparity(scene["left"], scene["right"], 0, 47, **DSM)
     old = sgm_disparity(scene["left"], scene["right"], 0, 47, **OLD)
-    # measured: flat 100 % / 1 px, gabled 99.6 % / 1 px, open 99.97 %; the two-sided
-    # erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px, open 86.9 %
+    # measured: flat 100 % / 0.5 px, gabled 99.2 % / 1 px, open 89.2 % (ground holes are left
+    # to the gridding); the two-sided erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px,
+    # open 86.9 %
     for k in (1, 2):
         c_new, wall_new = _metrics(new, scene, k)
         c_old, _ = _metrics(old, scene, k)
         assert c_new >= 0.95 and c_new >= c_old
         assert wall_new <= 1.5
     open_ = ndimage.distance_transform_edt(scene["label"] == 0) > 8
-    assert np.mean(np.abs(new - scene["d"])[open_] <= 1.0) >= 0.97
+    right = np.abs(new - scene["d"]) <= 1.0
+    assert right[open_].mean() >= 0.87
+    assert right[open_ & np.isfinite(new)].mean() >= 0.99
 
 
 def test_plane_fill_takes_the_surface_the_hole_belongs_to() -> None:
@@ -114,7 +117,7 @@ def test_plane_fill_takes_the_surface_the_hole_belongs_to() -> None:
     hole[15:25, 25:35] = True  # inside the roof
     hole[2:6, 5:12] = True  # in the ground
     masked = np.zeros(d.shape, bool)
-    filled = plane_fill(np.where(hole, np.nan, d), masked, 50.0, 2.0)
+    filled = plane_fill(np.where(hole, np.nan, d), masked, 50.0, 2.0, fill_lower=True)
     assert np.allclose(filled[hole], d[hole], atol=0.05)
 
 
