@@ -17,7 +17,8 @@ by valid pixels (its 1-px ring). Their disparities are split at the largest gap 
 values if that gap exceeds ``jump`` px: an *upper* population (the roof) and a *lower* one (the
 ground). A plane ``d = a + b·x + c·y`` is fitted to each population (least squares, then once
 more without residuals > 1 px; fewer than 6 pixels or a degenerate fit: their median).
-A mixed hole is split where the wall is: a pixel takes the upper surface if its nearest border pixel is upper and (where the tones of the two borders
+A mixed hole is split where the wall is: a pixel takes the upper surface if its nearest border
+pixel is upper and (where the tones of the two borders
 differ by more than half the image's spread) its grey value is nearer to the upper border's —
 except in the left image's occlusions: in a row run whose left border is lower and its right
 border higher, the first ``d_upper − d_lower`` px from the left border (the width the step hides
