@@ -9,8 +9,12 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
 3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`); every valid disparity of a
    tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and streamed into a
    :class:`~..surface.gridding.GridAccumulator` (median per cell). Disparities within 2 px
-   of a hole, a mask or the image border are dropped first (``edge_erosion``: foreground
-   fattening at occlusions and depth steps, half windows at borders).
+   of a mask or the image border (half windows), and within 2 px of a hole on the *lower* side
+   of a height step of 1.5 m (``edge_jump`` in px of this model's parallax) are dropped first
+   (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges stay.
+   Holes with a step on their border get the plane of their upper (object) border where that
+   is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the ground part of holes
+   is left to the gap interpolation (issue 19).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
