@@ -9,6 +9,11 @@ near a hole removes the roof edges as well, which were right. Here a valid pixel
 (chessboard) of an invalid pixel is removed only if it lies on the *lower* side of a
 discontinuity — some valid disparity within the same ``(2k+1)²`` window exceeds it by more than
 ``jump`` px — or within ``k`` px of a masked pixel or the image edge (half windows there).
+In the DSM path the test is turned round (``reach``): a pixel near a hole is kept only if it
+lies on the *upper* side of a step (some valid disparity within ``reach`` px is lower by more
+than ``jump``) and belongs to a disparity segment of at least ``segment_px`` px. Without the
+turn, hole borders on open terrain and the raised edges of blunder patches stayed, and terrain
+RMS on the ``aerial`` block rose from 0.0464 to 0.0531 m.
 
 Plane fill
 ----------
@@ -43,7 +48,8 @@ Array = NDArray[Any]
 _RING = np.ones((3, 3), bool)
 
 
-def erode_lower_side(disp: Array, masked: Array, k: int, jump: float) -> Array:
+def erode_lower_side(disp: Array, masked: Array, k: int, jump: float,
+                     small: Optional[Array] = None, reach: int = 0) -> Array:
     """Remove valid disparities near holes that lie on the lower side of a depth step.
 
     Parameters
@@ -56,6 +62,13 @@ def erode_lower_side(disp: Array, masked: Array, k: int, jump: float) -> Array:
         Erosion radius (px, chessboard).
     jump : float
         Disparity step (px) that makes a discontinuity.
+    small : array of bool, optional
+        Pixels of small disparity segments (blunder patches, not roofs): near a hole they are
+        eroded on either side of a step, as by the plain erosion.
+    reach : int
+        If > 0, a pixel near a hole is kept only on the *upper* side of a step (a valid
+        disparity within ``reach`` px is lower by more than ``jump``): no step, no exception
+        from the erosion, so open terrain is eroded as by the plain erosion.
 
     Returns
     -------
@@ -69,8 +82,17 @@ def erode_lower_side(disp: Array, masked: Array, k: int, jump: float) -> Array:
     size = 2 * int(k) + 1
     near_hole = ndimage.maximum_filter(~valid & ~masked, size=size, mode="constant", cval=False)
     near_mask = ndimage.maximum_filter(masked, size=size, mode="constant", cval=True)
-    upper = ndimage.maximum_filter(np.where(valid, disp, -np.inf), size=size, mode="nearest")
-    lower_side = upper - np.where(valid, disp, np.inf) > jump
+    if reach > 0:
+        # keep only the upper side of a step: a valid disparity lower by > jump within reach
+        low = ndimage.minimum_filter(np.where(valid, disp, np.inf), size=2 * int(reach) + 1,
+                                     mode="nearest")
+        lower_side = ~(np.where(valid, disp, -np.inf) - low > jump)
+    else:
+        upper = ndimage.maximum_filter(np.where(valid, disp, -np.inf), size=size,
+                                       mode="nearest")
+        lower_side = upper - np.where(valid, disp, np.inf) > jump
+    if small is not None:
+        lower_side |= small
     out[valid & (near_mask | (near_hole & lower_side))] = np.nan
     return out
 

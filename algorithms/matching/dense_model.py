@@ -9,9 +9,11 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
 3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`); every valid disparity of a
    tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and streamed into a
    :class:`~..surface.gridding.GridAccumulator` (median per cell). Disparities within 2 px
-   of a mask or the image border (half windows), and within 2 px of a hole on the *lower* side
-   of a height step of 1.5 m (``edge_jump`` in px of this model's parallax) are dropped first
-   (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges stay.
+   of a mask or the image border (half windows), and within 2 px of a hole unless on the
+   *upper* side of a height step of 1.5 m (``edge_jump`` in px of this model's parallax; a
+   lower disparity within ``edge_reach`` px) in a segment of ≥ ``segment_px`` px, are dropped
+   first (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges
+   stay, hole borders on open terrain and blunder patches go.
    Holes with a step on their border get the plane of their upper (object) border where that
    is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the ground part of holes
    is left to the gap interpolation (issue 19).
@@ -52,8 +54,11 @@ PathLike = Union[str, Path]
 
 #: Matching options of the DSM path that differ from :func:`.dense.iter_disparity_tiles`:
 #: disparities within 2 px of a hole, of a mask or of the image border are dropped (foreground
-#: fattening at occlusions and depth steps); the gridding fills the small gaps again.
-_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0}
+#: fattening at occlusions and depth steps) except on the upper side of a height step (a lower
+#: disparity within 20 px) in a disparity segment of ≥ 300 px, so roof edges stay but hole
+#: borders on open terrain and blunder patches go; the gridding fills the small gaps again.
+_DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0, "segment_px": 300,
+                                   "edge_reach": 20}
 #: Height step (m) that separates an object from its ground for the one-sided erosion and the
 #: plane fill (objects count from 2.5 m; ground slopes within a hole stay below it).
 _JUMP_M = 1.5
