@@ -16,7 +16,8 @@ On a synthetic block with truth (default: the ``small`` block as ``make demo`` b
    step with the same points moved to their true heights (what the reduction and the FE surface
    lose by themselves);
 4. dense: the disparity filters switched on one after the other (SGBM alone, + uniqueness,
-   + left–right check, + speckle filter, + edge erosion = production; production without the
+   + left–right check, + speckle filter, + one-sided edge erosion, + plane fill = production
+   with the DSM path's options (``dense_model.dsm_dense_options``); production without the
    coarse range narrowing), valid and correct disparities on object and open pixels, texture of
    the roofs, and the gridding steps (median per cell, outlier test, gap limit).
 
@@ -50,7 +51,7 @@ from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.epipolar import SIDES
 from photodem.algorithms.matching import dense as dense_mod
 from photodem.algorithms.matching import fbm_model
-from photodem.algorithms.matching.dense_model import _DENSE_DEFAULTS
+from photodem.algorithms.matching.dense_model import dsm_dense_options
 from photodem.algorithms.matching.model_setup import prepare_model
 from photodem.algorithms.processing import registry
 from photodem.algorithms.quality.objects import (
@@ -394,11 +395,13 @@ def fbm_chain(setup: Any, truth: Truth, et: EpiTruth, grey: Dict[str, np.ndarray
 #: Cumulative filter settings: SGBM alone, then each filter of production switched on.
 DENSE_STEPS: Tuple[Tuple[str, Dict[str, Any]], ...] = (
     ("SGBM alone", {"uniqueness": 0, "lr_max_diff": -1.0, "speckle_window": 0,
-                    "edge_erosion": 0}),
-    ("+ uniqueness 10 %", {"lr_max_diff": -1.0, "speckle_window": 0, "edge_erosion": 0}),
-    ("+ left–right check", {"speckle_window": 0, "edge_erosion": 0}),
-    ("+ speckle filter", {"edge_erosion": 0}),
-    ("+ edge erosion (production)", {}),
+                    "edge_erosion": 0, "plane_fill": 0}),
+    ("+ uniqueness 10 %", {"lr_max_diff": -1.0, "speckle_window": 0, "edge_erosion": 0,
+                           "plane_fill": 0}),
+    ("+ left–right check", {"speckle_window": 0, "edge_erosion": 0, "plane_fill": 0}),
+    ("+ speckle filter", {"edge_erosion": 0, "plane_fill": 0}),
+    ("+ one-sided edge erosion", {"plane_fill": 0}),
+    ("+ plane fill (production)", {}),
     ("production, full range (no coarse narrowing)", {"coarse_above": 0}),
 )
 
@@ -421,7 +424,7 @@ def dense_steps(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray]
     rr, cc = np.mgrid[0:h, 0:w]
     inter, open_, roof, tree = et.cls == 1, et.cls == 3, et.roof(), et.tree()
     for name, over in DENSE_STEPS:
-        opt = dict(_DENSE_DEFAULTS, **over)
+        opt = dict(dsm_dense_options(setup), **over)  # the DSM path's options
         t0 = time.perf_counter()
         d = dense_mod.sgm_disparity(grey["left"], grey["right"], setup.min_d, setup.max_d,
                                     **opt)

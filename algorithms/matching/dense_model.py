@@ -65,6 +65,13 @@ _JUMP_M = 1.5
 
 
 
+def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
+    """Matching options of the DSM path for one model: :data:`_DENSE_DEFAULTS` and the height
+    step of 1.5 m in px of the model's parallax (1 px = GSD·H/B m) as ``edge_jump``."""
+    jump = _JUMP_M * setup.pair.base / (float(setup.gsd) * setup.flying_height)
+    return dict(_DENSE_DEFAULTS, edge_jump=jump)
+
+
 def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
                 feedback: Feedback) -> None:
     """Grey (band mean) epipolar image as float32, NaN outside the original image."""
@@ -252,11 +259,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                          # 1 px of parallax in height
                          float(setup.gsd) * setup.flying_height / pair.base
                          if outlier_threshold is None else outlier_threshold, outlier_k)
-    for key, value in _DENSE_DEFAULTS.items():
+    for key, value in dsm_dense_options(setup).items():
         dense_options.setdefault(key, value)
-    # the step in px of this model's parallax (1 px = GSD·H/B m)
-    dense_options.setdefault("edge_jump", _JUMP_M * pair.base
-                             / (float(setup.gsd) * setup.flying_height))
     feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
                   f"disparities {setup.min_d}…{setup.max_d} px; DSM {grid.width}×{grid.height} "
                   f"cells at {spacing:.3f} m.")
@@ -294,4 +298,4 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
             "points": None, "reduced": None, "metrics": metrics}
 
 
-__all__ = ["match_model_dense"]
+__all__ = ["dsm_dense_options", "match_model_dense"]
