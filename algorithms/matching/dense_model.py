@@ -14,8 +14,8 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    lower disparity within ``edge_reach`` px) in a segment of ≥ ``segment_px`` px, are dropped
    first (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges
    stay, hole borders on open terrain and blunder patches go.
-   Holes with a step on their border get the plane of their upper (object) border where that
-   is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the ground part of holes
+   Holes with a step on their border get their upper (object) border's heights, by inverse
+   distance, where that is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the ground part of holes
    is left to the gap interpolation (issue 19).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
