@@ -15,8 +15,8 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    first (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges
    stay, hole borders on open terrain and blunder patches go.
    Holes with a step on their border get their upper (object) border's heights, by inverse
-   distance, where that is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the ground part of holes
-   is left to the gap interpolation (issue 19).
+   distance, where that is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the
+   ground part of holes is left to the gap interpolation (issue 19).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
