@@ -454,9 +454,9 @@
             <translation>Qualitätskontrolle</translation>
         </message>
         <message>
-            <source>Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference may have another grid, extent or CRS (the DEM is resampled onto it). Optionally co-registers the DEM first (horizontal shift and vertical bias after Nuth &amp; Kääb, estimated on stable terrain). Writes the difference model Δh = DEM − reference (with a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope class, in m and in ‰ of the flying height, and an HTML report with plots.</source>
+            <source>Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference may have another grid, extent or CRS (the DEM is resampled onto it). Optionally co-registers the DEM first (horizontal shift and vertical bias after Nuth &amp; Kääb, estimated on stable terrain). Writes the difference model Δh = DEM − reference (with a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope class, in m and in ‰ of the flying height, and an HTML report with plots. With the reference's terrain model (DTM) the cells are also classed into object interior, object edge, open terrain and other by their height above the DTM; with classes or a DTM the completeness per class is reported too: the share of the reference cells the DEM measures, and the shares within ±0.5 m and ±1 m (empty cells count as misses).</source>
             <extracomment>dem_compare: help</extracomment>
-            <translation>Vergleicht ein Höhenmodell (DOM oder DGM) im gemeinsamen Gebiet mit einem Referenzmodell; das Referenzmodell darf ein anderes Raster, eine andere Ausdehnung oder ein anderes KBS haben (das Höhenmodell wird darauf umgerechnet). Optional wird das Höhenmodell vorher koregistriert (Lageverschiebung und Höhenversatz nach Nuth &amp; Kääb, geschätzt auf stabilem Gelände). Schreibt das Differenzmodell Δh = Höhenmodell − Referenz (mit QGIS-Stil), eine Schummerung und ein Neigungsraster des Höhenmodells, Statistiken (Mittel, Median, Standardabweichung, RMS, NMAD, Quantile von |Δh|, 0,5-m-Klassen) insgesamt, je Klasse und je Neigungsklasse, in m und in ‰ der Flughöhe, sowie einen HTML-Bericht mit Diagrammen.</translation>
+            <translation>Vergleicht ein Höhenmodell (DOM oder DGM) im gemeinsamen Gebiet mit einem Referenzmodell; das Referenzmodell darf ein anderes Raster, eine andere Ausdehnung oder ein anderes KBS haben (das Höhenmodell wird darauf umgerechnet). Optional wird das Höhenmodell vorher koregistriert (Lageverschiebung und Höhenversatz nach Nuth &amp; Kääb, geschätzt auf stabilem Gelände). Schreibt das Differenzmodell Δh = Höhenmodell − Referenz (mit QGIS-Stil), eine Schummerung und ein Neigungsraster des Höhenmodells, Statistiken (Mittel, Median, Standardabweichung, RMS, NMAD, Quantile von |Δh|, 0,5-m-Klassen) insgesamt, je Klasse und je Neigungsklasse, in m und in ‰ der Flughöhe, sowie einen HTML-Bericht mit Diagrammen. Mit dem Geländemodell (DGM) der Referenz werden die Zellen außerdem nach ihrer Höhe über dem DGM in Objektinneres, Objektrand, offenes Gelände und Sonstiges eingeteilt; mit Klassen oder einem DGM wird auch die Vollständigkeit je Klasse angegeben: der Anteil der Referenzzellen, die das Höhenmodell misst, und die Anteile innerhalb ±0,5 m und ±1 m (leere Zellen zählen als Fehlschläge).</translation>
         </message>
         <message>
             <source>DEM to check</source>
@@ -469,9 +469,9 @@
             <translation>Referenzmodell</translation>
         </message>
         <message>
-            <source>Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, report.html, stats.json and stats.csv.</source>
+            <source>Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, report.html, stats.json and stats.csv; with classes or a DTM also completeness.csv.</source>
             <extracomment>dem_compare.output: help</extracomment>
-            <translation>Erhält difference.tif (+ .qml-Stil), hillshade.tif, slope.tif, report.html, stats.json und stats.csv.</translation>
+            <translation>Erhält difference.tif (+ .qml-Stil), hillshade.tif, slope.tif, report.html, stats.json und stats.csv; mit Klassen oder einem DGM auch completeness.csv.</translation>
         </message>
         <message>
             <source>Co-register before comparing</source>
@@ -524,6 +524,26 @@
             <translation>Für die Statistik in ‰ der Flughöhe.</translation>
         </message>
         <message>
+            <source>Terrain model (DTM) of the reference</source>
+            <extracomment>dem_compare.dtm: description</extracomment>
+            <translation>Geländemodell (DGM) der Referenz</translation>
+        </message>
+        <message>
+            <source>When the reference is a DSM: its terrain model. Cells at least the object height above it are objects (buildings, trees); statistics and completeness per object class.</source>
+            <extracomment>dem_compare.dtm: help</extracomment>
+            <translation>Wenn die Referenz ein DOM ist: ihr Geländemodell. Zellen, die mindestens die Objekthöhe darüber liegen, sind Objekte (Gebäude, Bäume); Statistik und Vollständigkeit je Objektklasse.</translation>
+        </message>
+        <message>
+            <source>Object height [m]</source>
+            <extracomment>dem_compare.object_height: description; mosaic.min_height: description</extracomment>
+            <translation>Objekthöhe [m]</translation>
+        </message>
+        <message>
+            <source>Height above the DTM from which a reference cell belongs to an object.</source>
+            <extracomment>dem_compare.object_height: help</extracomment>
+            <translation>Höhe über dem DGM, ab der eine Referenzzelle zu einem Objekt gehört.</translation>
+        </message>
+        <message>
             <source>Statistics of Δh [m]</source>
             <extracomment>dem_compare output stats</extracomment>
             <translation>Statistik von Δh [m]</translation>
@@ -542,6 +562,16 @@
             <source>Statistics per slope class</source>
             <extracomment>dem_compare output per_slope</extracomment>
             <translation>Statistik je Neigungsklasse</translation>
+        </message>
+        <message>
+            <source>Statistics per object class</source>
+            <extracomment>dem_compare output per_object</extracomment>
+            <translation>Statistik je Objektklasse</translation>
+        </message>
+        <message>
+            <source>Completeness per class</source>
+            <extracomment>dem_compare output completeness</extracomment>
+            <translation>Vollständigkeit je Klasse</translation>
         </message>
         <message>
             <source>Difference model (DEM − reference)</source>
@@ -572,6 +602,11 @@
             <source>Statistics as CSV</source>
             <extracomment>dem_compare output csv; point_compare output csv</extracomment>
             <translation>Statistik als CSV</translation>
+        </message>
+        <message>
+            <source>Completeness as CSV</source>
+            <extracomment>dem_compare output completeness_csv</extracomment>
+            <translation>Vollständigkeit als CSV</translation>
         </message>
         <message>
             <source>DEM profiles along a line</source>
@@ -2089,11 +2124,6 @@
             <translation>Wie weit eine Schnittlinie von der Nadirgrenze abweichen darf. Standard: ein Viertel des Abstands benachbarter Projektionszentren.</translation>
         </message>
         <message>
-            <source>Object height [m]</source>
-            <extracomment>mosaic.min_height: description</extracomment>
-            <translation>Objekthöhe [m]</translation>
-        </message>
-        <message>
             <source>Cells at least this high above the DTM are avoided by seams.</source>
             <extracomment>mosaic.min_height: help</extracomment>
             <translation>Zellen mindestens so hoch über dem DGM meiden die Schnittlinien.</translation>
@@ -3487,6 +3517,14 @@
             <source>Unexpected error (please report it):</source>
             <extracomment>plugin/widgets/run_panel.py:162</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference may have another grid, extent or CRS (the DEM is resampled onto it). Optionally co-registers the DEM first (horizontal shift and vertical bias after Nuth &amp; Kääb, estimated on stable terrain). Writes the difference model Δh = DEM − reference (with a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope class, in m and in ‰ of the flying height, and an HTML report with plots.</source>
+            <translation type="vanished">Vergleicht ein Höhenmodell (DOM oder DGM) im gemeinsamen Gebiet mit einem Referenzmodell; das Referenzmodell darf ein anderes Raster, eine andere Ausdehnung oder ein anderes KBS haben (das Höhenmodell wird darauf umgerechnet). Optional wird das Höhenmodell vorher koregistriert (Lageverschiebung und Höhenversatz nach Nuth &amp; Kääb, geschätzt auf stabilem Gelände). Schreibt das Differenzmodell Δh = Höhenmodell − Referenz (mit QGIS-Stil), eine Schummerung und ein Neigungsraster des Höhenmodells, Statistiken (Mittel, Median, Standardabweichung, RMS, NMAD, Quantile von |Δh|, 0,5-m-Klassen) insgesamt, je Klasse und je Neigungsklasse, in m und in ‰ der Flughöhe, sowie einen HTML-Bericht mit Diagrammen.</translation>
+        </message>
+        <message>
+            <source>Receives difference.tif (+ .qml style), hillshade.tif, slope.tif, report.html, stats.json and stats.csv.</source>
+            <translation type="vanished">Erhält difference.tif (+ .qml-Stil), hillshade.tif, slope.tif, report.html, stats.json und stats.csv.</translation>
         </message>
         <message>
             <source>Finds the georeference of an image without approximate values (position, scale, rotation and mirroring unknown) by matching area objects: the image is segmented by region growing at several thresholds, its regions and the reference polygons (one class of a vector layer, touching polygons dissolved — or a segmented orthophoto) are described by affine-invariant moment features, corresponding objects are found by a consistency search, verified, refined by ICP, and control points on their outlines give the final transform (affine, projective or 2nd-order polynomial). When no objects match (objects not homogeneous in the image), an area-based search compares the whole image with the rasterised polygons instead. Writes a QGIS Georeferencer .points file, the control points as GeoPackage, the image resampled into the map CRS, a copy with the control points embedded and a report (overlay, residuals, RMSE in px and m). Too few matching objects give a failure message with the counts of every stage, not a wrong result.</source>

@@ -16,7 +16,8 @@ Output layout::
     <output>/truth/dtm.tif         float32, NaN nodata, project CRS, cell = GSD/2
     <output>/truth/dsm.tif         float32 (DTM + buildings + trees)
     <output>/truth/landcover.tif   uint8, codes in :data:`.objects.LANDCOVER`
-    <output>/truth/buildings.gpkg  footprints with roof type, heights, platform height
+    <output>/truth/buildings.gpkg  footprints with roof type and look, heights, platform height
+    <output>/truth/chimneys.gpkg   chimney squares with building id and top height
     <output>/truth/breaklines.gpkg 3-D lines with kind (embankment_crest/_toe, ditch_edge/_bottom)
     <output>/truth/checkpoints.gpkg, checkpoints.csv   3-D centres of the bright target discs
 
@@ -143,8 +144,11 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
     spec = SIZES[size]
     if window is not None:
         spec = spec.with_window(window)
-    streams = np.random.SeedSequence(int(seed)).spawn(6)
+    # the seventh stream (roof looks, chimneys, crown details) came later: spawning seven
+    # children leaves the first six, and so the layout of earlier blocks, unchanged
+    streams = np.random.SeedSequence(int(seed)).spawn(7)
     layout, t_rng, o_rng, c_rng, x_rng = (np.random.default_rng(s) for s in streams[:5])
+    detail_rng = np.random.default_rng(streams[6])
 
     gsd = spec.gsd * (STEEP_GSD_FACTOR if terrain == "steep" else 1.0)
     origin = (float(400000 + 100 * layout.integers(0, 1500)),
@@ -180,7 +184,7 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
                   for im in plan.images]
     covered = unary_union(footprints)
     extent_core = float(np.sqrt(covered.area))
-    dtm, dsm, landcover, objects = place_objects(grid, dtm, o_rng, extent_core)
+    dtm, dsm, landcover, objects = place_objects(grid, dtm, o_rng, extent_core, detail_rng)
     feedback.progress(10.0)
 
     models = in_strip_models(plan, grid, dtm)
@@ -241,13 +245,32 @@ def _crs_wkt() -> str:
     return rasterio.crs.CRS.from_string(CRS).to_wkt()
 
 
+def _write_chimneys(scene: Scene, paths: Dict[str, Path], wkt: str) -> None:
+    """Chimney squares with their building and absolute top height (truth/chimneys.gpkg)."""
+    schema = {"geometry": "Polygon", "properties": OrderedDict(
+        [("building", "int"), ("top_z", "float")])}
+    with fiona.open(str(paths["chimneys"]), "w", driver="GPKG", layer="chimneys",
+                    schema=schema, crs_wkt=wkt) as dst:
+        for b in scene.objects.buildings:
+            e = np.array([np.cos(b.angle), np.sin(b.angle)])
+            n = np.array([-e[1], e[0]])
+            for cu, cv, side, top in b.chimneys:
+                c = np.array([b.x, b.y]) + cu * e + cv * n
+                h = side / 2.0
+                ring = [tuple(c + su * h * e + sv * h * n)
+                        for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                dst.write({"geometry": mapping(Polygon(ring)), "properties": OrderedDict(
+                    [("building", b.id), ("top_z", round(b.base_z + top, 4))])})
+
+
 def _write_vectors(scene: Scene, truth: Path) -> Dict[str, Path]:
     wkt = _crs_wkt()
     paths = {"buildings": truth / "buildings.gpkg", "breaklines": truth / "breaklines.gpkg",
-             "checkpoints": truth / "checkpoints.gpkg"}
+             "checkpoints": truth / "checkpoints.gpkg", "chimneys": truth / "chimneys.gpkg"}
     schema = {"geometry": "Polygon", "properties": OrderedDict(
         [("id", "int"), ("roof", "str"), ("height", "float"), ("ridge_height", "float"),
-         ("base_z", "float"), ("length", "float"), ("width", "float")])}
+         ("base_z", "float"), ("length", "float"), ("width", "float"), ("style", "str"),
+         ("chimneys", "int")])}
     with fiona.open(str(paths["buildings"]), "w", driver="GPKG", layer="buildings",
                     schema=schema, crs_wkt=wkt) as dst:
         for b in scene.objects.buildings:
@@ -256,7 +279,9 @@ def _write_vectors(scene: Scene, truth: Path) -> Dict[str, Path]:
                            [("id", b.id), ("roof", b.roof), ("height", round(b.height, 4)),
                             ("ridge_height", round(b.ridge_height, 4)),
                             ("base_z", round(b.base_z, 4)), ("length", round(b.length, 4)),
-                            ("width", round(b.width, 4))])})
+                            ("width", round(b.width, 4)), ("style", b.style),
+                            ("chimneys", len(b.chimneys))])})
+    _write_chimneys(scene, paths, wkt)
     schema = {"geometry": "3D LineString",
               "properties": OrderedDict([("id", "int"), ("kind", "str")])}
     with fiona.open(str(paths["breaklines"]), "w", driver="GPKG", layer="breaklines",

@@ -13,9 +13,15 @@ All heights are written into the truth rasters on the fine grid; the vector trut
 * **Buildings** — rectangles 8×10 … 12×16 m, gabled (ridge along the long side, pitch 30–45°,
   eaves 5–7 m) or flat (4–10 m). Each stands on a level platform: the DTM inside the footprint
   is set to the footprint's mean height and blended back over 4 m around it, so that
-  DSM − DTM inside the footprint equals the roof height exactly.
+  DSM − DTM inside the footprint equals the roof height exactly outside the chimneys.
+  Every block mixes roof looks (:data:`ROOF_STYLES`, see :mod:`.texture`); some gabled roofs
+  carry chimneys (0.5–0.7 m square, flat top 1–1.5 m above the highest roof point under them),
+  burned into the DSM as rendered.
 * **Trees** — isolated crowns (height 5–15 m, radius 2–5 m, profile
-  :math:`h\,(1 - (d/r)^2)^{0.6}`) and a closed forest patch (dense crowns 12–20 m).
+  :math:`h\,(1 - (d/r)^2)^{0.6}`) and a closed forest patch (dense crowns 12–20 m). Crowns
+  carry leaf clumps (relief ±0.2–0.4 m at λ ≈ 0.6 m, so the shading textures them) and about
+  half of the isolated trees (a fifth in the forest) are sparse: gaps of λ ≈ 1.5 m covering
+  15–35 % of the crown where the DSM is the ground and the land cover stays the ground's.
 * **Land cover** codes: :data:`LANDCOVER`.
 """
 
@@ -29,7 +35,7 @@ from scipy import ndimage
 from shapely.geometry import Point
 
 from ..raster.sample import bilinear_grid
-from .terrain import Grid
+from .terrain import Grid, band_noise
 
 #: Land-cover class codes of ``truth/landcover.tif``.
 LANDCOVER: Dict[int, str] = {
@@ -46,6 +52,12 @@ OPEN, ROAD, BUILDING, TREE, WATER, EMBANKMENT, FIELD = 1, 2, 3, 4, 5, 6, 7
 
 #: Field (parcel) types used by the texture: meadow, furrowed, crop, bare soil.
 PARCEL_TYPES = ("meadow", "furrowed", "crop", "bare")
+
+#: Roof looks per roof type; the first of each is the plain look of earlier versions.
+ROOF_STYLES: Dict[str, Tuple[str, ...]] = {
+    "gabled": ("stripes", "tiles", "two_tone"),
+    "flat": ("plain", "gravel", "fixtures"),
+}
 
 
 @dataclass
@@ -107,6 +119,10 @@ class Building:
     height: float  # eaves (flat: roof) height above the platform (m)
     ridge_height: float  # highest point above the platform (m)
     base_z: float = 0.0
+    style: str = ""  # one of ROOF_STYLES[roof]; "" is the plain look
+    texture_seed: int = 0  # seed of per-tile brightness and fixture layout
+    chimneys: List[Tuple[float, float, float, float]] = field(default_factory=list)
+    # chimneys: (u, v) centre in the building frame, side (m), top height above the platform
 
     def corners(self) -> np.ndarray:
         """Footprint corners (4, 2), counter-clockwise."""
@@ -154,6 +170,7 @@ class SceneObjects:
     parcel_origin: Tuple[float, float]
     buildings: List[Building] = field(default_factory=list)
     trees: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # x, y, radius, height
+    tree_sparse: np.ndarray = field(default_factory=lambda: np.zeros(0))  # gap share per tree
     breaklines: List[Tuple[str, np.ndarray]] = field(default_factory=list)  # kind, (N, 3)
 
     @property
@@ -315,18 +332,55 @@ def _level_platforms(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
         dtm[rows, cols] = w * b.base_z + (1.0 - w) * sub
 
 
+def _decorate_buildings(obj: SceneObjects, rng: np.random.Generator) -> None:
+    """Roof style, texture seed and chimneys of every building (from the detail stream).
+
+    Styles cycle through :data:`ROOF_STYLES` from a random start, so every block with three or
+    more roofs of a type has the plain look and the textured ones.
+    """
+    start = {k: int(rng.integers(len(v))) for k, v in ROOF_STYLES.items()}
+    count = dict.fromkeys(ROOF_STYLES, 0)
+    for b in obj.buildings:
+        styles = ROOF_STYLES[b.roof]
+        b.style = styles[(start[b.roof] + count[b.roof]) % len(styles)]
+        count[b.roof] += 1
+        b.texture_seed = int(rng.integers(2 ** 31))
+        # two thirds of the gabled roofs carry chimneys, the first one always
+        if b.roof != "gabled" or (rng.uniform() < 0.35 and any(o.chimneys for o in obj.buildings)):
+            continue
+        half = b.width / 2.0
+        for _ in range(int(rng.integers(1, 3))):
+            side = float(rng.uniform(0.5, 0.7))
+            u = float(rng.uniform(-1.0, 1.0) * (b.length / 2.0 - 1.5))
+            v = float(rng.choice([-1.0, 1.0]) * rng.uniform(0.0, half - 1.5))
+            # flat top above the highest roof point under the square (nearest the ridge)
+            top = float(b.roof_height(np.array(max(abs(v) - side / 2.0, 0.0))))
+            b.chimneys.append((u, v, side, top + float(rng.uniform(1.0, 1.5))))
+
+
 def _burn_buildings(grid: Grid, dsm: np.ndarray, landcover: np.ndarray,
                     obj: SceneObjects) -> None:
-    """Roofs into the DSM and BUILDING into the land cover (in place)."""
+    """Roofs and chimneys into the DSM and BUILDING into the land cover (in place)."""
     X, Y = grid.xs, grid.ys
     for b in obj.buildings:
         rows, cols = grid.window(b.x - b.radius, b.y - b.radius, b.x + b.radius, b.y + b.radius)
         u, v = b.local(X[:, cols], Y[rows, :])
         inside = (np.abs(u) <= b.length / 2.0) & (np.abs(v) <= b.width / 2.0)
         roof = b.base_z + b.roof_height(v)
+        for cu, cv, side, top in b.chimneys:
+            box = (np.abs(u - cu) <= side / 2.0) & (np.abs(v - cv) <= side / 2.0)
+            roof = np.where(box, b.base_z + top, roof)
         dsm[rows, cols] = np.where(inside, roof, dsm[rows, cols])
         lc = landcover[rows, cols]
         lc[inside] = BUILDING
+
+
+def chimney_mask(b: Building, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Cells (building frame coordinates ``u``, ``v``) covered by a chimney of ``b``."""
+    out = np.zeros(np.broadcast(u, v).shape, dtype=bool)
+    for cu, cv, side, _top in b.chimneys:
+        out |= (np.abs(u - cu) <= side / 2.0) & (np.abs(v - cv) <= side / 2.0)
+    return out
 
 
 def _place_isolated_trees(grid: Grid, obj: SceneObjects, rng: np.random.Generator,
@@ -352,21 +406,54 @@ def _place_isolated_trees(grid: Grid, obj: SceneObjects, rng: np.random.Generato
         n_isolated += 1
 
 
+def _crown_details(sub: Grid, rng: np.random.Generator, sparse: float
+                   ) -> Tuple[np.ndarray, np.ndarray]:
+    """Leaf-clump relief (m) and gap mask of one crown window ``sub``.
+
+    The clumps (λ ≈ 0.6 m, ±0.2–0.4 m) give the crown a texture through the shading; the gaps
+    (λ ≈ 1.5 m) cover the lowest ``sparse`` share of a smooth field (none when 0).
+    """
+    relief = rng.uniform(0.2, 0.4) * band_noise(rng, sub, 0.6)
+    if sparse <= 0.0:
+        return relief, np.zeros(sub.shape, dtype=bool)
+    field_ = band_noise(rng, sub, 1.5)
+    return relief, field_ < np.quantile(field_, sparse)
+
+
 def _burn_trees(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndarray,
-                obj: SceneObjects) -> None:
-    """Tree crowns into the DSM (where higher) and TREE into the land cover (in place)."""
+                obj: SceneObjects, rng: np.random.Generator) -> None:
+    """Tree crowns into the DSM (where higher) and TREE into the land cover (in place).
+
+    ``obj.tree_sparse`` (share of gaps per tree) comes from :func:`_tree_density`; in a gap
+    the DSM stays what it was (the ground or a lower crown) and so does the land cover.
+    """
     X, Y = grid.xs, grid.ys
-    for tx, ty, r, h in obj.trees:
+    for (tx, ty, r, h), sparse in zip(obj.trees, obj.tree_sparse):
         rows, cols = grid.window(tx - r, ty - r, tx + r, ty + r)
         d2 = ((X[:, cols] - tx) ** 2 + (Y[rows, :] - ty) ** 2) / (r * r)
-        crown = h * np.clip(1.0 - d2, 0.0, None) ** 0.6
+        sub = Grid(grid.x0 + cols.start * grid.cell, grid.y1 - rows.start * grid.cell,
+                   grid.cell, d2.shape[0], d2.shape[1])
+        relief, gaps = _crown_details(sub, rng, float(sparse))
+        shape_ = np.clip(1.0 - d2, 0.0, None) ** 0.6
+        # clumps fade out towards the crown edge, so the outline stays the profile's; the
+        # tree keeps its height h as the highest point
+        crown = np.minimum(h * shape_ + relief * np.minimum(shape_ * 3.0, 1.0), h)
         sub_dtm = dtm[rows, cols]
         sub_dsm = dsm[rows, cols]
         top = sub_dtm + crown
-        higher = (crown > 0.05) & (top > sub_dsm)
+        leaves = (h * shape_ > 0.05) & (crown > 0.05) & ~gaps
+        higher = leaves & (top > sub_dsm)
         sub_dsm[higher] = top[higher]
         lc = landcover[rows, cols]
-        lc[(crown > 0.05) & (lc != BUILDING)] = TREE
+        lc[leaves & (lc != BUILDING)] = TREE
+
+
+def _tree_density(n_forest: int, n_all: int, rng: np.random.Generator) -> np.ndarray:
+    """Gap share per tree: 0 (dense) or 0.15–0.35; half of the isolated trees are sparse,
+    a fifth of the forest trees."""
+    p = np.where(np.arange(n_all) < n_forest, 0.2, 0.5)
+    sparse = rng.uniform(size=n_all) < p
+    return np.where(sparse, rng.uniform(0.15, 0.35, n_all), 0.0)
 
 
 def _add_breaklines(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
@@ -389,12 +476,15 @@ def _add_breaklines(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
             obj.breaklines.append((kind, np.column_stack([xy[ok], z[ok]])))
 
 
-def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float
+def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float,
+                  detail_rng: Optional[np.random.Generator] = None
                   ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, SceneObjects]:
     """Modify the terrain, build the DSM and land cover, and return the object list.
 
     The random draws come in a fixed order (linear features and parcels, forest, buildings,
-    isolated trees), so a seed gives the same scene.
+    isolated trees), so a seed gives the same scene. Roof styles, chimneys and crown details
+    come from ``detail_rng`` (a stream of its own, so the layout does not depend on them;
+    derived from ``rng`` after the layout when not given).
 
     Parameters
     ----------
@@ -404,6 +494,7 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
     rng : numpy.random.Generator
     extent_core : float
         Size (m) of the area covered by the images; object counts scale with its square.
+    detail_rng : numpy.random.Generator, optional
 
     Returns
     -------
@@ -417,13 +508,18 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
     area = extent_core ** 2
     taken: List[Tuple[float, float, float]] = []  # x, y, keep-out radius
     trees = _place_forest(grid, obj, rng, extent_core, taken)
+    n_forest = len(trees)
     _place_buildings(grid, obj, rng, area, taken)
     _level_platforms(grid, dtm, obj)  # platforms first (they change the DTM)
     dsm = dtm.copy()
-    _burn_buildings(grid, dsm, landcover, obj)
     _place_isolated_trees(grid, obj, rng, area, taken, trees)
+    if detail_rng is None:
+        detail_rng = np.random.default_rng(int(rng.integers(2 ** 63)))
+    _decorate_buildings(obj, detail_rng)
+    _burn_buildings(grid, dsm, landcover, obj)
     obj.trees = np.array(trees, dtype=float).reshape(-1, 4)
-    _burn_trees(grid, dtm, dsm, landcover, obj)
+    obj.tree_sparse = _tree_density(n_forest, len(trees), detail_rng)
+    _burn_trees(grid, dtm, dsm, landcover, obj, detail_rng)
     _add_breaklines(grid, dtm, obj)
     return dtm, dsm, landcover, obj
 

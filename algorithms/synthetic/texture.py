@@ -4,9 +4,9 @@ The albedo raster lies on the truth grid (cell ≤ GSD/2) and is sampled bilinea
 renderer. Per land-cover class it holds: meadow, furrowed fields (sinusoidal furrows of period
 1.5–2.5 m whose lines run at ``texture_direction`` degrees counter-clockwise from the flight
 direction +X), crop rows, bare soil, asphalt roads with dashed centre lines, a gravel crest with
-rails on the embankment, water in the ditch, tiled (gabled) and gravel (flat) roofs, dark tree
-crowns. Everything is modulated by band-limited noise (λ ≈ 1 m and 5 m, plus a small
-per-band part) and by Lambert shading of the DSM,
+rails on the embankment, water in the ditch, roofs in several looks (:func:`roof_albedo`), dark
+tree crowns (their clumps textured by the shading). Everything is modulated by band-limited
+noise (λ ≈ 1 m and 5 m, plus a small per-band part) and by Lambert shading of the DSM,
 
 .. math:: s = \frac{0.35 + 0.65\,\max(0, \mathbf n\cdot\mathbf l)}{0.35 + 0.65\,l_z}
 
@@ -17,11 +17,20 @@ them analytically from their centres (see :mod:`.render`).
 
 from __future__ import annotations
 
-from typing import Tuple
+from typing import Dict, Tuple
 
 import numpy as np
 
-from .objects import BUILDING, EMBANKMENT, ROAD, TREE, WATER, SceneObjects, parcel_type_map
+from .objects import (
+    BUILDING,
+    EMBANKMENT,
+    ROAD,
+    TREE,
+    WATER,
+    Building,
+    SceneObjects,
+    parcel_type_map,
+)
 from .terrain import Grid, band_noise
 
 #: albedo of the check-point disc and its pad (all bands)
@@ -42,6 +51,8 @@ _COLOURS = {
     "roof_red": (0.56, 0.26, 0.19),
     "roof_grey": (0.40, 0.37, 0.36),
     "roof_flat": (0.58, 0.58, 0.55),
+    "roof_moss": (0.36, 0.33, 0.24),
+    "chimney": (0.50, 0.30, 0.24),
 }
 _SAND = {"meadow": (0.62, 0.55, 0.42), "bare": (0.68, 0.60, 0.46)}
 _ROCK = {"meadow": (0.45, 0.43, 0.40), "bare": (0.52, 0.49, 0.45)}
@@ -63,6 +74,83 @@ def _paint(albedo: np.ndarray, mask: np.ndarray, colour: Tuple[float, float, flo
     for b in range(3):
         value = colour[b] * factor if np.ndim(factor) == 0 else (colour[b] * factor)[mask]
         albedo[b][mask] = value
+
+
+def _tiles(b: Building, u: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Factor of a tiled roof: courses of 0.4 m down the slope, tiles 0.35 m wide, offset by
+    half a tile every other course, each tile ±8 % brighter or darker, a dark seam under every
+    course, dark ridge tiles and a bright gutter at the eaves."""
+    course, tile = 0.4, 0.35
+    iv = np.floor(np.abs(v) / course).astype(np.int64)
+    shift = np.where(iv % 2 == 1, tile / 2.0, 0.0)
+    iu = np.floor((u + b.length / 2.0 + 1.0 + shift) / tile).astype(np.int64)
+    table = 1.0 + 0.08 * rng.standard_normal((int(b.length / tile) + 8, int(b.width) + 4))
+    factor = table[np.clip(iu, 0, table.shape[0] - 1), np.clip(iv, 0, table.shape[1] - 1)]
+    frac = np.mod(np.abs(v), course) / course
+    factor = np.where(frac > 0.78, 0.72 * factor, factor)  # shadowed seam under a course
+    factor = np.where(np.abs(v) < 0.2, 0.62, factor)  # ridge tiles
+    return np.where(np.abs(v) > b.width / 2.0 - 0.25, 1.3, factor)  # gutter
+
+
+def _fixtures(b: Building, u: np.ndarray, v: np.ndarray, rng: np.random.Generator,
+              factor: np.ndarray) -> np.ndarray:
+    """Skylights (1–1.4 m, dark glass in a bright frame) and vents (0.3–0.5 m, dark or bright)
+    painted on a flat roof, kept 1 m inside its edge."""
+    n_sky, n_vent = int(rng.integers(1, 4)), int(rng.integers(2, 6))
+    for k in range(n_sky + n_vent):
+        side = rng.uniform(1.0, 1.4) if k < n_sky else rng.uniform(0.3, 0.5)
+        cu = rng.uniform(-1.0, 1.0) * (b.length / 2.0 - 1.0 - side / 2.0)
+        cv = rng.uniform(-1.0, 1.0) * (b.width / 2.0 - 1.0 - side / 2.0)
+        d = np.maximum(np.abs(u - cu), np.abs(v - cv))
+        if k < n_sky:
+            factor = np.where(d <= side / 2.0, 1.35, factor)
+            factor = np.where(d <= side / 2.0 - 0.12, 0.3, factor)
+        else:
+            factor = np.where(d <= side / 2.0, 0.45 if rng.uniform() < 0.6 else 1.45, factor)
+    return factor
+
+
+def roof_albedo(b: Building, u: np.ndarray, v: np.ndarray, fine: np.ndarray,
+                colours: Dict[str, Tuple[float, float, float]]) -> np.ndarray:
+    """RGB albedo (3, …) of the roof of ``b`` at building-frame coordinates ``u``, ``v``.
+
+    Looks by ``b.style`` (:data:`.objects.ROOF_STYLES`): gabled ``stripes`` (the plain 1 m
+    pattern across the slope), ``tiles`` (2-D tile courses, ridge and eaves lines) and
+    ``two_tone`` (tiles whose two halves differ in colour, e.g. one mossy); flat ``plain``
+    (faint noise with a bright rim), ``gravel`` (per-cell grain of 4–10 % contrast at the
+    0.1–0.2 m cell) and ``fixtures`` (gravel with skylights and vents). Chimney squares get
+    brick with a dark flue on top. Random parts come from ``b.texture_seed``.
+    """
+    rng = np.random.default_rng(b.texture_seed)
+    u, v = np.broadcast_arrays(u, v)
+    one = np.ones(u.shape, dtype=np.float32)
+    rim = (np.abs(u) > b.length / 2.0 - 0.4) | (np.abs(v) > b.width / 2.0 - 0.4)
+    if b.roof == "gabled":
+        colour = colours["roof_red"] if b.id % 3 else colours["roof_grey"]
+        rgb = np.stack([one * c for c in colour])
+        if b.style in ("tiles", "two_tone"):
+            factor = _tiles(b, u, v, rng) * (1.0 + 0.04 * fine)
+            if b.style == "two_tone":
+                other = colours["roof_moss"] if b.id % 2 else colours["roof_grey"]
+                rgb = np.where(v[None] > 0.0, np.array(other)[:, None, None], rgb)
+        else:
+            factor = 0.85 + 0.15 * np.sin(2.0 * np.pi * np.abs(v) / 1.0)
+    else:
+        rgb = np.stack([one * c for c in colours["roof_flat"]])
+        if b.style in ("gravel", "fixtures"):
+            grain = rng.uniform(0.04, 0.10)
+            factor = 1.0 + grain * rng.standard_normal(u.shape) + 0.04 * fine
+            factor = np.where(rim, 1.2, factor)
+            if b.style == "fixtures":
+                factor = _fixtures(b, u, v, rng, factor)
+        else:
+            factor = np.where(rim, 1.25, 0.95 + 0.1 * fine)
+    for cu, cv, side, _top in b.chimneys:
+        d = np.maximum(np.abs(u - cu), np.abs(v - cv))
+        brick = d <= side / 2.0
+        rgb = np.where(brick[None], np.array(colours["chimney"])[:, None, None], rgb)
+        factor = np.where(brick, np.where(d <= side / 2.0 - 0.15, 0.25, 1.0), factor)
+    return (rgb * factor).astype(np.float32)
 
 
 def make_albedo(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndarray,
@@ -142,16 +230,10 @@ def make_albedo(grid: Grid, dtm: np.ndarray, dsm: np.ndarray, landcover: np.ndar
         u, v = b.local(X[:, c_], Y[r_, :])
         inside = (landcover[r_, c_] == BUILDING) & (np.abs(u) <= b.length / 2.0) & (
             np.abs(v) <= b.width / 2.0)
-        if b.roof == "gabled":
-            colour = colours["roof_red"] if b.id % 3 else colours["roof_grey"]
-            pattern = 0.85 + 0.15 * np.sin(2.0 * np.pi * np.abs(v) / 1.0)
-        else:
-            colour = colours["roof_flat"]
-            edge = (np.abs(u) > b.length / 2.0 - 0.4) | (np.abs(v) > b.width / 2.0 - 0.4)
-            pattern = np.where(edge, 1.25, 0.95 + 0.1 * fine[r_, c_])
+        rgb = roof_albedo(b, u, v, fine[r_, c_], colours)
         for k in range(3):
             sub = albedo[k, r_, c_]
-            sub[inside] = (colour[k] * pattern)[inside]
+            sub[inside] = rgb[k][inside]
     _paint(albedo, landcover == TREE, colours["tree"], 1.0 + 0.25 * fine)
 
     # band-limited noise over everything, a little of it per band, then shading

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import shutil
 from pathlib import Path
 from typing import Any, Dict, Optional
 
@@ -188,3 +189,10 @@ def qgis_process_results(env: Dict[str, str], algorithm_id: str, cli_args: list)
     proc = run_qgis_process(env, "run", f"photodem:{algorithm_id}", "--json", "--", *cli_args)
     assert proc.returncode == 0, f"qgis_process failed ({proc.returncode}):\n{proc.stderr[-3000:]}"
     return json.loads(proc.stdout)["results"]
+
+
+def copy_block(block: Path, folder: Path, name: str = "block") -> Path:
+    """A copy of ``block`` as ``folder/name`` (each writer works on its own project)."""
+    target = Path(folder) / name
+    shutil.copytree(block, target)
+    return target

@@ -150,3 +150,15 @@ def qgis_iface(qgis_app, plugin):
     yield iface
     QgsProject.instance().clear()
     iface.close()
+
+
+@pytest.fixture(scope="session")
+def tiny_block(tmp_path_factory, plugin) -> Path:
+    """One tiny synthetic block (``synthetic_block --size tiny``) for the session. Read only:
+    a module or test that writes into a project takes a copy (``_qgis_helpers.copy_block``)."""
+    from photodem.algorithms.processing import registry
+
+    root = tmp_path_factory.mktemp("tiny") / "block"
+    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    return root
+

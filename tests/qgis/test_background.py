@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any, Dict, List
 
 import pytest
+from _qgis_helpers import copy_block
 
 pytestmark = pytest.mark.qgis
 
@@ -13,12 +14,9 @@ MODEL = "0101_0102"
 
 
 @pytest.fixture(scope="module")
-def tiny_project(tmp_path_factory) -> Path:
+def tiny_project(tmp_path_factory, tiny_block) -> Path:
     """The tiny synthetic project (6 images, 4 in-strip stereo models)."""
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("bg") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("bg"), "block")
     return root
 
 

@@ -19,6 +19,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/: the shared click table
+from _qgis_helpers import copy_block
 from edit_clicks import (
     BOW_TIE,
     CLICKS,
@@ -38,13 +39,9 @@ SHOTS = Path("/tmp/e")
 
 # -- the block, the surface and the stand-in workspace ---------------------------------------------
 @pytest.fixture(scope="module")
-def block(tmp_path_factory, plugin) -> Path:
+def block(tmp_path_factory, tiny_block, plugin) -> Path:
     """A tiny synthetic block, made once (each test edits a copy)."""
-    from photodem.algorithms.processing import registry
-
-    out = tmp_path_factory.mktemp("edit-block") / "block"
-    result = registry.run("synthetic_block", {"output": str(out), "size": "tiny"})
-    return Path(result.get("project", out))
+    return copy_block(tiny_block, tmp_path_factory.mktemp("edit-block"), "block")
 
 
 def write_surface(path: Path, crs: Optional[str] = SURFACE["crs"]) -> Path:

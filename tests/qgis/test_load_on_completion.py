@@ -9,16 +9,14 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
+from _qgis_helpers import copy_block
 
 pytestmark = pytest.mark.qgis
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("load") / "tiny"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+def tiny(tmp_path_factory, tiny_block) -> Path:
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("load"), "tiny")
     return root
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, List
 
 import pytest
+from _qgis_helpers import copy_block
 
 pytestmark = pytest.mark.qgis
 
@@ -14,12 +15,9 @@ MODELS = ["0101_0102", "0102_0103", "0201_0202", "0202_0203"]
 
 
 @pytest.fixture(scope="module")
-def tiny_project(tmp_path_factory) -> Path:
+def tiny_project(tmp_path_factory, tiny_block) -> Path:
     """The tiny project with its block layers per the contract (``.photodem/block.gpkg``)."""
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("ma") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("ma"), "block")
     _write_block_gpkg(root)
     return root
 

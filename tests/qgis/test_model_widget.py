@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from _qgis_helpers import copy_block
 
 pytestmark = pytest.mark.qgis
 
@@ -12,11 +13,8 @@ MODELS = ["0101_0102", "0102_0103", "0201_0202", "0202_0203"]
 
 
 @pytest.fixture(scope="module")
-def tiny_project(tmp_path_factory) -> Path:
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("mw") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+def tiny_project(tmp_path_factory, tiny_block) -> Path:
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("mw"), "block")
     return root
 
 

@@ -13,6 +13,7 @@ from typing import Any, List
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # tests/qgis: the click helpers
+from _qgis_helpers import copy_block
 from test_edit_tools import FakeAsk, draw
 
 pytestmark = pytest.mark.qgis
@@ -26,11 +27,8 @@ BREAKLINE = [(402270.0, 5674720.0), (402290.0, 5674725.0), (402310.0, 5674722.0)
 
 
 @pytest.fixture(scope="module")
-def block(tmp_path_factory, plugin) -> Path:
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("loop") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+def block(tmp_path_factory, tiny_block, plugin) -> Path:
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("loop"), "block")
     return root
 
 

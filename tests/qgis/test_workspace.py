@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
+from _qgis_helpers import copy_block
 
 pytestmark = pytest.mark.qgis
 
@@ -19,12 +20,11 @@ EDIT_TITLES = ["Start points", "Exclusion areas", "Boundaries", "Breaklines", "G
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory) -> Path:
+def demo(tmp_path_factory, tiny_block) -> Path:
     """The tiny synthetic project with a matched model and its filtered DTM (made once)."""
     from photodem.algorithms.processing import registry
 
-    root = tmp_path_factory.mktemp("ws") / "demo"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    root = copy_block(tiny_block, tmp_path_factory.mktemp("ws"), "demo")
     registry.run("match_model", {"project": str(root), "model": "0101_0102"})
     registry.run("filter_lowpass", {"input": str(root / "products/dsm/0101_0102/dsm.tif"),
                                     "project": str(root),

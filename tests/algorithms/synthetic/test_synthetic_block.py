@@ -116,12 +116,27 @@ def test_truth_surfaces_and_landcover(block: Path) -> None:
         buildings = [(shape(f["geometry"]), dict(f["properties"])) for f in src]
     assert len(buildings) >= 4
     assert {p["roof"] for _, p in buildings} == {"flat", "gabled"}
+    # every block mixes the plain roof looks with textured ones
+    styles = {p["style"] for _, p in buildings}
+    assert {"stripes", "plain"} & styles and {"tiles", "two_tone", "gravel", "fixtures"} & styles
+    with fiona.open(block / "truth/chimneys.gpkg") as src:
+        chimneys = [(shape(f["geometry"]), dict(f["properties"])) for f in src]
+    assert len(chimneys) == sum(p["chimneys"] for _, p in buildings) > 0
+    fixture = np.zeros(lc.shape, dtype=bool)
+    for poly, p in chimneys:
+        # the chimney's flat top is burned into the truth DSM exactly (cells wholly inside)
+        core = rasterize([(poly.buffer(-transform.a), 1)], out_shape=lc.shape,
+                         transform=transform, fill=0, dtype="uint8").astype(bool)
+        assert core.any() and np.allclose(dsm[core], p["top_z"], atol=1e-3)
+        fixture |= rasterize([(poly.buffer(transform.a), 1)], out_shape=lc.shape,
+                             transform=transform, fill=0, dtype="uint8").astype(bool)
     inside_any = np.zeros(lc.shape, dtype=bool)
     cell = transform.a
     for poly, p in buildings:
         mask = rasterize([(poly, 1)], out_shape=lc.shape, transform=transform, fill=0,
                          dtype="uint8").astype(bool)
         inside_any |= mask
+        mask &= ~fixture  # DSM − DTM is the roof height outside the chimneys
         h = (dsm - dtm)[mask]
         assert np.allclose(dtm[mask], p["base_z"], atol=1e-3)
         if p["roof"] == "flat":

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from photodem.algorithms.geometry.dem_intersection import intersect_rays_dem
@@ -64,3 +66,26 @@ def test_band_noise_is_smooth_and_normalised() -> None:
     assert n.dtype == np.float32 and n.shape == grid.shape
     assert 0.7 < n.std() < 1.3
     assert np.abs(np.diff(n, axis=1)).max() < 0.3  # features of ~5 m on 0.1 m cells
+
+
+def test_sparse_crowns_show_the_ground_dense_ones_do_not() -> None:
+    """A sparse crown has gaps where the truth DSM is the ground and the land cover stays
+    the ground's; a dense one has none; both carry leaf-clump relief."""
+    from photodem.algorithms.synthetic.objects import OPEN, TREE, _burn_trees  # private helper
+
+    grid = Grid(0.0, 20.0, 0.1, 200, 400)
+    dtm = np.full(grid.shape, 50.0)
+    dsm = dtm.copy()
+    lc = np.full(grid.shape, OPEN, dtype=np.uint8)
+    obj = SimpleNamespace(trees=np.array([[10.0, 10.0, 4.0, 10.0], [30.0, 10.0, 4.0, 10.0]]),
+                          tree_sparse=np.array([0.3, 0.0]))
+    _burn_trees(grid, dtm, dsm, lc, obj, np.random.default_rng(3))
+    d = np.hypot(grid.xs - 10.0, grid.ys - 10.0) < 3.0
+    gaps = d & (dsm == dtm)
+    assert 0.1 < gaps.mean() / d.mean() < 0.5
+    assert (lc[gaps] == OPEN).all() and (lc[d & ~gaps] == TREE).all()
+    d2 = np.hypot(grid.xs - 30.0, grid.ys - 10.0)
+    assert (dsm[d2 < 3.0] > dtm[d2 < 3.0]).all()
+    profile = 10.0 * np.clip(1.0 - (d2 / 4.0) ** 2, 0.0, None) ** 0.6
+    relief = (dsm - dtm - profile)[d2 < 3.0]
+    assert 0.1 < relief.std() < 0.5
