@@ -629,7 +629,8 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
                        borderValue=0)
         disp[ok == 0] = np.nan
     if ours and plane_fill > 0:
-        disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg)
+        disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
+                                window=block)
     if ours and fill_max_width > 0:
         disp = fill_holes_rows(disp, lmask, fill_max_width)
     disp[lmask] = np.nan

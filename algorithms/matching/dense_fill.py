@@ -29,8 +29,9 @@ A mixed hole is split where the wall is: a pixel takes the upper surface if its 
 pixel is upper and (where the tones of the two borders
 differ by more than half the image's spread) its grey value is nearer to the upper border's —
 except in the left image's occlusions: in a row run whose left border is lower and its right
-border higher, the first ``d_upper − d_lower`` px from the left border (the width the step hides
-from the right camera) are ground. A filled value outside the disparities of its population's
+border higher, the first ``d_upper − d_lower + window − 1`` px from the left border (the width
+the step hides from the right camera, and the ground pixels whose matching window reaches over
+the wall) are ground. A filled value outside the disparities of its population's
 border (±``jump``) is clipped to that range (a plane extrapolating a steep slope).
 
 In the DSM path only the upper (object) part of a mixed hole is filled: holes without a step
@@ -138,10 +139,11 @@ def _split(values: Array, jump: float, least: float = 0.1) -> Tuple[Optional[flo
     return split, keep
 
 
-def _occluded(hole: Array, disp: Array, split: float) -> Array:
+def _occluded(hole: Array, disp: Array, split: float, window: int = 0) -> Array:
     """Hole pixels the right camera cannot see: in a row run with a lower left and an upper
-    right border, the first ``d_right − d_left`` px from the left border (the width the step
-    hides); the rest of the run is the step's own invalid band."""
+    right border, the first ``d_right − d_left + window − 1`` px from the left border (the
+    width the step hides, and the ground pixels whose matching window reaches over the wall,
+    which fail with it); the rest of the run is the roof's own invalid band."""
     h, w = hole.shape
     cols = np.arange(w)[None, :]
     stop = ~hole
@@ -151,11 +153,12 @@ def _occluded(hole: Array, disp: Array, split: float) -> Array:
     lv = np.where(li >= 0, disp[rows, np.clip(li, 0, w - 1)], np.nan)
     rv = np.where(ri < w, disp[rows, np.clip(ri, 0, w - 1)], np.nan)
     with np.errstate(invalid="ignore"):
-        return hole & (lv < split) & (rv > split) & (cols - li <= rv - lv)
+        reach = rv - lv + max(int(window) - 1, 0)
+        return hole & (lv < split) & (rv > split) & (cols - li <= reach)
 
 
 def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional[Array] = None,
-              tone: float = 0.0, fill_lower: bool = False) -> Array:
+              tone: float = 0.0, fill_lower: bool = False, window: int = 0) -> Array:
     """Fill values of one hole (``hole``, ``ring`` are masks of a small window of ``disp``)."""
     ry, rx = np.nonzero(ring)
     rd = disp[ring].astype(np.float64)
@@ -181,7 +184,7 @@ def _fill_one(disp: Array, hole: Array, ring: Array, jump: float, grey: Optional
             g_lo = float(np.median(grey[lower_ring]))
             if abs(g_up - g_lo) > tone:
                 which = which * (np.abs(g - g_up) < np.abs(g - g_lo))
-        occ = _occluded(hole, np.where(ring, disp, np.nan), split)[hole]
+        occ = _occluded(hole, np.where(ring, disp, np.nan), split, window)[hole]
         which[occ] = 0
     out = np.empty(hy.size, np.float32)
     if not fill_lower:
@@ -213,7 +216,8 @@ def _idw(px: Array, py: Array, pv: Array, qx: Array, qy: Array) -> Array:
 
 
 def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
-               grey: Optional[Array] = None, fill_lower: bool = False) -> Array:
+               grey: Optional[Array] = None, fill_lower: bool = False,
+               window: int = 0) -> Array:
     """Fill holes of a disparity map from planes of their bordering surfaces (module notes).
 
     Parameters
@@ -233,6 +237,10 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
         Fill holes without a step and the lower part of holes with one as well; by default
         only the upper (object) part of a hole with a step is filled — the ground is left to
         the gridding's gap interpolation, which keeps open terrain as accurate as before.
+    window : int
+        Side (px) of the matching window: ground pixels whose window reaches over a wall fail
+        with the occluded ones, so the ground part of an occlusion is ``window − 1`` px wider
+        than the disparity step (without it roofs ran 1–1.5 m past their walls there).
 
     Returns
     -------
@@ -265,7 +273,7 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
             continue
         sub = out[win]
         sub[hole] = _fill_one(disp[win], hole, ring, jump,
-                              None if grey is None else grey[win], tone, fill_lower)
+                              None if grey is None else grey[win], tone, fill_lower, window)
     return out
 
 
