@@ -30,7 +30,7 @@ VARIANTS = {
     # the DSM path's filters (issue 19): one-sided edge erosion, plane fill of holes
     "PhotoDEM sgm, DSM filters (upper-side erosion, plane fill)": (
         "sgm", {"fill_max_width": 0, "edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0,
-                "segment_px": 300, "edge_reach": 20}),
+                "segment_px": 300, "edge_reach": 15}),
 }
 
 
