@@ -14,7 +14,8 @@ from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill
 
 GROUND = 8.0  # px
 #: the DSM path's filters (dense_model._DENSE_DEFAULTS)
-DSM = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0}
+DSM = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0, "segment_px": 300,
+       "edge_reach": 15}
 OLD = {"edge_erosion": 2}
 
 
@@ -96,17 +97,17 @@ def _metrics(disp: np.ndarray, s: Dict[str, np.ndarray], k: int) -> Tuple[float,
 def test_roofs_filled_and_walls_in_place(scene) -> None:
     new = sgm_disparity(scene["left"], scene["right"], 0, 47, **DSM)
     old = sgm_disparity(scene["left"], scene["right"], 0, 47, **OLD)
-    # measured: flat 100 % / 0.5 px, gabled 99.2 % / 1 px, open 89.2 % (ground holes are left
-    # to the gridding); the two-sided erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px,
-    # open 86.9 %
+    # measured: flat (textured) 100 % / 0 px, gabled (weak two-tone texture) 98.8 % / 1 px,
+    # open 86.9 % (ground holes are left to the gridding), 100 % of the measured open pixels
+    # right; the two-sided erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px, open 86.9 %
     for k in (1, 2):
         c_new, wall_new = _metrics(new, scene, k)
         c_old, _ = _metrics(old, scene, k)
-        assert c_new >= 0.95 and c_new >= c_old
-        assert wall_new <= 1.5
+        assert c_new >= 0.97 and c_new >= c_old
+        assert wall_new <= 1.0
     open_ = ndimage.distance_transform_edt(scene["label"] == 0) > 8
     right = np.abs(new - scene["d"]) <= 1.0
-    assert right[open_].mean() >= 0.87
+    assert right[open_].mean() >= 0.85
     assert right[open_ & np.isfinite(new)].mean() >= 0.99
 
 
@@ -129,3 +130,14 @@ def test_lower_side_erosion_keeps_the_roof_edge() -> None:
     assert np.isfinite(out[8:22, 15:17]).all()  # roof edge kept
     assert np.isnan(out[8:22, 13]).all()  # ground beside the step eroded
     assert np.isfinite(out[3:6, 12:14]).all()  # ground beside a hole without a step kept
+
+
+def test_plane_fill_leaves_the_occlusion_to_the_ground() -> None:
+    # ground (5 px) left of a roof (20 px) with the left image's occlusion between them: the
+    # step hides 15 px, and ground pixels whose 5-px window reaches over the wall fail too
+    d = np.full((20, 80), 5.0, np.float32)
+    d[:, 40:] = 20.0
+    d[:, 15:40] = np.nan  # 25 px: 15 occluded + 4 window + 6 roof pixels lost at the edge
+    filled = plane_fill(d, np.zeros(d.shape, bool), 100.0, 2.0, window=5)
+    assert np.isnan(filled[:, 15:34]).all()  # ground part left to the gridding
+    assert np.allclose(filled[:, 34:40], 20.0)  # the roof's own band filled from the roof
