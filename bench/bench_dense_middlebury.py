@@ -27,6 +27,10 @@ VARIANTS = {
     "PhotoDEM sgm, all gaps filled": ("sgm", {"fill_max_width": 10000}),
     "PhotoDEM sgm, all gaps filled, 16 MB tiles": ("sgm", {"fill_max_width": 10000,
                                                            "max_memory_mb": 16}),
+    # the DSM path's filters (issue 19): one-sided edge erosion, plane fill of holes
+    "PhotoDEM sgm, DSM filters (upper-side erosion, plane fill)": (
+        "sgm", {"fill_max_width": 0, "edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0,
+                "segment_px": 300, "edge_reach": 15}),
 }
 
 

@@ -16,7 +16,8 @@ On a synthetic block with truth (default: the ``small`` block as ``make demo`` b
    step with the same points moved to their true heights (what the reduction and the FE surface
    lose by themselves);
 4. dense: the disparity filters switched on one after the other (SGBM alone, + uniqueness,
-   + left–right check, + speckle filter, + edge erosion = production; production without the
+   + left–right check, + speckle filter, + one-sided edge erosion, + plane fill = production
+   with the DSM path's options (``dense_model.dsm_dense_options``); production without the
    coarse range narrowing), valid and correct disparities on object and open pixels, texture of
    the roofs, and the gridding steps (median per cell, outlier test, gap limit).
 
@@ -50,8 +51,8 @@ from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.geometry.epipolar import SIDES
 from photodem.algorithms.matching import dense as dense_mod
 from photodem.algorithms.matching import fbm_model
-from photodem.algorithms.matching.dense_model import _DENSE_DEFAULTS
-from photodem.algorithms.matching.model_setup import prepare_model
+from photodem.algorithms.matching.dense_model import dsm_dense_options
+from photodem.algorithms.matching.model_setup import footprint, prepare_model
 from photodem.algorithms.processing import registry
 from photodem.algorithms.quality.objects import (
     completeness,
@@ -84,6 +85,8 @@ class Truth:
     labels: np.ndarray
     heights: np.ndarray  # per building (index = label − 1)
     landcover: np.ndarray  # 3 building, 4 tree (synthetic LANDCOVER codes)
+    #: cells ≥ 1 m inside the stereo overlap at their own true height (seen by both images)
+    stereo: Optional[np.ndarray] = None
 
 
 def _read(path: Path) -> Tuple[np.ndarray, Any, Any]:
@@ -116,7 +119,35 @@ def load_truth(block: Path, setup: Any) -> Truth:
                        transform=t, fill=0, dtype="int32") if geoms else \
         np.zeros(dsm.shape, np.int32)
     return Truth(dsm, dtm, t, crs, cell, m.objects, m.interior, m.open, area, labels,
-                 np.asarray(heights), lc)
+                 np.asarray(heights), lc, stereo_cells(setup, dsm, area, t, cell))
+
+
+def stereo_cells(setup: Any, dsm: np.ndarray, area: np.ndarray, transform: Any,
+                 cell: float, step: float = 0.5, inside: float = 1.0) -> np.ndarray:
+    """Cells of the measuring area whose true surface point lies in both images' footprints
+    at its own height, at least ``inside`` m from the footprints' edge.
+
+    The measuring area is the overlap at the mid height; where the true surface is higher or
+    lower, a strip along the overlap's edge has no partner in the other image, and no stereo
+    method can measure it (issue 19: most open and object cells lost at the area's border).
+    """
+    cams, recs = setup.cameras, setup.records
+    z = np.where(area, dsm, np.nan)
+    out = np.zeros(dsm.shape, bool)
+    if not np.isfinite(z).any():
+        return out
+    for h in np.arange(np.floor(np.nanmin(z)), np.nanmax(z) + step, step):
+        sel = np.abs(z - h) <= step / 2
+        if not sel.any():
+            continue
+        both = footprint(cams[0], recs[0].eo, h).intersection(footprint(cams[1], recs[1].eo, h))
+        if both.is_empty:
+            continue
+        inner = both.buffer(-inside)
+        if not inner.is_empty:
+            out |= sel & geometry_mask([inner], out_shape=dsm.shape, transform=transform,
+                                       invert=True)
+    return out & area
 
 
 def on_truth_grid(path: Path, truth: Truth) -> np.ndarray:
@@ -131,8 +162,11 @@ def on_truth_grid(path: Path, truth: Truth) -> np.ndarray:
 def dsm_row(name: str, dsm: np.ndarray, truth: Truth, gsd: float) -> Dict[str, Any]:
     """The issue's table row of one DSM, plus heights of tall objects and outlines."""
     a = truth.area
+    st = truth.stereo if truth.stereo is not None else a
     c = completeness(dsm, truth.dsm, {"interior": truth.interior & a,
-                                      "objects": truth.objects & a, "open": truth.open & a})
+                                      "objects": truth.objects & a, "open": truth.open & a,
+                                      "interior_st": truth.interior & st,
+                                      "open_st": truth.open & st})
     ndsm_true = truth.dsm - truth.dtm
     tall = truth.objects & a & (ndsm_true >= 5.0)
     out = outline_metrics(np.where(a, dsm, np.nan), truth.dtm, truth.dsm,
@@ -149,6 +183,10 @@ def dsm_row(name: str, dsm: np.ndarray, truth: Truth, gsd: float) -> Dict[str, A
         "objects_measured_pct": 100 * c["objects"]["measured"],
         "open_0_5_pct": 100 * c["open"]["within_0_5"],
         "open_measured_pct": 100 * c["open"]["measured"],
+        # the same on cells both images see (:func:`stereo_cells`)
+        "interior_stereo_0_5_pct": 100 * c["interior_st"]["within_0_5"],
+        "open_stereo_0_5_pct": 100 * c["open_st"]["within_0_5"],
+        "stereo_share_of_area_pct": 100 * float(st.sum()) / max(int(a.sum()), 1),
         "tall_true_ndsm_median_m": float(np.median(ndsm_true[tall])),
         "tall_dsm_ndsm_median_m": float(np.nanmedian((dsm - truth.dtm)[tall])),
         "interior_right_median_m": float(np.median(dz[ok])) if ok.any() else None,
@@ -394,11 +432,13 @@ def fbm_chain(setup: Any, truth: Truth, et: EpiTruth, grey: Dict[str, np.ndarray
 #: Cumulative filter settings: SGBM alone, then each filter of production switched on.
 DENSE_STEPS: Tuple[Tuple[str, Dict[str, Any]], ...] = (
     ("SGBM alone", {"uniqueness": 0, "lr_max_diff": -1.0, "speckle_window": 0,
-                    "edge_erosion": 0}),
-    ("+ uniqueness 10 %", {"lr_max_diff": -1.0, "speckle_window": 0, "edge_erosion": 0}),
-    ("+ left–right check", {"speckle_window": 0, "edge_erosion": 0}),
-    ("+ speckle filter", {"edge_erosion": 0}),
-    ("+ edge erosion (production)", {}),
+                    "edge_erosion": 0, "plane_fill": 0}),
+    ("+ uniqueness 10 %", {"lr_max_diff": -1.0, "speckle_window": 0, "edge_erosion": 0,
+                           "plane_fill": 0}),
+    ("+ left–right check", {"speckle_window": 0, "edge_erosion": 0, "plane_fill": 0}),
+    ("+ speckle filter", {"edge_erosion": 0, "plane_fill": 0}),
+    ("+ one-sided edge erosion", {"plane_fill": 0}),
+    ("+ plane fill (production)", {}),
     ("production, full range (no coarse narrowing)", {"coarse_above": 0}),
 )
 
@@ -421,7 +461,7 @@ def dense_steps(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray]
     rr, cc = np.mgrid[0:h, 0:w]
     inter, open_, roof, tree = et.cls == 1, et.cls == 3, et.roof(), et.tree()
     for name, over in DENSE_STEPS:
-        opt = dict(_DENSE_DEFAULTS, **over)
+        opt = dict(dsm_dense_options(setup), **over)  # the DSM path's options
         t0 = time.perf_counter()
         d = dense_mod.sgm_disparity(grey["left"], grey["right"], setup.min_d, setup.max_d,
                                     **opt)

@@ -59,6 +59,8 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..input_errors import warn_input
 from ..memory import check_allocation
+from .dense_fill import erode_lower_side
+from .dense_fill import plane_fill as plane_fill_holes
 
 #: Matching methods; the first is the default.
 METHODS = ("sgm", "opencv_sgbm")
@@ -241,6 +243,10 @@ class _TileMatcher:
     fill_max_width: int
     edge_erosion: int
     range_guard: float
+    edge_jump: float = 0.0
+    plane_fill: float = 0.0
+    segment_px: int = 0
+    edge_reach: int = 0
 
     def _matcher(self, lo: int, n_d: int) -> Any:
         """SGBM for ``n_d`` disparities from ``lo``.
@@ -275,7 +281,9 @@ class _TileMatcher:
         disp = _match_frame(self.cv2, matcher, lg, rg, lo, hi, n_d, self.ours, block,
                             self.lr_max_diff, self.normalise_window, self.speckle_window,
                             int(self.speckle_range), self.fill_max_width,
-                            int(self.edge_erosion), float(self.range_guard))
+                            int(self.edge_erosion), float(self.range_guard),
+                            float(self.edge_jump), float(self.plane_fill),
+                            int(self.segment_px), int(self.edge_reach))
         return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
 
 
@@ -386,6 +394,10 @@ def iter_disparity_tiles(
     fill_max_width: int = 0,
     edge_erosion: int = 0,
     range_guard: float = 0.0,
+    edge_jump: float = 0.0,
+    plane_fill: float = 0.0,
+    segment_px: int = 0,
+    edge_reach: int = 0,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -425,6 +437,18 @@ def iter_disparity_tiles(
     range_guard : float
         Disparities closer than this (px) to ``min_disparity`` or ``max_disparity`` are
         removed; 0 = off.
+    edge_jump : float
+        With ``edge_erosion``: erode only the lower side of disparity steps larger than this
+        (px) and the borders of masks (:func:`.dense_fill.erode_lower_side`); 0 = erode every
+        border of a valid region.
+    plane_fill : float
+        Holes up to this inscribed diameter (px) are filled from planes of their bordering
+        surfaces split at steps of ``edge_jump`` (default 2 px) (:func:`.dense_fill.plane_fill`;
+        method "sgm"); 0 = off.
+    segment_px, edge_reach : int
+        With ``edge_jump``: a pixel near a hole is kept only in a disparity segment of at least
+        ``segment_px`` px (blunder patches go) and, if ``edge_reach`` > 0, only on the upper
+        side of a step (a disparity within ``edge_reach`` px lower by > ``edge_jump``). 0 = off.
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size : int, optional
@@ -449,7 +473,8 @@ def iter_disparity_tiles(
     # the right source pads with NaN outside its own right_shape
     match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
                          lr_max_diff, normalise_window, speckle_window, speckle_range,
-                         fill_max_width, edge_erosion, range_guard)
+                         fill_max_width, edge_erosion, range_guard, edge_jump, plane_fill,
+                         segment_px, edge_reach)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
@@ -534,10 +559,21 @@ def _range_from_coarse(coarse: Array, factor: int, core: Tuple[int, int, int, in
     return full
 
 
+def _small_segments(cv2: Any, disp: Array, area: int, step: float) -> Array:
+    """Valid pixels of disparity segments (8-connected, neighbours within ``step`` px) smaller
+    than ``area`` px — the blunder patches that one-sided erosion must not keep."""
+    bad = np.int16(-32768)
+    d16 = np.where(np.isfinite(disp), np.rint(disp * 16.0), bad).astype(np.int16)
+    before = d16 != bad
+    cv2.filterSpeckles(d16, bad, int(area), round(step * 16.0))
+    return before & (d16 == bad)
+
+
 def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d: int,
                  num_d: int, ours: bool, block: int, lr_max_diff: float, normalise_window: int,
                  speckle_window: int, speckle_range: int, fill_max_width: int,
-                 edge_erosion: int = 0, range_guard: float = 0.0) -> Array:
+                 edge_erosion: int = 0, range_guard: float = 0.0, edge_jump: float = 0.0,
+                 plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0) -> Array:
     """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape)."""
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
@@ -581,13 +617,20 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     if range_guard > 0:
         with np.errstate(invalid="ignore"):
             disp[(disp < min_d + range_guard) | (disp > max_d - range_guard)] = np.nan
-    if ours and edge_erosion > 0:
+    if ours and edge_erosion > 0 and edge_jump > 0:
+        # only the occluded (lower) side of a step, so that roof edges stay
+        small = _small_segments(cv2, disp, segment_px, 1.0) if segment_px > 0 else None
+        disp = erode_lower_side(disp, lmask, int(edge_erosion), edge_jump, small, edge_reach)
+    elif ours and edge_erosion > 0:
         # the frame outside the image is masked (NaN), so image borders are eroded too
         ok = (np.isfinite(disp) & ~lmask).astype(np.uint8)
         k = 2 * int(edge_erosion) + 1
         ok = cv2.erode(ok, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT,
                        borderValue=0)
         disp[ok == 0] = np.nan
+    if ours and plane_fill > 0:
+        disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
+                                window=block)
     if ours and fill_max_width > 0:
         disp = fill_holes_rows(disp, lmask, fill_max_width)
     disp[lmask] = np.nan
