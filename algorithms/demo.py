@@ -237,7 +237,8 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
         "mosaic": {**{k: mosaic.get(k) for k in ("mosaic", "seamlines", "report", "gsd",
                                                   "balance")},
                    "images": len(info["images"]),
-                   "occlusion": _occlusion_figures(orthos, block["truth_dsm"])},
+                   "occlusion": _occlusion_figures(project, info, orthos,
+                                                   block["truth_dsm"])},
         "objects": _object_figures(project, info, dsms, merged["dsm"], block),
         "models": [{"name": r["model"], "points": r["metrics"]["points_raw"],
                     "coverage_pct": r["metrics"]["coverage_pct"],
@@ -259,9 +260,15 @@ def _true_orthos(project: Project, info: Dict[str, Any], dsm: Path, folder: Path
         for im in info["images"]]
 
 
-def _occlusion_figures(orthos: List[Dict[str, Any]], truth_dsm: str) -> Dict[str, Any]:
-    """Each true ortho's occlusion mask against the truth visibility, and all pooled."""
-    per = [occlusion_agreement(o["visibility"], truth_dsm) for o in orthos]
+def _occlusion_figures(project: Project, info: Dict[str, Any], orthos: List[Dict[str, Any]],
+                       truth_dsm: str) -> Dict[str, Any]:
+    """Each true ortho's occlusion mask against the truth visibility (every cell whose true
+    point is in the image, DSM holes included), and all pooled."""
+    per = []
+    for im, o in zip(info["images"], orthos):
+        rec = project.image(im["name"])
+        per.append(occlusion_agreement(o["visibility"], truth_dsm,
+                                       camera=project.camera_of(rec), eo=rec.eo))
     return {"images": per, "all": pooled_agreement(per)}
 
 
@@ -404,11 +411,13 @@ def _object_markdown(f: Dict[str, Any]) -> List[str]:
                      f"{r['buildings']} |")
     occ = f["mosaic"]["occlusion"]
     lines += ["", "True orthos (on the merged DSM) against the truth visibility (the same "
-              "occlusion test on the true DSM), cells inside each image:", "",
-              "| image | occluded % (ortho) | occluded % (truth) | precision | recall | F1 |",
-              "|---|---|---|---|---|---|"]
+              "occlusion test on the true DSM), every cell whose true point lies in the image; "
+              "a cell without a DSM height counts as not occluded:", "",
+              "| image | occluded % (ortho) | occluded % (truth) | no DSM height % | precision "
+              "| recall | F1 |", "|---|---|---|---|---|---|---|"]
     for name, a in [(a["image"], a) for a in occ["images"]] + [("all", occ["all"])]:
         lines.append(f"| {name} | {_fmt(a['ortho_occluded_pct'], '.2f')} | "
-                     f"{_fmt(a['truth_occluded_pct'], '.2f')} | {_fmt(a['precision'], '.2f')} | "
+                     f"{_fmt(a['truth_occluded_pct'], '.2f')} | "
+                     f"{_fmt(a['no_height_pct'], '.2f')} | {_fmt(a['precision'], '.2f')} | "
                      f"{_fmt(a['recall'], '.2f')} | {_fmt(a['f1'], '.2f')} |")
     return lines

@@ -21,10 +21,13 @@ Agreement over the cells inside the image (code 1 or 2) that have a true height:
 .. math:: P = \frac{tp}{tp + fp}, \quad R = \frac{tp}{tp + fn}, \quad
           F_1 = \frac{2\,tp}{2\,tp + fp + fn} .
 
-Cells the ortho left at 0 because its DSM had no height there are not judged (they are
-indistinguishable from cells outside the image). The raster is processed in windows of
-``window_size`` cells (plus a ring of one cell for the opening); the truth DSM is read per
-window with the march margin, never whole.
+Which cells are judged: with the image's camera and orientation, every cell whose true
+surface point projects into the image — a cell the ortho left at 0 because its DSM had no
+height there then counts as *not occluded* in the ortho (``no_height`` counts them), so a DSM
+with holes where the occlusions are cannot look good. Without them, the cells the ortho marked
+1 or 2 (holes of the DSM cannot be told from cells outside the image). The raster is processed
+in windows of ``window_size`` cells (plus a ring of one cell for the opening); the truth DSM is
+read per window with the march margin, never whole.
 """
 
 from __future__ import annotations
@@ -40,10 +43,18 @@ from rasterio.windows import Window
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
-from .rectify import occlusion_flags, open_surface, read_surface, surface_heights
+from ..geometry.camera import Camera
+from ..geometry.orientation import ExteriorOrientation
+from .rectify import (
+    occlusion_flags,
+    open_surface,
+    project_grid,
+    read_surface,
+    surface_heights,
+)
 
 PathLike = Union[str, Path]
-COUNT_KEYS = ("cells", "tp", "fp", "fn", "tn")
+COUNT_KEYS = ("cells", "tp", "fp", "fn", "tn", "no_height")
 
 
 def ortho_centre(ortho: PathLike) -> NDArray[np.float64]:
@@ -95,25 +106,27 @@ def truth_occlusion(truth_ds: Any, centre: ArrayLike, xs: NDArray[np.float64],
 
 
 def _window_counts(vis: NDArray[np.uint8], truth_occ: NDArray[np.bool_],
-                   has_truth: NDArray[np.bool_]) -> Dict[str, int]:
-    judged = (vis > 0) & has_truth
+                   judged: NDArray[np.bool_]) -> Dict[str, int]:
     o, t = (vis == 2) & judged, truth_occ & judged
     return {"cells": int(judged.sum()), "tp": int((o & t).sum()), "fp": int((o & ~t).sum()),
-            "fn": int((~o & t).sum()), "tn": int((judged & ~o & ~t).sum())}
+            "fn": int((~o & t).sum()), "tn": int((judged & ~o & ~t).sum()),
+            "no_height": int((judged & (vis == 0)).sum())}
 
 
 def agreement_from_counts(counts: Dict[str, int]) -> Dict[str, Any]:
     """Precision, recall, F1 and the occluded shares (%) from summed counts (None where a
     ratio has no cells)."""
-    tp, fp, fn, n = (int(counts[k]) for k in ("tp", "fp", "fn", "cells"))
+    counts = {k: int(counts.get(k, 0)) for k in COUNT_KEYS}
+    tp, fp, fn, n = (counts[k] for k in ("tp", "fp", "fn", "cells"))
 
     def ratio(a: int, b: int) -> Optional[float]:
         return a / b if b else None
 
-    return {**{k: int(counts[k]) for k in COUNT_KEYS}, "precision": ratio(tp, tp + fp),
+    return {**counts, "precision": ratio(tp, tp + fp),
             "recall": ratio(tp, tp + fn), "f1": ratio(2 * tp, 2 * tp + fp + fn),
             "ortho_occluded_pct": 100.0 * ratio(tp + fp, n) if n else None,
-            "truth_occluded_pct": 100.0 * ratio(tp + fn, n) if n else None}
+            "truth_occluded_pct": 100.0 * ratio(tp + fn, n) if n else None,
+            "no_height_pct": 100.0 * ratio(counts["no_height"], n) if n else None}
 
 
 def pooled_agreement(results: Iterable[Dict[str, Any]]) -> Dict[str, Any]:
@@ -121,12 +134,13 @@ def pooled_agreement(results: Iterable[Dict[str, Any]]) -> Dict[str, Any]:
     total = dict.fromkeys(COUNT_KEYS, 0)
     for r in results:
         for k in COUNT_KEYS:
-            total[k] += int(r[k])
+            total[k] += int(r.get(k, 0))
     return agreement_from_counts(total)
 
 
 def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
-                        centre: Optional[ArrayLike] = None, window_size: int = 512,
+                        centre: Optional[ArrayLike] = None, camera: Optional[Camera] = None,
+                        eo: Optional[ExteriorOrientation] = None, window_size: int = 512,
                         feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Compare a true ortho's occlusion mask with the truth visibility from the true DSM.
 
@@ -137,8 +151,11 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
     truth_dsm : path
         True DSM (any grid; read in the visibility raster's CRS, bilinear at the cell centres).
     centre : array_like, shape (3,), optional
-        Projection centre of the image; default from the tags of the ortho beside
-        ``visibility`` (:func:`ortho_centre`).
+        Projection centre of the image; default ``eo.position``, else from the tags of the
+        ortho beside ``visibility`` (:func:`ortho_centre`).
+    camera, eo : optional
+        The image's camera and exterior orientation: judge every cell whose true surface point
+        lies in the image (see the module notes); without them the cells marked 1 or 2.
     window_size : int
         Window edge (cells); bounds the memory.
     feedback : Feedback, optional
@@ -147,14 +164,20 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
     Returns
     -------
     dict
-        ``cells`` (judged), ``tp``, ``fp``, ``fn``, ``tn``, ``precision``, ``recall``, ``f1``,
-        ``ortho_occluded_pct``, ``truth_occluded_pct`` (see the module notes), ``image``.
+        ``cells`` (judged), ``tp``, ``fp``, ``fn``, ``tn``, ``no_height``, ``precision``,
+        ``recall``, ``f1``, ``ortho_occluded_pct``, ``truth_occluded_pct``, ``no_height_pct``
+        (see the module notes), ``image``.
     """
     fb = ensure_feedback(feedback)
     visibility = Path(visibility)
     if window_size < 8:
         raise InputError("The window size must be at least 8 cells.")
-    C = ortho_centre(_ortho_of(visibility)) if centre is None else np.asarray(centre, float)
+    if (camera is None) != (eo is None):
+        raise InputError("Give both the camera and the orientation of the image, or neither.")
+    if centre is None:
+        C = eo.position if eo is not None else ortho_centre(_ortho_of(visibility))
+    else:
+        C = np.asarray(centre, float)
     total = dict.fromkeys(COUNT_KEYS, 0)
     with contextlib.ExitStack() as stack:
         vsrc = stack.enter_context(rasterio.open(visibility))
@@ -168,17 +191,33 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
             fb.check()
             h, w = min(window_size, H - r0), min(window_size, W - c0)
             vis = vsrc.read(1, window=Window(c0, r0, w, h))
-            if (vis > 0).any():
+            if camera is not None or (vis > 0).any():
                 # a ring of one cell, as the ortho's tiles have, for the 2 × 2 opening
                 xs = t.c + (np.arange(c0 - 1, c0 + w + 1) + 0.5) * t.a
                 ys = t.f + (np.arange(r0 - 1, r0 + h + 1) + 0.5) * t.e
                 occ, z = _truth(tds, C, xs, ys)
                 inner = (slice(1, -1), slice(1, -1))
-                for k, v in _window_counts(vis, occ[inner], np.isfinite(z[inner])).items():
+                judged = _judged(vis, xs, ys, z, camera, eo)[inner]
+                for k, v in _window_counts(vis, occ[inner], judged).items():
                     total[k] += v
             fb.progress(100.0 * (i + 1) / len(wins))
         image = vsrc.tags().get("PHOTODEM_IMAGE", visibility.stem)
     return {**agreement_from_counts(total), "image": image}
+
+
+def _judged(vis: NDArray[np.uint8], xs: NDArray[np.float64], ys: NDArray[np.float64],
+            z: NDArray[np.float64], camera: Optional[Camera], eo: Optional[ExteriorOrientation]
+            ) -> NDArray[np.bool_]:
+    """Cells to judge on the ringed grid: true point in the image (with a camera), else the
+    ortho's cells inside the image; always with a true height."""
+    has = np.isfinite(z)
+    if camera is None or eo is None:
+        ring = np.zeros(z.shape, dtype=bool)
+        ring[1:-1, 1:-1] = vis > 0
+        return ring & has
+    col, row = project_grid(camera, eo, xs, ys, np.where(has, z, 0.0))
+    return (has & (col >= -0.5) & (col <= camera.width - 0.5) & (row >= -0.5)
+            & (row <= camera.height - 0.5))
 
 
 __all__ = [

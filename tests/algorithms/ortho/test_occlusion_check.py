@@ -86,6 +86,11 @@ def test_ortho_on_the_true_dsm_agrees_with_the_truth(scene, tmp_path) -> None:
                             centre=scene["centre"], window_size=64)
     assert {k: b[k] for k in ("tp", "fp", "fn", "tn")} == {k: a[k] for k in
                                                            ("tp", "fp", "fn", "tn")}
+    # judged by the camera (every cell whose true point is in the image): still F1 = 1
+    rec = scene["project"].image("c1")
+    c = occlusion_agreement(res["visibility"], scene["root"] / "dsm.tif",
+                            camera=scene["project"].camera_of(rec), eo=rec.eo)
+    assert c["f1"] == pytest.approx(1.0) and c["no_height"] == 0 and c["cells"] >= a["cells"]
 
 
 def test_ortho_on_the_terrain_sees_no_occlusion(scene, tmp_path) -> None:
@@ -106,3 +111,29 @@ def test_visibility_needs_its_ortho_or_a_centre(scene, tmp_path) -> None:
     write_raster(path, np.ones((1, 10, 10), np.uint8), scene["grid"].transform, CRS)
     with pytest.raises(InputError, match="projection centre"):
         occlusion_agreement(path, scene["root"] / "dsm.tif")
+
+
+def test_holes_where_the_occlusions_are_count_with_the_camera(scene, tmp_path) -> None:
+    root, grid = scene["root"], scene["grid"]
+    with rasterio.open(root / "dsm.tif") as src:
+        dsm = src.read(1)
+    gx, gy = grid.xs + 0 * grid.ys, grid.ys + 0 * grid.xs
+    holed = dsm.copy()
+    holed[(gx > X0 + BX1) & (gx < X0 + BX1 + 5.0) & (np.abs(gy - Y0) < BY)] = np.nan
+    write_raster(tmp_path / "holed.tif", holed, grid.transform, CRS)
+    extent = (X0 - 10.0, Y0 - 20.0, X0 + 50.0, Y0 + 20.0)
+    res = orthorectify_image(scene["project"], "c1", tmp_path / "holed.tif",
+                             tmp_path / "holed_ortho.tif", gsd=CELL, extent=extent,
+                             dsm=tmp_path / "holed.tif")
+    rec = scene["project"].image("c1")
+    cam = scene["project"].camera_of(rec)
+    blind = occlusion_agreement(res["visibility"], root / "dsm.tif")
+    seen = occlusion_agreement(res["visibility"], root / "dsm.tif", camera=cam, eo=rec.eo)
+    # without the camera the hole is not judged: the strip behind the far wall is lost unseen
+    assert blind["no_height"] == 0 and blind["cells"] < seen["cells"]
+    # with it the hole's cells count as not occluded: the strip (4.09 m × 16 m) is missed
+    assert seen["no_height"] * CELL**2 == pytest.approx(5.0 * 2 * BY, rel=0.05)
+    assert seen["fn"] * CELL**2 > 0.8 * BH * BX1 / (H - BH) * 2 * BY
+    assert seen["recall"] < blind["recall"]
+    with pytest.raises(InputError, match="both"):
+        occlusion_agreement(res["visibility"], root / "dsm.tif", camera=cam)
