@@ -262,12 +262,15 @@ def _true_orthos(project: Project, info: Dict[str, Any], dsm: Path, folder: Path
 
 def _occlusion_figures(project: Project, info: Dict[str, Any], orthos: List[Dict[str, Any]],
                        truth_dsm: str) -> Dict[str, Any]:
-    """Each true ortho's occlusion mask against the truth visibility (every cell whose true
-    point is in the image, DSM holes included), and all pooled."""
+    """Each true ortho's occlusion mask against the truth visibility (every cell of the
+    models' measuring areas whose true point is in the image, DSM holes included), and all
+    pooled."""
+    area = unary_union([prepare_model(project, m["name"]).measuring_area()
+                        for m in info["models"]])
     per = []
     for im, o in zip(info["images"], orthos):
         rec = project.image(im["name"])
-        per.append(occlusion_agreement(o["visibility"], truth_dsm,
+        per.append(occlusion_agreement(o["visibility"], truth_dsm, area=area,
                                        camera=project.camera_of(rec), eo=rec.eo))
     return {"images": per, "all": pooled_agreement(per)}
 
@@ -411,8 +414,9 @@ def _object_markdown(f: Dict[str, Any]) -> List[str]:
                      f"{r['buildings']} |")
     occ = f["mosaic"]["occlusion"]
     lines += ["", "True orthos (on the merged DSM) against the truth visibility (the same "
-              "occlusion test on the true DSM), every cell whose true point lies in the image; "
-              "a cell without a DSM height counts as not occluded:", "",
+              "occlusion test on the true DSM), every cell of the models' measuring areas whose "
+              "true point lies in the image; a cell without a DSM height counts as not "
+              "occluded:", "",
               "| image | occluded % (ortho) | occluded % (truth) | no DSM height % | precision "
               "| recall | F1 |", "|---|---|---|---|---|---|---|"]
     for name, a in [(a["image"], a) for a in occ["images"]] + [("all", occ["all"])]:

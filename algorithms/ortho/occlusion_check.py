@@ -38,7 +38,9 @@ from typing import Any, Dict, Iterable, Optional, Tuple, Union
 
 import numpy as np
 import rasterio
+from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from rasterio.features import geometry_mask
 from rasterio.windows import Window
 
 from ..errors import InputError
@@ -140,8 +142,9 @@ def pooled_agreement(results: Iterable[Dict[str, Any]]) -> Dict[str, Any]:
 
 def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
                         centre: Optional[ArrayLike] = None, camera: Optional[Camera] = None,
-                        eo: Optional[ExteriorOrientation] = None, window_size: int = 512,
-                        feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+                        eo: Optional[ExteriorOrientation] = None, area: Any = None,
+                        window_size: int = 512, feedback: Optional[Feedback] = None
+                        ) -> Dict[str, Any]:
     """Compare a true ortho's occlusion mask with the truth visibility from the true DSM.
 
     Parameters
@@ -156,6 +159,10 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
     camera, eo : optional
         The image's camera and exterior orientation: judge every cell whose true surface point
         lies in the image (see the module notes); without them the cells marked 1 or 2.
+    area : shapely geometry, optional
+        Judge only cells inside it (CRS of the raster), e.g. the measuring area of the
+        models the DSM was matched in, so that the image's footprint beyond the DSM does not
+        count as holes.
     window_size : int
         Window edge (cells); bounds the memory.
     feedback : Feedback, optional
@@ -198,6 +205,9 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
                 occ, z = _truth(tds, C, xs, ys)
                 inner = (slice(1, -1), slice(1, -1))
                 judged = _judged(vis, xs, ys, z, camera, eo)[inner]
+                if area is not None:
+                    judged &= geometry_mask([area], out_shape=(h, w), invert=True,
+                                            transform=t * Affine.translation(c0, r0))
                 for k, v in _window_counts(vis, occ[inner], judged).items():
                     total[k] += v
             fb.progress(100.0 * (i + 1) / len(wins))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from shapely.geometry import box
 
 rasterio = pytest.importorskip("rasterio")
 pytest.importorskip("cv2")
@@ -91,6 +92,11 @@ def test_ortho_on_the_true_dsm_agrees_with_the_truth(scene, tmp_path) -> None:
     c = occlusion_agreement(res["visibility"], scene["root"] / "dsm.tif",
                             camera=scene["project"].camera_of(rec), eo=rec.eo)
     assert c["f1"] == pytest.approx(1.0) and c["no_height"] == 0 and c["cells"] >= a["cells"]
+    # an area: only its cells are judged (the half west of the nadir has no occlusion)
+    east = box(X0, Y0 - 20.0, X0 + 50.0, Y0 + 20.0)
+    d = occlusion_agreement(res["visibility"], scene["root"] / "dsm.tif",
+                            camera=scene["project"].camera_of(rec), eo=rec.eo, area=east)
+    assert d["tp"] == c["tp"] and d["cells"] == pytest.approx(c["cells"] * 5 / 6, rel=0.01)
 
 
 def test_ortho_on_the_terrain_sees_no_occlusion(scene, tmp_path) -> None:
