@@ -11,9 +11,12 @@
    ``dem_compare`` compares the merged DSM with the true DSM;
 6. ``filter_lowpass`` filters the merged DSM to a DTM (honouring the project's edits) and
    ``dem_compare`` compares it with the true DTM;
-7. ``mosaic`` rectifies every image as a true ortho on the merged DSM (occlusions filled from the
-   next best image), routes the seamlines around objects (DSM − DTM), balances the images and
-   writes the true-ortho mosaic.
+7. ``orthorectify`` makes every image a true ortho on the merged DSM (kept in ``orthos/``), and
+   ``mosaic`` mosaics them (occlusions filled from the next best image), routes the seamlines
+   around objects (DSM − DTM), balances the images and writes the true-ortho mosaic;
+8. the object figures of every model DSM and of the merged DSM (completeness of the object
+   interior and of open ground, building outlines) and the agreement of each true ortho's
+   occlusion mask with the truth visibility (issue 19).
 
 The summary is written as ``summary.json`` and ``summary.md`` into the demo folder.
 """
@@ -31,15 +34,19 @@ import rasterio
 from rasterio.features import shapes
 from scipy import ndimage
 from shapely.geometry import shape
+from shapely.ops import unary_union
 
 from .errors import PhotodemError
 from .feedback import Feedback, ensure_feedback
 from .geometry.epipolar import EpipolarPair
 from .georef.fit import corner_error
+from .matching.model_setup import prepare_model
+from .ortho.occlusion_check import occlusion_agreement, pooled_agreement
 from .processing import registry
 from .processing.batch import load_batch, run_batch
 from .project.edits import add_features
 from .project.model import Project
+from .quality.objects_run import object_figures, object_metrics
 from .quality.targets import target_centroids
 from .raster.io import PRODUCT_MARKER, open_image
 from .synthetic.objects import EMBANKMENT, TREE
@@ -219,14 +226,20 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
             "rms_permille_H": 1000.0 * s["rms"] / height, "report": c["report"]}
 
     feedback.info("True-ortho mosaic …")
+    orthos = _true_orthos(project, info, out / "dsm_merged.tif", out / "orthos")
     mosaic = registry.run("mosaic", {
-        "project": str(project.root), "dem": str(out / "dsm_merged.tif"), "true_ortho": True,
+        "project": str(project.root), "inputs": [o["ortho"] for o in orthos],
         "dsm": str(out / "dsm_merged.tif"), "dtm": dtm["dtm"],
         "output": str(out / "mosaic.tif")})
+    feedback.info("Object completeness of the DSMs and true-ortho occlusions against the "
+                  "truth …")
     return {
         "mosaic": {**{k: mosaic.get(k) for k in ("mosaic", "seamlines", "report", "gsd",
                                                   "balance")},
-                   "images": len(info["images"])},
+                   "images": len(info["images"]),
+                   "occlusion": _occlusion_figures(project, info, orthos,
+                                                   block["truth_dsm"])},
+        "objects": _object_figures(project, info, dsms, merged["dsm"], block),
         "models": [{"name": r["model"], "points": r["metrics"]["points_raw"],
                     "coverage_pct": r["metrics"]["coverage_pct"],
                     "measured_pct": r["metrics"].get("measured_pct"),
@@ -235,6 +248,49 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
         "dsm_merged": str(out / "dsm_merged.tif"), "dsm_vs_truth": stats(dsm_cmp),
         "dtm": dtm["dtm"], "dtm_vs_truth": stats(dtm_cmp),
     }
+
+
+def _true_orthos(project: Project, info: Dict[str, Any], dsm: Path, folder: Path
+                 ) -> List[Dict[str, Any]]:
+    """Every image as a true ortho on the DSM, kept in ``folder`` (``<image>.tif`` and
+    ``<image>_visibility.tif``) so that the occlusion masks can be judged."""
+    return [registry.run("orthorectify", {
+        "project": str(project.root), "image": im["name"], "dem": str(dsm), "dsm": str(dsm),
+        "true_ortho": True, "output": str(folder / f"{Path(im['name']).stem}.tif")})
+        for im in info["images"]]
+
+
+def _occlusion_figures(project: Project, info: Dict[str, Any], orthos: List[Dict[str, Any]],
+                       truth_dsm: str) -> Dict[str, Any]:
+    """Each true ortho's occlusion mask against the truth visibility (every cell of the
+    models' measuring areas whose true point is in the image, DSM holes included), and all
+    pooled."""
+    area = unary_union([prepare_model(project, m["name"]).measuring_area()
+                        for m in info["models"]])
+    per = []
+    for im, o in zip(info["images"], orthos):
+        rec = project.image(im["name"])
+        per.append(occlusion_agreement(o["visibility"], truth_dsm, area=area,
+                                       camera=project.camera_of(rec), eo=rec.eo))
+    return {"images": per, "all": pooled_agreement(per)}
+
+
+def _object_figures(project: Project, info: Dict[str, Any], dsms: List[Path], merged: str,
+                    block: Dict[str, Any]) -> List[Dict[str, Any]]:
+    """Object completeness and outlines (:func:`.quality.objects_run.object_metrics`) of each
+    model DSM in its measuring area and of the merged DSM in all of them together."""
+    truth = (block["truth_dsm"], block["truth_dtm"])
+    rows, areas = [], []
+    for m, dsm in zip(info["models"], dsms):
+        setup = prepare_model(project, m["name"])
+        areas.append(setup.measuring_area())
+        res = object_metrics(dsm, *truth, buildings=block["truth_buildings"], area=areas[-1],
+                             gsd=float(setup.gsd))
+        rows.append({"dsm": m["name"], **object_figures(res)})
+    res = object_metrics(merged, *truth, buildings=block["truth_buildings"],
+                         area=unary_union(areas), gsd=float(block["gsd_m"]))
+    rows.append({"dsm": "merged", **object_figures(res)})
+    return rows
 
 
 def _operator_exclusions(project: Project, landcover: str, min_area: float = 400.0) -> int:
@@ -322,6 +378,7 @@ def _markdown(s: Dict[str, Any]) -> str:
         c = f[key]
         lines.append(f"| {name} | {ref} | {c['mean']:.3f} | {c['rms']:.3f} | "
                      f"{c['nmad']:.3f} | {c['rms_permille_H']:.3f} | `{c['report']}` |")
+    lines += _object_markdown(f)
     mo = f["mosaic"]
     lines += ["", f"True-ortho mosaic of {mo.get('images')} images at {mo.get('gsd')} m: "
               f"`{mo.get('mosaic')}` (seamlines and footprints `{mo.get('seamlines')}`, "
@@ -333,3 +390,38 @@ def _markdown(s: Dict[str, Any]) -> str:
               "", "Truth files: " + ", ".join(f"`{Path(v).name}`" for v in s["truth"].values()),
               ""]
     return "\n".join(lines)
+
+
+def _fmt(v: Any, spec: str = ".1f") -> str:
+    """A figure for a table cell; an empty cell for None."""
+    return "" if v is None else format(v, spec)
+
+
+def _object_markdown(f: Dict[str, Any]) -> List[str]:
+    """The object rows of each DSM and the true-ortho occlusion agreement (issue 19)."""
+    lines = ["", "Objects in the DSMs against the true DSM (truth grid, each model's measuring "
+             "area; the merged DSM in all of them): object interior = ≥ 2.5 m above the true "
+             "DTM and ≥ 1 m inside the object, open = < 0.3 m above it and ≥ 1 m from any "
+             "object; outlines = footprint from the DSM (height above the true DTM ≥ half the "
+             "building's) against the true footprints:", "",
+             "| DSM | object interior within 0.5 m % | all object cells within 0.5 m % | "
+             "open within 0.5 m % | outline IoU | wall error GSD | buildings |",
+             "|---|---|---|---|---|---|---|"]
+    for r in f["objects"]:
+        lines.append(f"| {r['dsm']} | {_fmt(r['interior_0_5_pct'])} | "
+                     f"{_fmt(r['objects_0_5_pct'])} | {_fmt(r['open_0_5_pct'])} | "
+                     f"{_fmt(r['iou'], '.2f')} | {_fmt(r['wall_gsd'], '.1f')} | "
+                     f"{r['buildings']} |")
+    occ = f["mosaic"]["occlusion"]
+    lines += ["", "True orthos (on the merged DSM) against the truth visibility (the same "
+              "occlusion test on the true DSM), every cell of the models' measuring areas whose "
+              "true point lies in the image; a cell without a DSM height counts as not "
+              "occluded:", "",
+              "| image | occluded % (ortho) | occluded % (truth) | no DSM height % | precision "
+              "| recall | F1 |", "|---|---|---|---|---|---|---|"]
+    for name, a in [(a["image"], a) for a in occ["images"]] + [("all", occ["all"])]:
+        lines.append(f"| {name} | {_fmt(a['ortho_occluded_pct'], '.2f')} | "
+                     f"{_fmt(a['truth_occluded_pct'], '.2f')} | "
+                     f"{_fmt(a['no_height_pct'], '.2f')} | {_fmt(a['precision'], '.2f')} | "
+                     f"{_fmt(a['recall'], '.2f')} | {_fmt(a['f1'], '.2f')} |")
+    return lines

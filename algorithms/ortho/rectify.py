@@ -727,7 +727,7 @@ def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
     if not valid[inner].any():
         return out, vis
     if dsm_ds is not None:
-        occ = _occlusion(dsm_ds, zmax_dsm, eo, xe, ye, z, valid)
+        occ = occlusion_flags(dsm_ds, zmax_dsm, eo.position, xe, ye, z, valid)
         vis[valid[inner]] = np.where(occ[inner][valid[inner]], OCCLUDED, VISIBLE)
     else:
         vis[valid[inner]] = VISIBLE
@@ -755,11 +755,13 @@ def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
     return out, vis
 
 
-def _occlusion(dsm_ds: Any, zmax: Optional[float], eo: ExteriorOrientation, xs: Array,
-               ys: Array, z: Array, valid: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """Occlusion flags of a tile: the DSM window is read with the march margin, re-read
-    larger when the window turns out to hold higher objects than estimated."""
-    C = eo.position
+def occlusion_flags(dsm_ds: Any, zmax: Optional[float], centre: ArrayLike, xs: Array,
+                    ys: Array, z: Array, valid: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Occlusion flags of a tile (cell centres ``xs`` × ``ys`` with heights ``z``) seen from the
+    projection centre: the DSM window is read with the march margin, re-read larger when the
+    window turns out to hold higher objects than estimated; thin lines removed (see below).
+    :mod:`.occlusion_check` computes the truth visibility with it."""
+    C = np.asarray(centre, dtype=float).reshape(3)
     gx, gy = np.meshgrid(xs, ys)
     r = np.hypot(gx - C[0], gy - C[1])
     zz = np.where(valid, z, np.nan)
@@ -809,6 +811,7 @@ __all__ = [
     "default_gsd",
     "dem_footprint_box",
     "footprint_bounds",
+    "occlusion_flags",
     "open_surface",
     "orthorectify_image",
     "project_grid",

@@ -164,4 +164,26 @@ def object_metrics(dsm: PathLike, truth_dsm: PathLike, truth_dtm: PathLike, *,
     return {"completeness": comp, "outlines": outlines, "cell": cell}
 
 
-__all__ = ["object_metrics"]
+def object_figures(metrics: Dict[str, Any]) -> Dict[str, Any]:
+    """The headline figures of :func:`object_metrics` as one flat row (shares in %).
+
+    ``interior_0_5_pct``, ``interior_measured_pct``, ``objects_0_5_pct``, ``open_0_5_pct``,
+    ``iou`` (pooled outline IoU), ``wall_gsd`` (median wall position error in GSD),
+    ``buildings`` (judged footprints); None where a figure has no cells.
+    """
+    comp = metrics["completeness"]
+    out = metrics.get("outlines") or {}
+
+    def pct(key: str, share: str) -> Optional[float]:
+        v = comp.get(key, {}).get(share)
+        return None if v is None else 100.0 * float(v)
+
+    return {"interior_0_5_pct": pct("interior", "within_0_5"),
+            "interior_measured_pct": pct("interior", "measured"),
+            "objects_0_5_pct": pct("objects", "within_0_5"),
+            "open_0_5_pct": pct("open", "within_0_5"),
+            "iou": out.get("iou_pooled"), "wall_gsd": out.get("wall_median_gsd"),
+            "buildings": out.get("count", 0)}
+
+
+__all__ = ["object_figures", "object_metrics"]

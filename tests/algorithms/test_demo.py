@@ -23,6 +23,19 @@ def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
     text = Path(s["summary"]).read_text(encoding="utf-8")
     assert "DTM | true DTM" in text and "merged DSM" in text
     assert s["georef"]["corner_error_px"] < 1.0 and "Georeferencing against polygons" in text
+    # issue 19: object rows of every model DSM and the merged DSM, true-ortho occlusions
+    objects = surfaces["objects"]
+    assert [r["dsm"] for r in objects] == [m["name"] for m in s["models"]] + ["merged"]
+    for r in objects:
+        assert set(r) >= {"interior_0_5_pct", "objects_0_5_pct", "open_0_5_pct", "iou",
+                          "wall_gsd", "buildings"}
+        assert r["open_0_5_pct"] is not None and 0.0 <= r["open_0_5_pct"] <= 100.0
+    occ = surfaces["mosaic"]["occlusion"]
+    assert len(occ["images"]) == s["images"]
+    kept = list((Path(surfaces["dsm_merged"]).parent / "orthos").glob("*_visibility.tif"))
+    assert len(kept) == s["images"] and occ["all"]["cells"] > 0
+    assert occ["all"]["cells"] == sum(a["cells"] for a in occ["images"])
+    assert "object interior within 0.5 m" in text and "truth visibility" in text
 
 
 def test_demo_refuses_a_foreign_folder(tmp_path) -> None:
