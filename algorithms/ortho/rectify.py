@@ -68,7 +68,7 @@ from ..input_errors import check_raster
 from ..project.model import Project
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
 from ..raster.sample import bilinear, bilinear_grid
-from .visibility import march_margin, occluded
+from .visibility import fill_from_below, march_margin, occluded
 
 try:
     import cv2
@@ -85,6 +85,9 @@ RESAMPLING = ("nearest", "bilinear", "cubic")
 OUTSIDE, VISIBLE, OCCLUDED = 0, 1, 2
 #: cells of one output raster at most (a typo in the GSD must not fill the disk)
 MAX_CELLS = 2_000_000_000
+#: A true ortho fills the DSM's holes up to this size (m, across) from below: the ground behind
+#: walls that the matcher could not see gets a height, and the occlusion test finds it hidden.
+TRUE_ORTHO_FILL_M = 20.0
 
 
 # -- rasters in the project CRS ---------------------------------------------------------------
@@ -712,11 +715,7 @@ def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
     xe = transform.c + (np.arange(c0 - 1, c0 + tw + 1) + 0.5) * gsd
     ye = transform.f - (np.arange(r0 - 1, r0 + th + 1) + 0.5) * gsd
     bounds = (float(xe[0] - gsd), float(ye[-1] - gsd), float(xe[-1] + gsd), float(ye[0] + gsd))
-    got = read_surface(dem_ds, bounds)
-    if got is None:
-        z = np.full((th + 2, tw + 2), np.nan)
-    else:
-        z = surface_heights(got[0], got[1], xe, ye)
+    z = _tile_heights(dem_ds, bounds, xe, ye, dsm_ds is not None)
     col, row = project_grid(camera, eo, xe, ye, z)
     valid = (np.isfinite(z) & (col >= -0.5) & (col <= camera.width - 0.5)
              & (row >= -0.5) & (row <= camera.height - 0.5))
@@ -753,6 +752,25 @@ def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
     out[:n_bands] = np.moveaxis(res, -1, 0)
     out[n_bands][~bad] = alpha_value
     return out, vis
+
+
+def _tile_heights(dem_ds: Any, bounds: Extent, xe: Array, ye: Array, true_ortho: bool
+                  ) -> Array:
+    """Heights of the cell centres ``xe`` × ``ye`` (bilinear on the DEM). In a true ortho the
+    DSM's holes up to :data:`TRUE_ORTHO_FILL_M` across are filled from below first
+    (:func:`.visibility.fill_from_below`), from a window that reaches that far beyond the tile,
+    so that every tiling gives the same heights."""
+    size = 0
+    if true_ortho:
+        res = min(abs(dem_ds.transform.a), abs(dem_ds.transform.e))
+        size = math.floor(TRUE_ORTHO_FILL_M / res)
+    got = read_surface(dem_ds, bounds, margin_cells=2 + size)
+    if got is None:
+        return np.full((len(ye), len(xe)), np.nan)
+    arr = got[0]
+    if size and not np.isfinite(arr).all():
+        arr = fill_from_below(arr, size)
+    return surface_heights(arr, got[1], xe, ye)
 
 
 def occlusion_flags(dsm_ds: Any, zmax: Optional[float], centre: ArrayLike, xs: Array,

@@ -80,6 +80,60 @@ def _max_filters(dsm: Array, levels: Sequence[int]) -> Tuple[Tuple[int, Array], 
     return tuple(out)
 
 
+def fill_from_below(dsm: ArrayLike, max_size: int, quantile: float = 10.0) -> Array:
+    """Fill the holes of a matched DSM with a low height of their border.
+
+    A matcher leaves the ground behind a wall empty: one camera cannot see it. For a true
+    ortho that ground still needs a height, so that the occlusion test can find it hidden. A
+    hole that touches a wall is bordered by the roof on one side and by the ground on the
+    others; the ``quantile`` % of its border heights is the ground's (a hole inside a roof gets
+    the roof's height). Each hole is filled with one height.
+
+    Parameters
+    ----------
+    dsm : array_like, shape (rows, cols)
+        Heights, NaN = hole.
+    max_size : int
+        Holes whose bounding box is larger than this (cells) in either direction, and holes
+        that touch the array's edge, stay empty: a window that reaches ``max_size`` cells
+        beyond the cells of interest then fills them the same whatever the window.
+    quantile : float
+        Percentile of the border heights (a few low outliers of the border do not count).
+
+    Returns
+    -------
+    ndarray
+        A filled copy (float64).
+    """
+    from scipy import ndimage  # lazy: only true orthos on DSMs with holes need it
+
+    z = np.array(dsm, dtype=float)
+    hole = ~np.isfinite(z)
+    if not hole.any() or hole.all() or max_size < 1:
+        return z
+    labels, n = ndimage.label(hole)
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    keep = np.ones(n + 1, dtype=bool)
+    keep[0] = False
+    keep[edge] = False
+    for k, sl in enumerate(ndimage.find_objects(labels), start=1):
+        if sl is not None and max(sl[0].stop - sl[0].start, sl[1].stop - sl[1].start) > max_size:
+            keep[k] = False
+    if not keep.any():
+        return z
+    # the border cells of each hole (a cell between two holes goes to the higher label)
+    grown = ndimage.grey_dilation(np.where(keep[labels], labels, 0), size=3)
+    border = np.isfinite(z) & (grown > 0)
+    ids = np.flatnonzero(keep)
+    low = ndimage.labeled_comprehension(
+        z[border], grown[border], ids, lambda v: np.percentile(v, quantile), float, np.nan)
+    height = np.full(n + 1, np.nan)
+    height[ids] = low
+    fill = hole & keep[labels]
+    z[fill] = height[labels[fill]]
+    return z
+
+
 def occluded(
     x: ArrayLike,
     y: ArrayLike,
