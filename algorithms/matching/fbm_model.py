@@ -343,15 +343,28 @@ OBJECT_MIN_STEP = 1.5
 OBJECT_MIN_SLOPE = 1.0
 
 
-def _object_surfaces(mp: _ModelPoints, red: Any) -> Tuple[np.ndarray, List[Any]]:
+def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
     """Inliers that keep consistent upper surfaces, and breaklines at the height jumps.
 
     A groundel outlier with :data:`OBJECT_MIN_SUPPORT` agreeing neighbours (a roof in a
     groundel that is mostly ground) stays in; isolated outliers stay out. Jumps between
     supported neighbouring inliers become 2-D breaklines (:mod:`..surface.jumps`), so that the
     FE surface does not bridge a wall.
+
+    Parameters
+    ----------
+    pts : (n, 3) float
+        Raw points (x, y, z in m; any consistent units, e.g. disparity as z).
+    red : GroundelResult
+        Their groundel reduction (:func:`..surface.groundel.reduce_groundels`).
+
+    Returns
+    -------
+    inlier : (n,) bool
+        Points the surface uses.
+    lines : list of shapely geometries
+        Automatic 2-D breaklines.
     """
-    pts = mp.xyz
     support = point_support(pts[:, 0], pts[:, 1], pts[:, 2],
                             OBJECT_SUPPORT_GROUNDELS * red.cell_size)
     supported = support >= OBJECT_MIN_SUPPORT
@@ -368,7 +381,7 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
     grid, inlier, pts = setup.grid, ~red.outlier, mp.xyz
     breaklines = list(setup.breaklines)
     if surface.get("objects"):
-        inlier, auto = _object_surfaces(mp, red)
+        inlier, auto = object_surfaces(mp.xyz, red)
         breaklines += auto
     if interpolation == "fe":
         # a point's weight: its matching σ_Z and the scatter of the points about the local
@@ -630,4 +643,4 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
 
 
 __all__ = ["DEFAULT_PRESET", "POINT_FORMATS", "PRESETS", "PRESET_NAMES", "SPACING_GSD",
-           "epipolar_constraints", "match_model_fbm_lsm", "start_point_seeds"]
+           "epipolar_constraints", "match_model_fbm_lsm", "object_surfaces", "start_point_seeds"]
