@@ -341,6 +341,8 @@ OBJECT_SUPPORT_GROUNDELS = 1.5
 OBJECT_MIN_SUPPORT = 2
 OBJECT_MIN_STEP = 1.5
 OBJECT_MIN_SLOPE = 1.0
+#: Agreeing neighbours every point needs to be used at all (0: groundel inliers stay in).
+OBJECT_LONE = 1
 
 
 def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
@@ -368,7 +370,9 @@ def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
     support = point_support(pts[:, 0], pts[:, 1], pts[:, 2],
                             OBJECT_SUPPORT_GROUNDELS * red.cell_size)
     supported = support >= OBJECT_MIN_SUPPORT
-    inlier = ~red.outlier | supported
+    # a point no neighbour agrees with is a blunder even where its groundel does not flag it
+    # (small groundels of few points follow their blunders)
+    inlier = (~red.outlier & (support >= OBJECT_LONE)) | supported
     idx = np.flatnonzero(inlier)
     lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
                             OBJECT_MIN_SLOPE, supported=supported[idx])

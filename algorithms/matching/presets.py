@@ -20,9 +20,9 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # buildings (the DSM default): small windows, tight bidirectional check, small groundels,
     # median, little smoothing; groundel outliers that form a consistent upper surface stay,
     # and height jumps between points become breaklines (``objects``), so roofs and walls stay;
-    # a pull-in of 20 px reaches roofs about 10 m above the ground plane of a window at
-    # B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity)
-    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "pull_in": 20.0, "groundel_gsd": 10.0,
+    # a level-0 pull-in of 20 px reaches roofs about 10 m above the ground plane of a window
+    # at B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity)
+    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "object_pull_in": 20.0, "groundel_gsd": 10.0,
               "reduction": "median", "smoothing": 0.05, "objects": True},
     # vegetation: the lower envelope of the points of a groundel is taken as the terrain
     "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
