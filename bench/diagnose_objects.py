@@ -3,8 +3,9 @@
 On a synthetic block with truth (default: the ``small`` block as ``make demo`` builds it, model
 0102_0103) this script
 
-1. matches the model with fbm_lsm (``flat``, ``urban``) and dense, and measures the DSMs on the
-   truth grid inside the model's measuring area (:mod:`photodem.algorithms.quality.objects`):
+1. matches the model with fbm_lsm (``terrain``, formerly ``flat``; ``urban``) and dense, and
+   measures the DSMs on the truth grid inside the model's measuring area
+   (:mod:`photodem.algorithms.quality.objects`):
    completeness on object interior, all object and open cells, heights of objects ≥ 5 m,
    building outlines;
 2. builds the **true disparity** of every left epipolar pixel by projecting the truth DSM into
@@ -580,9 +581,10 @@ def _md(rows: List[Dict[str, Any]]) -> str:
 
 
 def _products(block: Path, out: Path, truth: Truth, gsd: float) -> List[Dict[str, Any]]:
-    """match_model for flat, urban and dense; the issue's table rows."""
+    """match_model for terrain, urban and dense; the issue's table rows."""
     rows = []
-    for name, params in (("fbm_lsm flat", {}), ("fbm_lsm urban", {"preset": "urban"}),
+    for name, params in (("fbm_lsm terrain", {"preset": "terrain"}),
+                         ("fbm_lsm urban", {"preset": "urban"}),
                          ("dense", {"method": "dense"})):
         r = registry.run("match_model", {"project": str(block), "model": MODEL,
                                          "output": str(out / name.replace(" ", "_")),
@@ -601,7 +603,7 @@ def diagnose(block: Path, work: Path) -> Dict[str, Any]:
     et = epipolar_truth(setup, truth)
     grey, mask, barriers = fbm_model._grey_epipolar(setup, Feedback())
     levels, chains = [], []
-    for preset in ("flat", "urban"):
+    for preset in ("terrain", "urban"):
         levels += fbm_levels(setup, et, grey, mask, barriers, preset)
         chains.append(fbm_chain(setup, truth, et, grey, mask, barriers, preset))
     steps, disp = dense_steps(setup_dense, et, grey)

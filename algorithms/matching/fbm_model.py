@@ -51,11 +51,19 @@ from ..raster.io import staged_folder
 from ..surface.fe_grid import fe_interpolate
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from ..surface.groundel import reduce_groundels
+from ..surface.jumps import jump_breaklines, point_support
 from ..surface.point_output import write_points
 from .hierarchy import EpipolarMatches, FbmLsmOptions, match_epipolar_fbm_lsm
 from .model_report import write_model_report
 from .model_setup import ModelSetup, footprint, prepare_model
-from .presets import DEFAULT_PRESET, POINT_FORMATS, PRESET_NAMES, PRESETS, SPACING_GSD
+from .presets import (
+    DEFAULT_PRESET,
+    POINT_FORMATS,
+    PRESET_NAMES,
+    PRESETS,
+    SPACING_GSD,
+    resolve_preset,
+)
 
 PathLike = Union[str, Path]
 
@@ -174,7 +182,7 @@ def _options(preset: str, overrides: Dict[str, Any]) -> Tuple[Any, Dict[str, Any
     values = dict(PRESETS[preset])
     values.update({k: v for k, v in overrides.items() if v is not None})
     names = {f.name for f in fields(FbmLsmOptions)}
-    surface_keys = ("groundel_gsd", "reduction", "smoothing")
+    surface_keys = ("groundel_gsd", "reduction", "smoothing", "objects")
     unknown = set(values) - names - set(surface_keys)
     if unknown:
         raise InputError(f"Unknown matching option(s): {', '.join(sorted(unknown))}.")
@@ -325,10 +333,60 @@ def _intersect(setup: ModelSetup, matches: EpipolarMatches) -> _ModelPoints:
     return _ModelPoints(pts[keep], sigma_z[keep], idx[keep], keep, allowed, len(d))
 
 
+#: Objects in the surface step (issue 19): neighbourhood of a point's support (groundels),
+#: agreeing neighbours that make a groundel outlier part of an upper or lower surface, and
+#: the smallest height jump (m) and jump slope between neighbouring points that become an
+#: automatic breakline.
+OBJECT_SUPPORT_GROUNDELS = 1.5
+OBJECT_MIN_SUPPORT = 2
+OBJECT_MIN_STEP = 1.5
+OBJECT_MIN_SLOPE = 1.0
+#: Agreeing neighbours every point needs to be used at all (0: groundel inliers stay in).
+OBJECT_LONE = 1
+
+
+def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
+    """Inliers that keep consistent upper surfaces, and breaklines at the height jumps.
+
+    A groundel outlier with :data:`OBJECT_MIN_SUPPORT` agreeing neighbours (a roof in a
+    groundel that is mostly ground) stays in; isolated outliers stay out. Jumps between
+    supported neighbouring inliers become 2-D breaklines (:mod:`..surface.jumps`), so that the
+    FE surface does not bridge a wall.
+
+    Parameters
+    ----------
+    pts : (n, 3) float
+        Raw points (x, y, z in m; any consistent units, e.g. disparity as z).
+    red : GroundelResult
+        Their groundel reduction (:func:`..surface.groundel.reduce_groundels`).
+
+    Returns
+    -------
+    inlier : (n,) bool
+        Points the surface uses.
+    lines : list of shapely geometries
+        Automatic 2-D breaklines.
+    """
+    support = point_support(pts[:, 0], pts[:, 1], pts[:, 2],
+                            OBJECT_SUPPORT_GROUNDELS * red.cell_size)
+    supported = support >= OBJECT_MIN_SUPPORT
+    # a point no neighbour agrees with is a blunder even where its groundel does not flag it
+    # (small groundels of few points follow their blunders)
+    inlier = (~red.outlier & (support >= OBJECT_LONE)) | supported
+    idx = np.flatnonzero(inlier)
+    lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
+                            OBJECT_MIN_SLOPE, supported=supported[idx])
+    return inlier, lines
+
+
 def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, Any],
              interpolation: str, max_gap: Optional[float], feedback: Feedback) -> np.ndarray:
     """DSM heights (float32, NaN outside the allowed cells) from the inlier points."""
     grid, inlier, pts = setup.grid, ~red.outlier, mp.xyz
+    breaklines = list(setup.breaklines)
+    if surface.get("objects"):
+        inlier, auto = object_surfaces(mp.xyz, red)
+        breaklines += auto
     if interpolation == "fe":
         # a point's weight: its matching σ_Z and the scatter of the points about the local
         # surface (σ1 of the groundels: texture, roughness, objects), which σ_Z of LSM
@@ -340,7 +398,7 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
         z_grid, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                                    weights=w, smoothing=float(surface.get("smoothing", 1.0)),
                                    reference_spacing=SPACING_GSD * setup.gsd,
-                                   breaklines=setup.breaklines, exclusions=setup.exclusions,
+                                   breaklines=breaklines, exclusions=setup.exclusions,
                                    boundaries=setup.boundaries, max_gap=max_gap,
                                    feedback=feedback.step(78, 92))
     else:
@@ -349,7 +407,7 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
         zg, n_cell = acc.reduce()
         z_grid = finish_grid(zg, n_cell, grid, math.inf if max_gap is None else max_gap,
                              setup.exclusions, setup.boundaries,
-                             setup.breaklines).z
+                             breaklines).z
     z_grid = np.asarray(z_grid, dtype=np.float32)
     z_grid[~mp.allowed] = np.nan
     return z_grid
@@ -492,8 +550,10 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         Cells farther than ``max_gap / 2`` (m) from every matched point stay NaN; default
         (or 0): every cell of the measuring area gets a height, and the report tells the
         measured share (cells within half a groundel of a point) from the interpolated one.
-    preset : {"flat", "hilly", "urban", "forest"}
-        Strategy preset (:data:`PRESETS`); explicit options win.
+    preset : {"urban", "terrain", "hilly", "forest"}
+        Strategy preset (:data:`PRESETS`); explicit options win. ``urban`` (default) keeps
+        buildings and trees; ``terrain`` (old name ``flat``, still accepted with a note in the
+        log) smooths them away.
     groundel : float, optional
         Groundel (reduction cell) side (m); default the preset's ``groundel_gsd`` × GSD.
     reduction : {"l1", "median", "lower"}, optional
@@ -518,6 +578,9 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     feedback = ensure_feedback(feedback)
     t_start = time.perf_counter()
     _check_choices(points_format, interpolation)
+    preset, note = resolve_preset(preset)
+    if note:
+        feedback.warning(note)
     opts, surface = _options(preset, dict(options, groundel_gsd=None, reduction=reduction,
                                           smoothing=smoothing))
     setup = prepare_model(project, model, spacing=spacing, spacing_gsd=SPACING_GSD,
@@ -584,4 +647,4 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
 
 
 __all__ = ["DEFAULT_PRESET", "POINT_FORMATS", "PRESETS", "PRESET_NAMES", "SPACING_GSD",
-           "epipolar_constraints", "match_model_fbm_lsm", "start_point_seeds"]
+           "epipolar_constraints", "match_model_fbm_lsm", "object_surfaces", "start_point_seeds"]

@@ -6,30 +6,49 @@ importing the matcher and its surface and report modules (``photodem list`` stay
 
 from __future__ import annotations
 
-from typing import Any, Dict
+from typing import Any, Dict, Optional, Tuple
 
 #: Strategy presets (seed-000 §3.1: empirical parameter sets per terrain type). Keys are
 #: fields of :class:`.hierarchy.FbmLsmOptions` or the surface options of
 #: :func:`.fbm_model.match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``).
 PRESETS: Dict[str, Dict[str, Any]] = {
-    # open, gently undulating terrain: large windows and groundels, L1 planes, smooth surface
-    "flat": {"fbm_window": 32, "groundel_gsd": 40.0, "reduction": "l1", "smoothing": 1.0},
+    # terrain only (was "flat"): large windows and groundels, L1 planes, smooth surface — a
+    # DTM-like surface: buildings and trees are reduced away as outliers (issue 19)
+    "terrain": {"fbm_window": 32, "groundel_gsd": 40.0, "reduction": "l1", "smoothing": 1.0},
     # hills: smaller windows follow the relief; medium groundels
     "hilly": {"fbm_window": 24, "groundel_gsd": 24.0, "reduction": "l1", "smoothing": 0.3},
-    # buildings: small windows, tight bidirectional check, small groundels, median, little
-    # smoothing so that roofs and walls stay sharp
-    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "groundel_gsd": 10.0,
-              "reduction": "median", "smoothing": 0.05},
+    # buildings (the DSM default): small windows, tight bidirectional check, small groundels,
+    # median, little smoothing; groundel outliers that form a consistent upper surface stay,
+    # and height jumps between points become breaklines (``objects``), so roofs and walls stay;
+    # a level-0 pull-in of 20 px reaches roofs about 10 m above the ground plane of a window
+    # at B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity)
+    "urban": {"fbm_window": 16, "bidir_tol": 0.5, "object_pull_in": 20.0, "groundel_gsd": 10.0,
+              "reduction": "median", "smoothing": 0.05, "objects": True},
     # vegetation: the lower envelope of the points of a groundel is taken as the terrain
     "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
                "smoothing": 0.3},
 }
 PRESET_NAMES = tuple(PRESETS)
-DEFAULT_PRESET = "flat"
+#: Old preset names still accepted (batch files); the run logs the new name.
+PRESET_ALIASES: Dict[str, str] = {"flat": "terrain"}
+#: The default keeps objects: a DSM is the surface with its buildings and trees (issue 19).
+DEFAULT_PRESET = "urban"
 #: Default DSM spacing in GSD; the presets' ``smoothing`` refers to cells of this size, so a
 #: DSM asked for at another spacing gets the same surface, sampled differently.
 SPACING_GSD = 2.0
 
 POINT_FORMATS = ("gpkg", "las")
 
-__all__ = ["DEFAULT_PRESET", "POINT_FORMATS", "PRESETS", "PRESET_NAMES", "SPACING_GSD"]
+
+
+def resolve_preset(name: str) -> Tuple[str, Optional[str]]:
+    """The preset a name stands for, and a deprecation note for an old name (else None)."""
+    new = PRESET_ALIASES.get(name)
+    if new is None:
+        return name, None
+    return new, (f"Preset '{name}' is now called '{new}' (a terrain preset: it removes "
+                 f"buildings and trees); '{name}' will be dropped in a later version.")
+
+
+__all__ = ["DEFAULT_PRESET", "POINT_FORMATS", "PRESETS", "PRESET_ALIASES", "PRESET_NAMES",
+           "SPACING_GSD", "resolve_preset"]

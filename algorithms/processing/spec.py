@@ -62,6 +62,9 @@ class Parameter:
         Bounds for ``number`` and ``integer``.
     options : tuple of str
         Choices of an ``enum``; the value is the option string.
+    aliases : tuple of str
+        Old names an ``enum`` still accepts (not offered as choices); the value is the alias
+        itself, so that the algorithm can map it and tell the operator the new name.
     unit : str
         Unit of a number (``"m"``, ``"px"``, ``"%"``, ``"°"``); shown to the operator.
     extensions : tuple of str
@@ -78,6 +81,7 @@ class Parameter:
     minimum: Optional[float] = None
     maximum: Optional[float] = None
     options: Tuple[str, ...] = ()
+    aliases: Tuple[str, ...] = ()
     unit: str = ""
     extensions: Tuple[str, ...] = ()
     help: str = ""
@@ -246,7 +250,7 @@ class Parameter:
             if 0 <= index < len(self.options) and index == value:
                 return self.options[index]
         text = str(value).strip().lower()
-        for option in self.options:
+        for option in self.options + self.aliases:
             if option.lower() == text:
                 return option
         raise InputError(

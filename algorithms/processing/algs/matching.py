@@ -9,7 +9,7 @@ from ...errors import InputError
 from ...feedback import Feedback
 from ...matching.dense import METHODS
 from ...matching.disparity_run import run_stereo_disparity
-from ...matching.presets import DEFAULT_PRESET, PRESET_NAMES
+from ...matching.presets import DEFAULT_PRESET, PRESET_ALIASES, PRESET_NAMES
 from ..spec import Algorithm, Output, Parameter, model_product
 
 # Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
@@ -119,10 +119,12 @@ class MatchModel(Algorithm):
                   help="Larger gaps stay empty (NaN). Default: 3 × the groundel size for "
                        "fbm_lsm, 10 × spacing for dense."),
         Parameter("preset", "enum", "Strategy preset (fbm_lsm)", default=DEFAULT_PRESET,
-                  options=PRESET_NAMES,
-                  help="flat: large windows and groundels, smooth surface; hilly: medium; "
-                       "urban: small windows and groundels, median, sharp edges; forest: lower "
-                       "envelope of the points per groundel. The options below override it."),
+                  options=PRESET_NAMES, aliases=tuple(PRESET_ALIASES),
+                  help="urban (default): small windows and groundels, keeps buildings and "
+                       "trees with sharp walls (a DSM); terrain (formerly flat): large windows "
+                       "and groundels, smooth surface without objects (nearly a DTM); hilly: "
+                       "medium; forest: lower envelope of the points per groundel. The options "
+                       "below override it."),
         Parameter("fbm_window", "integer", "Matching window [px] (fbm_lsm)", optional=True,
                   minimum=8, maximum=128, unit="px",
                   help="Side of the window of the robust consistency. Default: the preset's."),
@@ -136,7 +138,7 @@ class MatchModel(Algorithm):
         Parameter("groundel", "number", "Groundel size [m] (fbm_lsm)", optional=True,
                   minimum=0.0, unit="m",
                   help="Side of the cells of the robust reduction. Default: the preset's "
-                       "multiple of the GSD (flat: 40 × GSD)."),
+                       "multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD)."),
         Parameter("reduction", "enum", "Groundel reduction (fbm_lsm)", optional=True,
                   options=("l1", "median", "lower"),
                   help="l1: robust tilted plane; median; lower: lower envelope (vegetation). "
