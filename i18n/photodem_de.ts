@@ -954,14 +954,14 @@
             <translation>Strategievorgabe (fbm_lsm)</translation>
         </message>
         <message>
-            <source>flat: large windows and groundels, smooth surface; hilly: medium; urban: small windows and groundels, median, sharp edges; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
             <extracomment>match_model.preset: help</extracomment>
-            <translation>flach: große Fenster und Geländeelemente, glatte Fläche; hügelig: mittlere; städtisch: kleine Fenster und Geländeelemente, Median, scharfe Kanten; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+            <translation>städtisch (Standard): kleine Fenster und Geländeelemente, behält Gebäude und Bäume mit scharfen Wänden (ein DOM); Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
-            <source>flat</source>
-            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
-            <translation>flach</translation>
+            <source>terrain</source>
+            <extracomment>match_model.preset: option</extracomment>
+            <translation>Gelände</translation>
         </message>
         <message>
             <source>hilly</source>
@@ -1014,9 +1014,9 @@
             <translation>Größe der Geländeelemente [m] (fbm_lsm)</translation>
         </message>
         <message>
-            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (flat: 40 × GSD).</source>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD).</source>
             <extracomment>match_model.groundel: help</extracomment>
-            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (flach: 40 × GSD).</translation>
+            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (städtisch: 10 × GSD, Gelände: 40 × GSD).</translation>
         </message>
         <message>
             <source>Groundel reduction (fbm_lsm)</source>
@@ -1492,6 +1492,11 @@
             <source>default</source>
             <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option</extracomment>
             <translation>Standard</translation>
+        </message>
+        <message>
+            <source>flat</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option</extracomment>
+            <translation>flach</translation>
         </message>
         <message>
             <source>Its exclusion areas (keep/remove), manual ground points and breaklines are honoured.</source>
@@ -4439,6 +4444,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Unexpected error (please report it):</source>
             <extracomment>plugin/widgets/run_panel.py:185</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>flat: large windows and groundels, smooth surface; hilly: medium; urban: small windows and groundels, median, sharp edges; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <translation type="vanished">flach: große Fenster und Geländeelemente, glatte Fläche; hügelig: mittlere; städtisch: kleine Fenster und Geländeelemente, Median, scharfe Kanten; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (flat: 40 × GSD).</source>
+            <translation type="vanished">Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (flach: 40 × GSD).</translation>
         </message>
         <message>
             <source>Compares a DEM (DSM or DTM) with a reference DEM on their common area; the reference may have another grid, extent or CRS (the DEM is resampled onto it). Optionally co-registers the DEM first (horizontal shift and vertical bias after Nuth &amp; Kääb, estimated on stable terrain). Writes the difference model Δh = DEM − reference (with a QGIS style), a hillshade and a slope raster of the DEM, statistics (mean, median, std, RMS, NMAD, quantiles of |Δh|, 0.5 m classes) overall, per class and per slope class, in m and in ‰ of the flying height, and an HTML report with plots.</source>
