@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import InputError
+from ..matching.presets import DEFAULT_PRESET
 from ..project import toml_io
 from . import registry
 from .batch import SUMMARY_FILE, read_state
@@ -139,7 +140,7 @@ class BatchChoices:
     steps: List[str]
     workers: int = 1
     method: str = "fbm_lsm"
-    match_preset: str = "flat"
+    match_preset: str = DEFAULT_PRESET
     filter: str = FILTERS[0]
     filter_preset: str = "default"
     ortho: str = "mosaic"
@@ -153,6 +154,7 @@ def choice_options(algorithm: str, parameter: str) -> Tuple[str, ...]:
 def choice_default(algorithm: str, parameter: str) -> Any:
     """The default of a parameter, from the algorithm's spec."""
     return registry.get(algorithm).parameter(parameter).default
+
 
 
 def default_workers() -> int:

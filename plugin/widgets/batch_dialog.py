@@ -167,7 +167,8 @@ class BatchDialog(QtWidgets.QDialog):
             self.step_checks[step] = check
             grid.addWidget(check, row // 2, (row % 2) * 3)
         self.method_combo = _combo(box, batch_setup.choice_options("match_model", "method"))
-        self.match_preset = _combo(box, batch_setup.choice_options("match_model", "preset"))
+        self.match_preset = _combo(box, batch_setup.choice_options("match_model", "preset"),
+                                   default=batch_setup.choice_default("match_model", "preset"))
         self.filter_combo = _combo(box, batch_setup.FILTERS, names=True)
         self.filter_preset = _combo(box, batch_setup.choice_options("filter_lowpass", "preset"))
         self.ortho_combo = _combo(box, batch_setup.ORTHO_STEPS, names=True)
@@ -726,13 +727,15 @@ class BatchDialog(QtWidgets.QDialog):
         QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), text)
 
 
-def _combo(parent: QtWidgets.QWidget, options: Any, names: bool = False
-           ) -> QtWidgets.QComboBox:
-    """A combo of spec options (translated labels, the option as data)."""
+def _combo(parent: QtWidgets.QWidget, options: Any, names: bool = False,
+           default: Any = None) -> QtWidgets.QComboBox:
+    """A combo of spec options (translated labels, the option as data), on ``default``."""
     combo = QtWidgets.QComboBox(parent)
     for option in options:
         label = option if names else tr(option)
         combo.addItem(label, option)
+    if default is not None and combo.findData(default) >= 0:
+        combo.setCurrentIndex(combo.findData(default))
     return combo
 
 
