@@ -429,20 +429,17 @@ def iter_disparity_tiles(
         SGM penalties for disparity steps of 1 and > 1 px (default ``8·b²``, ``32·b²``).
     uniqueness : int
         Percent by which the best cost must beat the second best.
-    lr_max_diff : float
-        Left–right check tolerance (px); ``< 0`` switches the check off.
-    normalise_window : int
-        Window of the local radiometric normalisation (px); 0 = off.
+    lr_max_diff, normalise_window : float, int
+        Left–right check tolerance (px; < 0 = off); local radiometric normalisation (px; 0 off).
     speckle_window, speckle_range : int
         Speckle filter: region size (px) and disparity step (px) within a region.
     fill_max_width : int
         Widest invalid run along a row that is filled (px); 0 = no filling.
     edge_erosion : int
-        Disparities within this many px (chessboard distance) of an invalid or masked pixel are
-        removed before filling (method "sgm"); 0 = off.
+        Disparities within this many px (chessboard) of an invalid or masked pixel are removed
+        before filling (method "sgm"); 0 = off.
     range_guard : float
-        Disparities closer than this (px) to ``min_disparity`` or ``max_disparity`` are
-        removed; 0 = off.
+        Disparities within this many px of the range's ends are removed; 0 = off.
     edge_jump : float
         With ``edge_erosion``: erode only the lower side of disparity steps larger than this
         (px) and the borders of masks (:func:`.dense_fill.erode_lower_side`); 0 = erode every
@@ -455,19 +452,14 @@ def iter_disparity_tiles(
         With ``edge_jump``: a pixel near a hole is kept only in a disparity segment of at least
         ``segment_px`` px (blunder patches go) and, if ``edge_reach`` > 0, only on the upper
         side of a step (a disparity within ``edge_reach`` px lower by > ``edge_jump``). 0 = off.
-    wall_view : (float, float), optional
+    wall_view, wall_px : (float, float), optional; float
         Epipolar principal points (columns) of the left and right image: with ``edge_reach``,
-        where the left camera sees a wall wider than ``wall_px`` in an occlusion
-        (:func:`.dense_fill.wall_share_columns` × the step), roof edges next to holes are
-        eroded and such holes are not filled with roof (SGM spreads the roof over that wall).
-    wall_px : float
-        See ``wall_view``.
+        where the left camera sees a wall wider than ``wall_px`` in an occlusion, roof edges
+        near holes are eroded and such holes get no roof (:mod:`.dense_fill`).
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
-    tile_size : int, optional
-        Side of the tile core (px).
-    margin : int
-        Overlap of the tiles (px of context on each side, discarded afterwards).
+    tile_size, margin : int
+        Side of the tile core (px; optional) and the tiles' overlap (px of context per side).
     coarse_above : int
         A search range of more disparities than this is narrowed per tile by a coarse pass (see
         the module docstring); 0 = never.

@@ -51,6 +51,7 @@ from scipy import ndimage
 Array = NDArray[Any]
 _RING = np.ones((3, 3), bool)
 WALL_SPREAD = 0.33
+WALL_ROW = 64
 
 
 def erode_lower_side(disp: Array, masked: Array, k: int, jump: float,
@@ -114,17 +115,20 @@ def erode_lower_side(disp: Array, masked: Array, k: int, jump: float,
         lower_side |= small
     drop = valid & (near_mask | (near_hole & lower_side))
     if reach > 0 and wall_share is not None:
-        drop |= _wall_spill(valid, masked, step, wall_share, wall_px)
+        drop |= _wall_spill(disp, valid, masked, wall_share, wall_px)
     out[drop] = np.nan
     return out
 
 
-def _wall_spill(valid: Array, masked: Array, step: Array, wall_share: Array,
+def _wall_spill(disp: Array, valid: Array, masked: Array, wall_share: Array,
                 wall_px: float) -> Array:
-    """Valid pixels within ``WALL_SPREAD`` × the seen wall's width (share × step, where wider
-    than ``wall_px``) of a hole: the roof SGM spread over the wall."""
+    """Valid pixels within ``WALL_SPREAD`` × the seen wall's width (share × the step to the
+    lowest disparity within ``WALL_ROW`` px along the row — the occlusion lies between them —
+    where wider than ``wall_px``) of a hole: the roof SGM spread over the wall."""
+    low = ndimage.minimum_filter1d(np.where(valid, disp, np.inf), 2 * WALL_ROW + 1, axis=1,
+                                   mode="nearest")
     with np.errstate(invalid="ignore"):
-        width = np.where(valid, wall_share * step, 0.0)
+        width = np.where(valid & np.isfinite(low), wall_share * (disp - low), 0.0)
     wide = width > wall_px
     if not wide.any():
         return wide
