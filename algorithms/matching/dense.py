@@ -59,7 +59,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..input_errors import warn_input
 from ..memory import check_allocation
-from .dense_fill import erode_lower_side
+from .dense_fill import erode_lower_side, wall_share_columns
 from .dense_fill import plane_fill as plane_fill_holes
 
 #: Matching methods; the first is the default.
@@ -247,6 +247,8 @@ class _TileMatcher:
     plane_fill: float = 0.0
     segment_px: int = 0
     edge_reach: int = 0
+    wall_view: Optional[Tuple[float, float]] = None
+    wall_px: float = 20.0
 
     def _matcher(self, lo: int, n_d: int) -> Any:
         """SGBM for ``n_d`` disparities from ``lo``.
@@ -278,12 +280,14 @@ class _TileMatcher:
         lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
         lg[:, C0 - f0:C1 - f0] = lwin
         rg = self.right(R0, R1, f0, f1)
+        walls = (None if self.wall_view is None else wall_share_columns(
+            np.arange(f0, f1)[None, :], 0.5 * (lo + hi), self.wall_view))
         disp = _match_frame(self.cv2, matcher, lg, rg, lo, hi, n_d, self.ours, block,
                             self.lr_max_diff, self.normalise_window, self.speckle_window,
                             int(self.speckle_range), self.fill_max_width,
                             int(self.edge_erosion), float(self.range_guard),
                             float(self.edge_jump), float(self.plane_fill),
-                            int(self.segment_px), int(self.edge_reach))
+                            int(self.segment_px), int(self.edge_reach), walls, float(self.wall_px))
         return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
 
 
@@ -398,6 +402,8 @@ def iter_disparity_tiles(
     plane_fill: float = 0.0,
     segment_px: int = 0,
     edge_reach: int = 0,
+    wall_view: Optional[Tuple[float, float]] = None,
+    wall_px: float = 20.0,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -423,20 +429,17 @@ def iter_disparity_tiles(
         SGM penalties for disparity steps of 1 and > 1 px (default ``8·b²``, ``32·b²``).
     uniqueness : int
         Percent by which the best cost must beat the second best.
-    lr_max_diff : float
-        Left–right check tolerance (px); ``< 0`` switches the check off.
-    normalise_window : int
-        Window of the local radiometric normalisation (px); 0 = off.
+    lr_max_diff, normalise_window : float, int
+        Left–right check tolerance (px; < 0 = off); local radiometric normalisation (px; 0 off).
     speckle_window, speckle_range : int
         Speckle filter: region size (px) and disparity step (px) within a region.
     fill_max_width : int
         Widest invalid run along a row that is filled (px); 0 = no filling.
     edge_erosion : int
-        Disparities within this many px (chessboard distance) of an invalid or masked pixel are
-        removed before filling (method "sgm"); 0 = off.
+        Disparities within this many px (chessboard) of an invalid or masked pixel are removed
+        before filling (method "sgm"); 0 = off.
     range_guard : float
-        Disparities closer than this (px) to ``min_disparity`` or ``max_disparity`` are
-        removed; 0 = off.
+        Disparities within this many px of the range's ends are removed; 0 = off.
     edge_jump : float
         With ``edge_erosion``: erode only the lower side of disparity steps larger than this
         (px) and the borders of masks (:func:`.dense_fill.erode_lower_side`); 0 = erode every
@@ -449,12 +452,14 @@ def iter_disparity_tiles(
         With ``edge_jump``: a pixel near a hole is kept only in a disparity segment of at least
         ``segment_px`` px (blunder patches go) and, if ``edge_reach`` > 0, only on the upper
         side of a step (a disparity within ``edge_reach`` px lower by > ``edge_jump``). 0 = off.
+    wall_view, wall_px : (float, float), optional; float
+        Epipolar principal points (columns) of the left and right image: with ``edge_reach``,
+        where the left camera sees a wall wider than ``wall_px`` in an occlusion, roof edges
+        near holes are eroded and such holes get no roof (:mod:`.dense_fill`).
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
-    tile_size : int, optional
-        Side of the tile core (px).
-    margin : int
-        Overlap of the tiles (px of context on each side, discarded afterwards).
+    tile_size, margin : int
+        Side of the tile core (px; optional) and the tiles' overlap (px of context per side).
     coarse_above : int
         A search range of more disparities than this is narrowed per tile by a coarse pass (see
         the module docstring); 0 = never.
@@ -474,7 +479,7 @@ def iter_disparity_tiles(
     match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
                          lr_max_diff, normalise_window, speckle_window, speckle_range,
                          fill_max_width, edge_erosion, range_guard, edge_jump, plane_fill,
-                         segment_px, edge_reach)
+                         segment_px, edge_reach, wall_view, wall_px)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
@@ -573,8 +578,10 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
                  num_d: int, ours: bool, block: int, lr_max_diff: float, normalise_window: int,
                  speckle_window: int, speckle_range: int, fill_max_width: int,
                  edge_erosion: int = 0, range_guard: float = 0.0, edge_jump: float = 0.0,
-                 plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0) -> Array:
-    """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape)."""
+                 plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0,
+                 wall_share: Optional[Array] = None, wall_px: float = 20.0) -> Array:
+    """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape);
+    ``wall_share`` (per frame column), ``wall_px`` as :func:`.dense_fill.erode_lower_side`."""
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
     if ours and normalise_window > 1:
@@ -620,7 +627,8 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     if ours and edge_erosion > 0 and edge_jump > 0:
         # only the occluded (lower) side of a step, so that roof edges stay
         small = _small_segments(cv2, disp, segment_px, 1.0) if segment_px > 0 else None
-        disp = erode_lower_side(disp, lmask, int(edge_erosion), edge_jump, small, edge_reach)
+        disp = erode_lower_side(disp, lmask, int(edge_erosion), edge_jump, small, edge_reach,
+                                wall_share, wall_px)
     elif ours and edge_erosion > 0:
         # the frame outside the image is masked (NaN), so image borders are eroded too
         ok = (np.isfinite(disp) & ~lmask).astype(np.uint8)
@@ -630,7 +638,8 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
         disp[ok == 0] = np.nan
     if ours and plane_fill > 0:
         disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
-                                window=block)
+                                window=block, wall_share=wall_share,
+                                wall_px=wall_px)
     if ours and fill_max_width > 0:
         disp = fill_holes_rows(disp, lmask, fill_max_width)
     disp[lmask] = np.nan

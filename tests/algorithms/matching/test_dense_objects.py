@@ -141,3 +141,28 @@ def test_plane_fill_leaves_the_occlusion_to_the_ground() -> None:
     filled = plane_fill(d, np.zeros(d.shape, bool), 100.0, 2.0, window=5)
     assert np.isnan(filled[:, 15:34]).all()  # ground part left to the gridding
     assert np.allclose(filled[:, 34:40], 20.0)  # the roof's own band filled from the roof
+
+
+def test_wall_seen_by_the_left_camera_gets_no_roof() -> None:
+    # the same occlusion where the left camera sees the wall over all of it (wide-angle
+    # geometry): SGM's roof on the wall is eroded over a third of the wall's width and the
+    # hole is not filled with roof; where the wall is narrower than wall_px nothing changes
+    d = np.full((30, 100), 5.0, np.float32)
+    d[:, 40:] = 35.0  # a 30 px step
+    d[:, 15:40] = np.nan  # the hole; 40…49: roof disparities on the wall
+    masked = np.zeros(d.shape, bool)
+    share = np.ones((1, d.shape[1]))
+    out = erode_lower_side(d, masked, 2, 2.0, None, 15, share, wall_px=20.0)
+    assert np.isnan(out[5:25, 40:49]).all()  # within 0.33 × 30 px of the hole
+    assert np.isfinite(out[5:25, 52:97]).all()  # (the image border is eroded)
+    filled = plane_fill(out, masked, 100.0, 2.0, window=5, wall_share=share, wall_px=20.0)
+    assert np.isnan(filled[5:25, 15:49]).all()
+    narrow = erode_lower_side(d, masked, 2, 2.0, None, 15, 0.5 * share, wall_px=20.0)
+    assert np.isfinite(narrow[5:25, 42:97]).all()  # a 15 px wall: only the plain 2 px go
+
+
+def test_wall_share_is_zero_below_the_left_and_one_below_the_right_camera() -> None:
+    from photodem.algorithms.matching.dense_fill import wall_share_columns
+
+    f = wall_share_columns(np.array([100.0, 600.0]), 20.0, (100.0, 580.0))
+    assert np.allclose(f, [0.0, 1.0])
