@@ -78,6 +78,21 @@ def test_compare_writes_into_products_and_offers_the_difference(panel, project, 
     assert panel.statistics["stats"]["count"] == N * N
 
 
+def test_compare_co_registers_on_stable_terrain(panel, project, qtbot):
+    root, dem, ref = project
+    with rasterio.open(ref) as src:
+        z = src.read(1)
+    _write(root / "dem_up.tif", z + 0.4)  # a vertical bias the co-registration removes
+    panel.set_inputs(dem=str(root / "dem_up.tif"))
+    panel.coregister_check.setChecked(True)
+    panel.stable_edit.setText(_write(root / "stable.tif", np.ones((N, N))))
+    with qtbot.waitSignal(panel.difference_ready, timeout=60000):
+        assert panel.compare()
+    assert panel.wait()
+    assert panel.statistics["shift"]["dz"] == pytest.approx(-0.4, abs=0.01)
+    assert abs(panel.statistics["stats"]["mean"]) < 0.01
+
+
 def test_blunders_list_zoom_and_edits(panel, project, qtbot):
     root, _, ref = project
     assert panel.find_blunders()
