@@ -46,7 +46,7 @@ def project(tmp_path):
 
 @pytest.fixture
 def panel(qtbot, project):
-    root, dem, ref = project
+    root, _, ref = project
     w = QcPanel()
     qtbot.addWidget(w)
     w.set_project(root)
@@ -79,7 +79,7 @@ def test_compare_writes_into_products_and_offers_the_difference(panel, project, 
 
 
 def test_compare_co_registers_on_stable_terrain(panel, project, qtbot):
-    root, dem, ref = project
+    root, _, ref = project
     with rasterio.open(ref) as src:
         z = src.read(1)
     _write(root / "dem_up.tif", z + 0.4)  # a vertical bias the co-registration removes
@@ -137,7 +137,7 @@ def test_missing_inputs_are_reported(qtbot):
 def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
     from photodem.plugin.app.main_window import ToolboxWindow
 
-    root, dem, ref = project
+    root, _, ref = project
     window = ToolboxWindow(message_boxes=False)
     qtbot.addWidget(window)
     panel = window.open_quality_panel()
