@@ -165,9 +165,21 @@ class QcPanel(QtWidgets.QWidget):
         grid.addWidget(self.stats_button, 1, 1)
         grid.addWidget(self.cancel_button, 1, 2)
         grid.addWidget(self.progress, 1, 3)
+        # Compare only: co-registration (Nuth & Kääb) on the stable terrain, as dem_compare
+        self.coregister_check = QtWidgets.QCheckBox(tr("Co-register before comparing"), self)
+        self.coregister_check.setToolTip(tr("Estimate and remove a horizontal shift and a "
+                                            "vertical bias (Nuth & Kääb) on stable terrain "
+                                            "first (Compare only)."))
+        row, self.stable_edit = _path_row(
+            self, tr("Stable terrain (mask raster or polygons)"),
+            tr("Rasters or polygons (*.tif *.tiff *.gpkg *.shp *.geojson);;All files (*)"))
+        self.stable_edit.setPlaceholderText(tr("stable terrain: mask raster or polygons "
+                                               "(default: the whole common area)"))
+        grid.addWidget(self.coregister_check, 2, 0, 1, 2)
+        grid.addWidget(row, 2, 2, 1, 2)
         self.status = QtWidgets.QLabel(self)
         self.status.setWordWrap(True)
-        grid.addWidget(self.status, 2, 0, 1, 4)
+        grid.addWidget(self.status, 3, 0, 1, 4)
         self._show_area()
         return grid
 
@@ -413,6 +425,11 @@ class QcPanel(QtWidgets.QWidget):
         for key in ("classes", "class_field"):
             if given.get(key):
                 params[key] = given[key]
+        if self.coregister_check.isChecked():
+            params["coregister"] = True
+            stable = self.stable_edit.text().strip()
+            if stable:
+                params["stable"] = stable
         return self._start(AlgorithmWorker("dem_compare", params), self._compare_done,
                            tr("Comparing…"))
 

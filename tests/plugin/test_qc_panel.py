@@ -46,7 +46,7 @@ def project(tmp_path):
 
 @pytest.fixture
 def panel(qtbot, project):
-    root, dem, ref = project
+    root, _, ref = project
     w = QcPanel()
     qtbot.addWidget(w)
     w.set_project(root)
@@ -76,6 +76,21 @@ def test_compare_writes_into_products_and_offers_the_difference(panel, project, 
     assert path.startswith(str(root / "products" / "quality"))
     assert os.path.isfile(path) and os.path.isfile(path[:-4] + ".qml")
     assert panel.statistics["stats"]["count"] == N * N
+
+
+def test_compare_co_registers_on_stable_terrain(panel, project, qtbot):
+    root, _, ref = project
+    with rasterio.open(ref) as src:
+        z = src.read(1)
+    _write(root / "dem_up.tif", z + 0.4)  # a vertical bias the co-registration removes
+    panel.set_inputs(dem=str(root / "dem_up.tif"))
+    panel.coregister_check.setChecked(True)
+    panel.stable_edit.setText(_write(root / "stable.tif", np.ones((N, N))))
+    with qtbot.waitSignal(panel.difference_ready, timeout=60000):
+        assert panel.compare()
+    assert panel.wait()
+    assert panel.statistics["shift"]["dz"] == pytest.approx(-0.4, abs=0.01)
+    assert abs(panel.statistics["stats"]["mean"]) < 0.01
 
 
 def test_blunders_list_zoom_and_edits(panel, project, qtbot):
@@ -122,7 +137,7 @@ def test_missing_inputs_are_reported(qtbot):
 def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
     from photodem.plugin.app.main_window import ToolboxWindow
 
-    root, dem, ref = project
+    root, _, ref = project
     window = ToolboxWindow(message_boxes=False)
     qtbot.addWidget(window)
     panel = window.open_quality_panel()
