@@ -475,7 +475,7 @@
         </message>
         <message>
             <source>Co-register before comparing</source>
-            <extracomment>dem_compare.coregister: description</extracomment>
+            <extracomment>dem_compare.coregister: description; plugin/widgets/qc_panel.py:169</extracomment>
             <translation>Vor dem Vergleich koregistrieren</translation>
         </message>
         <message>
@@ -485,7 +485,7 @@
         </message>
         <message>
             <source>Stable terrain (mask raster or polygons)</source>
-            <extracomment>dem_compare.stable: description</extracomment>
+            <extracomment>dem_compare.stable: description; plugin/widgets/qc_panel.py:174</extracomment>
             <translation>Stabiles Gelände (Maskenraster oder Polygone)</translation>
         </message>
         <message>
@@ -2495,7 +2495,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:726; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2545,7 +2545,7 @@
         </message>
         <message>
             <source>Batch {0}: {1}; summary in {2}</source>
-            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:617</extracomment>
+            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:618</extracomment>
             <translation>Batch {0}: {1}; Zusammenfassung in {2}</translation>
         </message>
         <message>
@@ -2600,7 +2600,7 @@
         </message>
         <message>
             <source>Action</source>
-            <extracomment>plugin/qgis/edit_forms.py:113; plugin/widgets/qc_panel.py:264</extracomment>
+            <extracomment>plugin/qgis/edit_forms.py:113; plugin/widgets/qc_panel.py:276</extracomment>
             <translation>Aktion</translation>
         </message>
         <message>
@@ -2855,7 +2855,7 @@
         </message>
         <message>
             <source>Surface</source>
-            <extracomment>plugin/qgis/editing_toolbar.py:127; plugin/widgets/qc_panel.py:614</extracomment>
+            <extracomment>plugin/qgis/editing_toolbar.py:127; plugin/widgets/qc_panel.py:631</extracomment>
             <translation>Oberfläche</translation>
         </message>
         <message>
@@ -2920,7 +2920,7 @@
         </message>
         <message>
             <source>The project cannot be read: {0}</source>
-            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:320</extracomment>
+            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:321</extracomment>
             <translation>Das Projekt ist nicht lesbar: {0}</translation>
         </message>
         <message>
@@ -3005,7 +3005,7 @@
         </message>
         <message>
             <source>whole model</source>
-            <extracomment>plugin/qgis/qc_dock.py:319; plugin/widgets/qc_panel.py:107; plugin/widgets/qc_panel.py:348; plugin/widgets/qc_panel.py:422</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:319; plugin/widgets/qc_panel.py:107; plugin/widgets/qc_panel.py:360; plugin/widgets/qc_panel.py:439</extracomment>
             <translation>ganzes Modell</translation>
         </message>
         <message>
@@ -3035,7 +3035,7 @@
         </message>
         <message>
             <source>Whole model</source>
-            <extracomment>plugin/qgis/qc_dock.py:201; plugin/widgets/qc_panel.py:182</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:201; plugin/widgets/qc_panel.py:194</extracomment>
             <translation>Ganzes Modell</translation>
         </message>
         <message>
@@ -3225,7 +3225,7 @@
         </message>
         <message>
             <source>Products</source>
-            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:225</extracomment>
+            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:226</extracomment>
             <translation>Produkte</translation>
         </message>
         <message>
@@ -3310,92 +3310,92 @@
         </message>
         <message>
             <source>DTM filter</source>
-            <extracomment>plugin/widgets/batch_dialog.py:163; plugin/widgets/batch_dialog.py:176</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:163; plugin/widgets/batch_dialog.py:177</extracomment>
             <translation>DGM-Filter</translation>
         </message>
         <message>
             <source>Worker processes (default: cores − 1)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:188</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:189</extracomment>
             <translation>Worker-Prozesse (Vorgabe: Kerne − 1)</translation>
         </message>
         <message>
             <source>The log of the batch appears here.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:207</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:208</extracomment>
             <translation>Hier erscheint das Protokoll des Batches.</translation>
         </message>
         <message>
             <source>Open</source>
-            <extracomment>plugin/widgets/batch_dialog.py:210; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
             <translation>Öffnen</translation>
         </message>
         <message>
             <source>Show in folder</source>
-            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:212; plugin/widgets/run_panel.py:224</extracomment>
             <translation>Im Ordner zeigen</translation>
         </message>
         <message>
             <source>Log</source>
-            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:87</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:225; plugin/widgets/run_panel.py:87</extracomment>
             <translation>Protokoll</translation>
         </message>
         <message>
             <source>Run</source>
-            <extracomment>plugin/widgets/batch_dialog.py:237; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:238; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Ausführen</translation>
         </message>
         <message>
             <source>Write the batch file of these choices and run it</source>
-            <extracomment>plugin/widgets/batch_dialog.py:239</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:240</extracomment>
             <translation>Die Batch-Datei dieser Auswahl schreiben und ausführen</translation>
         </message>
         <message>
             <source>Resume</source>
-            <extracomment>plugin/widgets/batch_dialog.py:240</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:241</extracomment>
             <translation>Fortsetzen</translation>
         </message>
         <message>
             <source>Run the batch file again; finished tasks are skipped</source>
-            <extracomment>plugin/widgets/batch_dialog.py:241</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:242</extracomment>
             <translation>Die Batch-Datei erneut ausführen; fertige Aufgaben werden übersprungen</translation>
         </message>
         <message>
             <source>Re-run failed</source>
-            <extracomment>plugin/widgets/batch_dialog.py:242</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:243</extracomment>
             <translation>Fehlgeschlagene erneut ausführen</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:243; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:172</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:245; plugin/widgets/georef_review.py:172</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Batch is running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:693</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:694</extracomment>
             <translation>Batch läuft</translation>
         </message>
         <message>
             <source>The batch is still running. Cancel it, or keep it running in the background?</source>
-            <extracomment>plugin/widgets/batch_dialog.py:694</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:695</extracomment>
             <translation>Der Batch läuft noch. Abbrechen oder im Hintergrund weiterlaufen lassen?</translation>
         </message>
         <message>
             <source>Cancel the batch</source>
-            <extracomment>plugin/widgets/batch_dialog.py:696</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
             <translation>Batch abbrechen</translation>
         </message>
         <message>
             <source>Keep running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:698</extracomment>
             <translation>Weiterlaufen lassen</translation>
         </message>
         <message>
             <source>Back</source>
-            <extracomment>plugin/widgets/batch_dialog.py:698</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:699</extracomment>
             <translation>Zurück</translation>
         </message>
         <message>
@@ -3460,94 +3460,94 @@
         </message>
         <message>
             <source>Matching method</source>
-            <extracomment>plugin/widgets/batch_dialog.py:174</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:175</extracomment>
             <translation>Zuordnungsverfahren</translation>
         </message>
         <message>
             <source>Matching preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:175</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:176</extracomment>
             <translation>Voreinstellung der Zuordnung</translation>
         </message>
         <message>
             <source>Filter preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:177</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:178</extracomment>
             <translation>Voreinstellung des Filters</translation>
         </message>
         <message>
             <source>Single orthophotos or a mosaic</source>
-            <extracomment>plugin/widgets/batch_dialog.py:178</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:179</extracomment>
             <translation>Einzelne Orthofotos oder ein Mosaik</translation>
         </message>
         <message>
             <source>Workers</source>
-            <extracomment>plugin/widgets/batch_dialog.py:189</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:190</extracomment>
             <translation>Worker</translation>
         </message>
         <message>
             <source>Choose a project folder, or open a batch file.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:314</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:315</extracomment>
             <translation>Wählen Sie einen Projektordner oder öffnen Sie eine Batch-Datei.</translation>
         </message>
         <message>
             <source>Choose a project folder (with project.toml) first.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:375</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:376</extracomment>
             <translation>Wählen Sie zuerst einen Projektordner (mit project.toml).</translation>
         </message>
         <message>
             <source>Cancelling …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:501; plugin/widgets/run_panel.py:149</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:502; plugin/widgets/run_panel.py:149</extracomment>
             <translation>Wird abgebrochen …</translation>
         </message>
         <message>
             <source>No log yet: the task has not started.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:674</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:675</extracomment>
             <translation>Noch kein Protokoll: die Aufgabe hat noch nicht begonnen.</translation>
         </message>
         <message>
             <source>Run writes the batch file into {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:326</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:327</extracomment>
             <translation>Ausführen schreibt die Batch-Datei nach {0}</translation>
         </message>
         <message>
             <source>Open batch file</source>
-            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:393</extracomment>
             <translation>Batch-Datei öffnen</translation>
         </message>
         <message>
             <source>Batch files (*.toml)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:393</extracomment>
             <translation>Batch-Dateien (*.toml)</translation>
         </message>
         <message>
             <source>Running batch file {0} …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:487</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:488</extracomment>
             <translation>Batch-Datei {0} läuft …</translation>
         </message>
         <message>
             <source>elapsed {0} · remaining {1}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:603</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:604</extracomment>
             <translation>vergangen {0} · verbleibend {1}</translation>
         </message>
         <message>
             <source>Warning: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:169</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:169</extracomment>
             <translation>Warnung: </translation>
         </message>
         <message>
             <source>Error: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:183</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:183</extracomment>
             <translation>Fehler: </translation>
         </message>
         <message>
             <source>Batch file: {0}
 Run it again with: photodem batch {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:424</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:425</extracomment>
             <translation>Batch-Datei: {0}
 Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The batch file cannot be used: {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:398</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:399</extracomment>
             <translation>Die Batch-Datei kann nicht verwendet werden: {0}</translation>
         </message>
         <message>
@@ -4012,7 +4012,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Profile</source>
-            <extracomment>plugin/widgets/qc_panel.py:142; plugin/widgets/qc_panel.py:210</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:142; plugin/widgets/qc_panel.py:222</extracomment>
             <translation>Profil</translation>
         </message>
         <message>
@@ -4041,218 +4041,233 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Statistik des Gebiets</translation>
         </message>
         <message>
+            <source>Estimate and remove a horizontal shift and a vertical bias (Nuth &amp; Kääb) on stable terrain first (Compare only).</source>
+            <extracomment>plugin/widgets/qc_panel.py:170</extracomment>
+            <translation>Zuerst eine Lageverschiebung und einen Höhenversatz (Nuth &amp; Kääb) auf stabilem Gelände schätzen und entfernen (nur beim Vergleichen).</translation>
+        </message>
+        <message>
+            <source>Rasters or polygons (*.tif *.tiff *.gpkg *.shp *.geojson);;All files (*)</source>
+            <extracomment>plugin/widgets/qc_panel.py:175</extracomment>
+            <translation>Raster oder Polygone (*.tif *.tiff *.gpkg *.shp *.geojson);;Alle Dateien (*)</translation>
+        </message>
+        <message>
+            <source>stable terrain: mask raster or polygons (default: the whole common area)</source>
+            <extracomment>plugin/widgets/qc_panel.py:176</extracomment>
+            <translation>stabiles Gelände: Maskenraster oder Polygone (Vorgabe: die ganze gemeinsame Fläche)</translation>
+        </message>
+        <message>
             <source>xmin, ymin, xmax, ymax (reference CRS)</source>
-            <extracomment>plugin/widgets/qc_panel.py:179</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:191</extracomment>
             <translation>xmin, ymin, xmax, ymax (KBS der Referenz)</translation>
         </message>
         <message>
             <source>Use extent</source>
-            <extracomment>plugin/widgets/qc_panel.py:180</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:192</extracomment>
             <translation>Ausdehnung verwenden</translation>
         </message>
         <message>
             <source>Draw an area or press 'Statistics of the area'</source>
-            <extracomment>plugin/widgets/qc_panel.py:194</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:206</extracomment>
             <translation>Zeichnen Sie ein Gebiet oder drücken Sie „Statistik des Gebiets“</translation>
         </message>
         <message>
             <source>x1,y1;x2,y2;… (DEM CRS), or draw a line on the map</source>
-            <extracomment>plugin/widgets/qc_panel.py:208</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:220</extracomment>
             <translation>x1,y1;x2,y2;… (KBS des DHM) oder eine Linie in der Karte zeichnen</translation>
         </message>
         <message>
             <source>Draw a line on the map</source>
-            <extracomment>plugin/widgets/qc_panel.py:216</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:228</extracomment>
             <translation>Zeichnen Sie eine Linie in der Karte</translation>
         </message>
         <message>
             <source>Export CSV…</source>
-            <extracomment>plugin/widgets/qc_panel.py:221</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:233</extracomment>
             <translation>CSV exportieren…</translation>
         </message>
         <message>
             <source>Export PNG…</source>
-            <extracomment>plugin/widgets/qc_panel.py:223</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:235</extracomment>
             <translation>PNG exportieren…</translation>
         </message>
         <message>
             <source>Find blunders</source>
-            <extracomment>plugin/widgets/qc_panel.py:241</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:253</extracomment>
             <translation>Grobe Fehler suchen</translation>
         </message>
         <message>
             <source>To exclusion area</source>
-            <extracomment>plugin/widgets/qc_panel.py:258</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:270</extracomment>
             <translation>Als Ausschlussfläche</translation>
         </message>
         <message>
             <source>To ground point</source>
-            <extracomment>plugin/widgets/qc_panel.py:260</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:272</extracomment>
             <translation>Als Bodenpunkt</translation>
         </message>
         <message>
             <source>A ground point at the spot's centre with the reference height</source>
-            <extracomment>plugin/widgets/qc_panel.py:261</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:273</extracomment>
             <translation>Ein Bodenpunkt in der Mitte der Stelle mit der Höhe der Referenz</translation>
         </message>
         <message>
             <source>Click on the map to see every surface's height there.</source>
-            <extracomment>plugin/widgets/qc_panel.py:275</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:287</extracomment>
             <translation>Klicken Sie in die Karte, um dort die Höhe jeder Oberfläche zu sehen.</translation>
         </message>
         <message>
             <source>Computing statistics…</source>
-            <extracomment>plugin/widgets/qc_panel.py:384</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:396</extracomment>
             <translation>Statistik wird berechnet…</translation>
         </message>
         <message>
             <source>Comparing…</source>
-            <extracomment>plugin/widgets/qc_panel.py:417</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:434</extracomment>
             <translation>Vergleiche…</translation>
         </message>
         <message>
             <source>Done.</source>
-            <extracomment>plugin/widgets/qc_panel.py:455</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:472</extracomment>
             <translation>Fertig.</translation>
         </message>
         <message>
             <source>Searching blunders…</source>
-            <extracomment>plugin/widgets/qc_panel.py:488</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:505</extracomment>
             <translation>Suche grobe Fehler…</translation>
         </message>
         <message>
             <source>CSV (*.csv)</source>
-            <extracomment>plugin/widgets/qc_panel.py:597</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:614</extracomment>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
             <source>PNG image (*.png)</source>
-            <extracomment>plugin/widgets/qc_panel.py:597</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:614</extracomment>
             <translation>PNG-Bild (*.png)</translation>
         </message>
         <message>
             <source>Export profile</source>
-            <extracomment>plugin/widgets/qc_panel.py:598</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:615</extracomment>
             <translation>Profil exportieren</translation>
         </message>
         <message>
             <source>Area</source>
-            <extracomment>plugin/widgets/qc_panel.py:184</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:196</extracomment>
             <translation>Gebiet</translation>
         </message>
         <message>
             <source>|Δh − median| above k × NMAD, k =</source>
-            <extracomment>plugin/widgets/qc_panel.py:235</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:247</extracomment>
             <translation>|Δh − Median| über k × NMAD, k =</translation>
         </message>
         <message>
             <source>the DEM</source>
-            <extracomment>plugin/widgets/qc_panel.py:317</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:329</extracomment>
             <translation>das Höhenmodell</translation>
         </message>
         <message>
             <source>the reference</source>
-            <extracomment>plugin/widgets/qc_panel.py:317</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:329</extracomment>
             <translation>die Referenz</translation>
         </message>
         <message>
             <source>drawn area</source>
-            <extracomment>plugin/widgets/qc_panel.py:348</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:360</extracomment>
             <translation>gezeichnetes Gebiet</translation>
         </message>
         <message>
             <source>Give the extent as 'xmin, ymin, xmax, ymax'.</source>
-            <extracomment>plugin/widgets/qc_panel.py:361</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:373</extracomment>
             <translation>Geben Sie die Ausdehnung als „xmin, ymin, xmax, ymax“ an.</translation>
         </message>
         <message>
             <source>Open a project first: the comparison is written into its products folder.</source>
-            <extracomment>plugin/widgets/qc_panel.py:409</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:421</extracomment>
             <translation>Öffnen Sie zuerst ein Projekt: Der Vergleich wird in seinen Produktordner geschrieben.</translation>
         </message>
         <message>
             <source>A computation is running; wait or cancel it.</source>
-            <extracomment>plugin/widgets/qc_panel.py:435</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:452</extracomment>
             <translation>Eine Berechnung läuft; warten Sie oder brechen Sie sie ab.</translation>
         </message>
         <message>
             <source>Select a blunder in the list first.</source>
-            <extracomment>plugin/widgets/qc_panel.py:507</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:524</extracomment>
             <translation>Wählen Sie zuerst einen groben Fehler in der Liste.</translation>
         </message>
         <message>
             <source>Open a project with an edits.gpkg first: the edit goes into it.</source>
-            <extracomment>plugin/widgets/qc_panel.py:514</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:531</extracomment>
             <translation>Öffnen Sie zuerst ein Projekt mit edits.gpkg: Die Bearbeitung wird dort gespeichert.</translation>
         </message>
         <message>
             <source>The reference has no height at the spot's centre.</source>
-            <extracomment>plugin/widgets/qc_panel.py:552</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:569</extracomment>
             <translation>Die Referenz hat in der Mitte der Stelle keine Höhe.</translation>
         </message>
         <message>
             <source>Choose the surfaces first.</source>
-            <extracomment>plugin/widgets/qc_panel.py:562; plugin/widgets/qc_panel.py:608</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:579; plugin/widgets/qc_panel.py:625</extracomment>
             <translation>Wählen Sie zuerst die Oberflächen.</translation>
         </message>
         <message>
             <source>Height [m]</source>
-            <extracomment>plugin/widgets/qc_panel.py:614; plugin/widgets/qc_plots.py:170</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:631; plugin/widgets/qc_plots.py:170</extracomment>
             <translation>Höhe [m]</translation>
         </message>
         <message>
             <source>extent {0}</source>
-            <extracomment>plugin/widgets/qc_panel.py:363</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:375</extracomment>
             <translation>Ausdehnung {0}</translation>
         </message>
         <message>
             <source>Area: {0}</source>
-            <extracomment>plugin/widgets/qc_panel.py:374</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:386</extracomment>
             <translation>Gebiet: {0}</translation>
         </message>
         <message>
             <source>Cancelled.</source>
-            <extracomment>plugin/widgets/qc_panel.py:441</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:458</extracomment>
             <translation>Abgebrochen.</translation>
         </message>
         <message>
             <source>{0} blunder spots (|Δh − median| &gt; {1:.2f} m).</source>
-            <extracomment>plugin/widgets/qc_panel.py:493</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:510</extracomment>
             <translation>{0} Stellen mit groben Fehlern (|Δh − Median| &gt; {1:.2f} m).</translation>
         </message>
         <message>
             <source>Written to {0}.</source>
-            <extracomment>plugin/widgets/qc_panel.py:525</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:542</extracomment>
             <translation>In {0} geschrieben.</translation>
         </message>
         <message>
             <source>{0} stations, {1} breakline crossings, {2} check points</source>
-            <extracomment>plugin/widgets/qc_panel.py:576</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:593</extracomment>
             <translation>{0} Stationen, {1} Kreuzungen mit Bruchkanten, {2} Kontrollpunkte</translation>
         </message>
         <message>
             <source>At x = {0:.2f}, y = {1:.2f}</source>
-            <extracomment>plugin/widgets/qc_panel.py:621</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:638</extracomment>
             <translation>Bei x = {0:.2f}, y = {1:.2f}</translation>
         </message>
         <message>
             <source>'{0}' is no PhotoDEM project (no project.toml); choose the project folder.</source>
-            <extracomment>plugin/widgets/qc_panel.py:288</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:300</extracomment>
             <translation>„{0}“ ist kein PhotoDEM-Projekt (keine project.toml); wählen Sie den Projektordner.</translation>
         </message>
         <message>
             <source>Internal error: {0}</source>
-            <extracomment>plugin/widgets/qc_panel.py:460</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:477</extracomment>
             <translation>Interner Fehler: {0}</translation>
         </message>
         <message>
             <source>Profile written to {0}.</source>
-            <extracomment>plugin/widgets/qc_panel.py:602</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:619</extracomment>
             <translation>Profil nach {0} geschrieben.</translation>
         </message>
         <message>
             <source>Choose {0}: '{1}' is not a raster file.</source>
-            <extracomment>plugin/widgets/qc_panel.py:320</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:332</extracomment>
             <translation>Wählen Sie {0}: „{1}“ ist keine Rasterdatei.</translation>
         </message>
         <message>
