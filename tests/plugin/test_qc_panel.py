@@ -46,7 +46,7 @@ def project(tmp_path):
 
 @pytest.fixture
 def panel(qtbot, project):
-    root, _, ref = project
+    root, dem, ref = project
     w = QcPanel()
     qtbot.addWidget(w)
     w.set_project(root)
@@ -137,7 +137,7 @@ def test_missing_inputs_are_reported(qtbot):
 def test_typed_extent_and_line_and_the_standalone_entry(qtbot, project):
     from photodem.plugin.app.main_window import ToolboxWindow
 
-    root, _, ref = project
+    root, dem, ref = project
     window = ToolboxWindow(message_boxes=False)
     qtbot.addWidget(window)
     panel = window.open_quality_panel()
