@@ -954,9 +954,9 @@
             <translation>Strategievorgabe (fbm_lsm)</translation>
         </message>
         <message>
-            <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <source>general (default): keeps buildings and trees with sharp walls (a DSM) and open terrain as accurate as terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
             <extracomment>match_model.preset: help</extracomment>
-            <translation>städtisch (Standard): kleine Fenster und Geländeelemente, behält Gebäude und Bäume mit scharfen Wänden (ein DOM); Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+            <translation>allgemein (Standard): behält Gebäude und Bäume mit scharfen Wänden (ein DOM) und offenes Gelände so genau wie Gelände; städtisch: kleinere Fenster und Geländeelemente für bebaute Gebiete; Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>terrain</source>
@@ -967,6 +967,11 @@
             <source>hilly</source>
             <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
             <translation>hügelig</translation>
+        </message>
+        <message>
+            <source>general</source>
+            <extracomment>match_model.preset: option</extracomment>
+            <translation>allgemein</translation>
         </message>
         <message>
             <source>urban</source>
@@ -1014,9 +1019,9 @@
             <translation>Größe der Geländeelemente [m] (fbm_lsm)</translation>
         </message>
         <message>
-            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD).</source>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (general: 20, urban: 10, terrain: 40 × GSD).</source>
             <extracomment>match_model.groundel: help</extracomment>
-            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (städtisch: 10 × GSD, Gelände: 40 × GSD).</translation>
+            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (allgemein: 20, städtisch: 10, Gelände: 40 × GSD).</translation>
         </message>
         <message>
             <source>Groundel reduction (fbm_lsm)</source>
@@ -2495,7 +2500,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:726; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2545,7 +2550,7 @@
         </message>
         <message>
             <source>Batch {0}: {1}; summary in {2}</source>
-            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:617</extracomment>
+            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:618</extracomment>
             <translation>Batch {0}: {1}; Zusammenfassung in {2}</translation>
         </message>
         <message>
@@ -2920,7 +2925,7 @@
         </message>
         <message>
             <source>The project cannot be read: {0}</source>
-            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:320</extracomment>
+            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:321</extracomment>
             <translation>Das Projekt ist nicht lesbar: {0}</translation>
         </message>
         <message>
@@ -3225,7 +3230,7 @@
         </message>
         <message>
             <source>Products</source>
-            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:225</extracomment>
+            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:226</extracomment>
             <translation>Produkte</translation>
         </message>
         <message>
@@ -3310,92 +3315,92 @@
         </message>
         <message>
             <source>DTM filter</source>
-            <extracomment>plugin/widgets/batch_dialog.py:163; plugin/widgets/batch_dialog.py:176</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:163; plugin/widgets/batch_dialog.py:177</extracomment>
             <translation>DGM-Filter</translation>
         </message>
         <message>
             <source>Worker processes (default: cores − 1)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:188</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:189</extracomment>
             <translation>Worker-Prozesse (Vorgabe: Kerne − 1)</translation>
         </message>
         <message>
             <source>The log of the batch appears here.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:207</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:208</extracomment>
             <translation>Hier erscheint das Protokoll des Batches.</translation>
         </message>
         <message>
             <source>Open</source>
-            <extracomment>plugin/widgets/batch_dialog.py:210; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
             <translation>Öffnen</translation>
         </message>
         <message>
             <source>Show in folder</source>
-            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:212; plugin/widgets/run_panel.py:224</extracomment>
             <translation>Im Ordner zeigen</translation>
         </message>
         <message>
             <source>Log</source>
-            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:87</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:225; plugin/widgets/run_panel.py:87</extracomment>
             <translation>Protokoll</translation>
         </message>
         <message>
             <source>Run</source>
-            <extracomment>plugin/widgets/batch_dialog.py:237; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:238; plugin/widgets/run_panel.py:42</extracomment>
             <translation>Ausführen</translation>
         </message>
         <message>
             <source>Write the batch file of these choices and run it</source>
-            <extracomment>plugin/widgets/batch_dialog.py:239</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:240</extracomment>
             <translation>Die Batch-Datei dieser Auswahl schreiben und ausführen</translation>
         </message>
         <message>
             <source>Resume</source>
-            <extracomment>plugin/widgets/batch_dialog.py:240</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:241</extracomment>
             <translation>Fortsetzen</translation>
         </message>
         <message>
             <source>Run the batch file again; finished tasks are skipped</source>
-            <extracomment>plugin/widgets/batch_dialog.py:241</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:242</extracomment>
             <translation>Die Batch-Datei erneut ausführen; fertige Aufgaben werden übersprungen</translation>
         </message>
         <message>
             <source>Re-run failed</source>
-            <extracomment>plugin/widgets/batch_dialog.py:242</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:243</extracomment>
             <translation>Fehlgeschlagene erneut ausführen</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:243; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:172</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:245; plugin/widgets/georef_review.py:172</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Batch is running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:693</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:694</extracomment>
             <translation>Batch läuft</translation>
         </message>
         <message>
             <source>The batch is still running. Cancel it, or keep it running in the background?</source>
-            <extracomment>plugin/widgets/batch_dialog.py:694</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:695</extracomment>
             <translation>Der Batch läuft noch. Abbrechen oder im Hintergrund weiterlaufen lassen?</translation>
         </message>
         <message>
             <source>Cancel the batch</source>
-            <extracomment>plugin/widgets/batch_dialog.py:696</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
             <translation>Batch abbrechen</translation>
         </message>
         <message>
             <source>Keep running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:698</extracomment>
             <translation>Weiterlaufen lassen</translation>
         </message>
         <message>
             <source>Back</source>
-            <extracomment>plugin/widgets/batch_dialog.py:698</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:699</extracomment>
             <translation>Zurück</translation>
         </message>
         <message>
@@ -3460,94 +3465,94 @@
         </message>
         <message>
             <source>Matching method</source>
-            <extracomment>plugin/widgets/batch_dialog.py:174</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:175</extracomment>
             <translation>Zuordnungsverfahren</translation>
         </message>
         <message>
             <source>Matching preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:175</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:176</extracomment>
             <translation>Voreinstellung der Zuordnung</translation>
         </message>
         <message>
             <source>Filter preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:177</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:178</extracomment>
             <translation>Voreinstellung des Filters</translation>
         </message>
         <message>
             <source>Single orthophotos or a mosaic</source>
-            <extracomment>plugin/widgets/batch_dialog.py:178</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:179</extracomment>
             <translation>Einzelne Orthofotos oder ein Mosaik</translation>
         </message>
         <message>
             <source>Workers</source>
-            <extracomment>plugin/widgets/batch_dialog.py:189</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:190</extracomment>
             <translation>Worker</translation>
         </message>
         <message>
             <source>Choose a project folder, or open a batch file.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:314</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:315</extracomment>
             <translation>Wählen Sie einen Projektordner oder öffnen Sie eine Batch-Datei.</translation>
         </message>
         <message>
             <source>Choose a project folder (with project.toml) first.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:375</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:376</extracomment>
             <translation>Wählen Sie zuerst einen Projektordner (mit project.toml).</translation>
         </message>
         <message>
             <source>Cancelling …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:501; plugin/widgets/run_panel.py:149</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:502; plugin/widgets/run_panel.py:149</extracomment>
             <translation>Wird abgebrochen …</translation>
         </message>
         <message>
             <source>No log yet: the task has not started.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:674</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:675</extracomment>
             <translation>Noch kein Protokoll: die Aufgabe hat noch nicht begonnen.</translation>
         </message>
         <message>
             <source>Run writes the batch file into {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:326</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:327</extracomment>
             <translation>Ausführen schreibt die Batch-Datei nach {0}</translation>
         </message>
         <message>
             <source>Open batch file</source>
-            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:393</extracomment>
             <translation>Batch-Datei öffnen</translation>
         </message>
         <message>
             <source>Batch files (*.toml)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:392</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:393</extracomment>
             <translation>Batch-Dateien (*.toml)</translation>
         </message>
         <message>
             <source>Running batch file {0} …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:487</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:488</extracomment>
             <translation>Batch-Datei {0} läuft …</translation>
         </message>
         <message>
             <source>elapsed {0} · remaining {1}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:603</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:604</extracomment>
             <translation>vergangen {0} · verbleibend {1}</translation>
         </message>
         <message>
             <source>Warning: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:169</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:169</extracomment>
             <translation>Warnung: </translation>
         </message>
         <message>
             <source>Error: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:607; plugin/widgets/run_panel.py:183</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:183</extracomment>
             <translation>Fehler: </translation>
         </message>
         <message>
             <source>Batch file: {0}
 Run it again with: photodem batch {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:424</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:425</extracomment>
             <translation>Batch-Datei: {0}
 Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The batch file cannot be used: {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:398</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:399</extracomment>
             <translation>Die Batch-Datei kann nicht verwendet werden: {0}</translation>
         </message>
         <message>
@@ -4444,6 +4449,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Unexpected error (please report it):</source>
             <extracomment>plugin/widgets/run_panel.py:185</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <translation type="vanished">städtisch (Standard): kleine Fenster und Geländeelemente, behält Gebäude und Bäume mit scharfen Wänden (ein DOM); Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD).</source>
+            <translation type="vanished">Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (städtisch: 10 × GSD, Gelände: 40 × GSD).</translation>
         </message>
         <message>
             <source>flat: large windows and groundels, smooth surface; hilly: medium; urban: small windows and groundels, median, sharp edges; forest: lower envelope of the points per groundel. The options below override it.</source>
