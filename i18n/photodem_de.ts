@@ -954,9 +954,9 @@
             <translation>Strategievorgabe (fbm_lsm)</translation>
         </message>
         <message>
-            <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <source>general (default): keeps buildings and trees with sharp walls (a DSM) and open terrain as accurate as terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
             <extracomment>match_model.preset: help</extracomment>
-            <translation>städtisch (Standard): kleine Fenster und Geländeelemente, behält Gebäude und Bäume mit scharfen Wänden (ein DOM); Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+            <translation>allgemein (Standard): behält Gebäude und Bäume mit scharfen Wänden (ein DOM) und offenes Gelände so genau wie Gelände; städtisch: kleinere Fenster und Geländeelemente für bebaute Gebiete; Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>terrain</source>
@@ -967,6 +967,11 @@
             <source>hilly</source>
             <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; match_model.preset: option</extracomment>
             <translation>hügelig</translation>
+        </message>
+        <message>
+            <source>general</source>
+            <extracomment>match_model.preset: option</extracomment>
+            <translation>allgemein</translation>
         </message>
         <message>
             <source>urban</source>
@@ -1014,9 +1019,9 @@
             <translation>Größe der Geländeelemente [m] (fbm_lsm)</translation>
         </message>
         <message>
-            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD).</source>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (general: 20, urban: 10, terrain: 40 × GSD).</source>
             <extracomment>match_model.groundel: help</extracomment>
-            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (städtisch: 10 × GSD, Gelände: 40 × GSD).</translation>
+            <translation>Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (allgemein: 20, städtisch: 10, Gelände: 40 × GSD).</translation>
         </message>
         <message>
             <source>Groundel reduction (fbm_lsm)</source>
@@ -4459,6 +4464,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Unexpected error (please report it):</source>
             <extracomment>plugin/widgets/run_panel.py:185</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <translation type="vanished">städtisch (Standard): kleine Fenster und Geländeelemente, behält Gebäude und Bäume mit scharfen Wänden (ein DOM); Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+        </message>
+        <message>
+            <source>Side of the cells of the robust reduction. Default: the preset's multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD).</source>
+            <translation type="vanished">Seitenlänge der Zellen der robusten Reduktion. Standard: das Vielfache der GSD laut Vorgabe (städtisch: 10 × GSD, Gelände: 40 × GSD).</translation>
         </message>
         <message>
             <source>flat: large windows and groundels, smooth surface; hilly: medium; urban: small windows and groundels, median, sharp edges; forest: lower envelope of the points per groundel. The options below override it.</source>

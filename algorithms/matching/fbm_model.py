@@ -550,10 +550,10 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
         Cells farther than ``max_gap / 2`` (m) from every matched point stay NaN; default
         (or 0): every cell of the measuring area gets a height, and the report tells the
         measured share (cells within half a groundel of a point) from the interpolated one.
-    preset : {"urban", "terrain", "hilly", "forest"}
-        Strategy preset (:data:`PRESETS`); explicit options win. ``urban`` (default) keeps
-        buildings and trees; ``terrain`` (old name ``flat``, still accepted with a note in the
-        log) smooths them away.
+    preset : {"general", "urban", "terrain", "hilly", "forest"}
+        Strategy preset (:data:`PRESETS`); explicit options win. ``general`` (default) and
+        ``urban`` (built-up areas) keep buildings and trees; ``terrain`` (old name ``flat``,
+        still accepted with a note in the log) smooths them away.
     groundel : float, optional
         Groundel (reduction cell) side (m); default the preset's ``groundel_gsd`` × GSD.
     reduction : {"l1", "median", "lower"}, optional

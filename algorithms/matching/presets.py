@@ -17,8 +17,16 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     "terrain": {"fbm_window": 32, "groundel_gsd": 40.0, "reduction": "l1", "smoothing": 1.0},
     # hills: smaller windows follow the relief; medium groundels
     "hilly": {"fbm_window": 24, "groundel_gsd": 24.0, "reduction": "l1", "smoothing": 0.3},
-    # buildings (the DSM default): small windows, tight bidirectional check, small groundels,
-    # median, little smoothing; groundel outliers that form a consistent upper surface stay,
+    # the DSM default (issue 19): urban's object surface and finest-level pull-in, with
+    # 32 px windows, 20-GSD groundels and ρ ≥ 0.55 — on open aerial terrain urban's 16 px
+    # windows with the 20 px pull-in find clusters of wrong, mutually agreeing points
+    # (0.21 ‰ H against 0.044 here); on the roofs of the small blocks as good (tuning table in
+    # docs/decisions.md, "fbm_lsm keeps objects")
+    "general": {"fbm_window": 32, "bidir_tol": 0.5, "object_pull_in": 20.0, "rho_min": 0.55,
+                "groundel_gsd": 20.0, "reduction": "median", "smoothing": 0.05,
+                "objects": True},
+    # buildings: small windows, tight bidirectional check, small groundels, median, little
+    # smoothing; groundel outliers that form a consistent upper surface stay,
     # and height jumps between points become breaklines (``objects``), so roofs and walls stay;
     # a level-0 pull-in of 20 px reaches roofs about 10 m above the ground plane of a window
     # at B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity)
@@ -31,8 +39,9 @@ PRESETS: Dict[str, Dict[str, Any]] = {
 PRESET_NAMES = tuple(PRESETS)
 #: Old preset names still accepted (batch files); the run logs the new name.
 PRESET_ALIASES: Dict[str, str] = {"flat": "terrain"}
-#: The default keeps objects: a DSM is the surface with its buildings and trees (issue 19).
-DEFAULT_PRESET = "urban"
+#: The default keeps objects: a DSM is the surface with its buildings and trees (issue 19),
+#: without spoiling open terrain.
+DEFAULT_PRESET = "general"
 #: Default DSM spacing in GSD; the presets' ``smoothing`` refers to cells of this size, so a
 #: DSM asked for at another spacing gets the same surface, sampled differently.
 SPACING_GSD = 2.0

@@ -120,8 +120,9 @@ class MatchModel(Algorithm):
                        "fbm_lsm, 10 × spacing for dense."),
         Parameter("preset", "enum", "Strategy preset (fbm_lsm)", default=DEFAULT_PRESET,
                   options=PRESET_NAMES, aliases=tuple(PRESET_ALIASES),
-                  help="urban (default): small windows and groundels, keeps buildings and "
-                       "trees with sharp walls (a DSM); terrain (formerly flat): large windows "
+                  help="general (default): keeps buildings and trees with sharp walls (a "
+                       "DSM) and open terrain as accurate as terrain; urban: smaller windows "
+                       "and groundels for built-up areas; terrain (formerly flat): large windows "
                        "and groundels, smooth surface without objects (nearly a DTM); hilly: "
                        "medium; forest: lower envelope of the points per groundel. The options "
                        "below override it."),
@@ -138,7 +139,7 @@ class MatchModel(Algorithm):
         Parameter("groundel", "number", "Groundel size [m] (fbm_lsm)", optional=True,
                   minimum=0.0, unit="m",
                   help="Side of the cells of the robust reduction. Default: the preset's "
-                       "multiple of the GSD (urban: 10 × GSD, terrain: 40 × GSD)."),
+                       "multiple of the GSD (general: 20, urban: 10, terrain: 40 × GSD)."),
         Parameter("reduction", "enum", "Groundel reduction (fbm_lsm)", optional=True,
                   options=("l1", "median", "lower"),
                   help="l1: robust tilted plane; median; lower: lower envelope (vegetation). "
