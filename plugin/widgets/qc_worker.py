@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import traceback
 from typing import Any, Callable, Dict, Optional
 
-from ...algorithms.errors import Cancelled, PhotodemError
-from ..qt import QtCore, pyqtSlot
+from ..qt import QtCore
 from .worker import AlgorithmWorker
 
 
@@ -22,17 +20,6 @@ class FunctionWorker(AlgorithmWorker):
         self.function = function
         self.kwargs = dict(kwargs)
 
-    @pyqtSlot()
-    def run(self) -> None:
-        try:
-            result = self.function(**self.kwargs, feedback=self.feedback)
-        except Cancelled as exc:
-            self.cancelled.emit(str(exc))
-        except PhotodemError as exc:
-            self.failed.emit(str(exc), True)
-        except Exception:  # a bug: show the traceback, keep the GUI alive
-            self.failed.emit(traceback.format_exc(), False)
-        else:
-            self.finished.emit(result)
-        finally:
-            self.done.emit()
+    def call(self) -> Any:
+        """The core function with the worker's feedback."""
+        return self.function(**self.kwargs, feedback=self.feedback)

@@ -62,10 +62,14 @@ class AlgorithmWorker(QObject):
         """Ask the running algorithm to stop (thread-safe)."""
         self.feedback.cancel()
 
+    def call(self) -> Any:
+        """The work itself (in the worker's thread): the registry run of the algorithm."""
+        return registry.run(self.algorithm_id, self.params, self.feedback)
+
     @pyqtSlot()
     def run(self) -> None:
         try:
-            result = registry.run(self.algorithm_id, self.params, self.feedback)
+            result = self.call()
         except Cancelled as exc:
             self.cancelled.emit(str(exc))
         except PhotodemError as exc:
