@@ -42,6 +42,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
 from scipy.ndimage import maximum_filter
 
 from ..raster.sample import bilinear_grid
@@ -105,8 +106,6 @@ def fill_from_below(dsm: ArrayLike, max_size: int, quantile: float = 10.0) -> Ar
     ndarray
         A filled copy (float64).
     """
-    from scipy import ndimage  # lazy: only true orthos on DSMs with holes need it
-
     z = np.array(dsm, dtype=float)
     hole = ~np.isfinite(z)
     if not hole.any() or hole.all() or max_size < 1:
