@@ -56,6 +56,7 @@ from shapely.ops import transform as shapely_transform
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile, open_image
+from .class_legend import read_class_legend
 from .coregister import nuth_kaab
 from .objects import (
     OBJECT_CLASSES,
@@ -289,6 +290,15 @@ def _coregister(stack: contextlib.ExitStack, dem: Any, ref: Any, grid: Affine, w
         feedback.warning("The co-registration did not converge; the shift may be unreliable.")
     return {"dx": r.dx, "dy": r.dy, "dz": r.dz, "iterations": r.iterations,
             "converged": r.converged, "residual_nmad": r.residual_nmad}
+
+
+def class_names_of(classes: Optional[PathLike], legend: Optional[PathLike] = None
+                   ) -> Dict[str, str]:
+    """Names of the codes of a class *raster* (:func:`.class_legend.read_class_legend`);
+    empty for class polygons, whose classes are names already, and without classes."""
+    if classes is None or _vector_kind(classes):
+        return {}
+    return read_class_legend(classes, legend)
 
 
 class _ClassSource:

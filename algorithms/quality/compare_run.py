@@ -12,8 +12,7 @@ from typing import Any, Dict, Optional, Union
 
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import staged_folder
-from .class_legend import read_class_legend
-from .compare import _vector_kind, compare_dems
+from .compare import class_names_of, compare_dems
 from .names import report_path
 from .objects import OBJECT_HEIGHT
 from .points import point_compare
@@ -90,8 +89,7 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
     feedback = ensure_feedback(feedback)
     out = Path(output)
     names = DEM_COMPARE_FILES
-    legend = (read_class_legend(classes, class_legend)
-              if classes is not None and not _vector_kind(classes) else {})
+    legend = class_names_of(classes, class_legend)
     with staged_folder(out, replace=True, product="dem_compare") as tmp:
         result = compare_dems(
             dem, reference, coregister=coregister, stable=stable, classes=classes,

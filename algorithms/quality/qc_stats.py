@@ -18,8 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..feedback import Feedback
-from .class_legend import read_class_legend
-from .compare import _vector_kind, compare_dems
+from .compare import class_names_of, compare_dems
 
 PathLike = Union[str, Path]
 
@@ -103,10 +102,7 @@ def area_statistics(dem: PathLike, reference: PathLike, area: Any = None, *,
     hist = SignedHistogram()
     res = compare_dems(dem, reference, classes=classes, class_field=class_field, area=area,
                        window_size=window_size, on_window=hist.hook, feedback=feedback)
-    names: Dict[str, str] = {}
-    if classes is not None and not _vector_kind(classes):
-        names = read_class_legend(classes, class_legend)
-    res["class_names"] = names
+    res["class_names"] = class_names_of(classes, class_legend)
     res["histogram"] = hist.to_dict()
     return res
 
