@@ -524,7 +524,7 @@ def dem_rgba(z: NDArray[Any], dx: Any, dy: float, lo: float, hi: float,
     ``lo…hi`` and blended at its opacity over the grey hillshade.
     """
     ramp = ramp or elevation_ramp()
-    inner = z[1:-1, 1:-1]
+    inner = np.asarray(z[1:-1, 1:-1], dtype=np.float64)
     grey = hillshade_tile(z, dx, dy) * 255.0
     colour = apply_ramp(ramp, (inner - lo) / (hi - lo)).astype(np.float32)
     a = ramp.opacity
@@ -612,20 +612,24 @@ def overview_sidecar(path: PathLike) -> Path:
 def build_external_overviews(path: PathLike, feedback: Optional[Feedback] = None) -> Path:
     """Build overviews of ``path`` into its ``.ovr`` sidecar; the raster is not touched.
 
-    GDAL builds external overviews for a dataset opened read-only. They are built under a
-    hidden temporary name (through a symbolic link to the raster) and renamed when complete,
+    GDAL writes them to the sidecar, not into the file (``TIFF_USE_OVR``). They are built
+    under a hidden temporary name (through a symbolic link to the raster) and renamed when complete,
     so a failed build leaves no half-written ``.ovr``.
 
     Raises
     ------
     InputError
-        The folder is read-only, or an ``.ovr`` exists already.
+        The raster or its folder is read-only, or an ``.ovr`` exists already.
     """
     feedback = ensure_feedback(feedback)
     path = Path(path).resolve()
     target = overview_sidecar(path)
     if target.exists():
         raise InputError(f"'{target.name}' exists already; remove it to rebuild the overviews.")
+    if not os.access(path, os.W_OK):
+        raise InputError(f"'{path.name}' is read-only: GDAL opens it for writing to build "
+                         "overviews (into the sidecar only). Build them with "
+                         f"'gdaladdo -ro {path.name}' instead.")
     if not os.access(path.parent, os.W_OK):
         raise InputError(f"The folder of '{path.name}' is read-only: overviews cannot be "
                          f"written beside it ({path.parent}).")
@@ -633,9 +637,11 @@ def build_external_overviews(path: PathLike, feedback: Optional[Feedback] = None
     feedback.progress(0.0)
     try:
         os.symlink(path, link)
-        env = rasterio.Env(GDAL_TIF_OVR_BLOCKSIZE=256, COMPRESS_OVERVIEW="DEFLATE",
-                           INTERLEAVE_OVERVIEW="PIXEL", BIGTIFF_OVERVIEW="IF_SAFER")
-        with env, rasterio.open(link) as src:
+        env = rasterio.Env(TIFF_USE_OVR=True, GDAL_TIF_OVR_BLOCKSIZE=256,
+                           COMPRESS_OVERVIEW="DEFLATE", INTERLEAVE_OVERVIEW="PIXEL",
+                           BIGTIFF_OVERVIEW="IF_SAFER")
+        # update mode only lets GDAL build overviews; TIFF_USE_OVR sends them to the sidecar
+        with env, rasterio.open(link, "r+") as src:
             src.build_overviews(overview_factors(src.width, src.height), Resampling.average)
         os.replace(overview_sidecar(link), target)
     finally:
