@@ -299,7 +299,8 @@ def _valid_mask(src: Any, info: RasterInfo, data: NDArray[Any], window: Window,
 
 def _bands(info: RasterInfo, kind: str) -> List[int]:
     """The bands a kind is drawn from (+ the alpha band last, when there is one)."""
-    bands = list(info.rgb_bands) if kind in RGB_KINDS and info.rgb_bands else [1]
+    colour = info.rgb_bands and kind not in DEM_KINDS + ("difference",)
+    bands = list(info.rgb_bands) if colour else [1]
     return bands + ([info.alpha_band] if info.alpha_band else [])
 
 
@@ -586,8 +587,8 @@ def colorize(style: Style, data: NDArray[Any], grid_transform: Affine,
 def make_style(src: Any, info: RasterInfo, kind: str) -> Style:
     """The :class:`Style` of a raster (statistics read once, see :func:`band_stats`)."""
     eight_bit = info.dtype in ("uint8", "int8")
-    needs_stats = kind in DEM_KINDS or (kind not in ("difference",) and not (
-        eight_bit and kind in RGB_KINDS and info.rgb_bands))
+    colour_8bit = eight_bit and info.rgb_bands and kind not in DEM_KINDS
+    needs_stats = kind != "difference" and not colour_8bit
     stats = tuple(band_stats(src, info, kind)) if needs_stats else ((0.0, 255.0),)
     return Style(kind, stats, eight_bit)
 
