@@ -446,12 +446,25 @@ class Ramp:
         RGBA of each item.
     opacity : float
         The renderer's opacity (0…1).
+    lut : ndarray (LUT_SIZE, 4) uint8 or None
+        An interpolated ramp sampled evenly from the first to the last value (fast lookup).
     """
 
     discrete: bool
     values: Tuple[float, ...]
     colors: NDArray[np.uint8]
     opacity: float = 1.0
+    lut: Optional[NDArray[np.uint8]] = field(default=None, compare=False)
+
+
+#: Entries of the lookup table of an interpolated ramp (colour error < 1 level of 255).
+LUT_SIZE = 1024
+
+
+def _lut(values: Sequence[float], colors: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    x = np.linspace(values[0], values[-1], LUT_SIZE)
+    return np.stack([np.round(np.interp(x, values, colors[:, ch])) for ch in range(4)],
+                    axis=1).astype(np.uint8)
 
 
 @lru_cache(maxsize=8)
@@ -468,8 +481,10 @@ def qml_ramp(path: PathLike) -> Ramp:
         hexa = item.get("color", "#000000").lstrip("#")
         colors.append([int(hexa[i:i + 2], 16) for i in (0, 2, 4)] + [int(item.get("alpha",
                                                                                    "255"))])
-    return Ramp(shader.get("colorRampType", "INTERPOLATED") == "DISCRETE", tuple(values),
-                np.array(colors, dtype=np.uint8), float(renderer.get("opacity", "1")))
+    discrete = shader.get("colorRampType", "INTERPOLATED") == "DISCRETE"
+    rgba = np.array(colors, dtype=np.uint8)
+    lut = None if discrete or not np.all(np.isfinite(values)) else _lut(values, rgba)
+    return Ramp(discrete, tuple(values), rgba, float(renderer.get("opacity", "1")), lut)
 
 
 def elevation_ramp() -> Ramp:
@@ -490,6 +505,13 @@ def apply_ramp(ramp: Ramp, values: NDArray[Any]) -> NDArray[np.uint8]:
     if ramp.discrete:
         idx = np.searchsorted(np.asarray(ramp.values), v[ok], side="left")
         out[ok] = ramp.colors[np.minimum(idx, len(ramp.values) - 1)]
+        return out
+    if ramp.lut is not None:
+        v0, v1 = ramp.values[0], ramp.values[-1]
+        scaled = np.nan_to_num((v - v0) * ((LUT_SIZE - 1) / (v1 - v0)), nan=0.0)
+        idx = np.clip(np.rint(scaled), 0, LUT_SIZE - 1).astype(np.intp)
+        out = ramp.lut[idx]
+        out[~ok] = 0
         return out
     for ch in range(4):
         out[..., ch][ok] = np.round(np.interp(v[ok], ramp.values, ramp.colors[:, ch]))
@@ -512,9 +534,10 @@ def hillshade_tile(z: NDArray[Any], dx: Any, dy: float) -> NDArray[np.float64]:
 
     Cells whose neighbours are partly nodata are shaded as flat ground.
     """
-    p, q = horn_gradient(z, dx, dy)
+    p, q = horn_gradient(z, dx, dy, dtype=np.float32)
     s = shade(p, q)
-    return np.where(np.isnan(s), math.sin(math.radians(45.0)), s)
+    s[np.isnan(s)] = math.sin(math.radians(45.0))
+    return s
 
 
 def dem_rgba(z: NDArray[Any], dx: Any, dy: float, lo: float, hi: float,
@@ -525,13 +548,12 @@ def dem_rgba(z: NDArray[Any], dx: Any, dy: float, lo: float, hi: float,
     ``lo…hi`` and blended at its opacity over the grey hillshade.
     """
     ramp = ramp or elevation_ramp()
-    inner = np.asarray(z[1:-1, 1:-1], dtype=np.float64)
-    grey = hillshade_tile(z, dx, dy) * 255.0
-    colour = apply_ramp(ramp, (inner - lo) / (hi - lo)).astype(np.float32)
-    a = ramp.opacity
+    inner = np.asarray(z[1:-1, 1:-1], dtype=np.float32)
+    grey = hillshade_tile(z, dx, dy) * np.float32(255.0 * (1.0 - ramp.opacity))
+    colour = apply_ramp(ramp, (inner - np.float32(lo)) / np.float32(hi - lo))
+    blended = colour[..., :3] * np.float32(ramp.opacity) + grey[..., None]
     out = np.empty(inner.shape + (4,), dtype=np.uint8)
-    for ch in range(3):
-        out[..., ch] = np.clip(a * colour[..., ch] + (1.0 - a) * grey, 0, 255)
+    out[..., :3] = np.clip(blended, 0, 255)
     out[..., 3] = np.where(np.isfinite(inner), 255, 0)
     return out
 
