@@ -375,10 +375,12 @@ def _warped_tile(src: Any, info: RasterInfo, grid: TileGrid, kind: str,
     data = read_window(src, info, kind, Window(c0, r0, c1 - c0, r1 - r0), shape)
     src_transform = info.transform * Affine.translation(c0, r0) * Affine.scale(
         (c1 - c0) / shape[1], (r1 - r0) / shape[0])
+    # bilinear for heights: nearest would terrace slopes, and the hillshade shows terraces
+    resampling = Resampling.bilinear if kind in DEM_KINDS else Resampling.nearest
     for b in range(nb):
         reproject(data[b], out[b], src_transform=src_transform, src_crs=_crs(info.crs),
                   dst_transform=dst_transform, dst_crs=_crs(map_crs), src_nodata=np.nan,
-                  dst_nodata=np.nan, resampling=Resampling.nearest)
+                  dst_nodata=np.nan, resampling=resampling)
     return out
 
 
