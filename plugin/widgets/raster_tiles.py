@@ -13,6 +13,7 @@ Reading and colouring are Qt-free (:mod:`photodem.algorithms.raster.display`).
 
 from __future__ import annotations
 
+import logging
 import os
 import threading
 import time
@@ -28,6 +29,9 @@ from ..i18n import tr
 from ..qt import QtCore, QtGui, pyqtSignal
 from .map_layer import Bounds, MapLayer, ViewState
 
+LOG = logging.getLogger(__name__)
+#: A job's result when rendering its tile raised (the tile stays missing, not retried).
+FAILED = object()
 #: Bytes of tiles kept by all raster layers together (LRU).
 CACHE_BYTES = 128 * 1024 * 1024
 Key = Tuple[int, int, int]
@@ -140,7 +144,7 @@ class _Source:
 class _Signals(QtCore.QObject):
     """Carries finished tiles to the GUI thread (queued: it lives there)."""
 
-    done = pyqtSignal(object, object, object)  # source, key, QImage or None
+    done = pyqtSignal(object, object, object)  # source, key, QImage, None (stale) or FAILED
 
 
 class _TileJob(QtCore.QRunnable):
@@ -151,9 +155,10 @@ class _TileJob(QtCore.QRunnable):
 
     def run(self) -> None:
         try:
-            image = self.source.render(self.key)
+            image: Any = self.source.render(self.key)
         except Exception:  # a broken tile must not end the thread; it stays missing
-            image = None
+            LOG.exception("rendering tile %s of %s", self.key, self.source.path)
+            image = FAILED
         self.signals.done.emit(self.source, self.key, image)
 
 
@@ -193,6 +198,7 @@ class RasterLayer(MapLayer):
         self._signals = _Signals()
         self._signals.done.connect(self._tile_done)
         self._pending: Set[Key] = set()
+        self._failed: Set[Key] = set()
         self._value_handle: Any = None
         self._source = self._make_source(style, map_crs if info.has_crs else "")
 
@@ -304,6 +310,7 @@ class RasterLayer(MapLayer):
         self._source.close()
         CACHE.drop(self._owner)
         self._pending.clear()
+        self._failed.clear()
         self._source = self._make_source(style, map_crs)
         self.changed.emit()
 
@@ -312,16 +319,23 @@ class RasterLayer(MapLayer):
             self._restart(self._source.style, view_crs)
 
     def _request(self, key: Key) -> None:
-        if key in self._pending:
+        if key in self._pending or key in self._failed:
             return
         self._pending.add(key)
         thread_pool().start(_TileJob(self._source, key, self._signals))
 
-    def _tile_done(self, source: _Source, key: Key, image: Optional[QtGui.QImage]) -> None:
+    def _tile_done(self, source: _Source, key: Key, image: Any) -> None:
+        """A job ended: keep its tile; a tile dropped as stale but wanted again is asked
+        for anew; a failed one is not retried (until the layer restarts)."""
         if source is not self._source:
             return  # a job of a grid replaced since
         self._pending.discard(key)
-        if image is not None:
+        if image is FAILED:
+            self._failed.add(key)
+        elif image is None:
+            if key in source.wanted and not source.closed:
+                self._request(key)
+        else:
             CACHE.put((self._owner, key), image)
             if key in source.wanted:
                 self.changed.emit()

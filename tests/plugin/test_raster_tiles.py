@@ -214,3 +214,32 @@ def test_a_raster_in_another_crs_is_placed_on_the_map(qapp, tmp_path) -> None:
 def test_the_pool_is_shared(qapp) -> None:
     assert raster_tiles.thread_pool() is raster_tiles.thread_pool()
     assert raster_tiles.thread_pool().maxThreadCount() >= 2
+
+
+def test_a_dropped_tile_wanted_again_is_asked_for_anew(qapp, dem) -> None:
+    layer = RasterLayer(dem, map_crs=CRS)
+    try:
+        source, key = layer._source, (0, 0, 0)
+        source.wanted = frozenset({key})
+        layer._tile_done(source, key, None)  # dropped as stale while the view came back
+        assert key in layer._pending
+        assert layer.wait(10000) and layer.missing() == 0
+    finally:
+        layer.close()
+
+
+def test_a_failing_tile_is_not_retried(qapp, dem, monkeypatch) -> None:
+    layer = RasterLayer(dem, map_crs=CRS)
+    try:
+        def broken(*args, **kwargs):
+            raise OSError("disk gone")
+
+        monkeypatch.setattr(raster_tiles.display, "render_tile", broken)
+        view = _fit(layer)
+        _paint(layer, view)
+        assert layer.wait(10000)  # nothing pending: the failures are final
+        assert layer.missing() > 0 and layer._failed
+        _paint(layer, view)
+        assert not layer._pending
+    finally:
+        layer.close()
