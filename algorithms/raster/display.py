@@ -531,7 +531,7 @@ def _cell_size(grid_transform: Affine, map_crs: str, rows: int) -> Tuple[Any, fl
     return dx, dy
 
 
-def hillshade_tile(z: NDArray[Any], dx: Any, dy: float) -> NDArray[np.float64]:
+def hillshade_tile(z: NDArray[Any], dx: Any, dy: float) -> NDArray[np.float32]:
     """Illumination 0…1 (315°/45°) of the inner cells of ``z`` (a 1-cell margin around).
 
     Cells whose neighbours are partly nodata are shaded as flat ground.
