@@ -165,8 +165,8 @@ class EditSession(QtCore.QObject):
         try:
             content = read_edits(self.path)
         except InputError as exc:
-            self._refuse(tr("The edits file {0} cannot be read: {1} It is shown read-only and "
-                            "never written.").format(self.path, exc))
+            self._refuse(tr("The edits cannot be read; they are shown read-only and never "
+                            "written. {0}").format(exc))
             return
         self._crs = self._crs or content.crs_wkt
         for name, features in content.layers.items():

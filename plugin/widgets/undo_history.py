@@ -92,15 +92,18 @@ class UndoHistory(QtWidgets.QWidget):
 
     def _show_status(self, *_: Any) -> None:
         """Read-only, unsaved or saved: one line under the buttons."""
-        if self.session is None:
-            text = tr("No project open.")
-        elif self.session.read_only:
-            text = self.session.problem
-        elif self.session.dirty:
-            text = tr("Unsaved edits.")
-        else:
-            text = tr("All edits saved.")
-        self.status.setText(text)
+        try:
+            if self.session is None:
+                text = tr("No project open.")
+            elif self.session.read_only:
+                text = self.session.problem
+            elif self.session.dirty:
+                text = tr("Unsaved edits.")
+            else:
+                text = tr("All edits saved.")
+            self.status.setText(text)
+        except RuntimeError:  # the session's stack or this widget is being destroyed
+            pass
 
 
 __all__ = ["UndoHistory", "edit_actions"]
