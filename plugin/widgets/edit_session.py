@@ -318,6 +318,11 @@ class EditSession(QtCore.QObject):
                                 "since it was opened here; saving would lose those changes. "
                                 "Nothing was written. Open the project again to see them.")
                              .format(self.path))
+        access = edits_access(self.path) if self.path.exists() else None
+        if access is not None:  # a writer now would lose its changes to our rename
+            raise InputError(tr("The edits file {0} cannot be saved now ({1}); nothing was "
+                                "written. Close the program that holds it and save again.")
+                             .format(self.path, access[1]))
         layers = {name: [(fid, g, a) for fid, (g, a) in sorted(items.items())]
                   for name, items in self._layers.items()}
         path = save_edits(self.path, layers, self.crs)

@@ -257,3 +257,36 @@ def test_a_file_changed_by_another_program_is_not_overwritten(project: Path, qtb
     assert len(EditSession(project).features("start_points")) == 2
     s.add("start_points", Point(X0, Y0 + 4), {"height": 50.0})
     s.save()  # its own save is no change by another program
+
+
+def test_locked_file_is_read_only(project: Path, qtbot) -> None:
+    path = project / "edits.gpkg"
+    holder = sqlite3.connect(str(path))  # another program in the middle of writing
+    holder.execute("BEGIN IMMEDIATE")
+    try:
+        s = EditSession(project)
+        assert s.read_only and "locked" in s.problem and str(path) in s.problem
+        assert len(s.features("exclusion_areas")) == 2
+        with pytest.raises(InputError, match="locked"):
+            s.add("start_points", Point(X0, Y0), {"height": 1.0})
+    finally:
+        holder.rollback()
+        holder.close()
+
+
+def test_save_while_another_program_writes_is_refused(project: Path, qtbot) -> None:
+    path = project / "edits.gpkg"
+    s = EditSession(project)
+    s.add("start_points", Point(X0, Y0 + 5), {"height": 50.0})
+    old = path.read_bytes()
+    holder = sqlite3.connect(str(path))
+    holder.execute("BEGIN IMMEDIATE")
+    try:
+        with pytest.raises(InputError, match="cannot be saved now"):
+            s.save()
+    finally:
+        holder.rollback()
+        holder.close()
+    assert path.read_bytes() == old and s.dirty
+    s.save()
+    assert not s.dirty
