@@ -216,6 +216,7 @@ class VertexTool(_EditTool):
         self._drag: Optional[Tuple[int, Key, Coord]] = None
         self._drag_to: Optional[Tuple[float, float]] = None
         self._hover: Optional[Tuple[int, Key, Coord]] = None
+        self._press_pos = QtCore.QPoint()
 
     def deactivate(self) -> None:
         self._drag = self._drag_to = self._hover = None
@@ -237,6 +238,7 @@ class VertexTool(_EditTool):
             return True
         if event.button() == QtCore.Qt.LeftButton:
             self._drag, self._drag_to = hit, (x, y)
+            self._press_pos = QtCore.QPoint(event.pos())
             self.changed.emit()
             return True
         return False
@@ -257,7 +259,8 @@ class VertexTool(_EditTool):
             return False
         fid, key, _ = self._drag
         self._drag = self._drag_to = None
-        self.move_vertex(fid, key, x, y)
+        if event.pos() != self._press_pos:  # a click without a drag moves nothing
+            self.move_vertex(fid, key, x, y)
         self.changed.emit()
         return True
 

@@ -166,6 +166,9 @@ def test_drag_moves_exactly_the_clicked_vertex_to_the_release_point(qtbot, view,
     assert session.undo_stack.undoText() == "Move vertex"
     session.undo_stack.undo()
     assert session.feature("breaklines", 1)[0].equals(before)
+    qtbot.mouseClick(view, Qt.LeftButton, pos=start)  # a click without a drag: nothing
+    assert session.undo_stack.count() == count + 1 and session.undo_stack.canRedo()
+    assert session.feature("breaklines", 1)[0].equals(before)
 
 
 def test_move_without_surface_keeps_z_and_polygon_closed(qtbot, view, session) -> None:
