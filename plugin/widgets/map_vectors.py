@@ -42,9 +42,10 @@ def feature_label(fid: Any, attributes: Dict[str, Any]) -> str:
     return f"#{fid}"
 
 
-def read_file_features(path: Path, layer: Optional[str], map_crs: str) -> Tuple[List[Feature],
-                                                                               bool]:
-    """The features of ``layer`` of ``path`` in ``map_crs`` and whether the file has a CRS."""
+def read_file_features(path: Path, layer: Optional[str],
+                       map_crs: str) -> Tuple[List[Feature], Optional[str]]:
+    """The features of ``layer`` of ``path`` in ``map_crs`` (or in the file's CRS when
+    ``map_crs`` is empty) and the file's CRS as WKT (None: the file names none)."""
     # lazy: rasterio's CRS and the core reader load with the first file layer
     from rasterio.crs import CRS
 
@@ -55,12 +56,13 @@ def read_file_features(path: Path, layer: Optional[str], map_crs: str) -> Tuple[
     found = read_features(path, [layer] if layer else None, what="vector file")
     target = CRS.from_user_input(map_crs) if map_crs else None
     features: List[Feature] = []
-    has_crs = False
+    source_crs: Optional[str] = None
     for feat in found:
-        has_crs = has_crs or feat.crs is not None
+        if feat.crs is not None and source_crs is None:
+            source_crs = feat.crs.to_wkt()
         geom = to_crs(feat.geometry, feat.crs, target)
         features.append((feat.fid, shape(geom), feat.properties))
-    return features, has_crs or not found
+    return features, source_crs
 
 
 class VectorLayer(MapLayer):
@@ -92,6 +94,7 @@ class VectorLayer(MapLayer):
         self.map_crs = map_crs
         self.style = style if style is not None else style_for_kind(kind)
         self.has_crs = True
+        self.crs = ""  # the file's CRS when the map had none (the view adopts it)
         self._features: List[Feature] = []
         self._bounds: List[Tuple[float, float, float, float]] = []
         self._mupp = 1.0  # map units per pixel of the last drawing (for value_at)
@@ -103,8 +106,10 @@ class VectorLayer(MapLayer):
             features = [(fid, geom if isinstance(geom, BaseGeometry) else shape(geom),
                          dict(attrs or {})) for fid, geom, attrs in self.source()]
         else:
-            features, self.has_crs = read_file_features(Path(self.source), self.layer_name,
-                                                        self.map_crs)
+            features, crs = read_file_features(Path(self.source), self.layer_name,
+                                               self.map_crs)
+            self.has_crs = crs is not None or not features
+            self.crs = "" if self.map_crs else (crs or "")
         self._features = [f for f in features if f[1] is not None and not f[1].is_empty]
         self._bounds = [f[1].bounds for f in self._features]
 

@@ -32,6 +32,10 @@ SCREEN_DPI = 96.0
 SCALE_BAR_PX = 110
 
 
+class MixedCoordinatesError(InputError):
+    """A layer in pixel coordinates and one in map coordinates cannot share the view."""
+
+
 def nice_length(length: float) -> float:
     """The largest of 1, 2, 5 × 10ⁿ not above ``length`` (> 0) — a scale bar's length."""
     if length <= 0 or not math.isfinite(length):
@@ -63,6 +67,13 @@ def union_bounds(bounds: List[Bounds]) -> Optional[Bounds]:
 def _layer_has_crs(layer: MapLayer) -> bool:
     """Whether the layer is georeferenced (rasters and files say so; callables are)."""
     return bool(getattr(layer, "has_crs", True))
+
+
+def _layer_crs(layer: MapLayer) -> str:
+    """The CRS a georeferenced layer is drawn in when the view has none yet (a vector file's
+    ``crs``, a raster's ``info.crs``), or ``""``."""
+    crs = getattr(layer, "crs", "") or getattr(getattr(layer, "info", None), "crs", "")
+    return str(crs or "")
 
 
 class MapView(QtWidgets.QWidget):
@@ -133,17 +144,20 @@ class MapView(QtWidgets.QWidget):
         return None
 
     def check_layer(self, layer: MapLayer) -> None:
-        """Raise :class:`InputError` when ``layer`` cannot join the view: a raster without CRS
-        in a georeferenced view, or a georeferenced layer in a pixel-coordinate view."""
+        """Raise :class:`MixedCoordinatesError` when ``layer`` cannot join the view: a raster
+        without CRS in a georeferenced view, or a georeferenced layer in a pixel-coordinate
+        view."""
         if not self._layers:
             return
         georef = _layer_has_crs(layer)
         if self.is_georeferenced() and not georef:
-            raise InputError(tr("'{0}' has no coordinate reference system: it can only be "
-                                "shown alone, in pixel coordinates.").format(layer.name))
+            raise MixedCoordinatesError(
+                tr("'{0}' has no coordinate reference system: it can only be shown alone, in "
+                   "pixel coordinates.").format(layer.name))
         if not self.is_georeferenced() and georef:
-            raise InputError(tr("The map shows a raster in pixel coordinates; '{0}' is "
-                                "georeferenced and cannot be shown with it.").format(layer.name))
+            raise MixedCoordinatesError(
+                tr("The map shows a raster in pixel coordinates; '{0}' is georeferenced and "
+                   "cannot be shown with it.").format(layer.name))
 
     def add_layer(self, layer: MapLayer, index: int = 0) -> MapLayer:
         """Add ``layer`` at ``index`` (0 = on top); raises :class:`InputError` when it would
@@ -152,8 +166,8 @@ class MapView(QtWidgets.QWidget):
         if not self._layers:  # the first layer decides pixel or map coordinates
             if not _layer_has_crs(layer):
                 self.set_crs("")
-            elif not self._crs and getattr(layer, "crs", ""):
-                self.set_crs(str(layer.crs))
+            elif not self._crs and _layer_crs(layer):
+                self.set_crs(_layer_crs(layer))
         index = min(max(int(index), 0), len(self._layers))
         self._layers.insert(index, layer)
         layer.changed.connect(self._on_layer_changed)
@@ -528,4 +542,4 @@ def _padded(bounds: Bounds, margin: float = 0.03) -> Bounds:
     return (xmin - dx, ymin - dy, xmax + dx, ymax + dy)
 
 
-__all__ = ["MapView", "length_text", "nice_length", "union_bounds"]
+__all__ = ["MapView", "MixedCoordinatesError", "length_text", "nice_length", "union_bounds"]
