@@ -343,7 +343,7 @@ class MapWindowMixin:
 
     def _add_products(self, root: Path, problems: List[str]) -> None:
         """The products (found by their place in the folder, so a moved project still opens)
-        and the classified truth rasters of a synthetic project; DEMs end on top."""
+        and the classified truth rasters of a synthetic project (below the products)."""
         # lazy: product discovery walks the project folder only when one is opened
         from ...algorithms.project.products import classify, find_products
 
@@ -352,7 +352,9 @@ class MapWindowMixin:
         if truth.is_dir():
             products += [p for p in (classify(f) for f in sorted(truth.glob("*.tif")))
                          if p is not None and p.kind != "seamlines"]
-        for product in reversed(products):  # find_products lists the top one first
+        # vectors (seamlines) above the rasters; otherwise find_products' order, top first
+        products.sort(key=lambda p: p.kind != "seamlines")
+        for product in reversed(products):
             if product.kind == "seamlines":
                 layer = self.add_vector_file(product.path, "seamlines",
                                              name=product_label(product), layer="seamlines")
@@ -415,7 +417,8 @@ def product_label(product: Any) -> str:
     """The layer name of a product: ``DSM 0101_0102``, ``Ortho 0203`` (as in QGIS)."""
     names = {"dsm": tr("DSM"), "dtm": tr("DTM"), "difference": tr("Difference"),
              "ortho": tr("Ortho"), "mosaic": tr("Mosaic"), "seamlines": tr("Seamlines")}
-    return f"{names.get(product.kind, product.kind)} {product.name}"
+    kind = names.get(product.kind, product.kind)
+    return kind if product.name.lower() == product.kind else f"{kind} {product.name}"
 
 
 def _crs_name(crs: str) -> str:
