@@ -96,8 +96,36 @@ def geometry_to_blob(geometry: Any, srs_id: int) -> Optional[bytes]:
     if not point:
         xmin, ymin, xmax, ymax = geometry.bounds
         head += struct.pack("<4d", xmin, xmax, ymin, ymax)
-    dims = 3 if geometry.has_z else 2
-    return head + wkb.dumps(geometry, output_dimension=dims, byte_order=1, flavor="iso")
+    return head + iso_wkb(geometry)
+
+
+#: ISO WKB type codes (+1000 with Z).
+_WKB_TYPES = {"Point": 1, "LineString": 2, "Polygon": 3, "MultiPoint": 4, "MultiLineString": 5,
+              "MultiPolygon": 6, "GeometryCollection": 7}
+
+
+def iso_wkb(geometry: Any) -> bytes:
+    """Little-endian ISO WKB of a shapely geometry (Z as type + 1000), as the GeoPackage
+    standard asks; written here because shapely < 2 (Debian's, tier B) writes only the older
+    extended flavour."""
+    z = geometry.has_z
+    head = struct.pack("<BI", 1, _WKB_TYPES[geometry.geom_type] + (1000 if z else 0))
+
+    def points(coords: Any) -> bytes:
+        flat = [float(v) for c in coords for v in (tuple(c) + (0.0,))[:3 if z else 2]]
+        return struct.pack(f"<{len(flat)}d", *flat)
+
+    kind = geometry.geom_type
+    if kind == "Point":
+        return head + points(geometry.coords)
+    if kind == "LineString":
+        return head + struct.pack("<I", len(geometry.coords)) + points(geometry.coords)
+    if kind == "Polygon":
+        rings = [geometry.exterior] + list(geometry.interiors)
+        return head + struct.pack("<I", len(rings)) + b"".join(
+            struct.pack("<I", len(r.coords)) + points(r.coords) for r in rings)
+    parts = list(geometry.geoms)
+    return head + struct.pack("<I", len(parts)) + b"".join(iso_wkb(p) for p in parts)
 
 
 def _bounds_of_blob(blob: Optional[bytes]) -> Optional[Tuple[float, float, float, float]]:
@@ -354,5 +382,5 @@ def save_edits(path: PathLike, layers: Dict[str, Iterable[Sequence[Any]]],
     return path
 
 
-__all__ = ["EditsContent", "blob_to_geometry", "geometry_to_blob", "read_edits",
+__all__ = ["EditsContent", "blob_to_geometry", "geometry_to_blob", "iso_wkb", "read_edits",
            "register_gpkg_functions", "save_edits"]

@@ -299,7 +299,8 @@ def _valid_mask(src: Any, info: RasterInfo, data: NDArray[Any], window: Window,
 
 def _bands(info: RasterInfo, kind: str) -> List[int]:
     """The bands a kind is drawn from (+ the alpha band last, when there is one)."""
-    bands = list(info.rgb_bands) if kind in RGB_KINDS and info.rgb_bands else [1]
+    colour = info.rgb_bands and kind not in DEM_KINDS + ("difference",)
+    bands = list(info.rgb_bands) if colour else [1]
     return bands + ([info.alpha_band] if info.alpha_band else [])
 
 
@@ -374,10 +375,12 @@ def _warped_tile(src: Any, info: RasterInfo, grid: TileGrid, kind: str,
     data = read_window(src, info, kind, Window(c0, r0, c1 - c0, r1 - r0), shape)
     src_transform = info.transform * Affine.translation(c0, r0) * Affine.scale(
         (c1 - c0) / shape[1], (r1 - r0) / shape[0])
+    # bilinear for heights: nearest would terrace slopes, and the hillshade shows terraces
+    resampling = Resampling.bilinear if kind in DEM_KINDS else Resampling.nearest
     for b in range(nb):
         reproject(data[b], out[b], src_transform=src_transform, src_crs=_crs(info.crs),
                   dst_transform=dst_transform, dst_crs=_crs(map_crs), src_nodata=np.nan,
-                  dst_nodata=np.nan, resampling=Resampling.nearest)
+                  dst_nodata=np.nan, resampling=resampling)
     return out
 
 
@@ -445,12 +448,25 @@ class Ramp:
         RGBA of each item.
     opacity : float
         The renderer's opacity (0…1).
+    lut : ndarray (LUT_SIZE, 4) uint8 or None
+        An interpolated ramp sampled evenly from the first to the last value (fast lookup).
     """
 
     discrete: bool
     values: Tuple[float, ...]
     colors: NDArray[np.uint8]
     opacity: float = 1.0
+    lut: Optional[NDArray[np.uint8]] = field(default=None, compare=False)
+
+
+#: Entries of the lookup table of an interpolated ramp (colour error < 1 level of 255).
+LUT_SIZE = 1024
+
+
+def _lut(values: Sequence[float], colors: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    x = np.linspace(values[0], values[-1], LUT_SIZE)
+    return np.stack([np.round(np.interp(x, values, colors[:, ch])) for ch in range(4)],
+                    axis=1).astype(np.uint8)
 
 
 @lru_cache(maxsize=8)
@@ -467,8 +483,10 @@ def qml_ramp(path: PathLike) -> Ramp:
         hexa = item.get("color", "#000000").lstrip("#")
         colors.append([int(hexa[i:i + 2], 16) for i in (0, 2, 4)] + [int(item.get("alpha",
                                                                                    "255"))])
-    return Ramp(shader.get("colorRampType", "INTERPOLATED") == "DISCRETE", tuple(values),
-                np.array(colors, dtype=np.uint8), float(renderer.get("opacity", "1")))
+    discrete = shader.get("colorRampType", "INTERPOLATED") == "DISCRETE"
+    rgba = np.array(colors, dtype=np.uint8)
+    lut = None if discrete or not np.all(np.isfinite(values)) else _lut(values, rgba)
+    return Ramp(discrete, tuple(values), rgba, float(renderer.get("opacity", "1")), lut)
 
 
 def elevation_ramp() -> Ramp:
@@ -489,6 +507,13 @@ def apply_ramp(ramp: Ramp, values: NDArray[Any]) -> NDArray[np.uint8]:
     if ramp.discrete:
         idx = np.searchsorted(np.asarray(ramp.values), v[ok], side="left")
         out[ok] = ramp.colors[np.minimum(idx, len(ramp.values) - 1)]
+        return out
+    if ramp.lut is not None:
+        v0, v1 = ramp.values[0], ramp.values[-1]
+        scaled = np.nan_to_num((v - v0) * ((LUT_SIZE - 1) / (v1 - v0)), nan=0.0)
+        idx = np.clip(np.rint(scaled), 0, LUT_SIZE - 1).astype(np.intp)
+        out = ramp.lut[idx]
+        out[~ok] = 0
         return out
     for ch in range(4):
         out[..., ch][ok] = np.round(np.interp(v[ok], ramp.values, ramp.colors[:, ch]))
@@ -511,9 +536,10 @@ def hillshade_tile(z: NDArray[Any], dx: Any, dy: float) -> NDArray[np.float64]:
 
     Cells whose neighbours are partly nodata are shaded as flat ground.
     """
-    p, q = horn_gradient(z, dx, dy)
+    p, q = horn_gradient(z, dx, dy, dtype=np.float32)
     s = shade(p, q)
-    return np.where(np.isnan(s), math.sin(math.radians(45.0)), s)
+    s[np.isnan(s)] = math.sin(math.radians(45.0))
+    return s
 
 
 def dem_rgba(z: NDArray[Any], dx: Any, dy: float, lo: float, hi: float,
@@ -524,13 +550,12 @@ def dem_rgba(z: NDArray[Any], dx: Any, dy: float, lo: float, hi: float,
     ``lo…hi`` and blended at its opacity over the grey hillshade.
     """
     ramp = ramp or elevation_ramp()
-    inner = z[1:-1, 1:-1]
-    grey = hillshade_tile(z, dx, dy) * 255.0
-    colour = apply_ramp(ramp, (inner - lo) / (hi - lo)).astype(np.float32)
-    a = ramp.opacity
+    inner = np.asarray(z[1:-1, 1:-1], dtype=np.float32)
+    grey = hillshade_tile(z, dx, dy) * np.float32(255.0 * (1.0 - ramp.opacity))
+    colour = apply_ramp(ramp, (inner - np.float32(lo)) / np.float32(hi - lo))
+    blended = colour[..., :3] * np.float32(ramp.opacity) + grey[..., None]
     out = np.empty(inner.shape + (4,), dtype=np.uint8)
-    for ch in range(3):
-        out[..., ch] = np.clip(a * colour[..., ch] + (1.0 - a) * grey, 0, 255)
+    out[..., :3] = np.clip(blended, 0, 255)
     out[..., 3] = np.where(np.isfinite(inner), 255, 0)
     return out
 
@@ -586,8 +611,8 @@ def colorize(style: Style, data: NDArray[Any], grid_transform: Affine,
 def make_style(src: Any, info: RasterInfo, kind: str) -> Style:
     """The :class:`Style` of a raster (statistics read once, see :func:`band_stats`)."""
     eight_bit = info.dtype in ("uint8", "int8")
-    needs_stats = kind in DEM_KINDS or (kind not in ("difference",) and not (
-        eight_bit and kind in RGB_KINDS and info.rgb_bands))
+    colour_8bit = eight_bit and info.rgb_bands and kind not in DEM_KINDS
+    needs_stats = kind != "difference" and not colour_8bit
     stats = tuple(band_stats(src, info, kind)) if needs_stats else ((0.0, 255.0),)
     return Style(kind, stats, eight_bit)
 
@@ -612,20 +637,24 @@ def overview_sidecar(path: PathLike) -> Path:
 def build_external_overviews(path: PathLike, feedback: Optional[Feedback] = None) -> Path:
     """Build overviews of ``path`` into its ``.ovr`` sidecar; the raster is not touched.
 
-    GDAL builds external overviews for a dataset opened read-only. They are built under a
-    hidden temporary name (through a symbolic link to the raster) and renamed when complete,
+    GDAL writes them to the sidecar, not into the file (``TIFF_USE_OVR``). They are built
+    under a hidden temporary name (through a symbolic link to the raster) and renamed when complete,
     so a failed build leaves no half-written ``.ovr``.
 
     Raises
     ------
     InputError
-        The folder is read-only, or an ``.ovr`` exists already.
+        The raster or its folder is read-only, or an ``.ovr`` exists already.
     """
     feedback = ensure_feedback(feedback)
     path = Path(path).resolve()
     target = overview_sidecar(path)
     if target.exists():
         raise InputError(f"'{target.name}' exists already; remove it to rebuild the overviews.")
+    if not os.access(path, os.W_OK):
+        raise InputError(f"'{path.name}' is read-only: GDAL opens it for writing to build "
+                         "overviews (into the sidecar only). Build them with "
+                         f"'gdaladdo -ro {path.name}' instead.")
     if not os.access(path.parent, os.W_OK):
         raise InputError(f"The folder of '{path.name}' is read-only: overviews cannot be "
                          f"written beside it ({path.parent}).")
@@ -633,9 +662,11 @@ def build_external_overviews(path: PathLike, feedback: Optional[Feedback] = None
     feedback.progress(0.0)
     try:
         os.symlink(path, link)
-        env = rasterio.Env(GDAL_TIF_OVR_BLOCKSIZE=256, COMPRESS_OVERVIEW="DEFLATE",
-                           INTERLEAVE_OVERVIEW="PIXEL", BIGTIFF_OVERVIEW="IF_SAFER")
-        with env, rasterio.open(link) as src:
+        env = rasterio.Env(TIFF_USE_OVR=True, GDAL_TIF_OVR_BLOCKSIZE=256,
+                           COMPRESS_OVERVIEW="DEFLATE", INTERLEAVE_OVERVIEW="PIXEL",
+                           BIGTIFF_OVERVIEW="IF_SAFER")
+        # update mode only lets GDAL build overviews; TIFF_USE_OVR sends them to the sidecar
+        with env, rasterio.open(link, "r+") as src:
             src.build_overviews(overview_factors(src.width, src.height), Resampling.average)
         os.replace(overview_sidecar(link), target)
     finally:

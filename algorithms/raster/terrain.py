@@ -11,8 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 
-def horn_gradient(z: NDArray[Any], dx: Union[float, NDArray[Any]],
-                  dy: float) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+def horn_gradient(z: NDArray[Any], dx: Union[float, NDArray[Any]], dy: float,
+                  dtype: Any = np.float64) -> Tuple[NDArray[Any], NDArray[Any]]:
     """Horn's gradient (p = ∂z/∂x eastwards, q = ∂z/∂y northwards) of the inner cells.
 
     Parameters
@@ -23,13 +23,15 @@ def horn_gradient(z: NDArray[Any], dx: Union[float, NDArray[Any]],
         Cell width in metres (per row in a geographic CRS).
     dy : float
         Cell height in metres (positive).
+    dtype : numpy dtype
+        Of the computation (float32 for the screen, where speed matters more).
 
     Returns
     -------
     p, q : ndarray, shape (rows, cols)
         NaN where any of the 9 cells is NaN.
     """
-    z = np.asarray(z, dtype=np.float64)
+    z = np.asarray(z, dtype=dtype)
     a, b, c = z[:-2, :-2], z[:-2, 1:-1], z[:-2, 2:]
     d, f = z[1:-1, :-2], z[1:-1, 2:]
     g, h, i = z[2:, :-2], z[2:, 1:-1], z[2:, 2:]
@@ -53,6 +55,6 @@ def shade(p: NDArray[Any], q: NDArray[Any], azimuth: float = 315.0,
     az, alt = math.radians(azimuth), math.radians(altitude)
     lx, ly, lz = math.sin(az) * math.cos(alt), math.cos(az) * math.cos(alt), math.sin(alt)
     value = (lz - p * lx - q * ly) / np.sqrt(1.0 + p * p + q * q)
-    return np.clip(value, 0.0, 1.0)
+    return np.clip(value, 0.0, 1.0, out=value)
 
 

@@ -150,6 +150,7 @@ class EditSession(QtCore.QObject):
         self._next_fid: Dict[str, int] = dict.fromkeys(EDIT_LAYERS, 1)
         self.undo_stack = QtWidgets.QUndoStack(self)
         self.undo_stack.cleanChanged.connect(self._clean_changed)
+        self._stamp: Optional[Tuple[int, int]] = None
         self._load()
 
     def _clean_changed(self, clean: bool) -> None:
@@ -160,6 +161,7 @@ class EditSession(QtCore.QObject):
         """Read every edit layer; a bad file makes the session read-only with the reason."""
         if not self.path.exists():
             return  # created on save
+        self._stamp = self._file_stamp()
         try:
             content = read_edits(self.path)
         except InputError as exc:
@@ -181,6 +183,18 @@ class EditSession(QtCore.QObject):
                 self._refuse(tr("The edits file {0} is locked or unreadable ({1}); close the "
                                 "program that holds it and open the project again.").format(
                                     self.path, detail))
+
+    def _file_stamp(self) -> Optional[Tuple[int, int]]:
+        """(modification time, size) of the file, or None when it does not exist."""
+        try:
+            info = self.path.stat()
+        except OSError:
+            return None
+        return info.st_mtime_ns, info.st_size
+
+    def changed_on_disk(self) -> bool:
+        """Another program (QGIS) wrote ``edits.gpkg`` since it was loaded or saved here."""
+        return self._file_stamp() != self._stamp
 
     def _refuse(self, problem: str) -> None:
         self.read_only = True
@@ -282,19 +296,32 @@ class EditSession(QtCore.QObject):
         self.changed.emit(layer)
 
     # -- saving ----------------------------------------------------------------------------
-    def save(self) -> Path:
+    def save(self, overwrite_changes: bool = False) -> Path:
         """Write every edit layer to ``edits.gpkg`` atomically and mark the stack clean.
+
+        Parameters
+        ----------
+        overwrite_changes : bool
+            Save even when another program changed the file since it was loaded (its changes
+            are then lost); default: refuse.
 
         Raises
         ------
         InputError
-            A read-only session, or a write that failed (the file is then unchanged).
+            A read-only session, a file changed by another program, or a write that failed
+            (the file is then unchanged).
         """
         if self.read_only:
             raise InputError(self.problem)
+        if self.changed_on_disk() and not overwrite_changes:
+            raise InputError(tr("The edits file {0} was changed by another program (QGIS?) "
+                                "since it was opened here; saving would lose those changes. "
+                                "Nothing was written. Open the project again to see them.")
+                             .format(self.path))
         layers = {name: [(fid, g, a) for fid, (g, a) in sorted(items.items())]
                   for name, items in self._layers.items()}
         path = save_edits(self.path, layers, self.crs)
+        self._stamp = self._file_stamp()
         self.undo_stack.setClean()
         self.saved.emit(str(path))
         return path
@@ -320,4 +347,38 @@ class EditSession(QtCore.QObject):
         return True
 
 
-__all__ = ["EDITS_FILE", "EditSession", "add_text", "ask_save", "change_text", "delete_text"]
+def edit_layer_title(name: str) -> str:
+    """The name of an edit layer in the layer list (translated; the same as in QGIS)."""
+    titles = {"start_points": tr("Start points"), "exclusion_areas": tr("Exclusion areas"),
+              "boundaries": tr("Boundaries"), "breaklines": tr("Breaklines"),
+              "ground_points": tr("Ground points"), "seamlines": tr("Seamlines"),
+              "check_points": tr("Check points")}
+    return titles.get(name, name)
+
+
+def show_edits(view: Any, session: EditSession) -> List[Any]:
+    """Add one vector layer per edit layer to a MapView (kind ``edit:<layer>``, drawn from the
+    session's memory, the first edit layer on top) and draw each again when the session
+    changes it. Layers of that kind already in the view are replaced. Returns the layers."""
+    added = []
+    for name in reversed(list(EDIT_LAYERS)):
+        old = view.layer_by_kind(f"edit:{name}")
+        if old is not None:
+            view.remove_layer(old)
+        added.append(view.add_vector(session.source(name), f"edit:{name}",
+                                     name=edit_layer_title(name)))
+
+    def redraw(layer: str) -> None:
+        try:
+            drawn = view.layer_by_kind(f"edit:{layer}")
+        except RuntimeError:  # the view was closed before the session
+            return
+        if drawn is not None and hasattr(drawn, "reload"):
+            drawn.reload()
+
+    session.changed.connect(redraw)
+    return added[::-1]
+
+
+__all__ = ["EDITS_FILE", "EditSession", "add_text", "ask_save", "change_text", "delete_text",
+           "edit_layer_title", "show_edits"]

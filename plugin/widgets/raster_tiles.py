@@ -238,8 +238,7 @@ class RasterLayer(MapLayer):
         level = grid.level_for(view.map_units_per_pixel)
         keys = [(level, c, r) for c, r in grid.tiles_in(view.extent, level)]
         self._source.wanted = frozenset(keys)
-        painter.save()
-        painter.setOpacity(painter.opacity() * self.opacity)
+        painter.save()  # the view applies the layer's opacity (MapView._paint_layers)
         painter.setRenderHint(QtGui.QPainter.SmoothPixmapTransform, True)
         for key in keys:
             image = CACHE.get((self._owner, key))
@@ -247,7 +246,8 @@ class RasterLayer(MapLayer):
                 _draw(painter, view, grid, key, image, (0, 0, display.TILE))
                 continue
             self._request(key)
-            self._draw_coarser(painter, view, grid, key)
+            if not self._draw_coarser(painter, view, grid, key):
+                self._draw_finer(painter, view, grid, key)
         painter.restore()
 
     def value_at(self, x: float, y: float) -> Optional[str]:
@@ -327,8 +327,8 @@ class RasterLayer(MapLayer):
                 self.changed.emit()
 
     def _draw_coarser(self, painter: QtGui.QPainter, view: ViewState,
-                      grid: display.TileGrid, key: Key) -> None:
-        """Draw the part of the nearest cached coarser tile that covers ``key``."""
+                      grid: display.TileGrid, key: Key) -> bool:
+        """Draw the part of the nearest cached coarser tile that covers ``key`` (zoom in)."""
         level, col, row = key
         for up in range(1, grid.levels - level):
             f = 2 ** up
@@ -338,7 +338,19 @@ class RasterLayer(MapLayer):
                 size = display.TILE // f
                 _draw(painter, view, grid, key, image,
                       ((col % f) * size, (row % f) * size, size))
-                return
+                return True
+        return False
+
+    def _draw_finer(self, painter: QtGui.QPainter, view: ViewState,
+                    grid: display.TileGrid, key: Key) -> None:
+        """Draw the cached tiles of the next finer level inside ``key`` (zoom out)."""
+        level, col, row = key
+        if level == 0:
+            return
+        for child in ((level - 1, 2 * col + i, 2 * row + j) for j in (0, 1) for i in (0, 1)):
+            image = CACHE.get((self._owner, child))
+            if image is not None:
+                _draw(painter, view, grid, child, image, (0, 0, display.TILE))
 
 
 def _draw(painter: QtGui.QPainter, view: ViewState, grid: display.TileGrid, key: Key,

@@ -242,3 +242,18 @@ def test_maybe_save(project: Path, qtbot, answer, closes, saved) -> None:
     assert asked == [s]
     assert len(EditSession(project).features("start_points")) == (2 if saved else 1)
     assert s.dirty is not saved
+
+
+def test_a_file_changed_by_another_program_is_not_overwritten(project: Path, qtbot) -> None:
+    s = EditSession(project)
+    s.add("start_points", Point(X0, Y0 + 3), {"height": 50.0})
+    add_features(project / "edits.gpkg", "seamlines", [(LineString([(X0, Y0), (X0, Y0 + 9)]),
+                                                        {"note": "from QGIS"})])
+    theirs = (project / "edits.gpkg").read_bytes()
+    with pytest.raises(InputError, match="changed by another program"):
+        s.save()
+    assert (project / "edits.gpkg").read_bytes() == theirs and s.dirty
+    s.save(overwrite_changes=True)
+    assert len(EditSession(project).features("start_points")) == 2
+    s.add("start_points", Point(X0, Y0 + 4), {"height": 50.0})
+    s.save()  # its own save is no change by another program

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import fiona
 import pytest
-from shapely.geometry import LineString, MultiPolygon, Point, Polygon, shape
+from shapely import wkb
+from shapely.geometry import LineString, MultiLineString, MultiPolygon, Point, Polygon, shape
 
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.project import edits_save
@@ -15,6 +16,7 @@ from photodem.algorithms.project.edits import EDIT_LAYERS, add_features, create_
 from photodem.algorithms.project.edits_save import (
     blob_to_geometry,
     geometry_to_blob,
+    iso_wkb,
     read_edits,
     save_edits,
 )
@@ -25,13 +27,17 @@ SQUARE = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (2, 1), (2, 2), (1,
 
 @pytest.mark.parametrize("geometry", [Point(1.5, 2.5), Point(1, 2, 3.25),
                                       LineString([(0, 0, 1), (5, 5, 2.5)]), SQUARE,
-                                      MultiPolygon([SQUARE, Polygon([(9, 9), (10, 9), (10, 10)])])])
+                                      MultiPolygon([SQUARE, Polygon([(9, 9), (10, 9), (10, 10)])]),
+                                      MultiLineString([[(0, 0, 1), (1, 1, 2)],
+                                                       [(5, 5, 0), (6, 6, 1)]])])
 def test_blob_round_trip(geometry) -> None:
     blob = geometry_to_blob(geometry, 25832)
     assert blob[:2] == b"GP" and int.from_bytes(blob[4:8], "little") == 25832
     back = blob_to_geometry(blob)
     assert back.equals_exact(geometry, 0) and back.has_z == geometry.has_z
     assert geometry_to_blob(None, 1) is None and blob_to_geometry(None) is None
+    # shapely 2 writes ISO WKB itself (Debian's shapely 1.8 cannot: hence our writer)
+    assert iso_wkb(geometry) == wkb.dumps(geometry, byte_order=1, flavor="iso")
 
 
 def test_new_file_is_read_by_gdal_and_the_core_reader(tmp_path: Path) -> None:
