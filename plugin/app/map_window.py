@@ -384,33 +384,16 @@ class MapWindowMixin:
                              layer="stereo_models")
 
     def _add_edits(self, root: Path, problems: List[str]) -> None:
-        """The edit layers of the project's edit session (read-only for a bad file)."""
-        # lazy: the edit session (part E) loads edits.gpkg only when a project is opened
-        from ...algorithms.project.edits import EDIT_LAYERS
-        from ..widgets.edit_session import EditSession
+        """The edit layers of the project's edit session (read-only for a bad file), drawn
+        from its memory and redrawn on its changes."""
+        # lazy: the edit session loads edits.gpkg only when a project is opened
+        from ..widgets.edit_session import EditSession, show_edits
 
         session = EditSession(root, parent=self, crs=str(getattr(self.project, "crs", "")))
         self.edit_session = session
         if session.read_only:
             problems.append(session.problem)
-        for name in reversed(list(EDIT_LAYERS)):
-            self.add_vector_file(session.source(name), f"edit:{name}",
-                                 name=edit_layer_title(name))
-        session.changed.connect(self._on_edits_changed)
-
-    def _on_edits_changed(self, layer: str) -> None:
-        shown = self.map_view.layer_by_kind(f"edit:{layer}")
-        if shown is not None:
-            shown.reload()  # type: ignore[attr-defined]
-
-
-def edit_layer_title(name: str) -> str:
-    """The name of an edit layer in the layer list (the titles of the QGIS workspace)."""
-    titles = {"start_points": tr("Start points"), "exclusion_areas": tr("Exclusion areas"),
-              "boundaries": tr("Boundaries"), "breaklines": tr("Breaklines"),
-              "ground_points": tr("Ground points"), "seamlines": tr("Seamlines"),
-              "check_points": tr("Check points")}
-    return titles.get(name, name)
+        show_edits(self.map_view, session)
 
 
 def product_label(product: Any) -> str:
@@ -438,4 +421,4 @@ def _crs_name(crs: str) -> str:
         return crs[:24]
 
 
-__all__ = ["MapWindowMixin", "edit_layer_title", "product_label"]
+__all__ = ["MapWindowMixin", "product_label"]
