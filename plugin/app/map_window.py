@@ -55,6 +55,7 @@ class MapWindowMixin:
         self.map_view.setObjectName("photodemMap")
         window.setCentralWidget(self.map_view)
         self.layer_list = LayerList(self.map_view)
+        self.layer_list.message.connect(lambda text: self.report(text, warning=False))
         dock = QtWidgets.QDockWidget(tr("Layers"), window)
         dock.setObjectName("photodemLayers")
         dock.setWidget(self.layer_list)
@@ -169,10 +170,19 @@ class MapWindowMixin:
             return None
         if index is not None:
             view.move_layer(layer, index)
+        self._offer_overviews(layer)
         if not layer.has_crs:  # type: ignore[attr-defined]
             self.report(tr("'{0}' has no coordinate reference system: it is shown in pixel "
                            "coordinates.").format(Path(path).name))
         return layer
+
+    def _offer_overviews(self, layer: MapLayer) -> None:
+        """A big raster without overviews draws slowly: say how to build them."""
+        if getattr(layer, "needs_overviews", False):
+            window: QtWidgets.QMainWindow = self  # type: ignore[assignment]
+            window.statusBar().showMessage(
+                tr("{0} has no overviews and draws slowly: right-click it in the layer list "
+                   "→ Build overviews.").format(layer.name), 20000)
 
     def _raster_alone_or_with_map(self, path: Any, kind: str, name: str,
                                   georeferenced_view: bool, exc: Exception) -> Optional[MapLayer]:
@@ -363,9 +373,8 @@ class MapWindowMixin:
                                              name=product_label(product))
             if layer is None:
                 problems.append(tr("Product not shown: {0}").format(product.path))
-            elif getattr(layer, "needs_overviews", False):
-                self.map_view.window().statusBar().showMessage(
-                    tr("{0} has no overviews: drawing it is slow.").format(product.path.name))
+            else:
+                self._offer_overviews(layer)
 
     def _add_block(self, project: Any, problems: List[str]) -> None:
         """Footprints and stereo models from ``.photodem/block.gpkg`` (written when stale)."""

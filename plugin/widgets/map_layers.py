@@ -52,9 +52,12 @@ class LayerList(QtWidgets.QWidget):
     -------
     current_layer_changed(object)
         The selected layer (or None).
+    message(str)
+        Something the operator should read (an error of *Build overviews*).
     """
 
     current_layer_changed = pyqtSignal(object)
+    message = pyqtSignal(str)
 
     def __init__(self, view: MapView, parent: Optional[QtWidgets.QWidget] = None) -> None:
         super().__init__(parent)
@@ -242,9 +245,30 @@ class LayerList(QtWidgets.QWidget):
         up.setEnabled(self.up_button.isEnabled())
         down = menu.addAction(tr("Move down"), lambda: self.move_current(1))
         down.setEnabled(self.down_button.isEnabled())
+        layer = self.current_layer()
+        if getattr(layer, "needs_overviews", False):
+            menu.addAction(tr("Build overviews"), self.build_overviews_current)
         menu.addSeparator()
         menu.addAction(tr("Remove layer"), self.remove_current)
         return menu
+
+    def build_overviews_current(self) -> bool:
+        """Build the overviews of the selected raster (an ``.ovr`` beside it; the raster
+        itself is not changed) so that it draws fast; False with a message when it fails."""
+        layer = self.current_layer()
+        if layer is None or not hasattr(layer, "build_overviews"):
+            return False
+        QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.WaitCursor)
+        try:
+            target = layer.build_overviews()
+        except Exception as exc:  # InputError (read-only folder, .ovr exists) or GDAL's
+            self.message.emit(tr("Overviews of {0} not built: {1}").format(layer.name, exc))
+            return False
+        finally:
+            QtWidgets.QApplication.restoreOverrideCursor()
+        self.message.emit(tr("Overviews written to {0}.").format(target))
+        self.view.refresh()
+        return True
 
 
 def _disconnect(signal: object, slot: object) -> None:

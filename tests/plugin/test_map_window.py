@@ -14,6 +14,7 @@ pytest.importorskip("pytestqt")
 
 import numpy as np
 import rasterio
+from rasterio.transform import from_origin
 from shapely.geometry import Point
 
 from photodem.algorithms.processing import registry
@@ -205,3 +206,20 @@ def test_layer_list_visibility_order_opacity(window, tiny, qtbot):
         "Zoom to layer", "Move up", "Move down", "Remove layer"]
     panel.remove_current()
     assert view.layer_by_kind("dsm") is None and panel.list.count() == len(EXPECTED_KINDS) - 1
+
+
+def test_big_raster_without_overviews_offers_to_build_them(window, tmp_path):
+    big = tmp_path / "big.tif"
+    with rasterio.open(big, "w", driver="GTiff", width=2100, height=2100, count=1,
+                       dtype="uint8", crs="EPSG:25832",
+                       transform=from_origin(400000, 5700000, 1, 1)) as dst:
+        dst.write(np.full((1, 2100, 2100), 7, dtype="uint8"))
+    layer = window.add_map_file(big)
+    assert layer is not None and layer.needs_overviews
+    assert "Build overviews" in window.statusBar().currentMessage()
+    window.layer_list.select_layer(layer)
+    assert "Build overviews" in [a.text() for a in window.layer_list.context_menu().actions()]
+    assert window.layer_list.build_overviews_current()
+    assert not layer.needs_overviews and (tmp_path / "big.tif.ovr").is_file()
+    assert "Build overviews" not in [a.text() for a in
+                                     window.layer_list.context_menu().actions()]
