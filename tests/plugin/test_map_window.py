@@ -223,3 +223,26 @@ def test_big_raster_without_overviews_offers_to_build_them(window, tmp_path):
     assert not layer.needs_overviews and (tmp_path / "big.tif.ovr").is_file()
     assert "Build overviews" not in [a.text() for a in
                                      window.layer_list.context_menu().actions()]
+
+
+def test_a_finished_run_puts_its_rasters_on_the_map(window, tiny):
+    dsm = tiny / "truth" / "dsm.tif"
+    window.run_panel.show_result({"dsm": str(dsm), "report": str(tiny / "project.toml")})
+    window._on_run_finished("done", {"dsm": str(dsm)})
+    assert [layer.path for layer in window.map_view.layers()] == [dsm.resolve()]
+    window._on_run_finished("done", {"dsm": str(dsm)})  # not twice
+    assert len(window.map_view.layers()) == 1
+
+
+def test_corrupt_edits_are_shown_read_only(window, tiny, tmp_path):
+    broken = tmp_path / "broken"
+    shutil.copytree(tiny, broken)
+    edits = broken / "edits.gpkg"
+    edits.write_bytes(b"SQLite format 3\x00" + b"\x00" * 200)
+    before = edits.read_bytes()
+    assert window.open_project(broken)
+    assert window.edit_session.read_only
+    assert "edits" in window.statusBar().currentMessage()
+    assert [layer.kind for layer in window.map_view.layers()] == EXPECTED_KINDS
+    assert window.close_project()
+    assert edits.read_bytes() == before  # nothing written
