@@ -106,6 +106,25 @@ class MapWindowMixin:
         self.zoom_out_action.setShortcut(QtGui.QKeySequence.ZoomOut)
         self.zoom_out_action.triggered.connect(lambda _c=False: view.zoom_by(0.5))
         view_menu.addSeparator()
+        self._build_map_toolbar()
+
+    def _build_map_toolbar(self) -> None:
+        """Open project and the zooms one click away (the editing toolbar comes below)."""
+        window: QtWidgets.QMainWindow = self  # type: ignore[assignment]
+        style = window.style()
+        bar = QtWidgets.QToolBar(tr("Map"), window)
+        bar.setObjectName("photodemMapToolbar")
+        icons = ((self.open_project_action, QtWidgets.QStyle.SP_DirOpenIcon),
+                 (self.zoom_full_action, QtWidgets.QStyle.SP_DesktopIcon),
+                 (self.zoom_layer_action, QtWidgets.QStyle.SP_FileDialogContentsView),
+                 (self.zoom_in_action, QtWidgets.QStyle.SP_ArrowUp),
+                 (self.zoom_out_action, QtWidgets.QStyle.SP_ArrowDown))
+        for action, icon in icons:
+            action.setIcon(style.standardIcon(icon))
+            bar.addAction(action)
+        bar.setToolButtonStyle(QtCore.Qt.ToolButtonTextBesideIcon)
+        window.addToolBar(bar)
+        self.map_toolbar = bar
 
     # -- status bar ------------------------------------------------------------------------------
     def _on_cursor(self, x: float, y: float) -> None:

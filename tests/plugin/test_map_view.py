@@ -274,3 +274,19 @@ def test_unreadable_style_falls_back(tmp_path, caplog, monkeypatch):
         assert "edit_broken.qml" in caplog.text
     finally:
         map_styles.style_for_kind.cache_clear()
+
+
+def test_layer_list_follows_a_drag_and_drop_reorder(view, qtbot):
+    from photodem.plugin.widgets.map_layers import LayerList
+
+    a = view.add_vector(features, "edit:start_points", name="a")
+    b = view.add_vector(features, "edit:breaklines", name="b")
+    c = view.add_vector(features, "footprints", name="c")
+    panel = LayerList(view)
+    qtbot.addWidget(panel)
+    assert [panel.list.item(i).text() for i in range(3)] == ["c", "b", "a"]
+    # what a drop does to the model: the top row moves to the end
+    root = QtCore.QModelIndex()
+    assert panel.list.model().moveRow(root, 0, root, 3)
+    qtbot.waitUntil(lambda: view.layers() == [b, a, c])
+    assert [panel.list.item(i).text() for i in range(3)] == ["b", "a", "c"]
