@@ -156,6 +156,10 @@ class VectorLayer(MapLayer):
     # -- drawing ---------------------------------------------------------------------------------
     def paint(self, painter: QtGui.QPainter, view: ViewState) -> None:
         self._mupp = view.map_units_per_pixel
+        if not callable(self.source) and view.crs and view.crs != self.map_crs:
+            self.map_crs = view.crs  # the map changed its CRS: read the file into the new one
+            self.reload()
+            return  # reload's `changed` draws again
         xmin, ymin, xmax, ymax = view.extent
         if xmax <= xmin or ymax <= ymin:
             return

@@ -102,6 +102,7 @@ class MapView(QtWidgets.QWidget):
         self._tool: Optional[MapTool] = None
         self._cache: Optional[QtGui.QPixmap] = None  # the layers, drawn for _cache_state
         self._cache_state: Optional[ViewState] = None
+        self._generation = 0  # counts invalidations
         self._drag: Optional[QtCore.QPoint] = None  # last mouse position of a pan drag
         self.setFocusPolicy(QtCore.Qt.StrongFocus)
         self.setMouseTracking(True)
@@ -341,6 +342,7 @@ class MapView(QtWidgets.QWidget):
 
     def _invalidate(self) -> None:
         self._cache_state = None
+        self._generation += 1  # a change during a drawing keeps the cache stale
         self.update()
 
     def render_layers(self, state: Optional[ViewState] = None) -> QtGui.QImage:
@@ -373,10 +375,13 @@ class MapView(QtWidgets.QWidget):
         pixmap = QtGui.QPixmap(int(state.width * ratio), int(state.height * ratio))
         pixmap.setDevicePixelRatio(ratio)
         pixmap.fill(QtGui.QColor("white"))
+        generation = self._generation
         painter = QtGui.QPainter(pixmap)
         self._paint_layers(painter, state)
         painter.end()
-        self._cache, self._cache_state = pixmap, state
+        self._cache = pixmap
+        # a layer that changed while it drew (a file re-read) is drawn again at the next paint
+        self._cache_state = state if generation == self._generation else None
 
     def paintEvent(self, event: QtGui.QPaintEvent) -> None:
         state = self.view_state()
