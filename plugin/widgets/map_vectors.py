@@ -208,11 +208,16 @@ class VectorLayer(MapLayer):
         font = painter.font()
         font.setPointSizeF(self.style.label_size * 1.2)
         painter.setFont(font)
-        painter.setPen(QtGui.QColor(*self.style.label_colour))
         metrics = QtGui.QFontMetricsF(font)
+        halo = QtGui.QColor(255, 255, 255, 210)
+        colour = QtGui.QColor(*self.style.label_colour)
         for point, text in labels:
-            width = metrics.horizontalAdvance(text)
-            painter.drawText(QtCore.QPointF(point.x() - width / 2, point.y() - 6), text)
+            at = QtCore.QPointF(point.x() - metrics.horizontalAdvance(text) / 2, point.y() - 6)
+            painter.setPen(halo)  # a light halo keeps the label readable on imagery
+            for dx, dy in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                painter.drawText(at + QtCore.QPointF(dx, dy), text)
+            painter.setPen(colour)
+            painter.drawText(at, text)
 
 
 def _label_text(value: Any) -> str:

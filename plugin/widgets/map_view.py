@@ -404,21 +404,20 @@ class MapView(QtWidgets.QWidget):
         """The scale bar (bottom left), the north arrow and the frame."""
         painter.setRenderHint(QtGui.QPainter.Antialiasing, True)
         length = nice_length(SCALE_BAR_PX * state.map_units_per_pixel)
-        if length > 0:
+        if length > 0:  # a half-filled bar and its length to the right of it
             bar_px = length / state.map_units_per_pixel
-            x0, y0 = 12.0, state.height - 14.0
+            x0, y0 = 12.0, state.height - 16.0
             text = length_text(length, pixel_units=not state.crs)
             metrics = painter.fontMetrics()
-            box = QtCore.QRectF(x0 - 6, y0 - metrics.height() - 10,
-                                bar_px + 12, metrics.height() + 18)
-            painter.fillRect(box, QtGui.QColor(255, 255, 255, 190))
-            painter.setPen(QtGui.QPen(QtGui.QColor(30, 30, 30), 1.0))
-            half = bar_px / 2.0
-            painter.fillRect(QtCore.QRectF(x0, y0, half, 4), QtGui.QColor(30, 30, 30))
-            painter.drawRect(QtCore.QRectF(x0, y0, bar_px, 4))
-            painter.drawText(QtCore.QPointF(x0, y0 - 4), "0")
             width = metrics.horizontalAdvance(text)
-            painter.drawText(QtCore.QPointF(x0 + bar_px - width, y0 - 4), text)
+            box = QtCore.QRectF(x0 - 6, y0 - metrics.height() / 2 - 4,
+                                bar_px + width + 20, metrics.height() + 8)
+            painter.fillRect(box, QtGui.QColor(255, 255, 255, 200))
+            painter.setPen(QtGui.QPen(QtGui.QColor(30, 30, 30), 1.0))
+            painter.setBrush(QtCore.Qt.NoBrush)
+            painter.fillRect(QtCore.QRectF(x0, y0 - 2, bar_px / 2.0, 5), QtGui.QColor(30, 30, 30))
+            painter.drawRect(QtCore.QRectF(x0, y0 - 2, bar_px, 5))
+            painter.drawText(QtCore.QPointF(x0 + bar_px + 6, y0 + metrics.ascent() / 2 - 1), text)
         self._paint_north(painter, state)
         painter.setPen(QtGui.QPen(QtGui.QColor(120, 120, 120), 1.0))
         painter.setBrush(QtCore.Qt.NoBrush)
