@@ -1,7 +1,8 @@
-"""The standalone toolbox: algorithm tree, generated parameter form, run panel.
+"""The standalone main window: the map in the centre, layers on the left, the processing
+toolbox (algorithm tree, generated parameter form, run panel) docked on the right.
 
-Everything shown comes from the registry, so a new algorithm appears here (and in QGIS and the
-CLI) without any GUI code.
+Everything in the toolbox comes from the registry, so a new algorithm appears here (and in QGIS
+and the CLI) without any GUI code. The map half lives in :mod:`.map_window`.
 """
 
 from __future__ import annotations
@@ -16,14 +17,15 @@ from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 from ..widgets.parameter_form import SETTINGS_PROJECT, ParameterForm
 from ..widgets.run_panel import RunPanel
+from .map_window import MapWindowMixin
 
 ALG_ROLE = QtCore.Qt.UserRole + 1
 #: Settings keys of the window's layout and the algorithm shown last.
 SETTINGS_WINDOW = "PhotoDEM/toolbox/"
 
 
-class ToolboxWindow(QtWidgets.QMainWindow):
-    """Main window of ``photodem gui``.
+class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
+    """Main window of ``photodem gui``: map, layer list, processing toolbox.
 
     Parameters
     ----------
@@ -36,6 +38,8 @@ class ToolboxWindow(QtWidgets.QMainWindow):
     """
 
     algorithm_selected = pyqtSignal(str)
+    #: A project was opened on the map (its root folder).
+    project_opened = pyqtSignal(str)
 
     def __init__(self, parent: Optional[QtWidgets.QWidget] = None,
                  message_boxes: bool = True, settings: Any = None) -> None:
@@ -46,7 +50,9 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.settings = settings
         self.batch_dialog: Optional[Any] = None  # the batch dialog (kept while it runs)
         self.setWindowTitle(tr("PhotoDEM toolbox"))
-        self.resize(1200, 720)
+        self.resize(1400, 860)
+        self.setDockOptions(QtWidgets.QMainWindow.AnimatedDocks
+                            | QtWidgets.QMainWindow.AllowTabbedDocks)
         self.form: Optional[ParameterForm] = None
         self.last_georef = ""  # output folder of the last georeferencing run
         self.algorithm: Optional[Algorithm] = None
@@ -87,7 +93,13 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         top_layout = QtWidgets.QVBoxLayout(top)
         top_layout.setContentsMargins(6, 6, 6, 0)
         top_layout.addWidget(self.title)
-        top_layout.addWidget(self.help_label)
+        # the help of a long algorithm scrolls: the form below keeps its room in the dock
+        help_area = QtWidgets.QScrollArea()
+        help_area.setWidgetResizable(True)
+        help_area.setFrameShape(QtWidgets.QFrame.NoFrame)
+        help_area.setWidget(self.help_label)
+        help_area.setMaximumHeight(110)
+        top_layout.addWidget(help_area)
         top_layout.addWidget(self.form_area, 1)
         right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
         right.addWidget(top)
@@ -101,28 +113,41 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         right.setSizes([470, 230])
         self.right_splitter = right
 
-        splitter = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
+        # the toolbox is a dock beside the map: the tree above the form and the run panel
+        splitter = QtWidgets.QSplitter(QtCore.Qt.Vertical)
         splitter.addWidget(left)
         splitter.addWidget(right)
         splitter.setStretchFactor(0, 1)
         splitter.setStretchFactor(1, 3)
-        splitter.setSizes([360, 840])
+        splitter.setSizes([220, 560])
+        splitter.setMinimumWidth(380)
         self.splitter = splitter
-        self.setCentralWidget(splitter)
+        self._build_map()
+        self.toolbox_dock = QtWidgets.QDockWidget(tr("Processing toolbox"), self)
+        self.toolbox_dock.setObjectName("photodemToolbox")
+        self.toolbox_dock.setWidget(splitter)
+        self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.toolbox_dock)
+        self.resizeDocks([self.layers_dock, self.toolbox_dock], [240, 470], QtCore.Qt.Horizontal)
 
         self._build_menu()
-        self.statusBar().showMessage(tr("Choose an algorithm on the left."))
+        self.statusBar().showMessage(tr("Open a project (File menu) or choose an algorithm "
+                                        "in the toolbox."))
         self.populate()
 
         self.tree.currentItemChanged.connect(self._on_current_item)
         self.filter_edit.textChanged.connect(self._apply_filter)
         self.run_panel.run_requested.connect(self.run_current)
         self.run_panel.run_finished.connect(self._on_run_finished)
+        self.run_panel.show_on_map.connect(self.show_on_map)
         self._restore_layout()
 
     # -- building --------------------------------------------------------------------------------
     def _build_menu(self) -> None:
         file_menu = self.menuBar().addMenu(tr("&File"))
+        view_menu = self.menuBar().addMenu(tr("&View"))
+        self._build_map_menus(file_menu, view_menu)
+        for dock in (self.layers_dock, self.toolbox_dock):
+            view_menu.addAction(dock.toggleViewAction())
         quit_action = file_menu.addAction(tr("&Quit"))
         quit_action.setShortcut(QtGui.QKeySequence.Quit)
         quit_action.triggered.connect(self.close)
@@ -248,6 +273,8 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         self.statusBar().showMessage(text)
         if status == "failed" and self.message_boxes:
             QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(payload))
+        if status == "done":  # its rasters and vectors go on the map
+            self.add_run_outputs(self.run_panel.map_outputs())
         if (status == "done" and self.run_panel.algorithm_id == "georeference_polygons"
                 and isinstance(payload, dict) and payload.get("report")):
             self.last_georef = str(Path(payload["report"]).parent)
@@ -336,6 +363,7 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         if self.form is not None:
             self.form.remember(s)
         s.sync()
+
     def open_quality_panel(self) -> QtWidgets.QWidget:
         """Show the DEM quality panel (issue 20) in a dock of this window; returns the panel."""
         dock = self.findChild(QtWidgets.QDockWidget, "photodemQuality")
@@ -346,11 +374,16 @@ class ToolboxWindow(QtWidgets.QMainWindow):
             dock.setObjectName("photodemQuality")
             dock.setWidget(QcPanel(dock))
             self.addDockWidget(QtCore.Qt.RightDockWidgetArea, dock)
+            self.tabifyDockWidget(self.toolbox_dock, dock)
         dock.show()
         dock.raise_()
         return dock.widget()
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
+        session = self.edit_session
+        if session is not None and not session.maybe_save(self):
+            event.ignore()  # the operator cancelled: unsaved edits stay
+            return
         self.save_layout()
         if self.run_panel.is_running():
             self.run_panel.cancel()
@@ -362,6 +395,8 @@ class ToolboxWindow(QtWidgets.QMainWindow):
         if quality is not None and quality.widget().is_running():  # issue 20
             quality.widget().cancel()
             quality.widget().wait(30000)
+        self.map_view.set_tool(None)
+        self.map_view.clear_layers()  # stops the tile threads of the rasters
         super().closeEvent(event)
 
     def _about(self) -> None:

@@ -42,9 +42,10 @@ def feature_label(fid: Any, attributes: Dict[str, Any]) -> str:
     return f"#{fid}"
 
 
-def read_file_features(path: Path, layer: Optional[str], map_crs: str) -> Tuple[List[Feature],
-                                                                               bool]:
-    """The features of ``layer`` of ``path`` in ``map_crs`` and whether the file has a CRS."""
+def read_file_features(path: Path, layer: Optional[str],
+                       map_crs: str) -> Tuple[List[Feature], Optional[str]]:
+    """The features of ``layer`` of ``path`` in ``map_crs`` (or in the file's CRS when
+    ``map_crs`` is empty) and the file's CRS as WKT (None: the file names none)."""
     # lazy: rasterio's CRS and the core reader load with the first file layer
     from rasterio.crs import CRS
 
@@ -55,12 +56,13 @@ def read_file_features(path: Path, layer: Optional[str], map_crs: str) -> Tuple[
     found = read_features(path, [layer] if layer else None, what="vector file")
     target = CRS.from_user_input(map_crs) if map_crs else None
     features: List[Feature] = []
-    has_crs = False
+    source_crs: Optional[str] = None
     for feat in found:
-        has_crs = has_crs or feat.crs is not None
+        if feat.crs is not None and source_crs is None:
+            source_crs = feat.crs.to_wkt()
         geom = to_crs(feat.geometry, feat.crs, target)
         features.append((feat.fid, shape(geom), feat.properties))
-    return features, has_crs or not found
+    return features, source_crs
 
 
 class VectorLayer(MapLayer):
@@ -92,6 +94,7 @@ class VectorLayer(MapLayer):
         self.map_crs = map_crs
         self.style = style if style is not None else style_for_kind(kind)
         self.has_crs = True
+        self.crs = ""  # the file's CRS when the map had none (the view adopts it)
         self._features: List[Feature] = []
         self._bounds: List[Tuple[float, float, float, float]] = []
         self._mupp = 1.0  # map units per pixel of the last drawing (for value_at)
@@ -103,8 +106,10 @@ class VectorLayer(MapLayer):
             features = [(fid, geom if isinstance(geom, BaseGeometry) else shape(geom),
                          dict(attrs or {})) for fid, geom, attrs in self.source()]
         else:
-            features, self.has_crs = read_file_features(Path(self.source), self.layer_name,
-                                                        self.map_crs)
+            features, crs = read_file_features(Path(self.source), self.layer_name,
+                                               self.map_crs)
+            self.has_crs = crs is not None or not features
+            self.crs = "" if self.map_crs else (crs or "")
         self._features = [f for f in features if f[1] is not None and not f[1].is_empty]
         self._bounds = [f[1].bounds for f in self._features]
 
@@ -151,6 +156,10 @@ class VectorLayer(MapLayer):
     # -- drawing ---------------------------------------------------------------------------------
     def paint(self, painter: QtGui.QPainter, view: ViewState) -> None:
         self._mupp = view.map_units_per_pixel
+        if not callable(self.source) and view.crs and view.crs != self.map_crs:
+            self.map_crs = view.crs  # the map changed its CRS: read the file into the new one
+            self.reload()
+            return  # reload's `changed` draws again
         xmin, ymin, xmax, ymax = view.extent
         if xmax <= xmin or ymax <= ymin:
             return
@@ -199,11 +208,16 @@ class VectorLayer(MapLayer):
         font = painter.font()
         font.setPointSizeF(self.style.label_size * 1.2)
         painter.setFont(font)
-        painter.setPen(QtGui.QColor(*self.style.label_colour))
         metrics = QtGui.QFontMetricsF(font)
+        halo = QtGui.QColor(255, 255, 255, 210)
+        colour = QtGui.QColor(*self.style.label_colour)
         for point, text in labels:
-            width = metrics.horizontalAdvance(text)
-            painter.drawText(QtCore.QPointF(point.x() - width / 2, point.y() - 6), text)
+            at = QtCore.QPointF(point.x() - metrics.horizontalAdvance(text) / 2, point.y() - 6)
+            painter.setPen(halo)  # a light halo keeps the label readable on imagery
+            for dx, dy in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                painter.drawText(at + QtCore.QPointF(dx, dy), text)
+            painter.setPen(colour)
+            painter.drawText(at, text)
 
 
 def _label_text(value: Any) -> str:

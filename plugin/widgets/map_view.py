@@ -32,6 +32,10 @@ SCREEN_DPI = 96.0
 SCALE_BAR_PX = 110
 
 
+class MixedCoordinatesError(InputError):
+    """A layer in pixel coordinates and one in map coordinates cannot share the view."""
+
+
 def nice_length(length: float) -> float:
     """The largest of 1, 2, 5 × 10ⁿ not above ``length`` (> 0) — a scale bar's length."""
     if length <= 0 or not math.isfinite(length):
@@ -65,6 +69,13 @@ def _layer_has_crs(layer: MapLayer) -> bool:
     return bool(getattr(layer, "has_crs", True))
 
 
+def _layer_crs(layer: MapLayer) -> str:
+    """The CRS a georeferenced layer is drawn in when the view has none yet (a vector file's
+    ``crs``, a raster's ``info.crs``), or ``""``."""
+    crs = getattr(layer, "crs", "") or getattr(getattr(layer, "info", None), "crs", "")
+    return str(crs or "")
+
+
 class MapView(QtWidgets.QWidget):
     """The map widget: ordered layers, navigation, tools, scale bar.
 
@@ -91,6 +102,7 @@ class MapView(QtWidgets.QWidget):
         self._tool: Optional[MapTool] = None
         self._cache: Optional[QtGui.QPixmap] = None  # the layers, drawn for _cache_state
         self._cache_state: Optional[ViewState] = None
+        self._generation = 0  # counts invalidations
         self._drag: Optional[QtCore.QPoint] = None  # last mouse position of a pan drag
         self.setFocusPolicy(QtCore.Qt.StrongFocus)
         self.setMouseTracking(True)
@@ -133,17 +145,20 @@ class MapView(QtWidgets.QWidget):
         return None
 
     def check_layer(self, layer: MapLayer) -> None:
-        """Raise :class:`InputError` when ``layer`` cannot join the view: a raster without CRS
-        in a georeferenced view, or a georeferenced layer in a pixel-coordinate view."""
+        """Raise :class:`MixedCoordinatesError` when ``layer`` cannot join the view: a raster
+        without CRS in a georeferenced view, or a georeferenced layer in a pixel-coordinate
+        view."""
         if not self._layers:
             return
         georef = _layer_has_crs(layer)
         if self.is_georeferenced() and not georef:
-            raise InputError(tr("'{0}' has no coordinate reference system: it can only be "
-                                "shown alone, in pixel coordinates.").format(layer.name))
+            raise MixedCoordinatesError(
+                tr("'{0}' has no coordinate reference system: it can only be shown alone, in "
+                   "pixel coordinates.").format(layer.name))
         if not self.is_georeferenced() and georef:
-            raise InputError(tr("The map shows a raster in pixel coordinates; '{0}' is "
-                                "georeferenced and cannot be shown with it.").format(layer.name))
+            raise MixedCoordinatesError(
+                tr("The map shows a raster in pixel coordinates; '{0}' is georeferenced and "
+                   "cannot be shown with it.").format(layer.name))
 
     def add_layer(self, layer: MapLayer, index: int = 0) -> MapLayer:
         """Add ``layer`` at ``index`` (0 = on top); raises :class:`InputError` when it would
@@ -152,8 +167,8 @@ class MapView(QtWidgets.QWidget):
         if not self._layers:  # the first layer decides pixel or map coordinates
             if not _layer_has_crs(layer):
                 self.set_crs("")
-            elif not self._crs and getattr(layer, "crs", ""):
-                self.set_crs(str(layer.crs))
+            elif not self._crs and _layer_crs(layer):
+                self.set_crs(_layer_crs(layer))
         index = min(max(int(index), 0), len(self._layers))
         self._layers.insert(index, layer)
         layer.changed.connect(self._on_layer_changed)
@@ -327,6 +342,7 @@ class MapView(QtWidgets.QWidget):
 
     def _invalidate(self) -> None:
         self._cache_state = None
+        self._generation += 1  # a change during a drawing keeps the cache stale
         self.update()
 
     def render_layers(self, state: Optional[ViewState] = None) -> QtGui.QImage:
@@ -359,10 +375,13 @@ class MapView(QtWidgets.QWidget):
         pixmap = QtGui.QPixmap(int(state.width * ratio), int(state.height * ratio))
         pixmap.setDevicePixelRatio(ratio)
         pixmap.fill(QtGui.QColor("white"))
+        generation = self._generation
         painter = QtGui.QPainter(pixmap)
         self._paint_layers(painter, state)
         painter.end()
-        self._cache, self._cache_state = pixmap, state
+        self._cache = pixmap
+        # a layer that changed while it drew (a file re-read) is drawn again at the next paint
+        self._cache_state = state if generation == self._generation else None
 
     def paintEvent(self, event: QtGui.QPaintEvent) -> None:
         state = self.view_state()
@@ -385,21 +404,20 @@ class MapView(QtWidgets.QWidget):
         """The scale bar (bottom left), the north arrow and the frame."""
         painter.setRenderHint(QtGui.QPainter.Antialiasing, True)
         length = nice_length(SCALE_BAR_PX * state.map_units_per_pixel)
-        if length > 0:
+        if length > 0:  # a half-filled bar and its length to the right of it
             bar_px = length / state.map_units_per_pixel
-            x0, y0 = 12.0, state.height - 14.0
+            x0, y0 = 12.0, state.height - 16.0
             text = length_text(length, pixel_units=not state.crs)
             metrics = painter.fontMetrics()
-            box = QtCore.QRectF(x0 - 6, y0 - metrics.height() - 10,
-                                bar_px + 12, metrics.height() + 18)
-            painter.fillRect(box, QtGui.QColor(255, 255, 255, 190))
-            painter.setPen(QtGui.QPen(QtGui.QColor(30, 30, 30), 1.0))
-            half = bar_px / 2.0
-            painter.fillRect(QtCore.QRectF(x0, y0, half, 4), QtGui.QColor(30, 30, 30))
-            painter.drawRect(QtCore.QRectF(x0, y0, bar_px, 4))
-            painter.drawText(QtCore.QPointF(x0, y0 - 4), "0")
             width = metrics.horizontalAdvance(text)
-            painter.drawText(QtCore.QPointF(x0 + bar_px - width, y0 - 4), text)
+            box = QtCore.QRectF(x0 - 6, y0 - metrics.height() / 2 - 4,
+                                bar_px + width + 20, metrics.height() + 8)
+            painter.fillRect(box, QtGui.QColor(255, 255, 255, 200))
+            painter.setPen(QtGui.QPen(QtGui.QColor(30, 30, 30), 1.0))
+            painter.setBrush(QtCore.Qt.NoBrush)
+            painter.fillRect(QtCore.QRectF(x0, y0 - 2, bar_px / 2.0, 5), QtGui.QColor(30, 30, 30))
+            painter.drawRect(QtCore.QRectF(x0, y0 - 2, bar_px, 5))
+            painter.drawText(QtCore.QPointF(x0 + bar_px + 6, y0 + metrics.ascent() / 2 - 1), text)
         self._paint_north(painter, state)
         painter.setPen(QtGui.QPen(QtGui.QColor(120, 120, 120), 1.0))
         painter.setBrush(QtCore.Qt.NoBrush)
@@ -528,4 +546,4 @@ def _padded(bounds: Bounds, margin: float = 0.03) -> Bounds:
     return (xmin - dx, ymin - dy, xmax + dx, ymax + dy)
 
 
-__all__ = ["MapView", "length_text", "nice_length", "union_bounds"]
+__all__ = ["MapView", "MixedCoordinatesError", "length_text", "nice_length", "union_bounds"]

@@ -13,6 +13,9 @@ from .worker import AlgorithmWorker, start_in_thread
 
 #: Item data role of a result row that names an existing file or folder.
 PATH_ROLE = QtCore.Qt.UserRole + 7
+#: File endings the map shows as rasters and as vectors (``.json`` only as ``.geo.json``).
+RASTER_SUFFIXES = (".tif", ".tiff", ".vrt", ".img", ".jp2")
+VECTOR_SUFFIXES = (".gpkg", ".shp", ".geojson", ".fgb", ".kml")
 _LEVEL_COLOURS = {"info": None, "warning": "#b35c00", "error": "#c0392b", "ok": "#1e7d32"}
 
 
@@ -26,10 +29,13 @@ class RunPanel(QtWidgets.QWidget):
     run_finished(str, object)
         ``(status, payload)`` with status ``done`` (payload: output dict), ``failed``
         (message), ``cancelled`` (message).
+    show_on_map(str)
+        *Show on map* of an output raster or vector (its path).
     """
 
     run_requested = pyqtSignal()
     run_finished = pyqtSignal(str, object)
+    show_on_map = pyqtSignal(str)
 
     def __init__(self, parent: Optional[QtWidgets.QWidget] = None) -> None:
         super().__init__(parent)
@@ -197,7 +203,8 @@ class RunPanel(QtWidgets.QWidget):
 
     def show_result(self, result: Dict[str, Any]) -> None:
         """Show an output dict as a tree (nested dicts and lists expand); every output that is
-        an existing file or folder gets *Open* and *Show in folder*."""
+        an existing file or folder gets *Open* and *Show in folder*, a raster or vector also
+        *Show on map*."""
         self.result_view.clear()
         for key, value in result.items():
             self.result_view.addTopLevelItem(_tree_item(str(key), value))
@@ -221,6 +228,13 @@ class RunPanel(QtWidgets.QWidget):
         layout = QtWidgets.QHBoxLayout(box)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.setSpacing(2)
+        if is_map_file(path):
+            button = QtWidgets.QToolButton(box)
+            button.setText(tr("Show on map"))
+            button.setObjectName("showOnMap")
+            button.setAutoRaise(True)
+            button.clicked.connect(lambda _c=False: self.show_on_map.emit(path))
+            layout.addWidget(button)
         for text, folder in ((tr("Open"), False), (tr("Show in folder"), True)):
             button = QtWidgets.QToolButton(box)
             button.setText(text)
@@ -229,6 +243,10 @@ class RunPanel(QtWidgets.QWidget):
             layout.addWidget(button)
         layout.addStretch(1)
         return box
+
+    def map_outputs(self) -> List[str]:
+        """The outputs of the last result the map can show (rasters, vectors)."""
+        return [p for p in self.output_paths() if is_map_file(p)]
 
     # -- opening outputs -------------------------------------------------------------------------
     def output_paths(self) -> List[str]:
@@ -283,6 +301,14 @@ def _tree_item(key: str, value: Any) -> QtWidgets.QTreeWidgetItem:
         if isinstance(value, str) and len(value) > 1 and _is_path(value):
             item.setData(1, PATH_ROLE, value)
     return item
+
+
+def is_map_file(path: str) -> bool:
+    """True for an existing file the map can show, by its ending."""
+    p = Path(path)
+    name = p.name.lower()
+    return p.is_file() and (name.endswith(RASTER_SUFFIXES + VECTOR_SUFFIXES)
+                            or name.endswith(".geo.json"))
 
 
 def _is_path(text: str) -> bool:

@@ -274,3 +274,53 @@ def test_unreadable_style_falls_back(tmp_path, caplog, monkeypatch):
         assert "edit_broken.qml" in caplog.text
     finally:
         map_styles.style_for_kind.cache_clear()
+
+
+def test_layer_list_follows_a_drag_and_drop_reorder(view, qtbot):
+    from photodem.plugin.widgets.map_layers import LayerList
+
+    a = view.add_vector(features, "edit:start_points", name="a")
+    b = view.add_vector(features, "edit:breaklines", name="b")
+    c = view.add_vector(features, "footprints", name="c")
+    panel = LayerList(view)
+    qtbot.addWidget(panel)
+    assert [panel.list.item(i).text() for i in range(3)] == ["c", "b", "a"]
+    # what a drop does to the model: the top row moves to the end
+    root = QtCore.QModelIndex()
+    assert panel.list.model().moveRow(root, 0, root, 3)
+    qtbot.waitUntil(lambda: view.layers() == [b, a, c])
+    assert [panel.list.item(i).text() for i in range(3)] == ["b", "a", "c"]
+
+
+def test_file_vector_follows_the_map_crs(view, tmp_path, qtbot):
+    fiona = pytest.importorskip("fiona")
+    path = tmp_path / "p.gpkg"
+    with fiona.open(str(path), "w", driver="GPKG", crs="EPSG:25832",
+                    schema={"geometry": "Point", "properties": {"name": "str"}}) as dst:
+        dst.write({"geometry": {"type": "Point", "coordinates": (500000.0, 5400000.0)},
+                   "properties": {"name": "A"}})
+    layer = view.add_vector(path, "vector")
+    assert layer.bounds()[0] == pytest.approx(500000.0)
+    view.set_crs("EPSG:4326")
+    view.grab()
+    assert layer.bounds()[0] == pytest.approx(9.0, abs=1e-6)
+
+
+def test_a_change_while_drawing_keeps_the_cache_stale(view):
+    drawn = []
+
+    class Changing(MapLayer):
+        def bounds(self):
+            return None
+
+        def paint(self, painter, state):
+            drawn.append(1)
+            if len(drawn) == 1:
+                self.changed.emit()  # e.g. a file re-read in paint
+
+    view.add_layer(Changing("x", "vector"))
+    view.grab()
+    view.grab()
+    assert len(drawn) == 2
+    view.grab()
+    assert len(drawn) == 2
