@@ -83,3 +83,54 @@ OUTSIDE_MODELS: XY = (402250.0, 5674660.0)
 
 #: A click on the surface's nodata cells (a ground point: the form asks for a typed height).
 ON_NODATA: XY = (402337.0, 5674742.0)
+
+
+def write_surface(path, crs=SURFACE["crs"]):
+    """The analytic plane of :data:`SURFACE` as a float64 GeoTIFF (with its nodata box)."""
+    import numpy as np
+    import rasterio
+    from rasterio.transform import from_origin
+
+    xmin, ymin, xmax, ymax = SURFACE["bounds"]
+    res = SURFACE["res"]
+    cols, rows = int((xmax - xmin) / res), int((ymax - ymin) / res)
+    x = xmin + (np.arange(cols) + 0.5) * res
+    y = ymax - (np.arange(rows) + 0.5) * res
+    xx, yy = np.meshgrid(x, y)
+    z = surface_z(xx, yy)
+    bx0, by0, bx1, by1 = SURFACE["nodata_box"]
+    z[(xx > bx0) & (xx < bx1) & (yy > by0) & (yy < by1)] = -9999.0
+    profile = {"driver": "GTiff", "width": cols, "height": rows, "count": 1,
+               "dtype": "float64", "transform": from_origin(xmin, ymax, res, res),
+               "nodata": -9999.0}
+    if crs:
+        profile["crs"] = crs
+    with rasterio.open(path, "w", **profile) as dst:
+        dst.write(z, 1)
+    return path
+
+
+def check_written(case: Dict[str, object], hits: List[XY], rows: List[Tuple[object, dict]]
+                  ) -> None:
+    """Assert what a tool of ``case`` wrote (``rows``: (shapely geometry, properties) read back
+    from edits.gpkg) for the clicked pixels' map points ``hits``: one feature, its geometry
+    type, attributes, vertices at the hits and Z (or the start point's height) on the surface
+    to 1e-6 m. The QGIS and the standalone tests expect the same."""
+    assert len(rows) == 1, rows
+    geometry, props = rows[0]
+    assert case["geometry"] in geometry.geom_type
+    for key, value in case["attributes"].items():
+        assert props[key] == value, (key, props)
+    coords = (list(geometry.exterior.coords)[:-1] if "Polygon" in geometry.geom_type
+              else list(geometry.coords))
+    assert len(coords) == len(hits)
+    for (x, y, *_z), (hx, hy) in zip(coords, hits):
+        assert abs(x - hx) <= 1e-6 and abs(y - hy) <= 1e-6, ((x, y), (hx, hy))
+    if case.get("z") == "surface":
+        if case["layer"] == "start_points":
+            assert abs(props["height"] - surface_z(*hits[0])) <= 1e-6
+        else:
+            for x, y, z in coords:
+                assert abs(z - surface_z(x, y)) <= 1e-6
+    if case["layer"] == "exclusion_areas":
+        assert props["action"] in ("keep", "remove", "exclude")

@@ -14,7 +14,7 @@ import math
 import shutil
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Tuple
 
 import pytest
 
@@ -28,8 +28,9 @@ from edit_clicks import (
     INTERPOLATED,
     ON_NODATA,
     OUTSIDE_MODELS,
-    SURFACE,
+    check_written,
     surface_z,
+    write_surface,
 )
 
 pytestmark = pytest.mark.qgis
@@ -42,31 +43,6 @@ SHOTS = Path("/tmp/e")
 def block(tmp_path_factory, tiny_block, plugin) -> Path:
     """A tiny synthetic block, made once (each test edits a copy)."""
     return copy_block(tiny_block, tmp_path_factory.mktemp("edit-block"), "block")
-
-
-def write_surface(path: Path, crs: Optional[str] = SURFACE["crs"]) -> Path:
-    """The analytic plane of :data:`SURFACE` as a float64 GeoTIFF (with its nodata box)."""
-    import numpy as np
-    import rasterio
-    from rasterio.transform import from_origin
-
-    xmin, ymin, xmax, ymax = SURFACE["bounds"]
-    res = SURFACE["res"]
-    cols, rows = int((xmax - xmin) / res), int((ymax - ymin) / res)
-    x = xmin + (np.arange(cols) + 0.5) * res
-    y = ymax - (np.arange(rows) + 0.5) * res
-    xx, yy = np.meshgrid(x, y)
-    z = surface_z(xx, yy)
-    bx0, by0, bx1, by1 = SURFACE["nodata_box"]
-    z[(xx > bx0) & (xx < bx1) & (yy > by0) & (yy < by1)] = -9999.0
-    profile = {"driver": "GTiff", "width": cols, "height": rows, "count": 1,
-               "dtype": "float64", "transform": from_origin(xmin, ymax, res, res),
-               "nodata": -9999.0}
-    if crs:
-        profile["crs"] = crs
-    with rasterio.open(path, "w", **profile) as dst:
-        dst.write(z, 1)
-    return path
 
 
 class StandIn:
@@ -241,25 +217,7 @@ def test_tool_writes_the_feature_and_undo_removes_it(work, case):
     assert layer.featureCount() == 0  # QGIS's undo removes the edit
     layer.undoStack().redo()
     assert layer.featureCount() == 1
-    rows = saved(work, layer_name)
-    assert len(rows) == 1
-    geometry, props = rows[0]
-    assert case["geometry"] in geometry.geom_type
-    for key, value in case["attributes"].items():
-        assert props[key] == value
-    coords = (list(geometry.exterior.coords)[:-1] if "Polygon" in geometry.geom_type
-              else list(geometry.coords))
-    assert len(coords) == len(hits)
-    for (x, y, *_z), (hx, hy) in zip(coords, hits):
-        assert (x, y) == pytest.approx((hx, hy), abs=1e-6)
-    if case.get("z") == "surface":
-        if layer_name == "start_points":
-            assert props["height"] == pytest.approx(surface_z(*hits[0]), abs=1e-6)
-        else:
-            for x, y, z in coords:
-                assert z == pytest.approx(surface_z(x, y), abs=1e-6)
-    if layer_name == "exclusion_areas":
-        assert props["action"] in ("keep", "remove", "exclude")
+    check_written(case, hits, saved(work, layer_name))  # the standalone test expects the same
 
 
 def test_start_point_in_the_real_form(work, qgis_app):
