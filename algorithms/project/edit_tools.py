@@ -32,7 +32,7 @@ import pyproj
 import rasterio
 from numpy.typing import NDArray
 from rasterio.windows import Window
-from shapely.geometry import LineString, Point
+from shapely.geometry import LineString, MultiLineString, Point
 from shapely.ops import nearest_points
 
 from ..crs_check import crs_label, same_horizontal_crs
@@ -298,6 +298,77 @@ def _interpolated(xy: NDArray, end_heights: Optional[Tuple[float, float]]) -> ND
     return z0 + (z1 - z0) * length / length[-1]
 
 
+# -- re-drape ------------------------------------------------------------------------------------
+#: The edit layers whose heights come from a surface: Z of breaklines, ground and check points,
+#: the ``height`` field of start points.
+REDRAPE_LAYERS = ("breaklines", "start_points", "ground_points", "check_points")
+
+
+@dataclass
+class Redraped:
+    """The answer of :func:`redrape_feature`.
+
+    Attributes
+    ----------
+    geometry : shapely geometry or None
+        The feature with its new heights (Z); ``None`` for a start point (its height is a
+        field) or when there is no height (:attr:`reason`).
+    height : float or None
+        The new ``height`` of a start point.
+    reason : str or None
+        Why the feature got no new heights (a vertex outside the surface or on nodata).
+    """
+
+    geometry: Any = None
+    height: Optional[float] = None
+    reason: Optional[str] = None
+
+    @property
+    def ok(self) -> bool:
+        return self.reason is None
+
+
+def redrape_feature(surface: PathLike, layer: str, geometry: Any, crs: Any = None) -> Redraped:
+    """New heights of one edit feature from a surface (the *Re-drape* of both faces).
+
+    Breaklines get the bilinear Z of every vertex (each part of a multi-line), ground and check
+    points their Z, start points their ``height`` field; x and y stay as they are.
+
+    Parameters
+    ----------
+    surface : path
+        The DSM/DTM.
+    layer : str
+        One of :data:`REDRAPE_LAYERS`.
+    geometry : shapely geometry
+        The feature, in ``crs``.
+    crs : CRS-like, optional
+        The feature's CRS; ``None``: the surface's own.
+
+    Raises
+    ------
+    InputError
+        A layer without heights, or the errors of :func:`surface_heights`.
+    """
+    if layer not in REDRAPE_LAYERS:
+        raise InputError(f"The layer '{layer}' has no heights to re-drape; use one of "
+                         f"{', '.join(REDRAPE_LAYERS)}.")
+    if layer == "breaklines":
+        parts = []
+        for part in getattr(geometry, "geoms", [geometry]):
+            draped = drape_line(surface, list(part.coords), crs=crs)
+            if draped.reason:
+                return Redraped(reason=draped.reason)
+            parts.append(draped.line())
+        return Redraped(MultiLineString(parts) if hasattr(geometry, "geoms") else parts[0])
+    point = sample_height(surface, geometry.x, geometry.y, crs=crs)
+    if point.reason:
+        return Redraped(reason=point.reason)
+    if layer == "start_points":
+        return Redraped(height=point.z)
+    return Redraped(Point(geometry.x, geometry.y, point.z))
+
+
 # -- snapping --------------------------------------------------------------------------------------
 @dataclass
 class Snap:
@@ -363,5 +434,6 @@ def mosaic_seamlines(path: PathLike, crs: Any = None) -> List[Any]:
     return read_geometries(path, ("LineString",), crs, ("seamlines",))
 
 
-__all__ = ["NODATA", "OUTSIDE", "DrapedLine", "HeightSample", "Snap", "drape_line",
-           "mosaic_seamlines", "sample_height", "snap_to_lines", "surface_heights"]
+__all__ = ["NODATA", "OUTSIDE", "REDRAPE_LAYERS", "DrapedLine", "HeightSample", "Redraped",
+           "Snap", "drape_line", "mosaic_seamlines", "redrape_feature", "sample_height",
+           "snap_to_lines", "surface_heights"]

@@ -348,25 +348,19 @@ class EditController:
         changes = []
         for feature in features:
             shape = self.layer_geometry(layer, feature.geometry())
-            coords = [c[:2] for part in getattr(shape, "geoms", [shape]) for c in part.coords]
-            try:
-                draped = (edit_tools.drape_line(path, coords, crs=self.project_crs())
-                          if name == "breaklines" else None)
-                point = (edit_tools.sample_height(path, *coords[0], crs=self.project_crs())
-                         if draped is None else None)
+            try:  # the Qt-free part is the standalone tool's too
+                answer = edit_tools.redrape_feature(path, name, shape, crs=self.project_crs())
             except PhotodemError as exc:
                 self.message(str(exc), Qgis.Critical)
                 return None
-            reason = draped.reason if draped is not None else point.reason
-            if reason:
-                self.message(tr("Feature {0}: {1}").format(feature.id(), reason), Qgis.Critical)
+            if answer.reason:
+                self.message(tr("Feature {0}: {1}").format(feature.id(), answer.reason),
+                             Qgis.Critical)
                 return None
-            if name == "start_points":
-                changes.append((feature.id(), None, point.z))
+            if answer.geometry is None:
+                changes.append((feature.id(), None, answer.height))
                 continue
-            new = (LineString(draped.coords) if draped is not None
-                   else Point(coords[0][0], coords[0][1], point.z))
-            g = to_qgis(new)
+            g = to_qgis(answer.geometry)
             if layer.crs() != target:
                 g.transform(back)
             changes.append((feature.id(), g, None))
