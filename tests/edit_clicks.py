@@ -8,7 +8,7 @@ tests. Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block
 
 from __future__ import annotations
 
-from typing import Dict, List, Tuple
+from typing import Any, Dict, List, Tuple
 
 XY = Tuple[float, float]
 
@@ -134,3 +134,35 @@ def check_written(case: Dict[str, object], hits: List[XY], rows: List[Tuple[obje
                 assert abs(z - surface_z(x, y)) <= 1e-6
     if case["layer"] == "exclusion_areas":
         assert props["action"] in ("keep", "remove", "exclude")
+
+
+class FakeAsk:
+    """The tools' questions answered from ``answer`` (no dialog); every call is recorded."""
+
+    def __init__(self) -> None:
+        self.answer: Dict[str, Any] = {}
+        self.calls: List[Tuple[Any, ...]] = []
+
+    def height(self, title, height, message="", text_label=""):
+        self.calls.append(("height", height, message))
+        value = self.answer.get("height", height)
+        return None if value is None else (value, self.answer.get("text", ""))
+
+    def action(self):
+        self.calls.append(("action",))
+        return self.answer.get("action", "remove"), self.answer.get("text", "")
+
+    def breakline(self, heights, editable, message=""):
+        self.calls.append(("breakline", list(heights), list(editable), message))
+        typed = self.answer.get("heights")
+        out = [typed[i] if (typed and free) else z
+               for i, (z, free) in enumerate(zip(heights, editable))]
+        return out, self.answer.get("kind", "breakline")
+
+    def text(self, title, label):
+        self.calls.append(("text", title))
+        return self.answer.get("text", "")
+
+    def repair(self, message):
+        self.calls.append(("repair", message))
+        return bool(self.answer.get("repair", False))

@@ -42,7 +42,6 @@ from qgis.gui import (
 from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtGui import QColor
 from shapely import wkb
-from shapely.geometry import LineString, Point
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.project import edit_rules, edit_tools

@@ -28,6 +28,7 @@ from edit_clicks import (
     INTERPOLATED,
     ON_NODATA,
     OUTSIDE_MODELS,
+    FakeAsk,
     check_written,
     surface_z,
     write_surface,
@@ -64,38 +65,6 @@ class StandIn:
 
     def add_products(self, paths: Any) -> List[Any]:
         return []
-
-
-class FakeAsk:
-    """The tools' questions answered from ``answer`` (no dialog); every call is recorded."""
-
-    def __init__(self) -> None:
-        self.answer: Dict[str, Any] = {}
-        self.calls: List[Tuple[Any, ...]] = []
-
-    def height(self, title, height, message="", text_label=""):
-        self.calls.append(("height", height, message))
-        value = self.answer.get("height", height)
-        return None if value is None else (value, self.answer.get("text", ""))
-
-    def action(self):
-        self.calls.append(("action",))
-        return self.answer.get("action", "remove"), self.answer.get("text", "")
-
-    def breakline(self, heights, editable, message=""):
-        self.calls.append(("breakline", list(heights), list(editable), message))
-        typed = self.answer.get("heights")
-        out = [typed[i] if (typed and free) else z
-               for i, (z, free) in enumerate(zip(heights, editable))]
-        return out, self.answer.get("kind", "breakline")
-
-    def text(self, title, label):
-        self.calls.append(("text", title))
-        return self.answer.get("text", "")
-
-    def repair(self, message):
-        self.calls.append(("repair", message))
-        return bool(self.answer.get("repair", False))
 
 
 @pytest.fixture
