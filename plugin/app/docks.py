@@ -76,11 +76,15 @@ def batch_dock(window: Any, project: Optional[str] = None) -> QtWidgets.QDockWid
     if dock is None:
         dock = QtWidgets.QDockWidget(tr("Batch"), window)
         dock.setObjectName(BATCH_DOCK)
-        window.addDockWidget(Qt.BottomDockWidgetArea, dock)
+        window.addDockWidget(Qt.RightDockWidgetArea, dock)
+        quality = window.findChild(QtWidgets.QDockWidget, QUALITY_DOCK)
+        if quality is not None:  # one column of tabs beside the map: the map stays large
+            window.tabifyDockWidget(quality, dock)
     if dock.widget() is not dialog:
         dialog.setWindowFlags(Qt.Widget)
         dock.setWidget(dialog)
         dialog.finished.connect(lambda _r: dock.close())
+        dialog.backgrounded.connect(dock.close)  # the status bar's button shows it again
     dialog.show()
     dock.show()
     dock.raise_()

@@ -360,9 +360,8 @@ def window_message(window: Any) -> Message:
 
 def z_mode_labels() -> List[Tuple[str, str]]:
     """The breakline height modes with their labels."""
-    labels = {"drape": tr("Breakline Z: draped on the surface"),
-              "typed": tr("Breakline Z: typed"),
-              "interpolate": tr("Breakline Z: typed ends, interpolated")}
+    labels = {"drape": tr("Z draped"), "typed": tr("Z typed"),
+              "interpolate": tr("Z interpolated")}
     return [(mode, labels[mode]) for mode in edit_rules.Z_MODES]
 
 
@@ -387,6 +386,7 @@ class EditingToolbar(QtWidgets.QToolBar):
         self.context: Optional[EditContext] = None
         self.actions_: Dict[str, QtWidgets.QAction] = {}
         self.factories: Dict[str, Callable[[], Optional[MapTool]]] = {}
+        self.extra_surfaces: List[Tuple[str, str]] = []  # chosen by hand (set_surface)
         for layer, title in layer_titles().items():
             self.add_tool(layer, title, lambda name=layer: self.edit_tool(name))
         self.addSeparator()
@@ -394,11 +394,13 @@ class EditingToolbar(QtWidgets.QToolBar):
         self.surface_box.setObjectName("photodemSurface")
         self.surface_box.setToolTip(tr("The surface that gives new points and breaklines "
                                        "their heights"))
-        self.surface_box.setMinimumContentsLength(18)
+        self.surface_box.setMinimumContentsLength(12)
         self.surface_box.currentIndexChanged.connect(self._surface_chosen)
         self.addWidget(self.surface_box)
         self.z_box = QtWidgets.QComboBox(self)
         self.z_box.setObjectName("photodemZMode")
+        self.z_box.setToolTip(tr("Breakline heights: draped on the surface, typed at every "
+                                 "vertex, or typed at the ends and interpolated between"))
         for mode, label in z_mode_labels():
             self.z_box.addItem(label, mode)
         self.z_box.currentIndexChanged.connect(lambda _i: self.set_z_mode(self.z_box.currentData()))
@@ -407,6 +409,8 @@ class EditingToolbar(QtWidgets.QToolBar):
         self.save_action = self.addAction(tr("Save edits"), self.save)
         self.save_action.setShortcut(QtGui.QKeySequence.Save)
         self.set_project(None)
+        if self.view is not None:
+            self.view.layers_changed.connect(self.fill_surfaces)
 
     @property
     def view(self) -> Any:
@@ -473,24 +477,45 @@ class EditingToolbar(QtWidgets.QToolBar):
         for key in layer_titles():
             self.actions_[key].setEnabled(self.context is not None)
         self.save_action.setEnabled(self.context is not None)
+        self.fill_surfaces(root)
+
+    def surfaces(self, root: Optional[Any]) -> List[Tuple[str, str]]:
+        """(label, path) of the DSMs and DTMs: the project's products, then those on the map
+        (the truth rasters of a synthetic project, a raster added by hand)."""
+        found = [(f"{p.kind.upper()} {p.name}", str(p.path))
+                 for p in (find_products(root) if root is not None else [])
+                 if p.kind in ELEVATION_KINDS]
+        for layer in self.view.layers() if self.view is not None else []:
+            path = getattr(layer, "path", None)
+            if layer.kind in ELEVATION_KINDS and path is not None:
+                found.append((layer.name, str(path)))
+        unique: Dict[str, str] = {}
+        for label, path in found + self.extra_surfaces:
+            unique.setdefault(str(Path(path).resolve()), label)
+        return [(label, path) for path, label in unique.items()]
+
+    def fill_surfaces(self, root: Optional[Any] = None) -> None:
+        """The surface list again (the chosen one stays when still there)."""
+        if root is None and self.context is not None:
+            root = self.context.project.root
+        chosen = self.surface_box.currentData()
         with QtCore.QSignalBlocker(self.surface_box):
             self.surface_box.clear()
-        found = find_products(root) if root is not None else []
-        for product in found:
-            if product.kind in ELEVATION_KINDS:
-                self.surface_box.addItem(f"{product.kind.upper()} {product.name}",
-                                         str(product.path))
-        if not self.surface_box.count():
-            self.surface_box.addItem(tr("(no DSM or DTM yet)"), None)
+            for label, path in self.surfaces(root if self.context is not None else None):
+                self.surface_box.addItem(label, path)
+            if not self.surface_box.count():
+                self.surface_box.addItem(tr("(no DSM or DTM yet)"), None)
+            index = self.surface_box.findData(chosen) if chosen else -1
+            self.surface_box.setCurrentIndex(max(index, 0))
         self._surface_chosen()
 
     def set_surface(self, path: Any, name: str = "") -> None:
         """Choose the surface ``path`` (added to the list when missing)."""
-        index = self.surface_box.findData(str(path))
-        if index < 0:
-            self.surface_box.addItem(name or Path(path).stem, str(path))
-            index = self.surface_box.count() - 1
-        self.surface_box.setCurrentIndex(index)
+        path = str(Path(path).resolve())
+        if self.surface_box.findData(path) < 0:
+            self.extra_surfaces.append((name or Path(path).stem, path))
+            self.fill_surfaces()
+        self.surface_box.setCurrentIndex(self.surface_box.findData(path))
         self._surface_chosen()
 
     def _surface_chosen(self, _index: int = 0) -> None:

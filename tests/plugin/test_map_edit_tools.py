@@ -240,12 +240,14 @@ def test_no_project_disables_the_tools(work):
 
 @pytest.mark.parametrize("lang", ["en", "de"])
 def test_screenshot_capture_in_progress(work, lang):
+    from _translation_preview import install_preview_german
+
     from photodem.plugin.i18n import install_translator
 
     SHOTS.mkdir(parents=True, exist_ok=True)
     window = work["window"]
     if lang == "de":
-        install_translator("de_DE")
+        install_preview_german()
         window.removeToolBar(work["bar"])
         bar = editing_toolbar(window, ask=work["ask"])
         window.addToolBar(bar)
