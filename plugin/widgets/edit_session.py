@@ -320,4 +320,38 @@ class EditSession(QtCore.QObject):
         return True
 
 
-__all__ = ["EDITS_FILE", "EditSession", "add_text", "ask_save", "change_text", "delete_text"]
+def edit_layer_title(name: str) -> str:
+    """The name of an edit layer in the layer list (translated; the same as in QGIS)."""
+    titles = {"start_points": tr("Start points"), "exclusion_areas": tr("Exclusion areas"),
+              "boundaries": tr("Boundaries"), "breaklines": tr("Breaklines"),
+              "ground_points": tr("Ground points"), "seamlines": tr("Seamlines"),
+              "check_points": tr("Check points")}
+    return titles.get(name, name)
+
+
+def show_edits(view: Any, session: EditSession) -> List[Any]:
+    """Add one vector layer per edit layer to a MapView (kind ``edit:<layer>``, drawn from the
+    session's memory, the first edit layer on top) and draw each again when the session
+    changes it. Layers of that kind already in the view are replaced. Returns the layers."""
+    added = []
+    for name in reversed(list(EDIT_LAYERS)):
+        old = view.layer_by_kind(f"edit:{name}")
+        if old is not None:
+            view.remove_layer(old)
+        added.append(view.add_vector(session.source(name), f"edit:{name}",
+                                     name=edit_layer_title(name)))
+
+    def redraw(layer: str) -> None:
+        try:
+            drawn = view.layer_by_kind(f"edit:{layer}")
+        except RuntimeError:  # the view was closed before the session
+            return
+        if drawn is not None and hasattr(drawn, "reload"):
+            drawn.reload()
+
+    session.changed.connect(redraw)
+    return added[::-1]
+
+
+__all__ = ["EDITS_FILE", "EditSession", "add_text", "ask_save", "change_text", "delete_text",
+           "edit_layer_title", "show_edits"]

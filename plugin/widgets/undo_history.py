@@ -7,6 +7,7 @@ is called "<empty>" in the operator's language.
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any, Optional, Tuple
 
 from ..i18n import tr
@@ -68,10 +69,8 @@ class UndoHistory(QtWidgets.QWidget):
             for signal, slot in ((stack.canUndoChanged, self.undo_button.setEnabled),
                                  (stack.canRedoChanged, self.redo_button.setEnabled),
                                  (stack.cleanChanged, self._show_status)):
-                try:
+                with contextlib.suppress(TypeError):  # already disconnected
                     signal.disconnect(slot)
-                except TypeError:  # already disconnected
-                    pass
         self.session = session
         stack = session.undo_stack if session is not None else None
         self.view.setStack(stack)
