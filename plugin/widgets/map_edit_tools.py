@@ -29,6 +29,7 @@ from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 from . import edit_flow
 from .edit_forms import DialogAsker
 from .map_layer import MapTool, ViewState
+from .map_vertex_tools import DeleteFeatureTool, VertexTool, redrape
 
 XY = Tuple[float, float]
 #: ``message(text, level)`` with level ``info``, ``warning`` or ``critical``.
@@ -406,6 +407,13 @@ class EditingToolbar(QtWidgets.QToolBar):
         self.z_box.currentIndexChanged.connect(lambda _i: self.set_z_mode(self.z_box.currentData()))
         self.addWidget(self.z_box)
         self.addSeparator()
+        self.modify_actions = [self._tool_menu("vertex", tr("Vertices"), self.vertex_tool),
+                               self._tool_menu("delete", tr("Delete feature"),
+                                               self.delete_tool)]
+        self.redrape_action = self.addAction(tr("Re-drape"), self.redrape)
+        self.redrape_action.setToolTip(tr("New heights of every breakline and point from the "
+                                          "chosen surface (one undo step)"))
+        self.modify_actions.append(self.redrape_action)
         self.save_action = self.addAction(tr("Save edits"), self.save)
         self.save_action.setShortcut(QtGui.QKeySequence.Save)
         self.set_project(None)
@@ -417,10 +425,11 @@ class EditingToolbar(QtWidgets.QToolBar):
         return self.window_.map_view
 
     # -- tools -------------------------------------------------------------------------------------
-    def add_tool(self, key: str, text: str, factory: Callable[[], Optional[MapTool]]
-                 ) -> QtWidgets.QAction:
-        """A checkable action that makes ``factory()`` the map's tool (None: refused)."""
-        action = self.addAction(text)
+    def add_tool(self, key: str, text: str, factory: Callable[[], Optional[MapTool]],
+                 menu: Optional[QtWidgets.QMenu] = None) -> QtWidgets.QAction:
+        """A checkable action (on the toolbar, or in ``menu``) that makes ``factory()`` the
+        map's tool (None: refused)."""
+        action = menu.addAction(text) if menu is not None else self.addAction(text)
         action.setCheckable(True)
         action.setObjectName(f"photodemTool_{key}")
         action.toggled.connect(lambda on, k=key: self._toggled(k, on))
@@ -444,14 +453,64 @@ class EditingToolbar(QtWidgets.QToolBar):
             self.view.set_tool(None)
             return
         tool.tool_key = key
+        previous = self.view.tool()
         self.view.set_tool(tool)
         self.view.setFocus()
+        if previous is not None and hasattr(previous, "tool_key"):
+            previous.deleteLater()  # made by this toolbar: one tool object per activation
 
     def activate(self, key: str) -> Optional[MapTool]:
         """Switch the tool ``key`` on (as its action does); the map's tool or None."""
         self.actions_[key].setChecked(True)
         tool = self.view.tool()
         return tool if getattr(tool, "tool_key", None) == key else None
+
+    def _tool_menu(self, kind: str, text: str,
+                   factory: Callable[[str], Optional[MapTool]]) -> QtWidgets.QAction:
+        """A toolbar button with one tool per edit layer in its menu (vertex, delete)."""
+        menu = QtWidgets.QMenu(text, self)
+        for layer, title in layer_titles().items():
+            self.add_tool(f"{kind}:{layer}", title, lambda name=layer: factory(name), menu)
+        button = QtWidgets.QToolButton(self)
+        button.setText(text)
+        button.setMenu(menu)
+        button.setPopupMode(QtWidgets.QToolButton.InstantPopup)
+        button.setObjectName(f"photodemTools_{kind}")
+        return self.addWidget(button)
+
+    def _modify_tool(self, tool: Any) -> Any:
+        tool.message.connect(lambda text: self.message(text, "warning"))
+        return tool
+
+    def vertex_tool(self, layer: str) -> Optional[MapTool]:
+        """Move (drag) or delete (right click) vertices of ``layer``; heights from the
+        surface."""
+        if self.context is None or not self.context.can_edit(layer):
+            return None
+        return self._modify_tool(VertexTool(self.view, self.context.session, layer,
+                                            self.context.surface_path(False),
+                                            self.context.project, parent=self))
+
+    def delete_tool(self, layer: str) -> Optional[MapTool]:
+        """A click removes the feature of ``layer`` under the cursor."""
+        if self.context is None or not self.context.can_edit(layer):
+            return None
+        return self._modify_tool(DeleteFeatureTool(self.view, self.context.session, layer,
+                                                   parent=self))
+
+    def redrape(self) -> int:
+        """*Re-drape*: every breakline and point gets its heights from the chosen surface
+        again (one undo step); the number of features changed."""
+        path = self.context.surface_path(True) if self.context is not None else None
+        if path is None or not self.context.can_edit("breaklines"):
+            return 0
+        try:
+            count = redrape(self.context.session, path)
+        except PhotodemError as exc:
+            self.message(str(exc), "critical")
+            return 0
+        self.message(tr("{0} features re-draped on the surface.").format(count), "info")
+        return count
 
     def edit_tool(self, layer: str) -> Optional[MapTool]:
         if self.context is None:
@@ -474,9 +533,11 @@ class EditingToolbar(QtWidgets.QToolBar):
                 self.context.ask = DialogAsker(self.window_)
             self.context.seamline_files = self.seamline_files
             self.context.z_mode = self.z_box.currentData()
-        for key in layer_titles():
-            self.actions_[key].setEnabled(self.context is not None)
-        self.save_action.setEnabled(self.context is not None)
+        for key, action in self.actions_.items():
+            if not key.startswith("qc_"):
+                action.setEnabled(self.context is not None)
+        for action in self.modify_actions + [self.save_action]:
+            action.setEnabled(self.context is not None)
         self.fill_surfaces(root)
 
     def surfaces(self, root: Optional[Any]) -> List[Tuple[str, str]]:

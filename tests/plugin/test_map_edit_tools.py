@@ -27,6 +27,7 @@ from edit_clicks import (
     OUTSIDE_MODELS,
     FakeAsk,
     check_written,
+    surface_z,
     write_surface,
 )
 
@@ -230,6 +231,23 @@ def test_read_only_edits_refuse_the_tools(work, tmp_path, qtbot):
     assert not bar.actions_["ground_points"].isChecked()
     assert "read-only" in " ".join(t for _, t in window.messages)
     assert (root / "edits.gpkg").read_bytes() == b"not a geopackage"
+
+
+def test_vertex_delete_and_redrape_from_the_toolbar(work):
+    from photodem.plugin.widgets.map_vertex_tools import DeleteFeatureTool, VertexTool
+
+    work["ask"].answer = {"height": 30.0}
+    (hx, hy), = draw(work, "ground_points", [(402300.0, 5674700.0)])
+    assert isinstance(work["bar"].activate("vertex:ground_points"), VertexTool)
+    assert not work["bar"].actions_["ground_points"].isChecked()
+    assert work["bar"].redrape() == 1
+    (_, geometry, _), = work["session"].features("ground_points")
+    assert geometry.z == pytest.approx(surface_z(hx, hy), abs=1e-6)
+    work["session"].undo_stack.undo()
+    assert work["session"].features("ground_points")[0][1].z == 30.0
+    assert isinstance(work["bar"].activate("delete:ground_points"), DeleteFeatureTool)
+    click(work["view"], hx, hy)
+    assert work["session"].features("ground_points") == []
 
 
 def test_no_project_disables_the_tools(work):
