@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from typing import Any, Dict, Optional
 
-from ...algorithms.errors import InputError
 from ..i18n import tr
 from ..qt import QtCore, QtWidgets
 from ..widgets.map_edit_tools import EditingToolbar, editing_toolbar
@@ -33,14 +32,16 @@ def _dock(window: QtWidgets.QMainWindow, name: str, title: str, widget: QtWidget
     return dock
 
 
-def session_writer(window: Any) -> Any:
-    """The quality panel's ``edit_writer``: a blunder becomes an undoable edit of the window's
-    edit session (saved with *Save edits*), never a direct write to ``edits.gpkg``."""
+def session_writer(window: Any, fallback: Any) -> Any:
+    """The quality panel's ``edit_writer``: with a project open, a blunder becomes an undoable
+    edit of the window's edit session (saved with *Save edits*, never written behind the
+    session's back); without one, ``fallback`` (the panel's own writer into the project typed
+    in the panel)."""
     def write(layer: str, geometry: Any, attributes: Dict[str, Any]) -> None:
         session = getattr(window, "edit_session", None)
         if session is None:
-            raise InputError(tr("Open a PhotoDEM project first: the edit goes into its "
-                                "layer '{0}'.").format(layer))
+            fallback(layer, geometry, attributes)
+            return
         session.add(layer, geometry, attributes, text=tr("Blunder to {0}").format(layer))
     return write
 
@@ -56,7 +57,7 @@ def quality_dock(window: QtWidgets.QMainWindow) -> QtWidgets.QDockWidget:
     panel = dock.widget()
     if not panel.property("photodemBound"):
         panel.setProperty("photodemBound", True)
-        panel.edit_writer = session_writer(window)
+        panel.edit_writer = session_writer(window, panel.edit_writer)
         view = getattr(window, "map_view", None)
         if view is not None:
             panel.zoomTo.connect(lambda bounds: view.set_extent(tuple(bounds)))
