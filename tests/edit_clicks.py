@@ -2,9 +2,10 @@
 
 Shared by the QGIS tests (``tests/qgis/test_edit_tools.py``) and the standalone map's tests
 (``tests/plugin/test_map_edit_tools.py``), with the surface (:func:`write_surface`), the
-expectation check (:func:`check_written`) and the form stand-in (:class:`FakeAsk`). Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block
-(``synthetic_block --size tiny``); heights come from the analytic surface :data:`SURFACE`
-(a plane, so bilinear sampling is exact to rounding: asserted to 1e-6 m).
+expectation check (:func:`check_written`) and the form stand-in (:class:`FakeAsk`).
+Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block (``synthetic_block
+--size tiny``); heights come from the analytic surface :data:`SURFACE` (a plane, so bilinear
+sampling is exact to rounding: asserted to 1e-6 m).
 """
 
 from __future__ import annotations
