@@ -99,11 +99,13 @@ def _qc_tools(window: Any, bar: EditingToolbar) -> None:
         dock.show()
         return dock.widget()
 
-    bar.addSeparator()
-    bar.add_tool("qc_area", tr("QC area"), lambda: QcAreaTool(window.map_view, panel()))
-    bar.add_tool("qc_profile", tr("QC profile"), lambda: QcLineTool(window.map_view, panel()))
+    more = bar.more
+    more.addSeparator()
+    bar.add_tool("qc_area", tr("QC area"), lambda: QcAreaTool(window.map_view, panel()), more)
+    bar.add_tool("qc_profile", tr("QC profile"), lambda: QcLineTool(window.map_view, panel()),
+                 more)
     bar.add_tool("qc_identify", tr("QC identify"),
-                 lambda: QcIdentifyTool(window.map_view, panel()))
+                 lambda: QcIdentifyTool(window.map_view, panel()), more)
 
 
 def _project_opened(window: Any, bar: EditingToolbar, history: UndoHistory, root: str) -> None:
@@ -112,11 +114,11 @@ def _project_opened(window: Any, bar: EditingToolbar, history: UndoHistory, root
     bar.set_project(root)
     history.set_session(session)
     for action in getattr(bar, "undo_actions", ()):
-        bar.removeAction(action)
+        bar.more.removeAction(action)
         action.deleteLater()
     bar.undo_actions = edit_actions(session, bar) if session is not None else ()
     for action in bar.undo_actions:
-        bar.insertAction(bar.save_action, action)
+        bar.more.insertAction(bar.save_action, action)
     dock = window.findChild(QtWidgets.QDockWidget, QUALITY_DOCK)
     if dock is not None:
         dock.widget().set_project(root)
@@ -128,6 +130,8 @@ def install_editing(window: Any, ask: Any = None) -> EditingToolbar:
     bar = editing_toolbar(window, ask)
     window.addToolBarBreak()
     window.addToolBar(bar)
+    window.addToolBarBreak()
+    window.addToolBar(bar.more)
     _qc_tools(window, bar)
     history = UndoHistory(getattr(window, "edit_session", None))
     _dock(window, HISTORY_DOCK, tr("Undo history"), history)

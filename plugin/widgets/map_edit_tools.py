@@ -406,15 +406,17 @@ class EditingToolbar(QtWidgets.QToolBar):
             self.z_box.addItem(label, mode)
         self.z_box.currentIndexChanged.connect(lambda _i: self.set_z_mode(self.z_box.currentData()))
         self.addWidget(self.z_box)
-        self.addSeparator()
+        #: The second row: vertex and delete tools, re-drape, Undo/Redo, save, QC tools.
+        self.more = QtWidgets.QToolBar(tr("PhotoDEM edit tools"), window)
+        self.more.setObjectName("photodemEditTools")
         self.modify_actions = [self._tool_menu("vertex", tr("Vertices"), self.vertex_tool),
                                self._tool_menu("delete", tr("Delete feature"),
                                                self.delete_tool)]
-        self.redrape_action = self.addAction(tr("Re-drape"), self.redrape)
+        self.redrape_action = self.more.addAction(tr("Re-drape"), self.redrape)
         self.redrape_action.setToolTip(tr("New heights of every breakline and point from the "
                                           "chosen surface (one undo step)"))
         self.modify_actions.append(self.redrape_action)
-        self.save_action = self.addAction(tr("Save edits"), self.save)
+        self.save_action = self.more.addAction(tr("Save edits"), self.save)
         self.save_action.setShortcut(QtGui.QKeySequence.Save)
         self.set_project(None)
         if self.view is not None:
@@ -426,10 +428,10 @@ class EditingToolbar(QtWidgets.QToolBar):
 
     # -- tools -------------------------------------------------------------------------------------
     def add_tool(self, key: str, text: str, factory: Callable[[], Optional[MapTool]],
-                 menu: Optional[QtWidgets.QMenu] = None) -> QtWidgets.QAction:
-        """A checkable action (on the toolbar, or in ``menu``) that makes ``factory()`` the
-        map's tool (None: refused)."""
-        action = menu.addAction(text) if menu is not None else self.addAction(text)
+                 target: Any = None) -> QtWidgets.QAction:
+        """A checkable action (on this toolbar, or on ``target``: another toolbar or a menu)
+        that makes ``factory()`` the map's tool (None: refused)."""
+        action = (target if target is not None else self).addAction(text)
         action.setCheckable(True)
         action.setObjectName(f"photodemTool_{key}")
         action.toggled.connect(lambda on, k=key: self._toggled(k, on))
@@ -476,7 +478,7 @@ class EditingToolbar(QtWidgets.QToolBar):
         button.setMenu(menu)
         button.setPopupMode(QtWidgets.QToolButton.InstantPopup)
         button.setObjectName(f"photodemTools_{kind}")
-        return self.addWidget(button)
+        return self.more.addWidget(button)
 
     def _modify_tool(self, tool: Any) -> Any:
         tool.message.connect(lambda text: self.message(text, "warning"))

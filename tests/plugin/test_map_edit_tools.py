@@ -82,6 +82,7 @@ def work(tmp_path, block, qtbot):
     ask = FakeAsk()
     bar = editing_toolbar(window, ask=ask)
     window.addToolBar(bar)
+    window.addToolBar(bar.more)
     bar.set_project(root)
     bar.set_surface(write_surface(tmp_path / "plane_dsm.tif"), "plane DSM")
     bar.message = bar.context.message = lambda text, level="warning": window.messages.append(
@@ -267,8 +268,11 @@ def test_screenshot_capture_in_progress(work, lang):
     if lang == "de":
         install_preview_german()
         window.removeToolBar(work["bar"])
+        window.removeToolBar(work["bar"].more)
         bar = editing_toolbar(window, ask=work["ask"])
         window.addToolBar(bar)
+        window.addToolBarBreak()
+        window.addToolBar(bar.more)
         bar.set_project(work["root"])
         bar.context.message = lambda text, level="warning": window.statusBar().showMessage(text)
         work["bar"] = bar

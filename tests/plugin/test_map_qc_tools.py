@@ -232,6 +232,9 @@ def test_screenshot_docks(qtbot, root, lang):
         w.map_view.wait_rendered(5000)
         QtWidgets.QApplication.processEvents()
         assert w.grab().save(str(SHOTS / f"docks_{lang}.png"))
+        quality_dock(w).raise_()  # the statistics of the drawn area
+        QtWidgets.QApplication.processEvents()
+        assert w.grab().save(str(SHOTS / f"docks_quality_{lang}.png"))
         QtGui.QGuiApplication.processEvents()
     finally:
         install_translator("en")
