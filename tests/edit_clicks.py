@@ -1,14 +1,16 @@
 """Clicks of the editing tools → the features they must write (plain data, no Qt).
 
-Shared by the QGIS tests (``tests/qgis/test_edit_tools.py``) and, later, the standalone tool's
-tests. Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block
-(``synthetic_block --size tiny``); heights come from the analytic surface :data:`SURFACE`
-(a plane, so bilinear sampling is exact to rounding: asserted to 1e-6 m).
+Shared by the QGIS tests (``tests/qgis/test_edit_tools.py``) and the standalone map's tests
+(``tests/plugin/test_map_edit_tools.py``), with the surface (:func:`write_surface`), the
+expectation check (:func:`check_written`) and the form stand-in (:class:`FakeAsk`).
+Coordinates are map coordinates in EPSG:25832 on the tiny synthetic block (``synthetic_block
+--size tiny``); heights come from the analytic surface :data:`SURFACE` (a plane, so bilinear
+sampling is exact to rounding: asserted to 1e-6 m).
 """
 
 from __future__ import annotations
 
-from typing import Dict, List, Tuple
+from typing import Any, Dict, List, Tuple
 
 XY = Tuple[float, float]
 
@@ -83,3 +85,86 @@ OUTSIDE_MODELS: XY = (402250.0, 5674660.0)
 
 #: A click on the surface's nodata cells (a ground point: the form asks for a typed height).
 ON_NODATA: XY = (402337.0, 5674742.0)
+
+
+def write_surface(path, crs=SURFACE["crs"]):
+    """The analytic plane of :data:`SURFACE` as a float64 GeoTIFF (with its nodata box)."""
+    import numpy as np
+    import rasterio
+    from rasterio.transform import from_origin
+
+    xmin, ymin, xmax, ymax = SURFACE["bounds"]
+    res = SURFACE["res"]
+    cols, rows = int((xmax - xmin) / res), int((ymax - ymin) / res)
+    x = xmin + (np.arange(cols) + 0.5) * res
+    y = ymax - (np.arange(rows) + 0.5) * res
+    xx, yy = np.meshgrid(x, y)
+    z = surface_z(xx, yy)
+    bx0, by0, bx1, by1 = SURFACE["nodata_box"]
+    z[(xx > bx0) & (xx < bx1) & (yy > by0) & (yy < by1)] = -9999.0
+    profile = {"driver": "GTiff", "width": cols, "height": rows, "count": 1,
+               "dtype": "float64", "transform": from_origin(xmin, ymax, res, res),
+               "nodata": -9999.0}
+    if crs:
+        profile["crs"] = crs
+    with rasterio.open(path, "w", **profile) as dst:
+        dst.write(z, 1)
+    return path
+
+
+def check_written(case: Dict[str, object], hits: List[XY], rows: List[Tuple[object, dict]]
+                  ) -> None:
+    """Assert what a tool of ``case`` wrote (``rows``: (shapely geometry, properties) read back
+    from edits.gpkg) for the clicked pixels' map points ``hits``: one feature, its geometry
+    type, attributes, vertices at the hits and Z (or the start point's height) on the surface
+    to 1e-6 m. The QGIS and the standalone tests expect the same."""
+    assert len(rows) == 1, rows
+    geometry, props = rows[0]
+    assert case["geometry"] in geometry.geom_type
+    for key, value in case["attributes"].items():
+        assert props[key] == value, (key, props)
+    coords = (list(geometry.exterior.coords)[:-1] if "Polygon" in geometry.geom_type
+              else list(geometry.coords))
+    assert len(coords) == len(hits)
+    for (x, y, *_z), (hx, hy) in zip(coords, hits):
+        assert abs(x - hx) <= 1e-6 and abs(y - hy) <= 1e-6, ((x, y), (hx, hy))
+    if case.get("z") == "surface":
+        if case["layer"] == "start_points":
+            assert abs(props["height"] - surface_z(*hits[0])) <= 1e-6
+        else:
+            for x, y, z in coords:
+                assert abs(z - surface_z(x, y)) <= 1e-6
+    if case["layer"] == "exclusion_areas":
+        assert props["action"] in ("keep", "remove", "exclude")
+
+
+class FakeAsk:
+    """The tools' questions answered from ``answer`` (no dialog); every call is recorded."""
+
+    def __init__(self) -> None:
+        self.answer: Dict[str, Any] = {}
+        self.calls: List[Tuple[Any, ...]] = []
+
+    def height(self, title, height, message="", text_label=""):
+        self.calls.append(("height", height, message))
+        value = self.answer.get("height", height)
+        return None if value is None else (value, self.answer.get("text", ""))
+
+    def action(self):
+        self.calls.append(("action",))
+        return self.answer.get("action", "remove"), self.answer.get("text", "")
+
+    def breakline(self, heights, editable, message=""):
+        self.calls.append(("breakline", list(heights), list(editable), message))
+        typed = self.answer.get("heights")
+        out = [typed[i] if (typed and free) else z
+               for i, (z, free) in enumerate(zip(heights, editable))]
+        return out, self.answer.get("kind", "breakline")
+
+    def text(self, title, label):
+        self.calls.append(("text", title))
+        return self.answer.get("text", "")
+
+    def repair(self, message):
+        self.calls.append(("repair", message))
+        return bool(self.answer.get("repair", False))

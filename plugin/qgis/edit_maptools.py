@@ -1,9 +1,9 @@
 """The map tools of the "PhotoDEM editing" toolbar and what they do with a click or a drawing.
 
-The tools only translate clicks and layers: heights come from
-:mod:`photodem.algorithms.project.edit_tools` (``sample_height``, ``drape_line``,
-``snap_to_lines``), the checks from :mod:`~photodem.algorithms.project.edit_checks`
-(``models_at``, ``check_new_breakline``, ``check_new_polygon``, ``validate_edit``). Every edit is
+The tools only translate clicks and layers: what a new edit becomes (heights, repairs,
+crossings, snapping, validation) is decided by the core's
+:mod:`photodem.algorithms.project.edit_rules` through the steps shared with the standalone map
+(:mod:`photodem.plugin.widgets.edit_flow`). Every edit is
 written through the layer's edit buffer (``beginEditCommand`` / ``addFeature`` /
 ``endEditCommand``), so QGIS's undo/redo works and *Save layer edits* commits; nothing else is
 ever written.
@@ -42,24 +42,22 @@ from qgis.gui import (
 from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtGui import QColor
 from shapely import wkb
-from shapely.geometry import LineString, Point
 
 from ...algorithms.errors import PhotodemError
-from ...algorithms.project import edit_checks, edit_tools
+from ...algorithms.project import edit_rules, edit_tools
 from ...algorithms.project.edits import EDIT_LAYERS, edits_access
 from ...algorithms.project.stereo_models import block_footprints
 from ..i18n import tr
-from .edit_forms import DialogAsker
+from ..widgets import edit_flow
+from ..widgets.edit_forms import DialogAsker
 
-#: Breakline height modes of the toolbar: each vertex draped on the surface, every height typed,
-#: or linear between the typed heights of the two ends.
-Z_MODES = ("drape", "typed", "interpolate")
-#: Point layers and the label of their text field in the height form.
-POINT_LAYERS = {"start_points": "note", "ground_points": "note", "check_points": "id"}
-#: Layers whose geometry carries the height in Z.
-Z_LAYERS = ("breaklines", "ground_points", "check_points")
-#: Seamline vertices within this many screen pixels of a mosaic seamline are snapped onto it.
-SNAP_PIXELS = 12
+# The rules' constants, re-exported for the toolbar (one copy, in the core).
+Z_MODES = edit_rules.Z_MODES
+POINT_LAYERS = edit_rules.POINT_LAYERS
+Z_LAYERS = edit_rules.Z_LAYERS
+SNAP_PIXELS = edit_rules.SNAP_PIXELS
+#: Message levels of the shared edit steps (:mod:`..widgets.edit_flow`) in QGIS's terms.
+LEVELS = {"info": Qgis.Info, "warning": Qgis.Warning, "critical": Qgis.Critical}
 
 
 def edits_problem(path: Path) -> Optional[str]:
@@ -212,28 +210,21 @@ class EditController:
 
     def sample(self, x: float, y: float) -> Tuple[Optional[float], str]:
         """The surface height at a project point and, without one, why (for the form)."""
-        path = self.surface_path(needed=False)
-        if path is None:
-            return None, tr("No surface chosen; type the height.")
-        try:
-            answer = edit_tools.sample_height(path, x, y, crs=self.project_crs())
-        except PhotodemError as exc:
-            return None, str(exc)
-        return answer.z, answer.reason or ""
+        return edit_flow.sample(self, x, y)
 
-    # -- writing -------------------------------------------------------------------------------
+    # -- the host of the shared edit steps (:mod:`..widgets.edit_flow`) ---------------------------
+    @property
+    def project(self) -> Any:
+        return self.workspace.project
+
+    def say(self, text: str, level: str = "warning") -> None:
+        self.message(text, LEVELS.get(level, Qgis.Warning))
+
     def checked(self, name: str, geometry: Any, attributes: Dict[str, Any]) -> bool:
         """``validate_edit``: errors refuse the edit (message), warnings are shown."""
-        problems = edit_checks.validate_edit(name, geometry, attributes, self.workspace.project,
-                                             self.footprints())
-        bad = edit_checks.errors(problems)
-        if bad:
-            self.message(" ".join(p.message for p in bad), Qgis.Critical)
-            return False
-        if problems:
-            self.message(" ".join(p.message for p in problems))
-        return True
+        return edit_flow.checked(self, name, geometry, attributes)
 
+    # -- writing -------------------------------------------------------------------------------
     def write(self, layer: QgsVectorLayer, geometries: Sequence[Any],
               attributes: Dict[str, Any], title: str) -> bool:
         """Add features (project CRS) through the edit buffer as one undoable command."""
@@ -258,7 +249,13 @@ class EditController:
         layer.triggerRepaint()
         return True
 
-    # -- points --------------------------------------------------------------------------------
+    # -- points, polygons, lines -----------------------------------------------------------
+    def write_edit(self, layer: QgsVectorLayer, edit: Optional[edit_flow.Edit]) -> bool:
+        """Write what the shared edit steps decided (None: refused or cancelled)."""
+        if edit is None:
+            return False
+        return self.write(layer, [g for g, _ in edit.features], edit.features[0][1], edit.title)
+
     def add_point(self, name: str, cx: float, cy: float) -> bool:
         """A start, ground or check point at a canvas point: height from the surface (or
         typed), confirmed in the form, checked, written."""
@@ -266,62 +263,14 @@ class EditController:
         if layer is None:
             return False
         x, y = self.canvas_point(cx, cy)
-        z, reason = self.sample(x, y)
-        notes = [reason] if reason else []
-        if name == "start_points" and not edit_checks.models_at(self.workspace.project, x, y,
-                                                                self.footprints()):
-            notes.insert(0, tr("The point lies outside every stereo model; no model will use "
-                               "it."))
-            z = None  # the operator types the height there
-        if notes:
-            self.message(" ".join(notes))
-        titles = {"start_points": tr("Start point"), "ground_points": tr("Ground point"),
-                  "check_points": tr("Check point")}
-        label = tr("Id") if POINT_LAYERS[name] == "id" else tr("Note")
-        answer = self.ask.height(titles[name], z, " ".join(notes), label)
-        if answer is None:
-            return False
-        height, text = answer
-        if name == "start_points":
-            geometry, attributes = Point(x, y), {"height": height, "note": text or None}
-        else:
-            geometry, attributes = Point(x, y, height), {POINT_LAYERS[name]: text or None}
-        if not self.checked(name, geometry, attributes):
-            return False
-        return self.write(layer, [geometry], attributes, titles[name])
+        return self.write_edit(layer, edit_flow.point_edit(self, name, x, y))
 
-    # -- polygons ------------------------------------------------------------------------------
     def add_polygon(self, name: str, layer: QgsVectorLayer, geometry: QgsGeometry) -> bool:
         """An exclusion area or boundary: repaired with consent if self-intersecting, the
         action (or name) asked, checked, written."""
         polygon = self.layer_geometry(layer, geometry)
-        check = edit_checks.check_new_polygon(polygon)
-        if check.problems:
-            text = " ".join(p.message for p in check.problems)
-            self.mark([p.location for p in check.problems if p.location])
-            if check.repaired is None or not self.ask.repair(text):
-                self.message(tr("Polygon refused, nothing written: {0}").format(text),
-                             Qgis.Critical)
-                return False
-            polygon = check.repaired
-        if name == "exclusion_areas":
-            answer = self.ask.action()
-            if answer is None:
-                return False
-            attributes = {"action": answer[0], "note": answer[1] or None}
-            title = tr("Exclusion area")
-        else:
-            text = self.ask.text(tr("Boundary"), tr("Name"))
-            if text is None:
-                return False
-            attributes, title = {"name": text or None}, tr("Boundary")
-        parts = list(getattr(polygon, "geoms", [polygon]))
-        if not all(self.checked(name, part, attributes) for part in parts):
-            return False
-        self.clear_marks()
-        return self.write(layer, parts, attributes, title)
+        return self.write_edit(layer, edit_flow.polygon_edit(self, name, polygon))
 
-    # -- lines ---------------------------------------------------------------------------------
     def existing_lines(self, layer: QgsVectorLayer) -> List[Any]:
         """The layer's lines in the project CRS, unsaved ones of the edit buffer included."""
         return [self.layer_geometry(layer, f.geometry()) for f in layer.getFeatures()
@@ -333,71 +282,11 @@ class EditController:
         line = self.layer_geometry(layer, geometry)
         coords = [(c[0], c[1]) for c in line.coords]
         if name == "seamlines":
-            line = LineString(self.snapped(coords))
-            if not self.checked(name, line, {}):
-                return False
-            return self.write(layer, [line], {}, tr("Seamline"))
-        flat = LineString(coords)
-        crossings = edit_checks.check_new_breakline(flat, self.existing_lines(layer))
-        if crossings:
-            self.mark([p.location for p in crossings if p.location])
-            self.message(tr("Breakline refused, nothing written: {0}").format(
-                " ".join(p.message for p in crossings)), Qgis.Critical)
-            return False
-        self.clear_marks()
-        answer = self.breakline_heights(coords)
-        if answer is None:
-            return False
-        heights, kind = answer
-        line = LineString([(x, y, z) for (x, y), z in zip(coords, heights)])
-        attributes = {"kind": kind}
-        if not self.checked(name, line, attributes):
-            return False
-        return self.write(layer, [line], attributes, tr("Breakline"))
-
-    def breakline_heights(self, coords: List[Tuple[float, float]]
-                          ) -> Optional[Tuple[List[float], str]]:
-        """Vertex heights by the Z mode, confirmed (and completed) in the breakline form."""
-        n = len(coords)
-        heights: List[Optional[float]] = [None] * n
-        editable = [True] * n
-        message = ""
-        if self.z_mode in ("drape", "typed"):
-            path = self.surface_path(needed=self.z_mode == "drape")
-            if path is None and self.z_mode == "drape":
-                return None
-            if path is not None:
-                try:
-                    draped = edit_tools.drape_line(path, coords, crs=self.project_crs())
-                except PhotodemError as exc:
-                    self.message(str(exc), Qgis.Critical)
-                    return None
-                heights = [None if i in draped.missing else c[2]
-                           for i, c in enumerate(draped.coords)]
-                message = draped.reason or ""
-            if self.z_mode == "drape":
-                editable = [z is None for z in heights]
-        if self.z_mode == "interpolate":
-            editable = [i in (0, n - 1) for i in range(n)]
-            message = tr("Type the heights of the two ends; the others are interpolated.")
-        if message:
-            self.message(message)
-        answer = self.ask.breakline(heights, editable, message)
-        if answer is None:
-            return None
-        typed, kind = answer
-        if self.z_mode == "interpolate":
-            try:
-                line = edit_tools.drape_line(None, coords, mode="interpolate",
-                                             end_heights=(typed[0], typed[-1]))
-            except PhotodemError as exc:
-                self.message(str(exc), Qgis.Critical)
-                return None
-            typed = [c[2] for c in line.coords]
-        if any(z is None for z in typed):  # a form that let a vertex without height through
-            self.message(tr("Every vertex of a breakline needs a height."), Qgis.Warning)
-            return None
-        return [float(z) for z in typed], kind
+            edit = edit_flow.line_edit(self, name, coords, seam_lines=self.seamline_sources(),
+                                       tolerance=SNAP_PIXELS * self.canvas.mapUnitsPerPixel())
+        else:
+            edit = edit_flow.line_edit(self, name, coords, self.existing_lines(layer))
+        return self.write_edit(layer, edit)
 
     def seamline_sources(self) -> List[Any]:
         """The lines of every loaded mosaic seamline layer, in the project CRS."""
@@ -414,15 +303,8 @@ class EditController:
 
     def snapped(self, coords: List[Tuple[float, float]]) -> List[Tuple[float, float]]:
         """Seamline vertices snapped onto the mosaic's seamlines when close to one."""
-        lines = self.seamline_sources()
-        if not lines:
-            return coords
-        tolerance = SNAP_PIXELS * self.canvas.mapUnitsPerPixel()
-        out = []
-        for xy in coords:
-            snap = edit_tools.snap_to_lines(xy, lines, tolerance)
-            out.append(tuple(snap.point) if snap is not None else xy)
-        return out
+        return edit_rules.snapped(coords, self.seamline_sources(),
+                                  SNAP_PIXELS * self.canvas.mapUnitsPerPixel())
 
     # -- re-drape ------------------------------------------------------------------------------
     def redrape(self) -> int:

@@ -60,6 +60,7 @@ from shapely.geometry import LineString
 
 from ...algorithms.errors import InputError
 from ..i18n import tr
+from ..widgets.map_qc_tools import area_label
 from ..widgets.qc_panel import QcPanel
 from .edit_maptools import to_qgis, to_shapely
 from .workspace import _source_path, current_workspace, workspace_notifier
@@ -306,7 +307,7 @@ class QcDock(QDockWidget):
         """A polygon was drawn (canvas CRS): show it and compute its statistics."""
         self.area_band.setToGeometry(geometry, None)
         shape = to_shapely(self._to_layer(geometry, self.reference_combo))
-        self.panel.set_area(shape.wkt, tr("drawn polygon ({0:.0f} m²)").format(shape.area))
+        self.panel.set_area(shape.wkt, area_label(shape))
 
     def use_visible_extent(self) -> None:
         rect = QgsGeometry.fromRect(self.canvas.extent())

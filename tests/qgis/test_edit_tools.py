@@ -14,7 +14,7 @@ import math
 import shutil
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Tuple
 
 import pytest
 
@@ -28,8 +28,10 @@ from edit_clicks import (
     INTERPOLATED,
     ON_NODATA,
     OUTSIDE_MODELS,
-    SURFACE,
+    FakeAsk,
+    check_written,
     surface_z,
+    write_surface,
 )
 
 pytestmark = pytest.mark.qgis
@@ -42,31 +44,6 @@ SHOTS = Path("/tmp/e")
 def block(tmp_path_factory, tiny_block, plugin) -> Path:
     """A tiny synthetic block, made once (each test edits a copy)."""
     return copy_block(tiny_block, tmp_path_factory.mktemp("edit-block"), "block")
-
-
-def write_surface(path: Path, crs: Optional[str] = SURFACE["crs"]) -> Path:
-    """The analytic plane of :data:`SURFACE` as a float64 GeoTIFF (with its nodata box)."""
-    import numpy as np
-    import rasterio
-    from rasterio.transform import from_origin
-
-    xmin, ymin, xmax, ymax = SURFACE["bounds"]
-    res = SURFACE["res"]
-    cols, rows = int((xmax - xmin) / res), int((ymax - ymin) / res)
-    x = xmin + (np.arange(cols) + 0.5) * res
-    y = ymax - (np.arange(rows) + 0.5) * res
-    xx, yy = np.meshgrid(x, y)
-    z = surface_z(xx, yy)
-    bx0, by0, bx1, by1 = SURFACE["nodata_box"]
-    z[(xx > bx0) & (xx < bx1) & (yy > by0) & (yy < by1)] = -9999.0
-    profile = {"driver": "GTiff", "width": cols, "height": rows, "count": 1,
-               "dtype": "float64", "transform": from_origin(xmin, ymax, res, res),
-               "nodata": -9999.0}
-    if crs:
-        profile["crs"] = crs
-    with rasterio.open(path, "w", **profile) as dst:
-        dst.write(z, 1)
-    return path
 
 
 class StandIn:
@@ -88,38 +65,6 @@ class StandIn:
 
     def add_products(self, paths: Any) -> List[Any]:
         return []
-
-
-class FakeAsk:
-    """The tools' questions answered from ``answer`` (no dialog); every call is recorded."""
-
-    def __init__(self) -> None:
-        self.answer: Dict[str, Any] = {}
-        self.calls: List[Tuple[Any, ...]] = []
-
-    def height(self, title, height, message="", text_label=""):
-        self.calls.append(("height", height, message))
-        value = self.answer.get("height", height)
-        return None if value is None else (value, self.answer.get("text", ""))
-
-    def action(self):
-        self.calls.append(("action",))
-        return self.answer.get("action", "remove"), self.answer.get("text", "")
-
-    def breakline(self, heights, editable, message=""):
-        self.calls.append(("breakline", list(heights), list(editable), message))
-        typed = self.answer.get("heights")
-        out = [typed[i] if (typed and free) else z
-               for i, (z, free) in enumerate(zip(heights, editable))]
-        return out, self.answer.get("kind", "breakline")
-
-    def text(self, title, label):
-        self.calls.append(("text", title))
-        return self.answer.get("text", "")
-
-    def repair(self, message):
-        self.calls.append(("repair", message))
-        return bool(self.answer.get("repair", False))
 
 
 @pytest.fixture
@@ -241,25 +186,7 @@ def test_tool_writes_the_feature_and_undo_removes_it(work, case):
     assert layer.featureCount() == 0  # QGIS's undo removes the edit
     layer.undoStack().redo()
     assert layer.featureCount() == 1
-    rows = saved(work, layer_name)
-    assert len(rows) == 1
-    geometry, props = rows[0]
-    assert case["geometry"] in geometry.geom_type
-    for key, value in case["attributes"].items():
-        assert props[key] == value
-    coords = (list(geometry.exterior.coords)[:-1] if "Polygon" in geometry.geom_type
-              else list(geometry.coords))
-    assert len(coords) == len(hits)
-    for (x, y, *_z), (hx, hy) in zip(coords, hits):
-        assert (x, y) == pytest.approx((hx, hy), abs=1e-6)
-    if case.get("z") == "surface":
-        if layer_name == "start_points":
-            assert props["height"] == pytest.approx(surface_z(*hits[0]), abs=1e-6)
-        else:
-            for x, y, z in coords:
-                assert z == pytest.approx(surface_z(x, y), abs=1e-6)
-    if layer_name == "exclusion_areas":
-        assert props["action"] in ("keep", "remove", "exclude")
+    check_written(case, hits, saved(work, layer_name))  # the standalone test expects the same
 
 
 def test_start_point_in_the_real_form(work, qgis_app):
