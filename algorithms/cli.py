@@ -127,7 +127,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress or log lines")
     p.add_argument("--template", metavar="PROJECT", help="print an example batch file")
 
-    sub.add_parser("gui", help="start the standalone toolbox")
+    gui = sub.add_parser("gui", help="start the standalone toolbox")
+    gui.add_argument("project", nargs="?", default=None,
+                     help="a project folder or project.toml to open on the map")
 
     p = sub.add_parser("demo", help="run the whole chain on a synthetic block")
     p.add_argument("output", nargs="?", default="demo-output", metavar="FOLDER",
@@ -361,7 +363,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     return EXIT_FAILED if summary["status"] == "failed" else EXIT_OK
 
 
-def cmd_gui() -> int:
+def cmd_gui(project: Optional[str] = None) -> int:
     try:
         from ..plugin.app import main as app  # here, not above: Qt only when the GUI starts
     except ImportError as exc:
@@ -369,7 +371,7 @@ def cmd_gui() -> int:
             f"The standalone toolbox needs PyQt5 ({exc}); install it with "
             "'pip install photodem[gui]'."
         ) from exc
-    return int(app.main([PROG]))
+    return int(app.main([PROG], project=project))
 
 
 # -- helpers -------------------------------------------------------------------------------------
@@ -482,7 +484,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         if args.command == "batch":
             return cmd_batch(args)
         if args.command == "gui":
-            return cmd_gui()
+            return cmd_gui(args.project)
         if args.command == "demo":
             return cmd_demo(args)
         parser.print_help(sys.stderr)

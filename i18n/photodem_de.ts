@@ -140,7 +140,7 @@
         </message>
         <message>
             <source>Stereo models</source>
-            <extracomment>plugin/qgis/workspace.py:254; project_info output models; stereo_models output models; stereo_models: name</extracomment>
+            <extracomment>plugin/app/map_window.py:411; plugin/qgis/workspace.py:254; project_info output models; stereo_models output models; stereo_models: name</extracomment>
             <translation>Stereomodelle</translation>
         </message>
         <message>
@@ -1080,7 +1080,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/app/map_window.py:429; plugin/qgis/workspace.py:426</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1230,7 +1230,7 @@
         </message>
         <message>
             <source>DEM</source>
-            <extracomment>interpolate_dem output dem; interpolate_dem.output: description; plugin/qgis/qc_dock.py:191; plugin/widgets/qc_panel.py:130</extracomment>
+            <extracomment>interpolate_dem output dem; interpolate_dem.output: description; plugin/qgis/qc_dock.py:192; plugin/widgets/qc_panel.py:130</extracomment>
             <translation>DHM</translation>
         </message>
         <message>
@@ -1580,7 +1580,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/qgis/workspace.py:426; plugin/widgets/qc_filter.py:50</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/app/map_window.py:429; plugin/qgis/workspace.py:426; plugin/widgets/qc_filter.py:50</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -2100,7 +2100,7 @@
         </message>
         <message>
             <source>Seamlines</source>
-            <extracomment>mosaic.seamlines: description; plugin/qgis/workspace.py:410; plugin/qgis/workspace.py:427</extracomment>
+            <extracomment>mosaic.seamlines: description; plugin/app/map_window.py:430; plugin/qgis/workspace.py:410; plugin/qgis/workspace.py:427; plugin/widgets/edit_session.py:359</extracomment>
             <translation>Schnittlinien</translation>
         </message>
         <message>
@@ -2180,7 +2180,7 @@
         </message>
         <message>
             <source>Mosaic</source>
-            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/qgis/workspace.py:427</extracomment>
+            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/app/map_window.py:430; plugin/qgis/workspace.py:427</extracomment>
             <translation>Mosaik</translation>
         </message>
         <message>
@@ -2245,7 +2245,7 @@
         </message>
         <message>
             <source>Class attribute</source>
-            <extracomment>georeference_polygons.class_field: description; plugin/qgis/qc_dock.py:194</extracomment>
+            <extracomment>georeference_polygons.class_field: description; plugin/qgis/qc_dock.py:195</extracomment>
             <translation>Klassenattribut</translation>
         </message>
         <message>
@@ -2399,134 +2399,339 @@
             <translation>Verwendete Passpunkte</translation>
         </message>
         <message>
+            <source>QC area</source>
+            <extracomment>plugin/app/docks.py:107</extracomment>
+            <translation>Qualität: Fläche</translation>
+        </message>
+        <message>
+            <source>QC profile</source>
+            <extracomment>plugin/app/docks.py:108</extracomment>
+            <translation>Qualität: Profil</translation>
+        </message>
+        <message>
+            <source>QC identify</source>
+            <extracomment>plugin/app/docks.py:110</extracomment>
+            <translation>Qualität: Abfragen</translation>
+        </message>
+        <message>
+            <source>Undo history</source>
+            <extracomment>plugin/app/docks.py:140</extracomment>
+            <translation>Bearbeitungsverlauf</translation>
+        </message>
+        <message>
+            <source>DEM quality</source>
+            <extracomment>plugin/app/docks.py:56</extracomment>
+            <translation>DHM-Qualität</translation>
+        </message>
+        <message>
+            <source>Batch</source>
+            <extracomment>plugin/app/docks.py:78</extracomment>
+            <translation>Batch</translation>
+        </message>
+        <message>
+            <source>Blunder to {0}</source>
+            <extracomment>plugin/app/docks.py:45; plugin/qgis/qc_dock.py:452</extracomment>
+            <translation>Grober Fehler nach {0}</translation>
+        </message>
+        <message>
             <source>PhotoDEM toolbox</source>
-            <extracomment>plugin/app/main_window.py:48</extracomment>
+            <extracomment>plugin/app/main_window.py:53</extracomment>
             <translation>PhotoDEM-Werkzeugkasten</translation>
         </message>
         <message>
             <source>Search algorithms …</source>
-            <extracomment>plugin/app/main_window.py:56</extracomment>
+            <extracomment>plugin/app/main_window.py:63</extracomment>
             <translation>Algorithmen suchen …</translation>
         </message>
         <message>
-            <source>Choose an algorithm on the left.</source>
-            <extracomment>plugin/app/main_window.py:114</extracomment>
-            <translation>Links einen Algorithmus wählen.</translation>
+            <source>Processing toolbox</source>
+            <extracomment>plugin/app/main_window.py:127</extracomment>
+            <translation>Processing-Werkzeugkasten</translation>
+        </message>
+        <message>
+            <source>Open a project (File menu) or choose an algorithm in the toolbox.</source>
+            <extracomment>plugin/app/main_window.py:134</extracomment>
+            <translation>Öffnen Sie ein Projekt (Menü Datei) oder wählen Sie einen Algorithmus im Werkzeugkasten.</translation>
         </message>
         <message>
             <source>&amp;File</source>
-            <extracomment>plugin/app/main_window.py:125</extracomment>
+            <extracomment>plugin/app/main_window.py:148</extracomment>
             <translation>&amp;Datei</translation>
         </message>
         <message>
+            <source>&amp;View</source>
+            <extracomment>plugin/app/main_window.py:149</extracomment>
+            <translation>&amp;Ansicht</translation>
+        </message>
+        <message>
             <source>&amp;Quit</source>
-            <extracomment>plugin/app/main_window.py:126</extracomment>
+            <extracomment>plugin/app/main_window.py:153</extracomment>
             <translation>&amp;Beenden</translation>
         </message>
         <message>
             <source>&amp;Tools</source>
-            <extracomment>plugin/app/main_window.py:129</extracomment>
+            <extracomment>plugin/app/main_window.py:156</extracomment>
             <translation>&amp;Werkzeuge</translation>
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:130; plugin/qgis/plugin.py:113</extracomment>
+            <extracomment>plugin/app/main_window.py:157; plugin/qgis/plugin.py:113</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:131; plugin/qgis/plugin.py:115</extracomment>
+            <extracomment>plugin/app/main_window.py:158; plugin/qgis/plugin.py:115</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
             <source>Batch over stereo models…</source>
-            <extracomment>plugin/app/main_window.py:135; plugin/qgis/batch_actions.py:127</extracomment>
+            <extracomment>plugin/app/main_window.py:162; plugin/qgis/batch_actions.py:127</extracomment>
             <translation>Batch über Stereomodelle…</translation>
         </message>
         <message>
             <source>Run steps over many stereo models, resumable</source>
-            <extracomment>plugin/app/main_window.py:136; plugin/qgis/batch_actions.py:129</extracomment>
+            <extracomment>plugin/app/main_window.py:163; plugin/qgis/batch_actions.py:129</extracomment>
             <translation>Schritte über viele Stereomodelle ausführen, fortsetzbar</translation>
         </message>
         <message>
             <source>DEM quality…</source>
-            <extracomment>plugin/app/main_window.py:139; plugin/qgis/plugin.py:125</extracomment>
+            <extracomment>plugin/app/main_window.py:166; plugin/qgis/plugin.py:125</extracomment>
             <translation>DHM-Qualität…</translation>
         </message>
         <message>
             <source>Statistics, histogram, profiles, identify and blunders of a DEM against a reference</source>
-            <extracomment>plugin/app/main_window.py:140</extracomment>
+            <extracomment>plugin/app/main_window.py:167</extracomment>
             <translation>Statistik, Histogramm, Profile, Abfrage und grobe Fehler eines DHM gegenüber einer Referenz</translation>
         </message>
         <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:143</extracomment>
+            <extracomment>plugin/app/main_window.py:170</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:144</extracomment>
+            <extracomment>plugin/app/main_window.py:171</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:245</extracomment>
+            <extracomment>plugin/app/main_window.py:272</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:245</extracomment>
+            <extracomment>plugin/app/main_window.py:272</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:246; plugin/qgis/background.py:173</extracomment>
+            <extracomment>plugin/app/main_window.py:273; plugin/qgis/background.py:173</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:369</extracomment>
+            <extracomment>plugin/app/main_window.py:401</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:370</extracomment>
+            <extracomment>plugin/app/main_window.py:402</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:154</extracomment>
+            <extracomment>plugin/app/main_window.py:181</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:250; plugin/app/main_window.py:265; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/app/main_window.py:277; plugin/app/main_window.py:294; plugin/app/map_window.py:170; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
             <source>Batch running – show</source>
-            <extracomment>plugin/app/main_window.py:294</extracomment>
+            <extracomment>plugin/app/main_window.py:323</extracomment>
             <translation>Batch läuft – anzeigen</translation>
         </message>
         <message>
-            <source>DEM quality</source>
-            <extracomment>plugin/app/main_window.py:345</extracomment>
-            <translation>DHM-Qualität</translation>
-        </message>
-        <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:237; plugin/widgets/run_panel.py:124</extracomment>
+            <extracomment>plugin/app/main_window.py:264; plugin/widgets/run_panel.py:130</extracomment>
             <translation>{0} läuft …</translation>
         </message>
         <message>
             <source>Tools → Review georeferencing checks and edits its control points.</source>
-            <extracomment>plugin/app/main_window.py:254</extracomment>
+            <extracomment>plugin/app/main_window.py:283</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
             <source>Batch {0}: summary in {1}</source>
-            <extracomment>plugin/app/main_window.py:305</extracomment>
+            <extracomment>plugin/app/main_window.py:334</extracomment>
             <translation>Batch {0}: Zusammenfassung in {1}</translation>
+        </message>
+        <message>
+            <source>Difference</source>
+            <extracomment>plugin/app/map_window.py:429; plugin/qgis/workspace.py:426</extracomment>
+            <translation>Differenz</translation>
+        </message>
+        <message>
+            <source>Ortho</source>
+            <extracomment>plugin/app/map_window.py:430; plugin/qgis/workspace.py:427</extracomment>
+            <translation>Ortho</translation>
+        </message>
+        <message>
+            <source>Layers</source>
+            <extracomment>plugin/app/map_window.py:59</extracomment>
+            <translation>Layer</translation>
+        </message>
+        <message>
+            <source>Coordinates of the cursor</source>
+            <extracomment>plugin/app/map_window.py:66</extracomment>
+            <translation>Koordinaten des Mauszeigers</translation>
+        </message>
+        <message>
+            <source>Value of the top raster under the cursor</source>
+            <extracomment>plugin/app/map_window.py:67</extracomment>
+            <translation>Wert des obersten Rasters unter dem Mauszeiger</translation>
+        </message>
+        <message>
+            <source>Scale at 96 dpi</source>
+            <extracomment>plugin/app/map_window.py:69</extracomment>
+            <translation>Maßstab bei 96 dpi</translation>
+        </message>
+        <message>
+            <source>Coordinate reference system of the map</source>
+            <extracomment>plugin/app/map_window.py:70</extracomment>
+            <translation>Koordinatenbezugssystem der Karte</translation>
+        </message>
+        <message>
+            <source>&amp;Open project…</source>
+            <extracomment>plugin/app/map_window.py:88</extracomment>
+            <translation>Projekt ö&amp;ffnen…</translation>
+        </message>
+        <message>
+            <source>Add &amp;raster…</source>
+            <extracomment>plugin/app/map_window.py:91</extracomment>
+            <translation>&amp;Raster hinzufügen…</translation>
+        </message>
+        <message>
+            <source>Add &amp;vector…</source>
+            <extracomment>plugin/app/map_window.py:93</extracomment>
+            <translation>&amp;Vektor hinzufügen…</translation>
+        </message>
+        <message>
+            <source>Zoom &amp;full</source>
+            <extracomment>plugin/app/map_window.py:97</extracomment>
+            <translation>&amp;Gesamtansicht</translation>
+        </message>
+        <message>
+            <source>Zoom to &amp;layer</source>
+            <extracomment>plugin/app/map_window.py:100</extracomment>
+            <translation>Auf &amp;Layer zoomen</translation>
+        </message>
+        <message>
+            <source>Zoom &amp;in</source>
+            <extracomment>plugin/app/map_window.py:102</extracomment>
+            <translation>Hine&amp;inzoomen</translation>
+        </message>
+        <message>
+            <source>Zoom &amp;out</source>
+            <extracomment>plugin/app/map_window.py:105</extracomment>
+            <translation>Hera&amp;uszoomen</translation>
+        </message>
+        <message>
+            <source>Map</source>
+            <extracomment>plugin/app/map_window.py:115</extracomment>
+            <translation>Karte</translation>
+        </message>
+        <message>
+            <source>Open PhotoDEM project</source>
+            <extracomment>plugin/app/map_window.py:297; plugin/qgis/project_menu.py:133</extracomment>
+            <translation>PhotoDEM-Projekt öffnen</translation>
+        </message>
+        <message>
+            <source>pixels</source>
+            <extracomment>plugin/app/map_window.py:162</extracomment>
+            <translation>Pixel</translation>
+        </message>
+        <message>
+            <source>no CRS</source>
+            <extracomment>plugin/app/map_window.py:163</extracomment>
+            <translation>kein KBS</translation>
+        </message>
+        <message>
+            <source>Add raster</source>
+            <extracomment>plugin/app/map_window.py:307</extracomment>
+            <translation>Raster hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add vector</source>
+            <extracomment>plugin/app/map_window.py:307</extracomment>
+            <translation>Vektor hinzufügen</translation>
+        </message>
+        <message>
+            <source>Image footprints</source>
+            <extracomment>plugin/app/map_window.py:409; plugin/qgis/workspace.py:254</extracomment>
+            <translation>Bildfußabdrücke</translation>
+        </message>
+        <message>
+            <source>All files</source>
+            <extracomment>plugin/app/map_window.py:308</extracomment>
+            <translation>Alle Dateien</translation>
+        </message>
+        <message>
+            <source>PhotoDEM – {0}</source>
+            <extracomment>plugin/app/map_window.py:365</extracomment>
+            <translation>PhotoDEM – {0}</translation>
+        </message>
+        <message>
+            <source>pixel {0:.1f}, {1:.1f}</source>
+            <extracomment>plugin/app/map_window.py:134</extracomment>
+            <translation>Pixel {0:.1f}, {1:.1f}</translation>
+        </message>
+        <message>
+            <source>'{0}' has no coordinate reference system: it is shown in pixel coordinates.</source>
+            <extracomment>plugin/app/map_window.py:194</extracomment>
+            <translation>„{0}“ hat kein Koordinatenbezugssystem: es wird in Pixelkoordinaten angezeigt.</translation>
+        </message>
+        <message>
+            <source>{0} has no overviews and draws slowly: right-click it in the layer list → Build overviews.</source>
+            <extracomment>plugin/app/map_window.py:203</extracomment>
+            <translation>{0} hat keine Übersichten und wird langsam gezeichnet: Rechtsklick in der Layerliste → Übersichten erzeugen.</translation>
+        </message>
+        <message>
+            <source>'{0}' has no coordinate reference system: it is shown alone, in pixel coordinates.</source>
+            <extracomment>plugin/app/map_window.py:223</extracomment>
+            <translation>„{0}“ hat kein Koordinatenbezugssystem: es wird allein angezeigt, in Pixelkoordinaten.</translation>
+        </message>
+        <message>
+            <source>Rasters</source>
+            <extracomment>plugin/app/map_window.py:303</extracomment>
+            <translation>Raster</translation>
+        </message>
+        <message>
+            <source>Vectors</source>
+            <extracomment>plugin/app/map_window.py:305</extracomment>
+            <translation>Vektoren</translation>
+        </message>
+        <message>
+            <source>Project {0} opened.</source>
+            <extracomment>plugin/app/map_window.py:369; plugin/qgis/project_menu.py:152</extracomment>
+            <translation>Projekt {0} geöffnet.</translation>
+        </message>
+        <message>
+            <source>Cannot show '{0}': {1}</source>
+            <extracomment>plugin/app/map_window.py:188; plugin/app/map_window.py:235</extracomment>
+            <translation>„{0}“ kann nicht angezeigt werden: {1}</translation>
+        </message>
+        <message>
+            <source>Product not shown: {0}</source>
+            <extracomment>plugin/app/map_window.py:394</extracomment>
+            <translation>Produkt nicht angezeigt: {0}</translation>
+        </message>
+        <message>
+            <source>Footprints and stereo models not shown: {0}</source>
+            <extracomment>plugin/app/map_window.py:406</extracomment>
+            <translation>Bildfußabdrücke und Stereomodelle nicht angezeigt: {0}</translation>
         </message>
         <message>
             <source>PhotoDEM {1}: {0}</source>
@@ -2559,229 +2764,89 @@
             <translation>PhotoDEM-Batch: {0}</translation>
         </message>
         <message>
-            <source>keep (surface stays as measured)</source>
-            <extracomment>plugin/qgis/edit_forms.py:34</extracomment>
-            <translation>behalten (Oberfläche bleibt wie gemessen)</translation>
-        </message>
-        <message>
-            <source>remove (not matched; bridged in the DTM)</source>
-            <extracomment>plugin/qgis/edit_forms.py:35</extracomment>
-            <translation>entfernen (nicht zugeordnet; im DGM überbrückt)</translation>
-        </message>
-        <message>
-            <source>exclude (as remove)</source>
-            <extracomment>plugin/qgis/edit_forms.py:36</extracomment>
-            <translation>ausschließen (wie entfernen)</translation>
-        </message>
-        <message>
-            <source>breakline</source>
-            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51; plugin/widgets/qc_plots.py:156</extracomment>
-            <translation>Bruchkante</translation>
-        </message>
-        <message>
-            <source>structure line</source>
-            <extracomment>plugin/qgis/edit_forms.py:42; plugin/qgis/styles.py:51</extracomment>
-            <translation>Strukturlinie</translation>
-        </message>
-        <message>
-            <source>type a height</source>
-            <extracomment>plugin/qgis/edit_forms.py:52</extracomment>
-            <translation>Höhe eingeben</translation>
-        </message>
-        <message>
-            <source>Height</source>
-            <extracomment>plugin/qgis/edit_forms.py:91</extracomment>
-            <translation>Höhe</translation>
-        </message>
-        <message>
-            <source>Exclusion area</source>
-            <extracomment>plugin/qgis/edit_forms.py:106; plugin/qgis/edit_maptools.py:312; plugin/qgis/editing_toolbar.py:41</extracomment>
-            <translation>Ausschlussfläche</translation>
-        </message>
-        <message>
-            <source>What should happen inside the area?</source>
-            <extracomment>plugin/qgis/edit_forms.py:107</extracomment>
-            <translation>Was soll innerhalb der Fläche geschehen?</translation>
-        </message>
-        <message>
-            <source>Action</source>
-            <extracomment>plugin/qgis/edit_forms.py:113; plugin/widgets/qc_panel.py:276</extracomment>
-            <translation>Aktion</translation>
-        </message>
-        <message>
-            <source>Note</source>
-            <extracomment>plugin/qgis/edit_forms.py:115; plugin/qgis/edit_forms.py:94; plugin/qgis/edit_maptools.py:280</extracomment>
-            <translation>Notiz</translation>
-        </message>
-        <message>
-            <source>Breakline heights</source>
-            <extracomment>plugin/qgis/edit_forms.py:123</extracomment>
-            <translation>Höhen der Bruchkante</translation>
-        </message>
-        <message>
-            <source>Kind</source>
-            <extracomment>plugin/qgis/edit_forms.py:128; plugin/widgets/batch_dialog.py:137</extracomment>
-            <translation>Art</translation>
-        </message>
-        <message>
-            <source>Invalid polygon</source>
-            <extracomment>plugin/qgis/edit_forms.py:192</extracomment>
-            <translation>Ungültiges Polygon</translation>
-        </message>
-        <message>
-            <source>Use the repaired polygon?</source>
-            <extracomment>plugin/qgis/edit_forms.py:193</extracomment>
-            <translation>Das reparierte Polygon verwenden?</translation>
-        </message>
-        <message>
-            <source>Vertex {0}</source>
-            <extracomment>plugin/qgis/edit_forms.py:135</extracomment>
-            <translation>Stützpunkt {0}</translation>
-        </message>
-        <message>
             <source>The edits file {0} is locked or unreadable ({1}); close the program that holds it and try again.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:76</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:74</extracomment>
             <translation>Die Bearbeitungsdatei {0} ist gesperrt oder nicht lesbar ({1}); schließen Sie das Programm, das sie geöffnet hält, und versuchen Sie es erneut.</translation>
         </message>
         <message>
-            <source>Start point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:278; plugin/qgis/editing_toolbar.py:41</extracomment>
-            <translation>Startpunkt</translation>
-        </message>
-        <message>
-            <source>Ground point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:278; plugin/qgis/editing_toolbar.py:49</extracomment>
-            <translation>Bodenpunkt</translation>
-        </message>
-        <message>
-            <source>Check point</source>
-            <extracomment>plugin/qgis/edit_maptools.py:279; plugin/qgis/editing_toolbar.py:50</extracomment>
-            <translation>Kontrollpunkt</translation>
-        </message>
-        <message>
-            <source>Id</source>
-            <extracomment>plugin/qgis/edit_maptools.py:280</extracomment>
-            <translation>Kennung</translation>
-        </message>
-        <message>
-            <source>Breakline</source>
-            <extracomment>plugin/qgis/edit_maptools.py:356; plugin/qgis/editing_toolbar.py:49</extracomment>
-            <translation>Bruchkante</translation>
-        </message>
-        <message>
-            <source>Type the heights of the two ends; the others are interpolated.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:382</extracomment>
-            <translation>Geben Sie die Höhen der beiden Enden ein; die übrigen werden interpoliert.</translation>
-        </message>
-        <message>
             <source>Re-drape</source>
-            <extracomment>plugin/qgis/edit_maptools.py:447; plugin/qgis/editing_toolbar.py:145</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:329; plugin/qgis/editing_toolbar.py:145; plugin/widgets/map_edit_tools.py:415; plugin/widgets/map_vertex_tools.py:466</extracomment>
             <translation>Neu abgreifen</translation>
         </message>
         <message>
             <source>The edits file {0} does not exist.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:73</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:71</extracomment>
             <translation>Die Bearbeitungsdatei {0} existiert nicht.</translation>
         </message>
         <message>
             <source>The edits file {0} is read-only; make it writable to edit.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:75</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:73</extracomment>
             <translation>Die Bearbeitungsdatei {0} ist schreibgeschützt; machen Sie sie beschreibbar, um zu bearbeiten.</translation>
         </message>
         <message>
             <source>Open a PhotoDEM project first (PhotoDEM → Open project…).</source>
-            <extracomment>plugin/qgis/edit_maptools.py:149; plugin/qgis/editing_toolbar.py:229</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:147; plugin/qgis/editing_toolbar.py:229</extracomment>
             <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt (PhotoDEM → Projekt öffnen…).</translation>
         </message>
         <message>
-            <source>No surface chosen; type the height.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:217</extracomment>
-            <translation>Keine Oberfläche gewählt; geben Sie die Höhe ein.</translation>
-        </message>
-        <message>
-            <source>The point lies outside every stereo model; no model will use it.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:273</extracomment>
-            <translation>Der Punkt liegt außerhalb aller Stereomodelle; kein Modell wird ihn verwenden.</translation>
-        </message>
-        <message>
-            <source>Boundary</source>
-            <extracomment>plugin/qgis/edit_maptools.py:314; plugin/qgis/edit_maptools.py:317; plugin/qgis/editing_toolbar.py:43</extracomment>
-            <translation>Begrenzung</translation>
-        </message>
-        <message>
-            <source>Name</source>
-            <extracomment>plugin/qgis/edit_maptools.py:314</extracomment>
-            <translation>Name</translation>
-        </message>
-        <message>
-            <source>Seamline</source>
-            <extracomment>plugin/qgis/edit_maptools.py:339; plugin/qgis/editing_toolbar.py:44</extracomment>
-            <translation>Schnittlinie</translation>
-        </message>
-        <message>
-            <source>Every vertex of a breakline needs a height.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:398</extracomment>
-            <translation>Jeder Stützpunkt einer Bruchkante braucht eine Höhe.</translation>
-        </message>
-        <message>
             <source>Select breaklines or points in an edit layer of the project (breaklines, start, ground or check points) to re-drape them.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:434</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:316</extracomment>
             <translation>Wählen Sie Bruchkanten oder Punkte in einem Bearbeitungslayer des Projekts (Bruchkanten, Start-, Boden- oder Kontrollpunkte), um ihre Höhen neu abzugreifen.</translation>
         </message>
         <message>
             <source>Choose a surface (DSM or DTM) in the editing toolbar.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:200</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:198; plugin/widgets/map_edit_tools.py:103</extracomment>
             <translation>Wählen Sie in der Bearbeitungswerkzeugleiste eine Oberfläche (DOM oder DGM).</translation>
         </message>
         <message>
             <source>{0} features re-draped on the surface.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:455</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:337; plugin/widgets/map_edit_tools.py:514</extracomment>
             <translation>Höhen von {0} Objekten auf der Oberfläche neu abgegriffen.</translation>
         </message>
         <message>
             <source>The layer '{0}' of edits.gpkg is not loaded or missing; add it to the project's edits first.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:153</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:151</extracomment>
             <translation>Der Layer '{0}' von edits.gpkg ist nicht geladen oder fehlt; fügen Sie ihn zuerst den Bearbeitungen des Projekts hinzu.</translation>
         </message>
         <message>
             <source>The surface '{0}' has no CRS; assign it its CRS (Layer Properties → Source) first.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:203</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:201</extracomment>
             <translation>Die Oberfläche '{0}' hat kein KBS; weisen Sie ihr zuerst ihr KBS zu (Layereigenschaften → Quelle).</translation>
         </message>
         <message>
             <source>The surface '{0}' is not a file ({1}).</source>
-            <extracomment>plugin/qgis/edit_maptools.py:208</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:206</extracomment>
             <translation>Die Oberfläche '{0}' ist keine Datei ({1}).</translation>
         </message>
         <message>
             <source>QGIS refused the new feature of '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:254; plugin/qgis/qc_dock.py:454</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:245; plugin/qgis/qc_dock.py:455</extracomment>
             <translation>QGIS hat das neue Objekt von '{0}' abgelehnt.</translation>
         </message>
         <message>
-            <source>Breakline refused, nothing written: {0}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:344</extracomment>
-            <translation>Bruchkante abgelehnt, nichts geschrieben: {0}</translation>
-        </message>
-        <message>
             <source>Nothing selected in '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:439</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:321</extracomment>
             <translation>Nichts ausgewählt in '{0}'.</translation>
         </message>
         <message>
             <source>QGIS cannot edit the layer '{0}'.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:162</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:160</extracomment>
             <translation>QGIS kann den Layer '{0}' nicht bearbeiten.</translation>
         </message>
         <message>
-            <source>Polygon refused, nothing written: {0}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:303</extracomment>
-            <translation>Polygon abgelehnt, nichts geschrieben: {0}</translation>
+            <source>Feature {0}: {1}</source>
+            <extracomment>plugin/qgis/edit_maptools.py:356</extracomment>
+            <translation>Objekt {0}: {1}</translation>
         </message>
         <message>
-            <source>Feature {0}: {1}</source>
-            <extracomment>plugin/qgis/edit_maptools.py:479</extracomment>
-            <translation>Objekt {0}: {1}</translation>
+            <source>Start point</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:41; plugin/widgets/edit_flow.py:40; plugin/widgets/map_edit_tools.py:50</extracomment>
+            <translation>Startpunkt</translation>
+        </message>
+        <message>
+            <source>Exclusion area</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:41; plugin/widgets/edit_flow.py:100; plugin/widgets/edit_forms.py:106; plugin/widgets/map_edit_tools.py:50</extracomment>
+            <translation>Ausschlussfläche</translation>
         </message>
         <message>
             <source>Breakline (3-D)</source>
@@ -2797,6 +2862,31 @@
             <source>Check point (3-D)</source>
             <extracomment>plugin/qgis/editing_toolbar.py:43</extracomment>
             <translation>Kontrollpunkt (3D)</translation>
+        </message>
+        <message>
+            <source>Boundary</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:43; plugin/widgets/edit_flow.py:102; plugin/widgets/edit_flow.py:103; plugin/widgets/map_edit_tools.py:52</extracomment>
+            <translation>Begrenzung</translation>
+        </message>
+        <message>
+            <source>Seamline</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:44; plugin/widgets/edit_flow.py:123; plugin/widgets/map_edit_tools.py:53</extracomment>
+            <translation>Schnittlinie</translation>
+        </message>
+        <message>
+            <source>Breakline</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:49; plugin/widgets/edit_flow.py:134; plugin/widgets/map_edit_tools.py:51</extracomment>
+            <translation>Bruchkante</translation>
+        </message>
+        <message>
+            <source>Ground point</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:49; plugin/widgets/edit_flow.py:40; plugin/widgets/map_edit_tools.py:51</extracomment>
+            <translation>Bodenpunkt</translation>
+        </message>
+        <message>
+            <source>Check point</source>
+            <extracomment>plugin/qgis/editing_toolbar.py:50; plugin/widgets/edit_flow.py:41; plugin/widgets/map_edit_tools.py:52</extracomment>
+            <translation>Kontrollpunkt</translation>
         </message>
         <message>
             <source>Z: drape</source>
@@ -2830,7 +2920,7 @@
         </message>
         <message>
             <source>PhotoDEM editing</source>
-            <extracomment>plugin/qgis/editing_toolbar.py:89</extracomment>
+            <extracomment>plugin/qgis/editing_toolbar.py:89; plugin/widgets/map_edit_tools.py:382</extracomment>
             <translation>PhotoDEM-Bearbeitung</translation>
         </message>
         <message>
@@ -2964,19 +3054,9 @@
             <translation>Zuletzt geöffnete Projekte</translation>
         </message>
         <message>
-            <source>Open PhotoDEM project</source>
-            <extracomment>plugin/qgis/project_menu.py:133</extracomment>
-            <translation>PhotoDEM-Projekt öffnen</translation>
-        </message>
-        <message>
             <source>PhotoDEM project</source>
             <extracomment>plugin/qgis/project_menu.py:134</extracomment>
             <translation>PhotoDEM-Projekt</translation>
-        </message>
-        <message>
-            <source>Project {0} opened.</source>
-            <extracomment>plugin/qgis/project_menu.py:152</extracomment>
-            <translation>Projekt {0} geöffnet.</translation>
         </message>
         <message>
             <source>The project {0} is no longer there; it was removed from the recent projects.</source>
@@ -2990,97 +3070,87 @@
         </message>
         <message>
             <source>PhotoDEM – DEM quality</source>
-            <extracomment>plugin/qgis/qc_dock.py:154</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:155</extracomment>
             <translation>PhotoDEM – DHM-Qualität</translation>
         </message>
         <message>
             <source>Reference</source>
-            <extracomment>plugin/qgis/qc_dock.py:192; plugin/widgets/qc_panel.py:132</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:193; plugin/widgets/qc_panel.py:132</extracomment>
             <translation>Referenz</translation>
         </message>
         <message>
             <source>Classes (optional)</source>
-            <extracomment>plugin/qgis/qc_dock.py:193; plugin/widgets/qc_panel.py:134</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:194; plugin/widgets/qc_panel.py:134</extracomment>
             <translation>Klassen (optional)</translation>
         </message>
         <message>
             <source>visible extent</source>
-            <extracomment>plugin/qgis/qc_dock.py:315</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:316</extracomment>
             <translation>sichtbare Ausdehnung</translation>
         </message>
         <message>
             <source>whole model</source>
-            <extracomment>plugin/qgis/qc_dock.py:319; plugin/widgets/qc_panel.py:107; plugin/widgets/qc_panel.py:360; plugin/widgets/qc_panel.py:439</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:320; plugin/widgets/qc_panel.py:107; plugin/widgets/qc_panel.py:360; plugin/widgets/qc_panel.py:439</extracomment>
             <translation>ganzes Modell</translation>
         </message>
         <message>
             <source>Select a line layer in the layer tree first.</source>
-            <extracomment>plugin/qgis/qc_dock.py:334</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:335</extracomment>
             <translation>Wählen Sie zuerst einen Linienlayer im Layerbaum.</translation>
         </message>
         <message>
             <source>Choose a DTM of a PhotoDEM filter run (with its mask.tif) in the Filter review tab.</source>
-            <extracomment>plugin/qgis/qc_dock.py:393</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:394</extracomment>
             <translation>Wählen Sie im Reiter Filterprüfung ein DGM eines PhotoDEM-Filterlaufs (mit mask.tif).</translation>
         </message>
         <message>
             <source>eliminated</source>
-            <extracomment>plugin/qgis/qc_dock.py:400</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:401</extracomment>
             <translation>eliminiert</translation>
         </message>
         <message>
             <source>Draw area</source>
-            <extracomment>plugin/qgis/qc_dock.py:199</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:200</extracomment>
             <translation>Gebiet zeichnen</translation>
         </message>
         <message>
             <source>Visible extent</source>
-            <extracomment>plugin/qgis/qc_dock.py:200</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:201</extracomment>
             <translation>Sichtbare Ausdehnung</translation>
         </message>
         <message>
             <source>Whole model</source>
-            <extracomment>plugin/qgis/qc_dock.py:201; plugin/widgets/qc_panel.py:194</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:202; plugin/widgets/qc_panel.py:194</extracomment>
             <translation>Ganzes Modell</translation>
         </message>
         <message>
             <source>Show eliminated cells</source>
-            <extracomment>plugin/qgis/qc_dock.py:202</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:203</extracomment>
             <translation>Eliminierte Zellen zeigen</translation>
         </message>
         <message>
             <source>Draw profile</source>
-            <extracomment>plugin/qgis/qc_dock.py:203</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:204</extracomment>
             <translation>Profil zeichnen</translation>
         </message>
         <message>
             <source>Profile of feature</source>
-            <extracomment>plugin/qgis/qc_dock.py:204</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:205</extracomment>
             <translation>Profil eines Objekts</translation>
         </message>
         <message>
             <source>Identify</source>
-            <extracomment>plugin/qgis/qc_dock.py:205; plugin/widgets/qc_panel.py:144</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:206; plugin/widgets/qc_panel.py:144</extracomment>
             <translation>Abfragen</translation>
         </message>
         <message>
-            <source>drawn polygon ({0:.0f} m²)</source>
-            <extracomment>plugin/qgis/qc_dock.py:309</extracomment>
-            <translation>gezeichnetes Polygon ({0:.0f} m²)</translation>
-        </message>
-        <message>
             <source>eliminated cells ({0})</source>
-            <extracomment>plugin/qgis/qc_dock.py:396</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:397</extracomment>
             <translation>eliminierte Zellen ({0})</translation>
         </message>
         <message>
-            <source>Blunder to {0}</source>
-            <extracomment>plugin/qgis/qc_dock.py:451</extracomment>
-            <translation>Grober Fehler nach {0}</translation>
-        </message>
-        <message>
             <source>Open a PhotoDEM project first: the edit goes into its layer '{0}'.</source>
-            <extracomment>plugin/qgis/qc_dock.py:439</extracomment>
+            <extracomment>plugin/qgis/qc_dock.py:440</extracomment>
             <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt: Die Bearbeitung kommt in dessen Layer „{0}“.</translation>
         </message>
         <message>
@@ -3097,6 +3167,16 @@
             <source>exclude</source>
             <extracomment>plugin/qgis/styles.py:50</extracomment>
             <translation>ausschließen</translation>
+        </message>
+        <message>
+            <source>breakline</source>
+            <extracomment>plugin/qgis/styles.py:51; plugin/widgets/edit_forms.py:42; plugin/widgets/qc_plots.py:156</extracomment>
+            <translation>Bruchkante</translation>
+        </message>
+        <message>
+            <source>structure line</source>
+            <extracomment>plugin/qgis/styles.py:51; plugin/widgets/edit_forms.py:42</extracomment>
+            <translation>Strukturlinie</translation>
         </message>
         <message>
             <source>other values</source>
@@ -3175,48 +3255,33 @@
         </message>
         <message>
             <source>Start points</source>
-            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <extracomment>plugin/qgis/workspace.py:408; plugin/widgets/edit_session.py:357</extracomment>
             <translation>Startpunkte</translation>
         </message>
         <message>
             <source>Exclusion areas</source>
-            <extracomment>plugin/qgis/workspace.py:408</extracomment>
+            <extracomment>plugin/qgis/workspace.py:408; plugin/widgets/edit_session.py:357</extracomment>
             <translation>Ausschlussflächen</translation>
         </message>
         <message>
             <source>Boundaries</source>
-            <extracomment>plugin/qgis/workspace.py:409</extracomment>
+            <extracomment>plugin/qgis/workspace.py:409; plugin/widgets/edit_session.py:358</extracomment>
             <translation>Begrenzungen</translation>
         </message>
         <message>
             <source>Breaklines</source>
-            <extracomment>plugin/qgis/workspace.py:409</extracomment>
+            <extracomment>plugin/qgis/workspace.py:409; plugin/widgets/edit_session.py:358</extracomment>
             <translation>Bruchkanten</translation>
         </message>
         <message>
             <source>Ground points</source>
-            <extracomment>plugin/qgis/workspace.py:410</extracomment>
+            <extracomment>plugin/qgis/workspace.py:410; plugin/widgets/edit_session.py:359</extracomment>
             <translation>Bodenpunkte</translation>
         </message>
         <message>
             <source>Check points</source>
-            <extracomment>plugin/qgis/workspace.py:411</extracomment>
+            <extracomment>plugin/qgis/workspace.py:411; plugin/widgets/edit_session.py:360</extracomment>
             <translation>Kontrollpunkte</translation>
-        </message>
-        <message>
-            <source>Difference</source>
-            <extracomment>plugin/qgis/workspace.py:426</extracomment>
-            <translation>Differenz</translation>
-        </message>
-        <message>
-            <source>Ortho</source>
-            <extracomment>plugin/qgis/workspace.py:427</extracomment>
-            <translation>Ortho</translation>
-        </message>
-        <message>
-            <source>Image footprints</source>
-            <extracomment>plugin/qgis/workspace.py:254</extracomment>
-            <translation>Bildfußabdrücke</translation>
         </message>
         <message>
             <source>Edits</source>
@@ -3330,22 +3395,22 @@
         </message>
         <message>
             <source>Open</source>
-            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:211; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Öffnen</translation>
         </message>
         <message>
             <source>Show in folder</source>
-            <extracomment>plugin/widgets/batch_dialog.py:212; plugin/widgets/run_panel.py:224</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:212; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Im Ordner zeigen</translation>
         </message>
         <message>
             <source>Log</source>
-            <extracomment>plugin/widgets/batch_dialog.py:225; plugin/widgets/run_panel.py:87</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:225; plugin/widgets/run_panel.py:93</extracomment>
             <translation>Protokoll</translation>
         </message>
         <message>
             <source>Run</source>
-            <extracomment>plugin/widgets/batch_dialog.py:238; plugin/widgets/run_panel.py:42</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:238; plugin/widgets/run_panel.py:48</extracomment>
             <translation>Ausführen</translation>
         </message>
         <message>
@@ -3370,7 +3435,7 @@
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:45</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:244; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
@@ -3444,6 +3509,11 @@
             <translation>Modell</translation>
         </message>
         <message>
+            <source>Kind</source>
+            <extracomment>plugin/widgets/batch_dialog.py:137; plugin/widgets/edit_forms.py:128</extracomment>
+            <translation>Art</translation>
+        </message>
+        <message>
             <source>B/H</source>
             <extracomment>plugin/widgets/batch_dialog.py:137</extracomment>
             <translation>B/H</translation>
@@ -3500,7 +3570,7 @@
         </message>
         <message>
             <source>Cancelling …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:502; plugin/widgets/run_panel.py:149</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:502; plugin/widgets/run_panel.py:155</extracomment>
             <translation>Wird abgebrochen …</translation>
         </message>
         <message>
@@ -3535,12 +3605,12 @@
         </message>
         <message>
             <source>Warning: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:169</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:175</extracomment>
             <translation>Warnung: </translation>
         </message>
         <message>
             <source>Error: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:183</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:608; plugin/widgets/run_panel.py:189</extracomment>
             <translation>Fehler: </translation>
         </message>
         <message>
@@ -3554,6 +3624,286 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>The batch file cannot be used: {0}</source>
             <extracomment>plugin/widgets/batch_dialog.py:399</extracomment>
             <translation>Die Batch-Datei kann nicht verwendet werden: {0}</translation>
+        </message>
+        <message>
+            <source>Id</source>
+            <extracomment>plugin/widgets/edit_flow.py:78</extracomment>
+            <translation>Kennung</translation>
+        </message>
+        <message>
+            <source>Note</source>
+            <extracomment>plugin/widgets/edit_flow.py:78; plugin/widgets/edit_forms.py:115; plugin/widgets/edit_forms.py:94</extracomment>
+            <translation>Notiz</translation>
+        </message>
+        <message>
+            <source>Type the heights of the two ends; the others are interpolated.</source>
+            <extracomment>plugin/widgets/edit_flow.py:152</extracomment>
+            <translation>Geben Sie die Höhen der beiden Enden ein; die übrigen werden interpoliert.</translation>
+        </message>
+        <message>
+            <source>No surface chosen; type the height.</source>
+            <extracomment>plugin/widgets/edit_flow.py:48</extracomment>
+            <translation>Keine Oberfläche gewählt; geben Sie die Höhe ein.</translation>
+        </message>
+        <message>
+            <source>The point lies outside every stereo model; no model will use it.</source>
+            <extracomment>plugin/widgets/edit_flow.py:74</extracomment>
+            <translation>Der Punkt liegt außerhalb aller Stereomodelle; kein Modell wird ihn verwenden.</translation>
+        </message>
+        <message>
+            <source>Name</source>
+            <extracomment>plugin/widgets/edit_flow.py:102</extracomment>
+            <translation>Name</translation>
+        </message>
+        <message>
+            <source>Breakline refused, nothing written: {0}</source>
+            <extracomment>plugin/widgets/edit_flow.py:127</extracomment>
+            <translation>Bruchkante abgelehnt, nichts geschrieben: {0}</translation>
+        </message>
+        <message>
+            <source>Every vertex of a breakline needs a height.</source>
+            <extracomment>plugin/widgets/edit_flow.py:161</extracomment>
+            <translation>Jeder Stützpunkt einer Bruchkante braucht eine Höhe.</translation>
+        </message>
+        <message>
+            <source>Polygon refused, nothing written: {0}</source>
+            <extracomment>plugin/widgets/edit_flow.py:95</extracomment>
+            <translation>Polygon abgelehnt, nichts geschrieben: {0}</translation>
+        </message>
+        <message>
+            <source>keep (surface stays as measured)</source>
+            <extracomment>plugin/widgets/edit_forms.py:34</extracomment>
+            <translation>behalten (Oberfläche bleibt wie gemessen)</translation>
+        </message>
+        <message>
+            <source>remove (not matched; bridged in the DTM)</source>
+            <extracomment>plugin/widgets/edit_forms.py:35</extracomment>
+            <translation>entfernen (nicht zugeordnet; im DGM überbrückt)</translation>
+        </message>
+        <message>
+            <source>exclude (as remove)</source>
+            <extracomment>plugin/widgets/edit_forms.py:36</extracomment>
+            <translation>ausschließen (wie entfernen)</translation>
+        </message>
+        <message>
+            <source>type a height</source>
+            <extracomment>plugin/widgets/edit_forms.py:52</extracomment>
+            <translation>Höhe eingeben</translation>
+        </message>
+        <message>
+            <source>Height</source>
+            <extracomment>plugin/widgets/edit_forms.py:91</extracomment>
+            <translation>Höhe</translation>
+        </message>
+        <message>
+            <source>What should happen inside the area?</source>
+            <extracomment>plugin/widgets/edit_forms.py:107</extracomment>
+            <translation>Was soll innerhalb der Fläche geschehen?</translation>
+        </message>
+        <message>
+            <source>Action</source>
+            <extracomment>plugin/widgets/edit_forms.py:113; plugin/widgets/qc_panel.py:276</extracomment>
+            <translation>Aktion</translation>
+        </message>
+        <message>
+            <source>Breakline heights</source>
+            <extracomment>plugin/widgets/edit_forms.py:123</extracomment>
+            <translation>Höhen der Bruchkante</translation>
+        </message>
+        <message>
+            <source>Invalid polygon</source>
+            <extracomment>plugin/widgets/edit_forms.py:192</extracomment>
+            <translation>Ungültiges Polygon</translation>
+        </message>
+        <message>
+            <source>Use the repaired polygon?</source>
+            <extracomment>plugin/widgets/edit_forms.py:193</extracomment>
+            <translation>Das reparierte Polygon verwenden?</translation>
+        </message>
+        <message>
+            <source>Vertex {0}</source>
+            <extracomment>plugin/widgets/edit_forms.py:135</extracomment>
+            <translation>Stützpunkt {0}</translation>
+        </message>
+        <message>
+            <source>Add start point</source>
+            <extracomment>plugin/widgets/edit_session.py:37</extracomment>
+            <translation>Startpunkt hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add exclusion area</source>
+            <extracomment>plugin/widgets/edit_session.py:37</extracomment>
+            <translation>Ausschlussfläche hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add boundary</source>
+            <extracomment>plugin/widgets/edit_session.py:38</extracomment>
+            <translation>Begrenzung hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add breakline</source>
+            <extracomment>plugin/widgets/edit_session.py:38</extracomment>
+            <translation>Bruchkante hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add ground point</source>
+            <extracomment>plugin/widgets/edit_session.py:39</extracomment>
+            <translation>Bodenpunkt hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add seamline</source>
+            <extracomment>plugin/widgets/edit_session.py:39</extracomment>
+            <translation>Schnittlinie hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add check point</source>
+            <extracomment>plugin/widgets/edit_session.py:40</extracomment>
+            <translation>Kontrollpunkt hinzufügen</translation>
+        </message>
+        <message>
+            <source>Add feature</source>
+            <extracomment>plugin/widgets/edit_session.py:41</extracomment>
+            <translation>Objekt hinzufügen</translation>
+        </message>
+        <message>
+            <source>Change start point</source>
+            <extracomment>plugin/widgets/edit_session.py:46</extracomment>
+            <translation>Startpunkt ändern</translation>
+        </message>
+        <message>
+            <source>Change exclusion area</source>
+            <extracomment>plugin/widgets/edit_session.py:47</extracomment>
+            <translation>Ausschlussfläche ändern</translation>
+        </message>
+        <message>
+            <source>Change boundary</source>
+            <extracomment>plugin/widgets/edit_session.py:48</extracomment>
+            <translation>Begrenzung ändern</translation>
+        </message>
+        <message>
+            <source>Change breakline</source>
+            <extracomment>plugin/widgets/edit_session.py:48</extracomment>
+            <translation>Bruchkante ändern</translation>
+        </message>
+        <message>
+            <source>Change ground point</source>
+            <extracomment>plugin/widgets/edit_session.py:49</extracomment>
+            <translation>Bodenpunkt ändern</translation>
+        </message>
+        <message>
+            <source>Change seamline</source>
+            <extracomment>plugin/widgets/edit_session.py:49</extracomment>
+            <translation>Schnittlinie ändern</translation>
+        </message>
+        <message>
+            <source>Change check point</source>
+            <extracomment>plugin/widgets/edit_session.py:50</extracomment>
+            <translation>Kontrollpunkt ändern</translation>
+        </message>
+        <message>
+            <source>Change feature</source>
+            <extracomment>plugin/widgets/edit_session.py:51</extracomment>
+            <translation>Objekt ändern</translation>
+        </message>
+        <message>
+            <source>Delete start point</source>
+            <extracomment>plugin/widgets/edit_session.py:56</extracomment>
+            <translation>Startpunkt löschen</translation>
+        </message>
+        <message>
+            <source>Delete exclusion area</source>
+            <extracomment>plugin/widgets/edit_session.py:57</extracomment>
+            <translation>Ausschlussfläche löschen</translation>
+        </message>
+        <message>
+            <source>Delete boundary</source>
+            <extracomment>plugin/widgets/edit_session.py:58</extracomment>
+            <translation>Begrenzung löschen</translation>
+        </message>
+        <message>
+            <source>Delete breakline</source>
+            <extracomment>plugin/widgets/edit_session.py:58</extracomment>
+            <translation>Bruchkante löschen</translation>
+        </message>
+        <message>
+            <source>Delete ground point</source>
+            <extracomment>plugin/widgets/edit_session.py:59</extracomment>
+            <translation>Bodenpunkt löschen</translation>
+        </message>
+        <message>
+            <source>Delete seamline</source>
+            <extracomment>plugin/widgets/edit_session.py:59</extracomment>
+            <translation>Schnittlinie löschen</translation>
+        </message>
+        <message>
+            <source>Delete check point</source>
+            <extracomment>plugin/widgets/edit_session.py:60</extracomment>
+            <translation>Kontrollpunkt löschen</translation>
+        </message>
+        <message>
+            <source>Delete feature</source>
+            <extracomment>plugin/widgets/edit_session.py:61; plugin/widgets/map_edit_tools.py:413</extracomment>
+            <translation>Objekt löschen</translation>
+        </message>
+        <message>
+            <source>Unsaved edits</source>
+            <extracomment>plugin/widgets/edit_session.py:84</extracomment>
+            <translation>Ungespeicherte Bearbeitungen</translation>
+        </message>
+        <message>
+            <source>Save</source>
+            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:168</extracomment>
+            <translation>Speichern</translation>
+        </message>
+        <message>
+            <source>Discard</source>
+            <extracomment>plugin/widgets/edit_session.py:91</extracomment>
+            <translation>Verwerfen</translation>
+        </message>
+        <message>
+            <source>The edits of this project are not saved. Save them to {0}?</source>
+            <extracomment>plugin/widgets/edit_session.py:85</extracomment>
+            <translation>Die Bearbeitungen dieses Projekts sind nicht gespeichert. In {0} speichern?</translation>
+        </message>
+        <message>
+            <source>Edits not saved</source>
+            <extracomment>plugin/widgets/edit_session.py:350</extracomment>
+            <translation>Bearbeitungen nicht gespeichert</translation>
+        </message>
+        <message>
+            <source>Layer '{0}' has no field(s) {1}.</source>
+            <extracomment>plugin/widgets/edit_session.py:254</extracomment>
+            <translation>Der Layer '{0}' hat kein(e) Feld(er) {1}.</translation>
+        </message>
+        <message>
+            <source>Layer '{0}' has no feature {1}.</source>
+            <extracomment>plugin/widgets/edit_session.py:287</extracomment>
+            <translation>Der Layer '{0}' hat kein Objekt {1}.</translation>
+        </message>
+        <message>
+            <source>The edits file {0} was changed by another program (QGIS?) since it was opened here; saving would lose those changes. Nothing was written. Open the project again to see them.</source>
+            <extracomment>plugin/widgets/edit_session.py:317</extracomment>
+            <translation>Die Bearbeitungsdatei {0} wurde seit dem Öffnen hier von einem anderen Programm (QGIS?) geändert; Speichern würde diese Änderungen verlieren. Es wurde nichts geschrieben. Öffnen Sie das Projekt erneut, um sie zu sehen.</translation>
+        </message>
+        <message>
+            <source>The edits file {0} cannot be saved now ({1}); nothing was written. Close the program that holds it and save again.</source>
+            <extracomment>plugin/widgets/edit_session.py:323</extracomment>
+            <translation>Die Bearbeitungsdatei {0} kann jetzt nicht gespeichert werden ({1}); es wurde nichts geschrieben. Schließen Sie das Programm, das sie geöffnet hält, und speichern Sie erneut.</translation>
+        </message>
+        <message>
+            <source>The edits cannot be read; they are shown read-only and never written. {0}</source>
+            <extracomment>plugin/widgets/edit_session.py:168</extracomment>
+            <translation>Die Bearbeitungen können nicht gelesen werden; sie werden schreibgeschützt angezeigt und nie geschrieben. {0}</translation>
+        </message>
+        <message>
+            <source>The edits file {0} is read-only ({1}); make it writable to edit.</source>
+            <extracomment>plugin/widgets/edit_session.py:180</extracomment>
+            <translation>Die Bearbeitungsdatei {0} ist schreibgeschützt ({1}); machen Sie sie beschreibbar, um zu bearbeiten.</translation>
+        </message>
+        <message>
+            <source>The edits file {0} is locked or unreadable ({1}); close the program that holds it and open the project again.</source>
+            <extracomment>plugin/widgets/edit_session.py:183</extracomment>
+            <translation>Die Bearbeitungsdatei {0} ist gesperrt oder unlesbar ({1}); schließen Sie das Programm, das sie geöffnet hält, und öffnen Sie das Projekt erneut.</translation>
         </message>
         <message>
             <source>Use</source>
@@ -3679,11 +4029,6 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Switch off largest residual</source>
             <extracomment>plugin/widgets/georef_review.py:167</extracomment>
             <translation>Größten Restfehler abschalten</translation>
-        </message>
-        <message>
-            <source>Save</source>
-            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
-            <translation>Speichern</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
@@ -3819,6 +4164,196 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>Residuals (×{0:g})</source>
             <extracomment>plugin/widgets/georef_review.py:437</extracomment>
             <translation>Restfehler (×{0:g})</translation>
+        </message>
+        <message>
+            <source>Z draped</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:364</extracomment>
+            <translation>Z von der Oberfläche</translation>
+        </message>
+        <message>
+            <source>Z typed</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:364</extracomment>
+            <translation>Z eingegeben</translation>
+        </message>
+        <message>
+            <source>Z interpolated</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:365</extracomment>
+            <translation>Z interpoliert</translation>
+        </message>
+        <message>
+            <source>The surface that gives new points and breaklines their heights</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:396</extracomment>
+            <translation>Die Oberfläche, aus der neue Punkte und Bruchkanten ihre Höhen erhalten</translation>
+        </message>
+        <message>
+            <source>Breakline heights: draped on the surface, typed at every vertex, or typed at the ends and interpolated between</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:403</extracomment>
+            <translation>Höhen der Bruchkanten: auf die Oberfläche gelegt, an jedem Stützpunkt eingegeben oder an den Enden eingegeben und dazwischen interpoliert</translation>
+        </message>
+        <message>
+            <source>PhotoDEM edit tools</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:410</extracomment>
+            <translation>PhotoDEM-Bearbeitungswerkzeuge</translation>
+        </message>
+        <message>
+            <source>New heights of every breakline and point from the chosen surface (one undo step)</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:416</extracomment>
+            <translation>Neue Höhen aller Bruchkanten und Punkte aus der gewählten Oberfläche (ein Rückgängig-Schritt)</translation>
+        </message>
+        <message>
+            <source>Save edits</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:419</extracomment>
+            <translation>Bearbeitungen speichern</translation>
+        </message>
+        <message>
+            <source>Open a PhotoDEM project first (File → Open project…).</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:123; plugin/widgets/map_edit_tools.py:519</extracomment>
+            <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt (Datei → Projekt öffnen…).</translation>
+        </message>
+        <message>
+            <source>Vertices</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:412</extracomment>
+            <translation>Stützpunkte</translation>
+        </message>
+        <message>
+            <source>(no DSM or DTM yet)</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:570</extracomment>
+            <translation>(noch kein DOM oder DGM)</translation>
+        </message>
+        <message>
+            <source>Edits saved to {0}.</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:616</extracomment>
+            <translation>Bearbeitungen gespeichert in {0}.</translation>
+        </message>
+        <message>
+            <source>The surface '{0}' is not a file.</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:106</extracomment>
+            <translation>Die Oberfläche '{0}' ist keine Datei.</translation>
+        </message>
+        <message>
+            <source>The edits are read-only: {0}</source>
+            <extracomment>plugin/widgets/map_edit_tools.py:126</extracomment>
+            <translation>Die Bearbeitungen sind schreibgeschützt: {0}</translation>
+        </message>
+        <message>
+            <source>Opacity of the selected layer</source>
+            <extracomment>plugin/widgets/map_layers.py:77</extracomment>
+            <translation>Deckkraft des gewählten Layers</translation>
+        </message>
+        <message>
+            <source>Opacity</source>
+            <extracomment>plugin/widgets/map_layers.py:78</extracomment>
+            <translation>Deckkraft</translation>
+        </message>
+        <message>
+            <source>Move the layer up</source>
+            <extracomment>plugin/widgets/map_layers.py:79</extracomment>
+            <translation>Layer nach oben verschieben</translation>
+        </message>
+        <message>
+            <source>Move the layer down</source>
+            <extracomment>plugin/widgets/map_layers.py:81</extracomment>
+            <translation>Layer nach unten verschieben</translation>
+        </message>
+        <message>
+            <source>Zoom to layer</source>
+            <extracomment>plugin/widgets/map_layers.py:243; plugin/widgets/map_layers.py:83</extracomment>
+            <translation>Auf Layer zoomen</translation>
+        </message>
+        <message>
+            <source>Remove layer</source>
+            <extracomment>plugin/widgets/map_layers.py:252; plugin/widgets/map_layers.py:84</extracomment>
+            <translation>Layer entfernen</translation>
+        </message>
+        <message>
+            <source>Move up</source>
+            <extracomment>plugin/widgets/map_layers.py:244</extracomment>
+            <translation>Nach oben</translation>
+        </message>
+        <message>
+            <source>Move down</source>
+            <extracomment>plugin/widgets/map_layers.py:246</extracomment>
+            <translation>Nach unten</translation>
+        </message>
+        <message>
+            <source>Build overviews</source>
+            <extracomment>plugin/widgets/map_layers.py:250</extracomment>
+            <translation>Übersichten erzeugen</translation>
+        </message>
+        <message>
+            <source>Overviews written to {0}.</source>
+            <extracomment>plugin/widgets/map_layers.py:269</extracomment>
+            <translation>Übersichten geschrieben nach {0}.</translation>
+        </message>
+        <message>
+            <source>Overviews of {0} not built: {1}</source>
+            <extracomment>plugin/widgets/map_layers.py:265</extracomment>
+            <translation>Übersichten von {0} nicht erzeugt: {1}</translation>
+        </message>
+        <message>
+            <source>drawn polygon ({0:.0f} m²)</source>
+            <extracomment>plugin/widgets/map_qc_tools.py:28</extracomment>
+            <translation>gezeichnetes Polygon ({0:.0f} m²)</translation>
+        </message>
+        <message>
+            <source>A point has only this one vertex; delete the feature instead.</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:113</extracomment>
+            <translation>Ein Punkt hat nur diesen einen Stützpunkt; löschen Sie stattdessen das Objekt.</translation>
+        </message>
+        <message>
+            <source>Move vertex</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:303</extracomment>
+            <translation>Stützpunkt verschieben</translation>
+        </message>
+        <message>
+            <source>Delete vertex</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:316</extracomment>
+            <translation>Stützpunkt löschen</translation>
+        </message>
+        <message>
+            <source>Re-drape {0} features</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:463</extracomment>
+            <translation>{0} Objekte neu abgreifen</translation>
+        </message>
+        <message>
+            <source>A line needs at least 2 vertices; this one would keep only {0}. Delete the feature instead.</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:115</extracomment>
+            <translation>Eine Linie braucht mindestens 2 Stützpunkte; diese behielte nur {0}. Löschen Sie stattdessen das Objekt.</translation>
+        </message>
+        <message>
+            <source>A polygon needs at least 3 vertices; this one would keep only {0}. Delete the feature instead.</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:118</extracomment>
+            <translation>Ein Polygon braucht mindestens 3 Stützpunkte; dieses behielte nur {0}. Löschen Sie stattdessen das Objekt.</translation>
+        </message>
+        <message>
+            <source>Edit refused, nothing changed: {0}</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:325</extracomment>
+            <translation>Bearbeitung abgelehnt, nichts geändert: {0}</translation>
+        </message>
+        <message>
+            <source>The vertex was not moved: {0}</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:298</extracomment>
+            <translation>Der Stützpunkt wurde nicht verschoben: {0}</translation>
+        </message>
+        <message>
+            <source>The vertex was not deleted: {0}</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:313</extracomment>
+            <translation>Der Stützpunkt wurde nicht gelöscht: {0}</translation>
+        </message>
+        <message>
+            <source>Nothing re-draped: {0} {1}: {2}</source>
+            <extracomment>plugin/widgets/map_vertex_tools.py:452</extracomment>
+            <translation>Nichts neu abgegriffen: {0} {1}: {2}</translation>
+        </message>
+        <message>
+            <source>'{0}' has no coordinate reference system: it can only be shown alone, in pixel coordinates.</source>
+            <extracomment>plugin/widgets/map_view.py:156</extracomment>
+            <translation>„{0}“ hat kein Koordinatenbezugssystem: nur allein anzeigbar, in Pixelkoordinaten.</translation>
+        </message>
+        <message>
+            <source>The map shows a raster in pixel coordinates; '{0}' is georeferenced and cannot be shown with it.</source>
+            <extracomment>plugin/widgets/map_view.py:160</extracomment>
+            <translation>Die Karte zeigt ein Raster in Pixelkoordinaten; „{0}“ ist georeferenziert und kann nicht zusammen damit angezeigt werden.</translation>
         </message>
         <message>
             <source>Browse</source>
@@ -4377,7 +4912,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Value</source>
-            <extracomment>plugin/widgets/qc_plots.py:58; plugin/widgets/run_panel.py:62</extracomment>
+            <extracomment>plugin/widgets/qc_plots.py:58; plugin/widgets/run_panel.py:68</extracomment>
             <translation>Wert</translation>
         </message>
         <message>
@@ -4436,34 +4971,88 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Δh-Histogramm: {0} Zellen, NMAD {1:.3f} m</translation>
         </message>
         <message>
+            <source>nodata</source>
+            <extracomment>plugin/widgets/raster_tiles.py:266</extracomment>
+            <translation>NoData</translation>
+        </message>
+        <message>
             <source>The log of the run appears here.</source>
-            <extracomment>plugin/widgets/run_panel.py:57</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:63</extracomment>
             <translation>Hier erscheint das Protokoll des Laufs.</translation>
         </message>
         <message>
             <source>Open report</source>
-            <extracomment>plugin/widgets/run_panel.py:73</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:79</extracomment>
             <translation>Bericht öffnen</translation>
         </message>
         <message>
             <source>Result</source>
-            <extracomment>plugin/widgets/run_panel.py:88</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:94</extracomment>
             <translation>Ergebnis</translation>
         </message>
         <message>
             <source>Finished.</source>
-            <extracomment>plugin/widgets/run_panel.py:178</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:184</extracomment>
             <translation>Fertig.</translation>
         </message>
         <message>
             <source>Output</source>
-            <extracomment>plugin/widgets/run_panel.py:62</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:68</extracomment>
             <translation>Ausgabe</translation>
         </message>
         <message>
+            <source>Show on map</source>
+            <extracomment>plugin/widgets/run_panel.py:233</extracomment>
+            <translation>Auf Karte zeigen</translation>
+        </message>
+        <message>
             <source>Unexpected error (please report it):</source>
-            <extracomment>plugin/widgets/run_panel.py:185</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:191</extracomment>
             <translation>Unerwarteter Fehler (bitte melden):</translation>
+        </message>
+        <message>
+            <source>Undo</source>
+            <extracomment>plugin/widgets/undo_history.py:21; plugin/widgets/undo_history.py:48</extracomment>
+            <translation>Rückgängig</translation>
+        </message>
+        <message>
+            <source>Redo</source>
+            <extracomment>plugin/widgets/undo_history.py:22; plugin/widgets/undo_history.py:49</extracomment>
+            <translation>Wiederholen</translation>
+        </message>
+        <message>
+            <source>Undo the last edit (Ctrl+Z)</source>
+            <extracomment>plugin/widgets/undo_history.py:27</extracomment>
+            <translation>Letzte Bearbeitung rückgängig machen (Strg+Z)</translation>
+        </message>
+        <message>
+            <source>Redo the edit undone last (Ctrl+Y)</source>
+            <extracomment>plugin/widgets/undo_history.py:28</extracomment>
+            <translation>Zuletzt rückgängig gemachte Bearbeitung wiederholen (Strg+Y)</translation>
+        </message>
+        <message>
+            <source>&lt;empty&gt;</source>
+            <extracomment>plugin/widgets/undo_history.py:47</extracomment>
+            <translation>&lt;leer&gt;</translation>
+        </message>
+        <message>
+            <source>No project open.</source>
+            <extracomment>plugin/widgets/undo_history.py:97</extracomment>
+            <translation>Kein Projekt geöffnet.</translation>
+        </message>
+        <message>
+            <source>Unsaved edits.</source>
+            <extracomment>plugin/widgets/undo_history.py:101</extracomment>
+            <translation>Ungespeicherte Bearbeitungen.</translation>
+        </message>
+        <message>
+            <source>All edits saved.</source>
+            <extracomment>plugin/widgets/undo_history.py:103</extracomment>
+            <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>Choose an algorithm on the left.</source>
+            <translation type="vanished">Links einen Algorithmus wählen.</translation>
         </message>
         <message>
             <source>urban (default): small windows and groundels, keeps buildings and trees with sharp walls (a DSM); terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>

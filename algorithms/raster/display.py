@@ -82,7 +82,8 @@ def open_raster(path: PathLike) -> Any:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)  # shown in pixel coordinates
             return rasterio.open(path)
-    except rasterio.errors.RasterioError as exc:
+    except (rasterio.errors.RasterioError, rasterio.errors.RasterioIOError) as exc:
+        # rasterio 1.3 (Debian's) derives RasterioIOError from OSError, 1.4 from RasterioError
         raise InputError(f"GDAL cannot open the raster '{path.name}' ({path}): {exc}") from exc
 
 

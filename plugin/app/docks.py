@@ -95,6 +95,9 @@ def batch_dock(window: Any, project: Optional[str] = None) -> QtWidgets.QDockWid
 def _qc_tools(window: Any, bar: EditingToolbar) -> None:
     """The quality panel's map tools on the editing toolbar (they open the panel)."""
     def panel() -> Any:
+        opener = getattr(window, "open_quality_panel", None)  # the window places the dock
+        if opener is not None:
+            return opener()
         dock = quality_dock(window)
         dock.show()
         return dock.widget()

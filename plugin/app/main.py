@@ -11,8 +11,9 @@ from ..qt import QtWidgets
 _windows: list = []
 
 
-def main(argv: Optional[List[str]] = None) -> int:
-    """Create the application (or reuse a running one), show the toolbox, run the event loop."""
+def main(argv: Optional[List[str]] = None, project: Optional[str] = None) -> int:
+    """Create the application (or reuse a running one), show the toolbox (with ``project``
+    open on the map when given), run the event loop."""
     argv = list(sys.argv if argv is None else argv)
     app = QtWidgets.QApplication.instance()
     owns_app = app is None
@@ -28,6 +29,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     window = ToolboxWindow()
     _windows.append(window)  # keep a reference when the caller runs the event loop
     window.show()
+    if project:
+        window.open_project(project)  # a bad path is reported in the window, not raised
     if not owns_app:
         return 0
     return int(app.exec_())

@@ -17,6 +17,7 @@ from ..i18n import tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 from ..widgets.parameter_form import SETTINGS_PROJECT, ParameterForm
 from ..widgets.run_panel import RunPanel
+from .docks import batch_dock, install_editing, quality_dock
 from .map_window import MapWindowMixin
 
 ALG_ROLE = QtCore.Qt.UserRole + 1
@@ -133,6 +134,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         self.statusBar().showMessage(tr("Open a project (File menu) or choose an algorithm "
                                         "in the toolbox."))
         self.populate()
+        install_editing(self)  # editing toolbar, QC map tools, undo history (issue 21)
 
         self.tree.currentItemChanged.connect(self._on_current_item)
         self.filter_edit.textChanged.connect(self._apply_filter)
@@ -159,7 +161,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         # the batch dialog over stereo models (issue 20)
         self.batch_action = tools_menu.addAction(tr("Batch over stereo models…"))
         self.batch_action.setToolTip(tr("Run steps over many stereo models, resumable"))
-        self.batch_action.triggered.connect(lambda _checked=False: self.open_batch_dialog())
+        self.batch_action.triggered.connect(lambda _checked=False: batch_dock(self))
         # issue 20: the DEM quality panel, docked in this window
         self.quality_action = tools_menu.addAction(tr("DEM quality…"))
         self.quality_action.setToolTip(tr("Statistics, histogram, profiles, identify and "
@@ -320,7 +322,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         if getattr(self, "batch_button", None) is None:
             self.batch_button = QtWidgets.QPushButton(tr("Batch running – show"), self)
             self.batch_button.setFlat(True)
-            self.batch_button.clicked.connect(lambda _c=False: self.open_batch_dialog())
+            self.batch_button.clicked.connect(lambda _c=False: batch_dock(self))
             self.statusBar().addPermanentWidget(self.batch_button)
         self.batch_button.show()
 
@@ -366,14 +368,9 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
 
     def open_quality_panel(self) -> QtWidgets.QWidget:
         """Show the DEM quality panel (issue 20) in a dock of this window; returns the panel."""
-        dock = self.findChild(QtWidgets.QDockWidget, "photodemQuality")
-        if dock is None:
-            from ..widgets.qc_panel import QcPanel  # lazy: matplotlib loads on first use
-
-            dock = QtWidgets.QDockWidget(tr("DEM quality"), self)
-            dock.setObjectName("photodemQuality")
-            dock.setWidget(QcPanel(dock))
-            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, dock)
+        dock = quality_dock(self)
+        if dock.property("photodemTabbed") is None:  # first time: a tab beside the toolbox
+            dock.setProperty("photodemTabbed", True)
             self.tabifyDockWidget(self.toolbox_dock, dock)
         dock.show()
         dock.raise_()

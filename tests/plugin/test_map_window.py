@@ -246,3 +246,15 @@ def test_corrupt_edits_are_shown_read_only(window, tiny, tmp_path):
     assert [layer.kind for layer in window.map_view.layers()] == EXPECTED_KINDS
     assert window.close_project()
     assert edits.read_bytes() == before  # nothing written
+
+
+def test_gui_command_opens_a_project_given_on_the_command_line(tiny, qtbot):
+    from photodem.plugin.app import main as app_main
+
+    assert app_main.main(["photodem"], project=str(tiny / "project.toml")) == 0
+    window = app_main._windows.pop()
+    qtbot.addWidget(window)
+    assert window.project_root == tiny.resolve()
+    assert window.map_view.layer_by_kind("footprints") is not None
+    window.edit_session.ask = lambda parent, session: "discard"
+    window.map_view.clear_layers()

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import fiona
 import pytest
+import shapely
 from shapely import wkb
 from shapely.geometry import LineString, MultiLineString, MultiPolygon, Point, Polygon, shape
 
@@ -37,7 +38,8 @@ def test_blob_round_trip(geometry) -> None:
     assert back.equals_exact(geometry, 0) and back.has_z == geometry.has_z
     assert geometry_to_blob(None, 1) is None and blob_to_geometry(None) is None
     # shapely 2 writes ISO WKB itself (Debian's shapely 1.8 cannot: hence our writer)
-    assert iso_wkb(geometry) == wkb.dumps(geometry, byte_order=1, flavor="iso")
+    if shapely.__version__ >= "2":
+        assert iso_wkb(geometry) == wkb.dumps(geometry, byte_order=1, flavor="iso")
 
 
 def test_new_file_is_read_by_gdal_and_the_core_reader(tmp_path: Path) -> None:
