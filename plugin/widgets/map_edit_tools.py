@@ -16,7 +16,7 @@ What a drawing becomes is the same as in QGIS: both faces run the shared steps o
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Set, Tuple
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.project import edit_rules, edit_tools
@@ -388,6 +388,8 @@ class EditingToolbar(QtWidgets.QToolBar):
         self.actions_: Dict[str, QtWidgets.QAction] = {}
         self.factories: Dict[str, Callable[[], Optional[MapTool]]] = {}
         self.extra_surfaces: List[Tuple[str, str]] = []  # chosen by hand (set_surface)
+        self.hand_chosen: Optional[str] = None  # the surface the operator picked
+        self.dsm_paths: Set[str] = set()  # the DSMs among the surfaces (the default is one)
         for layer, title in layer_titles().items():
             self.add_tool(layer, title, lambda name=layer: self.edit_tool(name))
         self.addSeparator()
@@ -540,34 +542,49 @@ class EditingToolbar(QtWidgets.QToolBar):
                 action.setEnabled(self.context is not None)
         for action in self.modify_actions + [self.save_action]:
             action.setEnabled(self.context is not None)
+        self.hand_chosen = None  # another project: its newest DSM again
         self.fill_surfaces(root)
 
     def surfaces(self, root: Optional[Any]) -> List[Tuple[str, str]]:
         """(label, path) of the DSMs and DTMs: the project's products, then those on the map
         (the truth rasters of a synthetic project, a raster added by hand)."""
-        found = [(f"{p.kind.upper()} {p.name}", str(p.path))
-                 for p in (find_products(root) if root is not None else [])
+        products = find_products(root) if root is not None else []
+        found = [(f"{p.kind.upper()} {p.name}", str(p.path)) for p in products
                  if p.kind in ELEVATION_KINDS]
+        self.dsm_paths = {str(p.path.resolve()) for p in products if p.kind == "dsm"}
         for layer in self.view.layers() if self.view is not None else []:
             path = getattr(layer, "path", None)
             if layer.kind in ELEVATION_KINDS and path is not None:
                 found.append((layer.name, str(path)))
+                if layer.kind == "dsm":
+                    self.dsm_paths.add(str(Path(path).resolve()))
         unique: Dict[str, str] = {}
         for label, path in found + self.extra_surfaces:
             unique.setdefault(str(Path(path).resolve()), label)
         return [(label, path) for path, label in unique.items()]
 
+    def default_surface(self, paths: List[str]) -> Optional[str]:
+        """The newest DSM of ``paths`` (as QGIS's workspace chooses), else the newest one."""
+        def age(path: str) -> Tuple[bool, float]:
+            try:
+                return path in self.dsm_paths, Path(path).stat().st_mtime
+            except OSError:
+                return False, 0.0
+        return max(paths, key=age) if paths else None
+
     def fill_surfaces(self, root: Optional[Any] = None) -> None:
         """The surface list again (the chosen one stays when still there)."""
         if root is None and self.context is not None:
             root = self.context.project.root
-        chosen = self.surface_box.currentData()
         with QtCore.QSignalBlocker(self.surface_box):
             self.surface_box.clear()
-            for label, path in self.surfaces(root if self.context is not None else None):
+            found = self.surfaces(root if self.context is not None else None)
+            for label, path in found:
                 self.surface_box.addItem(label, path)
             if not self.surface_box.count():
                 self.surface_box.addItem(tr("(no DSM or DTM yet)"), None)
+            # the operator's choice stays; until there is one, the newest DSM
+            chosen = self.hand_chosen or self.default_surface([path for _l, path in found])
             index = self.surface_box.findData(chosen) if chosen else -1
             self.surface_box.setCurrentIndex(max(index, 0))
         self._surface_chosen()
@@ -575,13 +592,16 @@ class EditingToolbar(QtWidgets.QToolBar):
     def set_surface(self, path: Any, name: str = "") -> None:
         """Choose the surface ``path`` (added to the list when missing)."""
         path = str(Path(path).resolve())
+        self.hand_chosen = path
         if self.surface_box.findData(path) < 0:
             self.extra_surfaces.append((name or Path(path).stem, path))
             self.fill_surfaces()
         self.surface_box.setCurrentIndex(self.surface_box.findData(path))
         self._surface_chosen()
 
-    def _surface_chosen(self, _index: int = 0) -> None:
+    def _surface_chosen(self, index: int = -1) -> None:
+        if index >= 0:  # from the combo box: the operator's (or set_surface's) choice
+            self.hand_chosen = self.surface_box.currentData()
         if self.context is not None:
             self.context.surface = self.surface_box.currentData()
 

@@ -202,14 +202,18 @@ class MapView(QtWidgets.QWidget):
             self.remove_layer(layer)
 
     def add_raster(self, path: Union[str, Path], kind: str = "auto", name: str = "") -> MapLayer:
-        """Add the raster ``path`` on top (part R's tiled layer); raises :class:`InputError`
-        for a file GDAL can't open or a raster that can't join this view."""
+        """Add the raster ``path`` above the other rasters but under the vectors drawn over
+        them (edits stay visible); raises :class:`InputError` for a file GDAL can't open or a
+        raster that can't join this view. Without ``name`` the layer names itself ("DSM
+        0101_0102" for a product, else the file's stem)."""
         from .raster_tiles import RasterLayer  # lazy: loads GDAL/rasterio and the tile pool
 
-        layer = RasterLayer(path, kind=kind, name=name or Path(path).stem,
-                            map_crs=self._crs, parent=self)
+        layer = RasterLayer(path, kind=kind, name=name, map_crs=self._crs, parent=self)
+        layers = self.layers()
+        index = next((i for i, other in enumerate(layers) if isinstance(other, RasterLayer)),
+                     len(layers))
         try:
-            return self.add_layer(layer)
+            return self.add_layer(layer, index)
         except InputError:
             layer.close()
             raise

@@ -258,3 +258,22 @@ def test_gui_command_opens_a_project_given_on_the_command_line(tiny, qtbot):
     assert window.map_view.layer_by_kind("footprints") is not None
     window.edit_session.ask = lambda parent, session: "discard"
     window.map_view.clear_layers()
+
+
+def test_added_raster_goes_under_the_vectors_and_becomes_the_surface(window, tiny, tmp_path):
+    window.open_project(tiny)
+    view, bar = window.map_view, window.editing_toolbar
+    truth_dsm = str((tiny / "truth" / "dsm.tif").resolve())
+    assert bar.surface_box.currentData() == truth_dsm  # the newest DSM, not the DTM
+    newer = tmp_path / "dsm_new.tif"
+    shutil.copy(tiny / "truth" / "dsm.tif", newer)
+    layer = window.add_map_file(newer)
+    kinds = [other.kind for other in view.layers()]
+    index = view.layers().index(layer)
+    vectors = [i for i, kind in enumerate(kinds)
+               if kind.startswith("edit:") or kind in ("stereo_models", "footprints")]
+    assert index == max(vectors) + 1  # above the other rasters, under every vector
+    assert bar.surface_box.currentData() == str(newer.resolve())
+    bar.set_surface(truth_dsm)  # the operator's choice stays when layers change
+    window.add_map_file(tiny / "truth" / "dtm.tif")
+    assert bar.surface_box.currentData() == truth_dsm
