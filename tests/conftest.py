@@ -42,3 +42,35 @@ def chain_project(tmp_path):
                 models=[StereoModel(f"{a}_{b}", a, b) for a, b in zip(names, names[1:])]).save()
         return root
     return make
+
+
+@pytest.fixture
+def shots_dir(tmp_path) -> Path:
+    """Where screenshot tests save their PNGs: ``$PHOTODEM_SHOTS`` (to look at them) or a
+    temporary folder."""
+    folder = Path(os.environ.get("PHOTODEM_SHOTS") or tmp_path / "shots")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+@pytest.fixture
+def german(tmp_path, monkeypatch):
+    """A function that installs the German translation compiled from the committed
+    ``i18n/photodem_de.ts`` (skips without ``lrelease``); English again after the test."""
+    import shutil
+    import subprocess
+
+    from photodem.plugin import i18n
+
+    def install() -> None:
+        lrelease = shutil.which("lrelease") or shutil.which("/usr/lib/qt5/bin/lrelease")
+        if lrelease is None:
+            pytest.skip("lrelease not installed (Debian package qttools5-dev-tools)")
+        qm = tmp_path / "photodem_de.qm"
+        subprocess.run([lrelease, "-silent", str(ROOT / "i18n" / "photodem_de.ts"), "-qm",
+                        str(qm)], check=True)
+        monkeypatch.setattr(i18n, "I18N_DIR", tmp_path)
+        assert i18n.install_translator("de_DE") is not None
+
+    yield install
+    i18n.remove_translator()

@@ -38,7 +38,6 @@ from photodem.plugin.widgets.map_view import MapView
 
 QtTest = importlib.import_module(QtCore.__name__.rsplit(".", 1)[0] + ".QtTest")
 Qt = QtCore.Qt
-SHOTS = Path("/tmp/t")
 
 
 @pytest.fixture(scope="module")
@@ -258,15 +257,12 @@ def test_no_project_disables_the_tools(work):
 
 
 @pytest.mark.parametrize("lang", ["en", "de"])
-def test_screenshot_capture_in_progress(work, lang):
-    from _translation_preview import install_preview_german
-
+def test_screenshot_capture_in_progress(work, lang, shots_dir, german):
     from photodem.plugin.i18n import install_translator
 
-    SHOTS.mkdir(parents=True, exist_ok=True)
     window = work["window"]
     if lang == "de":
-        install_preview_german()
+        german()
         window.removeToolBar(work["bar"])
         window.removeToolBar(work["bar"].more)
         bar = editing_toolbar(window, ask=work["ask"])
@@ -290,7 +286,7 @@ def test_screenshot_capture_in_progress(work, lang):
         hover(work, 402312.0, 5674748.0)
         work["view"].wait_rendered(5000)
         QtWidgets.QApplication.processEvents()
-        assert window.grab().save(str(SHOTS / f"capture_{lang}.png"))
+        assert window.grab().save(str(shots_dir / f"capture_{lang}.png"))
     finally:
         install_translator("en")
 

@@ -23,7 +23,6 @@ from photodem.plugin.widgets.qc_panel import QcPanel
 
 QtTest = importlib.import_module(QtCore.__name__.rsplit(".", 1)[0] + ".QtTest")
 Qt = QtCore.Qt
-SHOTS = Path("/tmp/t")
 AREA = [(402270.0, 5674650.0), (402330.0, 5674650.0), (402330.0, 5674720.0),
         (402270.0, 5674720.0)]
 EXTENT = (402230.0, 5674615.0, 402370.0, 5674790.0)
@@ -194,16 +193,14 @@ def test_docks_follow_the_project_and_blunders_go_into_the_session(window, root)
 
 
 @pytest.mark.parametrize("lang", ["en", "de"])
-def test_screenshot_docks(qtbot, root, lang):
-    from _translation_preview import install_preview_german
+def test_screenshot_docks(qtbot, root, lang, shots_dir, german):
     from edit_clicks import CLICKS, FakeAsk
 
     from photodem.plugin.app.docks import batch_dock, install_editing, quality_dock
     from photodem.plugin.i18n import install_translator
 
-    SHOTS.mkdir(parents=True, exist_ok=True)
     if lang == "de":
-        install_preview_german()
+        german()
     try:
         w = DockWindow()
         qtbot.addWidget(w)
@@ -231,10 +228,10 @@ def test_screenshot_docks(qtbot, root, lang):
         batch_dock(w, str(root))
         w.map_view.wait_rendered(5000)
         QtWidgets.QApplication.processEvents()
-        assert w.grab().save(str(SHOTS / f"docks_{lang}.png"))
+        assert w.grab().save(str(shots_dir / f"docks_{lang}.png"))
         quality_dock(w).raise_()  # the statistics of the drawn area
         QtWidgets.QApplication.processEvents()
-        assert w.grab().save(str(SHOTS / f"docks_quality_{lang}.png"))
+        assert w.grab().save(str(shots_dir / f"docks_quality_{lang}.png"))
         QtGui.QGuiApplication.processEvents()
     finally:
         install_translator("en")

@@ -36,7 +36,6 @@ from edit_clicks import (
 
 pytestmark = pytest.mark.qgis
 
-SHOTS = Path("/tmp/e")
 
 
 # -- the block, the surface and the stand-in workspace ---------------------------------------------
@@ -189,7 +188,7 @@ def test_tool_writes_the_feature_and_undo_removes_it(work, case):
     check_written(case, hits, saved(work, layer_name))  # the standalone test expects the same
 
 
-def test_start_point_in_the_real_form(work, qgis_app):
+def test_start_point_in_the_real_form(work, qgis_app, shots_dir):
     """The real height form: pre-filled with the sampled height, edited, accepted."""
     from qgis.PyQt.QtCore import QTimer
     from qgis.PyQt.QtWidgets import QApplication, QDialogButtonBox, QDoubleSpinBox, QLineEdit
@@ -206,12 +205,11 @@ def test_start_point_in_the_real_form(work, qgis_app):
             return
         box = dialog.findChild(QDoubleSpinBox, "height")
         seen["prefilled"] = box.value()
-        dialog.grab().save(str(SHOTS / "height_form.png"))
+        dialog.grab().save(str(shots_dir / "height_form.png"))
         box.setValue(box.value() + 1.5)
         dialog.findChild(QLineEdit, "text").setText("edited")
         dialog.findChild(QDialogButtonBox).button(QDialogButtonBox.Ok).click()
 
-    SHOTS.mkdir(parents=True, exist_ok=True)
     QTimer.singleShot(0, fill)
     (hx, hy), = draw(work, "start_points", [CLICKS[0]["clicks"][0]])
     assert seen["prefilled"] == pytest.approx(surface_z(hx, hy), abs=1e-3)  # 3 decimals shown
@@ -488,14 +486,13 @@ def _unsaved_problem(work) -> None:
 
 
 @pytest.mark.parametrize("lang", ["en", "de"])
-def test_screenshot_toolbar_and_canvas(work, lang, qgis_app):
+def test_screenshot_toolbar_and_canvas(work, lang, qgis_app, shots_dir, german):
     from qgis.PyQt.QtWidgets import QApplication
 
     from photodem.plugin.i18n import install_translator
 
-    SHOTS.mkdir(parents=True, exist_ok=True)
     if lang == "de":
-        _install_preview_translation()
+        german()
         if work["bar"].toolbar in work["iface"].toolbars:
             work["iface"].toolbars.remove(work["bar"].toolbar)
         work["bar"].unload()
@@ -516,44 +513,9 @@ def test_screenshot_toolbar_and_canvas(work, lang, qgis_app):
             QApplication.processEvents()
             canvas.refreshAllLayers()
             canvas.waitWhileRendering()
-        assert window.grab().save(str(SHOTS / f"editing_{lang}.png"))
+        assert window.grab().save(str(shots_dir / f"editing_{lang}.png"))
     finally:
         install_translator("en")
-
-
-def _install_preview_translation() -> None:
-    """German with this part's new strings (/work/prompts/de_e.tsv) merged into a temporary
-    .qm — the shared .ts is merged by the lead, so the screenshot previews the result."""
-    import subprocess
-    import tempfile
-    import xml.etree.ElementTree as ET
-
-    from qgis.PyQt.QtCore import QCoreApplication, QTranslator
-
-    from photodem.plugin import i18n
-
-    ts = Path(i18n.I18N_DIR) / "photodem_de.ts"
-    tsv = Path("/work/prompts/de_e.tsv")
-    if not ts.is_file() or not tsv.is_file() or shutil.which("lrelease") is None:
-        pytest.skip("no German sources or lrelease to preview the translation")
-    tree = ET.parse(ts)
-    context = tree.getroot().find("context")
-    for line in tsv.read_text(encoding="utf-8").splitlines():
-        if "\t" not in line:
-            continue
-        english, german = line.split("\t", 1)
-        message = ET.SubElement(context, "message")
-        ET.SubElement(message, "source").text = english
-        ET.SubElement(message, "translation").text = german
-    folder = Path(tempfile.mkdtemp(prefix="photodem-de-"))
-    tree.write(folder / "de.ts", encoding="utf-8", xml_declaration=True)
-    subprocess.run(["lrelease", "-silent", str(folder / "de.ts"), "-qm", str(folder / "de.qm")],
-                   check=True)
-    i18n.remove_translator()
-    translator = QTranslator()
-    assert translator.load(str(folder / "de.qm"))
-    QCoreApplication.installTranslator(translator)
-    i18n._installed = translator
 
 
 # -- more bad input and modes --------------------------------------------------------------------
