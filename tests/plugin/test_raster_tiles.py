@@ -13,6 +13,8 @@ from affine import Affine
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 pytest.importorskip("pytestqt")
 
+from raster_files import CRS, RES, X0, Y0, write_raster
+
 from photodem.algorithms.errors import InputError
 from photodem.algorithms.raster.display import TILE
 from photodem.plugin.qt import QtGui
@@ -20,25 +22,10 @@ from photodem.plugin.widgets import raster_tiles
 from photodem.plugin.widgets.map_layer import ViewState
 from photodem.plugin.widgets.raster_tiles import RasterLayer, TileCache
 
-X0, Y0, RES = 400000.0, 5600000.0, 0.5
-CRS = "EPSG:25832"
 NODATA = -9999.0
 
 
-def _write(path, data, crs=CRS, nodata=None, transform=None):
-    data = np.asarray(data)
-    data = data[None] if data.ndim == 2 else data
-    profile = {"driver": "GTiff", "width": data.shape[2], "height": data.shape[1],
-               "count": data.shape[0], "dtype": str(data.dtype), "tiled": True,
-               "blockxsize": 256, "blockysize": 256,
-               "transform": transform or Affine(RES, 0, X0, 0, -RES, Y0)}
-    if crs:
-        profile["crs"] = crs
-    if nodata is not None:
-        profile["nodata"] = nodata
-    with rasterio.open(path, "w", **profile) as dst:
-        dst.write(data)
-    return path
+_write = write_raster  # the shared writer
 
 
 @pytest.fixture

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import rasterio
 from affine import Affine
+from raster_files import CRS, RES, X0, Y0, write_raster
 from rasterio.enums import Resampling
 from rasterio.warp import transform as warp_points
 
@@ -17,9 +18,6 @@ from photodem.algorithms.quality.rasters import DIFFERENCE_CLASSES
 from photodem.algorithms.raster import display
 from photodem.algorithms.raster.display import TILE, TileGrid
 
-X0, Y0, RES = 400000.0, 5600000.0, 0.5
-CRS = "EPSG:25832"
-
 
 def _dem(width: int, height: int) -> np.ndarray:
     rows, cols = np.mgrid[0:height, 0:width]
@@ -27,23 +25,7 @@ def _dem(width: int, height: int) -> np.ndarray:
             ).astype(np.float32)
 
 
-def _write(path, data, crs=CRS, transform=None, nodata=None, overviews=()):
-    data = np.asarray(data)
-    if data.ndim == 2:
-        data = data[None]
-    profile = {"driver": "GTiff", "width": data.shape[2], "height": data.shape[1],
-               "count": data.shape[0], "dtype": str(data.dtype),
-               "transform": transform or Affine(RES, 0, X0, 0, -RES, Y0),
-               "tiled": True, "blockxsize": 256, "blockysize": 256}
-    if crs:
-        profile["crs"] = crs
-    if nodata is not None:
-        profile["nodata"] = nodata
-    with rasterio.open(path, "w", **profile) as dst:
-        dst.write(data)
-        if overviews:
-            dst.build_overviews(list(overviews), Resampling.average)
-    return path
+_write = write_raster  # the shared writer
 
 
 # -- level choice ---------------------------------------------------------------------------------
