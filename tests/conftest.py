@@ -74,3 +74,14 @@ def german(tmp_path, monkeypatch):
 
     yield install
     i18n.remove_translator()
+
+
+@pytest.fixture(scope="session")
+def tiny_block(tmp_path_factory) -> Path:
+    """The tiny synthetic block (``synthetic_block --size tiny``, ≈ 4 s), made once per run.
+    Read it only: a test that writes into a project copies it first."""
+    from photodem.algorithms.processing import registry
+
+    root = tmp_path_factory.mktemp("tiny-block") / "block"
+    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
+    return root

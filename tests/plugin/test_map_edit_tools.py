@@ -41,13 +41,9 @@ Qt = QtCore.Qt
 
 
 @pytest.fixture(scope="module")
-def block(tmp_path_factory) -> Path:
-    """The tiny synthetic block, made once (each test edits a copy)."""
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("standalone-edit") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
-    return root
+def block(tiny_block) -> Path:
+    """The tiny synthetic block (each test edits a copy)."""
+    return tiny_block
 
 
 class Window(QtWidgets.QMainWindow):

@@ -29,12 +29,8 @@ EXTENT = (402230.0, 5674615.0, 402370.0, 5674790.0)
 
 
 @pytest.fixture(scope="module")
-def block(tmp_path_factory) -> Path:
-    from photodem.algorithms.processing import registry
-
-    root = tmp_path_factory.mktemp("standalone-qc") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
-    return root
+def block(tiny_block) -> Path:
+    return tiny_block
 
 
 @pytest.fixture

@@ -18,7 +18,6 @@ from rasterio.transform import from_origin
 from shapely.geometry import LineString, Point, Polygon
 
 from photodem.algorithms.errors import InputError
-from photodem.algorithms.processing import registry
 from photodem.algorithms.project.edits import create_edits
 from photodem.algorithms.project.model import Project
 from photodem.plugin.qt import QtCore, QtGui
@@ -58,11 +57,9 @@ def write_surface(path: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def block(tmp_path_factory) -> Path:
-    """The tiny synthetic block (≈ 4 s): a real project for the edit checks."""
-    root = tmp_path_factory.mktemp("vtx") / "block"
-    registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
-    return root
+def block(tiny_block) -> Path:
+    """The tiny synthetic block: a real project for the edit checks (read only)."""
+    return tiny_block
 
 
 @pytest.fixture(scope="module")

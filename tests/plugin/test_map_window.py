@@ -17,7 +17,6 @@ import rasterio
 from rasterio.transform import from_origin
 from shapely.geometry import Point
 
-from photodem.algorithms.processing import registry
 from photodem.algorithms.project.edits import EDIT_LAYERS
 from photodem.plugin.app.main_window import ToolboxWindow
 from photodem.plugin.qt import QtCore, QtGui, QtWidgets
@@ -29,10 +28,10 @@ EXPECTED_KINDS = [f"edit:{name}" for name in EDIT_LAYERS] + [
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    """The tiny synthetic project (made once for the module)."""
+def tiny(tiny_block, tmp_path_factory) -> Path:
+    """A copy of the tiny synthetic project for this module (its tests write into it)."""
     out = tmp_path_factory.mktemp("tiny") / "project"
-    registry.run("synthetic_block", {"output": str(out), "size": "tiny"})
+    shutil.copytree(tiny_block, out)
     return out
 
 
