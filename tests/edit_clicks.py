@@ -112,6 +112,19 @@ def write_surface(path, crs=SURFACE["crs"]):
     return path
 
 
+def write_mosaic_seamlines(path):
+    """A mosaic's seamlines file with one line at x = 402301 (the seamline tool snaps to it)."""
+    import fiona  # lazy: the click table itself is plain data
+
+    schema = {"geometry": "LineString", "properties": {"id": "int"}}
+    with fiona.open(path, "w", driver="GPKG", layer="seamlines", schema=schema,
+                    crs="EPSG:25832") as dst:
+        dst.write({"geometry": {"type": "LineString",
+                                "coordinates": [(402301.0, 5674600.0), (402301.0, 5674800.0)]},
+                   "properties": {"id": 1}})
+    return path
+
+
 def check_written(case: Dict[str, object], hits: List[XY], rows: List[Tuple[object, dict]]
                   ) -> None:
     """Assert what a tool of ``case`` wrote (``rows``: (shapely geometry, properties) read back

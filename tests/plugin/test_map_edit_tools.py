@@ -28,6 +28,7 @@ from edit_clicks import (
     FakeAsk,
     check_written,
     surface_z,
+    write_mosaic_seamlines,
     write_surface,
 )
 
@@ -198,15 +199,7 @@ def test_keys_backspace_escape_enter(work):
 
 
 def test_seamline_snaps_to_a_mosaic_seamline_on_the_map(work, tmp_path):
-    import fiona
-
-    path = tmp_path / "mosaic_seamlines.gpkg"
-    schema = {"geometry": "LineString", "properties": {"id": "int"}}
-    with fiona.open(path, "w", driver="GPKG", layer="seamlines", schema=schema,
-                    crs="EPSG:25832") as dst:
-        dst.write({"geometry": {"type": "LineString",
-                                "coordinates": [(402301.0, 5674600.0), (402301.0, 5674800.0)]},
-                   "properties": {"id": 1}})
+    path = write_mosaic_seamlines(tmp_path / "mosaic_seamlines.gpkg")
     work["view"].add_vector(path, "seamlines", name="mosaic seamlines", layer="seamlines")
     case = next(c for c in CLICKS if c["layer"] == "seamlines")
     draw(work, "seamlines", case["clicks"])

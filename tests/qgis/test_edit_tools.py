@@ -31,6 +31,7 @@ from edit_clicks import (
     FakeAsk,
     check_written,
     surface_z,
+    write_mosaic_seamlines,
     write_surface,
 )
 
@@ -357,16 +358,9 @@ def test_interpolated_breakline(work):
 
 
 def test_seamline_snaps_to_the_mosaic_seamlines(work, tmp_path):
-    import fiona
     from qgis.core import QgsProject, QgsVectorLayer
 
-    path = tmp_path / "mosaic_seamlines.gpkg"
-    schema = {"geometry": "LineString", "properties": {"id": "int"}}
-    with fiona.open(path, "w", driver="GPKG", layer="seamlines", schema=schema,
-                    crs="EPSG:25832") as dst:
-        dst.write({"geometry": {"type": "LineString",
-                                "coordinates": [(402301.0, 5674600.0), (402301.0, 5674800.0)]},
-                   "properties": {"id": 1}})
+    path = write_mosaic_seamlines(tmp_path / "mosaic_seamlines.gpkg")
     QgsProject.instance().addMapLayer(
         QgsVectorLayer(f"{path}|layername=seamlines", "mosaic seamlines", "ogr"))
     case = next(c for c in CLICKS if c["layer"] == "seamlines")
