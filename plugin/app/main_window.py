@@ -19,7 +19,7 @@ from ..widgets.parameter_form import SETTINGS_PROJECT, ParameterForm
 from ..widgets.run_panel import RunPanel
 from .docks import batch_dock, install_editing, quality_dock
 from .map_window import MapWindowMixin
-from .model_menu import ModelMenu, fill_project
+from .model_menu import ModelMenu, prefer_map_project
 
 ALG_ROLE = QtCore.Qt.UserRole + 1
 #: Settings keys of the window's layout and the algorithm shown last.
@@ -229,7 +229,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         self.form = ParameterForm(alg)
         self.form.restore(self.settings)  # the input of its last run
         if self.project_root is not None:  # the map's project wins over a remembered one
-            fill_project(self.form, str(self.project_root))
+            prefer_map_project(self.form, str(self.project_root))
         if previous is not None:
             self.form.carry_over(previous)  # the project and input in view stay
         if self.form._project_params and not self.form.project() and self.settings is not None:

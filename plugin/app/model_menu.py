@@ -16,6 +16,7 @@ The parameters come from :mod:`photodem.algorithms.project.model_runs`, as in QG
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from shapely.geometry import Point
@@ -59,6 +60,21 @@ def fill_project(form: Any, root: str) -> bool:
         return False
     form.set_values({params[0]: root})
     return True
+
+
+def _project_folder(path: str) -> Path:
+    """The folder of a project given as its folder or its ``project.toml``."""
+    folder = Path(path)
+    return (folder.parent if folder.suffix.lower() == ".toml" else folder).resolve()
+
+
+def prefer_map_project(form: Any, root: str) -> None:
+    """Give a newly shown form the map's project. Values remembered for another project
+    (its models, inputs, output folders) are dropped: they belong to that project."""
+    current = form.project() if form is not None else None
+    if current and _project_folder(current) != _project_folder(root):
+        form.set_values(default_values(form.algorithm))
+    fill_project(form, root)
 
 
 class ModelMenu(QtCore.QObject):
@@ -175,4 +191,4 @@ class ModelMenu(QtCore.QObject):
         return self.show_form("filter_lowpass", params)
 
 
-__all__ = ["ModelMenu", "default_values", "fill_project"]
+__all__ = ["ModelMenu", "default_values", "fill_project", "prefer_map_project"]

@@ -3,6 +3,7 @@ right click, and the project opened on the map in the toolbox's forms (pytest-qt
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from pathlib import Path
@@ -182,13 +183,21 @@ def test_opening_a_project_fills_the_forms(window, tiny, tmp_path):
 def test_the_maps_project_wins_over_the_remembered_one(tiny, tmp_path, qtbot):
     settings = QtCore.QSettings(str(tmp_path / "settings.ini"), QtCore.QSettings.IniFormat)
     settings.setValue("PhotoDEM/project", str(tmp_path / "elsewhere"))
-    settings.setValue("PhotoDEM/params/match_model", '{"project": "/remembered"}')
+    settings.setValue("PhotoDEM/params/match_model", json.dumps(
+        {"project": "/remembered", "model": "0909_0910", "output": "/remembered/out"}))
+    settings.setValue("PhotoDEM/params/epipolar_pair", json.dumps(
+        {"project": str(tiny / "project.toml"), "model": "0102_0103", "scale": 0.5}))
     w = ToolboxWindow(message_boxes=False, settings=settings)
     qtbot.addWidget(w)
     try:
         w.open_project(tiny)
         w.select_algorithm("match_model")
         assert w.form.project() == str(tiny.resolve())
+        values = w.form.values()  # what was remembered for the other project is gone
+        assert values["model"] == "0101_0102" and "output" not in values
+        w.form = None  # no carrying over: the remembered values of the same project stay
+        w.select_algorithm("epipolar_pair")
+        assert w.form.values()["model"] == "0102_0103" and w.form.values()["scale"] == 0.5
     finally:
         w.edit_session.ask = lambda parent, session: "discard"
         w.map_view.clear_layers()
