@@ -92,6 +92,13 @@ def test_right_press_lists_the_models_under_it(window, tiny, menus, qtbot):
     assert "Stereo model 0101_0102" in titles
     sub = next(a.menu() for a in menu.actions() if a.text() == "Stereo model 0101_0102")
     assert [a.text() for a in sub.actions()] == ENTRIES
+    # where two models overlap, both are offered
+    layer = window.map_view.layer_by_kind("stereo_models")
+    shapes = {a["name"]: g for _f, g, a in layer.features()}
+    inside = shapes["0101_0102"].intersection(shapes["0102_0103"]).representative_point()
+    _right_press(qtbot, window, inside.x, inside.y)
+    titles = [a.text() for a in menus[-1].actions()]
+    assert {"Stereo model 0101_0102", "Stereo model 0102_0103"} <= set(titles), titles
     # outside the block: no menu
     count = len(menus)
     xmin, ymin, _xmax, _ymax = window.map_view.extent()
