@@ -19,6 +19,7 @@ from ..widgets.parameter_form import SETTINGS_PROJECT, ParameterForm
 from ..widgets.run_panel import RunPanel
 from .docks import batch_dock, install_editing, quality_dock
 from .map_window import MapWindowMixin
+from .model_menu import ModelMenu, prefer_map_project
 
 ALG_ROLE = QtCore.Qt.UserRole + 1
 #: Settings keys of the window's layout and the algorithm shown last.
@@ -135,6 +136,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
                                         "in the toolbox."))
         self.populate()
         install_editing(self)  # editing toolbar, QC map tools, undo history (issue 21)
+        self.model_menu = ModelMenu(self)  # run from the map; the open project in the forms
 
         self.tree.currentItemChanged.connect(self._on_current_item)
         self.filter_edit.textChanged.connect(self._apply_filter)
@@ -226,6 +228,8 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
             f"{help_text}<br><span style='color:gray'>photodem run {alg.id}</span>")
         self.form = ParameterForm(alg)
         self.form.restore(self.settings)  # the input of its last run
+        if self.project_root is not None:  # the map's project wins over a remembered one
+            prefer_map_project(self.form, str(self.project_root))
         if previous is not None:
             self.form.carry_over(previous)  # the project and input in view stay
         if self.form._project_params and not self.form.project() and self.settings is not None:

@@ -14,6 +14,7 @@ the window's signal ``project_opened(str root)``.
 from __future__ import annotations
 
 import logging
+import warnings
 from pathlib import Path
 from typing import Any, Iterable, List, Optional
 
@@ -275,15 +276,41 @@ class MapWindowMixin:
     def add_run_outputs(self, paths: Iterable[str]) -> List[MapLayer]:
         """Add the raster and vector outputs of a finished run that are not on the map yet."""
         was_empty = not self.map_view.layers()
-        added = []
+        added, apart = [], []
         for path in paths:
             if is_map_file(path) and self.map_view.layer_by_path(path) is None:
+                if self._would_replace_the_map(path):  # an epipolar image: the map stays
+                    apart.append(Path(path).name)
+                    continue
                 layer = self.add_map_file(path)
                 if layer is not None:
                     added.append(layer)
         if added and was_empty:
             self.map_view.zoom_full()
+        if apart:
+            window: QtWidgets.QMainWindow = self  # type: ignore[assignment]
+            window.statusBar().showMessage(
+                tr("Not added to the map (no coordinate reference system): {0}. Show on map "
+                   "in the run panel shows one alone.").format(", ".join(apart)), 20000)
         return added
+
+    def _would_replace_the_map(self, path: Any) -> bool:
+        """True for a raster without CRS while the map shows georeferenced layers: adding
+        it would take the project off the map (the two never mix)."""
+        view = self.map_view
+        if Path(path).suffix.lower() not in RASTER_SUFFIXES or not view.layers() \
+                or not view.is_georeferenced():
+            return False
+        try:
+            # lazy: rasterio opens the file only to read its CRS
+            import rasterio
+
+            with warnings.catch_warnings():  # "not georeferenced" is what we ask about
+                warnings.simplefilter("ignore")
+                with rasterio.open(path) as src:
+                    return src.crs is None
+        except Exception:  # unreadable: add_map_file reports it
+            return False
 
     # -- dialogs ---------------------------------------------------------------------------------
     def _last_dir(self) -> str:

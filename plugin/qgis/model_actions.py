@@ -37,7 +37,12 @@ from qgis.PyQt.QtCore import QObject, QTimer
 from qgis.PyQt.QtWidgets import QAction, QInputDialog, QMenu
 
 from ...algorithms.errors import PhotodemError
-from ...algorithms.project.model import Project
+from ...algorithms.project.model_runs import (
+    NoDsmYet,
+    epipolar_pair_parameters,
+    filter_dsm_parameters,
+    match_model_parameters,
+)
 from ..i18n import tr
 from .background import run_in_background
 from .provider import PROVIDER_ID
@@ -129,9 +134,10 @@ class ModelActions(QObject):
         The output is the spec's default folder ``products/dsm/<model>/``, written out so the
         operator sees where the DSM goes.
         """
-        params: Dict[str, Any] = {"project": project, "model": model}
-        with contextlib.suppress(PhotodemError):  # unreadable: the dialog itself says so
-            params["output"] = str(Project.load(project).products_dir("dsm") / model)
+        try:
+            params = match_model_parameters(project, model)
+        except PhotodemError:  # unreadable: the dialog itself says so
+            params = {"project": project, "model": model}
         return self.open_dialog("match_model", params)
 
     def epipolar_pair(self, project: str, model: str) -> Any:
@@ -142,26 +148,27 @@ class ModelActions(QObject):
                 self.message(tr("Epipolar pair of {0} written to {1}.").format(
                     model, results.get("folder", "")), Qgis.Success)
 
-        task = run_in_background("epipolar_pair", {"project": project, "model": model}, done,
-                                 iface=self.iface)
+        try:
+            params = epipolar_pair_parameters(project, model)
+        except PhotodemError as exc:
+            self._warn(str(exc))
+            return None
+        task = run_in_background("epipolar_pair", params, done, iface=self.iface)
         self.tasks = [t for t in self.tasks if _alive(t)] + [task]
         return task
 
     def filter_dsm(self, project: str, model: str) -> Any:
         """Open the ``filter_lowpass`` dialog for the model's DSM (a message if it has none)."""
         try:
-            loaded = Project.load(project)
+            params = filter_dsm_parameters(project, model)
+        except NoDsmYet as exc:
+            self.message(tr("Stereo model {0} has no DSM yet ({1}); match it first.").format(
+                exc.model, exc.dsm), Qgis.Warning)
+            return None
         except PhotodemError as exc:
             self.message(str(exc), Qgis.Warning)
             return None
-        dsm = loaded.products_dir("dsm") / model / "dsm.tif"
-        if not dsm.is_file():
-            self.message(tr("Stereo model {0} has no DSM yet ({1}); match it first.").format(
-                model, loaded.relative_path(dsm)), Qgis.Warning)
-            return None
-        output = loaded.products_dir("dtm") / model
-        return self.open_dialog("filter_lowpass", {"input": str(dsm), "project": project,
-                                                   "output": str(output)})
+        return self.open_dialog("filter_lowpass", params)
 
     def open_dialog(self, algorithm_id: str, parameters: Dict[str, Any]) -> Any:
         """Show the Processing dialog of ``photodem:<algorithm_id>`` filled with ``parameters``.

@@ -87,11 +87,15 @@ class MapView(QtWidgets.QWidget):
         The shown extent changed (pan, zoom, resize, CRS).
     layers_changed()
         A layer was added or removed, or the order changed.
+    context_menu_requested(float, float, QPoint)
+        A right press no tool used: the map point of the pixel and the global position where
+        a context menu opens.
     """
 
     cursor_moved = pyqtSignal(float, float)
     extent_changed = pyqtSignal()
     layers_changed = pyqtSignal()
+    context_menu_requested = pyqtSignal(float, float, QtCore.QPoint)
 
     def __init__(self, parent: Optional[QtWidgets.QWidget] = None) -> None:
         super().__init__(parent)
@@ -473,6 +477,8 @@ class MapView(QtWidgets.QWidget):
             return
         if event.button() == QtCore.Qt.LeftButton:
             self._start_drag(event.pos())
+        elif event.button() == QtCore.Qt.RightButton:  # the tool has no use for it: a menu
+            self.context_menu_requested.emit(x, y, self.mapToGlobal(event.pos()))
 
     def _start_drag(self, pos: QtCore.QPoint) -> None:
         self._drag = QtCore.QPoint(pos)
