@@ -140,7 +140,7 @@
         </message>
         <message>
             <source>Stereo models</source>
-            <extracomment>plugin/app/map_window.py:411; plugin/qgis/workspace.py:254; project_info output models; stereo_models output models; stereo_models: name</extracomment>
+            <extracomment>plugin/app/map_window.py:438; plugin/qgis/workspace.py:254; project_info output models; stereo_models output models; stereo_models: name</extracomment>
             <translation>Stereomodelle</translation>
         </message>
         <message>
@@ -365,7 +365,7 @@
         </message>
         <message>
             <source>Epipolar pair</source>
-            <extracomment>epipolar_pair: name; plugin/qgis/model_actions.py:123; plugin/widgets/batch_dialog.py:137; plugin/widgets/batch_dialog.py:160</extracomment>
+            <extracomment>epipolar_pair: name; plugin/app/model_menu.py:107; plugin/qgis/model_actions.py:128; plugin/widgets/batch_dialog.py:137; plugin/widgets/batch_dialog.py:160</extracomment>
             <translation>Epipolarbildpaar</translation>
         </message>
         <message>
@@ -385,7 +385,7 @@
         </message>
         <message>
             <source>Stereo model</source>
-            <extracomment>epipolar_pair.model: description; match_model.model: description; plugin/qgis/model_actions.py:251</extracomment>
+            <extracomment>epipolar_pair.model: description; match_model.model: description; plugin/qgis/model_actions.py:258</extracomment>
             <translation>Stereomodell</translation>
         </message>
         <message>
@@ -1080,7 +1080,7 @@
         </message>
         <message>
             <source>DSM</source>
-            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/app/map_window.py:429; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>match_model output dsm; mosaic.dsm: description; plugin/app/map_window.py:456; plugin/qgis/workspace.py:426</extracomment>
             <translation>DOM</translation>
         </message>
         <message>
@@ -1580,7 +1580,7 @@
         </message>
         <message>
             <source>DTM</source>
-            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/app/map_window.py:429; plugin/qgis/workspace.py:426; plugin/widgets/qc_filter.py:50</extracomment>
+            <extracomment>filter_linear_prediction output dtm; filter_lowpass output dtm; mosaic.dtm: description; plugin/app/map_window.py:456; plugin/qgis/workspace.py:426; plugin/widgets/qc_filter.py:50</extracomment>
             <translation>DGM</translation>
         </message>
         <message>
@@ -2100,7 +2100,7 @@
         </message>
         <message>
             <source>Seamlines</source>
-            <extracomment>mosaic.seamlines: description; plugin/app/map_window.py:430; plugin/qgis/workspace.py:410; plugin/qgis/workspace.py:427; plugin/widgets/edit_session.py:359</extracomment>
+            <extracomment>mosaic.seamlines: description; plugin/app/map_window.py:457; plugin/qgis/workspace.py:410; plugin/qgis/workspace.py:427; plugin/widgets/edit_session.py:359</extracomment>
             <translation>Schnittlinien</translation>
         </message>
         <message>
@@ -2180,7 +2180,7 @@
         </message>
         <message>
             <source>Mosaic</source>
-            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/app/map_window.py:430; plugin/qgis/workspace.py:427</extracomment>
+            <extracomment>mosaic output mosaic; mosaic.output: description; plugin/app/map_window.py:457; plugin/qgis/workspace.py:427</extracomment>
             <translation>Mosaik</translation>
         </message>
         <message>
@@ -2435,303 +2435,333 @@
         </message>
         <message>
             <source>PhotoDEM toolbox</source>
-            <extracomment>plugin/app/main_window.py:53</extracomment>
+            <extracomment>plugin/app/main_window.py:54</extracomment>
             <translation>PhotoDEM-Werkzeugkasten</translation>
         </message>
         <message>
             <source>Search algorithms …</source>
-            <extracomment>plugin/app/main_window.py:63</extracomment>
+            <extracomment>plugin/app/main_window.py:64</extracomment>
             <translation>Algorithmen suchen …</translation>
         </message>
         <message>
             <source>Processing toolbox</source>
-            <extracomment>plugin/app/main_window.py:127</extracomment>
+            <extracomment>plugin/app/main_window.py:128</extracomment>
             <translation>Processing-Werkzeugkasten</translation>
         </message>
         <message>
             <source>Open a project (File menu) or choose an algorithm in the toolbox.</source>
-            <extracomment>plugin/app/main_window.py:134</extracomment>
+            <extracomment>plugin/app/main_window.py:135</extracomment>
             <translation>Öffnen Sie ein Projekt (Menü Datei) oder wählen Sie einen Algorithmus im Werkzeugkasten.</translation>
         </message>
         <message>
             <source>&amp;File</source>
-            <extracomment>plugin/app/main_window.py:148</extracomment>
+            <extracomment>plugin/app/main_window.py:150</extracomment>
             <translation>&amp;Datei</translation>
         </message>
         <message>
             <source>&amp;View</source>
-            <extracomment>plugin/app/main_window.py:149</extracomment>
+            <extracomment>plugin/app/main_window.py:151</extracomment>
             <translation>&amp;Ansicht</translation>
         </message>
         <message>
             <source>&amp;Quit</source>
-            <extracomment>plugin/app/main_window.py:153</extracomment>
+            <extracomment>plugin/app/main_window.py:155</extracomment>
             <translation>&amp;Beenden</translation>
         </message>
         <message>
             <source>&amp;Tools</source>
-            <extracomment>plugin/app/main_window.py:156</extracomment>
+            <extracomment>plugin/app/main_window.py:158</extracomment>
             <translation>&amp;Werkzeuge</translation>
         </message>
         <message>
             <source>Review georeferencing…</source>
-            <extracomment>plugin/app/main_window.py:157; plugin/qgis/plugin.py:113</extracomment>
+            <extracomment>plugin/app/main_window.py:159; plugin/qgis/plugin.py:113</extracomment>
             <translation>Georeferenzierung prüfen…</translation>
         </message>
         <message>
             <source>Check and edit the control points of a georeferencing result</source>
-            <extracomment>plugin/app/main_window.py:158; plugin/qgis/plugin.py:115</extracomment>
+            <extracomment>plugin/app/main_window.py:160; plugin/qgis/plugin.py:115</extracomment>
             <translation>Passpunkte eines Georeferenzierungsergebnisses prüfen und bearbeiten</translation>
         </message>
         <message>
             <source>Batch over stereo models…</source>
-            <extracomment>plugin/app/main_window.py:162; plugin/qgis/batch_actions.py:127</extracomment>
+            <extracomment>plugin/app/main_window.py:164; plugin/qgis/batch_actions.py:127</extracomment>
             <translation>Batch über Stereomodelle…</translation>
         </message>
         <message>
             <source>Run steps over many stereo models, resumable</source>
-            <extracomment>plugin/app/main_window.py:163; plugin/qgis/batch_actions.py:129</extracomment>
+            <extracomment>plugin/app/main_window.py:165; plugin/qgis/batch_actions.py:129</extracomment>
             <translation>Schritte über viele Stereomodelle ausführen, fortsetzbar</translation>
         </message>
         <message>
             <source>DEM quality…</source>
-            <extracomment>plugin/app/main_window.py:166; plugin/qgis/plugin.py:125</extracomment>
+            <extracomment>plugin/app/main_window.py:168; plugin/qgis/plugin.py:125</extracomment>
             <translation>DHM-Qualität…</translation>
         </message>
         <message>
             <source>Statistics, histogram, profiles, identify and blunders of a DEM against a reference</source>
-            <extracomment>plugin/app/main_window.py:167</extracomment>
+            <extracomment>plugin/app/main_window.py:169</extracomment>
             <translation>Statistik, Histogramm, Profile, Abfrage und grobe Fehler eines DHM gegenüber einer Referenz</translation>
         </message>
         <message>
             <source>&amp;Help</source>
-            <extracomment>plugin/app/main_window.py:170</extracomment>
+            <extracomment>plugin/app/main_window.py:172</extracomment>
             <translation>&amp;Hilfe</translation>
         </message>
         <message>
             <source>&amp;About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:171</extracomment>
+            <extracomment>plugin/app/main_window.py:173</extracomment>
             <translation>&amp;Über PhotoDEM</translation>
         </message>
         <message>
             <source>{0} finished.</source>
-            <extracomment>plugin/app/main_window.py:272</extracomment>
+            <extracomment>plugin/app/main_window.py:276</extracomment>
             <translation>{0} ist fertig.</translation>
         </message>
         <message>
             <source>{0} failed.</source>
-            <extracomment>plugin/app/main_window.py:272</extracomment>
+            <extracomment>plugin/app/main_window.py:276</extracomment>
             <translation>{0} ist fehlgeschlagen.</translation>
         </message>
         <message>
             <source>{0} was cancelled.</source>
-            <extracomment>plugin/app/main_window.py:273; plugin/qgis/background.py:173</extracomment>
+            <extracomment>plugin/app/main_window.py:277; plugin/qgis/background.py:173</extracomment>
             <translation>{0} wurde abgebrochen.</translation>
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:401</extracomment>
+            <extracomment>plugin/app/main_window.py:405</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:402</extracomment>
+            <extracomment>plugin/app/main_window.py:406</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
             <source>Other</source>
-            <extracomment>plugin/app/main_window.py:181</extracomment>
+            <extracomment>plugin/app/main_window.py:183</extracomment>
             <translation>Sonstiges</translation>
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:277; plugin/app/main_window.py:294; plugin/app/map_window.py:170; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:727; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
             <source>Batch running – show</source>
-            <extracomment>plugin/app/main_window.py:323</extracomment>
+            <extracomment>plugin/app/main_window.py:327</extracomment>
             <translation>Batch läuft – anzeigen</translation>
         </message>
         <message>
             <source>Running {0} …</source>
-            <extracomment>plugin/app/main_window.py:264; plugin/widgets/run_panel.py:130</extracomment>
+            <extracomment>plugin/app/main_window.py:268; plugin/widgets/run_panel.py:130</extracomment>
             <translation>{0} läuft …</translation>
         </message>
         <message>
             <source>Tools → Review georeferencing checks and edits its control points.</source>
-            <extracomment>plugin/app/main_window.py:283</extracomment>
+            <extracomment>plugin/app/main_window.py:287</extracomment>
             <translation>Werkzeuge → Georeferenzierung prüfen zeigt und bearbeitet die Passpunkte.</translation>
         </message>
         <message>
             <source>Batch {0}: summary in {1}</source>
-            <extracomment>plugin/app/main_window.py:334</extracomment>
+            <extracomment>plugin/app/main_window.py:338</extracomment>
             <translation>Batch {0}: Zusammenfassung in {1}</translation>
         </message>
         <message>
             <source>Difference</source>
-            <extracomment>plugin/app/map_window.py:429; plugin/qgis/workspace.py:426</extracomment>
+            <extracomment>plugin/app/map_window.py:456; plugin/qgis/workspace.py:426</extracomment>
             <translation>Differenz</translation>
         </message>
         <message>
             <source>Ortho</source>
-            <extracomment>plugin/app/map_window.py:430; plugin/qgis/workspace.py:427</extracomment>
+            <extracomment>plugin/app/map_window.py:457; plugin/qgis/workspace.py:427</extracomment>
             <translation>Ortho</translation>
         </message>
         <message>
             <source>Layers</source>
-            <extracomment>plugin/app/map_window.py:59</extracomment>
+            <extracomment>plugin/app/map_window.py:60</extracomment>
             <translation>Layer</translation>
         </message>
         <message>
             <source>Coordinates of the cursor</source>
-            <extracomment>plugin/app/map_window.py:66</extracomment>
+            <extracomment>plugin/app/map_window.py:67</extracomment>
             <translation>Koordinaten des Mauszeigers</translation>
         </message>
         <message>
             <source>Value of the top raster under the cursor</source>
-            <extracomment>plugin/app/map_window.py:67</extracomment>
+            <extracomment>plugin/app/map_window.py:68</extracomment>
             <translation>Wert des obersten Rasters unter dem Mauszeiger</translation>
         </message>
         <message>
             <source>Scale at 96 dpi</source>
-            <extracomment>plugin/app/map_window.py:69</extracomment>
+            <extracomment>plugin/app/map_window.py:70</extracomment>
             <translation>Maßstab bei 96 dpi</translation>
         </message>
         <message>
             <source>Coordinate reference system of the map</source>
-            <extracomment>plugin/app/map_window.py:70</extracomment>
+            <extracomment>plugin/app/map_window.py:71</extracomment>
             <translation>Koordinatenbezugssystem der Karte</translation>
         </message>
         <message>
             <source>&amp;Open project…</source>
-            <extracomment>plugin/app/map_window.py:88</extracomment>
+            <extracomment>plugin/app/map_window.py:89</extracomment>
             <translation>Projekt ö&amp;ffnen…</translation>
         </message>
         <message>
             <source>Add &amp;raster…</source>
-            <extracomment>plugin/app/map_window.py:91</extracomment>
+            <extracomment>plugin/app/map_window.py:92</extracomment>
             <translation>&amp;Raster hinzufügen…</translation>
         </message>
         <message>
             <source>Add &amp;vector…</source>
-            <extracomment>plugin/app/map_window.py:93</extracomment>
+            <extracomment>plugin/app/map_window.py:94</extracomment>
             <translation>&amp;Vektor hinzufügen…</translation>
         </message>
         <message>
             <source>Zoom &amp;full</source>
-            <extracomment>plugin/app/map_window.py:97</extracomment>
+            <extracomment>plugin/app/map_window.py:98</extracomment>
             <translation>&amp;Gesamtansicht</translation>
         </message>
         <message>
             <source>Zoom to &amp;layer</source>
-            <extracomment>plugin/app/map_window.py:100</extracomment>
+            <extracomment>plugin/app/map_window.py:101</extracomment>
             <translation>Auf &amp;Layer zoomen</translation>
         </message>
         <message>
             <source>Zoom &amp;in</source>
-            <extracomment>plugin/app/map_window.py:102</extracomment>
+            <extracomment>plugin/app/map_window.py:103</extracomment>
             <translation>Hine&amp;inzoomen</translation>
         </message>
         <message>
             <source>Zoom &amp;out</source>
-            <extracomment>plugin/app/map_window.py:105</extracomment>
+            <extracomment>plugin/app/map_window.py:106</extracomment>
             <translation>Hera&amp;uszoomen</translation>
         </message>
         <message>
             <source>Map</source>
-            <extracomment>plugin/app/map_window.py:115</extracomment>
+            <extracomment>plugin/app/map_window.py:116</extracomment>
             <translation>Karte</translation>
         </message>
         <message>
             <source>Open PhotoDEM project</source>
-            <extracomment>plugin/app/map_window.py:297; plugin/qgis/project_menu.py:133</extracomment>
+            <extracomment>plugin/app/map_window.py:324; plugin/qgis/project_menu.py:133</extracomment>
             <translation>PhotoDEM-Projekt öffnen</translation>
         </message>
         <message>
             <source>pixels</source>
-            <extracomment>plugin/app/map_window.py:162</extracomment>
+            <extracomment>plugin/app/map_window.py:163</extracomment>
             <translation>Pixel</translation>
         </message>
         <message>
             <source>no CRS</source>
-            <extracomment>plugin/app/map_window.py:163</extracomment>
+            <extracomment>plugin/app/map_window.py:164</extracomment>
             <translation>kein KBS</translation>
         </message>
         <message>
             <source>Add raster</source>
-            <extracomment>plugin/app/map_window.py:307</extracomment>
+            <extracomment>plugin/app/map_window.py:334</extracomment>
             <translation>Raster hinzufügen</translation>
         </message>
         <message>
             <source>Add vector</source>
-            <extracomment>plugin/app/map_window.py:307</extracomment>
+            <extracomment>plugin/app/map_window.py:334</extracomment>
             <translation>Vektor hinzufügen</translation>
         </message>
         <message>
             <source>Image footprints</source>
-            <extracomment>plugin/app/map_window.py:409; plugin/qgis/workspace.py:254</extracomment>
+            <extracomment>plugin/app/map_window.py:436; plugin/qgis/workspace.py:254</extracomment>
             <translation>Bildfußabdrücke</translation>
         </message>
         <message>
             <source>All files</source>
-            <extracomment>plugin/app/map_window.py:308</extracomment>
+            <extracomment>plugin/app/map_window.py:335</extracomment>
             <translation>Alle Dateien</translation>
         </message>
         <message>
             <source>PhotoDEM – {0}</source>
-            <extracomment>plugin/app/map_window.py:365</extracomment>
+            <extracomment>plugin/app/map_window.py:392</extracomment>
             <translation>PhotoDEM – {0}</translation>
         </message>
         <message>
             <source>pixel {0:.1f}, {1:.1f}</source>
-            <extracomment>plugin/app/map_window.py:134</extracomment>
+            <extracomment>plugin/app/map_window.py:135</extracomment>
             <translation>Pixel {0:.1f}, {1:.1f}</translation>
         </message>
         <message>
             <source>'{0}' has no coordinate reference system: it is shown in pixel coordinates.</source>
-            <extracomment>plugin/app/map_window.py:194</extracomment>
+            <extracomment>plugin/app/map_window.py:195</extracomment>
             <translation>„{0}“ hat kein Koordinatenbezugssystem: es wird in Pixelkoordinaten angezeigt.</translation>
         </message>
         <message>
             <source>{0} has no overviews and draws slowly: right-click it in the layer list → Build overviews.</source>
-            <extracomment>plugin/app/map_window.py:203</extracomment>
+            <extracomment>plugin/app/map_window.py:204</extracomment>
             <translation>{0} hat keine Übersichten und wird langsam gezeichnet: Rechtsklick in der Layerliste → Übersichten erzeugen.</translation>
         </message>
         <message>
             <source>'{0}' has no coordinate reference system: it is shown alone, in pixel coordinates.</source>
-            <extracomment>plugin/app/map_window.py:223</extracomment>
+            <extracomment>plugin/app/map_window.py:224</extracomment>
             <translation>„{0}“ hat kein Koordinatenbezugssystem: es wird allein angezeigt, in Pixelkoordinaten.</translation>
         </message>
         <message>
+            <source>Not added to the map (no coordinate reference system): {0}. Show on map in the run panel shows one alone.</source>
+            <extracomment>plugin/app/map_window.py:293</extracomment>
+            <translation>Nicht zur Karte hinzugefügt (kein Koordinatenbezugssystem): {0}. „Auf Karte zeigen“ im Ausführungsbereich zeigt eine davon allein.</translation>
+        </message>
+        <message>
             <source>Rasters</source>
-            <extracomment>plugin/app/map_window.py:303</extracomment>
+            <extracomment>plugin/app/map_window.py:330</extracomment>
             <translation>Raster</translation>
         </message>
         <message>
             <source>Vectors</source>
-            <extracomment>plugin/app/map_window.py:305</extracomment>
+            <extracomment>plugin/app/map_window.py:332</extracomment>
             <translation>Vektoren</translation>
         </message>
         <message>
             <source>Project {0} opened.</source>
-            <extracomment>plugin/app/map_window.py:369; plugin/qgis/project_menu.py:152</extracomment>
+            <extracomment>plugin/app/map_window.py:396; plugin/qgis/project_menu.py:152</extracomment>
             <translation>Projekt {0} geöffnet.</translation>
         </message>
         <message>
             <source>Cannot show '{0}': {1}</source>
-            <extracomment>plugin/app/map_window.py:188; plugin/app/map_window.py:235</extracomment>
+            <extracomment>plugin/app/map_window.py:189; plugin/app/map_window.py:236</extracomment>
             <translation>„{0}“ kann nicht angezeigt werden: {1}</translation>
         </message>
         <message>
             <source>Product not shown: {0}</source>
-            <extracomment>plugin/app/map_window.py:394</extracomment>
+            <extracomment>plugin/app/map_window.py:421</extracomment>
             <translation>Produkt nicht angezeigt: {0}</translation>
         </message>
         <message>
             <source>Footprints and stereo models not shown: {0}</source>
-            <extracomment>plugin/app/map_window.py:406</extracomment>
+            <extracomment>plugin/app/map_window.py:433</extracomment>
             <translation>Bildfußabdrücke und Stereomodelle nicht angezeigt: {0}</translation>
+        </message>
+        <message>
+            <source>Match this model…</source>
+            <extracomment>plugin/app/model_menu.py:106; plugin/qgis/model_actions.py:127</extracomment>
+            <translation>Dieses Modell zuordnen…</translation>
+        </message>
+        <message>
+            <source>Filter its DSM…</source>
+            <extracomment>plugin/app/model_menu.py:108; plugin/qgis/model_actions.py:129</extracomment>
+            <translation>Sein DOM filtern…</translation>
+        </message>
+        <message>
+            <source>A run is going on; wait until it has finished.</source>
+            <extracomment>plugin/app/model_menu.py:169</extracomment>
+            <translation>Ein Lauf ist im Gange; warten Sie, bis er beendet ist.</translation>
+        </message>
+        <message>
+            <source>Stereo model {0}</source>
+            <extracomment>plugin/app/model_menu.py:130; plugin/qgis/model_actions.py:284</extracomment>
+            <translation>Stereomodell {0}</translation>
+        </message>
+        <message>
+            <source>Stereo model {0} has no DSM yet ({1}); match it first.</source>
+            <extracomment>plugin/app/model_menu.py:185; plugin/qgis/model_actions.py:165</extracomment>
+            <translation>Stereomodell {0} hat noch kein DOM ({1}); ordnen Sie es zuerst zu.</translation>
         </message>
         <message>
             <source>PhotoDEM {1}: {0}</source>
@@ -2770,7 +2800,7 @@
         </message>
         <message>
             <source>Re-drape</source>
-            <extracomment>plugin/qgis/edit_maptools.py:329; plugin/qgis/editing_toolbar.py:145; plugin/widgets/map_edit_tools.py:415; plugin/widgets/map_vertex_tools.py:466</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:329; plugin/qgis/editing_toolbar.py:145; plugin/widgets/map_edit_tools.py:417; plugin/widgets/map_vertex_tools.py:466</extracomment>
             <translation>Neu abgreifen</translation>
         </message>
         <message>
@@ -2800,7 +2830,7 @@
         </message>
         <message>
             <source>{0} features re-draped on the surface.</source>
-            <extracomment>plugin/qgis/edit_maptools.py:337; plugin/widgets/map_edit_tools.py:514</extracomment>
+            <extracomment>plugin/qgis/edit_maptools.py:337; plugin/widgets/map_edit_tools.py:516</extracomment>
             <translation>Höhen von {0} Objekten auf der Oberfläche neu abgegriffen.</translation>
         </message>
         <message>
@@ -2960,42 +2990,22 @@
         </message>
         <message>
             <source>Stereo model:</source>
-            <extracomment>plugin/qgis/model_actions.py:252</extracomment>
+            <extracomment>plugin/qgis/model_actions.py:259</extracomment>
             <translation>Stereomodell:</translation>
         </message>
         <message>
-            <source>Match this model…</source>
-            <extracomment>plugin/qgis/model_actions.py:122</extracomment>
-            <translation>Dieses Modell zuordnen…</translation>
-        </message>
-        <message>
-            <source>Filter its DSM…</source>
-            <extracomment>plugin/qgis/model_actions.py:124</extracomment>
-            <translation>Sein DOM filtern…</translation>
-        </message>
-        <message>
             <source>Select the stereo-models layer of a PhotoDEM project first.</source>
-            <extracomment>plugin/qgis/model_actions.py:235</extracomment>
+            <extracomment>plugin/qgis/model_actions.py:242</extracomment>
             <translation>Wählen Sie zuerst den Stereomodell-Layer eines PhotoDEM-Projekts.</translation>
         </message>
         <message>
             <source>The layer '{0}' names no PhotoDEM project.</source>
-            <extracomment>plugin/qgis/model_actions.py:95</extracomment>
+            <extracomment>plugin/qgis/model_actions.py:100</extracomment>
             <translation>Der Layer „{0}“ nennt kein PhotoDEM-Projekt.</translation>
         </message>
         <message>
-            <source>Stereo model {0} has no DSM yet ({1}); match it first.</source>
-            <extracomment>plugin/qgis/model_actions.py:159</extracomment>
-            <translation>Stereomodell {0} hat noch kein DOM ({1}); ordnen Sie es zuerst zu.</translation>
-        </message>
-        <message>
-            <source>Stereo model {0}</source>
-            <extracomment>plugin/qgis/model_actions.py:277</extracomment>
-            <translation>Stereomodell {0}</translation>
-        </message>
-        <message>
             <source>Epipolar pair of {0} written to {1}.</source>
-            <extracomment>plugin/qgis/model_actions.py:142</extracomment>
+            <extracomment>plugin/qgis/model_actions.py:148</extracomment>
             <translation>Epipolarbildpaar von {0} nach {1} geschrieben.</translation>
         </message>
         <message>
@@ -3842,7 +3852,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Delete feature</source>
-            <extracomment>plugin/widgets/edit_session.py:61; plugin/widgets/map_edit_tools.py:413</extracomment>
+            <extracomment>plugin/widgets/edit_session.py:61; plugin/widgets/map_edit_tools.py:415</extracomment>
             <translation>Objekt löschen</translation>
         </message>
         <message>
@@ -4182,47 +4192,47 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The surface that gives new points and breaklines their heights</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:396</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:398</extracomment>
             <translation>Die Oberfläche, aus der neue Punkte und Bruchkanten ihre Höhen erhalten</translation>
         </message>
         <message>
             <source>Breakline heights: draped on the surface, typed at every vertex, or typed at the ends and interpolated between</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:403</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:405</extracomment>
             <translation>Höhen der Bruchkanten: auf die Oberfläche gelegt, an jedem Stützpunkt eingegeben oder an den Enden eingegeben und dazwischen interpoliert</translation>
         </message>
         <message>
             <source>PhotoDEM edit tools</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:410</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:412</extracomment>
             <translation>PhotoDEM-Bearbeitungswerkzeuge</translation>
         </message>
         <message>
             <source>New heights of every breakline and point from the chosen surface (one undo step)</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:416</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:418</extracomment>
             <translation>Neue Höhen aller Bruchkanten und Punkte aus der gewählten Oberfläche (ein Rückgängig-Schritt)</translation>
         </message>
         <message>
             <source>Save edits</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:419</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:421</extracomment>
             <translation>Bearbeitungen speichern</translation>
         </message>
         <message>
             <source>Open a PhotoDEM project first (File → Open project…).</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:123; plugin/widgets/map_edit_tools.py:519</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:123; plugin/widgets/map_edit_tools.py:521</extracomment>
             <translation>Öffnen Sie zuerst ein PhotoDEM-Projekt (Datei → Projekt öffnen…).</translation>
         </message>
         <message>
             <source>Vertices</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:412</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:414</extracomment>
             <translation>Stützpunkte</translation>
         </message>
         <message>
             <source>(no DSM or DTM yet)</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:570</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:585</extracomment>
             <translation>(noch kein DOM oder DGM)</translation>
         </message>
         <message>
             <source>Edits saved to {0}.</source>
-            <extracomment>plugin/widgets/map_edit_tools.py:616</extracomment>
+            <extracomment>plugin/widgets/map_edit_tools.py:636</extracomment>
             <translation>Bearbeitungen gespeichert in {0}.</translation>
         </message>
         <message>
@@ -4347,12 +4357,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>'{0}' has no coordinate reference system: it can only be shown alone, in pixel coordinates.</source>
-            <extracomment>plugin/widgets/map_view.py:156</extracomment>
+            <extracomment>plugin/widgets/map_view.py:160</extracomment>
             <translation>„{0}“ hat kein Koordinatenbezugssystem: nur allein anzeigbar, in Pixelkoordinaten.</translation>
         </message>
         <message>
             <source>The map shows a raster in pixel coordinates; '{0}' is georeferenced and cannot be shown with it.</source>
-            <extracomment>plugin/widgets/map_view.py:160</extracomment>
+            <extracomment>plugin/widgets/map_view.py:164</extracomment>
             <translation>Die Karte zeigt ein Raster in Pixelkoordinaten; „{0}“ ist georeferenziert und kann nicht zusammen damit angezeigt werden.</translation>
         </message>
         <message>
