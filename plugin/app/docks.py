@@ -137,7 +137,12 @@ def install_editing(window: Any, ask: Any = None) -> EditingToolbar:
     window.addToolBar(bar.more)
     _qc_tools(window, bar)
     history = UndoHistory(getattr(window, "edit_session", None))
-    _dock(window, HISTORY_DOCK, tr("Undo history"), history)
+    # under *Layers*: the toolbox on the right keeps its height for the forms
+    history_dock = _dock(window, HISTORY_DOCK, tr("Undo history"), history,
+                         Qt.LeftDockWidgetArea)
+    layers = getattr(window, "layers_dock", None)
+    if layers is not None:  # the layer list keeps two thirds of the height
+        window.resizeDocks([layers, history_dock], [540, 200], Qt.Vertical)
     window.editing_toolbar, window.undo_history = bar, history
     window.project_opened.connect(
         lambda root: _project_opened(window, bar, history, root))
