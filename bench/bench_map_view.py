@@ -47,56 +47,23 @@ import numpy as np
 import rasterio
 from rasterio.enums import Resampling
 from rasterio.windows import from_bounds
-from photodem.plugin.qt import QtGui, QtWidgets
+from photodem.plugin.qt import QtWidgets
 app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
-from photodem.plugin.widgets.map_layer import ViewState
 from photodem.plugin.widgets.raster_tiles import RasterLayer
 
 path, kind, width, height, steps = sys.argv[1], sys.argv[2], *map(int, sys.argv[3:6])
-try:
-    from photodem.plugin.widgets.map_view import MapView
-except ImportError:
-    MapView = None
-
-
-class ImageView:
-    # the layer's paint on an image of the view's size: the path MapView takes
-    def __init__(self, layer):
-        self.layer, self.state = layer, None
-    def set_extent(self, b):
-        cx, cy = (b[0] + b[2]) / 2, (b[1] + b[3]) / 2
-        s = max((b[2] - b[0]) / width, (b[3] - b[1]) / height)
-        self.state = ViewState((cx - width / 2 * s, cy - height / 2 * s, cx + width / 2 * s,
-                                cy + height / 2 * s), width, height, self.layer.map_crs)
-    def extent(self):
-        return self.state.extent
-    def render(self):
-        image = QtGui.QImage(width, height, QtGui.QImage.Format_ARGB32_Premultiplied)
-        image.fill(0)
-        painter = QtGui.QPainter(image)
-        self.layer.paint(painter, self.state)
-        painter.end()
-    def wait_rendered(self, timeout_ms):
-        self.render()
-        ok = self.layer.wait(timeout_ms)
-        self.render()
-        return ok
-
+from photodem.plugin.widgets.map_view import MapView
 
 t = time.perf_counter()
 layer = RasterLayer(path, kind=kind, map_crs="EPSG:25832")
 t_open = time.perf_counter() - t
-if MapView is not None:
-    view = MapView()
-    view.set_crs("EPSG:25832")
-    view.resize(width, height)
-    view.show()
-    app.processEvents()
-    view.add_layer(layer)
-    render = lambda: view.render_layers()
-else:
-    view = ImageView(layer)
-    render = view.render
+view = MapView()
+view.set_crs("EPSG:25832")
+view.resize(width, height)
+view.show()
+app.processEvents()
+view.add_layer(layer)
+render = lambda: view.render_layers()
 bounds = layer.bounds()
 
 t = time.perf_counter()
@@ -146,7 +113,7 @@ for i in range(steps):
     peers.append(peer(view.extent()))
 
 q = lambda v, p: float(np.percentile(v, p))
-print(json.dumps({"view": "MapView" if MapView is not None else "paint on QImage",
+print(json.dumps({"view": "MapView",
                   "open_s": t_open, "first_s": t_first, "first_peer_s": peer_first,
                   "step_median_s": q(full, 50), "step_p90_s": q(full, 90),
                   "frame_median_s": q(frame, 50), "peer_median_s": q(peers, 50),
