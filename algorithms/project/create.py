@@ -19,7 +19,7 @@ from .edits import create_edits
 from .importers import import_project
 from .model import Project
 from .stereo_models import block_bounds, block_footprints, detect_stereo_models
-from .validate import validate_project
+from .validate import DEFAULT_MAX_TILT, validate_project
 
 PathLike = Union[str, Path]
 
@@ -27,7 +27,7 @@ PathLike = Union[str, Path]
 def create_project(output: PathLike, images: PathLike, exterior: PathLike,
                    interior: Optional[PathLike] = None, crs: Optional[str] = None,
                    angle_unit: str = "degrees", dem: Optional[PathLike] = None,
-                   terrain_height: Optional[float] = None,
+                   terrain_height: Optional[float] = None, max_tilt: float = DEFAULT_MAX_TILT,
                    feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Create the project folder ``output`` (new or empty); nothing is left when it fails.
 
@@ -50,6 +50,8 @@ def create_project(output: PathLike, images: PathLike, exterior: PathLike,
         DEM for the terrain height and the footprints.
     terrain_height : float, optional
         Mean terrain height (m), used when no DEM is given.
+    max_tilt : float
+        |ω| or |φ| above this (degrees) is a warning, not an error (drone and oblique frames).
     feedback : Feedback, optional
         Progress, log and cancellation.
 
@@ -76,11 +78,13 @@ def create_project(output: PathLike, images: PathLike, exterior: PathLike,
     feedback.info(f"Read {len(project.images)} images and {len(project.cameras)} camera(s).")
     feedback.progress(20)
     # structural errors first: without them the geometry below is meaningful
-    validate_project(project, check_files=True, stereo_partners=False).raise_if_errors()
+    validate_project(project, check_files=True, max_tilt=max_tilt,
+                     stereo_partners=False).raise_if_errors()
     feedback.progress(35)
     dem_grid, footprints = _terrain(project, dem, terrain_height, warnings, feedback)
     feedback.progress(55)
-    report = validate_project(project, check_files=False, dem=dem_grid, stereo_partners=False)
+    report = validate_project(project, check_files=False, dem=dem_grid, max_tilt=max_tilt,
+                              stereo_partners=False)
     report.raise_if_errors()
     project.models = detect_stereo_models(project, footprints=footprints)
     warnings += _unpaired_images(project)

@@ -8,10 +8,11 @@ from typing import Any, Dict, Union
 
 from ..feedback import Feedback
 from .model import Project
-from .validate import validate_project
+from .validate import DEFAULT_MAX_TILT, validate_project
 
 
-def project_info(path: Union[str, Path], feedback: Feedback) -> Dict[str, Any]:
+def project_info(path: Union[str, Path], feedback: Feedback,
+                 max_tilt: float = DEFAULT_MAX_TILT) -> Dict[str, Any]:
     """List a project's CRS, images, cameras and stereo models and validate it.
 
     Validation warnings and errors go to ``feedback`` (errors as warnings starting with
@@ -23,6 +24,8 @@ def project_info(path: Union[str, Path], feedback: Feedback) -> Dict[str, Any]:
         Project folder or ``project.toml``.
     feedback : Feedback
         Receives the validation messages.
+    max_tilt : float
+        |ω| or |φ| above this (degrees) is reported as a warning.
 
     Returns
     -------
@@ -47,7 +50,7 @@ def project_info(path: Union[str, Path], feedback: Feedback) -> Dict[str, Any]:
         })
     cameras = {name: cam.to_dict() for name, cam in project.cameras.items()}
     models = [m.to_dict() for m in project.models]
-    report = validate_project(project, check_files=True)
+    report = validate_project(project, check_files=True, max_tilt=max_tilt)
     for w in report.warnings:
         feedback.warning(w)
     for e in report.errors:

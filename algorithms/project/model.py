@@ -16,7 +16,7 @@ What is wrong with a project file is sorted by kind (issue 16):
   camera, a stereo model naming an unknown image (or the same image twice), and image or model
   names used twice. A model is never silently dropped.
 * **Content** — the file is well formed but the block cannot be used as it is: a CRS that PROJ
-  does not understand, no images, tilts over the limit, missing image files, implausible
+  does not understand, no images, a camera looking up, missing image files, implausible
   heights… These are errors and warnings of :func:`.validate.validate_project`; each algorithm
   decides when to raise them (``project_info`` lists them all and then exits with an error).
 """

@@ -12,14 +12,17 @@ Errors (the project cannot be used as it is):
 * the CRS is missing, not understood by pyproj, or geographic (positions must be metric);
 * two images share a name; an image names an unknown camera;
 * an image file is missing, or its size differs from its camera's (read from the header only);
-* implausible angles: |ω| or |φ| above ``max_tilt`` (30° for vertical aerial images) — usually a
-  wrong angle unit or rotation convention;
+* a camera looking up: the optical axis at or above the horizon (a tilt from the nadir of 90°
+  or more), which no aerial image has — usually a wrong angle unit or rotation convention;
 * implausible heights: a projection centre at or below the terrain (DEM mean under the
   footprint, else the project's terrain height, else 0 m), more than 100 km above it, or a
   non-finite position.
 
-Warnings (the run goes on): a flying height above ground below 20 m or above 15 km, and images
-without any stereo partner (no stereo model contains them).
+Warnings (the run goes on): |ω| or |φ| above ``max_tilt`` (default 30°; drone and oblique frames
+are tilted on purpose, but a wrong angle unit or rotation convention looks the same), a flying
+height above ground below 20 m or above 15 km, and images without any stereo partner (no stereo
+model contains them). Tilt is a fact to report: geometry, matching and orthos work for any frame
+orientation that looks down.
 """
 
 from __future__ import annotations
@@ -41,6 +44,8 @@ from .stereo_models import block_bounds, detect_stereo_models
 PLAUSIBLE_HEIGHT_M = (20.0, 15000.0)
 #: Heights above ground (m) beyond this are an error (swapped coordinates, wrong units…).
 ABSURD_HEIGHT_M = 100000.0
+#: |ω| or |φ| (degrees) above this is reported as a warning by default.
+DEFAULT_MAX_TILT = 30.0
 
 
 @dataclass
@@ -92,7 +97,8 @@ def check_crs(crs: Optional[str]) -> Optional[str]:
 
 
 def validate_project(project: Project, check_files: bool = True, dem: Any = None,
-                     max_tilt: float = 30.0, stereo_partners: bool = True) -> ValidationReport:
+                     max_tilt: float = DEFAULT_MAX_TILT,
+                     stereo_partners: bool = True) -> ValidationReport:
     """Check a project (see module notes for the list of checks).
 
     Parameters
@@ -103,7 +109,8 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
     dem : path or DemSampler, optional
         Terrain for the height checks and footprints; default ``project.terrain_height``.
     max_tilt : float
-        Largest plausible |ω| and |φ| in degrees (30° for vertical aerial images).
+        |ω| or |φ| above this (degrees) is reported as a warning (30° suits vertical aerial
+        images; drone and oblique frames need more). A camera looking up is always an error.
     stereo_partners : bool
         Warn about images without a stereo partner; uses ``project.models`` or, when the project
         has none, :func:`~.stereo_models.detect_stereo_models` with its defaults.
@@ -140,13 +147,7 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
             rep.errors.append(f"Image '{rec.name}' has a non-finite position or rotation.")
             continue
         usable.append(rec)
-        omega, phi, _ = rec.eo.opk("degrees")
-        if abs(omega) > max_tilt or abs(phi) > max_tilt:
-            rep.errors.append(
-                f"Image '{rec.name}': omega = {omega:.3f}°, phi = {phi:.3f}° exceed ±{max_tilt:g}° "
-                "for a vertical aerial image. Check the angle unit (degrees/gon/radians) and the "
-                "rotation convention (PATB omega-phi-kappa, camera to world)."
-            )
+        _check_tilt(rec, max_tilt, rep)
 
     if check_files:
         _check_files(project, usable, rep)
@@ -169,6 +170,32 @@ def validate_project(project: Project, check_files: bool = True, dem: Any = None
                     "it can be orthorectified but not used for matching."
                 )
     return rep
+
+
+def tilt_from_nadir(rec: Any) -> float:
+    """Angle (degrees) between an image's optical axis and the nadir (0° for a vertical image,
+    90° for a camera looking at the horizon)."""
+    down = -float(rec.eo.viewing_direction[2])
+    return math.degrees(math.acos(max(-1.0, min(1.0, down))))
+
+
+def _check_tilt(rec: Any, max_tilt: float, rep: ValidationReport) -> None:
+    """An error for a camera looking up (tilt ≥ 90°), a warning for |ω| or |φ| above
+    ``max_tilt``."""
+    omega, phi, _ = rec.eo.opk("degrees")
+    hint = ("Check the angle unit (degrees/gon/radians) and the rotation convention (PATB "
+            "omega-phi-kappa, camera to world).")
+    tilt = tilt_from_nadir(rec)
+    if tilt >= 90.0:
+        rep.errors.append(
+            f"Image '{rec.name}': omega = {omega:.3f}°, phi = {phi:.3f}° point the camera "
+            f"{tilt:.1f}° away from the nadir, i.e. at or above the horizon; an aerial camera "
+            f"looks down. {hint}")
+    elif abs(omega) > max_tilt or abs(phi) > max_tilt:
+        rep.warnings.append(
+            f"Image '{rec.name}': omega = {omega:.3f}°, phi = {phi:.3f}° exceed ±{max_tilt:g}° "
+            f"(max_tilt; tilt from the nadir {tilt:.1f}°). Fine for a drone or oblique frame; "
+            f"otherwise {hint[0].lower()}{hint[1:]}")
 
 
 def _check_files(project: Project, records: List[Any], rep: ValidationReport) -> None:
@@ -240,5 +267,5 @@ def _check_heights(project: Project, records: List[Any], dem: Any,
             )
 
 
-__all__ = ["ABSURD_HEIGHT_M", "PLAUSIBLE_HEIGHT_M", "ValidationReport", "check_crs",
-           "validate_project"]
+__all__ = ["ABSURD_HEIGHT_M", "DEFAULT_MAX_TILT", "PLAUSIBLE_HEIGHT_M", "ValidationReport",
+           "check_crs", "tilt_from_nadir", "validate_project"]

@@ -37,6 +37,11 @@ class ProjectCreate(Algorithm):
         Parameter("dem", "raster", "DEM for terrain heights and footprints", optional=True),
         Parameter("terrain_height", "number", "Mean terrain height [m]", optional=True,
                   unit="m", help="Used when no DEM is given."),
+        Parameter("max_tilt", "number", "Largest tilt without a warning [°]", default=30.0,
+                  minimum=0.0, maximum=90.0, unit="°",
+                  help="|omega| or |phi| above this is reported as a warning (30° suits "
+                       "vertical aerial images; drone and oblique frames are tilted more). Only "
+                       "a camera looking up is refused."),
         Parameter("output", "output_folder", "Project folder"),
     )
     outputs = (
@@ -53,7 +58,8 @@ class ProjectCreate(Algorithm):
         return create_project(
             params["output"], params["images"], params["exterior"], params.get("interior"),
             crs=params.get("crs"), angle_unit=params["angle_unit"], dem=params.get("dem"),
-            terrain_height=params.get("terrain_height"), feedback=feedback)
+            terrain_height=params.get("terrain_height"), max_tilt=params["max_tilt"],
+            feedback=feedback)
 
 
 class ProjectInfo(Algorithm):
@@ -64,11 +70,19 @@ class ProjectInfo(Algorithm):
     help = (
         "Lists a project's CRS, images (position, angles in degrees, whether the file exists), "
         "cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the "
-        "result of its validation. Validation warnings and errors are reported; a project with "
-        "errors (a CRS PROJ does not know, no images, missing image files…) ends with an error "
-        "naming the first of them."
+        "result of its validation. Validation warnings (tilts above max_tilt, unusual flying "
+        "heights, images without a stereo partner) and errors are reported; a project with "
+        "errors (a CRS PROJ does not know, no images, missing image files, a camera looking "
+        "up…) ends with an error naming the first of them (exit code 2 on the command line)."
     )
-    parameters = (Parameter("project", "project", "Project folder"),)
+    parameters = (
+        Parameter("project", "project", "Project folder"),
+        Parameter("max_tilt", "number", "Largest tilt without a warning [°]", default=30.0,
+                  minimum=0.0, maximum=90.0, unit="°",
+                  help="|omega| or |phi| above this is reported as a warning (30° suits "
+                       "vertical aerial images; drone and oblique frames are tilted more). Only "
+                       "a camera looking up is refused."),
+    )
     outputs = (
         Output("name", "string", "Project name"),
         Output("crs", "string", "Project CRS"),
@@ -81,7 +95,7 @@ class ProjectInfo(Algorithm):
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...project.info import project_info
 
-        return project_info(params["project"], feedback)
+        return project_info(params["project"], feedback, max_tilt=params["max_tilt"])
 
 
 class StereoModels(Algorithm):

@@ -58,10 +58,21 @@ def test_image_size_differs(tmp_path: Path) -> None:
     only_error(validate_project(p), "im2", "80 × 100 px", "100 × 80 px", "swapped")
 
 
-def test_implausible_angles(tmp_path: Path) -> None:
+def test_tilt_above_max_tilt_is_a_warning(tmp_path: Path) -> None:
     p = make_project(tmp_path)
     p.images[0].eo = ExteriorOrientation.from_opk(p.images[0].eo.position, 45.0, 0.0, 0.0)
-    only_error(validate_project(p), "im0", "omega = 45.000°", "angle unit")
+    rep = validate_project(p, stereo_partners=False)
+    assert rep.ok
+    assert len(rep.warnings) == 1
+    assert all(w in rep.warnings[0] for w in ("im0", "omega = 45.000°", "max_tilt", "angle unit"))
+    assert validate_project(p, max_tilt=50.0, stereo_partners=False).warnings == []
+
+
+@pytest.mark.parametrize("omega, phi", [(120.0, 0.0), (0.0, -95.0), (180.0, 0.0), (91.0, 10.0)])
+def test_camera_looking_up_is_refused(tmp_path: Path, omega: float, phi: float) -> None:
+    p = make_project(tmp_path)
+    p.images[0].eo = ExteriorOrientation.from_opk(p.images[0].eo.position, omega, phi, 0.0)
+    only_error(validate_project(p, max_tilt=90.0), "im0", "horizon", "angle unit")
 
 
 def test_camera_below_terrain_and_absurd_height(tmp_path: Path) -> None:
