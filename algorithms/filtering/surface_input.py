@@ -51,7 +51,7 @@ from ..feedback import Feedback, ensure_feedback
 from ..input_errors import reading, warn_input
 from ..project.edits import read_layer
 from ..project.model import Project
-from ..project.points_io import check_distinct_points, read_points
+from ..project.points_io import check_distinct_points, import_laspy, laz_check, read_points
 from ..quality.names import report_path
 from ..quality.report import _CSS, _embed, _table, new_figure, write_json
 from ..raster.io import staged_folder, write_raster
@@ -205,11 +205,10 @@ def _read_raster(path: Path, crs: Any) -> FilterInput:
 
 
 def _read_las(path: Path) -> Tuple[Array, Any]:
-    try:
-        import laspy  # optional dependency: only LAS input needs it
-    except ImportError as exc:
-        raise InputError(f"Reading '{path.name}' needs the Python package laspy (with lazrs for "
-                         "LAZ): pip install laspy[lazrs]; or convert it to XYZ text.") from exc
+    """x, y, z (n, 3) and the CRS (WKT or None) of a LAS/LAZ file; an InputError naming the
+    missing package (laspy) or LAZ backend (lazrs) and the pip command."""
+    laspy = import_laspy()
+    laz_check(laspy, path)
     try:
         las = laspy.read(str(path))
     except Exception as exc:  # laspy raises its own errors

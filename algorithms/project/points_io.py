@@ -320,8 +320,9 @@ def import_laspy() -> Any:
 def laz_check(laspy: Any, path: Path) -> None:
     """An InputError when ``path`` is LAZ and laspy has no LAZ backend."""
     if path.suffix.lower() == ".laz" and not laspy.LazBackend.detect_available():
-        raise InputError(f"'{path.name}' is a compressed LAZ file, which needs a LAZ backend: "
-                         "install lazrs (pip install \"laspy[lazrs]\") or use .las.")
+        raise InputError(f"'{path.name}' is a compressed LAZ file, but laspy has no LAZ backend "
+                         "(lazrs or laszip) installed: pip install \"laspy[lazrs]\" (or pip "
+                         "install lazrs), or use .las.")
 
 
 def read_las(path: PathLike, chunk: int = 2_000_000) -> Tuple[Array, Array, Array, Any,
