@@ -243,6 +243,45 @@ def read_interior_yaml(path: PathLike) -> Dict[str, Camera]:
 
 # -- OPK CSV and text ------------------------------------------------------------------------------
 _OPK_FIELDS = ("filename", "x", "y", "z", "omega", "phi", "kappa")
+#: Other header names of the OPK fields (orthority's older CSVs: easting, northing, altitude).
+_OPK_ALIASES = {"easting": "x", "northing": "y", "altitude": "z", "image": "filename",
+                "name": "filename", "camera_id": "camera"}
+
+
+def sniff_csv_dialect(lines: Sequence[str]) -> Tuple[str, str]:
+    """Delimiter (comma, semicolon, tab or space) and quote character (``"`` or ``'``) of CSV
+    lines, from their first rows.
+
+    Orthority's example files are space separated with single-quoted fields
+    (``'filename' 'x' … 'camera'`` and quoted camera names that contain spaces); spreadsheets
+    write comma or semicolon CSV with double quotes.
+    """
+    sample = "\n".join(lines[:20])
+    try:
+        dialect = csv.Sniffer().sniff(sample, delimiters=",;\t ")
+        delimiter, quote = dialect.delimiter, dialect.quotechar or '"'
+    except csv.Error:  # too few rows or no consistent delimiter: count in the first line
+        first = lines[0]
+        delimiter = next((d for d in (",", ";", "\t") if d in first), " ")
+        quote = "'" if first.lstrip().startswith("'") else '"'
+    return delimiter, quote
+
+
+def _opk_header_index(header: Sequence[str], path: Path) -> Tuple[List[int], Optional[int]]:
+    """Column indices of the OPK fields (and of ``camera``, if any) in a header row, matched
+    case-insensitively after stripping quotes; an InputError naming the header found."""
+    names = [c.strip().strip("'\"").strip().lower() for c in header]
+    names = [_OPK_ALIASES.get(n, n) for n in names]
+    missing = [f for f in _OPK_FIELDS if f not in names]
+    if missing:
+        found = ", ".join(f"'{c.strip()}'" for c in header)
+        raise InputError(
+            f"'{path}': the header lacks {', '.join(missing)}; it has {found}. Expected "
+            f"{','.join(_OPK_FIELDS)} (any case, comma, semicolon, tab or space separated, "
+            "optionally quoted; and optionally camera)."
+        )
+    cam = names.index("camera") if "camera" in names else None
+    return [names.index(f) for f in _OPK_FIELDS], cam
 
 
 def _is_number(text: str) -> bool:
@@ -275,8 +314,11 @@ def read_opk_csv(path: PathLike, *, angle_unit: str, crs: Optional[str] = None) 
     ----------
     path : path
         CSV with the fields ``filename, x, y, z, omega, phi, kappa`` (and optionally ``camera``
-        and others, ignored). With a header the columns are found by name; without one they are
-        taken in that order. Comma, semicolon, tab or space delimited.
+        and others, ignored). With a header the columns are found by name (any case, quoted or
+        not; ``easting, northing, altitude`` for x, y, z); without one they are taken in that
+        order. Comma, semicolon, tab or space delimited, fields optionally quoted with ``"`` or
+        ``'`` (the delimiter and the quote are sniffed: orthority's space-separated, quoted
+        files are read as they are).
     angle_unit : {"degrees", "gon", "radians"}
         Unit of ω, φ, κ (required: never guessed).
     crs : str, optional
@@ -288,27 +330,14 @@ def read_opk_csv(path: PathLike, *, angle_unit: str, crs: Optional[str] = None) 
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"'{path}' holds no exterior orientation rows.")
-    try:
-        dialect = csv.Sniffer().sniff("\n".join(lines[:5]), delimiters=",;\t ")
-        delimiter = dialect.delimiter
-    except csv.Error:
-        delimiter = ","
+    delimiter, quote = sniff_csv_dialect(lines)
     rows = [[c.strip() for c in r] for r in
-            csv.reader(io.StringIO("\n".join(lines)), delimiter=delimiter,
+            csv.reader(io.StringIO("\n".join(lines)), delimiter=delimiter, quotechar=quote,
                        skipinitialspace=True)]
     rows = [[c for c in r if c != ""] if delimiter == " " else r for r in rows]
     first = rows[0]
-    has_header = len(first) >= 4 and not _is_number(first[1])
-    if has_header:
-        header = [c.lower() for c in first]
-        missing = [f for f in _OPK_FIELDS if f not in header]
-        if missing:
-            raise InputError(
-                f"'{path}': the header lacks {', '.join(missing)}; expected "
-                f"{','.join(_OPK_FIELDS)} (and optionally camera)."
-            )
-        idx = [header.index(f) for f in _OPK_FIELDS]
-        cam_idx = header.index("camera") if "camera" in header else None
+    if len(first) >= 4 and not _is_number(first[1]):  # a header row
+        idx, cam_idx = _opk_header_index(first, path)
         body, first_line = rows[1:], 2
     else:
         idx, cam_idx, body, first_line = list(range(7)), None, rows, 1
@@ -534,8 +563,9 @@ def detect_exterior_format(path: PathLike) -> str:
         return "opensfm"
     for line in head.splitlines():
         if line.strip() and not line.lstrip().startswith("#"):
-            return "csv" if ("," in line or ";" in line or path.suffix.lower() == ".csv") \
-                else "text"
+            quoted = '"' in line or "'" in line  # orthority's quoted, space-separated CSV
+            return "csv" if ("," in line or ";" in line or quoted
+                             or path.suffix.lower() == ".csv") else "text"
     raise InputError(f"'{path}' is empty.")
 
 
