@@ -47,7 +47,7 @@ from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from .dense import GreySource, iter_disparity_tiles
-from .model_report import write_model_report
+from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
 
 PathLike = Union[str, Path]
@@ -170,20 +170,30 @@ class _Outliers:
     k: float
 
 
+def _pct(part: int, whole: int) -> float:
+    """``100 · part / whole`` (0 for an empty whole)."""
+    return 100.0 * part / whole if whole else 0.0
+
+
 def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCounts,
              max_gap: float, outliers: _Outliers) -> Dict[str, Any]:
-    """Headline figures: points, coverage of the measuring area, valid and filled shares."""
+    """Headline figures: points, the valid share of the disparities, and the shares of the
+    measuring area that are measured (a cell with a triangulated point), interpolated (a gap
+    filled) and empty; they add up to 100 %, ``coverage_pct`` = measured + interpolated."""
     grid = setup.grid
     area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions, grid)
     n_area = int(area.sum())
-    n_have = int((np.isfinite(res.z) & area).sum())
-    coverage = 100.0 * n_have / n_area if n_area else 0.0
+    have = np.isfinite(res.z) & area
+    n_have = int(have.sum())
+    n_filled = int((have & res.filled).sum())
     n_left, n_valid = counts.n_left, counts.n_valid
     return {
         "points": int(acc.points),
-        "coverage_pct": coverage,
-        "valid_disparity_pct": 100.0 * n_valid / n_left if n_left else 0.0,
-        "filled_pct": 100.0 * int(res.filled.sum()) / n_area if n_area else 0.0,
+        "coverage_pct": _pct(n_have, n_area),
+        "measured_pct": _pct(n_have - n_filled, n_area),
+        "interpolated_pct": _pct(n_filled, n_area),
+        "empty_pct": _pct(n_area - n_have, n_area),
+        "valid_disparity_pct": _pct(n_valid, n_left),
         "spacing_m": setup.spacing,
         "cells": [grid.width, grid.height],
         "disparity_range_px": [setup.min_d, setup.max_d],
@@ -307,9 +317,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                            dsm=tmp / "dsm.tif", count=tmp / "count.tif",
                            exclusions=setup.exclusions)
         feedback.progress(100.0)
-    feedback.info(f"Model {m.name}: {metrics['points']} points, coverage "
-                  f"{metrics['coverage_pct']:.1f} %, valid disparities "
-                  f"{metrics['valid_disparity_pct']:.1f} %.")
+    feedback.info(f"Model {m.name}: {metrics['points']} points; {coverage_sentence(metrics)}")
     return {"dsm": str(out / "dsm.tif"), "count": str(out / "count.tif"), "sigma": None,
             "report": str(out / "report.json"), "report_html": str(out / "report.html"),
             "points": None, "reduced": None, "metrics": metrics}

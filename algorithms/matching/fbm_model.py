@@ -54,7 +54,7 @@ from ..surface.groundel import reduce_groundels
 from ..surface.jumps import jump_breaklines, point_support
 from ..surface.point_output import write_points
 from .hierarchy import EpipolarMatches, FbmLsmOptions, match_epipolar_fbm_lsm
-from .model_report import write_model_report
+from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, footprint, prepare_model
 from .presets import (
     DEFAULT_PRESET,
@@ -416,14 +416,19 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
 def _metrics(setup: ModelSetup, mp: _ModelPoints, red: Any, z_grid: np.ndarray,
              count: np.ndarray, cell: float, seeds: Optional[np.ndarray],
              matches: EpipolarMatches, max_gap: Optional[float]) -> Dict[str, Any]:
-    """Headline figures of the model: counts, coverage, measured share, σ1/σ2, geometry."""
+    """Headline figures of the model: counts, σ1/σ2, geometry and the shares of the model area
+    (``allowed``) that are measured (a height within ½ groundel of a matched point),
+    interpolated (a height filled between points) and empty; they add up to 100 %, and
+    ``coverage_pct`` = measured + interpolated. ``failed_windows_finest_pct``: the share of
+    the matching windows that failed at the finest pyramid level."""
     grid, pair, allowed = setup.grid, setup.pair, mp.allowed
     n_area = int(allowed.sum())
     n_have = int((np.isfinite(z_grid) & allowed).sum())
     coverage = 100.0 * n_have / n_area if n_area else 0.0
-    # measured: within half a groundel of a matched point (the rest is interpolated)
+    # measured: a height within half a groundel of a matched point (the rest is interpolated)
     near = ndimage.distance_transform_edt(count == 0) * grid.spacing <= 0.5 * cell
-    measured = 100.0 * int((near & allowed).sum()) / n_area if n_area else 0.0
+    n_measured = int((near & np.isfinite(z_grid) & allowed).sum())
+    measured = 100.0 * n_measured / n_area if n_area else 0.0
     summary = red.summary()
     H = setup.flying_height
     return {
@@ -433,6 +438,8 @@ def _metrics(setup: ModelSetup, mp: _ModelPoints, red: Any, z_grid: np.ndarray,
         "outliers": red.n_outliers,
         "coverage_pct": coverage,
         "measured_pct": measured,
+        "interpolated_pct": 100.0 * (n_have - n_measured) / n_area if n_area else 0.0,
+        "empty_pct": 100.0 - coverage if n_area else 0.0,
         "sigma1_m": summary.get("sigma1_m"),
         "sigma2_m": summary.get("sigma2_m"),
         "sigma2_permille": (1000.0 * summary["sigma2_m"] / H
@@ -444,6 +451,7 @@ def _metrics(setup: ModelSetup, mp: _ModelPoints, red: Any, z_grid: np.ndarray,
         "height_range_m": [setup.z_min, setup.z_max],
         "start_points": 0 if seeds is None else len(seeds),
         "failed_windows": len(matches.failures),
+        "failed_windows_finest_pct": matches.stats.get("total", {}).get("failure_pct_level0"),
         "max_gap_m": max_gap,
         "base_px": float(pair.base * pair.focal_px / H) if H > 0 else None,
         "epipolar_mpx": pair.sizes[0][0] * pair.sizes[0][1] / 1e6,
@@ -637,8 +645,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
                            count=tmp / "count.tif", failures=fail_xy)
         feedback.progress(100.0)
     feedback.info(f"Model {m.name}: {metrics['points_raw']} points, "
-                  f"{metrics['points_reduced']} groundels, coverage "
-                  f"{metrics['coverage_pct']:.1f} %.")
+                  f"{metrics['points_reduced']} groundels; {coverage_sentence(metrics)}")
     return {"dsm": str(out / "dsm.tif"),
             "sigma": str(out / "sigma.tif") if sigma_grid is not None else None,
             "count": str(out / "count.tif"), "points": str(out / f"points{suffix}"),

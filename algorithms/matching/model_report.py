@@ -3,9 +3,10 @@ r"""The internal quality report of one matched stereo model: ``report.json`` + `
 The HTML is self-contained (figures as embedded PNG, drawn on matplotlib's Agg canvas by the
 helpers of :mod:`..quality.report`, with the look of the DEM-comparison report):
 
-1. headline metrics: method, model, images, points raw / reduced / failed, coverage, the
-   internal accuracies σ1 (raw points) and σ2 = F·σ1/√n̄ (reduced points, seed-000 §5.1) in
-   metres and in per mille of the flying height (:math:`v_{‰} = 1000\,v/H`), spacing, timings;
+1. headline metrics: method, model, images, points raw / reduced / failed, the shares of the
+   model area measured / interpolated / empty (they add up to 100 %), the internal accuracies
+   σ1 (raw points) and σ2 = F·σ1/√n̄ (reduced points, seed-000 §5.1) in metres and in per
+   mille of the flying height (:math:`v_{‰} = 1000\,v/H`), spacing, timings;
 2. one row per pyramid level / measuring module with whatever counters the matcher recorded
    (features, candidates, windows, failures, LSM tried / failed …); a key ending in ``_pct``
    is a percentage, other numbers are shown as counts or values;
@@ -70,10 +71,14 @@ HEADLINE: Tuple[Tuple[str, Tuple[Tuple[str, str], ...], str], ...] = (
      "count"),
     ("points failed", (("metrics", "points_failed"), ("metrics", "failed")), "count"),
     ("outliers (reduction)", (("reduction", "outliers"), ("metrics", "outliers")), "count"),
-    ("coverage", (("metrics", "coverage_pct"),), "pct"),
-    ("measured (within ½ groundel of a point)", (("metrics", "measured_pct"),), "pct"),
+    ("coverage (measured + interpolated)", (("metrics", "coverage_pct"),), "pct"),
+    ("measured", (("metrics", "measured_pct"),), "pct"),
+    ("interpolated", (("metrics", "interpolated_pct"), ("metrics", "filled_pct")), "pct"),
+    ("empty", (("metrics", "empty_pct"),), "pct"),
+    ("valid disparities", (("metrics", "valid_disparity_pct"),), "pct"),
     ("failed matching windows", (("metrics", "failed_windows"),), "count"),
-    ("filled by interpolation", (("metrics", "filled_pct"),), "pct"),
+    ("failed windows at the finest level", (("metrics", "failed_windows_finest_pct"),),
+     "pct"),
     ("grid spacing", (("metrics", "spacing_m"), ("options", "spacing")), "m"),
     ("groundel size", (("reduction", "cell_m"),), "m"),
     ("mean points per groundel", (("reduction", "n_mean"),), "value"),
@@ -141,6 +146,21 @@ def _label(key: str) -> str:
             text = text[: -len(suffix)] + unit
             break
     return text.replace("_", " ")
+
+
+def coverage_sentence(metrics: Dict[str, Any]) -> str:
+    """The run log's coverage sentence: what was measured, interpolated and left empty (% of
+    the model area), the valid disparities (dense) or the failed windows at the finest level
+    (fbm_lsm)."""
+    parts = [f"measured {_number(metrics.get('measured_pct')) or 0.0:.1f} %, interpolated "
+             f"{_number(metrics.get('interpolated_pct')) or 0.0:.1f} %, empty "
+             f"{_number(metrics.get('empty_pct')) or 0.0:.1f} % of the model area"]
+    if _number(metrics.get("valid_disparity_pct")) is not None:
+        parts.append(f"valid disparities {metrics['valid_disparity_pct']:.1f} %")
+    if _number(metrics.get("failed_windows_finest_pct")) is not None:
+        parts.append(f"failed windows at the finest level "
+                     f"{metrics['failed_windows_finest_pct']:.1f} %")
+    return "; ".join(parts) + "."
 
 
 def headline_table(report: Dict[str, Any]) -> str:
@@ -400,6 +420,7 @@ def write_model_report(folder: PathLike, report: Dict[str, Any], *, dsm: PathLik
 __all__ = [
     "COVERAGE_CLASSES",
     "coverage_classes",
+    "coverage_sentence",
     "dict_table",
     "figure_coverage",
     "figure_dsm",

@@ -110,6 +110,9 @@ def test_single_start_point_covers_the_model_within_0_1_permille(result, block) 
     assert m["start_points"] == 1
     assert m["coverage_pct"] == pytest.approx(100.0)  # default: every cell gets a height
     assert m["measured_pct"] > 50.0  # cells within ½ groundel of a matched point
+    # the rest is interpolated, and said so: measured + interpolated + empty = 100 %
+    assert m["measured_pct"] + m["interpolated_pct"] + m["empty_pct"] == pytest.approx(100.0)
+    assert m["measured_pct"] < m["coverage_pct"] and m["interpolated_pct"] > 0.0
     dz = _measured_open_errors(result, block)
     assert dz.size > 1000
     rms = float(np.sqrt(np.mean(dz**2)))
