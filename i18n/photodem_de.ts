@@ -89,6 +89,16 @@
             <translation>Wird verwendet, wenn kein Geländemodell angegeben ist.</translation>
         </message>
         <message>
+            <source>Largest tilt without a warning [°]</source>
+            <extracomment>project_create.max_tilt: description; project_info.max_tilt: description</extracomment>
+            <translation>Größte Neigung ohne Warnung [°]</translation>
+        </message>
+        <message>
+            <source>|omega| or |phi| above this is reported as a warning (30° suits vertical aerial images; drone and oblique frames are tilted more). Only a camera looking up is refused.</source>
+            <extracomment>project_create.max_tilt: help; project_info.max_tilt: help</extracomment>
+            <translation>|Omega| oder |Phi| darüber wird als Warnung gemeldet (30° passt zu Senkrechtluftbildern; Drohnen- und Schrägaufnahmen sind stärker geneigt). Abgelehnt wird nur eine Kamera, die nach oben blickt.</translation>
+        </message>
+        <message>
             <source>Project folder</source>
             <extracomment>project_create output project; project_create.output: description; project_info.project: description; stereo_models.project: description; synthetic_block output project</extracomment>
             <translation>Projektordner</translation>
@@ -119,9 +129,9 @@
             <translation>Projektinformationen</translation>
         </message>
         <message>
-            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation. Validation warnings and errors are reported; a project with errors (a CRS PROJ does not know, no images, missing image files…) ends with an error naming the first of them.</source>
+            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation. Validation warnings (tilts above max_tilt, unusual flying heights, images without a stereo partner) and errors are reported; a project with errors (a CRS PROJ does not know, no images, missing image files, a camera looking up…) ends with an error naming the first of them (exit code 2 on the command line).</source>
             <extracomment>project_info: help</extracomment>
-            <translation>Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf. Warnungen und Fehler der Prüfung werden gemeldet; ein Projekt mit Fehlern (ein KBS, das PROJ nicht kennt, keine Bilder, fehlende Bilddateien …) endet mit einem Fehler, der den ersten davon nennt.</translation>
+            <translation>Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf. Warnungen (Neigungen über max_tilt, ungewöhnliche Flughöhen, Bilder ohne Stereopartner) und Fehler der Prüfung werden gemeldet; ein Projekt mit Fehlern (ein KBS, das PROJ nicht kennt, keine Bilder, fehlende Bilddateien, eine Kamera, die nach oben blickt …) endet mit einem Fehler, der den ersten davon nennt (Exit-Code 2 auf der Kommandozeile).</translation>
         </message>
         <message>
             <source>Project name</source>
@@ -2415,7 +2425,7 @@
         </message>
         <message>
             <source>Undo history</source>
-            <extracomment>plugin/app/docks.py:140</extracomment>
+            <extracomment>plugin/app/docks.py:141</extracomment>
             <translation>Bearbeitungsverlauf</translation>
         </message>
         <message>
@@ -5059,6 +5069,10 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation. Validation warnings and errors are reported; a project with errors (a CRS PROJ does not know, no images, missing image files…) ends with an error naming the first of them.</source>
+            <translation type="vanished">Listet KBS, Bilder (Position, Winkel in Grad, ob die Datei vorhanden ist), Kameras und Stereomodelle (B/H, Überlappung in %, Bodenauflösung, Flughöhe über Grund) eines Projekts sowie das Ergebnis seiner Prüfung auf. Warnungen und Fehler der Prüfung werden gemeldet; ein Projekt mit Fehlern (ein KBS, das PROJ nicht kennt, keine Bilder, fehlende Bilddateien …) endet mit einem Fehler, der den ersten davon nennt.</translation>
         </message>
         <message>
             <source>Choose an algorithm on the left.</source>
