@@ -14,7 +14,6 @@ import pytest
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 pytest.importorskip("pytestqt")
 
-from photodem.algorithms.processing import registry
 from photodem.plugin.app.main_window import ToolboxWindow
 from photodem.plugin.qt import QtCore, QtWidgets
 
@@ -23,24 +22,13 @@ ENTRIES = ["Match this model…", "Epipolar pair", "Filter its DSM…"]
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    """The tiny synthetic project (made once for the module)."""
+def tiny(tiny_block, tmp_path_factory) -> Path:
+    """A copy of the tiny synthetic project for this module (its tests write into it)."""
     out = tmp_path_factory.mktemp("tiny") / "project"
-    registry.run("synthetic_block", {"output": str(out), "size": "tiny"})
+    shutil.copytree(tiny_block, out)
     return out
 
 
-@pytest.fixture
-def window(qtbot):
-    w = ToolboxWindow(message_boxes=False)
-    qtbot.addWidget(w)
-    w.show()
-    qtbot.waitExposed(w)
-    yield w
-    w.run_panel.wait(120000)
-    if w.edit_session is not None:
-        w.edit_session.ask = lambda parent, session: "discard"
-    w.map_view.clear_layers()
 
 
 @pytest.fixture

@@ -18,7 +18,6 @@ from rasterio.transform import from_origin
 from shapely.geometry import Point
 
 from photodem.algorithms.project.edits import EDIT_LAYERS
-from photodem.plugin.app.main_window import ToolboxWindow
 from photodem.plugin.qt import QtCore, QtGui, QtWidgets
 from photodem.plugin.widgets.map_layers import LayerList
 
@@ -35,16 +34,6 @@ def tiny(tiny_block, tmp_path_factory) -> Path:
     return out
 
 
-@pytest.fixture
-def window(qtbot):
-    w = ToolboxWindow(message_boxes=False)
-    qtbot.addWidget(w)
-    w.show()
-    qtbot.waitExposed(w)
-    yield w
-    if w.edit_session is not None:
-        w.edit_session.ask = lambda parent, session: "discard"
-    w.map_view.clear_layers()
 
 
 def test_open_project_lists_the_expected_layers(window, tiny, qtbot):
