@@ -4,7 +4,8 @@ r"""Importers for the orientation files users have.
   allowed, optional ``camera`` column) with the orthority **interior-parameter YAML**;
 * **plain OPK text** (``name x y z omega phi kappa [camera]``, whitespace separated, ``#``
   comments);
-* **OpenSfM** ``reconstruction.json`` (ODM's ``opensfm/reconstruction.json``).
+* **OpenSfM / ODM** reconstructions and ODM project folders (:mod:`.importers_opensfm`);
+* **orthority's exterior GeoJSON** (``oty`` format).
 
 OPK angles are PATB ω-φ-κ (camera→world, :math:`R = R_x(\omega) R_y(\varphi) R_z(\kappa)`), as
 used by orthority; their unit (degrees, gon or radians) must always be stated. The CRS of an OPK
@@ -30,171 +31,47 @@ When no sensor size is known (normalised focal length, and every OpenSfM camera)
 *nominal* sensor whose larger side is 1 mm: pixel size ``1 / max(w, h)`` mm, so the focal length
 in "mm" equals the normalised focal length. Ground geometry (rays, GSD in m) is unaffected.
 
-OpenSfM stores positions in a topocentric frame (east-north-up at ``reference_lla``) and
-rotations world→camera as axis-angle (x right, y down, z forward). :func:`read_opensfm`
-converts the centres through ECEF into the target CRS (default: the UTM zone of
-``reference_lla``, WGS 84 ellipsoidal heights) and carries the rotation along: the camera axes
-are offset by ±``d`` from the centre in ENU, transformed, and the rotation is the orthonormal
-(polar) factor of the resulting Jacobian, which absorbs the grid convergence and the curvature
-between the reference point and the camera.
+OpenSfM and ODM reconstructions (plain OpenSfM topocentric, ODM's UTM-with-offset
+``reconstruction.json``, ODM's ``reconstruction.topocentric.json``, or an ODM project folder)
+are read by :mod:`.importers_opensfm`, which describes the frames; orthority's exterior GeoJSON
+(``world_crs``, ``xyz``, ``opk`` in radians) by :func:`read_oty_geojson`.
 """
 
 from __future__ import annotations
 
 import csv
-import functools
 import io
 import json
-import math
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Dict, List, Optional, Sequence, Tuple
 
-import numpy as np
-import pyproj
 import yaml
-from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..geometry.camera import Camera
-from ..geometry.orientation import ExteriorOrientation, check_angle_unit, opensfm_to_patb
+from ..geometry.orientation import ExteriorOrientation, check_angle_unit
+from .importers_common import (
+    IMAGE_EXTENSIONS,
+    ImportedBlock,
+    ImportedImage,
+    PathLike,
+    camera_from_normalised,
+    crs_from_prj,
+    image_stem,
+    normalise_crs,
+    resolve_crs,
+    same_crs,
+)
+from .importers_opensfm import (
+    crs_to_enu,
+    enu_to_crs,
+    read_opensfm,
+    transform_pose,
+    utm_crs_of,
+)
 from .model import ImageRecord, Project
 
-PathLike = Union[str, Path]
-IMAGE_EXTENSIONS = (".tif", ".tiff", ".jpg", ".jpeg", ".png")
-_WGS84_A = 6378137.0
-_WGS84_F = 1.0 / 298.257223563
-
-
-@dataclass
-class ImportedImage:
-    """One image of an exterior-orientation file, before it is matched to a file."""
-
-    name: str
-    eo: ExteriorOrientation
-    camera: Optional[str] = None
-    source_name: str = ""  # the name as written in the file (may carry an extension)
-
-
-@dataclass
-class ImportedBlock:
-    """What an importer read: CRS, cameras (may be empty for OPK files) and images."""
-
-    crs: Optional[str]
-    cameras: Dict[str, Camera] = field(default_factory=dict)
-    images: List[ImportedImage] = field(default_factory=list)
-    warnings: List[str] = field(default_factory=list)
-
-
-# -- CRS -------------------------------------------------------------------------------------------
-def normalise_crs(crs: Any) -> str:
-    """A CRS as ``EPSG:xxxx`` when it is exactly an EPSG CRS, else as WKT2.
-
-    Raises
-    ------
-    InputError
-        When pyproj does not understand ``crs``.
-    """
-    try:
-        c = pyproj.CRS.from_user_input(crs)
-    except Exception as exc:  # pyproj.exceptions.CRSError
-        raise InputError(
-            f"The CRS '{str(crs)[:80]}' is not understood ({exc}). Give it as EPSG:xxxx, WKT or "
-            "a PROJ string."
-        ) from exc
-    code = c.to_epsg(min_confidence=100)
-    return f"EPSG:{code}" if code else c.to_wkt()
-
-
-def crs_from_prj(path: PathLike) -> Optional[str]:
-    """The CRS in a ``.prj`` beside ``path`` (same stem), or ``None`` when there is none."""
-    prj = Path(path).with_suffix(".prj")
-    if not prj.is_file():
-        return None
-    text = prj.read_text(encoding="utf-8", errors="replace").strip()
-    if not text:
-        return None
-    try:
-        return normalise_crs(text)
-    except InputError as exc:
-        raise InputError(f"The CRS in '{prj}' is not understood: {exc}") from exc
-
-
-def _resolve_crs(path: PathLike, crs: Optional[str], warnings: List[str]) -> Optional[str]:
-    from_prj = crs_from_prj(path)
-    if crs:
-        given = normalise_crs(crs)
-        if from_prj is not None and not _same_crs(given, from_prj):
-            warnings.append(
-                f"The CRS parameter differs from the .prj beside '{Path(path).name}'; "
-                "the parameter is used."
-            )
-        return given
-    return from_prj
-
-
-def _same_crs(a: str, b: str) -> bool:
-    return pyproj.CRS.from_user_input(a) == pyproj.CRS.from_user_input(b)
-
-
-# -- interior orientation ------------------------------------------------------------------------
-def _pair(value: Any, what: str) -> Tuple[float, float]:
-    if isinstance(value, (list, tuple)):
-        if len(value) != 2:
-            raise InputError(f"{what} must be one number or a pair [x, y], not {value!r}.")
-        return float(value[0]), float(value[1])
-    return float(value), float(value)
-
-
-def camera_from_normalised(name: str, width: int, height: int, focal: Any,
-                           cx: float = 0.0, cy: float = 0.0,
-                           sensor_size: Optional[Sequence[float]] = None,
-                           **distortion: float) -> Camera:
-    r"""A :class:`Camera` from orthority/OpenSfM-style interior parameters.
-
-    Parameters
-    ----------
-    width, height : int
-        Image size (pixels).
-    focal : float or (float, float)
-        Focal length in the units of ``sensor_size``; without ``sensor_size`` normalised by
-        max(w, h) (then pixels are square and a nominal 1 mm sensor is used, see module notes).
-    cx, cy : float
-        Principal-point offsets in normalised image coordinates (y down, / max(w, h)).
-    sensor_size : (float, float), optional
-        Sensor width and height in mm.
-    **distortion
-        ``k1, k2, k3, p1, p2`` (others must be zero).
-
-    Notes
-    -----
-    With :math:`f_x \ne f_y` the y pixel pitch is scaled, :math:`p_y' = p_y f_x / f_y`, so that
-    both focal lengths in pixels are kept with the one focal length of :class:`Camera`.
-    """
-    w, h = int(width), int(height)
-    s = float(max(w, h))
-    fx, fy = _pair(focal, f"Camera '{name}': focal_len")
-    if sensor_size is not None:
-        sw, sh = _pair(sensor_size, f"Camera '{name}': sensor_size")
-        px, py = sw / w, sh / h
-    else:
-        px = py = 1.0 / s  # nominal: larger sensor side = 1 "mm"
-    if not (fx > 0 and fy > 0):
-        raise InputError(f"Camera '{name}': focal length must be positive, not {focal!r}.")
-    if fx != fy:
-        py = py * fx / fy
-    supported = {"k1", "k2", "k3", "p1", "p2"}
-    extra = {k: float(v) for k, v in distortion.items() if k not in supported and float(v) != 0}
-    if extra:
-        raise InputError(
-            f"Camera '{name}': distortion coefficients {', '.join(sorted(extra))} are not "
-            "supported (PhotoDEM uses Brown k1-k3, p1-p2)."
-        )
-    dist = {k: float(distortion.get(k, 0.0) or 0.0) for k in supported}
-    return Camera(
-        name=name, width=w, height=h, focal_length=fx, pixel_size=(px, py),
-        principal_point=(float(cx) * s * px + 0.0, -float(cy) * s * py + 0.0), **dist,
-    )
+_stem = image_stem
 
 
 def read_interior_yaml(path: PathLike) -> Dict[str, Camera]:
@@ -302,10 +179,6 @@ def _opk_image(name: str, values: Sequence[str], unit: str, where: str,
     return ImportedImage(name=_stem(name), eo=eo, camera=camera or None, source_name=name)
 
 
-def _stem(name: str) -> str:
-    p = Path(name.strip())
-    return p.stem if p.suffix.lower() in IMAGE_EXTENSIONS else p.name
-
 
 def read_opk_csv(path: PathLike, *, angle_unit: str, crs: Optional[str] = None) -> ImportedBlock:
     """Exterior orientation from an orthority-style OPK CSV.
@@ -342,7 +215,7 @@ def read_opk_csv(path: PathLike, *, angle_unit: str, crs: Optional[str] = None) 
     else:
         idx, cam_idx, body, first_line = list(range(7)), None, rows, 1
     warnings: List[str] = []
-    block = ImportedBlock(crs=_resolve_crs(path, crs, warnings), warnings=warnings)
+    block = ImportedBlock(crs=resolve_crs(path, crs, warnings), warnings=warnings)
     for n, row in enumerate(body, start=first_line):
         if len(row) < max(idx) + 1:
             raise InputError(f"'{path}' line {n}: expected {max(idx) + 1} fields, got {len(row)}.")
@@ -361,7 +234,7 @@ def read_opk_text(path: PathLike, *, angle_unit: str, crs: Optional[str] = None
     unit = check_angle_unit(angle_unit)
     path = Path(path)
     warnings: List[str] = []
-    block = ImportedBlock(crs=_resolve_crs(path, crs, warnings), warnings=warnings)
+    block = ImportedBlock(crs=resolve_crs(path, crs, warnings), warnings=warnings)
     for n, line in enumerate(path.read_text(encoding="utf-8-sig", errors="replace").splitlines(),
                              start=1):
         fields = line.split("#", 1)[0].split()
@@ -381,186 +254,55 @@ def read_opk_text(path: PathLike, *, angle_unit: str, crs: Optional[str] = None
         raise InputError(f"'{path}' holds no exterior orientation rows.")
     return block
 
+def read_oty_geojson(path: PathLike, *, crs: Optional[str] = None) -> ImportedBlock:
+    """Exterior orientation from orthority's GeoJSON (``oty`` exterior parameters).
 
-# -- OpenSfM ---------------------------------------------------------------------------------------
-def _ecef_from_enu_matrix(lat_deg: float, lon_deg: float) -> NDArray[np.float64]:
-    """Columns: east, north, up unit vectors of the local frame at (lat, lon) in ECEF."""
-    lat, lon = math.radians(lat_deg), math.radians(lon_deg)
-    sl, cl, sp, cp = math.sin(lon), math.cos(lon), math.sin(lat), math.cos(lat)
-    return np.array([[-sl, -sp * cl, cp * cl],
-                     [cl, -sp * sl, cp * sl],
-                     [0.0, cp, sp]])
-
-
-def _lla_to_ecef(lat: float, lon: float, alt: float) -> NDArray[np.float64]:
-    e2 = _WGS84_F * (2.0 - _WGS84_F)
-    la, lo = math.radians(lat), math.radians(lon)
-    n = _WGS84_A / math.sqrt(1.0 - e2 * math.sin(la) ** 2)
-    return np.array([(n + alt) * math.cos(la) * math.cos(lo),
-                     (n + alt) * math.cos(la) * math.sin(lo),
-                     (n * (1.0 - e2) + alt) * math.sin(la)])
-
-
-def utm_crs_of(lat: float, lon: float) -> str:
-    """``EPSG:326zz`` / ``EPSG:327zz``: the WGS 84 UTM zone of a point."""
-    zone = math.floor((lon + 180.0) / 6.0) % 60 + 1
-    return f"EPSG:{(32600 if lat >= 0 else 32700) + zone}"
-
-
-@functools.lru_cache(maxsize=16)
-def _ecef_transformer(crs: str, inverse: bool = False) -> Any:
-    target = pyproj.CRS.from_user_input(crs)
-    if not target.is_projected and not target.is_geographic:
-        raise InputError(f"The target CRS '{target.name}' must be projected or geographic.")
-    target3d = target.to_3d() if len(target.axis_info) < 3 else target
-    src, dst = pyproj.CRS.from_epsg(4978), target3d
-    if inverse:
-        src, dst = dst, src
-    return pyproj.Transformer.from_crs(src, dst, always_xy=True)
-
-
-def enu_to_crs(points: ArrayLike, reference_lla: Sequence[float], crs: str) -> NDArray[np.float64]:
-    r"""Topocentric ENU points (..., 3) at ``reference_lla`` → ``crs`` (x, y, ellipsoidal h).
-
-    :math:`X_{ECEF} = X_0 + M\,(e, n, u)^T` with :math:`M` the ENU→ECEF matrix at the reference
-    (WGS 84), then pyproj ECEF → ``crs`` (promoted to 3-D; heights stay ellipsoidal).
-    """
-    lat, lon, alt = (float(v) for v in reference_lla)
-    p = np.asarray(points, dtype=float)
-    ecef = _lla_to_ecef(lat, lon, alt) + p @ _ecef_from_enu_matrix(lat, lon).T
-    t = _ecef_transformer(crs)
-    x, y, z = t.transform(ecef[..., 0], ecef[..., 1], ecef[..., 2])
-    return np.stack([np.asarray(x), np.asarray(y), np.asarray(z)], axis=-1)
-
-
-def crs_to_enu(points: ArrayLike, reference_lla: Sequence[float], crs: str) -> NDArray[np.float64]:
-    """Inverse of :func:`enu_to_crs`."""
-    lat, lon, alt = (float(v) for v in reference_lla)
-    p = np.asarray(points, dtype=float)
-    t = _ecef_transformer(crs, inverse=True)
-    x, y, z = t.transform(p[..., 0], p[..., 1], p[..., 2])
-    ecef = np.stack([np.asarray(x), np.asarray(y), np.asarray(z)], axis=-1)
-    return (ecef - _lla_to_ecef(lat, lon, alt)) @ _ecef_from_enu_matrix(lat, lon)
-
-
-def transform_pose(eo: ExteriorOrientation, transform: Any, step: float = 10.0
-                   ) -> ExteriorOrientation:
-    r"""Carry a pose through a point transformation (e.g. ENU → map CRS).
-
-    The centre is transformed; the rotation is the orthonormal polar factor of the Jacobian
-    :math:`J_{:,i} \approx (T(C + d\,r_i) - T(C - d\,r_i)) / 2d` along the camera axes
-    :math:`r_i` (columns of R), :math:`R' = U V^T` from the SVD :math:`J = U S V^T`. Central
-    differences make the error :math:`O(d^2)` (≈ 1e-12 rad for d = 10 m on the Earth).
-
-    Parameters
-    ----------
-    transform : callable
-        Maps points (..., 3) to points (..., 3).
-    """
-    C, R = eo.position, eo.rotation
-    pts = np.concatenate([C[None], C + step * R.T, C - step * R.T])  # rows: C, C+d r_i, C-d r_i
-    out = np.asarray(transform(pts), dtype=float)
-    J = (out[1:4] - out[4:7]).T / (2.0 * step)
-    U, _, Vt = np.linalg.svd(J)
-    R_new = U @ Vt
-    if np.linalg.det(R_new) < 0:  # a left-handed target (e.g. lat/lon axis order) is unusable
-        raise InputError("The target CRS has left-handed axes; choose a projected CRS (x east).")
-    return ExteriorOrientation(out[0], R_new)
-
-
-def _opensfm_camera(name: str, d: Dict[str, Any]) -> Camera:
-    kind = str(d.get("projection_type", "perspective")).lower()
-    if kind not in ("perspective", "brown", "simple_radial", "radial"):
-        raise InputError(
-            f"OpenSfM camera '{name}' has projection_type '{kind}'; PhotoDEM supports "
-            "perspective, simple_radial, radial and brown frame cameras."
-        )
-    w, h = int(d["width"]), int(d["height"])
-    if "focal" in d:
-        focal: Any = float(d["focal"])
-    else:
-        focal = [float(d["focal_x"]), float(d.get("focal_y", d["focal_x"]))]
-    dist = {k: float(d.get(k, 0.0)) for k in ("k1", "k2", "k3", "p1", "p2")}
-    return camera_from_normalised(name, w, h, focal, cx=float(d.get("c_x", 0.0)),
-                                  cy=float(d.get("c_y", 0.0)), **dist)
-
-
-def read_opensfm(path: PathLike, crs: Optional[str] = None,
-                 reconstruction: Optional[int] = None) -> ImportedBlock:
-    """Cameras and poses from an OpenSfM/ODM ``reconstruction.json``.
-
-    Parameters
-    ----------
-    path : path
-        The ``reconstruction.json`` (a list of reconstructions).
-    crs : str, optional
-        Target CRS; default the WGS 84 UTM zone of ``reference_lla``.
-    reconstruction : int, optional
-        Import only this reconstruction (0 = the largest, first one); default all.
-
-    Notes
-    -----
-    ``reference_lla`` is read from the reconstruction, else from ``reference_lla.json`` beside
-    the file. Shot names lose their image extension (``DJI_0001.JPG`` → ``DJI_0001``).
+    A FeatureCollection with ``world_crs`` and per feature the properties ``filename``,
+    ``camera``, ``xyz`` (in ``world_crs``) and ``opk`` (PATB ω, φ, κ in **radians**); the point
+    geometry (WGS 84 lon/lat) is not used. ``crs`` overrides ``world_crs`` (with a warning when
+    they differ).
     """
     path = Path(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(path.read_text(encoding="utf-8-sig"))
+        features = data["features"]
     except Exception as exc:
-        raise InputError(f"Cannot read the OpenSfM reconstruction '{path}': {exc}") from exc
-    recs = data if isinstance(data, list) else [data]
-    if reconstruction is not None:
-        if not 0 <= reconstruction < len(recs):
-            raise InputError(f"'{path}' has {len(recs)} reconstruction(s), not #{reconstruction}.")
-        recs = [recs[reconstruction]]
+        raise InputError(f"'{path}' is not orthority's exterior GeoJSON: {exc}") from exc
     warnings: List[str] = []
-    block: Optional[ImportedBlock] = None
-    seen: Dict[str, str] = {}
-    for rec in recs:
-        if not isinstance(rec, dict) or "shots" not in rec or "cameras" not in rec:
-            raise InputError(f"'{path}' is not an OpenSfM reconstruction (no cameras/shots).")
-        lla = rec.get("reference_lla")
-        if lla is None:
-            side = path.with_name("reference_lla.json")
-            if not side.is_file():
-                raise InputError(
-                    f"'{path}' has no reference_lla and there is no reference_lla.json beside "
-                    "it; the topocentric coordinates cannot be georeferenced."
-                )
-            lla = json.loads(side.read_text(encoding="utf-8"))
-        ref = (float(lla["latitude"]), float(lla["longitude"]), float(lla["altitude"]))
-        if block is None:
-            target = normalise_crs(crs) if crs else utm_crs_of(ref[0], ref[1])
-            block = ImportedBlock(crs=target, warnings=warnings)
-        assert block.crs is not None
-        target_crs = block.crs
-        for cam_name, cam in rec["cameras"].items():
-            if cam_name not in block.cameras:
-                block.cameras[cam_name] = _opensfm_camera(cam_name, cam)
-        for shot_name, shot in rec["shots"].items():
-            pose = opensfm_to_patb(shot["rotation"], shot["translation"])
-            eo = transform_pose(pose, lambda p, r=ref, c=target_crs: enu_to_crs(p, r, c))
-            name = _stem(shot_name)
-            if name in seen:
-                raise InputError(f"'{path}': image '{name}' appears in two reconstructions.")
-            seen[name] = shot_name
-            block.images.append(ImportedImage(name=name, eo=eo, camera=str(shot["camera"]),
-                                              source_name=shot_name))
-    if block is None or not block.images:
-        raise InputError(f"'{path}' holds no oriented images.")
+    world = data.get("world_crs")
+    target = normalise_crs(crs) if crs else (normalise_crs(world) if world else None)
+    if crs and world and not same_crs(target, normalise_crs(world)):
+        warnings.append(f"The CRS parameter differs from world_crs of '{path.name}'; "
+                        "the parameter is used.")
+    block = ImportedBlock(crs=target, warnings=warnings)
+    for n, feature in enumerate(features, start=1):
+        try:
+            props = feature["properties"]
+            name = str(props["filename"])
+            values = [*(float(v) for v in props["xyz"]), *(float(v) for v in props["opk"])]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"'{path}' feature {n}: needs filename, xyz and opk ({exc}).") from exc
+        block.images.append(_opk_image(name, [str(v) for v in values], "radians",
+                                       f"'{path}' feature {n}", props.get("camera")))
+    if not block.images:
+        raise InputError(f"'{path}' holds no exterior orientation features.")
     return block
 
 
 # -- detection and project assembly --------------------------------------------------------------
 def detect_exterior_format(path: PathLike) -> str:
-    """``"opensfm"``, ``"csv"`` or ``"text"`` from the extension and the first lines."""
+    """``"opensfm"``, ``"oty"``, ``"csv"`` or ``"text"`` from the extension and the first lines.
+
+    A folder is an ODM project or OpenSfM folder (``"opensfm"``); a JSON object with
+    ``"features"`` is orthority's exterior GeoJSON (``"oty"``).
+    """
     path = Path(path)
-    if path.suffix.lower() == ".json":
+    if path.is_dir():
         return "opensfm"
     with open(path, encoding="utf-8-sig", errors="replace") as f:
         head = f.read(4096)
-    if head.lstrip().startswith(("[", "{")):
-        return "opensfm"
+    if path.suffix.lower() in (".json", ".geojson") or head.lstrip().startswith(("[", "{")):
+        return "oty" if '"FeatureCollection"' in head or '"features"' in head else "opensfm"
     for line in head.splitlines():
         if line.strip() and not line.lstrip().startswith("#"):
             quoted = '"' in line or "'" in line  # orthority's quoted, space-separated CSV
@@ -590,11 +332,14 @@ def read_exterior(path: PathLike, *, angle_unit: Optional[str] = None,
                   crs: Optional[str] = None) -> ImportedBlock:
     """Read any supported exterior-orientation file (format from :func:`detect_exterior_format`).
 
-    ``angle_unit`` is required for OPK files and ignored for OpenSfM.
+    ``angle_unit`` is required for OPK files and ignored for OpenSfM/ODM and orthority's GeoJSON
+    (radians by definition).
     """
     kind = detect_exterior_format(path)
     if kind == "opensfm":
         return read_opensfm(path, crs=crs)
+    if kind == "oty":
+        return read_oty_geojson(path, crs=crs)
     if angle_unit is None:
         raise InputError("The angle unit of OPK files must be given (degrees, gon or radians).")
     reader = read_opk_csv if kind == "csv" else read_opk_text
@@ -621,7 +366,8 @@ def import_project(
         Folder with the image files; names in the exterior file are matched with or without
         extension (:data:`IMAGE_EXTENSIONS`).
     exterior : path
-        OPK CSV, OPK text or OpenSfM ``reconstruction.json``.
+        OPK CSV, OPK text, orthority's exterior GeoJSON, an OpenSfM/ODM reconstruction or an
+        ODM project / ``opensfm`` folder (:func:`.importers_opensfm.read_opensfm`).
     interior : path, optional
         Orthority camera YAML; required for OPK files, optional for OpenSfM (its cameras win).
     crs : str, optional
@@ -690,6 +436,7 @@ __all__ = [
     "read_opensfm",
     "read_opk_csv",
     "read_opk_text",
+    "read_oty_geojson",
     "transform_pose",
     "utm_crs_of",
 ]
