@@ -204,3 +204,18 @@ def test_odm_errors(tmp_path: Path) -> None:
     rec.write_text(json.dumps([{"cameras": {}, "shots": {}}]))
     with pytest.raises(InputError, match="reference_lla"):
         read_opensfm(rec)
+
+
+def test_older_odm_model_geo_file_without_topocentric_file(tilted: Project, tmp_path: Path
+                                                           ) -> None:
+    """Older ODM: the CRS and offset in odm_georeferencing_model_geo.txt; an archive without
+    reconstruction.topocentric.json: the GPS positions decide, the offset comes from the file."""
+    root = write_odm(tilted, tmp_path / "odm")
+    geo = root / "odm_georeferencing"
+    (geo / "coords.txt").rename(geo / "odm_georeferencing_model_geo.txt")
+    (root / "opensfm" / "reconstruction.topocentric.json").unlink()
+    block = read_opensfm(root, crs=tilted.crs)
+    assert block.checks["frame"] == FRAME_ODM_UTM
+    assert "odm_georeferencing_model_geo.txt" in block.warnings[0]
+    dist, angle = worst(block.images, tilted)
+    assert dist < CM and angle < ARCSEC
