@@ -85,8 +85,9 @@ def _centres(project: Project) -> np.ndarray:
     return np.array([rec.eo.position for rec in project.images], dtype=float)
 
 
-def _shot(eo: ExteriorOrientation, camera: str, gps: Sequence[float]) -> Dict[str, Any]:
-    rotation, translation = eo.to_opensfm()
+def _shot(eo: Any, camera: str, gps: Sequence[float]) -> Dict[str, Any]:
+    """A shot from a pose (:class:`ExteriorOrientation` or OpenSfM's (rotation, translation))."""
+    rotation, translation = eo.to_opensfm() if isinstance(eo, ExteriorOrientation) else eo
     return {"rotation": rotation.tolist(), "translation": translation.tolist(),
             "camera": camera, "orientation": 1, "capture_time": 0.0,
             "gps_position": [float(v) for v in gps], "gps_dop": 0.05}
@@ -98,7 +99,7 @@ def _topocentric_poses(project: Project, reference: LLA) -> Dict[str, ExteriorOr
             for rec in project.images}
 
 
-def _reconstruction(project: Project, poses: Dict[str, ExteriorOrientation],
+def _reconstruction(project: Project, poses: Dict[str, Any],
                     gps: Dict[str, np.ndarray], reference: LLA) -> list:
     """One OpenSfM reconstruction (as a one-element list) of the project's images."""
     shots = {rec.path.rsplit("/", 1)[-1] if rec.path else rec.name:
@@ -175,7 +176,7 @@ def write_odm(project: Project, folder: PathLike) -> Path:
     poses = _topocentric_poses(project, ref)
     gps = {name: eo.position for name, eo in poses.items()}
     A, b = odm_affine(ref, georef)
-    utm = {name: enu_to_odm_utm(eo, A, b) for name, eo in poses.items()}
+    utm = {name: enu_to_odm_utm(eo, A, b) for name, eo in poses.items()}  # (rotation, t)
     centres = enu_to_crs(np.array([eo.position for eo in poses.values()]), ref, georef.crs)
     with staged_folder(folder, product=PRODUCT) as tmp:
         osfm = tmp / "opensfm"

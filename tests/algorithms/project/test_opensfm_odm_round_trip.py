@@ -17,7 +17,12 @@ import pyproj
 import pytest
 
 from photodem.algorithms.errors import InputError
-from photodem.algorithms.geometry.orientation import ExteriorOrientation, opk_to_matrix
+from photodem.algorithms.geometry.orientation import (
+    ExteriorOrientation,
+    matrix_to_axis_angle,
+    opensfm_to_patb,
+    opk_to_matrix,
+)
 from photodem.algorithms.project.exporters import write_odm, write_opensfm, write_orthority
 from photodem.algorithms.project.importers import (
     detect_exterior_format,
@@ -27,7 +32,13 @@ from photodem.algorithms.project.importers import (
 from photodem.algorithms.project.importers_opensfm import (
     FRAME_ODM_UTM,
     FRAME_TOPOCENTRIC,
+    OdmGeoref,
+    eigen_angle_axis,
+    enu_to_crs,
+    enu_to_odm_utm,
     locate_opensfm,
+    odm_affine,
+    odm_utm_to_enu,
     parse_odm_coords,
 )
 from photodem.algorithms.project.model import Project
@@ -219,3 +230,39 @@ def test_older_odm_model_geo_file_without_topocentric_file(tilted: Project, tmp_
     assert "odm_georeferencing_model_geo.txt" in block.warnings[0]
     dist, angle = worst(block.images, tilted)
     assert dist < CM and angle < ARCSEC
+
+
+ANGLES = [(0.0, 0.0, 0.0), (180.0, 0.0, 0.0), (30.0, 5.0, 70.0), (-20.0, 25.0, -150.0),
+          (10.0, -35.0, 120.0), (179.0, 1.0, 3.0), (0.0, 0.0, 180.0), (90.0, 0.0, 0.0)]
+
+
+def test_eigen_angle_axis_of_rotations_is_the_axis_angle() -> None:
+    for angles in ANGLES:  # both of Eigen's branches: trace > 0 and the largest diagonal
+        R = opk_to_matrix(*angles)
+        got, want = eigen_angle_axis(R), matrix_to_axis_angle(R)
+        assert rotation_angle(opk_to_matrix(0, 0, 0), R) == pytest.approx(np.linalg.norm(got))
+        if np.linalg.norm(want) < math.pi - 1e-6:  # at 180° ±axis are the same rotation
+            np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+@pytest.mark.parametrize("easting", [500000.0, 585000.0])
+def test_odm_pose_model_inverts_exactly_far_from_the_reference(easting: float) -> None:
+    """ODM's pose of a camera 1 km from the reference is inverted to 1e-6 m and 1e-6″; as ODM's
+    own tools read it (no scale factor), it lies 0.35–0.44 m off on and near the central
+    meridian."""
+    crs = "EPSG:32632"
+    lon, lat = pyproj.Transformer.from_crs(crs, "EPSG:4326", always_xy=True).transform(
+        easting, 5674700.0)
+    ref = (lat, lon, 0.0)
+    georef = OdmGeoref(crs, (easting, 5674700.0), "test")
+    A, b = odm_affine(ref, georef)
+    for i, angles in enumerate(ANGLES):
+        eo = ExteriorOrientation.from_opk([700.0 - 300 * i, 700.0, 120.0], *angles)
+        rotation, translation = enu_to_odm_utm(eo, A, b)
+        back = odm_utm_to_enu(rotation, translation, A, b)
+        assert np.abs(back.position - eo.position).max() < 1e-6
+        assert rotation_angle(back.rotation, eo.rotation) < 1e-6 * ARCSEC
+    eo = ExteriorOrientation.from_opk([707.0, 707.0, 120.0], 5.0, -3.0, 40.0)
+    as_odm = opensfm_to_patb(*enu_to_odm_utm(eo, A, b)).position + (*georef.offset, 0.0)
+    gap = np.linalg.norm((enu_to_crs(eo.position, ref, crs) - as_odm)[:2])
+    assert 0.3 < gap < 0.5
