@@ -427,6 +427,22 @@ class _Reading:
     linear_gap: float = 0.0  # largest distance between ODM's reading and the exact centres
 
 
+def _shot_pose(shot: Any, name: str, path: Path
+               ) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A shot's ``rotation`` and ``translation`` (3 numbers each), checked."""
+    try:
+        rotation = np.asarray(shot["rotation"], dtype=float).reshape(3)
+        translation = np.asarray(shot["translation"], dtype=float).reshape(3)
+        str(shot["camera"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"'{path}': shot '{name}' needs rotation, translation (3 numbers each) "
+                         f"and camera ({exc}).") from exc
+    if not (np.isfinite(rotation).all() and np.isfinite(translation).all()):
+        raise InputError(f"'{path}': shot '{name}' has a rotation or translation that is not "
+                         "a finite number.")
+    return rotation, translation
+
+
 def _read_shots(recs: List[Dict[str, Any]], path: Path, frame: str, target: str,
                 georef: Optional[OdmGeoref]) -> _Reading:
     """All shots of ``recs`` read in ``frame`` and converted to ``target``."""
@@ -437,12 +453,13 @@ def _read_shots(recs: List[Dict[str, Any]], path: Path, frame: str, target: str,
         to_target = functools.partial(enu_to_crs, reference_lla=ref, crs=target)
         affine = odm_affine(ref, georef) if frame == FRAME_ODM_UTM and georef else None
         for shot_name, shot in rec["shots"].items():
-            pose = opensfm_to_patb(shot["rotation"], shot["translation"])
+            rotation, translation = _shot_pose(shot, shot_name, path)
+            pose = opensfm_to_patb(rotation, translation)
             if affine is not None:
                 assert georef is not None
                 # where ODM's own tools put the camera: the file's centre plus the offset
                 linear = pose.position + (georef.offset[0], georef.offset[1], 0.0)
-                pose = odm_utm_to_enu(shot["rotation"], shot["translation"], *affine)
+                pose = odm_utm_to_enu(rotation, translation, *affine)
             eo = transform_pose(pose, to_target)
             if affine is not None:
                 exact = enu_to_crs(pose.position, ref, georef.crs)

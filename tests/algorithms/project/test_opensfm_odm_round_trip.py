@@ -266,3 +266,12 @@ def test_odm_pose_model_inverts_exactly_far_from_the_reference(easting: float) -
     as_odm = opensfm_to_patb(*enu_to_odm_utm(eo, A, b)).position + (*georef.offset, 0.0)
     gap = np.linalg.norm((enu_to_crs(eo.position, ref, crs) - as_odm)[:2])
     assert 0.3 < gap < 0.5
+
+
+def test_bad_shot_is_an_input_error(tmp_path: Path) -> None:
+    lla = {"latitude": 51.0, "longitude": 9.0, "altitude": 100.0}
+    rec = tmp_path / "reconstruction.json"
+    rec.write_text(json.dumps([{"cameras": {}, "reference_lla": lla,
+                                "shots": {"a.jpg": {"rotation": [0, 0], "camera": "c"}}}]))
+    with pytest.raises(InputError, match=r"shot 'a\.jpg' needs rotation"):
+        read_opensfm(rec)
