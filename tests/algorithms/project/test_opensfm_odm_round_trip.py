@@ -275,3 +275,43 @@ def test_bad_shot_is_an_input_error(tmp_path: Path) -> None:
                                 "shots": {"a.jpg": {"rotation": [0, 0], "camera": "c"}}}]))
     with pytest.raises(InputError, match=r"shot 'a\.jpg' needs rotation"):
         read_opensfm(rec)
+
+
+def _orthority_param_io():
+    return pytest.importorskip("orthority.param_io",
+                               reason="orthority is not installed (make .venv-bench)")
+
+
+def _max_differences(ext: dict, truth: Project):
+    """Largest centre distance (m) and ω/φ/κ difference (rad, wrapped) of orthority's
+    exterior parameters against the truth."""
+    by_name = {rec.name: rec.eo for rec in truth.images}
+    dist = max(float(np.linalg.norm(np.subtract(e["xyz"], by_name[Path(k).stem].position)))
+               for k, e in ext.items())
+    angle = max(float(np.abs((np.subtract(e["opk"], by_name[Path(k).stem].opk("radians"))
+                              + math.pi) % (2 * math.pi) - math.pi).max()) for k, e in ext.items())
+    return dist, angle
+
+
+def test_orthority_reads_our_orthority_files_as_we_do(tilted: Project, tmp_path: Path) -> None:
+    param_io = _orthority_param_io()
+    files = write_orthority(tilted, tmp_path / "oty")
+    for ext in (param_io.OtyReader(files["geojson"]).read_ext_param(),
+                param_io.CsvReader(files["csv"], crs=tilted.crs).read_ext_param()):
+        dist, angle = _max_differences(ext, tilted)
+        assert dist < 1e-9 and angle < 1e-12
+    cams = param_io.read_oty_int_param(files["yaml"])
+    for name, cam in tilted.cameras.items():
+        assert cams[name]["focal_len"] == cam.focal_length
+        assert tuple(cams[name]["im_size"]) == (cam.width, cam.height)
+
+
+def test_orthority_reads_our_odm_file_as_odm_does(tilted: Project, tmp_path: Path) -> None:
+    """orthority adds reconstruction.json's coordinates to reference_lla's UTM position: right
+    for ODM's grid-aligned file (as ODM's own tools read it), not for a topocentric one."""
+    param_io = _orthority_param_io()
+    root = write_odm(tilted, tmp_path / "odm")
+    reader = param_io.OsfmReader(root / "opensfm" / "reconstruction.json", crs="EPSG:32632")
+    dist, angle = _max_differences(reader.read_ext_param(), tilted)
+    block = read_opensfm(root)
+    assert dist < block.checks["odm_linear_gap_m"] + 1e-3 and angle < 2 * ARCSEC
