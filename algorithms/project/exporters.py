@@ -165,7 +165,8 @@ def _coords_text(georef: OdmGeoref, centres_odm: np.ndarray) -> str:
 
 
 def write_odm(project: Project, folder: PathLike) -> Path:
-    """An ODM project folder as ODM leaves it after its OpenSfM stage (see module notes).
+    """An ODM project folder as ODM leaves it after its OpenSfM stage (see module notes); the
+    images are not copied (put them in ``images/`` for an import).
 
     Returns
     -------

@@ -290,7 +290,7 @@ def parse_odm_coords(path: PathLike) -> OdmGeoref:
                 raise ValueError(head[2])
             crs = f"EPSG:{(32600 if hemi == 'N' else 32700) + zone}"
         else:
-            crs = normalise_crs(lines[0])
+            crs = normalise_crs(lines[0].strip("'"))  # ODM allows a quoted PROJ string
         x_off, y_off = (float(v) for v in lines[1].split()[:2])
     except (ValueError, IndexError) as exc:
         raise InputError(

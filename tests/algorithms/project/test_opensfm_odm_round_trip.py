@@ -208,8 +208,10 @@ def test_odm_errors(tmp_path: Path) -> None:
     coords.write_text("WGS84 UTM 99X\n1 2\n")
     with pytest.raises(InputError, match="WGS84 UTM"):
         parse_odm_coords(coords)
-    coords.write_text("EPSG:32633\n440143 4588391\n")
-    assert parse_odm_coords(coords).offset == (440143.0, 4588391.0)
+    coords.write_text("'+proj=utm +zone=33 +datum=WGS84 +units=m +no_defs'\n440143 4588391\n")
+    georef = parse_odm_coords(coords)
+    assert georef.offset == (440143.0, 4588391.0)
+    assert pyproj.CRS(georef.crs).to_epsg(min_confidence=70) == 32633
     rec = tmp_path / "osfm" / "reconstruction.json"
     rec.parent.mkdir()
     rec.write_text(json.dumps([{"cameras": {}, "shots": {}}]))
