@@ -14,9 +14,9 @@
             <translation>Projekt</translation>
         </message>
         <message>
-            <source>Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their orientation: an OPK CSV or text file with the camera YAML (orthority format), or an OpenSfM/ODM reconstruction.json. The block is validated and its stereo models are detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first).</source>
+            <source>Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their orientation: an OPK CSV or text file with the camera YAML (orthority format), orthority's exterior GeoJSON, or an OpenSfM/ODM reconstruction.json (in an ODM project: opensfm/reconstruction.json; its frame is read from ODM's georeferencing files and checked against the GPS positions). The block is validated and its stereo models are detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first).</source>
             <extracomment>project_create: help</extracomment>
-            <translation>Legt ein PhotoDEM-Projekt (project.toml + edits.gpkg) aus einem Bildordner und der Orientierung der Bilder an: eine OPK-CSV- oder Textdatei mit der Kamera-YAML (Orthority-Format) oder eine OpenSfM/ODM-reconstruction.json. Der Bildverband wird geprüft und seine Stereomodelle werden bestimmt (Überlappung ≥ 25 %, B/H 0,2–1,2, Nachbarn im selben Streifen zuerst).</translation>
+            <translation>Legt ein PhotoDEM-Projekt (project.toml + edits.gpkg) aus einem Bildordner und der Orientierung der Bilder an: eine OPK-CSV- oder Textdatei mit der Kamera-YAML (Orthority-Format), die Außenorientierungs-GeoJSON von Orthority oder eine OpenSfM/ODM-reconstruction.json (in einem ODM-Projekt: opensfm/reconstruction.json; ihr Bezugssystem wird aus den Georeferenzierungsdateien von ODM gelesen und gegen die GPS-Positionen geprüft). Der Bildverband wird geprüft und seine Stereomodelle werden bestimmt (Überlappung ≥ 25 %, B/H 0,2–1,2, Nachbarn im selben Streifen zuerst).</translation>
         </message>
         <message>
             <source>Images folder</source>
@@ -24,9 +24,9 @@
             <translation>Bildordner</translation>
         </message>
         <message>
-            <source>Exterior orientation (OPK CSV/text or reconstruction.json)</source>
+            <source>Exterior orientation (OPK CSV/text, GeoJSON or reconstruction.json)</source>
             <extracomment>project_create.exterior: description</extracomment>
-            <translation>Äußere Orientierung (OPK-CSV/-Text oder reconstruction.json)</translation>
+            <translation>Äußere Orientierung (OPK-CSV/-Text, GeoJSON oder reconstruction.json)</translation>
         </message>
         <message>
             <source>x, y, z in the project CRS; omega, phi, kappa PATB (camera to world).</source>
@@ -5069,6 +5069,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their orientation: an OPK CSV or text file with the camera YAML (orthority format), or an OpenSfM/ODM reconstruction.json. The block is validated and its stereo models are detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first).</source>
+            <translation type="vanished">Legt ein PhotoDEM-Projekt (project.toml + edits.gpkg) aus einem Bildordner und der Orientierung der Bilder an: eine OPK-CSV- oder Textdatei mit der Kamera-YAML (Orthority-Format) oder eine OpenSfM/ODM-reconstruction.json. Der Bildverband wird geprüft und seine Stereomodelle werden bestimmt (Überlappung ≥ 25 %, B/H 0,2–1,2, Nachbarn im selben Streifen zuerst).</translation>
+        </message>
+        <message>
+            <source>Exterior orientation (OPK CSV/text or reconstruction.json)</source>
+            <translation type="vanished">Äußere Orientierung (OPK-CSV/-Text oder reconstruction.json)</translation>
         </message>
         <message>
             <source>Lists a project's CRS, images (position, angles in degrees, whether the file exists), cameras and stereo models (B/H, overlap %, GSD, flying height above ground), and the result of its validation. Validation warnings and errors are reported; a project with errors (a CRS PROJ does not know, no images, missing image files…) ends with an error naming the first of them.</source>

@@ -18,14 +18,18 @@ class ProjectCreate(Algorithm):
     group_id = "project"
     help = (
         "Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their "
-        "orientation: an OPK CSV or text file with the camera YAML (orthority format), or an "
-        "OpenSfM/ODM reconstruction.json. The block is validated and its stereo models are "
+        "orientation: an OPK CSV or text file with the camera YAML (orthority format), "
+        "orthority's exterior GeoJSON, or an OpenSfM/ODM reconstruction.json (in an ODM "
+        "project: opensfm/reconstruction.json; its frame is read from ODM's georeferencing "
+        "files and checked against the GPS positions). The block is validated and its stereo "
+        "models are "
         "detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first)."
     )
     parameters = (
         Parameter("images", "folder", "Images folder"),
-        Parameter("exterior", "file", "Exterior orientation (OPK CSV/text or reconstruction.json)",
-                  extensions=(".csv", ".txt", ".json", ".opk"),
+        Parameter("exterior", "file", "Exterior orientation (OPK CSV/text, GeoJSON or "
+                  "reconstruction.json)",
+                  extensions=(".csv", ".txt", ".json", ".geojson", ".opk"),
                   help="x, y, z in the project CRS; omega, phi, kappa PATB (camera to world)."),
         Parameter("interior", "file", "Interior orientation (camera YAML)", optional=True,
                   extensions=(".yaml", ".yml"),
