@@ -1,0 +1,152 @@
+"""Tiles of a block product as Dask tasks: one code path for one process and for a cluster.
+
+A tiled product (mosaic, filter) lists its tiles as jobs and hands them with one task function
+to :func:`map_tiles`. The parts every tile needs (seamlines, balancing, a filter's global
+parameters) are computed once by the caller and passed as ``shared``: on a cluster they are
+scattered to every worker once, not pickled into every task. The results come back in the
+order of the jobs, so a product that sums overlapping tiles (a filter's feather) adds them in
+the same order as the single-process run and stays bit-identical to it.
+
+Schedulers (the ``scheduler`` parameter of the tiled algorithms):
+
+``""``
+    No Dask: the tiles run one after the other in this process (as before Dask).
+``"local"``
+    A ``distributed.LocalCluster`` on this machine (one single-threaded worker process per
+    core, at most :data:`LOCAL_WORKERS`), shut down afterwards.
+``"tcp://host:port"``
+    The running Dask scheduler at that address; its workers must see the inputs and the
+    output folder under the same paths (a shared file system).
+
+Memory per task: one tile and its overlap — about ``(tile + 2·overlap)² ×`` the product's
+bytes per cell (:func:`task_bytes`); nothing else grows with the block. The client keeps the
+output open and writes each tile as its turn comes; finished tiles wait on their workers.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
+
+from ..errors import InputError
+from ..feedback import Feedback, ensure_feedback
+
+#: Workers of ``scheduler="local"`` (at most; never more than the cores).
+LOCAL_WORKERS = 4
+
+#: What an operator installs to use a scheduler.
+INSTALL_HINT = 'pip install "photodem[dask]"'
+
+
+def check_scheduler(scheduler: Optional[str]) -> str:
+    """The scheduler text stripped, or an InputError naming the accepted forms."""
+    text = (scheduler or "").strip()
+    if text in ("", "local") or text.startswith(("tcp://", "tls://", "inproc://")):
+        return text
+    raise InputError(f"Scheduler '{text}' is neither empty (this process), 'local' (a Dask "
+                     "cluster on this machine) nor an address such as tcp://host:8786.")
+
+
+def _distributed() -> Any:
+    """The ``distributed`` module, or an InputError saying how to install it."""
+    try:
+        import distributed  # optional: Dask is an extra, the plugin works without it
+    except ImportError as exc:
+        raise InputError("Running tiles on a Dask scheduler needs Dask distributed: "
+                         f"{INSTALL_HINT}") from exc
+    return distributed
+
+
+@contextmanager
+def dask_client(scheduler: str, feedback: Optional[Feedback] = None) -> Iterator[Any]:
+    """A ``distributed.Client`` for ``scheduler`` (``"local"`` or an address), closed after.
+
+    A LocalCluster made here is shut down on leaving; a remote scheduler is left running.
+    The dashboard link is reported.
+    """
+    fb = ensure_feedback(feedback)
+    dist = _distributed()
+    cluster = None
+    try:
+        if scheduler == "local":
+            n = max(1, min(LOCAL_WORKERS, os.cpu_count() or 1))
+            cluster = dist.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                        dashboard_address=":0")
+            client = dist.Client(cluster)
+        else:
+            try:
+                client = dist.Client(scheduler, timeout="20s")
+            except OSError as exc:
+                raise InputError(f"No Dask scheduler answers at {scheduler}: {exc}") from exc
+        fb.info(f"Dask scheduler {client.scheduler.address}, dashboard "
+                f"{client.dashboard_link}.")
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def map_tiles(task: Callable[..., Any], jobs: Sequence[Any], shared: Tuple[Any, ...] = (),
+              scheduler: str = "", feedback: Optional[Feedback] = None
+              ) -> Iterator[Tuple[int, Any]]:
+    """``(index, task(*shared, job))`` for every job, in the order of the jobs.
+
+    Parameters
+    ----------
+    task : callable
+        A module-level function (picklable); it must not write the product itself.
+    jobs : sequence
+        One small, picklable description per tile (e.g. its window).
+    shared : tuple
+        Arguments every task needs, computed once (scattered once to every worker).
+    scheduler : str
+        See the module notes; ``""`` runs the tasks here, one after the other.
+    feedback : Feedback, optional
+        Progress counts finished tiles; cancelling stops submitting and cancels the rest.
+    """
+    fb = ensure_feedback(feedback)
+    scheduler = check_scheduler(scheduler)
+    n = max(len(jobs), 1)
+    if not scheduler:
+        for i, job in enumerate(jobs):
+            fb.check()
+            yield i, task(*shared, job)
+            fb.progress(100.0 * (i + 1) / n)
+        return
+    with dask_client(scheduler, fb) as client:
+        yield from _on_cluster(client, task, jobs, shared, fb)
+
+
+def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
+                shared: Tuple[Any, ...], fb: Feedback) -> Iterator[Tuple[int, Any]]:
+    """:func:`map_tiles` on a client: submit every tile, hand the results back in order."""
+    scattered = [client.scatter(s, broadcast=True) for s in shared]
+    # pure=False: a re-run of the same product recomputes its tiles (inputs may have changed)
+    futures: List[Any] = [client.submit(task, *scattered, job, pure=False, retries=2)
+                          for job in jobs]
+    fb.info(f"{len(futures)} tiles submitted to the Dask cluster.")
+    try:
+        for i in range(len(futures)):
+            fb.check()
+            result = futures[i].result()
+            futures[i] = None  # the worker may drop the tile once we hold it
+            yield i, result
+            fb.progress(100.0 * (i + 1) / max(len(jobs), 1))
+    finally:
+        pending = [f for f in futures if f is not None]
+        if pending:
+            client.cancel(pending)
+
+
+def task_bytes(tile: int, overlap: int, bytes_per_cell: float) -> int:
+    """Memory bound of one tile task: ``(tile + 2·overlap)² × bytes_per_cell`` (bytes)."""
+    side = int(tile) + 2 * int(overlap)
+    return int(side * side * float(bytes_per_cell))
+
+
+__all__ = ["INSTALL_HINT", "LOCAL_WORKERS", "check_scheduler", "dask_client", "map_tiles",
+           "task_bytes"]
