@@ -21,4 +21,14 @@ def scheduler_parameter() -> Parameter:
              "same; needs pip install \"photodem[dask]\".")
 
 
-__all__ = ["scheduler_parameter"]
+def tile_parameter() -> Parameter:
+    """The filters' ``tile`` parameter: side of a tile including its overlap (cells)."""
+    return Parameter(
+        "tile", "integer", "Tile size [cells]", optional=True, minimum=256, maximum=16384,
+        unit="cells",
+        help="Larger DSMs are filtered in overlapping tiles of at most this many cells a side "
+             "(overlap included; the filter's reach). Default 4096; memory about 150 bytes "
+             "per cell of a tile.")
+
+
+__all__ = ["scheduler_parameter", "tile_parameter"]
