@@ -457,20 +457,36 @@ class _CompareJob:
     grid: _ComparisonGrid
     area: Optional[_Area]
 
+    @classmethod
+    def of(cls, paths: Tuple[Any, Any, Any, Any], class_field: Optional[str],
+           object_height: float, shift: Optional[Dict[str, Any]], grid: _ComparisonGrid,
+           area: Optional[_Area]) -> _CompareJob:
+        """From ``(dem, reference, classes, dtm)`` (None where not given) and the shift."""
+        dem, ref, classes, dtm = (None if p is None else str(p) for p in paths)
+        return cls(str(dem), str(ref), classes, class_field, dtm, float(object_height),
+                   (shift["dx"], shift["dy"]) if shift else (0.0, 0.0),
+                   shift["dz"] if shift else 0.0, grid, area)
+
+    def sources(self, stack: contextlib.ExitStack, ref: Any, src: Any, fb: Feedback
+                ) -> Tuple[_GridReader, _ClassSource, _ObjectSource]:
+        """The DEM on the comparison grid, the classes and the object classes (open)."""
+        g = self.grid
+        return (_GridReader(stack, src, ref.crs, g.transform, g.width, g.height,
+                            Resampling.bilinear, self.shift),
+                _ClassSource(stack, self.classes, self.class_field, ref, g.transform, g.width,
+                             g.height, fb),
+                _ObjectSource(stack, self.dtm, ref, g.transform, g.width, g.height,
+                              self.object_height))
+
 
 def _window_task(job: _CompareJob, win: Tuple[int, int, int, int]) -> Tuple[Any, ...]:
     """:func:`_window_values` of one window with the rasters opened here (a Dask task)."""
-    g = job.grid
     with contextlib.ExitStack() as stack:
         ref = _open_raster(stack, job.reference, "reference DEM")
         src = _open_raster(stack, job.dem, "DEM")
-        reader = _GridReader(stack, src, ref.crs, g.transform, g.width, g.height,
-                             Resampling.bilinear, job.shift)
-        classes = _ClassSource(stack, job.classes, job.class_field, ref, g.transform, g.width,
-                               g.height, Feedback())
-        objects = _ObjectSource(stack, job.dtm, ref, g.transform, g.width, g.height,
-                                job.object_height)
-        return _window_values(ref, reader, job.dz0, g, (classes, objects), job.area, win)
+        reader, classes, objects = job.sources(stack, ref, src, Feedback())
+        return _window_values(ref, reader, job.dz0, job.grid, (classes, objects), job.area,
+                              win)
 
 
 def _window_values(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
@@ -610,9 +626,7 @@ def compare_dems(
     on_window : callable, optional
         ``on_window(row, col, dz)`` per window (grid rows/cols; NaN outside ``area``).
     scheduler : str
-        ``""`` (windows here), ``"local"`` or ``"tcp://host:port"``: the windows are Dask
-        tasks (read, warp, slope, classes on the workers; memory per task ≈ 60 bytes ×
-        window_size²); statistics, Δh raster and result are the same.
+        ``""`` (here), ``"local"`` or ``"tcp://host:port"``: where the windows run (same result).
     feedback : Feedback, optional
         Progress per window; cancelling raises Cancelled and leaves no difference raster.
 
@@ -632,7 +646,6 @@ def compare_dems(
         Unreadable files, missing CRS, no overlap, no valid heights, missing class attribute.
     """
     fb = ensure_feedback(feedback)
-    scheduler = check_scheduler(scheduler)
     if classes is not None and _vector_kind(classes) and not class_field:
         raise InputError("Class polygons need the attribute that holds the class "
                          "(class_field); give its name.")
@@ -643,26 +656,18 @@ def compare_dems(
         grid, width, height = cg.transform, cg.width, cg.height
         fb.info(f"Comparison grid: {width} × {height} cells of the reference "
                 f"({abs(grid.a):g} × {abs(grid.e):g}), {ref.crs.to_string()}.")
-        shift = None
-        if coregister:
-            shift = _coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
-                                fb.step(0, 10))
-        dem_reader = _GridReader(stack, src, ref.crs, grid, width, height, Resampling.bilinear,
-                                 (shift["dx"], shift["dy"]) if shift else (0.0, 0.0))
-        class_src = _ClassSource(stack, classes, class_field, ref, grid, width, height, fb)
-        obj_src = _ObjectSource(stack, dtm, ref, grid, width, height, object_height)
+        shift = (_coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
+                             fb.step(0, 10)) if coregister else None)
+        zone = _Area(area, cg) if area is not None else None
+        job = _CompareJob.of((dem, reference, classes, dtm), class_field, object_height, shift,
+                             cg, zone)
+        dem_reader, class_src, obj_src = job.sources(stack, ref, src, fb)
         acc = DifferenceAccumulator(memory_budget=memory_budget)
         comp = {"class": CompletenessAccumulator(), "object": CompletenessAccumulator()}
         out_ds = _difference_output(stack, difference_path, ref, cg)
-        zone = _Area(area, cg) if area is not None else None
-        dz0 = shift["dz"] if shift else 0.0
-        job = _CompareJob(
-            str(dem), str(reference), None if classes is None else str(classes), class_field,
-            None if dtm is None else str(dtm), object_height,
-            (shift["dx"], shift["dy"]) if shift else (0.0, 0.0), dz0, cg, zone)
-        n_ref, n_dem = _accumulate(ref, dem_reader, dz0, cg, (class_src, obj_src), out_ds,
+        n_ref, n_dem = _accumulate(ref, dem_reader, job.dz0, cg, (class_src, obj_src), out_ds,
                                    (acc, comp), window_size, (10.0 if coregister else 0.0, fb),
-                                   zone, on_window, (scheduler, job))
+                                   zone, on_window, (check_scheduler(scheduler), job))
         _check_overlap_heights(n_ref, n_dem, acc, dem, reference)
         res = acc.result(flying_height)
 
