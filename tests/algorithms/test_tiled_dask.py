@@ -122,3 +122,35 @@ def test_tiled_dem_compare_on_dask_equals_one_process(tiny_block, dsm_060, clust
         assert one[key] == dask[key], key
     assert np.array_equal(_read(tmp_path / "one" / "difference.tif"),
                           _read(tmp_path / "dask" / "difference.tif"), equal_nan=True)
+
+
+def _crop(src_path: Path, out: Path, rows: slice, cols: slice, dz: float = 0.0,
+          shift: float = 0.0) -> Path:
+    """A part of a DSM (optionally raised by ``dz`` and its grid moved by ``shift`` m)."""
+    with rasterio.open(src_path) as src:
+        z = src.read(1)[rows, cols] + np.float32(dz)
+        t = src.transform * Affine.translation(cols.start or 0, rows.start or 0)
+        prof = src.profile
+    prof.update(width=z.shape[1], height=z.shape[0],
+                transform=Affine.translation(shift, shift) * t)
+    with rasterio.open(out, "w", **prof) as dst:
+        dst.write(z.astype(np.float32), 1)
+    return out
+
+
+@pytest.mark.slow
+def test_tiled_dsm_merge_on_dask_equals_one_process(dsm_060, cluster_address, tmp_path):
+    """Three overlapping DSMs (one on a shifted grid: resampled), 20 tiles of 64 cells with
+    the step rule's halo: the same DSM, counts and seam statistics."""
+    parts = [_crop(dsm_060, tmp_path / "a.tif", slice(0, 200), slice(0, 250)),
+             _crop(dsm_060, tmp_path / "b.tif", slice(100, 307), slice(0, 250), dz=0.05),
+             _crop(dsm_060, tmp_path / "c.tif", slice(0, 307), slice(120, 250), shift=0.3)]
+    base = {"inputs": [str(p) for p in parts], "tile": 64}
+    one = registry.run("dsm_merge", {**base, "output": str(tmp_path / "one.tif")})
+    dask = registry.run("dsm_merge", {**base, "output": str(tmp_path / "dask.tif"),
+                                      "scheduler": cluster_address})
+    assert len(one["seams"]) == 3 and one["seams"] == dask["seams"]
+    assert one["coverage"] == dask["coverage"]
+    for name in ("", "_count"):
+        assert np.array_equal(_read(tmp_path / f"one{name}.tif"),
+                              _read(tmp_path / f"dask{name}.tif"), equal_nan=True)
