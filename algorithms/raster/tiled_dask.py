@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import os
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
@@ -123,23 +123,57 @@ def map_tiles(task: Callable[..., Any], jobs: Sequence[Any], shared: Tuple[Any, 
 
 def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
                 shared: Tuple[Any, ...], fb: Feedback) -> Iterator[Tuple[int, Any]]:
-    """:func:`map_tiles` on a client: submit every tile, hand the results back in order."""
+    """:func:`map_tiles` on a client: a sliding window of tasks, results handed back in order.
+
+    At most :func:`_in_flight` tasks are submitted or waiting to be taken at a time, so
+    finished tiles never pile up on the workers or here beyond that window.
+    """
+    dist = _distributed()
     scattered = [client.scatter(s, broadcast=True) for s in shared]
-    # pure=False: a re-run of the same product recomputes its tiles (inputs may have changed)
-    futures: List[Any] = [client.submit(task, *scattered, job, pure=False, retries=2)
-                          for job in jobs]
-    fb.info(f"{len(futures)} tiles submitted to the Dask cluster.")
+    done = dist.as_completed(with_results=True)
+    index: Dict[Any, int] = {}
+    live: Dict[Any, Any] = {}  # key → future of the tiles not taken yet
+    ready: Dict[int, Any] = {}
+    n, limit = len(jobs), _in_flight(client)
+    submitted = taken = 0
+
+    def submit() -> None:
+        nonlocal submitted
+        # pure=False: a re-run of the product recomputes its tiles (inputs may have changed);
+        # retries: a lost worker's tile runs again elsewhere
+        fut = client.submit(task, *scattered, jobs[submitted], pure=False, retries=2)
+        index[fut.key] = submitted
+        live[fut.key] = fut
+        done.add(fut)
+        submitted += 1
+
+    fb.info(f"{n} tiles for the Dask cluster, at most {limit} at a time.")
     try:
-        for i in range(len(futures)):
+        while submitted < min(n, limit):
+            submit()
+        for fut, result in done:
             fb.check()
-            result = futures[i].result()
-            futures[i] = None  # the worker may drop the tile once we hold it
-            yield i, result
-            fb.progress(100.0 * (i + 1) / max(len(jobs), 1))
-    finally:
-        pending = [f for f in futures if f is not None]
-        if pending:
-            client.cancel(pending)
+            ready[index.pop(fut.key)] = result
+            live.pop(fut.key, None)  # the worker may drop the tile: we hold it now
+            while taken in ready:
+                yield taken, ready.pop(taken)
+                taken += 1
+                fb.progress(100.0 * taken / max(n, 1))
+                if submitted < n:
+                    submit()
+    finally:  # cancelled or failed: the tiles not taken are not computed further
+        done.clear()
+        if live:
+            client.cancel(list(live.values()))
+
+
+def _in_flight(client: Any) -> int:
+    """Tiles submitted at a time: 4 per worker thread (at least 8)."""
+    try:
+        threads = sum(client.nthreads().values())
+    except (OSError, AttributeError, TypeError):
+        threads = 2
+    return max(8, 4 * int(threads))
 
 
 def task_bytes(tile: int, overlap: int, bytes_per_cell: float) -> int:
