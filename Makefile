@@ -12,7 +12,8 @@ export MPLBACKEND ?= Agg
 # Debian packages of tier B: QGIS 3.22 with the core's dependencies from Debian.
 APT_PACKAGES := qgis python3-qgis qgis-providers python3-pyqt5 python3-rasterio python3-fiona \
 	python3-shapely python3-pyproj python3-skimage python3-scipy python3-matplotlib python3-yaml python3-opencv \
-	python3-pytest python3-pytestqt python3-venv qttools5-dev-tools pyqt5-dev-tools
+	python3-pytest python3-pytestqt python3-venv qttools5-dev-tools pyqt5-dev-tools \
+	python3-dask python3-distributed
 
 .PHONY: demo test test-a test-b test-fast gui bench lint zip venv venv-qgis apt clean
 

@@ -134,7 +134,7 @@ from .surface_input import (
     read_filter_input,
     write_filter_outputs,
 )
-from .tiles import MAX_CELLS, filter_in_tiles
+from .tiles import filter_in_tiles, tile_limit
 
 Array = NDArray[Any]
 PathLike = Union[str, Path]
@@ -925,7 +925,7 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
     """
     feedback = ensure_feedback(feedback)
     prm = params or LPParameters()
-    limit = MAX_CELLS if max_cells is None else int(max_cells)
+    limit = tile_limit(max_cells)
     if z.shape[0] * z.shape[1] > limit:
         return _filter_tiled(z, grid, prm, constraints, sigma, limit, feedback)
     obs = _observations(z, prm, constraints, sigma)

@@ -93,7 +93,7 @@ from .surface_input import (
     to_crs,
     write_filter_outputs,
 )
-from .tiles import MAX_CELLS, filter_in_tiles
+from .tiles import filter_in_tiles, tile_limit
 
 PathLike = Union[str, Path]
 Array = NDArray[Any]
@@ -762,7 +762,7 @@ def lowpass_filter(z: Array, spacing: float, params: LowpassParameters,
     if grid is None:
         grid = Grid(Affine(spacing, 0, 0, 0, -spacing, shape[0] * spacing), shape[1], shape[0],
                     spacing)
-    limit = MAX_CELLS if max_cells is None else int(max_cells)
+    limit = tile_limit(max_cells)
     if shape[0] * shape[1] > limit:
         return _filter_tiled(z, spacing, params, constraints, grid, limit, feedback, start)
     cons = constraints if constraints is not None else FilterConstraints.empty(grid)

@@ -15,11 +15,19 @@ ground mask, the weights) come from the tile whose core holds the cell. With an 
 least the filter's reach — the largest window (low-pass) or the correlation reach of the finer
 pyramid levels (linear prediction) — the joined DTM differs from the untiled one by less than
 the DSM noise (tests: tiled vs untiled on a mid-size grid).
+
+On a Dask cluster (:func:`tiling`, the filters' ``scheduler`` parameter) every tile is a task
+(:func:`..raster.tiled_dask.map_tiles`); the tiles' DTMs are joined here in the order of the
+tiles, so the result is bit-identical to the tiled run in one process. The filters' global
+parameters (the blunder height range of the whole DSM) travel inside ``run_tile``.
 """
 
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple
 
 import numpy as np
@@ -27,6 +35,7 @@ from affine import Affine
 from numpy.typing import NDArray
 
 from ..feedback import Feedback, ensure_feedback
+from ..raster.tiled_dask import check_scheduler, map_tiles
 from ..surface.gridding import Grid
 from .surface_input import FilterConstraints, check_ground_points
 
@@ -40,6 +49,42 @@ MAX_CELLS = 4096 * 4096
 ALIGN = 128
 
 Window = Tuple[int, int, int, int]  # r0, r1, c0, c1
+
+
+@dataclass(frozen=True)
+class Tiling:
+    """Where and how large the filters' tiles are for the code inside :func:`tiling`."""
+
+    scheduler: str = ""
+    max_cells: Optional[int] = None
+
+
+_TILING: ContextVar[Optional[Tiling]] = ContextVar("photodem_filter_tiling", default=None)
+
+
+def _current() -> Tiling:
+    """The tiling set by the innermost :func:`tiling` block (none: this process, MAX_CELLS)."""
+    return _TILING.get() or Tiling()
+
+
+@contextmanager
+def tiling(scheduler: Optional[str] = "", tile: Optional[int] = None) -> Iterator[Tiling]:
+    """Filter in tiles of at most ``tile``² cells (default :data:`MAX_CELLS`) on ``scheduler``
+    (``""`` this process, ``"local"`` or ``"tcp://host:port"``: Dask) inside the block."""
+    t = Tiling(check_scheduler(scheduler), None if not tile else int(tile) ** 2)
+    token = _TILING.set(t)
+    try:
+        yield t
+    finally:
+        _TILING.reset(token)
+
+
+def tile_limit(max_cells: Optional[int] = None) -> int:
+    """Cells above which a grid is tiled: ``max_cells``, else :func:`tiling`'s, else
+    :data:`MAX_CELLS`."""
+    if max_cells is not None:
+        return int(max_cells)
+    return _current().max_cells or MAX_CELLS
 
 
 def _splits(n: int, core: int) -> List[Tuple[int, int]]:
@@ -118,6 +163,47 @@ def iter_tiles(shape: Tuple[int, int], max_cells: int, overlap: int
         yield i, pad, core
 
 
+def _run_tile_task(run_tile: Callable[..., Dict[str, Any]],
+                   job: Tuple[Array, Grid, Optional[FilterConstraints]]) -> Dict[str, Any]:
+    """One tile as a Dask task (its messages stay on the worker)."""
+    zt, gt, ct = job
+    return run_tile(zt, gt, ct, Feedback())
+
+
+@dataclass
+class _Join:
+    """The feathered sum of the tiles' DTMs and the cell-wise products of their cores."""
+
+    acc: Array
+    wsum: Array
+    ground: Array
+    disagree: List[Dict[str, Any]]
+    first: Dict[str, Any]
+
+    def add(self, i: int, tile: Tuple[Window, Window], res: Dict[str, Any], grid: Grid,
+            shape: Tuple[int, int], overlap: int) -> None:
+        """Add tile ``i`` (``(padded, core)`` windows) with the filter's result ``res``."""
+        pad, core = tile
+        r0, r1, c0, c1 = pad
+        dtm = np.asarray(res["dtm"], np.float32)
+        wt = feather(pad, shape, overlap)
+        ok = np.isfinite(dtm)
+        self.acc[r0:r1, c0:c1] += np.where(ok, wt * dtm, 0.0)
+        self.wsum[r0:r1, c0:c1] += np.where(ok, wt, 0.0)
+        q0, q1, p0, p1 = core
+        self.ground[q0:q1, p0:p1] = np.asarray(res["ground"], bool)[q0 - r0:q1 - r0,
+                                                                     p0 - c0:p1 - c0]
+        cg = sub_grid(grid, core)
+        for b in res.get("ground_points_disagreeing") or []:
+            if b.get("status") == "outside":
+                continue
+            rr, _ = cg.cell_of(np.array([b["x"]]), np.array([b["y"]]))
+            if rr[0] >= 0:
+                self.disagree.append(b)
+        if i == 0:
+            self.first = {k: v for k, v in res.items() if k not in ("dtm", "ground")}
+
+
 def filter_in_tiles(run_tile: Callable[[Array, Grid, Optional[FilterConstraints], Feedback],
                                        Dict[str, Any]],
                     z: Array, grid: Grid, constraints: Optional[FilterConstraints],
@@ -145,40 +231,33 @@ def filter_in_tiles(run_tile: Callable[[Array, Grid, Optional[FilterConstraints]
     feedback = ensure_feedback(feedback)
     shape = tuple(z.shape)
     tiles = tile_windows(shape, max_cells, overlap)  # type: ignore[arg-type]
-    acc = np.zeros(shape, np.float32)
-    wsum = np.zeros(shape, np.float32)
-    ground = np.zeros(shape, bool)
-    disagree: List[Dict[str, Any]] = []
-    first: Dict[str, Any] = {}
+    join = _Join(np.zeros(shape, np.float32), np.zeros(shape, np.float32),
+                 np.zeros(shape, bool), [], {})
     n = len(tiles)
-    for i, (pad, core) in enumerate(tiles):
-        r0, r1, c0, c1 = pad
-        g = sub_grid(grid, pad)
-        feedback.info(f"Tile {i + 1} of {n}: rows {r0}–{r1}, columns {c0}–{c1}.")
-        res = run_tile(np.array(z[r0:r1, c0:c1], np.float32), g,
-                       sub_constraints(constraints, pad), feedback.step(100.0 * i / n,
-                                                                        100.0 * (i + 1) / n))
-        dtm = np.asarray(res["dtm"], np.float32)
-        wt = feather(pad, shape, overlap)  # type: ignore[arg-type]
-        ok = np.isfinite(dtm)
-        acc[r0:r1, c0:c1] += np.where(ok, wt * dtm, 0.0)
-        wsum[r0:r1, c0:c1] += np.where(ok, wt, 0.0)
-        q0, q1, p0, p1 = core
-        ground[q0:q1, p0:p1] = np.asarray(res["ground"], bool)[q0 - r0:q1 - r0, p0 - c0:p1 - c0]
-        cg = sub_grid(grid, core)
-        for b in res.get("ground_points_disagreeing") or []:
-            if b.get("status") == "outside":
-                continue
-            rr, _ = cg.cell_of(np.array([b["x"]]), np.array([b["y"]]))
-            if rr[0] >= 0:
-                disagree.append(b)
-        if i == 0:
-            first = {k: v for k, v in res.items() if k not in ("dtm", "ground")}
-        del res, dtm
+    scheduler = _current().scheduler
+    if scheduler:
+        jobs = [(np.array(z[p[0]:p[1], p[2]:p[3]], np.float32), sub_grid(grid, p),
+                 sub_constraints(constraints, p)) for p, _ in tiles]
+        feedback.info(f"{n} tiles on the Dask scheduler {scheduler}.")
+        for i, res in map_tiles(_run_tile_task, jobs, (run_tile,), scheduler, feedback):
+            jobs[i] = None  # type: ignore[call-overload]
+            join.add(i, tiles[i], res, grid, shape, overlap)
+    else:
+        for i, (pad, core) in enumerate(tiles):
+            r0, r1, c0, c1 = pad
+            feedback.info(f"Tile {i + 1} of {n}: rows {r0}–{r1}, columns {c0}–{c1}.")
+            res = run_tile(np.array(z[r0:r1, c0:c1], np.float32), sub_grid(grid, pad),
+                           sub_constraints(constraints, pad),
+                           feedback.step(100.0 * i / n, 100.0 * (i + 1) / n))
+            join.add(i, (pad, core), res, grid, shape, overlap)
+            del res
+    acc, wsum, ground, disagree, first = (join.acc, join.wsum, join.ground, join.disagree,
+                                          join.first)
     with np.errstate(invalid="ignore", divide="ignore"):
         dtm_all = np.where(wsum > 0, acc / np.where(wsum > 0, wsum, 1.0), np.nan)
     dtm_all = dtm_all.astype(np.float32)
     del acc, wsum
+    join.acc = join.wsum = np.empty(0, np.float32)
     if constraints is not None and len(constraints.ground_points):
         disagree += [b for b in check_ground_points(dtm_all, grid, constraints.ground_points,
                                                     float("inf"))
@@ -188,5 +267,5 @@ def filter_in_tiles(run_tile: Callable[[Array, Grid, Optional[FilterConstraints]
             "tiles": n, "first": first}
 
 
-__all__ = ["MAX_CELLS", "feather", "filter_in_tiles", "iter_tiles", "sub_constraints",
-           "sub_grid", "tile_windows"]
+__all__ = ["MAX_CELLS", "Tiling", "feather", "filter_in_tiles", "iter_tiles", "sub_constraints",
+           "sub_grid", "tile_limit", "tile_windows", "tiling"]

@@ -45,6 +45,7 @@ Outputs
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import time
@@ -75,6 +76,7 @@ from ..raster.io import (
     overview_factors,
     scratch_folder,
 )
+from ..raster.tiled_dask import check_scheduler, map_tiles
 from . import balance as bal
 from . import seamlines as sl
 from .rectify import orthorectify_image
@@ -413,6 +415,7 @@ class _MosaicPlan:
     corridor: Optional[float]
     min_height: float
     tile: int
+    scheduler: str = ""
 
     @property
     def feather_px(self) -> float:
@@ -473,7 +476,7 @@ def _plan_mosaic(inputs: Sequence[PathLike], output: PathLike, gsd: Optional[flo
         infos, names, infos[0].crs, transform, W, H, s, Path(output), ref_index, seamlines,
         _seam_sources(seamlines, project), 10.0 * s if feather is None else float(feather),
         options["balance"], options["dsm"], options["dtm"], options["corridor"],
-        options["min_height"], options["tile"])
+        options["min_height"], options["tile"], check_scheduler(options.get("scheduler")))
 
 
 def _sample_seam_grid(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, fb: Feedback
@@ -594,34 +597,58 @@ def _mosaic_tile(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, part: _Par
     return data[:, inner[0], inner[1]], alpha[inner]
 
 
+def _mosaic_tile_task(plan: _MosaicPlan, grid: _SeamGrid, part: _Partition, radio: _Radiometry,
+                      bounds: Tuple[int, int, int, int],
+                      srcs: Optional[List[Any]] = None) -> Tuple[Array, Array, int, int]:
+    """One tile of step 4 as a task: bands and alpha in the output type, filled and covered
+    cells. Opens the orthos itself unless ``srcs`` are given (a Dask worker has its own)."""
+    infos, dtype = plan.infos, plan.infos[0].dtype
+    halo = math.ceil(plan.feather_px / 2.0) + 1 if plan.feather_px >= 1.0 else 0
+    counts = _TileCounts()
+    with ExitStack() as stack:
+        if srcs is None:
+            srcs = [stack.enter_context(rasterio.open(i.path)) for i in infos]
+        data, alpha = _mosaic_tile(srcs, plan, grid, part, radio, bounds, halo, counts)
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        lo, hi = _dtype_range(dtype)
+        data = np.clip(np.rint(data), lo, hi)
+    data = np.where(alpha[None], data, 0).astype(dtype)
+    a = np.where(alpha, _alpha_value(dtype), 0).astype(dtype)
+    return data, a, counts.filled, counts.covered
+
+
 def _write_mosaic(srcs: List[Any], plan: _MosaicPlan, grid: _SeamGrid, part: _Partition,
                   radio: _Radiometry, fb: Feedback) -> _TileCounts:
-    """Step 4 of the module notes: the mosaic COG, tile by tile, with overviews and tags."""
+    """Step 4 of the module notes: the mosaic COG, tile by tile, with overviews and tags.
+
+    With ``plan.scheduler`` the tiles are Dask tasks (:mod:`..raster.tiled_dask`): seams and
+    balancing travel once to every worker, each task reads its tile plus halo from the orthos
+    (memory ≈ (tile + 2·halo)² × images touching it × (bands + 1) × 4 bytes), and this
+    process writes the tiles into the staged COG in their order — the same bytes as here.
+    """
     infos, W, H = plan.infos, plan.width, plan.height
-    dtype = infos[0].dtype
-    lo, hi = _dtype_range(dtype)
     nb = len(infos[0].colour)
-    halo = math.ceil(plan.feather_px / 2.0) + 1 if plan.feather_px >= 1.0 else 0
-    prof = gtiff_profile(W, H, nb + 1, dtype, plan.crs, transform=plan.transform, nodata=None)
+    prof = gtiff_profile(W, H, nb + 1, infos[0].dtype, plan.crs, transform=plan.transform,
+                         nodata=None)
     tile = max(int(plan.tile), 64)
-    tiles = [(r, c) for r in range(0, H, tile) for c in range(0, W, tile)]
+    jobs = [(r, min(r + tile, H), c, min(c + tile, W))
+            for r in range(0, H, tile) for c in range(0, W, tile)]
     counts = _TileCounts()
-    tfb = fb.step(30, 95)
+    if plan.scheduler:
+        task: Any = _mosaic_tile_task
+    else:  # here: the orthos are open already
+        task = functools.partial(_mosaic_tile_task, srcs=srcs)
     # a Cloud-Optimised GeoTIFF: the mosaic is the block's deliverable
     with cog_output(plan.output, prof) as (tmp, scratch_prof), \
             open_image(tmp, "w", **scratch_prof) as dst:
-        for t_idx, (r0, c0) in enumerate(tiles):
-            tfb.progress(100.0 * t_idx / len(tiles))
-            r1, c1 = min(r0 + tile, H), min(c0 + tile, W)
-            data, alpha = _mosaic_tile(srcs, plan, grid, part, radio, (r0, r1, c0, c1), halo,
-                                       counts)
-            if np.issubdtype(np.dtype(dtype), np.integer):
-                data = np.clip(np.rint(data), lo, hi)
-            data = np.where(alpha[None], data, 0).astype(dtype)
-            a = np.where(alpha, _alpha_value(dtype), 0).astype(dtype)
+        for i, (data, a, filled, covered) in map_tiles(task, jobs, (plan, grid, part, radio),
+                                                        plan.scheduler, fb.step(30, 95)):
+            r0, r1, c0, c1 = jobs[i]
             win = Window(c0, r0, c1 - c0, r1 - r0)
             dst.write(data, indexes=list(range(1, nb + 1)), window=win)
             dst.write(a, nb + 1, window=win)
+            counts.filled += filled
+            counts.covered += covered
         dst.colorinterp = [*infos[0].colorinterp, ColorInterp.alpha]
         dst.update_tags(PHOTODEM_MOSAIC="1", PHOTODEM_IMAGES=",".join(plan.names),
                         PHOTODEM_GSD=f"{plan.gsd:g}", PHOTODEM_SEAMLINES=part.stats["mode"],
@@ -668,6 +695,7 @@ def mosaic_orthos(
     project: Any = None,
     tile: int = 1024,
     seam_cells: int = 1024,
+    scheduler: str = "",
     feedback: Optional[Feedback] = None,
 ) -> Dict[str, Any]:
     """Mosaic orthos into one raster with seamlines and radiometric balancing.
@@ -702,6 +730,9 @@ def mosaic_orthos(
         Side of the mosaic tiles (cells); bounds the memory.
     seam_cells : int
         Longest side of the seam grid (cells); bounds the memory of seams and balancing.
+    scheduler : str
+        ``""`` (tiles in this process), ``"local"`` or ``"tcp://host:port"``: the tiles as Dask
+        tasks (:mod:`..raster.tiled_dask`); the mosaic is the same bytes either way.
     feedback : Feedback, optional
 
     Returns
@@ -717,6 +748,7 @@ def mosaic_orthos(
     plan = _plan_mosaic(inputs, output, gsd, {
         "seamlines": seamlines, "balance": balance, "feather": feather, "reference": reference,
         "dsm": dsm, "dtm": dtm, "corridor": corridor, "min_height": min_height, "tile": tile,
+        "scheduler": scheduler,
     }, project, fb)
     W, H, s, names = plan.width, plan.height, plan.gsd, plan.names
     paths = sibling_paths(plan.output)
@@ -871,6 +903,7 @@ class MosaicOptions:
     min_height: float = 2.0
     tile: int = 1024
     seam_cells: int = 1024
+    scheduler: str = ""
 
 
 @dataclass

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
@@ -56,6 +57,7 @@ from shapely.ops import transform as shapely_transform
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile, open_image
+from ..raster.tiled_dask import check_scheduler, map_tiles
 from .class_legend import read_class_legend
 from .coregister import nuth_kaab
 from .objects import (
@@ -440,48 +442,113 @@ def _difference_output(stack: contextlib.ExitStack, path: Optional[PathLike], re
     return stack.enter_context(open_image(tmp, "w", **profile))
 
 
+@dataclass
+class _CompareJob:
+    """What a window task on a Dask worker opens itself (paths and options, picklable)."""
+
+    dem: str
+    reference: str
+    classes: Optional[str]
+    class_field: Optional[str]
+    dtm: Optional[str]
+    object_height: float
+    shift: Tuple[float, float]
+    dz0: float
+    grid: _ComparisonGrid
+    area: Optional[_Area]
+
+    @classmethod
+    def of(cls, paths: Tuple[Any, Any, Any, Any], class_field: Optional[str],
+           object_height: float, shift: Optional[Dict[str, Any]], grid: _ComparisonGrid,
+           area: Optional[_Area]) -> _CompareJob:
+        """From ``(dem, reference, classes, dtm)`` (None where not given) and the shift."""
+        dem, ref, classes, dtm = (None if p is None else str(p) for p in paths)
+        return cls(str(dem), str(ref), classes, class_field, dtm, float(object_height),
+                   (shift["dx"], shift["dy"]) if shift else (0.0, 0.0),
+                   shift["dz"] if shift else 0.0, grid, area)
+
+    def sources(self, stack: contextlib.ExitStack, ref: Any, src: Any, fb: Feedback
+                ) -> Tuple[_GridReader, _ClassSource, _ObjectSource]:
+        """The DEM on the comparison grid, the classes and the object classes (open)."""
+        g = self.grid
+        return (_GridReader(stack, src, ref.crs, g.transform, g.width, g.height,
+                            Resampling.bilinear, self.shift),
+                _ClassSource(stack, self.classes, self.class_field, ref, g.transform, g.width,
+                             g.height, fb),
+                _ObjectSource(stack, self.dtm, ref, g.transform, g.width, g.height,
+                              self.object_height))
+
+
+def _window_task(job: _CompareJob, win: Tuple[int, int, int, int]) -> Tuple[Any, ...]:
+    """:func:`_window_values` of one window with the rasters opened here (a Dask task)."""
+    with contextlib.ExitStack() as stack:
+        ref = _open_raster(stack, job.reference, "reference DEM")
+        src = _open_raster(stack, job.dem, "DEM")
+        reader, classes, objects = job.sources(stack, ref, src, Feedback())
+        return _window_values(ref, reader, job.dz0, job.grid, (classes, objects), job.area,
+                              win)
+
+
+def _window_values(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
+                   sources: Tuple[_ClassSource, _ObjectSource], area: Optional[_Area],
+                   win: Tuple[int, int, int, int]) -> Tuple[Any, ...]:
+    """Δh of one window ``(row, col, h, w)``, its groups, the valid reference cells and the
+    numbers of valid reference and DEM heights (cell-wise: no statistics here)."""
+    classes, objects = sources
+    t = grid.transform
+    r, c, h, w = win
+    refp = _read_window(ref, grid.r_off + r - 1, grid.c_off + c - 1, h + 2, w + 2)
+    z_ref = refp[1:-1, 1:-1]
+    z_dem = dem_reader.read(r, c, h, w) + dz0
+    if area is not None:  # outside the area: as if neither DEM had a height there
+        outside = ~area.inside(r, c, h, w)
+        z_ref = np.where(outside, np.nan, z_ref)
+        z_dem[outside] = np.nan
+    groups = {"slope": slope_class_index(_slope_deg(refp, t.a, t.e))}
+    labels = classes.labels(t * Affine.translation(c, r), r, c, h, w)
+    if labels is not None:
+        groups["class"] = labels
+    obj = objects.labels(ref, grid, r, c, h, w)
+    if obj is not None:
+        groups["object"] = obj
+    ref_valid = np.isfinite(z_ref)
+    return (z_dem - z_ref, groups, ref_valid, int(np.count_nonzero(ref_valid)),
+            int(np.count_nonzero(np.isfinite(z_dem))))
+
+
 def _accumulate(ref: Any, dem_reader: _GridReader, dz0: float, grid: _ComparisonGrid,
                 sources: Tuple[_ClassSource, _ObjectSource], out_ds: Any,
                 accs: Tuple[DifferenceAccumulator, Dict[str, CompletenessAccumulator]],
                 window_size: int, progress: Tuple[float, Feedback],
                 area: Optional[_Area] = None,
-                on_window: Optional[WindowHook] = None) -> Tuple[int, int]:
+                on_window: Optional[WindowHook] = None,
+                job: Optional[Tuple[str, _CompareJob]] = None) -> Tuple[int, int]:
     """Feed Δh of every window (with slope, class and object groups) to the accumulators.
 
     Writes Δh. Returns the numbers of valid reference and DEM heights. ``sources`` are the
     class and object-class sources; ``accs`` the statistics and the completeness per grouping
     (``"class"``, ``"object"``); ``progress`` is (the share already done in %, the feedback).
     With ``area`` only its windows are read and cells outside it are empty; ``on_window``
-    receives ``(row, col, dz)`` of every window (grid rows/columns).
+    receives ``(row, col, dz)`` of every window (grid rows/columns). With ``job`` =
+    (scheduler, what to open) the windows are Dask tasks (:mod:`..raster.tiled_dask`); the
+    statistics are still added here, window by window in the same order: the same result.
     """
-    classes, objects = sources
     acc, comp = accs
     base, fb = progress
-    t = grid.transform
     wins = grid.windows(window_size, area.window if area is not None else None)
+    if job is not None and job[0]:
+        results = map_tiles(_window_task, wins, (job[1],), job[0], fb.step(base, 100.0))
+    else:
+        results = ((i, _window_values(ref, dem_reader, dz0, grid, sources, area, win))
+                   for i, win in enumerate(wins))
     n_ref = n_dem = 0
-    for i, (r, c, h, w) in enumerate(wins):
-        refp = _read_window(ref, grid.r_off + r - 1, grid.c_off + c - 1, h + 2, w + 2)
-        z_ref = refp[1:-1, 1:-1]
-        z_dem = dem_reader.read(r, c, h, w) + dz0
-        if area is not None:  # outside the area: as if neither DEM had a height there
-            outside = ~area.inside(r, c, h, w)
-            z_ref = np.where(outside, np.nan, z_ref)
-            z_dem[outside] = np.nan
-        dz = z_dem - z_ref
-        n_ref += int(np.count_nonzero(np.isfinite(z_ref)))
-        n_dem += int(np.count_nonzero(np.isfinite(z_dem)))
-        groups = {"slope": slope_class_index(_slope_deg(refp, t.a, t.e))}
-        labels = classes.labels(t * Affine.translation(c, r), r, c, h, w)
-        if labels is not None:
-            groups["class"] = labels
-        obj = objects.labels(ref, grid, r, c, h, w)
-        if obj is not None:
-            groups["object"] = obj
+    for i, (dz, groups, ref_valid, nr, nd) in results:
+        r, c, h, w = wins[i]
+        n_ref += nr
+        n_dem += nd
         for name in ("class", "object"):
             if name in groups:
-                comp[name].add_labels(dz, groups[name],
-                                      truth_valid=np.isfinite(z_ref))
+                comp[name].add_labels(dz, groups[name], truth_valid=ref_valid)
         acc.add(dz, groups)
         if on_window is not None:
             on_window(r, c, dz)
@@ -522,6 +589,7 @@ def compare_dems(
     object_height: float = OBJECT_HEIGHT,
     area: Any = None,
     on_window: Optional[WindowHook] = None,
+    scheduler: str = "",
     feedback: Optional[Feedback] = None,
 ) -> Dict[str, Any]:
     """Compare a DEM with a reference DEM on the reference grid, window by window.
@@ -557,6 +625,8 @@ def compare_dems(
         Only the cells whose centres lie in it (reference CRS); only its window is read.
     on_window : callable, optional
         ``on_window(row, col, dz)`` per window (grid rows/cols; NaN outside ``area``).
+    scheduler : str
+        ``""`` (here), ``"local"`` or ``"tcp://host:port"``: where the windows run (same result).
     feedback : Feedback, optional
         Progress per window; cancelling raises Cancelled and leaves no difference raster.
 
@@ -586,21 +656,18 @@ def compare_dems(
         grid, width, height = cg.transform, cg.width, cg.height
         fb.info(f"Comparison grid: {width} × {height} cells of the reference "
                 f"({abs(grid.a):g} × {abs(grid.e):g}), {ref.crs.to_string()}.")
-        shift = None
-        if coregister:
-            shift = _coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
-                                fb.step(0, 10))
-        dem_reader = _GridReader(stack, src, ref.crs, grid, width, height, Resampling.bilinear,
-                                 (shift["dx"], shift["dy"]) if shift else (0.0, 0.0))
-        class_src = _ClassSource(stack, classes, class_field, ref, grid, width, height, fb)
-        obj_src = _ObjectSource(stack, dtm, ref, grid, width, height, object_height)
+        shift = (_coregister(stack, src, ref, grid, width, height, stable, coreg_max_cells,
+                             fb.step(0, 10)) if coregister else None)
+        zone = _Area(area, cg) if area is not None else None
+        job = _CompareJob.of((dem, reference, classes, dtm), class_field, object_height, shift,
+                             cg, zone)
+        dem_reader, class_src, obj_src = job.sources(stack, ref, src, fb)
         acc = DifferenceAccumulator(memory_budget=memory_budget)
         comp = {"class": CompletenessAccumulator(), "object": CompletenessAccumulator()}
         out_ds = _difference_output(stack, difference_path, ref, cg)
-        zone = _Area(area, cg) if area is not None else None
-        n_ref, n_dem = _accumulate(ref, dem_reader, shift["dz"] if shift else 0.0, cg,
-                                   (class_src, obj_src), out_ds, (acc, comp), window_size,
-                                   (10.0 if coregister else 0.0, fb), zone, on_window)
+        n_ref, n_dem = _accumulate(ref, dem_reader, job.dz0, cg, (class_src, obj_src), out_ds,
+                                   (acc, comp), window_size, (10.0 if coregister else 0.0, fb),
+                                   zone, on_window, (check_scheduler(scheduler), job))
         _check_overlap_heights(n_ref, n_dem, acc, dem, reference)
         res = acc.result(flying_height)
 

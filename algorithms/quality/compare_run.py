@@ -60,7 +60,8 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
                     classes: Optional[PathLike] = None, class_field: Optional[str] = None,
                     flying_height: Optional[float] = None, dtm: Optional[PathLike] = None,
                     object_height: Optional[float] = None,
-                    class_legend: Optional[PathLike] = None,
+                    class_legend: Optional[PathLike] = None, window_size: int = 1024,
+                    scheduler: str = "",
                     feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Compare a DEM with a reference and write :data:`DEM_COMPARE_FILES` into ``output``.
 
@@ -76,6 +77,8 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
         Names of the codes of a class raster (:func:`.class_legend.read_class_legend`; by
         default the QGIS style beside the raster). The report shows "name (code)"; the
         statistics stay keyed by code, and ``class_names`` maps code → name.
+    window_size, scheduler
+        As :func:`.compare.compare_dems` (tiles, and where they run).
     output : path
         Output folder (an earlier ``dem_compare`` folder there is replaced).
     feedback : Feedback, optional
@@ -96,7 +99,7 @@ def run_dem_compare(dem: PathLike, reference: PathLike, output: PathLike, *,
             class_field=class_field, flying_height=flying_height,
             difference_path=tmp / names["difference"], dtm=dtm,
             object_height=OBJECT_HEIGHT if object_height is None else float(object_height),
-            feedback=feedback.step(0.0, 60.0))
+            window_size=window_size, scheduler=scheduler, feedback=feedback.step(0.0, 60.0))
         if legend:
             result["class_names"] = {k: legend[k] for k in result.get("per_class") or {}
                                      if k in legend}

@@ -52,7 +52,7 @@ import warnings
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import rasterio
@@ -66,6 +66,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..quality.stats import DifferenceAccumulator
 from ..raster.io import atomic_output, cog_output, gtiff_profile, open_image, overview_factors
+from ..raster.tiled_dask import check_scheduler, map_tiles
 from .merge_steps import REF_RADIUS, STEP_M, combine_keeping_steps, step_aware
 
 PathLike = Union[str, Path]
@@ -334,9 +335,9 @@ class _MergeSources:
     pairs: List[Tuple[int, int]]
     step: float = STEP_M
 
-    def window(self, transform: Affine, s: float, r0: int, c0: int, h: int, w: int,
-               accs: Dict[Tuple[int, int], Any]) -> Tuple[Array, Array]:
-        """Merged heights and input count of one output window; feeds the seam statistics.
+    def window(self, transform: Affine, s: float, r0: int, c0: int, h: int, w: int
+               ) -> Tuple[Array, Array, Dict[Tuple[int, int], Array]]:
+        """Merged heights, input count and Δh of every overlapping pair on one window.
 
         The inputs are read with a halo of :data:`.merge_steps.REF_RADIUS` cells (context
         of the step rule at the window's border), so windows join without seams.
@@ -347,7 +348,7 @@ class _MergeSources:
         wb = (wt.c, wt.f - hh * s, wt.c + wh * s, wt.f)
         idx = [j for j, i in enumerate(self.infos) if _overlap(i.bounds, wb)]
         if not idx:
-            return np.full((h, w), np.nan, np.float32), np.zeros((h, w), np.uint16)
+            return np.full((h, w), np.nan, np.float32), np.zeros((h, w), np.uint16), {}
         layers = np.stack([_read_window(self.srcs[j], 1, self.infos[j], self.target, wt,
                                         (hh, wh), rh, ch, self.step) for j in idx])
         sig = None
@@ -357,10 +358,9 @@ class _MergeSources:
         layers = layers[:, g:g + h, g:g + w]
         cnt = np.isfinite(layers).sum(axis=0).astype(np.uint16)
         pos = {j: n for n, j in enumerate(idx)}
-        for a, b in self.pairs:
-            if a in pos and b in pos:
-                accs[(a, b)].add(layers[pos[a]] - layers[pos[b]])
-        return zc, cnt
+        diffs = {(a, b): layers[pos[a]] - layers[pos[b]] for a, b in self.pairs
+                 if a in pos and b in pos}
+        return zc, cnt, diffs
 
     def _sigma(self, j: int, wt: Affine, shape: Tuple[int, int], r0: int, c0: int) -> Array:
         """σ of input ``j`` on the window (NaN when it has none)."""
@@ -385,6 +385,48 @@ def _open_sources(stack: ExitStack, infos: List[_Input], target: Any, mode: str,
             raise InputError(f"The σ raster '{i.sigma_path}' does not have the grid of "
                              f"'{i.path.name}'; give σ on the DSM's grid.")
     return _MergeSources(infos, srcs, sig_srcs, target, mode, n_sigma, pairs, step)
+
+
+@dataclass
+class _MergeJob:
+    """What a window task on a Dask worker opens itself (picklable): inputs and the grid."""
+
+    infos: List[_Input]
+    target: Any
+    mode: str
+    n_sigma: int
+    pairs: List[Tuple[int, int]]
+    step: float
+    transform: Affine
+    spacing: float
+
+
+def _merge_window_task(job: _MergeJob, win: Tuple[int, int, int, int]
+                       ) -> Tuple[Array, Array, Dict[Tuple[int, int], Array]]:
+    """:meth:`_MergeSources.window` of ``win`` = (row, col, h, w), inputs opened here."""
+    with ExitStack() as stack:
+        sources = _open_sources(stack, job.infos, job.target, job.mode, job.n_sigma, job.pairs,
+                                job.step)
+        return sources.window(job.transform, job.spacing, *win)
+
+
+def _merged_windows(sources: _MergeSources, job: _MergeJob, shape: Tuple[int, int], tile: int,
+                    scheduler: str, feedback: Feedback) -> Iterator[Tuple[Any, ...]]:
+    """``(window, heights, count, pair differences)`` of every output window, in order:
+    here, or as Dask tasks on ``scheduler`` (:mod:`..raster.tiled_dask`; memory per task ≈
+    8 · (tile + 2·halo)² · inputs bytes plus tile² · 4 bytes per overlapping pair)."""
+    height, width = shape
+    wins = [(r, c, min(tile, height - r), min(tile, width - c))
+            for r in range(0, height, tile) for c in range(0, width, tile)]
+    if scheduler:
+        results: Iterable[Tuple[int, Any]] = map_tiles(_merge_window_task, wins, (job,),
+                                                       scheduler, feedback.step(0.0, 95.0))
+    else:
+        results = ((i, sources.window(job.transform, job.spacing, *win))
+                   for i, win in enumerate(wins))
+    for i, (zc, cnt, diffs) in results:
+        feedback.progress(95.0 * i / len(wins))
+        yield (wins[i], zc, cnt, diffs)
 
 
 def _seam_records(accs: Dict[Tuple[int, int], Any], infos: List[_Input]) -> List[Dict[str, Any]]:
@@ -426,7 +468,8 @@ def _write_seam_report(tmp_json: PathLike, tmp_csv: PathLike, result: Dict[str, 
 
 def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median",
                spacing: Optional[float] = None, tile: int = 512,
-               feedback: Optional[Feedback] = None, step: float = STEP_M) -> Dict[str, Any]:
+               feedback: Optional[Feedback] = None, step: float = STEP_M,
+               scheduler: str = "") -> Dict[str, Any]:
     """Merge DSMs onto a common grid (see the module notes).
 
     Parameters
@@ -445,6 +488,9 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     step : float
         Height spread (m) of a cell's inputs above which they are treated as different
         surfaces (a wall) and not averaged (module notes "Walls"); 0 = plain median / mean.
+    scheduler : str
+        ``""`` (windows here), ``"local"`` or ``"tcp://host:port"``: the windows as Dask tasks;
+        the seam statistics are still added here in window order (the same result).
 
     Returns
     -------
@@ -454,6 +500,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
         ``cells, covered, coverage, spacing, width, height, mode, sigma_inputs``.
     """
     feedback = ensure_feedback(feedback)
+    scheduler = check_scheduler(scheduler)
     infos, target, out_paths = _checked_inputs(inputs, output, mode, feedback)
     if not step >= 0:
         raise InputError(f"The step threshold must not be negative, got {step}.")
@@ -472,7 +519,7 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
     budget = max(2 ** 20, (64 * 2 ** 20) // max(len(pairs), 1))
     accs = {p: DifferenceAccumulator(memory_budget=budget) for p in pairs}
     tile = max(16, int(tile) // 16 * 16)
-    n_tr, n_tc = math.ceil(height / tile), math.ceil(width / tile)
+    job = _MergeJob(infos, target, mode, n_sigma, pairs, step, transform, s)
     covered = 0
     crs_out = target
     with ExitStack() as stack:
@@ -486,18 +533,14 @@ def merge_dsms(inputs: Sequence[PathLike], output: PathLike, mode: str = "median
         tmp_csv = stack.enter_context(atomic_output(out_paths["csv"]))
         with open_image(tmp_dsm, "w", **dsm_profile) as dst, \
                 open_image(tmp_cnt, "w", **cnt_profile) as cnt_dst:
-            k = 0
-            for tr in range(n_tr):
-                for tc in range(n_tc):
-                    feedback.progress(95.0 * k / (n_tr * n_tc))
-                    k += 1
-                    r0, c0 = tr * tile, tc * tile
-                    h, w = min(tile, height - r0), min(tile, width - c0)
-                    zc, cnt = sources.window(transform, s, r0, c0, h, w, accs)
-                    covered += int(np.isfinite(zc).sum())
-                    win = Window(c0, r0, w, h)
-                    dst.write(zc[None], window=win)
-                    cnt_dst.write(cnt[None], window=win)
+            for (r0, c0, h, w), zc, cnt, diffs in _merged_windows(
+                    sources, job, (height, width), tile, scheduler, feedback):
+                for pair, d in diffs.items():
+                    accs[pair].add(d)
+                covered += int(np.isfinite(zc).sum())
+                win = Window(c0, r0, w, h)
+                dst.write(zc[None], window=win)
+                cnt_dst.write(cnt[None], window=win)
             feedback.progress(96.0)
             _overviews(dst, width, height, Resampling.average)
             _overviews(cnt_dst, width, height, Resampling.nearest)

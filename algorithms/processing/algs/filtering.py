@@ -6,6 +6,7 @@ from typing import Any, Dict
 
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter
+from ..tiled import scheduler_parameter, tile_parameter
 
 # Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
 
@@ -82,6 +83,7 @@ class FilterLowpass(Algorithm):
                   default=False,
                   help="Writes diff_01.tif, diff_02.tif … (DSM − smoothed surface) for "
                        "inspection."),
+        tile_parameter(), scheduler_parameter(),
     )
     outputs = (
         Output("dtm", "raster", "DTM"),
@@ -94,14 +96,16 @@ class FilterLowpass(Algorithm):
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...filtering.lowpass import run_filter_lowpass  # lazy: keeps photodem list fast
+        from ...filtering.tiles import tiling  # lazy: keeps photodem list fast
 
-        return run_filter_lowpass(
-            params["input"], params["output"], preset=params.get("preset") or "default",
-            project=params.get("project"), spacing=params.get("spacing"),
-            crs=params.get("crs") or None,
-            overrides={k: params.get(k) for k in ("max_window", "iterations", "threshold",
-                                                   "slope")},
-            write_iterations=bool(params.get("write_iterations")), feedback=feedback)
+        with tiling(params.get("scheduler"), params.get("tile")):
+            return run_filter_lowpass(
+                params["input"], params["output"], preset=params.get("preset") or "default",
+                project=params.get("project"), spacing=params.get("spacing"),
+                crs=params.get("crs") or None,
+                overrides={k: params.get(k) for k in ("max_window", "iterations", "threshold",
+                                                       "slope")},
+                write_iterations=bool(params.get("write_iterations")), feedback=feedback)
 
 
 class FilterEvaluate(Algorithm):
@@ -199,6 +203,7 @@ class FilterLinearPrediction(Algorithm):
                   help="Cells and points within this of the DTM are labelled ground."),
         Parameter("write_levels", "bool", "Write the DTM of every pyramid level",
                   default=False, help="Writes level_0.tif … level_k.tif for inspection."),
+        tile_parameter(), scheduler_parameter(),
     )
     outputs = (
         Output("dtm", "raster", "DTM"),
@@ -211,17 +216,19 @@ class FilterLinearPrediction(Algorithm):
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
         from ...filtering.linear_prediction import run_filter_linear_prediction
+        from ...filtering.tiles import tiling  # lazy: keeps photodem list fast
 
         overrides = {k: params.get(k) for k in ("coarse_spacing", "cutoff", "half_weight",
                                                  "noise_share", "iterations",
                                                  "ground_tolerance")}
         if params.get("slope") is not None:
             overrides["slope"] = float(params["slope"]) / 100.0  # % → m/m
-        return run_filter_linear_prediction(
-            params["input"], params["output"], preset=params.get("preset") or "default",
-            project=params.get("project"), spacing=params.get("spacing"),
-            crs=params.get("crs") or None, overrides=overrides,
-            write_levels=bool(params.get("write_levels")), feedback=feedback)
+        with tiling(params.get("scheduler"), params.get("tile")):
+            return run_filter_linear_prediction(
+                params["input"], params["output"], preset=params.get("preset") or "default",
+                project=params.get("project"), spacing=params.get("spacing"),
+                crs=params.get("crs") or None, overrides=overrides,
+                write_levels=bool(params.get("write_levels")), feedback=feedback)
 
 
 ALGORITHMS = [FilterLowpass, FilterEvaluate, FilterLinearPrediction]

@@ -9,6 +9,7 @@ from ...errors import InputError
 from ...feedback import Feedback
 from ...project.model import Project
 from ..spec import Algorithm, Output, Parameter, project_product
+from ..tiled import scheduler_parameter
 
 # Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
 
@@ -233,6 +234,7 @@ class Mosaic(Algorithm):
         Parameter("seam_cells", "integer", "Seam grid size [cells]", default=1024,
                   minimum=64, maximum=8192, unit="cells",
                   help="Longest side of the reduced grid for seams and balancing."),
+        scheduler_parameter(),
         Parameter("output", "output_raster", "Mosaic", optional=True, extensions=(".tif",),
                   help="Default: <project>/products/mosaic/mosaic.tif."),
     )
@@ -277,7 +279,8 @@ class Mosaic(Algorithm):
             feather=g("feather"), reference=g("reference") or None,
             corridor=g("corridor") or None,
             min_height=2.0 if g("min_height") is None else params["min_height"],
-            tile=g("tile") or 1024, seam_cells=g("seam_cells") or 1024)
+            tile=g("tile") or 1024, seam_cells=g("seam_cells") or 1024,
+            scheduler=g("scheduler") or "")
         res = run_mosaic(output, sources, options, feedback)
         return {k: res[k] for k in ("mosaic", "seamlines", "report", "gsd", "cells", "seams",
                                     "balance")}

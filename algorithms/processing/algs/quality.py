@@ -8,6 +8,7 @@ from typing import Any, Dict
 from ...feedback import Feedback
 from ...raster.io import staged_folder
 from ..spec import Algorithm, Output, Parameter
+from ..tiled import scheduler_parameter
 
 # Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
 
@@ -66,6 +67,11 @@ class DemCompare(Algorithm):
         Parameter("object_height", "number", "Object height [m]", default=2.5, minimum=0.1,
                   unit="m", help="Height above the DTM from which a reference cell belongs to "
                                  "an object."),
+        Parameter("tile", "integer", "Tile size [cells]", default=1024, minimum=16,
+                  maximum=16384, unit="cells",
+                  help="The comparison grid is processed in tiles of this many cells a side "
+                       "(memory about 60 bytes per cell of a tile)."),
+        scheduler_parameter(),
     )
     outputs = (
         Output("stats", "json", "Statistics of Δh [m]"),
@@ -93,7 +99,8 @@ class DemCompare(Algorithm):
             classes=params.get("classes"), class_field=params.get("class_field"),
             flying_height=params.get("flying_height"), dtm=params.get("dtm"),
             object_height=params.get("object_height"),
-            class_legend=params.get("class_legend"), feedback=feedback)
+            class_legend=params.get("class_legend"), window_size=params.get("tile") or 1024,
+            scheduler=params.get("scheduler") or "", feedback=feedback)
 
 
 class DemProfile(Algorithm):

@@ -7,6 +7,7 @@ from typing import Any, Dict, List, Optional
 
 from ...feedback import Feedback
 from ..spec import Algorithm, Output, Parameter, project_product
+from ..tiled import scheduler_parameter
 
 # Domain modules are imported inside each run(), not here: keeps `photodem list` fast.
 
@@ -47,6 +48,11 @@ class DsmMerge(Algorithm):
         Parameter("step", "number", "Step threshold [m]", default=1.0, minimum=0.0, unit="m",
                   help="Inputs of a cell that differ by more than this see different surfaces "
                        "(a wall): they are not averaged. 0 = plain median / mean."),
+        Parameter("tile", "integer", "Tile size [cells]", default=512, minimum=16,
+                  maximum=16384, unit="cells",
+                  help="The merged DSM is processed in tiles of this many cells a side "
+                       "(memory about 8 bytes per cell and input of a tile)."),
+        scheduler_parameter(),
     )
     outputs = (
         Output("dsm", "raster", "Merged DSM"),
@@ -68,7 +74,8 @@ class DsmMerge(Algorithm):
 
         res = merge_dsms(params["inputs"], params["output"], mode=params.get("mode", "median"),
                          spacing=params.get("spacing") or None, feedback=feedback,
-                         step=float(params.get("step", 1.0)))
+                         step=float(params.get("step", 1.0)), tile=params.get("tile") or 512,
+                         scheduler=params.get("scheduler") or "")
         return {k: res[k] for k in ("dsm", "count", "seams", "report", "csv", "coverage")}
 
 

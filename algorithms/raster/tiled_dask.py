@@ -1,0 +1,186 @@
+"""Tiles of a block product as Dask tasks: one code path for one process and for a cluster.
+
+A tiled product (mosaic, filter) lists its tiles as jobs and hands them with one task function
+to :func:`map_tiles`. The parts every tile needs (seamlines, balancing, a filter's global
+parameters) are computed once by the caller and passed as ``shared``: on a cluster they are
+scattered to every worker once, not pickled into every task. The results come back in the
+order of the jobs, so a product that sums overlapping tiles (a filter's feather) adds them in
+the same order as the single-process run and stays bit-identical to it.
+
+Schedulers (the ``scheduler`` parameter of the tiled algorithms):
+
+``""``
+    No Dask: the tiles run one after the other in this process (as before Dask).
+``"local"``
+    A ``distributed.LocalCluster`` on this machine (one single-threaded worker process per
+    core, at most :data:`LOCAL_WORKERS`), shut down afterwards.
+``"tcp://host:port"``
+    The running Dask scheduler at that address; its workers must see the inputs and the
+    output folder under the same paths (a shared file system).
+
+Memory per task: one tile and its overlap — about ``(tile + 2·overlap)² ×`` the product's
+bytes per cell (:func:`task_bytes`); nothing else grows with the block. The client keeps the
+output open and writes each tile as its turn comes; finished tiles wait on their workers.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
+
+from ..errors import InputError
+from ..feedback import Feedback, ensure_feedback
+
+#: Workers of ``scheduler="local"`` (at most; never more than the cores).
+LOCAL_WORKERS = 4
+
+#: What an operator installs to use a scheduler.
+INSTALL_HINT = 'pip install "photodem[dask]"'
+
+
+def check_scheduler(scheduler: Optional[str]) -> str:
+    """The scheduler text stripped, or an InputError naming the accepted forms."""
+    text = (scheduler or "").strip()
+    if text in ("", "local") or text.startswith(("tcp://", "tls://", "inproc://")):
+        return text
+    raise InputError(f"Scheduler '{text}' is neither empty (this process), 'local' (a Dask "
+                     "cluster on this machine) nor an address such as tcp://host:8786.")
+
+
+def _distributed() -> Any:
+    """The ``distributed`` module, or an InputError saying how to install it."""
+    try:
+        import distributed  # optional: Dask is an extra, the plugin works without it
+    except ImportError as exc:
+        raise InputError("Running tiles on a Dask scheduler needs Dask distributed: "
+                         f"{INSTALL_HINT}") from exc
+    return distributed
+
+
+@contextmanager
+def dask_client(scheduler: str, feedback: Optional[Feedback] = None) -> Iterator[Any]:
+    """A ``distributed.Client`` for ``scheduler`` (``"local"`` or an address), closed after.
+
+    A LocalCluster made here is shut down on leaving; a remote scheduler is left running.
+    The dashboard link is reported.
+    """
+    fb = ensure_feedback(feedback)
+    dist = _distributed()
+    cluster = None
+    try:
+        if scheduler == "local":
+            n = max(1, min(LOCAL_WORKERS, os.cpu_count() or 1))
+            cluster = dist.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                        dashboard_address=":0")
+            client = dist.Client(cluster)
+        else:
+            try:
+                client = dist.Client(scheduler, timeout="20s")
+            except OSError as exc:
+                raise InputError(f"No Dask scheduler answers at {scheduler}: {exc}") from exc
+        fb.info(f"Dask scheduler {client.scheduler.address}, dashboard "
+                f"{client.dashboard_link}.")
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def map_tiles(task: Callable[..., Any], jobs: Sequence[Any], shared: Tuple[Any, ...] = (),
+              scheduler: str = "", feedback: Optional[Feedback] = None
+              ) -> Iterator[Tuple[int, Any]]:
+    """``(index, task(*shared, job))`` for every job, in the order of the jobs.
+
+    Parameters
+    ----------
+    task : callable
+        A module-level function (picklable); it must not write the product itself.
+    jobs : sequence
+        One small, picklable description per tile (e.g. its window).
+    shared : tuple
+        Arguments every task needs, computed once (scattered once to every worker).
+    scheduler : str
+        See the module notes; ``""`` runs the tasks here, one after the other.
+    feedback : Feedback, optional
+        Progress counts finished tiles; cancelling stops submitting and cancels the rest.
+    """
+    fb = ensure_feedback(feedback)
+    scheduler = check_scheduler(scheduler)
+    n = max(len(jobs), 1)
+    if not scheduler:
+        for i, job in enumerate(jobs):
+            fb.check()
+            yield i, task(*shared, job)
+            fb.progress(100.0 * (i + 1) / n)
+        return
+    with dask_client(scheduler, fb) as client:
+        yield from _on_cluster(client, task, jobs, shared, fb)
+
+
+def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
+                shared: Tuple[Any, ...], fb: Feedback) -> Iterator[Tuple[int, Any]]:
+    """:func:`map_tiles` on a client: a sliding window of tasks, results handed back in order.
+
+    At most :func:`_in_flight` tasks are submitted or waiting to be taken at a time, so
+    finished tiles never pile up on the workers or here beyond that window.
+    """
+    dist = _distributed()
+    scattered = [client.scatter(s, broadcast=True) for s in shared]
+    done = dist.as_completed(with_results=True)
+    index: Dict[Any, int] = {}
+    live: Dict[Any, Any] = {}  # key → future of the tiles not taken yet
+    ready: Dict[int, Any] = {}
+    n, limit = len(jobs), _in_flight(client)
+    submitted = taken = 0
+
+    def submit() -> None:
+        nonlocal submitted
+        # pure=False: a re-run of the product recomputes its tiles (inputs may have changed);
+        # retries: a lost worker's tile runs again elsewhere
+        fut = client.submit(task, *scattered, jobs[submitted], pure=False, retries=2)
+        index[fut.key] = submitted
+        live[fut.key] = fut
+        done.add(fut)
+        submitted += 1
+
+    fb.info(f"{n} tiles for the Dask cluster, at most {limit} at a time.")
+    try:
+        while submitted < min(n, limit):
+            submit()
+        for fut, result in done:
+            fb.check()
+            ready[index.pop(fut.key)] = result
+            live.pop(fut.key, None)  # the worker may drop the tile: we hold it now
+            while taken in ready:
+                yield taken, ready.pop(taken)
+                taken += 1
+                fb.progress(100.0 * taken / max(n, 1))
+                if submitted < n:
+                    submit()
+    finally:  # cancelled or failed: the tiles not taken are not computed further
+        done.clear()
+        if live:
+            client.cancel(list(live.values()))
+
+
+def _in_flight(client: Any) -> int:
+    """Tiles submitted at a time: 4 per worker thread (at least 8)."""
+    try:
+        threads = sum(client.nthreads().values())
+    except (OSError, AttributeError, TypeError):
+        threads = 2
+    return max(8, 4 * int(threads))
+
+
+def task_bytes(tile: int, overlap: int, bytes_per_cell: float) -> int:
+    """Memory bound of one tile task: ``(tile + 2·overlap)² × bytes_per_cell`` (bytes)."""
+    side = int(tile) + 2 * int(overlap)
+    return int(side * side * float(bytes_per_cell))
+
+
+__all__ = ["INSTALL_HINT", "LOCAL_WORKERS", "check_scheduler", "dask_client", "map_tiles",
+           "task_bytes"]
