@@ -29,7 +29,7 @@ import os
 from contextlib import contextmanager
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
-from ..errors import InputError
+from ..errors import InputError, PhotodemError
 from ..feedback import Feedback, ensure_feedback
 
 #: Workers of ``scheduler="local"`` (at most; never more than the cores).
@@ -140,8 +140,9 @@ def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
     def submit() -> None:
         nonlocal submitted
         # pure=False: a re-run of the product recomputes its tiles (inputs may have changed);
-        # retries: a lost worker's tile runs again elsewhere
-        fut = client.submit(task, *scattered, jobs[submitted], pure=False, retries=2)
+        # retries: a lost worker's tile runs again elsewhere (operator errors come back as
+        # results, so they are not retried)
+        fut = client.submit(_guarded, task, *scattered, jobs[submitted], pure=False, retries=2)
         index[fut.key] = submitted
         live[fut.key] = fut
         done.add(fut)
@@ -153,6 +154,8 @@ def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
             submit()
         for fut, result in done:
             fb.check()
+            if isinstance(result, _OperatorError):
+                raise result.error
             ready[index.pop(fut.key)] = result
             live.pop(fut.key, None)  # the worker may drop the tile: we hold it now
             while taken in ready:
@@ -165,6 +168,24 @@ def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
         done.clear()
         if live:
             client.cancel(list(live.values()))
+
+
+class _OperatorError:
+    """A tile's operator error, handed back as a result: Dask retries only exceptions."""
+
+    def __init__(self, error: PhotodemError) -> None:
+        self.error = error
+
+
+def _guarded(task: Callable[..., Any], *args: Any) -> Any:
+    """``task(*args)``, with an operator error returned instead of raised (no retry).
+
+    A bad input fails the same way on every worker; only a lost worker is worth a retry.
+    """
+    try:
+        return task(*args)
+    except PhotodemError as exc:
+        return _OperatorError(exc)
 
 
 def _in_flight(client: Any) -> int:

@@ -36,6 +36,21 @@ def _square(x: int, job: int) -> int:
     return x * job * job
 
 
+def _bad_tile(folder: str, job: int) -> int:
+    """Counts its attempts in ``folder`` and fails with an operator error on tile 1."""
+    with open(Path(folder) / f"attempt-{job}", "a") as f:
+        f.write("x")
+    if job == 1:
+        raise InputError("tile 1 has no data")
+    return job
+
+
+def test_operator_error_in_a_tile_is_not_retried(cluster_address, tmp_path) -> None:
+    with pytest.raises(InputError, match="tile 1 has no data"):
+        list(map_tiles(_bad_tile, [0, 1, 2], (str(tmp_path),), cluster_address))
+    assert (tmp_path / "attempt-1").read_text() == "x"  # one attempt, no retries
+
+
 def test_scheduler_text_is_checked() -> None:
     assert check_scheduler(" local ") == "local"
     assert check_scheduler(None) == ""
