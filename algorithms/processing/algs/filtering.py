@@ -12,8 +12,9 @@ from ..spec import Algorithm, Output, Parameter
 GROUP = "DTM filtering"
 GROUP_ID = "filtering"
 
-#: Preset names shared by both filters (tables in ``algorithms/filtering/presets.py``).
-PRESETS = ("default", "flat", "hilly", "urban", "forest", "steep")
+#: Preset names shared by both filters (tables in ``algorithms/filtering/presets.py``); ``auto``
+#: picks one from the input (same tuple as ``presets.FILTER_PRESET_CHOICES``).
+PRESETS = ("auto", "default", "flat", "hilly", "urban", "forest", "steep")
 
 #: Input extensions the filters accept (raster or points).
 FILTER_INPUT_EXTENSIONS = (".tif", ".tiff", ".vrt", ".img", ".xyz", ".txt", ".csv", ".asc",
@@ -31,9 +32,11 @@ def common_filter_parameters() -> tuple:
                   help="Receives dtm.tif, ndsm.tif, mask.tif (raster input) or labels.txt "
                        "(point input), report.json and report.html. Written completely or not "
                        "at all."),
-        Parameter("preset", "enum", "Parameter preset", default="default", options=PRESETS,
-                  help="default serves all terrain types; flat, hilly, urban, forest and steep "
-                       "are tuned variants. Options given below override the preset."),
+        Parameter("preset", "enum", "Parameter preset", default="auto", options=PRESETS,
+                  help="auto picks steep, forest or default from the input's terrain slope and "
+                       "vegetation share and reports why; default serves most terrain types; "
+                       "flat, hilly, urban, forest and steep are tuned variants. Options given "
+                       "below override the preset."),
         Parameter("project", "project", "Project (edits.gpkg)", optional=True,
                   help="Its exclusion areas (keep/remove), manual ground points and breaklines "
                        "are honoured."),
@@ -96,7 +99,7 @@ class FilterLowpass(Algorithm):
         from ...filtering.lowpass import run_filter_lowpass  # lazy: keeps photodem list fast
 
         return run_filter_lowpass(
-            params["input"], params["output"], preset=params.get("preset") or "default",
+            params["input"], params["output"], preset=params.get("preset") or "auto",
             project=params.get("project"), spacing=params.get("spacing"),
             crs=params.get("crs") or None,
             overrides={k: params.get(k) for k in ("max_window", "iterations", "threshold",
@@ -218,7 +221,7 @@ class FilterLinearPrediction(Algorithm):
         if params.get("slope") is not None:
             overrides["slope"] = float(params["slope"]) / 100.0  # % → m/m
         return run_filter_linear_prediction(
-            params["input"], params["output"], preset=params.get("preset") or "default",
+            params["input"], params["output"], preset=params.get("preset") or "auto",
             project=params.get("project"), spacing=params.get("spacing"),
             crs=params.get("crs") or None, overrides=overrides,
             write_levels=bool(params.get("write_levels")), feedback=feedback)
