@@ -162,9 +162,10 @@ LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
 #: Preset names, in the order the GUIs list them.
 PRESET_NAMES = ("default", "flat", "hilly", "urban", "forest", "steep")
 
-#: What the filter algorithms offer: ``auto`` (the default; chosen from the input's slope and
-#: vegetation share, :mod:`.auto_preset`) and the named presets.
-FILTER_PRESET_CHOICES = ("auto",) + PRESET_NAMES
+#: What the filter algorithms offer: the named presets and ``auto`` (the default, chosen from
+#: the input's slope and vegetation share, :mod:`.auto_preset`; last, so that the positions of
+#: the older names stay).
+FILTER_PRESET_CHOICES = PRESET_NAMES + ("auto",)
 
 
 def preset(table: Dict[str, Dict[str, Any]], name: str) -> Dict[str, Any]:

@@ -13,8 +13,9 @@ GROUP = "DTM filtering"
 GROUP_ID = "filtering"
 
 #: Preset names shared by both filters (tables in ``algorithms/filtering/presets.py``); ``auto``
-#: picks one from the input (same tuple as ``presets.FILTER_PRESET_CHOICES``).
-PRESETS = ("auto", "default", "flat", "hilly", "urban", "forest", "steep")
+#: (the default) picks one from the input. It comes last so that the positions Processing
+#: gives the older names stay (same tuple as ``presets.FILTER_PRESET_CHOICES``).
+PRESETS = ("default", "flat", "hilly", "urban", "forest", "steep", "auto")
 
 #: Input extensions the filters accept (raster or points).
 FILTER_INPUT_EXTENSIONS = (".tif", ".tiff", ".vrt", ".img", ".xyz", ".txt", ".csv", ".asc",
@@ -33,10 +34,11 @@ def common_filter_parameters() -> tuple:
                        "(point input), report.json and report.html. Written completely or not "
                        "at all."),
         Parameter("preset", "enum", "Parameter preset", default="auto", options=PRESETS,
-                  help="auto picks steep, forest or default from the input's terrain slope and "
-                       "vegetation share and reports why; default serves most terrain types; "
-                       "flat, hilly, urban, forest and steep are tuned variants. Options given "
-                       "below override the preset."),
+                  help="auto (the default) measures the input's terrain slope and vegetated "
+                       "share and takes steep for steep vegetated ground, else default, and "
+                       "reports why; default serves most terrain types; flat, hilly, urban, "
+                       "forest and steep are tuned variants. Options given below override the "
+                       "preset."),
         Parameter("project", "project", "Project (edits.gpkg)", optional=True,
                   help="Its exclusion areas (keep/remove), manual ground points and breaklines "
                        "are honoured."),

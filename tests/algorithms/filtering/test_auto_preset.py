@@ -96,6 +96,16 @@ def test_auto_picks_steep_for_the_steep_forest_with_numbers(forest: Dict[str, An
     assert reason.startswith("preset steep: median slope") and "% of the cells" in reason
 
 
+def test_auto_is_the_default_and_last_choice() -> None:
+    from photodem.algorithms.filtering.presets import FILTER_PRESET_CHOICES
+    from photodem.algorithms.processing.algs.filtering import PRESETS
+
+    assert PRESETS == FILTER_PRESET_CHOICES and PRESETS[-1] == "auto"
+    for fid in ("filter_lowpass", "filter_linear_prediction"):
+        spec = {p.name: p for p in registry.get(fid).parameters}
+        assert spec["preset"].default == "auto"
+
+
 def test_auto_keeps_default_on_flat_open_terrain(tmp_path: Path) -> None:
     check = assess_terrain(read_filter_input(_flat_open_dsm(tmp_path / "flat.tif")))
     assert check.slope_median_deg < 3.0 and check.vegetation_share < 0.2
