@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 from ..feedback import Feedback
-from .surface_input import FilterInput, dtm_slope
+from .surface_input import FilterInput
 
 Array = NDArray[Any]
 
@@ -104,11 +104,29 @@ def _envelope(zmin: Array, gx: Array, gy: Array, k: int, spacing: float,
     if not known.any():
         return np.full(shape, np.nan)
     _, (r, c) = ndimage.distance_transform_edt(~known, return_indices=True)
-    env = env[r, c]  # empty blocks take the nearest block's value
+    return _to_cells(env[r, c], k, shape)  # empty blocks take the nearest block's value
+
+
+def _to_cells(blocks: Array, k: int, shape: Tuple[int, int]) -> Array:
+    """Bilinear interpolation of k × k block values (at the block centres) to the cells."""
     rows = (np.arange(shape[0]) + 0.5) / k - 0.5
     cols = (np.arange(shape[1]) + 0.5) / k - 0.5
     rr, cc = np.meshgrid(rows, cols, indexing="ij")
-    return ndimage.map_coordinates(env, [rr, cc], order=1, mode="nearest")
+    return ndimage.map_coordinates(blocks, [rr, cc], order=1, mode="nearest")
+
+
+def _block_means(z: Array, known: Array, f: int) -> Tuple[Array, Array]:
+    """Mean of the known cells of every f × f block, and whether a block has any."""
+    h, w = z.shape
+    hb, wb = -(-h // f), -(-w // f)
+    vals = np.zeros((hb * f, wb * f))
+    cnt = np.zeros((hb * f, wb * f))
+    vals[:h, :w] = np.where(known, z, 0.0)
+    cnt[:h, :w] = known
+    vs = vals.reshape(hb, f, wb, f).sum(axis=(1, 3))
+    cs = cnt.reshape(hb, f, wb, f).sum(axis=(1, 3))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return vs / cs, cs > 0
 
 
 def assess_terrain(inp: FilterInput, cell_m: float = ENVELOPE_CELL_M) -> TerrainCheck:
@@ -145,11 +163,22 @@ def choose_preset(check: TerrainCheck) -> Tuple[str, str]:
     return "default", f"preset default: {numbers}"
 
 
+def _slope_at(z: Array, r: Array, c: Array, spacing: float) -> Array:
+    """Gradient magnitude (m/m) at cells (r, c) by central differences (one-sided at the
+    border; 0 where a neighbour has no height), as :func:`.surface_input.dtm_slope`."""
+    h, w = z.shape
+    r0, r1 = np.maximum(r - 1, 0), np.minimum(r + 1, h - 1)
+    c0, c1 = np.maximum(c - 1, 0), np.minimum(c + 1, w - 1)
+    gy = (z[r1, c] - z[r0, c]) / (np.maximum(r1 - r0, 1) * spacing)
+    gx = (z[r, c1] - z[r, c0]) / (np.maximum(c1 - c0, 1) * spacing)
+    return np.nan_to_num(np.hypot(gx, gy))
+
+
 def _pits(low: Array, dtm: Array, limit: Array, k: int) -> Array:
     """The cells of ``low`` where the DTM lies more than ``limit`` below the terrain its
     surroundings predict: the local least-squares plane through the DTM outside ``low``
-    (windows of 4 ``k`` cells; it continues slopes, also to the grid border), else the
-    membrane interpolation of those cells.
+    (windows of 4 ``k`` cells, on blocks of ``k/2`` cells; it continues slopes, also to the
+    grid border), else the membrane interpolation of those blocks.
 
     A DTM that bridges an object (a roof, a wood without ground returns) interpolates the
     ground around it and so follows that prediction; a DTM that has cut into the terrain does
@@ -159,14 +188,24 @@ def _pits(low: Array, dtm: Array, limit: Array, k: int) -> Array:
 
     if not low.any():
         return low
-    known = ~low & np.isfinite(dtm)
-    values = np.where(known, dtm, 0.0)
-    around = plane_smooth(values, known, 2 * k, min_count=max(3, k))
+    # on blocks of half a window: the prediction needs metres, not cells (at full resolution
+    # it costs 40 s on 16 M cells, now ≈ 5 s)
+    f = max(1, k // 2)
+    mean, known = _block_means(dtm, ~low & np.isfinite(dtm), f)
+    values = np.where(known, mean, 0.0)
+    kb = max(2, -(-2 * k // f))
+    around = plane_smooth(values, known, kb, min_count=max(3, kb))
+    r, c = np.nonzero(low)
     gap = ~np.isfinite(around)
-    if gap.any():
+    if gap[r // f, c // f].any():  # a membrane only where a low cell needs one
         around = np.where(gap, membrane_fill(values, known), around)
+    at = ndimage.map_coordinates(np.asarray(around, float), [(r + 0.5) / f - 0.5,
+                                                             (c + 0.5) / f - 0.5],
+                                 order=1, mode="nearest")  # bilinear, at the low cells only
+    out = np.zeros(low.shape, bool)
     with np.errstate(invalid="ignore"):
-        return low & (around - dtm > limit)
+        out[r, c] = at - dtm[r, c] > limit[r, c]
+    return out
 
 
 def dtm_plausibility(z: Array, dtm: Array, spacing: float) -> Tuple[List[str], Dict[str, Any]]:
@@ -193,9 +232,10 @@ def dtm_plausibility(z: Array, dtm: Array, spacing: float) -> Tuple[List[str], D
     clear = np.where(np.isfinite(z) & np.isfinite(d), z - d, np.inf)
     k = max(3, round(CHECK_WINDOW_M / spacing) | 1)
     local = ndimage.minimum_filter(clear, size=k, mode="nearest")
-    slope = np.nan_to_num(dtm_slope(d, spacing))
-    limit = CHECK_DEPTH_M + 2.0 * slope * spacing
     valid = np.isfinite(d) & np.isfinite(local)
+    limit = np.full(d.shape, CHECK_DEPTH_M)
+    r, c = np.nonzero(valid & (local > CHECK_DEPTH_M))  # the slope only where it can matter
+    limit[r, c] += 2.0 * _slope_at(d, r, c, spacing) * spacing
     low = valid & (local > limit)
     cut = _pits(low, d, limit, k)
     n_valid = max(int(valid.sum()), 1)
