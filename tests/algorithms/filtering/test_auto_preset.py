@@ -158,6 +158,8 @@ def test_default_run_on_laz_chooses_and_reports(forest: Dict[str, Any], tmp_path
     assert m["preset"] == "steep" and m["preset_choice"]["requested"] == "auto"
     assert "median slope" in m["preset_choice"]["reason"]
     assert m["plausibility"]["share"] < 0.01 and not m["warnings"]
+    page = (Path(res["report"]).parent / "report.html").read_text(encoding="utf-8")
+    assert "Chosen automatically: preset steep: median slope" in page
     err = _dtm_errors(forest["scene"], res["dtm"])
     old = registry.run(fid, {"input": laz, "preset": "default",
                              "output": str(tmp_path / "default")})
