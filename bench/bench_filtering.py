@@ -29,6 +29,12 @@
 (c) Speed: a synthetic 4000 × 4000 DSM (1 m; terrain, ~3000 buildings, forest patches, noise)
     filtered by each filter in a child process: seconds and peak resident memory
     (VmHWM of the child, so the peak is the filter's). Targets ≤ 60 s, ≤ 4 GB.
+(d) Steep forest (issue 22): the synthetic 400 m scene of ``synthetic/forest_scene.py``
+    (slopes 31–45°, closed canopy, ≈ 4 % ground returns) as LAZ, both filters with the preset
+    ``auto`` (the default), ``default`` (the default before auto) and ``steep``: DTM − true
+    DTM RMS, NMAD, min, max (m), RMS in ‰ of the relief, the plausibility warnings, seconds.
+    Goal: RMS ≤ 0.5 m with ``auto``.
+Parts (a) and (b) also run both filters with ``auto``: it must keep ``default`` there.
 
 Filters that are not registered yet are reported as missing rows, not as errors.
 """
@@ -70,6 +76,9 @@ SAMP11_CRS = "EPSG:25832"
 #: Synthetic C5 case: analysis spacing (m) and the accuracy targets (m).
 C5_SPACING = 0.5
 C5_TARGETS = {"abs_mean_m": 0.1, "std_m": 0.35, "q95_m": 0.7}
+#: Steep forest (d): presets compared and the goal (m) for the preset auto.
+FOREST_PRESETS = ("auto", "default", "steep")
+FOREST_GOAL_RMS_M = 0.5
 SPEED_SIZE = 4000
 SPEED_TARGETS = {"seconds": 60.0, "peak_mb": 4096.0}
 
@@ -182,6 +191,23 @@ def _origin_rows(xyz: np.ndarray, tmp: Path, kappas: Dict[str, float]
              "kappa_max_pct": float(max(k))} for key, k in found.items()]
 
 
+def _auto_rows(pts: Path, tmp: Path, have: set) -> List[Dict[str, Any]]:
+    """Both filters with the preset ``auto`` on samp11 (the choice and the ISPRS measures)."""
+    rows: List[Dict[str, Any]] = []
+    for fid in FILTERS:
+        if fid not in have:
+            continue
+        t0 = time.perf_counter()
+        res = _run_filter(fid, {"input": str(pts), "output": str(tmp / f"isprs_auto_{fid}"),
+                                "preset": "auto"})
+        dt = time.perf_counter() - t0
+        m = _evaluate(res["labels"], SAMP11, tmp / f"ev_auto_{fid}")
+        row = _class_row(f"{fid} (auto → {res['metrics'].get('preset')})", m, dt)
+        row["warnings"] = len(res["metrics"].get("warnings") or [])
+        rows.append(row)
+    return rows
+
+
 def _isprs(tmp: Path, have: set) -> Dict[str, Any]:
     if not SAMP11.is_file():
         return {"skipped": f"ISPRS data not found at {SAMP11}"}
@@ -217,6 +243,7 @@ def _isprs(tmp: Path, have: set) -> Dict[str, Any]:
             row["grid_m"] = spacing
         rows.append(row)
 
+    rows.extend(_auto_rows(pts, tmp, have))
     try:
         import CSF  # noqa: F401
     except ImportError:
@@ -354,6 +381,7 @@ def _synthetic(tmp: Path, have: set) -> Dict[str, Any]:
     # partly, the "flat" preset and linear prediction by metres
     runs = [(fid, proj, "default") for fid in FILTERS for proj in (False, True)]
     runs.insert(1, ("filter_lowpass", False, "flat"))
+    runs += [(fid, True, "auto") for fid in FILTERS]
     for fid, proj, preset in runs:
         case = f"{fid} ({preset}) {'with' if proj else 'without'} exclusion areas"
         if fid not in have:
@@ -378,7 +406,8 @@ def _synthetic(tmp: Path, have: set) -> Dict[str, Any]:
             ok = (abs(s["mean_m"]) <= C5_TARGETS["abs_mean_m"] and s["std_m"] <= C5_TARGETS[
                 "std_m"] and s["q95_m"] <= C5_TARGETS["q95_m"])
             row = {"part": "b", "case": f"{case}, {scope}", **s, "meets_c5": ok,
-                   "seconds": round(dt, 2)}
+                   "seconds": round(dt, 2), "chosen": res["metrics"].get("preset"),
+                   "warnings": len(res["metrics"].get("warnings") or [])}
             if scope == "all cells":
                 for name, cls in (("embankment", EMBANKMENT), ("ditch", WATER),
                                   ("building", BUILDING), ("tree", TREE)):
@@ -398,6 +427,61 @@ def _synthetic(tmp: Path, have: set) -> Dict[str, Any]:
              "slope no longer does), the 'flat' preset (thresholds 0.3–2 m, 5 % slope "
              "allowance) and linear prediction by metres, which is why embankments get a "
              "'keep' exclusion area"]
+    return {"rows": rows, "notes": notes}
+
+
+# -- (d) steep forest ----------------------------------------------------------------------------
+
+
+def _forest_errors(scene: Any, dtm_path: str) -> Dict[str, Any]:
+    """DTM − true DTM at the DTM's cell centres: RMS, NMAD, min, max (m) and RMS in ‰ of the
+    relief."""
+    import rasterio
+
+    with rasterio.open(dtm_path) as src:
+        dtm = src.read(1).astype(np.float64)
+        truth = scene.truth_at(src.transform, dtm.shape)
+    e = (dtm - truth)[np.isfinite(dtm)]
+    rms = float(np.sqrt(np.mean(e ** 2)))
+    relief = scene.slope_stats()["relief_m"]
+    return {"rms_m": rms, "nmad_m": float(1.4826 * np.median(np.abs(e - np.median(e)))),
+            "min_m": float(e.min()), "max_m": float(e.max()),
+            "rms_permille_relief": 1000.0 * rms / relief}
+
+
+def _forest(tmp: Path, have: set) -> Dict[str, Any]:
+    from photodem.algorithms.synthetic.forest_scene import make_forest_scene, write_forest_points
+
+    t0 = time.perf_counter()
+    scene = make_forest_scene("bench")
+    laz = write_forest_points(scene, tmp / "steep_forest.laz")
+    made = time.perf_counter() - t0
+    rows: List[Dict[str, Any]] = []
+    for fid in FILTERS:
+        for preset in FOREST_PRESETS:
+            case = f"steep forest: {fid} ({preset})"
+            if fid not in have:
+                rows.append({"part": "d", "case": case, "status": "not registered"})
+                continue
+            t0 = time.perf_counter()
+            res = _run_filter(fid, {"input": str(laz), "preset": preset,
+                                    "output": str(tmp / f"forest_{fid}_{preset}")})
+            dt = time.perf_counter() - t0
+            m = res["metrics"]
+            err = _forest_errors(scene, res["dtm"])
+            rows.append({"part": "d", "case": case, "chosen": m.get("preset"), **err,
+                         "meets_goal": err["rms_m"] <= FOREST_GOAL_RMS_M,
+                         "warnings": len(m.get("warnings") or []),
+                         "dug_in_share": (m.get("plausibility") or {}).get("share"),
+                         "seconds": round(dt, 2)})
+    st = scene.slope_stats()
+    notes = [f"steep forest (algorithms/synthetic/forest_scene.py, size bench, seed 22): "
+             f"{scene.side:.0f} m square, {len(scene.points)} points (LAZ), ground returns "
+             f"{100.0 * scene.ground_share:.1f} %, canopy cover {100.0 * scene.canopy_cover:.0f} %,"
+             f" slope median {st['slope_median_deg']:.0f}° (5–95 %: {st['slope_q05_deg']:.0f}–"
+             f"{st['slope_q95_deg']:.0f}°), relief {st['relief_m']:.0f} m; made and written in "
+             f"{made:.1f} s. Goal: DTM RMS ≤ {FOREST_GOAL_RMS_M} m with preset auto; "
+             "'default' is the preset that was the default before auto"]
     return {"rows": rows, "notes": notes}
 
 
@@ -477,13 +561,14 @@ def run() -> dict:
     have = _registered()
     if "filter_evaluate" not in have:
         return {"skipped": "filter_evaluate is not registered"}
-    parts = os.environ.get("PHOTODEM_BENCH_FILTERING_PARTS", "abc")
+    parts = os.environ.get("PHOTODEM_BENCH_FILTERING_PARTS", "abcd")
     result: Dict[str, Any] = {"title": "DSM → DTM filtering: ISPRS samp11 (vs CSF, SMRF), "
-                                       "synthetic matched DSM (C5), 4000 × 4000 speed",
+                                       "synthetic matched DSM (C5), 4000 × 4000 speed, "
+                                       "steep forest",
                               "rows": [], "notes": []}
     with tempfile.TemporaryDirectory(prefix="bench-filtering-") as tmp_s:
         tmp = Path(tmp_s)
-        for key, fn in (("a", _isprs), ("b", _synthetic), ("c", _speed)):
+        for key, fn in (("a", _isprs), ("b", _synthetic), ("c", _speed), ("d", _forest)):
             if key not in parts:
                 continue
             sub = tmp / key

@@ -108,6 +108,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..linalg import CG_LP, pcg
 from ..surface.gridding import Grid
+from .auto_preset import check_dtm, is_auto, resolve_preset
 from .lp_pyramid import (
     BreaklineSides,
     breakline_sides,
@@ -1018,7 +1019,7 @@ def _sigma_grid(inp: Any) -> Optional[Array]:
     return out.reshape(inp.grid.shape)
 
 
-def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str = "default",
+def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str = "auto",
                                  project: Optional[PathLike] = None,
                                  spacing: Optional[float] = None, crs: Any = None,
                                  overrides: Optional[Dict[str, Any]] = None,
@@ -1033,7 +1034,8 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
     output : path
         Output folder (new or empty), written completely or not at all.
     preset : str
-        Name in :data:`~.presets.LINEAR_PREDICTION_PRESETS`.
+        Name in :data:`~.presets.LINEAR_PREDICTION_PRESETS`, or ``auto`` (chosen from the
+        input, :mod:`.auto_preset`; the choice and its reason are reported).
     project : path, optional
         Project whose edits are honoured.
     spacing : float, optional
@@ -1051,10 +1053,12 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
         ``dtm``, ``ndsm``, ``mask`` or ``labels``, ``report``, ``metrics``.
     """
     feedback = ensure_feedback(feedback)
-    values = linear_prediction_preset(preset)
-    values.update({k: v for k, v in (overrides or {}).items() if v is not None})
-    prm = LPParameters.from_dict(values)
+    ov = {k: v for k, v in (overrides or {}).items() if v is not None}
+    values = linear_prediction_preset("default" if is_auto(preset) else preset)
+    LPParameters.from_dict({**values, **ov})  # bad presets and options fail before reading
     inp = read_filter_input(input, spacing=spacing, crs=crs, feedback=feedback)
+    name, choice = resolve_preset(preset, inp, feedback)
+    prm = LPParameters.from_dict({**linear_prediction_preset(name), **ov})
     cons = read_filter_constraints(project, inp.grid, inp.crs)
     feedback.progress(5.0)
     t0 = time.perf_counter()
@@ -1072,7 +1076,7 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
                 np.repeat(lvl, f, axis=0), f, axis=1)[:inp.grid.height, :inp.grid.width]
     report: Dict[str, Any] = {
         "algorithm": "filter_linear_prediction",
-        "preset": preset or "default",
+        "preset": name,
         "parameters": asdict(prm),
         "cells_valid": n_valid,
         "cells_ground": n_ground,
@@ -1086,6 +1090,9 @@ def run_filter_linear_prediction(input: PathLike, output: PathLike, preset: str 
         "ground_points_disagreeing": res.disagreeing,
         "warnings": [],
     }
+    if choice is not None:
+        report["preset_choice"] = choice
+    check_dtm(inp, res.dtm, report, feedback)
     if res.disagreeing:
         msg = (f"{len(res.disagreeing)} manual ground point(s) differ from the filtered surface "
                f"by more than {prm.ground_tolerance:g} m (listed in the report).")

@@ -80,6 +80,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..project.model import Project
 from ..surface.gridding import Grid, polygon_mask
+from .auto_preset import check_dtm, is_auto, resolve_preset
 from .presets import lowpass_preset
 from .surface_input import (
     FilterConstraints,
@@ -834,7 +835,7 @@ def _border_nodata(has: Array, reach: int = 3) -> Array:
     return np.isin(lab, edge) & far
 
 
-def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default",
+def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "auto",
                        project: Optional[PathLike] = None, spacing: Optional[float] = None,
                        crs: Any = None, overrides: Optional[Dict[str, Any]] = None,
                        write_iterations: bool = False,
@@ -848,7 +849,8 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
     output : path
         Output folder (new or empty).
     preset : str
-        Name in :data:`.presets.LOWPASS_PRESETS`.
+        Name in :data:`.presets.LOWPASS_PRESETS`, or ``auto`` (chosen from the input's slope
+        and vegetation share, :mod:`.auto_preset`; the choice and its reason are reported).
     project : path, optional
         Project whose edits.gpkg is honoured.
     spacing : float, optional
@@ -867,8 +869,12 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
         ``dtm``, ``ndsm``, ``mask`` or ``labels``, ``report`` (paths) and ``metrics``.
     """
     feedback = ensure_feedback(feedback)
-    params = lowpass_parameters(preset, overrides)
+    auto = is_auto(preset)
+    params = lowpass_parameters("default" if auto else preset, overrides)  # checks early
     inp: FilterInput = read_filter_input(input, spacing=spacing, crs=crs, feedback=feedback)
+    name, choice = resolve_preset(preset, inp, feedback)
+    if auto:
+        params = lowpass_parameters(name, overrides)
     if project is not None and str(project) != "" and inp.crs is None:
         prj_crs = Project.load(project).crs
         if prj_crs:
@@ -901,6 +907,9 @@ def run_filter_lowpass(input: PathLike, output: PathLike, preset: str = "default
         "ground_points_disagreeing": res["ground_points_disagreeing"],
         "warnings": [],
     }
+    if choice is not None:
+        report["preset_choice"] = choice
+    check_dtm(inp, res["dtm"], report, feedback)
     extra = {f"diff_{i:02d}": d for i, d in enumerate(res["differences"], start=1)}
     out = write_filter_outputs(output, inp, res["dtm"], res["ground"], report,
                                extra_rasters=extra, feedback=feedback.step(85.0, 100.0),

@@ -98,15 +98,19 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "low_outlier_m": 2.0,
         "ground_slope_factor": 1.25,
     },
+    # steep: tuned on the synthetic steep forest (algorithms/synthetic/forest_scene.py, slopes
+    # 31–45°, 93 % canopy, 4 % ground returns): no low-outlier cut (ground returns under a
+    # closed canopy are isolated pits among crown returns), planes take the slope, so the
+    # slope allowance covers curvature only (30 %, was 60 %) and the thresholds can be lower
     "steep": {
         "windows_m": (40.0, 25.0, 15.0, 8.0),
-        "thresholds_m": (4.0, 2.5, 1.5, 1.0),
+        "thresholds_m": (2.5, 1.5, 1.0, 0.6),
         "down_threshold_m": 8.0,
-        "slope_pct": 60.0,
+        "slope_pct": 30.0,
         "final_smoothing_m": 3.0,
         "height_margin_m": 30.0,
         "ground_tolerance_m": 1.0,
-        "low_outlier_m": 2.0,
+        "low_outlier_m": 0.0,
         "ground_slope_factor": 1.5,
     },
 }
@@ -147,14 +151,21 @@ LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
                "max_shift": 1.0, "iterations": 5, "fine_iterations": 2,
                "ground_tolerance": 0.6,
               "low_outlier": 2.0, "ground_slope_factor": 1.25},
-    "steep": {"coarse_spacing": 16.0, "half_weight": 0.6, "cutoff": 2.0, "low_cutoff": 8.0,
-              "band_above": 2.5, "band_below": 8.0, "slope": 0.6, "shift_factor": 1.0,
+    # steep: tuned on the synthetic steep forest like the low-pass preset (no low-outlier cut;
+    # the coarser levels' trend takes the slope: allowance 0.3, tighter weights)
+    "steep": {"coarse_spacing": 32.0, "half_weight": 0.3, "cutoff": 1.0, "low_cutoff": 8.0,
+              "band_above": 1.0, "band_below": 8.0, "slope": 0.3, "shift_factor": 1.0,
               "max_shift": 1.0, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 1.0,
-             "low_outlier": 2.0, "ground_slope_factor": 1.5},
+             "low_outlier": 0.0, "ground_slope_factor": 1.5},
 }
 
 #: Preset names, in the order the GUIs list them.
 PRESET_NAMES = ("default", "flat", "hilly", "urban", "forest", "steep")
+
+#: What the filter algorithms offer: the named presets and ``auto`` (the default, chosen from
+#: the input's slope and vegetation share, :mod:`.auto_preset`; last, so that the positions of
+#: the older names stay).
+FILTER_PRESET_CHOICES = PRESET_NAMES + ("auto",)
 
 
 def preset(table: Dict[str, Dict[str, Any]], name: str) -> Dict[str, Any]:
@@ -181,5 +192,5 @@ def linear_prediction_preset(name: str = "default") -> Dict[str, Any]:
     return preset(LINEAR_PREDICTION_PRESETS, name)
 
 
-__all__ = ["LINEAR_PREDICTION_PRESETS", "LOWPASS_PRESETS", "PRESET_NAMES",
+__all__ = ["FILTER_PRESET_CHOICES", "LINEAR_PREDICTION_PRESETS", "LOWPASS_PRESETS", "PRESET_NAMES",
            "linear_prediction_preset", "lowpass_preset", "preset"]

@@ -772,6 +772,9 @@ def _html_report(report: Dict[str, Any], title: str, figure: Optional[Any] = Non
              f"<p>Input <b>{html.escape(report_path(str(report.get('input', ''))))}</b> "
              f"({html.escape(str(report.get('source', '')))}), preset "
              f"<b>{html.escape(str(report.get('preset', '')))}</b>.</p>"]
+    choice = report.get("preset_choice") or {}
+    if choice.get("reason"):
+        parts.append(f"<p>Chosen automatically: {html.escape(str(choice['reason']))}.</p>")
     summary = [["cells with a height", str(report.get("cells_valid", ""))],
                ["ground cells", str(report.get("cells_ground", ""))],
                ["eliminated share", f"{100.0 * float(report.get('eliminated_share', 0.0)):.2f} %"],

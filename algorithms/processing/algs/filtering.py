@@ -13,8 +13,10 @@ from ..tiled import scheduler_parameter, tile_parameter
 GROUP = "DTM filtering"
 GROUP_ID = "filtering"
 
-#: Preset names shared by both filters (tables in ``algorithms/filtering/presets.py``).
-PRESETS = ("default", "flat", "hilly", "urban", "forest", "steep")
+#: Preset names shared by both filters (tables in ``algorithms/filtering/presets.py``); ``auto``
+#: (the default) picks one from the input. It comes last so that the positions Processing
+#: gives the older names stay (same tuple as ``presets.FILTER_PRESET_CHOICES``).
+PRESETS = ("default", "flat", "hilly", "urban", "forest", "steep", "auto")
 
 #: Input extensions the filters accept (raster or points).
 FILTER_INPUT_EXTENSIONS = (".tif", ".tiff", ".vrt", ".img", ".xyz", ".txt", ".csv", ".asc",
@@ -32,9 +34,12 @@ def common_filter_parameters() -> tuple:
                   help="Receives dtm.tif, ndsm.tif, mask.tif (raster input) or labels.txt "
                        "(point input), report.json and report.html. Written completely or not "
                        "at all."),
-        Parameter("preset", "enum", "Parameter preset", default="default", options=PRESETS,
-                  help="default serves all terrain types; flat, hilly, urban, forest and steep "
-                       "are tuned variants. Options given below override the preset."),
+        Parameter("preset", "enum", "Parameter preset", default="auto", options=PRESETS,
+                  help="auto (the default) measures the input's terrain slope and vegetated "
+                       "share and takes steep for steep vegetated ground, else default, and "
+                       "reports why; default serves most terrain types; flat, hilly, urban, "
+                       "forest and steep are tuned variants. Options given below override the "
+                       "preset."),
         Parameter("project", "project", "Project (edits.gpkg)", optional=True,
                   help="Its exclusion areas (keep/remove), manual ground points and breaklines "
                        "are honoured."),
@@ -100,7 +105,7 @@ class FilterLowpass(Algorithm):
 
         with tiling(params.get("scheduler"), params.get("tile")):
             return run_filter_lowpass(
-                params["input"], params["output"], preset=params.get("preset") or "default",
+                params["input"], params["output"], preset=params.get("preset") or "auto",
                 project=params.get("project"), spacing=params.get("spacing"),
                 crs=params.get("crs") or None,
                 overrides={k: params.get(k) for k in ("max_window", "iterations", "threshold",
@@ -225,7 +230,7 @@ class FilterLinearPrediction(Algorithm):
             overrides["slope"] = float(params["slope"]) / 100.0  # % → m/m
         with tiling(params.get("scheduler"), params.get("tile")):
             return run_filter_linear_prediction(
-                params["input"], params["output"], preset=params.get("preset") or "default",
+                params["input"], params["output"], preset=params.get("preset") or "auto",
                 project=params.get("project"), spacing=params.get("spacing"),
                 crs=params.get("crs") or None, overrides=overrides,
                 write_levels=bool(params.get("write_levels")), feedback=feedback)
