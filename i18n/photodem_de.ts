@@ -564,6 +564,26 @@
             <translation>Höhe über dem DGM, ab der eine Referenzzelle zu einem Objekt gehört.</translation>
         </message>
         <message>
+            <source>Tile size [cells]</source>
+            <extracomment>dem_compare.tile: description; dsm_merge.tile: description; filter_linear_prediction.tile: description; filter_lowpass.tile: description; mosaic.tile: description; refine_object_space.tile: description</extracomment>
+            <translation>Kachelgröße [Zellen]</translation>
+        </message>
+        <message>
+            <source>The comparison grid is processed in tiles of this many cells a side (memory about 60 bytes per cell of a tile).</source>
+            <extracomment>dem_compare.tile: help</extracomment>
+            <translation>Das Vergleichsraster wird in Kacheln mit so vielen Zellen Seitenlänge verarbeitet (Speicher etwa 60 Byte je Zelle einer Kachel).</translation>
+        </message>
+        <message>
+            <source>Dask scheduler for the tiles</source>
+            <extracomment>dem_compare.scheduler: description; dsm_merge.scheduler: description; filter_linear_prediction.scheduler: description; filter_lowpass.scheduler: description; mosaic.scheduler: description</extracomment>
+            <translation>Dask-Scheduler für die Kacheln</translation>
+        </message>
+        <message>
+            <source>Empty: the tiles run one after the other in this process. 'local': a Dask cluster on this machine. tcp://host:8786: that Dask cluster, whose workers see the inputs and the output folder under the same paths. The result is the same; needs pip install "photodem[dask]".</source>
+            <extracomment>dem_compare.scheduler: help; dsm_merge.scheduler: help; filter_linear_prediction.scheduler: help; filter_lowpass.scheduler: help; mosaic.scheduler: help</extracomment>
+            <translation>Leer: Die Kacheln laufen nacheinander in diesem Prozess. 'local': ein Dask-Cluster auf diesem Rechner. tcp://host:8786: dieser Dask-Cluster, dessen Worker die Eingaben und den Ausgabeordner unter denselben Pfaden sehen. Das Ergebnis ist dasselbe; benötigt pip install "photodem[dask]".</translation>
+        </message>
+        <message>
             <source>Statistics of Δh [m]</source>
             <extracomment>dem_compare output stats</extracomment>
             <translation>Statistik von Δh [m]</translation>
@@ -1204,6 +1224,11 @@
             <translation>Eingaben einer Zelle, die um mehr als diesen Wert voneinander abweichen, sehen verschiedene Oberflächen (eine Wand): sie werden nicht gemittelt. 0 = einfacher Median / Mittelwert.</translation>
         </message>
         <message>
+            <source>The merged DSM is processed in tiles of this many cells a side (memory about 8 bytes per cell and input of a tile).</source>
+            <extracomment>dsm_merge.tile: help</extracomment>
+            <translation>Das zusammengeführte DOM wird in Kacheln mit so vielen Zellen Seitenlänge verarbeitet (Speicher etwa 8 Byte je Zelle und Eingabe einer Kachel).</translation>
+        </message>
+        <message>
             <source>Inputs per cell</source>
             <extracomment>dsm_merge output count</extracomment>
             <translation>Eingaben je Zelle</translation>
@@ -1449,11 +1474,6 @@
             <translation>Bildnamen, durch Kommas getrennt. Standard: jedes Bild, dessen Fußabdruck eine Kachel überdeckt.</translation>
         </message>
         <message>
-            <source>Tile size [cells]</source>
-            <extracomment>mosaic.tile: description; refine_object_space.tile: description</extracomment>
-            <translation>Kachelgröße [Zellen]</translation>
-        </message>
-        <message>
             <source>Side of the computation windows (plus overlap); bounds the memory.</source>
             <extracomment>refine_object_space.tile: help</extracomment>
             <translation>Seitenlänge der Rechenfenster (zuzüglich Überlappung); begrenzt den Speicherbedarf.</translation>
@@ -1499,9 +1519,9 @@
             <translation>Parametervorgabe</translation>
         </message>
         <message>
-            <source>default serves all terrain types; flat, hilly, urban, forest and steep are tuned variants. Options given below override the preset.</source>
+            <source>auto (the default) measures the input's terrain slope and vegetated share and takes steep for steep vegetated ground, else default, and reports why; default serves most terrain types; flat, hilly, urban, forest and steep are tuned variants. Options given below override the preset.</source>
             <extracomment>filter_linear_prediction.preset: help; filter_lowpass.preset: help</extracomment>
-            <translation>default dient allen Geländetypen; flat, hilly, urban, forest und steep sind abgestimmte Varianten. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+            <translation>auto (die Vorgabe) misst die Geländeneigung und den bewachsenen Anteil der Eingabe und wählt steep für steiles bewachsenes Gelände, sonst default, und berichtet, warum; default dient den meisten Geländetypen; flat, hilly, urban, forest und steep sind abgestimmte Varianten. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>default</source>
@@ -1512,6 +1532,11 @@
             <source>flat</source>
             <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option</extracomment>
             <translation>flach</translation>
+        </message>
+        <message>
+            <source>auto</source>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; georeference_polygons.search: option</extracomment>
+            <translation>automatisch</translation>
         </message>
         <message>
             <source>Its exclusion areas (keep/remove), manual ground points and breaklines are honoured.</source>
@@ -1587,6 +1612,11 @@
             <source>Writes diff_01.tif, diff_02.tif … (DSM − smoothed surface) for inspection.</source>
             <extracomment>filter_lowpass.write_iterations: help</extracomment>
             <translation>Schreibt diff_01.tif, diff_02.tif … (DOM − geglättete Oberfläche) zur Kontrolle.</translation>
+        </message>
+        <message>
+            <source>Larger DSMs are filtered in overlapping tiles of at most this many cells a side (overlap included; the filter's reach). Default 4096; memory about 150 bytes per cell of a tile.</source>
+            <extracomment>filter_linear_prediction.tile: help; filter_lowpass.tile: help</extracomment>
+            <translation>Größere DOMs werden in überlappenden Kacheln von höchstens so vielen Zellen Seitenlänge gefiltert (einschließlich der Überlappung, der Reichweite des Filters). Standard 4096; Speicher etwa 150 Byte je Zelle einer Kachel.</translation>
         </message>
         <message>
             <source>DTM</source>
@@ -2337,11 +2367,6 @@
             <source>objects: match image regions to the polygons as objects; area: compare the whole image with the rasterised polygons (rotation and scale by Fourier–Mellin, shift by correlation, refined by ECC), and when that fails the polygons' individual outlines with the image's edge directions — for objects that are not homogeneous in the image, such as glaciers; auto: objects, and the area-based search when they give no result. Polygon layers only.</source>
             <extracomment>georeference_polygons.search: help</extracomment>
             <translation>objects: Bildregionen als Objekte den Polygonen zuordnen; area: das ganze Bild mit den gerasterten Polygonen vergleichen (Drehung und Maßstab nach Fourier–Mellin, Verschiebung durch Korrelation, Verfeinerung mit ECC) und, wenn das scheitert, die einzelnen Umrisse der Polygone mit den Kantenrichtungen des Bildes — für Objekte, die im Bild nicht homogen sind, etwa Gletscher; auto: Objekte, und die flächenbasierte Suche, wenn sie kein Ergebnis liefern. Nur für Polygonlayer.</translation>
-        </message>
-        <message>
-            <source>auto</source>
-            <extracomment>georeference_polygons.search: option</extracomment>
-            <translation>automatisch</translation>
         </message>
         <message>
             <source>objects</source>
@@ -5069,6 +5094,10 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>default serves all terrain types; flat, hilly, urban, forest and steep are tuned variants. Options given below override the preset.</source>
+            <translation type="vanished">default dient allen Geländetypen; flat, hilly, urban, forest und steep sind abgestimmte Varianten. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>Creates a PhotoDEM project (project.toml + edits.gpkg) from a folder of images and their orientation: an OPK CSV or text file with the camera YAML (orthority format), or an OpenSfM/ODM reconstruction.json. The block is validated and its stereo models are detected (overlap ≥ 25 %, B/H 0.2–1.2, in-strip neighbours first).</source>
