@@ -35,8 +35,8 @@ class SyntheticBlock(Algorithm):
                        "base 4600 px, H ≈ 1150 m) of which a 1024×1024 px window over the "
                        "common ground patch is rendered — for height accuracy in ‰ of H; "
                        "drone: six 768×576 px frames of a drone camera flown ≈ 70 m above "
-                       "ground, tilted 0–35° in varying directions towards a common patch (convergent "
-                       "pairs, GSD 10 cm at nadir)."),
+                       "ground, tilted 0–35° in varying directions towards a common patch "
+                       "(convergent pairs, GSD 10 cm at nadir)."),
         Parameter("terrain", "enum", "Terrain type", default="gentle",
                   options=("gentle", "dunes", "steep"),
                   help="steep: relief > 100 m with slopes of 45° and more (flown 2.5× higher)."),
