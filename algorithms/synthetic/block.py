@@ -75,7 +75,7 @@ CRS = "EPSG:25832"
 #: lowest terrain to expect below the mean height, per terrain type (m): sizes the grid
 _LOW = {"gentle": 15.0, "dunes": 12.0, "steep": 100.0}
 #: extent factor of a drone block's object placement (see build_scene)
-DRONE_EXTENT_FACTOR = 1.4
+DRONE_EXTENT_FACTOR = 1.25
 _BASE = {"gentle": (40.0, 120.0), "dunes": (5.0, 40.0), "steep": (700.0, 1200.0)}
 
 
