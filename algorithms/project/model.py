@@ -464,6 +464,7 @@ class Project:
                 overlap=d.number("overlap_pct", float("nan")) / 100.0,
                 gsd=d.number("gsd_m", float("nan")),
                 height_above_ground=d.number("height_above_ground_m", float("nan")),
+                convergence=d.number("convergence_deg", float("nan")),
             ))
         terrain = head.number("terrain_height_m", None)
         return cls(

@@ -157,6 +157,25 @@ def _order(project: Project, a: str, b: str) -> Tuple[str, str]:
     return (a, b) if s >= 0 else (b, a)
 
 
+#: Tilt (°) from which a model's GSD is taken at its overlap instead of below the camera.
+TILTED_DEG = 5.0
+
+
+def _image_gsd(project: Project, rec: Any, height: float, centre: Optional[NDArray]) -> float:
+    r"""GSD (m) of one image of a model: :math:`H c/\delta` for a (near-)vertical image; for a
+    tilted one (> :data:`TILTED_DEG`) at the model's overlap centre, the distance D along the
+    ray scaled by the foreshortening of the ground, :math:`D/(f\sqrt{\cos i})` (i the ray's
+    angle from the vertical; geometric mean of the two ground directions)."""
+    cam = project.camera_of(rec)
+    tilt = math.degrees(math.acos(float(np.clip(rec.eo.rotation[2, 2], -1.0, 1.0))))
+    if tilt <= TILTED_DEG or centre is None:
+        return float(cam.gsd(height))
+    ray = centre - rec.eo.position
+    dist = float(np.linalg.norm(ray))
+    cos_i = abs(float(ray[2])) / dist
+    return dist / cam.focal_length_px / math.sqrt(max(cos_i, 0.1))
+
+
 def model_geometry(project: Project, left: str, right: str, dem: DemLike = None,
                    footprints: Optional[Footprints] = None, kind: str = "manual",
                    order: bool = True, labels: Optional[Dict[str, str]] = None) -> StereoModel:
@@ -187,7 +206,11 @@ def model_geometry(project: Project, left: str, right: str, dem: DemLike = None,
     inter = fl.intersection(fr).area
     smaller = min(fl.area, fr.area)
     overlap = inter / smaller if smaller > 0 else 0.0
-    gsd = 0.5 * (float(project.camera_of(rl).gsd(H_l)) + float(project.camera_of(rr).gsd(H_r)))
+    centre = None
+    if not fl.intersection(fr).is_empty:
+        c = fl.intersection(fr).centroid
+        centre = np.array([c.x, c.y, 0.5 * (hl + hr)])
+    gsd = 0.5 * (_image_gsd(project, rl, H_l, centre) + _image_gsd(project, rr, H_r, centre))
     if labels is None:
         labels = image_labels([r.name for r in project.images])
     return StereoModel(name=f"{labels[left]}_{labels[right]}", left=left, right=right, kind=kind,

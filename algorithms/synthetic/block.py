@@ -209,7 +209,9 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
         footprints[_index(plan, m.right)]) for m in models])
     disc_radius = float(np.clip(1.7 * gsd, 0.3, 2.0))
     region = model_area.buffer(-(PAD_FACTOR * disc_radius + 2.0))
-    checkpoints = choose_checkpoints(grid, dtm, dsm, landcover, region, 3 * max(len(models), 1),
+    # three per model, at most 18 (the drone block has 15 models on one patch)
+    n_check = min(3 * max(len(models), 1), 18)
+    checkpoints = choose_checkpoints(grid, dtm, dsm, landcover, region, n_check,
                                      PAD_FACTOR * disc_radius, c_rng)
     checkpoints = flatten_sites(grid, dtm, dsm, checkpoints, PAD_FACTOR * disc_radius + 1.0)
     feedback.progress(12.0)
