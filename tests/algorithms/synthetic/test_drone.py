@@ -180,3 +180,42 @@ def test_nadir_block_models_have_small_convergence(tiny_block: Path) -> None:
                                  in_strip_only=True)
     assert {m.name for m in found} == {m.name for m in project.models}
     assert all(m.convergence < 6.0 for m in found)
+
+
+def _at(path: Path, xs: list, ys: list) -> np.ndarray:
+    """Values of a truth raster at the cells holding the points (xs, ys)."""
+    with rasterio.open(path) as ds:
+        data = ds.read(1)
+        cols, rows = ~ds.transform * (np.asarray(xs), np.asarray(ys))
+    r = np.clip(np.floor(rows).astype(int), 0, data.shape[0] - 1)
+    c = np.clip(np.floor(cols).astype(int), 0, data.shape[1] - 1)
+    return data[r, c]
+
+
+@pytest.mark.slow
+def test_drone_dense_goal_on_open_terrain(drone_block: Path, tmp_path: Path) -> None:
+    """Dense DSM of a drone pair (0101 tilted 24° forward, 0102 near-nadir; convergence 22°):
+    NMAD on open terrain ≤ 1.5 · GSD · H/B (issue 22), and honest coverage figures."""
+    from photodem.algorithms.processing import registry
+
+    project = Project.load(drone_block)
+    model = project.model("0101_0102")
+    res = registry.run("match_model", {"project": str(drone_block), "model": model.name,
+                                       "method": "dense", "output": str(tmp_path / "dsm")})
+    m = res["metrics"]
+    assert abs(m["measured_pct"] + m["interpolated_pct"] + m["empty_pct"] - 100.0) < 1e-6
+    with rasterio.open(res["dsm"]) as ds:
+        dsm, tr, shape = ds.read(1), ds.transform, ds.shape
+    with rasterio.open(res["count"]) as ds:
+        measured = ds.read(1) > 0
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+    xs, ys = rasterio.transform.xy(tr, rows.ravel(), cols.ravel())
+    truth, lc = (_at(drone_block / f"truth/{n}.tif", xs, ys).reshape(shape)
+                 for n in ("dsm", "landcover"))
+    err = (dsm - truth)[measured & np.isin(lc, (1, 2, 6, 7))]
+    nmad = 1.4826 * np.median(np.abs(err - np.median(err)))
+    goal = 1.5 * model.gsd / model.b_h
+    print(f"open NMAD {nmad:.3f} m (goal {goal:.3f} m), measured {m['measured_pct']:.1f} %")
+    assert err.size > 10000
+    assert nmad <= goal
+    assert m["measured_pct"] > 40.0
