@@ -103,7 +103,9 @@ def evaluate(project: Any, model_name: str, result: Dict[str, Any], block: Dict[
            "object_distance_m": distance,
            "goal_nmad_m": 1.5 * m.gsd / m.b_h}
     for label, codes in (("open", OPEN), ("objects", OBJECTS)):
-        s = _stats(np.where(np.isin(lc, codes), err, np.nan))
+        cls = np.isin(lc, codes)
+        out[f"{label}_measured_pct"] = 100.0 * float(measured[inside & cls].mean())
+        s = _stats(np.where(cls, err, np.nan))
         out[f"{label}_nmad_m"] = s["nmad_m"]
         out[f"{label}_rmse_m"] = s["rmse_m"]
         out[f"{label}_nmad_permille"] = 1000.0 * s["nmad_m"] / distance
