@@ -51,6 +51,13 @@ pixel at (c₀, r₀) of the full frame (W_f × H_f px, pitch δ):
 so that window pixel (c, r) is exactly frame pixel (c₀ + c, r₀ + r); distortion (none here) is
 centred on the principal point, which lies outside the windows of the outer images. Each image
 gets its own camera (``synthetic_aerial_<image>``).
+
+**The "drone" size** (:func:`plan_drone`) leaves the normal case: a 1/2.3" 4:3 camera scaled to
+768 × 576 px (c = 0.9 w, f = 691 px) flies H = GSD·f ≈ 69 m above the mean terrain in two strips
+of three frames, each aimed at a ground point of a common patch (:data:`DRONE_LAYOUT`), so the
+frames are tilted 0–35° in varying directions (forward, backward, sideways). B/H is no longer
+(1 − p)·0.9: each model's B/H and convergence (angle between the optical axes, 19–55°) come
+from the stereo-model detection on the terrain; ``base`` is the mean in-strip distance.
 """
 
 from __future__ import annotations
