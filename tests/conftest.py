@@ -85,3 +85,14 @@ def tiny_block(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("tiny-block") / "block"
     registry.run("synthetic_block", {"output": str(root), "size": "tiny"})
     return root
+
+
+@pytest.fixture(scope="session")
+def drone_block(tmp_path_factory) -> Path:
+    """The synthetic drone block (``synthetic_block --size drone``, ≈ 15 s), made once per
+    run. Read it only: a test that writes into a project copies it first."""
+    from photodem.algorithms.processing import registry
+
+    root = tmp_path_factory.mktemp("drone-block") / "block"
+    registry.run("synthetic_block", {"output": str(root), "size": "drone"})
+    return root

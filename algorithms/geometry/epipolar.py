@@ -26,6 +26,24 @@ then applied in the original camera (:meth:`EpipolarPair.to_original`), so the m
 for distorted cameras too; :meth:`EpipolarPair.from_original` inverts it through the camera's
 undistortion.
 
+**Convergent pairs** (optical axes more than :data:`CONVERGENT_DEG` apart, e.g. drone frames
+tilted towards each other): the mean-axis rotation and the mean focal length leave the local
+scale of the resampling far from 1 (one image shrunk where the other is stretched) and the
+epipolar images hold all of both frames, most of it outside the stereo overlap. With ground
+points of the overlap (``overlap_points``) the pair is instead rectified with the *minimal
+distortion* rotation (:func:`minimal_distortion_rotation`, in the spirit of Loop & Zhang): the
+normal plane turns about the base by the angle α, and :math:`f_n` is chosen, so that the
+local area scale of both images over the overlap is as close to 1 as possible — for a ray
+:math:`v` with angles :math:`\theta_s, \theta_n` to the optical axes of the original and the
+normal camera, one epipolar pixel covers
+
+.. math:: s_s(v) = \frac{f_s}{f_n}\left(\frac{\cos\theta_n}{\cos\theta_s}\right)^{3/2}
+
+original pixels (linear, from the area ratio of the two image planes); α minimises
+:math:`\sum (\log s - \overline{\log s})^2` over both images and the points, and
+:math:`f_n` sets :math:`\overline{\log s} = 0`. The epipolar images are then cut to the
+projection of the overlap points (plus a margin), so no pixel is spent outside the overlap.
+
 Triangulation in the normal case: with :math:`x_s = col_s - c_{x,s}`, parallax
 :math:`p = x_l - x_r` (px), depth :math:`D = f_n B / p`, and the point is
 :math:`X = C_l + R_n\,(x_l, -(row - c_y), -f_n)\,D / f_n`.
@@ -49,6 +67,11 @@ SIDES = ("left", "right")
 
 #: Pixels per row block when writing resampled epipolar images (bounds the memory).
 RESAMPLE_BLOCK_PIXELS = 1_000_000
+#: Angle (°) between the two optical axes above which a pair with known overlap points is
+#: rectified with minimal distortion and cut to the overlap (module notes).
+CONVERGENT_DEG = 10.0
+#: Margin (px) around the projected overlap of a cropped (convergent) epipolar pair.
+CROP_MARGIN_PX = 16
 
 
 def _side_index(side: str) -> int:
@@ -74,6 +97,87 @@ def normal_rotation(eo_left: ExteriorOrientation, eo_right: ExteriorOrientation
     z /= nz
     y = np.cross(z, x)
     return np.column_stack([x, y, z]), base
+
+
+def convergence_deg(eo_left: ExteriorOrientation, eo_right: ExteriorOrientation) -> float:
+    """Angle (°) between the optical axes of two images."""
+    c = float(np.clip(eo_left.rotation[:, 2] @ eo_right.rotation[:, 2], -1.0, 1.0))
+    return float(np.degrees(np.arccos(c)))
+
+
+def _rotated_about_base(R_n: Array, alpha: float) -> Array:
+    """``R_n`` turned by ``alpha`` (rad) about its x axis (the base)."""
+    c, s = np.cos(alpha), np.sin(alpha)
+    return R_n @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _log_scales(R_n: Array, eos: Tuple[ExteriorOrientation, ExteriorOrientation],
+                focals: Tuple[float, float], points: Array) -> Array:
+    """log of f_s (cos θ_n / cos θ_s)^{3/2} (the scale without 1/f_n), (2, n); NaN behind a
+    camera or the normal plane."""
+    out = []
+    for eo, f in zip(eos, focals):
+        v = points - eo.position
+        v = v / np.linalg.norm(v, axis=1)[:, None]
+        cos_s = -(v @ eo.rotation[:, 2])
+        cos_n = -(v @ R_n[:, 2])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out.append(np.where((cos_s > 0.05) & (cos_n > 0.05),
+                                np.log(f) + 1.5 * (np.log(cos_n) - np.log(cos_s)), np.nan))
+    return np.array(out)
+
+
+def minimal_distortion_rotation(eo_left: ExteriorOrientation, eo_right: ExteriorOrientation,
+                                focals: Tuple[float, float], points: ArrayLike,
+                                max_angle: float = 60.0) -> Tuple[Array, float, float]:
+    """Normal rotation and focal length (px) with the least resampling distortion.
+
+    Parameters
+    ----------
+    focals : (float, float)
+        Principal distances (px) of the original images.
+    points : array (n, 3)
+        World points of the stereo overlap (e.g. its outline and centre at the terrain
+        heights).
+    max_angle : float
+        Largest turn (°) about the base from the mean-axis rotation that is tried.
+
+    Returns
+    -------
+    rotation : ndarray (3, 3)
+    focal_px : float
+        :math:`f_n` with a mean log scale of 0 over both images (module notes).
+    spread : float
+        RMS of the log scales (0 = no distortion; 0.1 ≈ ±10 %).
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    R0, _ = normal_rotation(eo_left, eo_right)
+    eos = (eo_left, eo_right)
+
+    def cost(alpha: float) -> float:
+        ls = _log_scales(_rotated_about_base(R0, alpha), eos, focals, pts)
+        if not np.isfinite(ls).all():
+            return np.inf  # a point behind the normal plane: not a usable rotation
+        return float(np.mean((ls - ls.mean()) ** 2))
+
+    lim = np.radians(max_angle)
+    grid = np.linspace(-lim, lim, 121)
+    costs = np.array([cost(a) for a in grid])
+    k = int(np.argmin(costs))
+    if not np.isfinite(costs[k]):
+        raise GeometryError("No rotation about the base keeps the overlap in front of both "
+                            "normal images; the pair cannot be normalised.")
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    for _ in range(40):  # golden-section refinement inside the bracketing grid cells
+        a = hi - 0.618 * (hi - lo)
+        b = lo + 0.618 * (hi - lo)
+        if cost(a) < cost(b):
+            hi = b
+        else:
+            lo = a
+    R_n = _rotated_about_base(R0, 0.5 * (lo + hi))
+    ls = _log_scales(R_n, eos, focals, pts)
+    return R_n, float(np.exp(ls.mean())), float(np.sqrt(np.mean((ls - ls.mean()) ** 2)))
 
 
 def _pixel_affine(camera: Camera) -> Array:
@@ -125,7 +229,8 @@ class EpipolarPair:
     def from_orientations(cls, camera_left: Camera, eo_left: ExteriorOrientation,
                           camera_right: Camera, eo_right: ExteriorOrientation,
                           scale: float = 1.0, names: Tuple[str, str] = ("left", "right"),
-                          border_samples: int = 64) -> EpipolarPair:
+                          border_samples: int = 64, overlap_points: Optional[ArrayLike] = None,
+                          rectification: str = "auto") -> EpipolarPair:
         """Normalise a pair.
 
         Parameters
@@ -136,36 +241,94 @@ class EpipolarPair:
         border_samples : int
             Points per image edge used to find the epipolar image extents (distortion bends
             the edges, so the four corners are not enough).
+        overlap_points : array (n, 3), optional
+            World points of the stereo overlap (outline at the lowest and highest terrain):
+            needed for the minimal-distortion rectification, which also cuts the images to
+            their projection (module notes).
+        rectification : {"auto", "mean_axis", "minimal_distortion"}
+            ``auto``: minimal distortion when ``overlap_points`` are given and the optical axes
+            are more than :data:`CONVERGENT_DEG` apart, else the mean-axis rotation.
         """
         if not scale > 0:
             raise InputError(f"Epipolar scale must be positive, got {scale}.")
+        if rectification not in ("auto", "mean_axis", "minimal_distortion"):
+            raise InputError(f"Unknown rectification {rectification!r}; use auto, mean_axis or "
+                             "minimal_distortion.")
+        pts = None if overlap_points is None else np.asarray(overlap_points, float).reshape(-1, 3)
+        minimal = pts is not None and (
+            rectification == "minimal_distortion"
+            or (rectification == "auto" and convergence_deg(eo_left, eo_right) > CONVERGENT_DEG))
+        if rectification == "minimal_distortion" and pts is None:
+            raise InputError("The minimal-distortion rectification needs overlap points.")
         R_n, base = normal_rotation(eo_left, eo_right)
-        f_n = scale * 0.5 * (camera_left.focal_length_px + camera_right.focal_length_px)
-        pair = cls((camera_left, camera_right), (eo_left, eo_right), R_n, base, f_n,
+        f_n = 0.5 * (camera_left.focal_length_px + camera_right.focal_length_px)
+        if minimal:
+            R_n, f_opt, _ = minimal_distortion_rotation(
+                eo_left, eo_right, (camera_left.focal_length_px, camera_right.focal_length_px),
+                pts)
+            # never coarser than the originals' mean: a DSM cell of one GSD keeps its points
+            f_n = max(f_n, f_opt)
+        pair = cls((camera_left, camera_right), (eo_left, eo_right), R_n, base, scale * f_n,
                    (0.0, 0.0), 0.0, ((1, 1), (1, 1)), np.zeros((2, 3, 3)), tuple(names))
-        # extents: original borders in normal coordinates (col with cx=0, row with cy=0)
+        pair._set_extents(border_samples, pts if minimal else None)
+        return pair
+
+    def _set_extents(self, border_samples: int, crop: Optional[Array]) -> None:
+        """Sizes and principal points from the original borders in normal coordinates, cut to
+        the projected ``crop`` points (plus :data:`CROP_MARGIN_PX`) when given."""
         u_rng, w_rng = [], []
-        for s, cam in enumerate(pair.cameras):
+        for s, cam in enumerate(self.cameras):
             border = border_pixels(cam, border_samples)
-            u, w = pair._original_to_normal(s, border[:, 0], border[:, 1])
+            u, w = self._original_to_normal(s, border[:, 0], border[:, 1])
             if not (np.isfinite(u).all() and np.isfinite(w).all()):
                 raise GeometryError("An image border looks away from the normal image plane; "
                                     "the pair cannot be normalised.")
-            u_rng.append((u.min(), u.max()))
-            w_rng.append((w.min(), w.max()))
-        w_lo = min(r[0] for r in w_rng)
-        w_hi = max(r[1] for r in w_rng)
+            lo_u, hi_u, lo_w, hi_w = u.min(), u.max(), w.min(), w.max()
+            if crop is not None:
+                cu, cw = self._world_to_normal(s, crop)
+                m = CROP_MARGIN_PX
+                lo_u, hi_u = max(lo_u, np.nanmin(cu) - m), min(hi_u, np.nanmax(cu) + m)
+                lo_w, hi_w = max(lo_w, np.nanmin(cw) - m), min(hi_w, np.nanmax(cw) + m)
+            u_rng.append((lo_u, hi_u))
+            w_rng.append((lo_w, hi_w))
+        if crop is not None:  # rows: where both images see the overlap
+            w_lo, w_hi = max(r[0] for r in w_rng), min(r[1] for r in w_rng)
+        else:
+            w_lo, w_hi = min(r[0] for r in w_rng), max(r[1] for r in w_rng)
+        if not w_hi > w_lo or any(not hi > lo for lo, hi in u_rng):
+            raise GeometryError("The stereo overlap does not project into both images.")
         cy = float(np.ceil(w_hi))
         height = int(cy - np.floor(w_lo)) + 1
         cx, sizes = [], []
         for lo, hi in u_rng:
             cx.append(float(-np.floor(lo)))
             sizes.append((int(np.ceil(hi) - np.floor(lo)) + 1, height))
-        pair.cx = (cx[0], cx[1])
-        pair.cy = cy
-        pair.sizes = (sizes[0], sizes[1])
-        pair.homographies = np.stack([pair._homography(0), pair._homography(1)])
-        return pair
+        self.cx = (cx[0], cx[1])
+        self.cy = cy
+        self.sizes = (sizes[0], sizes[1])
+        self.homographies = np.stack([self._homography(0), self._homography(1)])
+
+    def _world_to_normal(self, s: int, points: Array) -> Tuple[Array, Array]:
+        """World points → normal image coordinates (u right, w up) in px of side ``s``."""
+        v = (points - self.eos[s].position) @ self.rotation
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(v[..., 2] < 0, -self.focal_px / v[..., 2], np.nan)
+        return v[..., 0] * scale, v[..., 1] * scale
+
+    def local_scale(self, side: str, points: ArrayLike) -> Array:
+        """Original pixels per epipolar pixel (linear, from the area ratio) at world points.
+
+        1 means no resampling distortion; see the module notes.
+        """
+        s = _side_index(side)
+        v = np.asarray(points, dtype=float).reshape(-1, 3) - self.eos[s].position
+        v = v / np.linalg.norm(v, axis=1)[:, None]
+        cos_s = -(v @ self.eos[s].rotation[:, 2])
+        cos_n = -(v @ self.rotation[:, 2])
+        f_s = self.cameras[s].focal_length_px
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where((cos_s > 0) & (cos_n > 0),
+                            f_s / self.focal_px * (cos_n / cos_s) ** 1.5, np.nan)
 
     def _homography(self, s: int) -> Array:
         cam, eo = self.cameras[s], self.eos[s]
@@ -317,10 +480,8 @@ class EpipolarPair:
     def world_to_epipolar(self, points: ArrayLike, side: str) -> Tuple[Array, Array]:
         """World points (..., 3) → epipolar pixel (col, row) of ``side`` (no distortion)."""
         s = _side_index(side)
-        v = (np.asarray(points, dtype=float) - self.eos[s].position) @ self.rotation
-        with np.errstate(divide="ignore", invalid="ignore"):
-            scale = np.where(v[..., 2] < 0, -self.focal_px / v[..., 2], np.nan)
-        return v[..., 0] * scale + self.cx[s], self.cy - v[..., 1] * scale
+        u, w = self._world_to_normal(s, np.asarray(points, dtype=float))
+        return u + self.cx[s], self.cy - w
 
     def disparity_range(self, z_min: float, z_max: float,
                         xy: Optional[ArrayLike] = None) -> Tuple[float, float]:

@@ -76,6 +76,20 @@ def footprint(cam: Any, eo: Any, height: float, n: int = 16) -> Any:
         return Polygon()
 
 
+def overlap_points(areas: List[Any]) -> np.ndarray:
+    """World points (n, 3) of the outlines of overlap polygons ``(z, polygon)``, each at its
+    height, and their centres: where a stereo model's epipolar images must reach."""
+    pts = []
+    for z, area in areas:
+        for poly in getattr(area, "geoms", [area]):
+            if poly.is_empty or not hasattr(poly, "exterior"):
+                continue
+            xy = np.vstack([np.asarray(poly.exterior.coords)[:, :2],
+                            np.asarray(poly.centroid.coords)[:, :2]])
+            pts.append(np.column_stack([xy, np.full(len(xy), z)]))
+    return np.concatenate(pts) if pts else np.empty((0, 3))
+
+
 def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
                   spacing_gsd: float = 1.0, min_height: Optional[float] = None,
                   max_height: Optional[float] = None, disparity_margin: int = 4) -> ModelSetup:
@@ -106,13 +120,12 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     m = project.model(model)
     recs = [project.image(m.left), project.image(m.right)]
     cams = [project.camera_of(r) for r in recs]
-    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
-                                          names=(recs[0].name, recs[1].name))
     mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
     terrain = project.terrain_height
     H = m.height_above_ground
     if terrain is None:
-        terrain = mean_z - (H if np.isfinite(H) else 10.0 * pair.base)
+        base = float(np.linalg.norm(recs[1].eo.position - recs[0].eo.position))
+        terrain = mean_z - (H if np.isfinite(H) else 10.0 * base)
     if not np.isfinite(H):
         H = mean_z - float(terrain)
     z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
@@ -128,6 +141,15 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     if overlap.is_empty or overlap.area <= 0:
         raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
                             f"'{m.name}' do not overlap; check the model or the orientations.")
+    areas = []
+    for z in (z_min, z_mid, z_max):  # narrow (cropped) images may overlap at z_mid only
+        a = footprint(cams[0], recs[0].eo, z).intersection(footprint(cams[1], recs[1].eo, z))
+        if not a.is_empty:
+            areas.append((z, a))
+    # convergent pairs: minimal-distortion rectification cut to the overlap on the terrain
+    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
+                                          names=(recs[0].name, recs[1].name),
+                                          overlap_points=overlap_points(areas))
     gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
     spacing = float(spacing) if spacing else float(spacing_gsd * gsd)
     if not spacing > 0:
@@ -146,12 +168,7 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     excl, bounds, lines = (read_constraints(project.edits_path)
                            if Path(project.edits_path).is_file() else ([], [], []))
     check_breaklines(lines)
-    areas = []
-    for z in (z_min, z_mid, z_max):  # narrow (cropped) images may overlap at z_mid only
-        a = footprint(cams[0], recs[0].eo, z).intersection(footprint(cams[1], recs[1].eo, z))
-        if not a.is_empty:
-            areas.append(a)
-    extent = unary_union(areas)
+    extent = unary_union([a for _, a in areas])
     if bounds:
         extent = extent.intersection(unary_union(bounds))
         if extent.is_empty:
@@ -164,4 +181,4 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
                       boundaries=bounds, breaklines=lines)
 
 
-__all__ = ["ModelSetup", "footprint", "prepare_model"]
+__all__ = ["ModelSetup", "footprint", "overlap_points", "prepare_model"]

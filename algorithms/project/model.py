@@ -23,6 +23,7 @@ What is wrong with a project file is sorted by kind (issue 16):
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -180,6 +181,9 @@ class StereoModel:
         Mean ground sample distance of the two images (m).
     height_above_ground : float
         Mean flying height above the terrain (m).
+    convergence : float
+        Angle (°) between the two optical axes (0 for parallel vertical images; a convergent
+        drone or oblique pair 20–60°); NaN when unknown.
     """
 
     name: str
@@ -191,9 +195,10 @@ class StereoModel:
     overlap: float = float("nan")
     gsd: float = float("nan")
     height_above_ground: float = float("nan")
+    convergence: float = float("nan")
 
     def to_dict(self) -> Dict[str, Any]:
-        return {
+        out: Dict[str, Any] = {
             "name": self.name,
             "left": self.left,
             "right": self.right,
@@ -204,6 +209,9 @@ class StereoModel:
             "gsd_m": round(self.gsd, 5),
             "height_above_ground_m": round(self.height_above_ground, 3),
         }
+        if math.isfinite(self.convergence):
+            out["convergence_deg"] = round(self.convergence, 3)
+        return out
 
     @classmethod
     def from_dict(cls, d: Dict[str, Any]) -> StereoModel:
@@ -217,6 +225,7 @@ class StereoModel:
             overlap=float(d.get("overlap_pct", float("nan"))) / 100.0,
             gsd=float(d.get("gsd_m", float("nan"))),
             height_above_ground=float(d.get("height_above_ground_m", float("nan"))),
+            convergence=float(d.get("convergence_deg", float("nan"))),
         )
 
 
@@ -455,6 +464,7 @@ class Project:
                 overlap=d.number("overlap_pct", float("nan")) / 100.0,
                 gsd=d.number("gsd_m", float("nan")),
                 height_above_ground=d.number("height_above_ground_m", float("nan")),
+                convergence=d.number("convergence_deg", float("nan")),
             ))
         terrain = head.number("terrain_height_m", None)
         return cls(

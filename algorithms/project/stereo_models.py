@@ -13,7 +13,11 @@ Model geometry
 
 Detection (:func:`detect_stereo_models`)
     1. Candidate pairs: images whose centres are closer than the sum of their footprint radii
-       (k-d tree), with overlap ≥ ``min_overlap`` and B/H inside ``b_h_range``.
+       (radius = farthest footprint vertex from the projection centre, so a tilted frame that
+       looks far to one side still finds its partners; k-d tree), with overlap *on the
+       terrain* ≥ ``min_overlap``, B/H inside ``b_h_range`` and optical axes at most
+       ``max_convergence`` apart (the convergence angle; drone and oblique pairs of 20–60° are
+       models like vertical ones). Every model reports its convergence and B/H.
     2. Strip direction: each image's *nearest-neighbour base* gives an axial direction (mod
        180°). The dominant direction is the mode of these directions (the direction with the
        most others within ``strip_angle_tolerance``), refined by the doubled-angle mean of its
@@ -47,6 +51,7 @@ from shapely.geometry import Polygon
 
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, ensure_feedback
+from ..geometry.epipolar import convergence_deg
 from ..geometry.stereo import (
     DemLike,
     Footprints,
@@ -152,6 +157,25 @@ def _order(project: Project, a: str, b: str) -> Tuple[str, str]:
     return (a, b) if s >= 0 else (b, a)
 
 
+#: Tilt (°) from which a model's GSD is taken at its overlap instead of below the camera.
+TILTED_DEG = 5.0
+
+
+def _image_gsd(project: Project, rec: Any, height: float, centre: Optional[NDArray]) -> float:
+    r"""GSD (m) of one image of a model: :math:`H c/\delta` for a (near-)vertical image; for a
+    tilted one (> :data:`TILTED_DEG`) at the model's overlap centre, the distance D along the
+    ray scaled by the foreshortening of the ground, :math:`D/(f\sqrt{\cos i})` (i the ray's
+    angle from the vertical; geometric mean of the two ground directions)."""
+    cam = project.camera_of(rec)
+    tilt = math.degrees(math.acos(float(np.clip(rec.eo.rotation[2, 2], -1.0, 1.0))))
+    if tilt <= TILTED_DEG or centre is None:
+        return float(cam.gsd(height))
+    ray = centre - rec.eo.position
+    dist = float(np.linalg.norm(ray))
+    cos_i = abs(float(ray[2])) / dist
+    return dist / cam.focal_length_px / math.sqrt(max(cos_i, 0.1))
+
+
 def model_geometry(project: Project, left: str, right: str, dem: DemLike = None,
                    footprints: Optional[Footprints] = None, kind: str = "manual",
                    order: bool = True, labels: Optional[Dict[str, str]] = None) -> StereoModel:
@@ -182,12 +206,17 @@ def model_geometry(project: Project, left: str, right: str, dem: DemLike = None,
     inter = fl.intersection(fr).area
     smaller = min(fl.area, fr.area)
     overlap = inter / smaller if smaller > 0 else 0.0
-    gsd = 0.5 * (float(project.camera_of(rl).gsd(H_l)) + float(project.camera_of(rr).gsd(H_r)))
+    centre = None
+    if not fl.intersection(fr).is_empty:
+        c = fl.intersection(fr).centroid
+        centre = np.array([c.x, c.y, 0.5 * (hl + hr)])
+    gsd = 0.5 * (_image_gsd(project, rl, H_l, centre) + _image_gsd(project, rr, H_r, centre))
     if labels is None:
         labels = image_labels([r.name for r in project.images])
     return StereoModel(name=f"{labels[left]}_{labels[right]}", left=left, right=right, kind=kind,
                        base=base, b_h=float(base / H) if H > 0 else float("nan"),
-                       overlap=float(overlap), gsd=float(gsd), height_above_ground=float(H))
+                       overlap=float(overlap), gsd=float(gsd), height_above_ground=float(H),
+                       convergence=convergence_deg(rl.eo, rr.eo))
 
 
 def overlap_polygon(project: Project, left: str, right: str, dem: DemLike = None,
@@ -267,6 +296,13 @@ class _Criteria:
     b_h_range: Tuple[float, float]
     tol: float
     in_strip_only: bool
+    max_convergence: float = 60.0
+
+    def accepts(self, m: StereoModel) -> bool:
+        """Enough overlap on the terrain, a useful B/H, optical axes not too far apart."""
+        return (m.overlap >= self.min_overlap
+                and self.b_h_range[0] <= m.b_h <= self.b_h_range[1]
+                and not m.convergence > self.max_convergence)
 
 
 def _candidate_models(project: Project, lay: _Layout, fp: Footprints, crit: _Criteria
@@ -290,7 +326,7 @@ def _candidate_models(project: Project, lay: _Layout, fp: Footprints, crit: _Cri
             continue
         m = model_geometry(project, names[i], names[j], footprints=fp, labels=labels,
                            kind="in-strip" if in_strip else "cross-strip")
-        if m.overlap >= crit.min_overlap and crit.b_h_range[0] <= m.b_h <= crit.b_h_range[1]:
+        if crit.accepts(m):
             models.append(m)
     return models, strip_pairs
 
@@ -363,6 +399,7 @@ def detect_stereo_models(
     strip_angle_tolerance: float = 20.0,
     in_strip_only: bool = False,
     footprints: Optional[Footprints] = None,
+    max_convergence: float = 60.0,
 ) -> List[StereoModel]:
     """Find the stereo models of a block (rule and order in the module notes).
 
@@ -381,10 +418,15 @@ def detect_stereo_models(
         Return only in-strip pairs.
     footprints : dict, optional
         Precomputed :func:`block_footprints` of all images.
+    max_convergence : float
+        Largest angle (°) between the two optical axes: convergent drone or oblique pairs up to
+        it are models when their overlap on the terrain and B/H are useful; beyond it the two
+        views of a surface differ too much to match.
 
     Returns
     -------
     list of StereoModel
+        Each with its ``convergence`` (°) and B/H.
     """
     names = [r.name for r in project.images]
     if len(names) < 2:
@@ -392,7 +434,7 @@ def detect_stereo_models(
     fp = footprints if footprints is not None else block_footprints(project, dem=dem)
     tol = math.radians(strip_angle_tolerance)
     lay = _Layout.of(project, names, fp, tol)
-    crit = _Criteria(min_overlap, b_h_range, tol, in_strip_only)
+    crit = _Criteria(min_overlap, b_h_range, tol, in_strip_only, max_convergence)
     models, strip_pairs = _candidate_models(project, lay, fp, crit)
     models.sort(key=_StripOrder(lay, strip_pairs, models).key)
     return models
@@ -427,7 +469,8 @@ def run_stereo_models(project_path: Union[str, Path], *, detect: bool = True,
                       min_overlap: float = 0.25, b_h_range: Tuple[float, float] = (0.2, 1.2),
                       strip_angle_tolerance: float = 20.0, in_strip_only: bool = False,
                       manual: Optional[str] = None, dem: Optional[Union[str, Path]] = None,
-                      feedback: Optional[Feedback] = None) -> Dict[str, Any]:
+                      feedback: Optional[Feedback] = None,
+                      max_convergence: float = 60.0) -> Dict[str, Any]:
     """Set a project's stereo models (detected and/or manual) and save ``project.toml``.
 
     Parameters
@@ -450,6 +493,8 @@ def run_stereo_models(project_path: Union[str, Path], *, detect: bool = True,
         DEM for terrain heights and footprints; default the project's terrain height.
     feedback : Feedback, optional
         Progress and messages.
+    max_convergence : float
+        Largest angle (°) between the optical axes of a detected model.
 
     Returns
     -------
@@ -466,7 +511,8 @@ def run_stereo_models(project_path: Union[str, Path], *, detect: bool = True,
     if detect:
         models = detect_stereo_models(
             project, dem=surface, min_overlap=min_overlap, b_h_range=b_h_range,
-            strip_angle_tolerance=strip_angle_tolerance, in_strip_only=in_strip_only)
+            strip_angle_tolerance=strip_angle_tolerance, in_strip_only=in_strip_only,
+            max_convergence=max_convergence)
     feedback.progress(60)
     by_label = {label: name for name, label in
                 image_labels([r.name for r in project.images]).items()}

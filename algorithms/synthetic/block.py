@@ -74,6 +74,8 @@ from .texture import PAD_FACTOR, make_albedo
 CRS = "EPSG:25832"
 #: lowest terrain to expect below the mean height, per terrain type (m): sizes the grid
 _LOW = {"gentle": 15.0, "dunes": 12.0, "steep": 100.0}
+#: extent factor of a drone block's object placement (see build_scene)
+DRONE_EXTENT_FACTOR = 1.25
 _BASE = {"gentle": (40.0, 120.0), "dunes": (5.0, 40.0), "steep": (700.0, 1200.0)}
 
 
@@ -169,7 +171,8 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
     planes = [base - _LOW[terrain]] + ([base + _LOW[terrain] + 25.0] if spec.windowed else [])
     pts = np.concatenate([footprint_points(plan.camera_of(im), im.eo, z)
                           for im in plan.images for z in planes])
-    cell = gsd / 2.0
+    # drone: oblique frames see far (≈ 2 H): a truth cell of one nadir GSD bounds the grid
+    cell = gsd if spec.drone else gsd / 2.0
     margin = 0.03 * float(np.ptp(pts[:, 0])) + 20 * cell
     x0 = np.floor((pts[:, 0].min() - margin) / cell) * cell
     y1 = np.ceil((pts[:, 1].max() + margin) / cell) * cell
@@ -192,15 +195,23 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
                   for im in plan.images]
     covered = unary_union(footprints)
     extent_core = float(np.sqrt(covered.area))
-    dtm, dsm, landcover, objects = place_objects(grid, dtm, o_rng, extent_core, detail_rng)
+    placement = _drone_patch(footprints) if spec.drone else None
+    if placement is not None:
+        # the lines (embankment, ditch, road) lie at 0.15–0.28 × extent from the grid centre:
+        # a wider extent keeps them at the edge of the drone patch and leaves room for objects
+        extent_core *= DRONE_EXTENT_FACTOR
+    dtm, dsm, landcover, objects = place_objects(grid, dtm, o_rng, extent_core, detail_rng,
+                                                 placement)
     feedback.progress(10.0)
 
-    models = in_strip_models(plan, grid, dtm)
+    models = in_strip_models(plan, grid, dtm, all_pairs=spec.drone)
     model_area = unary_union([footprints[_index(plan, m.left)].intersection(
         footprints[_index(plan, m.right)]) for m in models])
     disc_radius = float(np.clip(1.7 * gsd, 0.3, 2.0))
     region = model_area.buffer(-(PAD_FACTOR * disc_radius + 2.0))
-    checkpoints = choose_checkpoints(grid, dtm, dsm, landcover, region, 3 * max(len(models), 1),
+    # three per model, at most 18 (the drone block has 15 models on one patch)
+    n_check = min(3 * max(len(models), 1), 18)
+    checkpoints = choose_checkpoints(grid, dtm, dsm, landcover, region, n_check,
                                      PAD_FACTOR * disc_radius, c_rng)
     checkpoints = flatten_sites(grid, dtm, dsm, checkpoints, PAD_FACTOR * disc_radius + 1.0)
     feedback.progress(12.0)
@@ -211,15 +222,29 @@ def build_scene(size: str = "small", terrain: str = "gentle", seed: int = 1,
                  size, terrain, int(seed), spec.supersample, spec.tile_rays, models, streams[5])
 
 
+def _drone_patch(footprints: List[Polygon]) -> Optional[Tuple[float, float, float, float]]:
+    """Bounds of the ground every frame of a drone block sees (buildings and trees go there,
+    so every convergent model has objects to match), widened by 15 m; None if there is none."""
+    common = footprints[0]
+    for fp in footprints[1:]:
+        common = common.intersection(fp)
+    if common.is_empty or common.area <= 0:
+        return None
+    return tuple(common.buffer(15.0).bounds)  # type: ignore[return-value]
+
+
 def _index(plan: FlightPlan, name: str) -> int:
     return [im.name for im in plan.images].index(name)
 
 
-def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[StereoModel]:
+def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray, all_pairs: bool = False,
+                    min_overlap: float = 0.25) -> List[StereoModel]:
     """Consecutive in-strip pairs with base, B/H, overlap, GSD and height above ground.
 
     The terrain height of an image is the mean DTM along its footprint outline (on the mean
     terrain plane) and at its nadir point; the footprint is then taken at that height.
+    ``all_pairs`` (drone blocks): every pair whose footprints overlap by ≥ ``min_overlap``
+    instead, kind ``in-strip`` or ``cross-strip``.
     """
     fps, heights = [], []
     for im in plan.images:
@@ -231,8 +256,11 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
         heights.append(float(im.eo.position[2]) - zt)
         fps.append(_polygon(footprint_points(cam, im.eo, zt)))
     models: List[StereoModel] = []
-    for a, b in zip(plan.images[:-1], plan.images[1:]):
-        if a.strip != b.strip:
+    ims = plan.images
+    pairs = ([(a, b) for k, a in enumerate(ims) for b in ims[k + 1:]] if all_pairs
+             else list(zip(ims[:-1], ims[1:])))
+    for a, b in pairs:
+        if a.strip != b.strip and not all_pairs:
             continue
         ia, ib = _index(plan, a.name), _index(plan, b.name)
         # left = smaller coordinate along the base direction, i.e. along camera x
@@ -241,8 +269,11 @@ def in_strip_models(plan: FlightPlan, grid: Grid, dtm: np.ndarray) -> List[Stere
         base = float(np.linalg.norm(a.eo.position - b.eo.position))
         h = 0.5 * (heights[ia] + heights[ib])
         overlap = fps[ia].intersection(fps[ib]).area / min(fps[ia].area, fps[ib].area)
+        if all_pairs and overlap < min_overlap:
+            continue
         models.append(StereoModel(
-            name=f"{left.name}_{right.name}", left=left.name, right=right.name, kind="in-strip",
+            name=f"{left.name}_{right.name}", left=left.name, right=right.name,
+            kind="in-strip" if a.strip == b.strip else "cross-strip",
             base=base, b_h=base / h, overlap=float(overlap),
             gsd=float(plan.camera_of(a).gsd(h)), height_above_ground=h))
     return models
@@ -439,6 +470,13 @@ def _detected_models(project: Project, scene: Scene, feedback: Feedback) -> List
     may accept (e.g. image 1 with image 3 over high mountains) are not added: the block's
     models are the consecutive in-strip pairs."""
     dem = DemSampler(scene.dtm, scene.grid.transform)
+    if scene.plan.camera is not None and SIZES[scene.size].drone:
+        # drone: the models are what the detection finds on the terrain (convergent pairs too)
+        found_all = detect_stereo_models(project, dem=dem)
+        if found_all:
+            return found_all
+        feedback.warning("Stereo-model detection found no model; the planned pairs are kept.")
+        return list(scene.models)
     found = {m.name: m for m in detect_stereo_models(project, dem=dem, in_strip_only=True)}
     planned = [m.name for m in scene.models]
     if all(name in found for name in planned):

@@ -51,6 +51,13 @@ pixel at (c₀, r₀) of the full frame (W_f × H_f px, pitch δ):
 so that window pixel (c, r) is exactly frame pixel (c₀ + c, r₀ + r); distortion (none here) is
 centred on the principal point, which lies outside the windows of the outer images. Each image
 gets its own camera (``synthetic_aerial_<image>``).
+
+**The "drone" size** (:func:`plan_drone`) leaves the normal case: a 1/2.3" 4:3 camera scaled to
+768 × 576 px (c = 0.9 w, f = 691 px) flies H = GSD·f ≈ 69 m above the mean terrain in two strips
+of three frames, each aimed at a ground point of a common patch (:data:`DRONE_LAYOUT`), so the
+frames are tilted 0–35° in varying directions (forward, backward, sideways). B/H is no longer
+(1 − p)·0.9: each model's B/H and convergence (angle between the optical axes, 19–55°) come
+from the stereo-model detection on the terrain; ``base`` is the mean in-strip distance.
 """
 
 from __future__ import annotations
@@ -93,7 +100,11 @@ class SizeSpec:
         ``focal_mm``, of which only a ``width`` × ``height`` window over the common ground
         patch is rendered (module notes).
     pixel_mm, focal_mm : float
-        Pixel pitch and principal distance (mm) of the windowed frame camera.
+        Pixel pitch and principal distance (mm) of the windowed frame camera, or of the drone
+        camera (``layout="drone"``).
+    layout : {"strips", "drone"}
+        ``strips``: near-vertical images in strips (normal case); ``drone``: two strips of
+        frames tilted 0–35° towards a common patch (:func:`plan_drone`).
     """
 
     width: int
@@ -106,6 +117,12 @@ class SizeSpec:
     frame: int = 0
     pixel_mm: float = 0.0
     focal_mm: float = FOCAL_LENGTH_MM
+    layout: str = "strips"
+
+    @property
+    def drone(self) -> bool:
+        """A low drone flight with tilted, convergent frames (:func:`plan_drone`)."""
+        return self.layout == "drone"
 
     @property
     def windowed(self) -> bool:
@@ -128,6 +145,12 @@ SIZES: Dict[str, SizeSpec] = {
     # 23 cm film scanned at 20 µm, wide angle c = 153 mm: B/H = 0.6, B_px = 4600 at 60 %
     "aerial": SizeSpec(1024, 1024, 0.15, 1, 3, 2, 1 << 20, frame=11500, pixel_mm=0.020,
                        focal_mm=153.0),
+    # 1/2.3" 4:3 drone camera scaled to 768 × 576 px (pitch 8.0 µm), c = 0.9 w = 5.53 mm;
+    # GSD 10 cm at nadir → H ≈ 69 m; frames tilted 0–35° towards a common patch
+    # one ray per pixel: the oblique frames see far (a large truth grid), and the block must
+    # render in ≈ 15 s for the tests
+    "drone": SizeSpec(768, 576, 0.10, 2, 3, 1, 1 << 19, pixel_mm=0.0080,
+                      focal_mm=0.9 * 768 * 0.0080, layout="drone"),
 }
 
 #: GSD factor of the steep terrain type (flying higher keeps the relief < ½ flying height)
@@ -195,6 +218,9 @@ def make_camera(spec: SizeSpec, name: str) -> Camera:
     Normal sizes: along-track format 0.9 c (c = 100 mm). Windowed sizes: the full square frame
     (``spec.frame`` px of ``spec.pixel_mm``, c = ``spec.focal_mm``).
     """
+    if spec.drone:
+        return Camera(name=name, width=spec.width, height=spec.height, focal_length=spec.focal_mm,
+                      pixel_size=(spec.pixel_mm, spec.pixel_mm))
     if spec.windowed:
         return Camera(name=name, width=spec.frame, height=spec.frame, focal_length=spec.focal_mm,
                       pixel_size=(spec.pixel_mm, spec.pixel_mm))
@@ -243,6 +269,8 @@ def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float,
     point (origin, terrain_height) — the planned nadir of the middle image.
     """
     camera = make_camera(spec, f"synthetic_{size_name}")
+    if spec.drone:
+        return plan_drone(camera, gsd, origin, terrain_height, rng)
     H = gsd * camera.focal_length / camera.pixel_size[0]
     base = (1.0 - forward_overlap) * camera.width * gsd
     spacing = (1.0 - side_overlap) * camera.height * gsd
@@ -265,6 +293,68 @@ def plan_flight(spec: SizeSpec, size_name: str, gsd: float, origin: Tuple[float,
         for im in images:
             im.window, im.camera = _window(camera, im, centre, spec)
     return FlightPlan(camera, images, gsd, H, base, spacing, terrain_height)
+
+
+#: Drone layout in units of the flying height H, relative to the block centre: per image the
+#: projection centre (x, y) and the ground point (x, y) the optical axis aims at. Strip 1 flies
+#: east (images 0101–0103), strip 2 west (0201–0203), so the camera x axis (= flight direction)
+#: flips between the strips. 0101/0103 look forward/backward at the same patch (convergence
+#: ≈ 50°), 0201–0203 look sideways (south) at 25–35° — convergent with each other and with the
+#: first strip; 0102 is near-nadir.
+DRONE_LAYOUT: Tuple[Tuple[Tuple[float, float], Tuple[float, float]], ...] = (
+    ((-0.45, -0.25), (0.00, -0.20)),
+    ((0.00, -0.25), (0.05, -0.22)),
+    ((0.45, -0.25), (0.00, -0.15)),
+    ((0.40, 0.30), (0.10, -0.05)),
+    ((0.00, 0.30), (0.00, -0.15)),
+    ((-0.45, 0.32), (-0.05, -0.25)),
+)
+
+
+def aim_rotation(position: np.ndarray, target: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    r"""Camera→world rotation (PATB) of a camera at ``position`` looking at ``target`` with its
+    x axis as close as possible to the horizontal ``heading`` (the flight direction).
+
+    The camera looks along −z, so :math:`z = (C - T)/\lVert C - T\rVert`; x is the heading
+    orthogonalised to z and y = z × x (a nadir camera flying east gets R = I).
+    """
+    z = np.asarray(position, float) - np.asarray(target, float)
+    z /= np.linalg.norm(z)
+    x = np.asarray(heading, float) - (np.asarray(heading, float) @ z) * z
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def plan_drone(camera: Camera, gsd: float, origin: Tuple[float, float], terrain_height: float,
+               rng: np.random.Generator) -> FlightPlan:
+    """A drone flight of six frames tilted 0–35° in varying directions (:data:`DRONE_LAYOUT`).
+
+    H = GSD · c/δ above the mean terrain; each aim point gets ±2 % H of jitter and each centre
+    ±1 % H (and ±0.5 % H in height), so the tilts vary by about ±1°. The plan's ``base`` is
+    the mean distance of consecutive in-strip images, ``strip_spacing`` that of the strips.
+    """
+    H = gsd * camera.focal_length / camera.pixel_size[0]
+    images: List[PlannedImage] = []
+    ox, oy = origin
+    for k, ((px, py), (tx, ty)) in enumerate(DRONE_LAYOUT):
+        s, i = divmod(k, 3)
+        pos = np.array([ox + px * H, oy + py * H, terrain_height + H])
+        pos += rng.normal(0.0, [0.01 * H, 0.01 * H, 0.005 * H])
+        target = np.array([ox + tx * H, oy + ty * H, terrain_height])
+        target[:2] += rng.normal(0.0, 0.02 * H, 2)
+        heading = np.array([1.0, 0.0, 0.0]) if s == 0 else np.array([-1.0, 0.0, 0.0])
+        rot = aim_rotation(pos, target, heading)
+        images.append(PlannedImage(f"{s + 1:02d}{i + 1:02d}", s, i,
+                                   ExteriorOrientation(pos, rot)))
+    pos = np.array([im.eo.position for im in images])
+    base = float(np.mean([np.linalg.norm(pos[k + 1] - pos[k]) for k in (0, 1, 3, 4)]))
+    spacing = float(abs(pos[3:, 1].mean() - pos[:3, 1].mean()))
+    return FlightPlan(camera, images, gsd, H, base, spacing, terrain_height)
+
+
+def tilt_degrees(eo: ExteriorOrientation) -> float:
+    """Angle (°) between the optical axis and the nadir."""
+    return float(np.degrees(np.arccos(np.clip(eo.rotation[2, 2], -1.0, 1.0))))
 
 
 def _window(frame: Camera, image: PlannedImage, centre: np.ndarray, spec: SizeSpec

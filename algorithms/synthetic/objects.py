@@ -28,7 +28,7 @@ All heights are written into the truth rasters on the fine grid; the vector trut
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 from scipy import ndimage
@@ -479,8 +479,16 @@ def _add_breaklines(grid: Grid, dtm: np.ndarray, obj: SceneObjects) -> None:
             obj.breaklines.append((kind, np.column_stack([xy[ok], z[ok]])))
 
 
+class _PlacementArea:
+    """Only the ``bounds`` of a grid: where the forest, buildings and trees are placed."""
+
+    def __init__(self, bounds: Tuple[float, float, float, float]) -> None:
+        self.bounds = bounds
+
+
 def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_core: float,
-                  detail_rng: Optional[np.random.Generator] = None
+                  detail_rng: Optional[np.random.Generator] = None,
+                  placement: Optional[Tuple[float, float, float, float]] = None
                   ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, SceneObjects]:
     """Modify the terrain, build the DSM and land cover, and return the object list.
 
@@ -498,6 +506,9 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
     extent_core : float
         Size (m) of the area covered by the images; object counts scale with its square.
     detail_rng : numpy.random.Generator, optional
+    placement : (xmin, ymin, xmax, ymax), optional
+        Where the forest, buildings and isolated trees go (default the whole grid), e.g. the
+        patch every image of a drone block sees.
 
     Returns
     -------
@@ -510,12 +521,13 @@ def place_objects(grid: Grid, dtm: np.ndarray, rng: np.random.Generator, extent_
     landcover = _shape_linear_features(grid, dtm, obj)
     area = extent_core ** 2
     taken: List[Tuple[float, float, float]] = []  # x, y, keep-out radius
-    trees = _place_forest(grid, obj, rng, extent_core, taken)
+    where: Any = grid if placement is None else _PlacementArea(placement)
+    trees = _place_forest(where, obj, rng, extent_core, taken)
     n_forest = len(trees)
-    _place_buildings(grid, obj, rng, area, taken)
+    _place_buildings(where, obj, rng, area, taken)
     _level_platforms(grid, dtm, obj)  # platforms first (they change the DTM)
     dsm = dtm.copy()
-    _place_isolated_trees(grid, obj, rng, area, taken, trees)
+    _place_isolated_trees(where, obj, rng, area, taken, trees)
     if detail_rng is None:
         detail_rng = np.random.default_rng(int(rng.integers(2 ** 63)))
     _decorate_buildings(obj, detail_rng)

@@ -28,12 +28,15 @@ class SyntheticBlock(Algorithm):
     parameters = (
         Parameter("output", "output_folder", "Output project folder"),
         Parameter("size", "enum", "Block size", default="small",
-                  options=("tiny", "small", "medium", "large", "aerial"),
+                  options=("tiny", "small", "medium", "large", "aerial", "drone"),
                   help="tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: "
                        "1408×2000 px; large: 2400×3400 px (≈ 8 Mpx); aerial: three "
                        "wide-angle film frames in one strip (11500 px, c = 153 mm, B/H 0.6, "
                        "base 4600 px, H ≈ 1150 m) of which a 1024×1024 px window over the "
-                       "common ground patch is rendered — for height accuracy in ‰ of H."),
+                       "common ground patch is rendered — for height accuracy in ‰ of H; "
+                       "drone: six 768×576 px frames of a drone camera flown ≈ 70 m above "
+                       "ground, tilted 0–35° in varying directions towards a common patch "
+                       "(convergent pairs, GSD 10 cm at nadir)."),
         Parameter("terrain", "enum", "Terrain type", default="gentle",
                   options=("gentle", "dunes", "steep"),
                   help="steep: relief > 100 m with slopes of 45° and more (flown 2.5× higher)."),
