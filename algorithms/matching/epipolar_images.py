@@ -20,6 +20,7 @@ from ..geometry.projection import ray_at_height, world_to_pixel
 from ..jsonable import json_ready
 from ..project.model import Project
 from ..raster.io import gtiff_profile, open_image, staged_folder
+from .model_setup import model_heights, model_pair, overlap_areas
 
 
 def _y_parallax_check(pair: EpipolarPair, height: float, n: int = 15) -> float:
@@ -95,9 +96,10 @@ def write_epipolar_pair(project: Project, model_name: str, out_dir: Path, scale:
     model = project.model(model_name)
     recs = [project.image(model.left), project.image(model.right)]
     cams = [project.camera_of(r) for r in recs]
-    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
-                                          scale=scale,
-                                          names=(recs[0].name, recs[1].name))
+    # the geometry matching uses: a convergent pair is rectified with minimal distortion and
+    # cut to its overlap at the model's height range
+    z_min, z_mid, z_max, _ = model_heights(project, model, recs)
+    pair = model_pair(cams, recs, overlap_areas(cams, recs, (z_min, z_mid, z_max)), scale)
     # read both inputs first: a bad file fails before any output exists
     images = [project.read_image(rec) for rec in recs]
     feedback.info(f"Epipolar pair {model.name}: base {pair.base:.2f} m, "

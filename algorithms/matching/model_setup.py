@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, List, Optional
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 from shapely.geometry import Polygon
@@ -90,6 +90,50 @@ def overlap_points(areas: List[Any]) -> np.ndarray:
     return np.concatenate(pts) if pts else np.empty((0, 3))
 
 
+def model_heights(project: Project, m: Any, recs: List[Any],
+                  min_height: Optional[float] = None, max_height: Optional[float] = None
+                  ) -> Tuple[float, float, float, float]:
+    """``(z_min, z_mid, z_max, H)`` of a model: its height range (default terrain ∓/± 0.3 H),
+    the terrain height clipped into it and the flying height above ground H (m)."""
+    mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
+    terrain = project.terrain_height
+    H = m.height_above_ground
+    if terrain is None:
+        base = float(np.linalg.norm(recs[1].eo.position - recs[0].eo.position))
+        terrain = mean_z - (H if np.isfinite(H) else 10.0 * base)
+    if not np.isfinite(H):
+        H = mean_z - float(terrain)
+    z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
+    z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
+    if not z_max > z_min:
+        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
+    if z_max >= mean_z:
+        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
+                         "give a lower max_height.")
+    return z_min, float(np.clip(float(terrain), z_min, z_max)), z_max, float(H)
+
+
+def overlap_areas(cams: List[Any], recs: List[Any], heights: Tuple[float, ...]
+                  ) -> List[Tuple[float, Any]]:
+    """``(z, polygon)`` of the two footprints' overlap at each height where they overlap
+    (narrow, cropped images may overlap at the middle height only)."""
+    areas = []
+    for z in heights:
+        a = footprint(cams[0], recs[0].eo, z).intersection(footprint(cams[1], recs[1].eo, z))
+        if not a.is_empty:
+            areas.append((z, a))
+    return areas
+
+
+def model_pair(cams: List[Any], recs: List[Any], areas: List[Tuple[float, Any]],
+               scale: float = 1.0) -> EpipolarPair:
+    """The epipolar pair of a model, as matching and the ``epipolar_pair`` product use it:
+    a convergent pair gets the minimal-distortion rectification cut to its overlap."""
+    return EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
+                                          scale=scale, names=(recs[0].name, recs[1].name),
+                                          overlap_points=overlap_points(areas))
+
+
 def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
                   spacing_gsd: float = 1.0, min_height: Optional[float] = None,
                   max_height: Optional[float] = None, disparity_margin: int = 4) -> ModelSetup:
@@ -120,36 +164,14 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     m = project.model(model)
     recs = [project.image(m.left), project.image(m.right)]
     cams = [project.camera_of(r) for r in recs]
-    mean_z = 0.5 * float(recs[0].eo.position[2] + recs[1].eo.position[2])
-    terrain = project.terrain_height
-    H = m.height_above_ground
-    if terrain is None:
-        base = float(np.linalg.norm(recs[1].eo.position - recs[0].eo.position))
-        terrain = mean_z - (H if np.isfinite(H) else 10.0 * base)
-    if not np.isfinite(H):
-        H = mean_z - float(terrain)
-    z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
-    z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
-    if not z_max > z_min:
-        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
-    if z_max >= mean_z:
-        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
-                         "give a lower max_height.")
-    z_mid = float(np.clip(float(terrain), z_min, z_max))
+    z_min, z_mid, z_max, H = model_heights(project, m, recs, min_height, max_height)
     fp = [footprint(c, r.eo, z_mid) for c, r in zip(cams, recs)]
     overlap = fp[0].intersection(fp[1])
     if overlap.is_empty or overlap.area <= 0:
         raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
                             f"'{m.name}' do not overlap; check the model or the orientations.")
-    areas = []
-    for z in (z_min, z_mid, z_max):  # narrow (cropped) images may overlap at z_mid only
-        a = footprint(cams[0], recs[0].eo, z).intersection(footprint(cams[1], recs[1].eo, z))
-        if not a.is_empty:
-            areas.append((z, a))
-    # convergent pairs: minimal-distortion rectification cut to the overlap on the terrain
-    pair = EpipolarPair.from_orientations(cams[0], recs[0].eo, cams[1], recs[1].eo,
-                                          names=(recs[0].name, recs[1].name),
-                                          overlap_points=overlap_points(areas))
+    areas = overlap_areas(cams, recs, (z_min, z_mid, z_max))
+    pair = model_pair(cams, recs, areas)
     gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
     spacing = float(spacing) if spacing else float(spacing_gsd * gsd)
     if not spacing > 0:
@@ -181,4 +203,5 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
                       boundaries=bounds, breaklines=lines)
 
 
-__all__ = ["ModelSetup", "footprint", "overlap_points", "prepare_model"]
+__all__ = ["ModelSetup", "footprint", "model_heights", "model_pair", "overlap_areas",
+           "overlap_points", "prepare_model"]
