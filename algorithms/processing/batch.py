@@ -931,10 +931,8 @@ def _run_on_dask(plan: BatchPlan, hooks: _Hooks, state: Optional[Dict[str, Any]]
         if outputs is not None:
             skip[task.index] = outputs
     with batch_dask.connect(n_workers, scheduler) as (client, cluster):
-        link = batch_dask.dashboard(client)
-        hooks.log(f"Dask dashboard: {link}" if link else
-                  "Dask dashboard: none (it needs the Python package bokeh)",
-                  quiet=link is None)
+        link = batch_dask.dashboard(client, local=cluster is not None)
+        hooks.log(f"Dask dashboard: {link or 'none'}", quiet=link is None)
         folders = [("the run folder", plan.run_dir)]
         if plan.project is not None:
             folders.insert(0, ("the project folder", plan.project))

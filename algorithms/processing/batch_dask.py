@@ -271,7 +271,7 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
     with dask.config.set({"distributed.scheduler.allowed-failures": _ALLOWED_FAILURES}):
         cluster = distributed.LocalCluster(
             n_workers=n_workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-            scheduler_port=0, dashboard_address=_dashboard_address(), memory_limit=0,
+            scheduler_port=0, dashboard_address="127.0.0.1:0", memory_limit=0,
             silence_logs=logging.ERROR)
     try:
         client = distributed.Client(cluster, set_as_default=False)
@@ -283,21 +283,21 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
         cluster.close()
 
 
-def _dashboard_address() -> Optional[str]:
-    """A free port for the dashboard when Bokeh is installed (it draws it), else none."""
-    try:
-        import bokeh  # noqa: F401  # optional: the dashboard needs it
-    except ImportError:
-        return None
-    return "127.0.0.1:0"
+def dashboard(client: Any, local: bool) -> Optional[str]:
+    """The dashboard's address for the batch log, or ``None`` when the scheduler has none.
 
-
-def dashboard(client: Any) -> Optional[str]:
-    """The dashboard's address, or ``None`` when the scheduler has no dashboard."""
+    A local cluster's dashboard is on a free port; it draws only with Bokeh installed.
+    """
+    link = None
     with contextlib.suppress(Exception):
         if client.scheduler_info().get("services", {}).get("dashboard"):
-            return str(client.dashboard_link)
-    return None
+            link = str(client.dashboard_link)
+    if link and local:
+        try:
+            import bokeh  # noqa: F401  # optional: the dashboard draws with it
+        except ImportError:
+            link += " (it needs the Python package bokeh)"
+    return link
 
 
 def check_shared_paths(client: Any, paths: Sequence[Tuple[str, Any]],
