@@ -49,6 +49,8 @@ from .batch import Task, execute_task, no_result
 #: What to do when Dask distributed is missing (one line, for the CLI, QGIS and the GUI).
 INSTALL_HINT = ("a batch with more than one worker or a scheduler needs Dask distributed: "
                 "pip install \"photodem[dask]\" (Debian: apt install python3-distributed)")
+#: Seconds to reach a scheduler.
+CONNECT_TIMEOUT_S = 20.0
 #: Seconds to wait for the first worker of a scheduler's cluster.
 WORKER_TIMEOUT_S = 60.0
 #: Runs of a task whose worker died while running it: the next start fails it instead.
@@ -258,7 +260,8 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
 
     if scheduler:
         try:
-            client = distributed.Client(scheduler, timeout="20s", set_as_default=False)
+            client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s",
+                                        set_as_default=False)
         except (OSError, TimeoutError) as exc:
             raise InputError(f"Cannot reach the Dask scheduler '{scheduler}': {exc}; start it "
                              "with 'dask scheduler' and check the address (tcp://host:8786)."
