@@ -359,6 +359,7 @@ class DaskRun:
         self.inbox: queue.Queue = queue.Queue()
         self.started: Dict[int, List[str]] = {}  # task index → the workers that started it
         self.failed: Set[int] = set()  # tasks failed or erred (their dependents do not run)
+        self.cancelling = False
 
     def submit(self, tasks: Sequence[Task], skip: Dict[int, Dict[str, Any]],
                depends: Dict[int, List[int]]) -> Dict[int, Any]:
@@ -445,8 +446,8 @@ class DaskRun:
 
     def _record(self, task: Task, future: Any) -> None:
         """Record a finished future: its record, or why it ended without one."""
-        if future.cancelled():
-            return  # not started: its record says "cancelled"
+        if future.cancelled() or (self.cancelling and future.status == "error"):
+            return  # not started, or lost to the cancel: its record says "cancelled"
         if future.status == "finished":
             result = future.result()
             if result.get("status") == "failed":
@@ -473,6 +474,7 @@ class DaskRun:
 
     def _cancel(self, pending: Dict[int, Any]) -> None:
         """Tell the running tasks to stop; cancel the ones not started."""
+        self.cancelling = True
         self.hooks.log("cancel: telling the running tasks to stop", quiet=True)
         with contextlib.suppress(Exception):
             self.cancel_event.set()

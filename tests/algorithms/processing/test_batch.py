@@ -154,7 +154,8 @@ def test_cancel_in_process_leaves_no_output(fake_algs, project_dir, tmp_path):
 
 
 def test_cancel_worker_processes_leaves_no_output(fake_algs, project_dir, tmp_path):
-    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=5.0, steps=100)],
+    second = dict(_sleep_step(seconds=0.1), name="after")  # waits for the first: not run
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=5.0, steps=100), second],
                                     workers=2), run_dir=tmp_path / "run")
     feedback = Feedback()
     timer = threading.Timer(1.5, feedback.cancel)
@@ -163,7 +164,7 @@ def test_cancel_worker_processes_leaves_no_output(fake_algs, project_dir, tmp_pa
     summary = batch.run_batch(plan, feedback)
     timer.cancel()
     assert summary["status"] == "cancelled"
-    assert [t["status"] for t in summary["tasks"]] == ["cancelled"] * 3
+    assert [t["status"] for t in summary["tasks"]] == ["cancelled"] * 6
     assert time.perf_counter() - start < 5.0  # stopped cooperatively, not after 5 s
     assert _no_outputs(project_dir) == []
 
