@@ -271,7 +271,11 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
         finally:
             client.close()
         return
-    with dask.config.set({"distributed.scheduler.allowed-failures": _ALLOWED_FAILURES}):
+    # The nannies would set OMP/MKL/OPENBLAS_NUM_THREADS=1 in the workers, and in this process
+    # (Dask sets them before it spawns): the algorithms keep their threads, as in-process.
+    with dask.config.set({"distributed.scheduler.allowed-failures": _ALLOWED_FAILURES,
+                          "distributed.nanny.pre-spawn-environ": {
+                              "MALLOC_TRIM_THRESHOLD_": 65536}}):
         cluster = distributed.LocalCluster(
             n_workers=n_workers, threads_per_worker=1, processes=True, host="127.0.0.1",
             scheduler_port=0, dashboard_address="127.0.0.1:0", memory_limit=0,
