@@ -362,7 +362,7 @@ class DaskRun:
         self.topic = f"{self.prefix}-progress"
         self.inbox: queue.Queue = queue.Queue()
         self.started: Dict[int, List[str]] = {}  # task index → the workers that started it
-        self.failed: Set[int] = set()  # tasks failed or erred (their dependents do not run)
+        self.erred: Set[int] = set()  # tasks Dask gave up (it errs the tasks waiting for them)
         self.cancelling = False
 
     def submit(self, tasks: Sequence[Task], skip: Dict[int, Dict[str, Any]],
@@ -453,17 +453,14 @@ class DaskRun:
         if future.cancelled() or (self.cancelling and future.status == "error"):
             return  # not started, or lost to the cancel: its record says "cancelled"
         if future.status == "finished":
-            result = future.result()
-            if result.get("status") == "failed":
-                self.failed.add(task.index)
-            self.hooks.finish(task, result)
+            self.hooks.finish(task, future.result())
             return
-        self.failed.add(task.index)
+        self.erred.add(task.index)
         self.hooks.finish(task, no_result("failed", self._error(task, future.exception())))
 
     def _error(self, task: Task, exc: BaseException) -> str:
         """Why a task erred: a dependency erred, its workers were lost, or an error of Dask."""
-        failed = [self.tasks[i] for i in self.depends.get(task.index, []) if i in self.failed]
+        failed = [self.tasks[i] for i in self.depends.get(task.index, []) if i in self.erred]
         if failed:  # Dask errs the tasks that wait for an erred one: this one did not run
             same = [d for d in failed if d.item_kind == task.item_kind and d.item == task.item]
             if task.item is not None and same:
