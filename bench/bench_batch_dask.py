@@ -96,7 +96,9 @@ def run() -> dict:
     notes = [
         f"2 workers / 1 worker: {ratio:.2f}× the models per minute on this machine "
         "(2 cores shared with other processes; the ratio is bounded by 2 and by the cores "
-        "free during the run).",
+        "free during the run). The tiny models take seconds: the workers' first imports "
+        "(≈ 1–2 s of CPU each, counted in their first task) and the cluster's start and stop "
+        "weigh more than they would for large models.",
         f"Per model (1 worker, tiny block): {per_model_s:.1f} s; the batch's own cost per "
         f"task on Dask: {cost['overhead_per_task_ms']:.0f} ms, cluster start + stop "
         f"{cost['cluster_start_stop_s']:.1f} s.",
