@@ -293,7 +293,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
 
 def check_scheduler(address: Optional[str]) -> Optional[str]:
     """A Dask scheduler's address as given (``tcp://host:8786``, ``host:8786``), ``None`` for
-    none (empty: this machine).
+    this machine (empty, or ``local`` as for the tiled algorithms' ``--scheduler``).
 
     Raises
     ------
@@ -301,7 +301,7 @@ def check_scheduler(address: Optional[str]) -> Optional[str]:
         An address without a port, or with spaces.
     """
     text = (address or "").strip()
-    if not text:
+    if not text or text.lower() == "local":
         return None
     if not re.fullmatch(r"(?:[a-z][a-z0-9+]*://)?[^\s/:]+(?::\d+)?|"
                         r"(?:[a-z][a-z0-9+]*://)?\[[0-9a-fA-F:]+\](?::\d+)?", text) \

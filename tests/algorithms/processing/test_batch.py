@@ -333,8 +333,9 @@ def test_the_command_line_scheduler_wins_over_the_batch_file(fake_algs, project_
     assert "scheduler: tcp://10.0.0.5:8786" in capsys.readouterr().out
     assert cli.main(["batch", str(file), "--dry-run", "--scheduler", "tcp://h:1"]) == 0
     assert "scheduler: tcp://h:1" in capsys.readouterr().out
-    assert cli.main(["batch", str(file), "--dry-run", "--scheduler", ""]) == 0
-    assert "scheduler: this machine" in capsys.readouterr().out
+    for local in ("", "local"):
+        assert cli.main(["batch", str(file), "--dry-run", "--scheduler", local]) == 0
+        assert "scheduler: this machine" in capsys.readouterr().out
 
 
 def test_an_unreachable_scheduler_is_one_line(fake_algs, project_dir, tmp_path, monkeypatch):
