@@ -69,7 +69,7 @@ BENCH_PEERS := orthority opencv-python-headless xdem cloth-simulation-filter pys
 $(VENV_BENCH)/.installed: pyproject.toml
 	$(PY) -m venv $(VENV_BENCH)
 	$(VENV_BENCH)/bin/pip install -q --upgrade pip
-	$(VENV_BENCH)/bin/pip install -q -e . $(BENCH_PEERS)
+	$(VENV_BENCH)/bin/pip install -q -e ".[dask]" $(BENCH_PEERS)
 	touch $@
 
 bench: $(VENV_BENCH)/.installed

@@ -5,7 +5,8 @@ Usage::
     photodem list [--json]
     photodem help ID [--json]
     photodem run ID --name-with-dashes VALUE … [--json] [--quiet]
-    photodem batch FILE.toml [--workers N] [--resume | --no-resume] [--dry-run] [--json]
+    photodem batch FILE.toml [--workers N] [--scheduler tcp://HOST:8786] [--resume | --no-resume]
+                   [--dry-run] [--json]
     photodem batch --template PROJECT
     photodem gui
     photodem --version
@@ -120,6 +121,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("batch", help="run algorithms over the stereo models of a project")
     p.add_argument("file", nargs="?", metavar="FILE.toml")
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: file)")
+    p.add_argument("--scheduler", metavar="tcp://HOST:8786", default=None,
+                   help="run the tasks on this Dask scheduler's cluster (default: file, else "
+                        "this machine); the project must be on storage every worker sees")
     p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
                    help="skip tasks completed by an earlier run with the same parameters")
     p.add_argument("--dry-run", action="store_true", help="show the tasks, run nothing")
@@ -333,13 +337,15 @@ def cmd_batch(args: argparse.Namespace) -> int:
         if args.workers < 1:
             raise UsageError(f"--workers {args.workers}: give a whole number ≥ 1")
         plan.workers = args.workers
+    if args.scheduler is not None:  # the CLI wins over [batch] scheduler
+        plan.scheduler = batch_mod.check_scheduler(args.scheduler)
     if args.dry_run:
         if args.json:
             print(json.dumps(plan.to_dict(), indent=2, default=str))
         else:
             state = batch_mod.read_state(plan.state_home) if args.resume else {}
             print(f"project: {plan.project}\nrun folder: {plan.run_dir}\n"
-                  f"workers: {plan.workers}")
+                  f"workers: {plan.workers}\nscheduler: {plan.scheduler or 'this machine'}")
             for t in plan.tasks:
                 would = "skip" if batch_mod.resumable(t, state) is not None else "run"
                 print(f"  [{would}] {t.key}: {t.algorithm} {json.dumps(t.params)}")

@@ -5,6 +5,7 @@ A batch file is TOML::
     [batch]
     project = "../blocks/ngi"      # project folder (relative to the batch file)
     workers = 2                      # worker processes (1 = run in this process)
+    # scheduler = "tcp://10.0.0.5:8786"  # a Dask cluster instead (the CLI's --scheduler wins)
     output = "{project}/runs/night"  # run folder; default <project>/runs/<timestamp>/
 
     [[steps]]
@@ -36,19 +37,27 @@ Semantics (kept simple on purpose):
 - **Placeholders** in parameter strings: ``{project}`` (project folder), ``{run}`` (run folder),
   ``{step}`` (step name), ``{model}`` / ``{image}`` / ``{file}`` (the task's item). Other braces
   stay as they are.
-- **Order.** Steps run one after the other; the tasks of one step run in parallel on ``workers``
-  processes (``spawn`` context, each running one task at a time and reused across steps;
-  ``workers = 1`` runs them in this process). Every task calls :func:`.registry.run`, so its
-  result is the same as from Python, the CLI or QGIS.
-- **Lost workers.** A worker process that dies without a result (killed, out of memory) costs
-  only its own task: the task runs once more on a new worker (logged); a second death makes it
-  ``failed`` ("worker process N died (signal 9, SIGKILL) …"). A worker stopped with SIGTERM
-  (not by the batch's cancel) cancels its task and counts as lost. A task that failed with an
-  error is not run again. Other tasks and later steps go on as after any failure.
-- **Parent death.** Workers end with the batch: on Linux the kernel sends them SIGTERM when the
-  batch process dies (``PR_SET_PDEATHSIG``), elsewhere a thread watches the parent pid. A worker
-  told so cancels its task (which discards its staged output) and exits within
-  :data:`ORPHAN_GRACE` seconds.
+- **Order.** With ``workers = 1`` (and no scheduler) the tasks run one after the other in this
+  process, step by step, without Dask. Otherwise every task is a task of Dask distributed
+  (:mod:`.batch_dask`) on a ``LocalCluster`` of ``workers`` processes (one thread each) or on
+  the cluster of ``scheduler``; a task waits only for the tasks of earlier steps for the same
+  model/image/file, for every task of an earlier step without items and for every task of an
+  earlier step over another kind of item, so one model may be matched while another is still
+  resampled. Every task calls :func:`.registry.run`, so its result is the same as from
+  Python, the CLI or QGIS. Dask is optional: without it, a batch that needs it is refused in
+  one line that says how to install it.
+- **Lost workers.** A worker process that dies while running a task (killed, out of memory)
+  costs only its own task: Dask runs it once more on another worker (logged: "its worker …
+  was lost; running the task once more"); a second death makes it ``failed`` ("the worker
+  running it died …, the second time for this task"). Each run of a task writes an
+  ``attempt`` line to its log. A task that failed with an error is not run again. Other tasks
+  and later steps go on as after any failure.
+- **Parent death.** The local cluster's scheduler and nannies live in the batch process; its
+  worker processes exit as soon as the batch process is gone. Their tasks' staged outputs are
+  left as leftovers the next batch removes (see Leftovers).
+- **Shared storage.** On a scheduler's cluster, the project and the run folder must be on
+  storage that every worker sees at the same path; each worker is asked before the first task
+  runs, and one that cannot see them stops the batch with one line naming it.
 - **Lock.** ``<project>/.photodem/batch.lock`` (beside the resume state) is created atomically
   with the pid, host, start time and run folder of the batch; a second batch on the same
   project is refused at once with an operator error naming the holder. A lock whose process
@@ -82,8 +91,9 @@ Semantics (kept simple on purpose):
   therefore never resume (each run has a new folder); put products under ``{project}``. Input
   file contents are not hashed.
 - **Cancel.** :meth:`Feedback.cancel` (Ctrl-C in the CLI) stops scheduling; running tasks are
-  asked to stop (a shared flag their Feedback checks), which makes the algorithms discard their
-  staged outputs; workers that do not stop within ``grace`` seconds are killed. The batch is
+  asked to stop (a Dask event their Feedback checks), which makes the algorithms discard their
+  staged outputs; a local cluster whose tasks do not stop within ``grace`` seconds is closed,
+  which kills its workers (a scheduler's workers are left to finish them). The batch is
   ``cancelled`` only when a task was: a task that finished before the cancel reached it stays
   ``done``, and a cancel after the last task changes nothing.
 - **Logs.** ``<run>/batch.log`` (the whole run), one log per task (``<run>/<step>.log`` or
@@ -93,20 +103,13 @@ Semantics (kept simple on purpose):
 
 from __future__ import annotations
 
-import collections
 import contextlib
-import ctypes
 import datetime as _dt
 import hashlib
 import json
-import multiprocessing
-import multiprocessing.connection as mp_connection
 import os
 import re
-import signal
 import socket
-import sys
-import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -128,7 +131,7 @@ LOCK_FILE = Path(".photodem") / "batch.lock"
 SUMMARY_FILE = "summary.json"
 TASK_STATUSES = ("done", "skipped", "failed", "cancelled")
 _PLACEHOLDER = re.compile(r"\{(project|run|step|model|image|file)\}")
-_BATCH_KEYS = {"project", "workers", "output"}
+_BATCH_KEYS = {"project", "workers", "output", "scheduler"}
 _STEP_KEYS = {"algorithm", "name", "models", "images", "files", "params"}
 #: Parameter kinds whose values are files: a step over them iterates over ``files``.
 _FILE_ITEM_KINDS = ("raster", "file")
@@ -185,6 +188,8 @@ class BatchPlan:
     base_dir: Optional[Path] = field(default=None, repr=False)
     #: True when the run folder is the default ``runs/<timestamp>/`` (not named by the batch).
     run_auto: bool = False
+    #: A Dask scheduler's address (``tcp://host:8786``); None: this machine.
+    scheduler: Optional[str] = None
 
     def to_dict(self) -> Dict[str, Any]:
         return {
@@ -192,6 +197,7 @@ class BatchPlan:
             "project": str(self.project) if self.project else None,
             "run": str(self.run_dir),
             "workers": self.workers,
+            "scheduler": self.scheduler,
             "steps": list(self.steps),
             "tasks": [
                 {"step": t.step, "algorithm": t.algorithm, "item": t.item, "params": t.params,
@@ -243,7 +249,7 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
                          "with project = …, workers = …, output = … below it.")
     head = dict(head)
     _check_keys(head, _BATCH_KEYS, "[batch]")
-    for key in ("project", "output"):
+    for key in ("project", "output", "scheduler"):
         _text(head, key, "[batch]")
     project: Any = None
     project_dir: Optional[Path] = None
@@ -277,12 +283,32 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
         raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
     plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
                      state_home=home, config=config, base_dir=Path(base_dir),
-                     run_auto=run_auto)
+                     run_auto=run_auto, scheduler=check_scheduler(head.get("scheduler")))
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, dict):
             raise InputError(f"Batch file: step {number} is not a table.")
         _plan_step(plan, project, step, number, Path(base_dir))
     return plan
+
+
+def check_scheduler(address: Optional[str]) -> Optional[str]:
+    """A Dask scheduler's address as given (``tcp://host:8786``, ``host:8786``), ``None`` for
+    this machine (empty, or ``local`` as for the tiled algorithms' ``--scheduler``).
+
+    Raises
+    ------
+    InputError
+        An address without a port, or with spaces.
+    """
+    text = (address or "").strip()
+    if not text or text.lower() == "local":
+        return None
+    if not re.fullmatch(r"(?:[a-z][a-z0-9+]*://)?[^\s/:]+(?::\d+)?|"
+                        r"(?:[a-z][a-z0-9+]*://)?\[[0-9a-fA-F:]+\](?::\d+)?", text) \
+            or not re.search(r":\d+$", text):
+        raise InputError(f"Dask scheduler {address!r}: give its address as tcp://host:port, "
+                         "e.g. tcp://10.0.0.5:8786.")
+    return text
 
 
 def _text(table: Dict[str, Any], key: str, where: str) -> None:
@@ -676,285 +702,8 @@ def execute_task(algorithm: str, params: Dict[str, Any], log_path: PathLike,
     return result
 
 
-# -- worker processes ----------------------------------------------------------------------------
-#: Seconds an orphaned worker (its batch parent died) gets to discard its staged output before
-#: it exits anyway (an algorithm that does not check its feedback in time).
-ORPHAN_GRACE = 3.0
-_PR_SET_PDEATHSIG = 1  # from linux/prctl.h
-
-#: In a worker: a task is running (a parent's death then cancels it before the worker exits).
-_busy = False
-#: In a worker: the batch parent is gone (or sent SIGTERM); the running task is cancelled.
-_orphaned = threading.Event()
-
-
-def _worker_main(conn: Any, cancel_flag: Any, modules: Sequence[str], parent_pid: int) -> None:
-    """A worker process: run the tasks the parent sends until it sends ``None`` or is gone.
-
-    Each job is ``(index, algorithm, params, log)``; the worker answers with
-    ``("progress", index, pct)`` messages and one ``("result", index, dict)``.
-    """
-    global _busy
-    _die_with_parent(parent_pid)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C (cancel_flag)
-    registry.add_modules(modules)
-
-    def is_canceled() -> bool:
-        return bool(cancel_flag.value) or _orphaned.is_set()
-
-    while True:
-        try:
-            job = conn.recv()
-        except (EOFError, OSError):  # the parent is gone
-            return
-        if job is None:
-            return
-        index, algorithm, params, log = job
-        _busy = True  # until the result is sent: a SIGTERM then lets the task finish or cancel
-        result = execute_task(algorithm, params, log, is_canceled, _progress_sender(conn, index))
-        sent = _send(conn, ("result", index, result))
-        _busy = False
-        if not sent or _orphaned.is_set():
-            return
-
-
-def _die_with_parent(parent_pid: int) -> None:
-    """End this worker when the batch parent dies (SIGTERM on Linux, else a watchdog thread)."""
-    signal.signal(signal.SIGTERM, lambda signum, frame: _orphan())
-    armed = False
-    # The kernel signals when the *thread* that started us ends: run_batch starts the workers
-    # and ends them before it returns, so that thread outlives them.
-    if sys.platform.startswith("linux"):
-        with contextlib.suppress(Exception):  # no libc symbol: fall back to the watchdog
-            libc = ctypes.CDLL(None, use_errno=True)
-            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0) == 0
-    if os.getppid() != parent_pid:  # the parent died before the signal was armed
-        os._exit(0)
-    if not armed:
-        threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
-
-
-def _watch_parent(parent_pid: int) -> None:
-    while os.getppid() == parent_pid:
-        time.sleep(0.5)
-    _orphan()
-
-
-def _orphan() -> None:
-    """The parent is gone: exit now when idle, else cancel the task and exit soon after."""
-    if _orphaned.is_set():
-        return
-    _orphaned.set()  # the task's feedback now reports cancel: its staged output is discarded
-    if not _busy:
-        os._exit(0)
-    timer = threading.Timer(ORPHAN_GRACE, os._exit, args=(1,))
-    timer.daemon = True
-    timer.start()
-
-
-def _progress_sender(conn: Any, index: int) -> Callable[[float], None]:
-    last = [-1.0]
-
-    def progress(pct: float) -> None:
-        if pct - last[0] >= 1.0 or pct >= 100.0:  # at most ~100 messages per task
-            last[0] = pct
-            if not _send(conn, ("progress", index, pct)):
-                _orphan()  # the parent's end of the pipe is closed
-
-    return progress
-
-
-def _send(conn: Any, message: Any) -> bool:
-    """Send on a pipe; False when the other end is gone."""
-    try:
-        conn.send(message)
-    except (OSError, ValueError):  # BrokenPipeError, or a closed connection
-        return False
-    return True
-
-
-def _exit_cause(exitcode: Optional[int]) -> str:
-    """``died (signal 9, SIGKILL)`` or ``ended with exit code 1`` for a worker's exit code."""
-    if exitcode is not None and exitcode < 0:
-        try:
-            name = signal.Signals(-exitcode).name
-        except ValueError:
-            name = "unknown signal"
-        return f"died (signal {-exitcode}, {name})"
-    return f"ended with exit code {exitcode}"
-
-
-@dataclass
-class _Worker:
-    """A worker process, the parent's end of its pipe and the task it runs (None: idle)."""
-
-    process: Any
-    conn: Any
-    task: Optional[Task] = None
-    #: The worker cancelled its task on a SIGTERM that was not the batch's cancel; it exits.
-    stopped: bool = False
-
-
-class _Pool:
-    """At most ``n`` spawned worker processes; a worker that dies costs only its own task.
-
-    A task whose worker dies without a result runs once more on a new worker; a second death
-    makes it ``failed``. Cancellation is a shared flag the tasks' feedback checks.
-    """
-
-    def __init__(self, n: int, modules: Sequence[str], log: Callable[..., None],
-                 finish: Callable[[Task, Dict[str, Any]], None], progress: _Progress) -> None:
-        self.ctx = multiprocessing.get_context("spawn")
-        self.n = n
-        self.modules = tuple(modules)
-        self.log = log  # log(message, warning=False, quiet=False): batch.log (and operator)
-        self.finish = finish  # records a task's result
-        self.progress = progress
-        # A shared byte, not an Event: a worker killed while holding an Event's internal lock
-        # would leave every other worker blocked in is_set().
-        self.cancel_flag = self.ctx.RawValue("b", 0)
-        self.workers: List[_Worker] = []
-
-    # -- workers ---------------------------------------------------------------------------------
-    def _spawn(self) -> _Worker:
-        conn, child = self.ctx.Pipe()
-        process = self.ctx.Process(
-            target=_worker_main, name="photodem-batch-worker",
-            args=(child, self.cancel_flag, self.modules, os.getpid()),
-        )
-        process.start()
-        child.close()  # a worker's death then shows as EOF on our end
-        worker = _Worker(process, conn)
-        self.workers.append(worker)
-        return worker
-
-    def _idle(self) -> Optional[_Worker]:
-        """An idle live worker (a new one while fewer than ``n`` run), or None."""
-        for worker in [w for w in self.workers if w.task is None and not w.process.is_alive()]:
-            self._drop(worker)  # died between tasks: nothing lost
-        for worker in self.workers:
-            if worker.task is None:
-                return worker
-        return self._spawn() if len(self.workers) < self.n else None
-
-    def _busy(self) -> List[_Worker]:
-        return [w for w in self.workers if w.task is not None]
-
-    def _drop(self, worker: _Worker) -> None:
-        with contextlib.suppress(Exception):
-            worker.conn.close()
-        self.workers.remove(worker)
-
-    def _collect(self, worker: _Worker) -> None:
-        """Read the worker's messages; a result finishes its task."""
-        while worker.task is not None:
-            try:
-                if not worker.conn.poll():
-                    return
-                kind, index, value = worker.conn.recv()
-            except (EOFError, OSError):  # the worker died; the caller sees its exit
-                return
-            if kind == "progress":
-                self.progress.set(index, min(value, 99.0))
-            elif kind == "result" and value.get("status") == "cancelled" \
-                    and not self.cancel_flag.value:
-                worker.stopped = True  # someone stopped the worker: as if it had died
-            elif kind == "result":
-                task, worker.task = worker.task, None
-                self.finish(task, value)
-
-    # -- a step ----------------------------------------------------------------------------------
-    def run(self, tasks: List[Task], feedback: Feedback, grace: float) -> None:
-        """Run ``tasks`` on the workers; return when all are finished (or cancelled)."""
-        queue = collections.deque(tasks)
-        lost: Dict[int, int] = {}  # task index → deaths of its workers
-        cancel_deadline: Optional[float] = None
-        while queue or self._busy():
-            if feedback.is_canceled() and cancel_deadline is None:
-                self.cancel_flag.value = 1  # running tasks stop at their next progress check
-                queue.clear()  # tasks not started keep their record "cancelled"
-                cancel_deadline = time.monotonic() + grace
-            if cancel_deadline is not None and time.monotonic() > cancel_deadline:
-                self._kill_busy("worker killed: it did not stop within the grace time "
-                                "after the cancel")
-                return
-            while queue and (worker := self._idle()) is not None:
-                task = queue.popleft()
-                worker.task = task
-                self.log(f"{task.key}: started on worker process {worker.process.pid}",
-                         quiet=True)
-                self.progress.set(task.index, 0.0)  # started
-                _send(worker.conn, (task.index, task.algorithm, task.params, str(task.log)))
-            busy = self._busy()
-            mp_connection.wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
-                               timeout=0.1)
-            for worker in busy:
-                self._collect(worker)
-                if worker.task is not None and not worker.process.is_alive():
-                    self._lost(worker, feedback, queue, lost)
-
-    def _lost(self, worker: _Worker, feedback: Feedback, queue: collections.deque[Task],
-              lost: Dict[int, int]) -> None:
-        """A worker died: its task runs again once, or fails (is cancelled during a cancel)."""
-        worker.process.join(1.0)
-        self._collect(worker)  # a result sent just before the exit still counts
-        task = worker.task
-        self._drop(worker)
-        if task is None:
-            return
-        cause = f"worker process {worker.process.pid} " + (
-            "was stopped (SIGTERM)" if worker.stopped else _exit_cause(worker.process.exitcode))
-        lost[task.index] = lost.get(task.index, 0) + 1
-        if feedback.is_canceled():
-            self.finish(task, _no_result("cancelled", f"{cause} during the cancel"))
-        elif lost[task.index] == 1:
-            self.log(f"{task.key}: {cause}; running the task once more", warning=True)
-            queue.appendleft(task)
-        else:
-            self.finish(task, _no_result(
-                "failed", f"{cause}, the second time for this task; if memory ran out, "
-                          "use fewer workers"))
-
-    def _kill_busy(self, reason: str) -> None:
-        """Kill the workers that still run a task; their tasks end ``cancelled``."""
-        busy = self._busy()
-        for worker in busy:
-            worker.process.kill()
-        for worker in busy:
-            worker.process.join(2.0)
-            self._collect(worker)  # finished after all: keep the result
-            if worker.task is not None:
-                self.finish(worker.task, _no_result("cancelled", reason))
-                worker.task = None
-            self._drop(worker)
-
-    def close(self) -> None:
-        """End the workers: idle ones at once; running ones (an interrupted batch) are
-        cancelled, then killed after a few seconds."""
-        self.cancel_flag.value = 1  # only tasks of an interrupted batch still run
-        deadline = time.monotonic() + 3.0
-        while time.monotonic() < deadline:
-            live = [w for w in self._busy() if w.process.is_alive()]
-            if not live:
-                break
-            mp_connection.wait([w.conn for w in live] + [w.process.sentinel for w in live],
-                               timeout=0.1)
-            for worker in live:
-                self._collect(worker)  # a task that finished or was cancelled meanwhile
-        for worker in self._busy():
-            self._collect(worker)
-        self._kill_busy("worker killed: the batch was interrupted")
-        for worker in self.workers:
-            _send(worker.conn, None)
-        for worker in list(self.workers):
-            worker.process.join(2.0)
-            if worker.process.is_alive():
-                worker.process.kill()
-                worker.process.join(1.0)
-            self._drop(worker)
-
-
-def _no_result(status: str, error: str) -> Dict[str, Any]:
+def no_result(status: str, error: str) -> Dict[str, Any]:
+    """The record of a task that ended without running to its end (not run, lost, cancelled)."""
     return {"status": status, "outputs": {}, "duration_s": 0.0, "error": error}
 
 
@@ -990,6 +739,7 @@ def run_batch(
     resume: bool = True,
     extra_modules: Sequence[str] = (),
     grace: float = 10.0,
+    scheduler: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Run a planned batch and return its summary (also written to ``<run>/summary.json``).
 
@@ -1004,7 +754,8 @@ def run_batch(
         the feedback are called in the batch's thread: ``task_progress(index, pct)`` (0 when a
         task starts) and ``task_finished(index, record)`` (the batch dialog's rows).
     workers : int, optional
-        Worker processes; default ``plan.workers``. ``1`` runs the tasks in this process.
+        Worker processes of a local Dask cluster; default ``plan.workers``. ``1`` runs the
+        tasks in this process (without Dask).
     resume : bool
         Skip tasks that an earlier run completed with the same parameters.
     extra_modules : sequence of str
@@ -1013,6 +764,10 @@ def run_batch(
     grace : float
         Seconds that running tasks get to stop after a cancel before their workers are
         killed.
+    scheduler : str, optional
+        A Dask scheduler's address (``tcp://host:8786``); default ``plan.scheduler``. Its
+        workers run the tasks (``workers`` is then not used); they must see the project and
+        the run folder at the same paths.
 
     Returns
     -------
@@ -1024,10 +779,16 @@ def run_batch(
     Raises
     ------
     InputError
-        When another batch holds the lock of the project (or of the resume state's folder), or
-        the run folder cannot be created.
+        When another batch holds the lock of the project (or of the resume state's folder),
+        the run folder cannot be created, Dask is needed but not installed, the scheduler is
+        not reachable or a worker cannot see the project or the run folder.
     """
     feedback = ensure_feedback(feedback)
+    scheduler = check_scheduler(scheduler if scheduler is not None else plan.scheduler)
+    if scheduler or (workers if workers is not None else plan.workers) > 1:
+        from .batch_dask import import_distributed  # lazy: Dask only when it is needed
+
+        import_distributed()  # before the lock and the run folder: nothing to undo
     n_workers = max(1, int(workers if workers is not None else plan.workers))
     lock, notes = _acquire_lock(plan)
     try:
@@ -1039,101 +800,152 @@ def run_batch(
             _atomic_json(lock, _lock_info(plan))
         output_policy.remove_stale([lock.parent, plan.run_dir], notes.append)
         modules = [*extra_modules, *registry.extra_modules()]
-        return _run_locked(plan, feedback, n_workers, resume, modules, grace, notes)
+        return _run_locked(plan, feedback, n_workers, resume, modules, grace, notes,
+                           scheduler)
     finally:
         _release_lock(lock)
 
 
-def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: bool,
-                modules: Sequence[str], grace: float, notes: List[str]) -> Dict[str, Any]:
-    """The body of :func:`run_batch`, with the lock held and the run folder created."""
-    started = _dt.datetime.now().isoformat(timespec="seconds")
-    t0 = time.perf_counter()
-    state = read_state(plan.state_home) if resume else {}
-    records: List[Dict[str, Any]] = [
-        {"step": t.step, "algorithm": t.algorithm, "item": t.item, "status": "cancelled",
-         "outputs": {}, "duration_s": 0.0, "error": None, "log": str(t.log),
-         "hash": t.params_hash}
-        for t in plan.tasks
-    ]
-    progress = _Progress(feedback, len(plan.tasks))
-    batch_log = open(plan.run_dir / "batch.log", "a", encoding="utf-8")  # noqa: SIM115
+class _Hooks:
+    """What the batch does as tasks start and finish: ``batch.log``, the records, the resume
+    state and the progress (in the batch's thread)."""
 
-    def log(message: str, warning: bool = False, quiet: bool = False) -> None:
+    def __init__(self, plan: BatchPlan, feedback: Feedback, batch_log: TextIO) -> None:
+        self.plan = plan
+        self.feedback = feedback
+        self.batch_log = batch_log
+        self.progress = _Progress(feedback, len(plan.tasks))
+        self.records: List[Dict[str, Any]] = [
+            {"step": t.step, "algorithm": t.algorithm, "item": t.item, "status": "cancelled",
+             "outputs": {}, "duration_s": 0.0, "error": None, "log": str(t.log),
+             "hash": t.params_hash}
+            for t in plan.tasks
+        ]
+
+    def log(self, message: str, warning: bool = False, quiet: bool = False) -> None:
         """A line in batch.log and (unless ``quiet``) for the operator."""
-        batch_log.write(f"{time.strftime('%H:%M:%S')} {message}\n")
-        batch_log.flush()
+        self.batch_log.write(f"{time.strftime('%H:%M:%S')} {message}\n")
+        self.batch_log.flush()
         if not quiet:
-            (feedback.warning if warning else feedback.info)(message)
+            (self.feedback.warning if warning else self.feedback.info)(message)
 
-    def finish(task: Task, result: Dict[str, Any]) -> None:
-        record = records[task.index]
+    def finish(self, task: Task, result: Dict[str, Any]) -> None:
+        """Record a task's result (and, when done, its resume record)."""
+        record = self.records[task.index]
         record.update({k: result.get(k) for k in ("status", "outputs", "duration_s", "error")})
         if result.get("warnings"):
             record["warnings"] = result["warnings"]
         if record["status"] != "cancelled":
-            progress.set(task.index, 100.0)
-        _notify(feedback, "task_finished", task.index, dict(record))
+            self.progress.set(task.index, 100.0)
+        _notify(self.feedback, "task_finished", task.index, dict(record))
         label = task.key
         if record["status"] == "done":
-            state_all = read_state(plan.state_home)
+            home = self.plan.state_home
+            state_all = read_state(home)
             state_all[task.key] = {"hash": task.params_hash, "algorithm": task.algorithm,
-                                   "outputs": record["outputs"], "run": str(plan.run_dir),
+                                   "outputs": record["outputs"], "run": str(self.plan.run_dir),
                                    "finished": _dt.datetime.now().isoformat(timespec="seconds")}
-            _write_state(plan.state_home, state_all)
-            log(f"{label}: done in {record['duration_s']:.1f} s")
+            _write_state(home, state_all)
+            self.log(f"{label}: done in {record['duration_s']:.1f} s")
+        elif record["status"] == "skipped":
+            self.log(f"{label}: skipped (complete from an earlier run)")
         elif record["status"] == "failed":
-            log(f"{label}: FAILED: {record['error']}", warning=True)
+            self.log(f"{label}: FAILED: {record['error']}", warning=True)
         elif record["status"] == "cancelled":
-            log(f"{label}: cancelled")
+            self.log(f"{label}: cancelled")
 
-    log(f"batch {plan.file or ''}: {len(plan.tasks)} task(s) in {len(plan.steps)} step(s), "
-        f"{n_workers} worker(s), run folder {plan.run_dir}")
+
+def _run_locked(plan: BatchPlan, feedback: Feedback, n_workers: int, resume: bool,
+                modules: Sequence[str], grace: float, notes: List[str],
+                scheduler: Optional[str]) -> Dict[str, Any]:
+    """The body of :func:`run_batch`, with the lock held and the run folder created."""
+    started = _dt.datetime.now().isoformat(timespec="seconds")
+    t0 = time.perf_counter()
+    state = read_state(plan.state_home) if resume else {}
+    batch_log = open(plan.run_dir / "batch.log", "a", encoding="utf-8")  # noqa: SIM115
+    hooks = _Hooks(plan, feedback, batch_log)
+    where = (f"Dask scheduler {scheduler}" if scheduler
+             else "this process" if n_workers == 1 else f"{n_workers} worker(s)")
+    hooks.log(f"batch {plan.file or ''}: {len(plan.tasks)} task(s) in {len(plan.steps)} "
+              f"step(s), {where}, run folder {plan.run_dir}")
     for note in notes:
-        log(note)
-    failed_items: Dict[tuple, str] = {}
-    pool: Optional[_Pool] = None
+        hooks.log(note)
     try:
-        for step in plan.steps:
-            if feedback.is_canceled():
-                break
-            todo: List[Task] = []
-            for task in (t for t in plan.tasks if t.step == step):
-                blocker = failed_items.get((task.item_kind, task.item))
-                if task.item is not None and blocker is not None:
-                    finish(task, _no_result("failed", f"not run because step '{blocker}' "
-                                                      f"failed for {task.item_kind} "
-                                                      f"'{task.name}'"))
-                    continue
-                outputs = resumable(task, state) if resume else None
-                if outputs is not None:
-                    finish(task, {"status": "skipped", "outputs": outputs, "duration_s": 0.0,
-                                  "error": None})
-                    log(f"{task.key}: skipped (complete from an earlier run)")
-                    continue
-                todo.append(task)
-            if not todo:
-                continue
-            log(f"step {step}: {len(todo)} task(s)")
-            if n_workers == 1:
-                _run_in_process(todo, feedback, progress, finish)
-            else:
-                if pool is None:
-                    pool = _Pool(n_workers, modules, log, finish, progress)
-                pool.run(todo, feedback, grace)
-            for task in todo:
-                if records[task.index]["status"] == "failed" and task.item is not None:
-                    failed_items.setdefault((task.item_kind, task.item), step)
+        if n_workers == 1 and not scheduler:
+            _run_in_process(plan, hooks, state if resume else None)
+        else:
+            n_workers = _run_on_dask(plan, hooks, state if resume else None, n_workers,
+                                     scheduler, modules, grace)
     finally:
-        if pool is not None:
-            pool.close()
-        summary = _summary(plan, records, started, t0, n_workers, resume)
+        summary = _summary(plan, hooks.records, started, t0, n_workers, resume)
+        if scheduler:
+            summary["scheduler"] = scheduler
         _atomic_json(plan.run_dir / SUMMARY_FILE, summary)
         batch_log.write(f"{time.strftime('%H:%M:%S')} batch {summary['status']}: "
                         + ", ".join(f"{v} {k}" for k, v in summary["counts"].items() if v)
                         + "\n")
         batch_log.close()
     return summary
+
+
+def _run_in_process(plan: BatchPlan, hooks: _Hooks, state: Optional[Dict[str, Any]]) -> None:
+    """Run the tasks one after the other in this process (``workers = 1``, no Dask)."""
+    failed_items: Dict[tuple, str] = {}
+    feedback = hooks.feedback
+    for task in plan.tasks:
+        if feedback.is_canceled():
+            return  # the records of the tasks not started say "cancelled"
+        blocker = failed_items.get((task.item_kind, task.item))
+        if task.item is not None and blocker is not None:
+            hooks.finish(task, no_result("failed", f"not run because step '{blocker}' failed "
+                                                   f"for {task.item_kind} '{task.name}'"))
+        else:
+            outputs = resumable(task, state) if state is not None else None
+            if outputs is not None:
+                hooks.finish(task, {"status": "skipped", "outputs": outputs,
+                                    "duration_s": 0.0, "error": None})
+                continue
+            hooks.progress.set(task.index, 0.0)  # started (per-task hooks show it as running)
+            result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
+                                  lambda pct, i=task.index: hooks.progress.set(i, pct))
+            hooks.finish(task, result)
+        if hooks.records[task.index]["status"] == "failed" and task.item is not None:
+            failed_items.setdefault((task.item_kind, task.item), task.step)
+
+
+def _run_on_dask(plan: BatchPlan, hooks: _Hooks, state: Optional[Dict[str, Any]],
+                 n_workers: int, scheduler: Optional[str], modules: Sequence[str],
+                 grace: float) -> int:
+    """Run the tasks on Dask (a LocalCluster of ``n_workers``, or ``scheduler``'s cluster).
+
+    Returns
+    -------
+    int
+        The number of workers that ran the batch.
+    """
+    from . import batch_dask  # lazy: Dask only for workers > 1 or a scheduler
+
+    skip: Dict[int, Dict[str, Any]] = {}
+    for task in plan.tasks:
+        outputs = resumable(task, state) if state is not None else None
+        if outputs is not None:
+            skip[task.index] = outputs
+    with batch_dask.connect(n_workers, scheduler) as (client, cluster):
+        link = batch_dask.dashboard(client, local=cluster is not None)
+        hooks.log(f"Dask dashboard: {link or 'none'}", quiet=link is None)
+        folders = [("the run folder", plan.run_dir)]
+        if plan.project is not None:
+            folders.insert(0, ("the project folder", plan.project))
+        n_workers = batch_dask.check_shared_paths(client, folders)
+        run = batch_dask.DaskRun(client, hooks, modules)
+        depends = batch_dask.dependencies(plan.tasks)
+        futures = run.submit(plan.tasks, skip, depends)
+        killed = run.follow(plan.tasks, futures, hooks.feedback, float(grace),
+                            can_kill=cluster is not None)
+        if killed and cluster is not None:
+            hooks.log("closing the local Dask cluster: tasks did not stop after the cancel",
+                      quiet=True)
+    return n_workers
 
 
 def _summary(plan: BatchPlan, records: List[Dict[str, Any]], started: str, t0: float,
@@ -1167,17 +979,6 @@ def _atomic_json(path: Path, data: Dict[str, Any]) -> None:
     tmp = path.with_name(output_policy.staging_name(path.name))
     tmp.write_text(json.dumps(data, indent=2, default=str), encoding="utf-8")
     os.replace(tmp, path)
-
-
-def _run_in_process(tasks: List[Task], feedback: Feedback, progress: _Progress,
-                    finish: Callable[[Task, Dict[str, Any]], None]) -> None:
-    for task in tasks:
-        if feedback.is_canceled():
-            return  # the records of the tasks not started say "cancelled"
-        progress.set(task.index, 0.0)  # started (per-task hooks show it as running)
-        result = execute_task(task.algorithm, task.params, task.log, feedback.is_canceled,
-                              lambda pct, i=task.index: progress.set(i, pct))
-        finish(task, result)
 
 
 # -- the run folder ------------------------------------------------------------------------------

@@ -34,7 +34,7 @@ from ..errors import InputError
 from ..matching.presets import DEFAULT_PRESET
 from ..project import toml_io
 from . import registry
-from .batch import SUMMARY_FILE, read_state
+from .batch import SUMMARY_FILE, check_scheduler, read_state
 
 #: Per-model steps, in the order of the chain.
 MODEL_STEPS = ("epipolar_pair", "match_model")
@@ -144,6 +144,8 @@ class BatchChoices:
     filter: str = FILTERS[0]
     filter_preset: str = "default"
     ortho: str = "mosaic"
+    #: A Dask scheduler's address (``tcp://host:8786``); empty or None: this machine.
+    scheduler: Optional[str] = None
 
 
 def choice_options(algorithm: str, parameter: str) -> Tuple[str, ...]:
@@ -168,7 +170,8 @@ def batch_config(choices: BatchChoices) -> Dict[str, Any]:
     Raises
     ------
     InputError
-        No model or no step chosen, or a step that needs a DSM no chosen step makes.
+        No model or no step chosen, a step that needs a DSM no chosen step makes, or a
+        scheduler address that is not ``tcp://host:port``.
     """
     if not choices.models:
         raise InputError("Choose at least one stereo model.")
@@ -205,9 +208,12 @@ def batch_config(choices: BatchChoices) -> Dict[str, Any]:
         dtm = f"{{project}}/products/dtm/{choices.filter}/dtm.tif"
     if "ortho" in chosen:
         steps.append(_ortho_step(choices, dtm or dsm))
-    return {"batch": {"project": str(Path(choices.project).resolve()),
-                      "workers": int(choices.workers)},
-            "steps": steps}
+    head: Dict[str, Any] = {"project": str(Path(choices.project).resolve()),
+                            "workers": int(choices.workers)}
+    scheduler = check_scheduler(choices.scheduler)
+    if scheduler:
+        head["scheduler"] = scheduler
+    return {"batch": head, "steps": steps}
 
 
 def _model_step(algorithm: str, models: List[str], params: Dict[str, Any]) -> Dict[str, Any]:

@@ -2,7 +2,8 @@
 
 The dialog shows the project's stereo models (name, kind, B/H, overlap and the state of each
 per-model step from earlier batches) with check boxes, the steps to run and their choices (from
-the algorithms' specs), and the workers. *Run* writes the batch file of these choices into
+the algorithms' specs), the workers and an optional Dask scheduler (empty: this machine). *Run*
+writes the batch file of these choices into
 ``<project>/.photodem/batches/`` and runs it with the existing runner (:func:`run_batch`: same
 state folder, lock and resume rules as ``photodem batch FILE``) off the GUI thread; *Resume*
 runs the current batch file again (tasks complete from an earlier run are skipped); *Open batch
@@ -189,6 +190,14 @@ class BatchDialog(QtWidgets.QDialog):
         self.workers_spin.setToolTip(tr("Worker processes (default: cores − 1)"))
         grid.addWidget(QtWidgets.QLabel(tr("Workers"), box), 3, 0)
         grid.addWidget(self.workers_spin, 3, 1)
+        self.scheduler_edit = QtWidgets.QLineEdit(box)
+        self.scheduler_edit.setObjectName("scheduler")
+        self.scheduler_edit.setPlaceholderText(tr("empty = this machine"))
+        self.scheduler_edit.setToolTip(tr(
+            "Address of a Dask scheduler (tcp://host:8786) whose workers run the batch; the "
+            "project must be on storage every worker sees at the same path."))
+        grid.addWidget(QtWidgets.QLabel(tr("Scheduler"), box), 3, 2)
+        grid.addWidget(self.scheduler_edit, 3, 3, 1, 3)
         self.file_label = QtWidgets.QLabel(box)
         self.file_label.setWordWrap(True)
         self.file_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
@@ -270,6 +279,8 @@ class BatchDialog(QtWidgets.QDialog):
         workers = self.settings.value(SETTINGS_PREFIX + "workers", None)
         if workers not in (None, ""):
             self.workers_spin.setValue(int(workers))
+        self.scheduler_edit.setText(str(self.settings.value(SETTINGS_PREFIX + "scheduler", "")
+                                        or ""))
         geometry = self.settings.value(SETTINGS_PREFIX + "geometry", None)
         if isinstance(geometry, QtCore.QByteArray):
             self.restoreGeometry(geometry)
@@ -281,6 +292,7 @@ class BatchDialog(QtWidgets.QDialog):
         for key, combo in self._combos().items():
             s.setValue(SETTINGS_PREFIX + key, combo.currentData())
         s.setValue(SETTINGS_PREFIX + "workers", self.workers_spin.value())
+        s.setValue(SETTINGS_PREFIX + "scheduler", self.scheduler())
         s.setValue(SETTINGS_PREFIX + "geometry", self.saveGeometry())
         if self.project_folder() is not None:
             s.setValue(SETTINGS_PROJECT, str(self.project_folder()))
@@ -369,6 +381,10 @@ class BatchDialog(QtWidgets.QDialog):
             item = self.table.item(row, COL_MODEL)
             item.setCheckState(Qt.Checked if item.text() in names else Qt.Unchecked)
 
+    def scheduler(self) -> str:
+        """The Dask scheduler's address as typed (empty: this machine)."""
+        return self.scheduler_edit.text().strip()
+
     def choices(self) -> BatchChoices:
         """The operator's choices as :class:`BatchChoices`."""
         folder = self.project_folder()
@@ -381,7 +397,7 @@ class BatchDialog(QtWidgets.QDialog):
             match_preset=self.match_preset.currentData(),
             filter=self.filter_combo.currentData(),
             filter_preset=self.filter_preset.currentData(),
-            ortho=self.ortho_combo.currentData())
+            ortho=self.ortho_combo.currentData(), scheduler=self.scheduler() or None)
 
     # -- batch files -----------------------------------------------------------------------------
     def open_batch_file(self, path: Optional[str] = None) -> bool:
@@ -407,6 +423,7 @@ class BatchDialog(QtWidgets.QDialog):
             self.table.setRowCount(0)
             self._rows = {}
         self.workers_spin.setValue(plan.workers)
+        self.scheduler_edit.setText(plan.scheduler or "")
         self._rows_from_plan(plan, check=True)
         self.batch_file = Path(path).resolve()
         self.opened_file = True
@@ -473,7 +490,8 @@ class BatchDialog(QtWidgets.QDialog):
         self.log_view.clear()
         self.tabs.setCurrentIndex(0)
         self.progress_bar.setValue(0)
-        worker = BatchWorker(path, workers=self.workers_spin.value(), only=only)
+        worker = BatchWorker(path, workers=self.workers_spin.value(), only=only,
+                             scheduler=self.scheduler())
         worker.planned.connect(self._on_planned)
         worker.progress.connect(self._on_progress)
         worker.task_progress.connect(self._on_task_progress)
@@ -662,6 +680,7 @@ class BatchDialog(QtWidgets.QDialog):
         self.project_edit.setEnabled(not running)
         self._set_steps_enabled(not running and not self.opened_file)
         self.workers_spin.setEnabled(not running)
+        self.scheduler_edit.setEnabled(not running)
 
     # -- opening logs and products ---------------------------------------------------------------
     def open_log(self, row_number: int) -> Optional[str]:

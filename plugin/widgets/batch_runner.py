@@ -66,8 +66,11 @@ class BatchWorker(QObject):
     done = pyqtSignal()
 
     def __init__(self, batch_file: Path, workers: Optional[int] = None, resume: bool = True,
-                 only: Optional[Sequence[str]] = None, parent: Optional[QObject] = None) -> None:
+                 only: Optional[Sequence[str]] = None, parent: Optional[QObject] = None,
+                 scheduler: Optional[str] = None) -> None:
         super().__init__(parent)
+        #: A Dask scheduler's address; "" runs on this machine, None as the batch file says.
+        self.scheduler = scheduler
         self.batch_file = Path(batch_file)
         self.only = list(only) if only else None  # run these models/images/files alone
         self.workers = workers
@@ -89,7 +92,7 @@ class BatchWorker(QObject):
                 plan.tasks = batch_setup.only_items(plan.tasks, self.only)
             self.planned.emit(plan)
             self.summary = batch.run_batch(plan, self.feedback, workers=self.workers,
-                                           resume=self.resume)
+                                           resume=self.resume, scheduler=self.scheduler)
         except PhotodemError as exc:
             self.error = str(exc)
             self.failed.emit(self.error)

@@ -20,6 +20,7 @@ if str(FAKES) not in sys.path:
 import _fake_algs  # noqa: E402
 
 from photodem.algorithms.processing import registry  # noqa: E402
+from photodem.algorithms.project import toml_io  # noqa: E402
 from photodem.plugin.qt import QSettings, Qt  # noqa: E402
 from photodem.plugin.widgets import batch_dialog as bd  # noqa: E402
 
@@ -213,6 +214,9 @@ def test_choices_are_remembered(qtbot, dialog, settings, tiny_block):
     d = dialog(tiny_block)
     _choose(d, {"match_model", "dsm_merge", "filter"}, MODELS, workers=3)
     d.filter_preset.setCurrentIndex(d.filter_preset.findData("urban"))
+    d.scheduler_edit.setText("tcp://10.0.0.5:8786")
+    written = toml_io.loads(d.write_batch_file().read_text())
+    assert written["batch"]["scheduler"] == "tcp://10.0.0.5:8786"
     d.close()
     again = dialog()
     assert again.project_edit.text() == str(tiny_block.resolve())
@@ -220,6 +224,9 @@ def test_choices_are_remembered(qtbot, dialog, settings, tiny_block):
         "match_model", "dsm_merge", "filter"}
     assert again.filter_preset.currentData() == "urban"
     assert again.workers_spin.value() == 3
+    assert again.scheduler_edit.text() == "tcp://10.0.0.5:8786"
+    again.scheduler_edit.setText("")  # empty: this machine, no scheduler in the file
+    assert "scheduler" not in toml_io.loads(again.write_batch_file().read_text())["batch"]
 
 
 def test_bad_input_is_reported(qtbot, dialog, tmp_path):

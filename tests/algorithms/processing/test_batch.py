@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 import threading
 import time
 
@@ -153,17 +154,27 @@ def test_cancel_in_process_leaves_no_output(fake_algs, project_dir, tmp_path):
 
 
 def test_cancel_worker_processes_leaves_no_output(fake_algs, project_dir, tmp_path):
-    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=5.0, steps=100)],
+    second = dict(_sleep_step(seconds=0.1), name="after")  # waits for the first: not run
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step(seconds=20.0, steps=400), second],
                                     workers=2), run_dir=tmp_path / "run")
-    feedback = Feedback()
-    timer = threading.Timer(1.5, feedback.cancel)
+    class CancelWhenRunning(Feedback):
+        def task_progress(self, index, pct):  # a task reported progress: it runs
+            if pct > 0:
+                self.cancel()
+
+    feedback = CancelWhenRunning()
+    timer = threading.Timer(15.0, feedback.cancel)  # in case no progress came through
     timer.start()
     start = time.perf_counter()
     summary = batch.run_batch(plan, feedback)
     timer.cancel()
     assert summary["status"] == "cancelled"
-    assert [t["status"] for t in summary["tasks"]] == ["cancelled"] * 3
-    assert time.perf_counter() - start < 5.0  # stopped cooperatively, not after 5 s
+    assert [t["status"] for t in summary["tasks"]] == ["cancelled"] * 6
+    logs = [(tmp_path / "run" / "sleep" / f"{m}.log").read_text()
+            for m in ("a_b", "b_c") if (tmp_path / "run" / "sleep" / f"{m}.log").exists()]
+    assert any("Cancelled" in text or "cancel" in text.lower() for text in logs), logs
+    # stopped cooperatively, not after 20 s (the local Dask cluster's start and stop: 2–5 s)
+    assert time.perf_counter() - start < 12.0
     assert _no_outputs(project_dir) == []
 
 
@@ -260,3 +271,85 @@ def test_relative_raster_lists_are_taken_from_the_batch_file_folder(tmp_path):
     expected = [str(base.resolve() / "a.tif"), str(base.resolve() / "m" / "b.tif")]
     assert batch._anchored(alg, "inputs", "a.tif, m/b.tif", base) == expected
     assert batch._anchored(alg, "inputs", ["a.tif", "m/b.tif"], base) == expected
+
+
+# -- Dask (issue 24): what needs no cluster ------------------------------------------------------
+def _task(index, step, item=None, kind=None):
+    return batch.Task(index=index, step=step, algorithm="x", item=item,
+                      item_kind=kind if item is not None else None, params={}, log=None)
+
+
+def test_a_task_waits_for_the_earlier_steps_of_its_item_and_for_steps_without_items():
+    from photodem.algorithms.processing.batch_dask import dependencies
+
+    tasks = [_task(0, "epi", "a", "model"), _task(1, "epi", "b", "model"),
+             _task(2, "match", "a", "model"), _task(3, "match", "b", "model"),
+             _task(4, "merge"),
+             _task(5, "ortho", "1", "image"), _task(6, "ortho", "2", "image"),
+             _task(7, "check", "a", "model")]
+    assert dependencies(tasks) == {
+        0: [], 1: [], 2: [0], 3: [1],  # model b is not held up by model a
+        4: [0, 1, 2, 3],  # a step without items waits for everything before it
+        5: [0, 1, 2, 3, 4], 6: [0, 1, 2, 3, 4],  # another kind of item: every earlier task
+        7: [0, 2, 4, 5, 6],
+    }
+
+
+def test_without_dask_more_workers_say_how_to_install_it(fake_algs, project_dir, tmp_path,
+                                                         monkeypatch, capsys):
+    from photodem.algorithms import cli
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step()], workers=2),
+                            run_dir=tmp_path / "run")
+    with pytest.raises(InputError, match=r'pip install "photodem\[dask\]"') as info:
+        batch.run_batch(plan)
+    assert "apt install python3-distributed" in str(info.value)
+    assert not (tmp_path / "run").exists()  # refused before the lock and the run folder
+    assert not (project_dir / ".photodem" / "batch.lock").exists()
+    file = project_dir.parent / "b.toml"
+    file.write_text(toml_io.dumps(_config(project_dir, [_sleep_step()], workers=2,
+                                          output=str(tmp_path / "run"))))
+    assert cli.main(["batch", str(file), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "python3-distributed" in err
+    assert cli.main(["batch", str(file), "--quiet", "--workers", "1"]) == 0  # in-process
+
+
+@pytest.mark.parametrize("address", ["tcp://10.0.0.5", "tcp://a b:8786", "http://x/y:1"])
+def test_a_bad_scheduler_address_is_an_operator_error(fake_algs, project_dir, address):
+    with pytest.raises(InputError, match="tcp://host:port"):
+        batch.plan_batch(_config(project_dir, [_sleep_step()], scheduler=address))
+
+
+def test_the_command_line_scheduler_wins_over_the_batch_file(fake_algs, project_dir, capsys):
+    from photodem.algorithms import cli
+
+    file = project_dir.parent / "b.toml"
+    file.write_text(toml_io.dumps(_config(project_dir, [_sleep_step()],
+                                          scheduler="tcp://10.0.0.5:8786")))
+    assert batch.load_batch(file).scheduler == "tcp://10.0.0.5:8786"
+    assert cli.main(["batch", str(file), "--dry-run"]) == 0
+    assert "scheduler: tcp://10.0.0.5:8786" in capsys.readouterr().out
+    assert cli.main(["batch", str(file), "--dry-run", "--scheduler", "tcp://h:1"]) == 0
+    assert "scheduler: tcp://h:1" in capsys.readouterr().out
+    for local in ("", "local"):
+        assert cli.main(["batch", str(file), "--dry-run", "--scheduler", local]) == 0
+        assert "scheduler: this machine" in capsys.readouterr().out
+
+
+def test_an_unreachable_scheduler_is_one_line(fake_algs, project_dir, tmp_path, monkeypatch):
+    pytest.importorskip("distributed")
+    import socket
+
+    from photodem.algorithms.processing import batch_dask
+
+    monkeypatch.setattr(batch_dask, "CONNECT_TIMEOUT_S", 1.0)
+    with socket.socket() as s:  # a free port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    plan = batch.plan_batch(_config(project_dir, [_sleep_step()]), run_dir=tmp_path / "run")
+    with pytest.raises(InputError, match="Cannot reach the Dask scheduler") as info:
+        batch.run_batch(plan, scheduler=f"tcp://127.0.0.1:{port}")
+    assert "\n" not in str(info.value)
+    assert not (project_dir / ".photodem" / "batch.lock").exists()

@@ -36,6 +36,18 @@ def test_choices_become_a_batch_file_the_runner_plans(project_dir):
     assert [t.key for t in plan.tasks][:2] == ["epipolar_pair/a_b", "epipolar_pair/c_d"]
     assert plan.tasks[-1].params["dem"] == str(
         project_dir.resolve() / "products/dtm/filter_linear_prediction/dtm.tif")
+    assert "scheduler" not in config["batch"] and plan.scheduler is None  # this machine
+
+
+def test_a_scheduler_goes_into_the_batch_file(project_dir):
+    choices = BatchChoices(project_dir, ["a_b"], ["epipolar_pair"],
+                           scheduler=" tcp://10.0.0.5:8786 ")
+    config = batch_setup.batch_config(choices)
+    assert config["batch"]["scheduler"] == "tcp://10.0.0.5:8786"
+    assert batch.load_batch(batch_setup.write_batch(choices)).scheduler == "tcp://10.0.0.5:8786"
+    choices.scheduler = "10.0.0.5"  # no port
+    with pytest.raises(InputError, match="tcp://host:port"):
+        batch_setup.batch_config(choices)
 
 
 def test_bad_choices_are_refused_with_a_reason(project_dir):

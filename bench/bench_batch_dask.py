@@ -1,0 +1,113 @@
+"""Batch throughput on Dask distributed (issue 24): models per minute with 1 and 2 workers on
+this machine, and the batch's own cost per task (scheduler, state file, logs).
+
+- **Throughput.** The four stereo models of the ``tiny`` synthetic block, each through
+  ``epipolar_pair`` → ``match_model`` (fbm_lsm, general), with ``workers = 1`` (in the batch
+  process, no Dask) and ``workers = 2`` (a ``LocalCluster`` of two processes, one thread
+  each). Models per minute = 4 / wall time of ``run_batch`` (cluster start and stop
+  included); the ratio says how far two workers scale on this machine (2 cores, shared).
+- **Cost per task.** A batch of many quick tasks run once, then again with everything
+  complete: the second run submits every task to Dask (each returns ``skipped`` unless a
+  dependency failed), so its wall time over the number of tasks is the batch's own cost per
+  task (Dask scheduling and transfer, result records, batch.log) without the cluster start,
+  which is measured apart.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Dict, List
+
+MODELS_STEPS = ("epipolar_pair", "match_model")
+#: Steps of quick tasks (epipolar resampling of the tiny block's 4 models each).
+QUICK_STEPS = 12
+
+
+def _plan(project: Path, run: Path, steps: List[Dict[str, Any]], workers: int) -> Any:
+    from photodem.algorithms.processing import batch
+
+    return batch.plan_batch({"batch": {"project": str(project), "workers": workers},
+                             "steps": steps}, run_dir=run)
+
+
+def _model_steps(tag: str) -> List[Dict[str, Any]]:
+    return [{"algorithm": "epipolar_pair", "name": "epipolar", "models": "all",
+             "params": {"output": f"{{project}}/products/{tag}/epipolar/{{model}}"}},
+            {"algorithm": "match_model", "name": "match", "models": "all",
+             "params": {"output": f"{{project}}/products/{tag}/dsm/{{model}}"}}]
+
+
+def _throughput(project: Path, tmp: Path, workers: int) -> Dict[str, Any]:
+    from photodem.algorithms.processing import batch
+
+    plan = _plan(project, tmp / f"run-w{workers}", _model_steps(f"w{workers}"), workers)
+    n_models = len({t.item for t in plan.tasks})
+    t0 = time.perf_counter()
+    summary = batch.run_batch(plan, resume=False)
+    wall = time.perf_counter() - t0
+    busy = sum(t["duration_s"] for t in summary["tasks"])
+    return {"case": f"{n_models} models, epipolar + match", "workers": workers,
+            "status": summary["status"], "wall_s": round(wall, 2),
+            "task_time_s": round(busy, 2),
+            "models_per_min": round(60.0 * n_models / wall, 2)}
+
+
+def _overhead(project: Path, tmp: Path) -> Dict[str, Any]:
+    from photodem.algorithms.processing import batch, batch_dask
+
+    steps = [{"algorithm": "epipolar_pair", "name": f"e{i}", "models": "all",
+              "params": {"output": f"{{project}}/products/quick/e{i}/{{model}}"}}
+             for i in range(QUICK_STEPS)]
+    batch.run_batch(_plan(project, tmp / "quick-1", steps, 2))  # makes the products
+    t0 = time.perf_counter()
+    with batch_dask.connect(2, None):
+        pass
+    start_stop = time.perf_counter() - t0
+    plan = _plan(project, tmp / "quick-2", steps, 2)
+    t0 = time.perf_counter()
+    summary = batch.run_batch(plan)
+    wall = time.perf_counter() - t0
+    n = len(plan.tasks)
+    per_task = (wall - start_stop) / n
+    return {"case": f"{n} tasks, all complete (resumed)", "workers": 2,
+            "status": f"{summary['counts']['skipped']} skipped", "wall_s": round(wall, 2),
+            "cluster_start_stop_s": round(start_stop, 2),
+            "overhead_per_task_ms": round(1000.0 * per_task, 1)}
+
+
+def run() -> dict:
+    try:
+        import distributed  # noqa: F401  # optional: the Dask path needs it
+    except ImportError:
+        return {"skipped": "Dask distributed is not installed (pip install \"photodem[dask]\")"}
+    from photodem.algorithms.processing import registry
+
+    with tempfile.TemporaryDirectory(prefix="bench-batch-dask-") as tmp_name:
+        tmp = Path(tmp_name)
+        project = tmp / "block"
+        registry.run("synthetic_block", {"output": str(project), "size": "tiny"})
+        one = _throughput(project, tmp, 1)
+        two = _throughput(project, tmp, 2)
+        cost = _overhead(project, tmp)
+    ratio = one["wall_s"] / two["wall_s"] if two["wall_s"] else float("nan")
+    per_model_s = 60.0 / one["models_per_min"]
+    notes = [
+        f"2 workers / 1 worker: {ratio:.2f}× the models per minute on this machine "
+        "(2 cores shared with other processes; the ratio is bounded by 2 and by the cores "
+        "free during the run). The tiny models take seconds: the workers' first imports "
+        "(≈ 1–2 s of CPU each, counted in their first task) and the cluster's start and stop "
+        "weigh more than they would for large models.",
+        f"Per model (1 worker, tiny block): {per_model_s:.1f} s; the batch's own cost per "
+        f"task on Dask: {cost['overhead_per_task_ms']:.0f} ms, cluster start + stop "
+        f"{cost['cluster_start_stop_s']:.1f} s.",
+        "Projection for 4 000 models of the large size (≈ 60 s each, issue 24): "
+        "4 000 × 60 s / N workers = 67 h / N, e.g. 8.3 h on 8 workers, 2.1 h on 32; the "
+        "per-task cost above (× 2 tasks per model) is < 0.1 % of that. What limits scaling: "
+        "the shared storage's bandwidth (each model reads 2 images and writes its epipolar "
+        "pair and DSM), the batch's resume state (rewritten after every task) and the "
+        "scheduler's per-task cost.",
+    ]
+    return {"title": "Batch on Dask distributed: models per minute, cost per task",
+            "rows": [one, two, cost], "notes": notes}
