@@ -142,7 +142,7 @@ class BatchChoices:
     method: str = "fbm_lsm"
     match_preset: str = DEFAULT_PRESET
     filter: str = FILTERS[0]
-    filter_preset: str = "default"
+    filter_preset: str = "auto"
     ortho: str = "mosaic"
     #: A Dask scheduler's address (``tcp://host:8786``); empty or None: this machine.
     scheduler: Optional[str] = None

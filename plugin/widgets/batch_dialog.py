@@ -171,7 +171,9 @@ class BatchDialog(QtWidgets.QDialog):
         self.match_preset = _combo(box, batch_setup.choice_options("match_model", "preset"),
                                    default=batch_setup.choice_default("match_model", "preset"))
         self.filter_combo = _combo(box, batch_setup.FILTERS, names=True)
-        self.filter_preset = _combo(box, batch_setup.choice_options("filter_lowpass", "preset"))
+        self.filter_preset = _combo(box, batch_setup.choice_options("filter_lowpass", "preset"),
+                                    default=batch_setup.choice_default("filter_lowpass",
+                                                                       "preset"))
         self.ortho_combo = _combo(box, batch_setup.ORTHO_STEPS, names=True)
         for combo, tip in ((self.method_combo, tr("Matching method")),
                            (self.match_preset, tr("Matching preset")),
