@@ -33,6 +33,14 @@ Low-pass (:mod:`.lowpass`, the iterative "Phoenics" method, Raguse 2000 §3.3.1)
 ``ground_slope_factor``
     The tolerance grows by this factor × local DTM slope × grid spacing (SMRF-style elevation
     threshold; the DTM misses slope × spacing between its nodes on steep terrain).
+``refine_radius_m``, ``refine_tolerances_m``
+    ``steep`` only: after the iterations, remaining cells more than each tolerance in turn
+    above the least-squares plane through the remaining cells within ± ``refine_radius_m``
+    are eliminated (shrubs and low crowns among sparse ground returns,
+    :mod:`.steep_ground`).
+``trend_window_m``
+    ``steep`` only: the holes are filled as a local plane trend (window of this side) plus the
+    membrane fill of the residuals, so the DTM follows the slope across gaps and at the border.
 """
 
 from __future__ import annotations
@@ -112,6 +120,9 @@ LOWPASS_PRESETS: Dict[str, Dict[str, Any]] = {
         "ground_tolerance_m": 1.0,
         "low_outlier_m": 0.0,
         "ground_slope_factor": 1.5,
+        "refine_radius_m": 8.0,
+        "refine_tolerances_m": (1.5, 0.8, 0.5, 0.4),
+        "trend_window_m": 30.0,
     },
 }
 
@@ -156,7 +167,8 @@ LINEAR_PREDICTION_PRESETS: Dict[str, Dict[str, Any]] = {
     "steep": {"coarse_spacing": 32.0, "half_weight": 0.3, "cutoff": 1.0, "low_cutoff": 8.0,
               "band_above": 1.0, "band_below": 8.0, "slope": 0.3, "shift_factor": 1.0,
               "max_shift": 1.0, "iterations": 4, "fine_iterations": 2, "ground_tolerance": 1.0,
-             "low_outlier": 0.0, "ground_slope_factor": 1.5},
+             "low_outlier": 0.0, "ground_slope_factor": 1.5, "refine_radius": 8.0,
+             "refine_tolerances": (1.5, 0.8, 0.5, 0.4), "trend_window": 30.0},
 }
 
 #: Preset names, in the order the GUIs list them.

@@ -1,0 +1,44 @@
+"""The steep presets' plane test of the ground cells and the trend fill (steep_ground)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from photodem.algorithms.filtering.lowpass import membrane_fill
+from photodem.algorithms.filtering.steep_ground import refine_ground, trend_fill
+
+
+def _slope(shape=(160, 160), spacing=0.5) -> np.ndarray:
+    """A 45° plane (1 m/m along the columns, 0.3 along the rows), heights in metres."""
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]].astype(float) * spacing
+    return 100.0 + 1.0 * cols + 0.3 * rows
+
+
+def test_refine_drops_shrubs_keeps_the_sloping_ground() -> None:
+    rng = np.random.default_rng(5)
+    truth = _slope()
+    z = truth + rng.normal(0.0, 0.03, truth.shape)
+    ground = rng.random(truth.shape) < 0.05  # sparse ground returns
+    shrub = ~ground & (rng.random(truth.shape) < 0.012)  # a fifth of the candidates
+    z[shrub] += rng.uniform(1.5, 5.0, shrub.sum())
+    cand = ground | shrub
+    kept = refine_ground(z, cand, 0.5, 8.0, (1.5, 0.8, 0.5, 0.4))
+    assert not (kept & ~cand).any()
+    assert (kept & shrub).sum() <= 0.05 * shrub.sum()  # ≥ 95 % of the shrubs dropped
+    assert (ground & ~kept).sum() <= 0.01 * ground.sum()  # ≤ 1 % of the ground lost
+    prot = np.zeros_like(cand)
+    prot[shrub] = True  # protected cells (manual ground points) stay
+    assert refine_ground(z, cand, 0.5, 8.0, (0.5,), protected=prot)[shrub].all()
+    assert np.array_equal(refine_ground(z, cand, 0.5, 0.0, (0.5,)), cand)  # 0 = off
+
+
+def test_trend_fill_follows_the_slope_where_the_membrane_runs_flat() -> None:
+    truth = _slope()
+    known = np.zeros(truth.shape, bool)
+    known[::6, :121:6] = True  # ground only on the left 60 m; the right 20 m are a gap
+    values = np.where(known, truth, np.nan)
+    filled = trend_fill(values, known, 0.5, 30.0)
+    assert np.array_equal(filled[known], truth[known].astype(np.float32))
+    assert np.abs(filled - truth).max() < 0.01  # a plane is reproduced, also 20 m out
+    flat = membrane_fill(values, known)
+    assert np.abs(flat - truth).max() > 10.0  # what the plain membrane does there
