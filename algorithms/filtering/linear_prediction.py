@@ -79,6 +79,14 @@ Hierarchy (data pyramid)
     terrain up to half a cell away: on a slope its residual to a smooth surface spreads by
     about slope·s/2, at the finest level too).
 
+Steep vegetated slopes (preset ``steep``)
+    At the end, the ground cells more than 1.5, 0.8, 0.5, 0.4 m in turn above the
+    least-squares plane through the ground cells within ± ``refine_radius`` are dropped, and
+    the DTM is the remaining ground cells filled by a local plane trend plus the membrane fill
+    of the residuals (:mod:`.steep_ground`): under a closed canopy the few ground cells are
+    too sparse for the prediction, which reverts to the coarser levels' trend between them,
+    and shrubs among them lift it by metres.
+
 Operator edits (:class:`~.surface_input.FilterConstraints`)
     ``remove`` cells are never observations (bridged); ``keep`` cells are no observations
     either (the terrain around them is predicted without them) and the DTM equals the DSM

@@ -45,6 +45,13 @@ Elimination
     iteration, isolated pits (``low_outlier_m`` below their second lowest neighbour,
     :func:`.surface_input.low_outliers`) are eliminated by a local, slope-invariant test.
 
+Steep vegetated slopes (preset ``steep``)
+    After the bumps, remaining cells more than 1.5, 0.8, 0.5, 0.4 m in turn above the
+    least-squares plane through the remaining cells within ± ``refine_radius_m`` are
+    eliminated (shrubs and low crowns among a few per cent of ground cells), and the holes are
+    filled as a local plane trend plus the membrane fill of the residuals, which follows the
+    slope across gaps and at the border (:mod:`.steep_ground`).
+
 Hole filling
     Membrane (Laplace) interpolation :math:`\nabla^2 z = 0` of the eliminated and empty cells
     with the ground cells as fixed values, solved coarse to fine on a pyramid (block means of

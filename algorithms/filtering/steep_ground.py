@@ -30,7 +30,11 @@ times) as wide, and beyond that the membrane fill of the trend itself.
 On the synthetic steep forest (:mod:`..synthetic.forest_scene`, small, 0.5 m grid) the
 low-pass filter's candidates (3920 cells, 882 of them 1–5 m up) keep 3035 cells with 8 not on
 the ground after the plane test (R = 8 m), and the DTM RMS falls from 1.70 m to 0.12 m with the
-trend fill (1.13 m with the membrane fill of only the true ground cells).
+trend fill (1.13 m with the membrane fill of only the true ground cells); linear
+prediction's ground cells give 0.16 m. A 30 m trend window beats 20 m (0.12 against 0.16 m,
+lowest −0.6 against −4.3 m): near the border a 20 m window may hold ground cells only along a
+line, whose plane tilts at random. On the 400 m bench scene (1.2 M points): 0.09 m low-pass,
+0.06 m linear prediction.
 """
 
 from __future__ import annotations
