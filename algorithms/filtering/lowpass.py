@@ -480,9 +480,13 @@ class LowpassParameters:
         return cls(**values)
 
     def report(self) -> Dict[str, Any]:
-        """The parameters the report lists (without the preset name and the tiles' range)."""
+        """The parameters the report lists (without the preset name, the tiles' range and
+        the ``steep`` presets' steps where they are off)."""
+        off = set() if self.refine_radius_m > 0 else {"refine_radius_m", "refine_tolerances_m"}
+        if not self.trend_window_m > 0:
+            off.add("trend_window_m")
         return {f.name: getattr(self, f.name) for f in fields(self)
-                if f.name not in ("preset", "height_range")}
+                if f.name not in {"preset", "height_range"} | off}
 
 
 def _schedule(par: Dict[str, Any], ov: Dict[str, Any]) -> Tuple[List[float], List[float]]:

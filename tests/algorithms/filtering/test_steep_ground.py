@@ -42,3 +42,18 @@ def test_trend_fill_follows_the_slope_where_the_membrane_runs_flat() -> None:
     assert np.abs(filled - truth).max() < 0.01  # a plane is reproduced, also 20 m out
     flat = membrane_fill(values, known)
     assert np.abs(flat - truth).max() > 10.0  # what the plain membrane does there
+
+
+def test_only_the_steep_presets_take_the_steps() -> None:
+    from photodem.algorithms.filtering.lowpass import lowpass_parameters
+    from photodem.algorithms.filtering.presets import (
+        LINEAR_PREDICTION_PRESETS,
+        LOWPASS_PRESETS,
+        PRESET_NAMES,
+    )
+
+    for name in PRESET_NAMES:
+        on = name == "steep"
+        assert (LOWPASS_PRESETS[name].get("refine_radius_m", 0.0) > 0) == on
+        assert (LINEAR_PREDICTION_PRESETS[name].get("refine_radius", 0.0) > 0) == on
+        assert ("trend_window_m" in lowpass_parameters(name).report()) == on
