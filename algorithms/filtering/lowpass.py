@@ -848,7 +848,7 @@ def _refine(st: _State, params: LowpassParameters, spacing: float) -> int:
         return 0
     kept = refine_ground(st.m, st.support, spacing, float(params.refine_radius_m),
                          [float(t) for t in params.refine_tolerances_m],
-                         protected=st.gp_cells | st.keep)
+                         protected=st.gp_cells | st.keep, valid=st.valid)
     dropped = st.support & ~kept & ~st.gp_cells
     st.support &= ~dropped
     st.m[dropped] = np.nan

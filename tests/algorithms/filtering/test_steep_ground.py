@@ -32,6 +32,17 @@ def test_refine_drops_shrubs_keeps_the_sloping_ground() -> None:
     assert np.array_equal(refine_ground(z, cand, 0.5, 0.0, (0.5,)), cand)  # 0 = off
 
 
+def test_refine_leaves_dense_ground_and_its_terrace_edges() -> None:
+    z = _slope()
+    z[:, 80:] += 3.0  # a 3 m retaining wall across the slope, open ground everywhere
+    cand = np.ones(z.shape, bool)
+    cand[::7, ::5] = False  # a few objects removed by the filter
+    assert np.array_equal(refine_ground(z, cand, 0.5, 8.0, (1.5, 0.8, 0.5, 0.4)), cand)
+    sparse = np.zeros(z.shape, bool)
+    sparse[::4, ::4] = True  # 6 % of the cells: the upper edge is judged (and lost)
+    assert not refine_ground(z, sparse, 0.5, 8.0, (1.5, 0.8, 0.5, 0.4))[:, 80:84].any()
+
+
 def test_trend_fill_follows_the_slope_where_the_membrane_runs_flat() -> None:
     truth = _slope()
     known = np.zeros(truth.shape, bool)
