@@ -79,6 +79,14 @@ Hierarchy (data pyramid)
     terrain up to half a cell away: on a slope its residual to a smooth surface spreads by
     about slope·s/2, at the finest level too).
 
+Steep vegetated slopes (preset ``steep``)
+    At the end, the ground cells more than 1.5, 0.8, 0.5, 0.4 m in turn above the
+    least-squares plane through the ground cells within ± ``refine_radius`` are dropped, and
+    the DTM is the remaining ground cells filled by a local plane trend plus the membrane fill
+    of the residuals (:mod:`.steep_ground`): under a closed canopy the few ground cells are
+    too sparse for the prediction, which reverts to the coarser levels' trend between them,
+    and shrubs among them lift it by metres.
+
 Operator edits (:class:`~.surface_input.FilterConstraints`)
     ``remove`` cells are never observations (bridged); ``keep`` cells are no observations
     either (the terrain around them is predicted without them) and the DTM equals the DSM
@@ -124,6 +132,7 @@ from .lp_pyramid import (
     upsample_sides,
 )
 from .presets import linear_prediction_preset
+from .steep_ground import refine_ground, trend_fill
 from .surface_input import (
     check_ground_points,
     dtm_slope,
@@ -207,6 +216,15 @@ class LPParameters:
         are always filled. 0 = fill everything.
     cg_tol : float
         Relative residual at which the conjugate gradients stop.
+    refine_radius : float
+        Half side (m) of the window of the ground cells' plane test at the end
+        (:func:`.steep_ground.refine_ground`); 0 = off (all presets but ``steep``).
+    refine_tolerances : tuple of float
+        Heights (m) above that plane beyond which a ground cell is dropped, one pass each.
+    trend_window : float
+        With the plane test: the DTM is the remaining ground cells filled by a local plane
+        trend of this window (m) plus the membrane fill of the residuals
+        (:func:`.steep_ground.trend_fill`) instead of the prediction.
     """
 
     coarse_spacing: float = 32.0
@@ -232,6 +250,9 @@ class LPParameters:
     low_outlier: float = 1.5
     max_gap: float = 0.0
     cg_tol: float = 5e-3
+    refine_radius: float = 0.0
+    refine_tolerances: Tuple[float, ...] = ()
+    trend_window: float = 0.0
 
     @classmethod
     def from_dict(cls, values: Dict[str, Any]) -> LPParameters:
@@ -966,7 +987,41 @@ def filter_linear_prediction(z: Array, grid: Grid, params: Optional[LPParameters
                       f"{100.0 * rows[-1]['eliminated_total_share']:.1f} % eliminated "
                       f"({time.perf_counter() - t_start:.1f} s).")
     dtm, ground = _final_ground(coarser.dtm, obs, fit.bumps, grid, prm)
+    if prm.refine_radius > 0:
+        dtm, ground = _steep_finish(dtm, ground, obs, fit.bumps, grid, prm, constraints,
+                                    feedback)
     return LPResult(dtm, ground, weights0, rows, disagreeing, levels_out)
+
+
+def _steep_finish(dtm: Array, ground: Array, obs: _Observations, bumps: Array, grid: Grid,
+                  prm: LPParameters, constraints: Any,
+                  feedback: Feedback) -> Tuple[Array, Array]:
+    """The ``steep`` presets' end (:mod:`.steep_ground`): the plane test of the ground cells,
+    the trend fill of the DTM from the remaining ones, and the ground cells against it.
+
+    Shrubs and low crowns among sparse ground returns lift the prediction by metres on a
+    steep forested slope; the prediction also reverts to the coarser levels' trend far from
+    the ground cells, where that trend misses the slope.
+    """
+    valid0, keep = obs.valid0, obs.keep & obs.valid0
+    hard = np.zeros(dtm.shape, bool)
+    if len(obs.gpts):
+        r, c = grid.cell_of(obs.gpts[:, 0], obs.gpts[:, 1])
+        hard[r[r >= 0], c[r >= 0]] = True
+    cand = ground & ~keep & np.isfinite(obs.obs0)
+    kept = refine_ground(obs.obs0, cand, grid.spacing, prm.refine_radius,
+                         [float(t) for t in prm.refine_tolerances])
+    feedback.info(f"{int((cand & ~kept).sum())} ground cells stand above the plane through the "
+                  f"ground around them (window {2 * prm.refine_radius:g} m): eliminated.")
+    values = np.where(kept, obs.obs0, np.nan).astype(np.float32)
+    values[hard] = dtm[hard]  # the DTM passes through the manual ground points
+    values[keep] = obs.z0[keep]
+    known = kept | hard | keep
+    barrier = getattr(constraints, "barrier", None)
+    filled = trend_fill(values, known, grid.spacing, prm.trend_window, barrier)
+    filled = np.where(np.isfinite(dtm) | ~valid0, filled, np.nan)  # max_gap holes stay empty
+    filled[keep] = obs.z0[keep]
+    return _final_ground(filled, obs, bumps | (cand & ~kept), grid, prm)
 
 
 def _on_terrain(z: Array, cand: Array, prm: LPParameters, spacing: float) -> Array:

@@ -45,6 +45,13 @@ Elimination
     iteration, isolated pits (``low_outlier_m`` below their second lowest neighbour,
     :func:`.surface_input.low_outliers`) are eliminated by a local, slope-invariant test.
 
+Steep vegetated slopes (preset ``steep``)
+    After the bumps, remaining cells more than 1.5, 0.8, 0.5, 0.4 m in turn above the
+    least-squares plane through the remaining cells within ± ``refine_radius_m`` are
+    eliminated (shrubs and low crowns among a few per cent of ground cells), and the holes are
+    filled as a local plane trend plus the membrane fill of the residuals, which follows the
+    slope across gaps and at the border (:mod:`.steep_ground`).
+
 Hole filling
     Membrane (Laplace) interpolation :math:`\nabla^2 z = 0` of the eliminated and empty cells
     with the ground cells as fixed values, solved coarse to fine on a pyramid (block means of
@@ -82,6 +89,7 @@ from ..project.model import Project
 from ..surface.gridding import Grid, polygon_mask
 from .auto_preset import check_dtm, is_auto, resolve_preset
 from .presets import lowpass_preset
+from .steep_ground import refine_ground, trend_fill
 from .surface_input import (
     FilterConstraints,
     FilterInput,
@@ -437,6 +445,14 @@ class LowpassParameters:
     height_range : (float, float) or None
         Height quantiles of the blunder test; None = those of the grid (tiles get the whole
         DSM's, so that every tile makes the same test).
+    refine_radius_m : float
+        Half side (m) of the window of the ground candidates' plane test
+        (:func:`.steep_ground.refine_ground`); 0 = off (all presets but ``steep``).
+    refine_tolerances_m : list of float
+        Heights (m) above that plane beyond which a candidate is dropped, one pass each.
+    trend_window_m : float
+        Window (m) of the plane trend of the hole filling (:func:`.steep_ground.trend_fill`);
+        0 = the plain membrane fill.
     """
 
     windows_m: List[float]
@@ -450,6 +466,9 @@ class LowpassParameters:
     ground_slope_factor: float = 0.0
     preset: str = "default"
     height_range: Optional[Tuple[float, float]] = None
+    refine_radius_m: float = 0.0
+    refine_tolerances_m: Sequence[float] = ()
+    trend_window_m: float = 0.0
 
     @classmethod
     def from_dict(cls, values: Dict[str, Any]) -> LowpassParameters:
@@ -461,9 +480,13 @@ class LowpassParameters:
         return cls(**values)
 
     def report(self) -> Dict[str, Any]:
-        """The parameters the report lists (without the preset name and the tiles' range)."""
+        """The parameters the report lists (without the preset name, the tiles' range and
+        the ``steep`` presets' steps where they are off)."""
+        off = set() if self.refine_radius_m > 0 else {"refine_radius_m", "refine_tolerances_m"}
+        if not self.trend_window_m > 0:
+            off.add("trend_window_m")
         return {f.name: getattr(self, f.name) for f in fields(self)
-                if f.name not in ("preset", "height_range")}
+                if f.name not in {"preset", "height_range"} | off}
 
 
 def _schedule(par: Dict[str, Any], ov: Dict[str, Any]) -> Tuple[List[float], List[float]]:
@@ -716,7 +739,11 @@ def _fill(st: _State, params: LowpassParameters, cons: FilterConstraints, grid: 
         disagree = check_ground_points(free, grid, st.gp, float(params.ground_tolerance_m))
         del free
     feedback.progress(done)
-    dtm = membrane_fill(ground_vals, known, st.barrier, cons.barrier_z)
+    if params.trend_window_m > 0:
+        dtm = trend_fill(ground_vals, known, spacing, float(params.trend_window_m), st.barrier,
+                         cons.barrier_z)
+    else:
+        dtm = membrane_fill(ground_vals, known, st.barrier, cons.barrier_z)
     dtm[keep_known] = st.dsm[keep_known]
     dtm[st.gp_cells] = st.gp_z[st.gp_cells]
     dtm[outside] = np.nan
@@ -797,6 +824,11 @@ def lowpass_filter(z: Array, spacing: float, params: LowpassParameters,
     eliminated_total += n_bumps
     feedback.info(f"{n_bumps} cells stand above their neighbourhood by more than the ground "
                   "tolerance (low objects): eliminated.")
+    n_refined = _refine(st, params, spacing)
+    eliminated_total += n_refined
+    if n_refined:
+        feedback.info(f"{n_refined} cells stand above the plane through the ground around them "
+                      f"(window {2 * params.refine_radius_m:g} m): eliminated.")
     feedback.progress(100.0 * len(windows) / n_steps)
     dtm, disagree = _fill(st, params, cons, grid, spacing, feedback,
                           100.0 * (len(windows) + 1) / n_steps)
@@ -805,7 +837,22 @@ def lowpass_filter(z: Array, spacing: float, params: LowpassParameters,
             "ground_points_disagreeing": disagree,
             "eliminated_share": eliminated_total / st.n_filterable,
             "cells_valid": int(st.valid.sum()), "cells_ground": int(ground.sum()),
-            "cells_bumps": n_bumps, "seconds": time.perf_counter() - start}
+            "cells_bumps": n_bumps, "cells_refined": n_refined,
+            "seconds": time.perf_counter() - start}
+
+
+def _refine(st: _State, params: LowpassParameters, spacing: float) -> int:
+    """The ``steep`` presets' plane test of the remaining cells (:mod:`.steep_ground`);
+    returns the number of cells it eliminated."""
+    if not params.refine_radius_m > 0:
+        return 0
+    kept = refine_ground(st.m, st.support, spacing, float(params.refine_radius_m),
+                         [float(t) for t in params.refine_tolerances_m],
+                         protected=st.gp_cells | st.keep, valid=st.valid)
+    dropped = st.support & ~kept & ~st.gp_cells
+    st.support &= ~dropped
+    st.m[dropped] = np.nan
+    return int(dropped.sum())
 
 
 def _height_range(zv: Array) -> Tuple[float, float]:
