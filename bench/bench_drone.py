@@ -65,6 +65,29 @@ def overlap_cells(project: Any, model: Any, dsm_path: str, truth_dsm: str) -> np
     return inside.reshape(z.shape)
 
 
+def visible_cells(project: Any, model: Any, dsm_path: str, truth_dsm: str,
+                  inside: np.ndarray) -> np.ndarray:
+    """Overlap cells whose true surface point both projection centres see (the truth DSM,
+    :func:`~photodem.algorithms.ortho.visibility.occluded`): what a matcher can measure."""
+    import rasterio
+    from rasterio.transform import xy
+
+    from photodem.algorithms.ortho.visibility import occluded
+
+    z, tr = _truth_on(dsm_path, truth_dsm)
+    rows, cols = np.nonzero(inside)
+    xs, ys = (np.asarray(v) for v in xy(tr, rows, cols))
+    zs = z[rows, cols]
+    with rasterio.open(truth_dsm) as ds:
+        full, full_tr = ds.read(1).astype(np.float64), ds.transform
+    seen = np.ones(rows.size, bool)
+    for name in (model.left, model.right):
+        seen &= ~occluded(xs, ys, zs, project.image(name).eo.position, full, full_tr)
+    out = np.zeros_like(inside)
+    out[rows[seen], cols[seen]] = True
+    return out
+
+
 def _stats(err: np.ndarray) -> Dict[str, float]:
     v = err[np.isfinite(err)]
     if v.size == 0:
@@ -85,6 +108,7 @@ def evaluate(project: Any, model_name: str, result: Dict[str, Any], block: Dict[
     with rasterio.open(result["count"]) as ds:
         measured = ds.read(1) > 0
     inside = overlap_cells(project, m, result["dsm"], block["truth_dsm"])
+    seen = visible_cells(project, m, result["dsm"], block["truth_dsm"], inside)
     truth, _ = _truth_on(result["dsm"], block["truth_dsm"])
     lc, _ = _truth_on(result["dsm"], block["truth_landcover"], nearest=True)
     err = np.where(measured & inside, dsm - truth, np.nan)
@@ -97,6 +121,8 @@ def evaluate(project: Any, model_name: str, result: Dict[str, Any], block: Dict[
     out = {"model": model_name, "b_h": round(m.b_h, 3),
            "convergence_deg": round(m.convergence, 1),
            "measured_overlap_pct": 100.0 * float(measured[inside].mean()),
+           "visible_overlap_pct": 100.0 * float(seen.sum()) / max(int(inside.sum()), 1),
+           "measured_visible_pct": 100.0 * float(measured[seen].mean()),
            "measured_pct": metrics.get("measured_pct"),
            "interpolated_pct": metrics.get("interpolated_pct"),
            "failed_windows_finest_pct": metrics.get("failed_windows_finest_pct"),
@@ -105,6 +131,7 @@ def evaluate(project: Any, model_name: str, result: Dict[str, Any], block: Dict[
     for label, codes in (("open", OPEN), ("objects", OBJECTS)):
         cls = np.isin(lc, codes)
         out[f"{label}_measured_pct"] = 100.0 * float(measured[inside & cls].mean())
+        out[f"{label}_measured_visible_pct"] = 100.0 * float(measured[seen & cls].mean())
         s = _stats(np.where(cls, err, np.nan))
         out[f"{label}_nmad_m"] = s["nmad_m"]
         out[f"{label}_rmse_m"] = s["rmse_m"]
