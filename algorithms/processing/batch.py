@@ -120,6 +120,7 @@ from .. import output_policy
 from ..errors import Cancelled, InputError, PhotodemError
 from ..feedback import Feedback, ensure_feedback
 from ..project import toml_io
+from ..raster import tiled_dask
 from . import registry
 from .spec import Parameter, project_files, split_list
 
@@ -298,17 +299,10 @@ def check_scheduler(address: Optional[str]) -> Optional[str]:
     Raises
     ------
     InputError
-        An address without a port, or with spaces.
+        An address without a port, or with spaces (:func:`.tiled_dask.check_scheduler`).
     """
-    text = (address or "").strip()
-    if not text or text.lower() == "local":
-        return None
-    if not re.fullmatch(r"(?:[a-z][a-z0-9+]*://)?[^\s/:]+(?::\d+)?|"
-                        r"(?:[a-z][a-z0-9+]*://)?\[[0-9a-fA-F:]+\](?::\d+)?", text) \
-            or not re.search(r":\d+$", text):
-        raise InputError(f"Dask scheduler {address!r}: give its address as tcp://host:port, "
-                         "e.g. tcp://10.0.0.5:8786.")
-    return text
+    text = tiled_dask.check_scheduler(address)
+    return None if text in ("", "local") else text
 
 
 def _text(table: Dict[str, Any], key: str, where: str) -> None:

@@ -26,6 +26,7 @@ output open and writes each tile as its turn comes; finished tiles wait on their
 from __future__ import annotations
 
 import os
+import re
 from contextlib import contextmanager
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
@@ -39,13 +40,27 @@ LOCAL_WORKERS = 4
 INSTALL_HINT = 'pip install "photodem[dask]"'
 
 
+#: A scheduler's address: ``[scheme://]host:port`` (an IPv6 host in brackets).
+_ADDRESS = re.compile(r"(?:[a-z][a-z0-9+]*://)?(?:[^\s/:\[\]]+|\[[0-9a-fA-F:]+\]):\d+")
+
+
 def check_scheduler(scheduler: Optional[str]) -> str:
-    """The scheduler text stripped, or an InputError naming the accepted forms."""
+    """The scheduler text stripped: ``""`` (this process), ``"local"`` (a cluster on this
+    machine) or an address (``tcp://host:8786``, ``host:8786``) — the one check of every
+    ``--scheduler``, the batch's included.
+
+    Raises
+    ------
+    InputError
+        Anything else, e.g. an address without a port or with spaces.
+    """
     text = (scheduler or "").strip()
-    if text in ("", "local") or text.startswith(("tcp://", "tls://", "inproc://")):
-        return text
-    raise InputError(f"Scheduler '{text}' is neither empty (this process), 'local' (a Dask "
-                     "cluster on this machine) nor an address such as tcp://host:8786.")
+    if text.lower() in ("", "local"):
+        return text.lower()
+    if not _ADDRESS.fullmatch(text):
+        raise InputError(f"Dask scheduler '{text}': give its address as tcp://host:port (e.g. "
+                         "tcp://host:8786), 'local' for a cluster on this machine, or nothing.")
+    return text
 
 
 def _distributed() -> Any:
