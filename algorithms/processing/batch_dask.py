@@ -33,7 +33,6 @@ runs in the batch's process, without Dask).
 from __future__ import annotations
 
 import contextlib
-import logging
 import os
 import queue
 import time
@@ -43,6 +42,7 @@ from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Set,
 
 from ..errors import InputError
 from ..feedback import Feedback
+from ..raster.tiled_dask import local_cluster
 from . import registry
 from .batch import Task, execute_task, no_result
 
@@ -256,8 +256,6 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
         Dask is not installed, or the scheduler cannot be reached.
     """
     distributed = import_distributed()
-    import dask  # lazy: with distributed, only for a Dask batch
-
     if scheduler:
         try:
             client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s",
@@ -271,50 +269,12 @@ def connect(n_workers: int, scheduler: Optional[str]) -> Iterator[Tuple[Any, Opt
         finally:
             client.close()
         return
-    with _worker_environ(n_workers) as environ:
-        with dask.config.set({"distributed.scheduler.allowed-failures": _ALLOWED_FAILURES,
-                              "distributed.nanny.pre-spawn-environ": environ}):
-            cluster = distributed.LocalCluster(
-                n_workers=n_workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                scheduler_port=0, dashboard_address="127.0.0.1:0", memory_limit=0,
-                silence_logs=logging.ERROR)
+    with local_cluster(n_workers, allowed_failures=_ALLOWED_FAILURES) as cluster:
+        client = distributed.Client(cluster, set_as_default=False)
         try:
-            client = distributed.Client(cluster, set_as_default=False)
-            try:
-                yield client, cluster
-            finally:
-                client.close()
+            yield client, cluster
         finally:
-            cluster.close()
-
-
-#: Variables that set the threads of the numeric libraries (OpenCV, OpenMP, BLAS).
-_THREAD_VARIABLES = ("OPENCV_FOR_THREADS_NUM", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
-                     "MKL_NUM_THREADS")
-
-
-@contextlib.contextmanager
-def _worker_environ(n_workers: int) -> Iterator[Dict[str, str]]:
-    """The environment of a local cluster's workers: each gets its share of the cores for
-    the threads of OpenCV and BLAS (variables the operator set are kept).
-
-    Without it, every worker's OpenCV used every core: two workers on two cores matched a
-    model in 14 s instead of 5 s. Dask's own defaults are not used either: they pin BLAS to
-    one thread but not OpenCV, and set ``MALLOC_TRIM_THRESHOLD_``, which turns off glibc's
-    adaptive mmap threshold (every large numpy temporary is mapped and zeroed anew). The
-    nannies set these variables in this process before they spawn a worker; they are
-    restored when the cluster is closed.
-    """
-    share = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
-    saved = {k: os.environ.get(k) for k in _THREAD_VARIABLES}
-    try:
-        yield {k: v if v is not None else share for k, v in saved.items()}
-    finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
+            client.close()
 
 
 def dashboard(client: Any, local: bool) -> Optional[str]:
