@@ -146,13 +146,14 @@ def test_staged_folder_never_replaces_or_marks_a_project(tmp_path):
     assert (out / "project.toml").is_file()
 
 
-#: The swap with a SIGINT between its two renames, in a fresh interpreter: its main thread
-#: alone, with Python's default SIGINT handler, whatever earlier tests left in this process
-#: (e.g. the threads of a Dask client).
+#: The swap with a SIGINT between its two renames, in a fresh interpreter with Python's default
+#: SIGINT handler — whatever earlier tests left in this process, and although a shell starts
+#: background jobs with SIGINT ignored (then Python keeps it ignored and nothing is raised).
 _SWAP_INTERRUPTED = """
 import os, signal, sys
 from pathlib import Path
 from photodem.algorithms.raster import io as rio
+signal.signal(signal.SIGINT, signal.default_int_handler)
 out = Path(sys.argv[1])
 with rio.staged_folder(out, replace=True, product="alpha") as tmp:
     (tmp / "v").write_text("old")
