@@ -143,3 +143,29 @@ def test_task_manager_cancel_reaches_the_batch(qtbot, ws_iface, chain_project,
         assert "cancelled before it started" in d.log_view.toPlainText()
     else:
         assert d.summary["counts"]["cancelled"] == 2
+
+
+def test_scheduler_typed_in_qgis_goes_into_the_batch_file(qtbot, ws_iface, tiny_block,
+                                                           tmp_path) -> None:
+    """The Scheduler field of the dialog opened from QGIS's menu, typed with key events."""
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    from photodem.algorithms.project import toml_io
+    from photodem.plugin.qgis import batch_actions
+    from photodem.plugin.qgis.workspace import open_workspace
+
+    root = copy_block(tiny_block, tmp_path, "blk")
+    open_workspace(ws_iface, root)
+    menu = batch_actions.BatchMenu(ws_iface, "PhotoDEM", batch_actions.QIcon())
+    menu.register()
+    menu.action.trigger()
+    d = menu.dialog
+    qtbot.addWidget(d)
+    d.show()
+    QTest.mouseClick(d.scheduler_edit, Qt.LeftButton)
+    QTest.keyClicks(d.scheduler_edit, "tcp://10.0.0.5:8786")
+    written = toml_io.loads(d.write_batch_file().read_text())
+    assert written["batch"]["scheduler"] == "tcp://10.0.0.5:8786"
+    d.scheduler_edit.clear()  # empty: this machine, nothing in the file
+    assert "scheduler" not in toml_io.loads(d.write_batch_file().read_text())["batch"]
