@@ -43,13 +43,7 @@ import numpy as np
 from rasterio.windows import Window
 
 from ..feedback import Feedback, ensure_feedback
-from ..geometry.epipolar import (
-    CONVERGENT_DEG,
-    RESAMPLE_BLOCK_PIXELS,
-    SIDES,
-    EpipolarPair,
-    convergence_deg,
-)
+from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
 from .dense import GreySource, iter_disparity_tiles
@@ -103,8 +97,7 @@ def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
     cx = setup.pair.cx
     view = (float(cx[0]), float(cx[1])) if _WALL_RULE else None
     options = dict(_DENSE_DEFAULTS, edge_jump=jump, wall_view=view)
-    eo = [rec.eo for rec in setup.records]
-    if convergence_deg(eo[0], eo[1]) > CONVERGENT_DEG:
+    if setup.convergent:
         options.update(_CONVERGENT_OPTIONS)
     return options
 

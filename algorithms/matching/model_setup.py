@@ -22,7 +22,7 @@ from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
 from ..errors import GeometryError, InputError
-from ..geometry.epipolar import EpipolarPair
+from ..geometry.epipolar import CONVERGENT_DEG, EpipolarPair, convergence_deg
 from ..geometry.stereo import image_footprint
 from ..project.breaklines import check_breaklines
 from ..project.edits import read_constraints
@@ -58,6 +58,17 @@ class ModelSetup:
     @property
     def names(self) -> List[str]:
         return [r.name for r in self.records]
+
+    @property
+    def convergence(self) -> float:
+        """Angle between the two optical axes, degrees."""
+        return convergence_deg(self.records[0].eo, self.records[1].eo)
+
+    @property
+    def convergent(self) -> bool:
+        """Optical axes more than :data:`~..geometry.epipolar.CONVERGENT_DEG` apart (drone
+        and oblique pairs): the matchers use their convergent options."""
+        return self.convergence > CONVERGENT_DEG
 
     def measuring_area(self) -> Any:
         """The stereo overlap at the mid height, inside the boundaries."""

@@ -225,3 +225,48 @@ def test_drone_dense_goal_on_open_terrain(drone_block: Path, tmp_path: Path) -> 
     assert m["measured_pct"] > 70.0
     options = json.loads(Path(res["report"]).read_text())["options"]
     assert (options["normalise_window"], options["block_size"]) == (21, 7)
+
+
+def _fbm_failure_pct(project: Project, model: str, convergent: bool) -> float:
+    """Failed windows (%) at the finest level of the FBM hierarchy on a model's epipolar pair,
+    with the convergent-model options or the nadir preset."""
+    from photodem.algorithms.feedback import ensure_feedback
+    from photodem.algorithms.matching.fbm_model import _grey_epipolar, _options
+    from photodem.algorithms.matching.hierarchy import match_epipolar_fbm_lsm
+    from photodem.algorithms.matching.model_setup import prepare_model
+
+    setup = prepare_model(project, model, spacing_gsd=2.0)
+    grey, mask, barriers = _grey_epipolar(setup, ensure_feedback(None))
+    opts, _ = _options("general", {}, convergent=convergent)
+    matches = match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d, setup.max_d,
+                                     mask=mask, barriers=barriers, options=opts)
+    return float(matches.stats["total"]["failure_pct_level0"])
+
+
+@pytest.mark.slow
+def test_drone_fbm_failed_windows_goal(drone_block: Path) -> None:
+    """fbm_lsm on the most convergent pair (0101_0103, 47°): the convergent-model options
+    (48 px windows, 1 px bidirectional tolerance, Förstner roundness ≥ 0.4) fail ≤ 20 % of the
+    finest windows (seed 1: 16.6 %; the nadir preset's 32 px windows: 32.4 %)."""
+    project = Project.load(drone_block)
+    assert project.model("0101_0103").convergence > 40.0
+    convergent = _fbm_failure_pct(project, "0101_0103", True)
+    nadir = _fbm_failure_pct(project, "0101_0103", False)
+    print(f"failed windows at the finest level: {convergent:.1f} % (nadir preset {nadir:.1f} %)")
+    assert convergent <= 20.0
+    assert nadir > convergent + 8.0
+
+
+def test_fbm_convergent_options_and_explicit_values() -> None:
+    """A convergent model gets 1.5 × the preset's window, ≥ 1 px bidirectional tolerance and
+    roundness ≤ 0.4; explicit options win; nadir models keep the preset."""
+    from photodem.algorithms.matching.fbm_model import _options
+
+    nadir, _ = _options("general", {})
+    conv, _ = _options("general", {}, convergent=True)
+    assert (nadir.fbm_window, nadir.bidir_tol, nadir.q_min) == (32, 0.5, 0.6)
+    assert (conv.fbm_window, conv.bidir_tol, conv.q_min) == (48, 1.0, 0.4)
+    urban, _ = _options("urban", {}, convergent=True)
+    assert urban.fbm_window == 24
+    mine, _ = _options("general", {"fbm_window": 32, "bidir_tol": 0.5}, convergent=True)
+    assert (mine.fbm_window, mine.bidir_tol, mine.q_min) == (32, 0.5, 0.4)
