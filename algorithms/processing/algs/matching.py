@@ -128,7 +128,8 @@ class MatchModel(Algorithm):
                        "below override it."),
         Parameter("fbm_window", "integer", "Matching window [px] (fbm_lsm)", optional=True,
                   minimum=8, maximum=128, unit="px",
-                  help="Side of the window of the robust consistency. Default: the preset's."),
+                  help="Side of the window of the robust consistency. Default: the preset's "
+                       "(1.5 × on convergent drone and oblique pairs)."),
         Parameter("rho_min", "number", "Minimum correlation (fbm_lsm)", optional=True,
                   minimum=0.0, maximum=1.0,
                   help="Candidates with a smaller correlation coefficient are dropped. "
