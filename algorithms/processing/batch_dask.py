@@ -42,6 +42,7 @@ from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Set,
 
 from ..errors import InputError
 from ..feedback import Feedback
+from ..raster import tiled_dask
 from ..raster.tiled_dask import local_cluster
 from . import registry
 from .batch import Task, execute_task, no_result
@@ -67,11 +68,7 @@ _PROGRESS_EVERY_S = 0.25
 
 def import_distributed() -> Any:
     """The ``distributed`` module, or an operator error saying how to install it."""
-    try:
-        import distributed  # optional: only batches with workers > 1 or a scheduler need it
-    except ImportError as exc:
-        raise InputError(f"Cannot run the batch: {INSTALL_HINT}.") from exc
-    return distributed
+    return tiled_dask.import_distributed(f"Cannot run the batch: {INSTALL_HINT}.")
 
 
 # -- the dependencies ----------------------------------------------------------------------------

@@ -64,13 +64,17 @@ def check_scheduler(scheduler: Optional[str]) -> str:
     return text
 
 
-def _distributed() -> Any:
-    """The ``distributed`` module, or an InputError saying how to install it."""
+def import_distributed(refusal: Optional[str] = None) -> Any:
+    """The ``distributed`` module, or an InputError saying how to install it — the one
+    import of Dask distributed of the tiled products and the batch.
+
+    ``refusal``: the whole message without Dask (default: the tiled products' message).
+    """
     try:
         import distributed  # optional: Dask is an extra, the plugin works without it
     except ImportError as exc:
-        raise InputError("Running tiles on a Dask scheduler needs Dask distributed: "
-                         f"{INSTALL_HINT}") from exc
+        raise InputError(refusal or "Running tiles on a Dask scheduler needs Dask "
+                         f"distributed: {INSTALL_HINT}") from exc
     return distributed
 
 
@@ -81,7 +85,7 @@ def local_cluster(n_workers: int, allowed_failures: Optional[int] = None) -> Ite
 
     ``allowed_failures`` sets the scheduler's ``distributed.scheduler.allowed-failures``.
     """
-    dist = _distributed()
+    dist = import_distributed()
     import dask  # lazy: comes with distributed, only for a local cluster
 
     with _worker_environ(n_workers) as environ:
@@ -136,7 +140,7 @@ def dask_client(scheduler: str, feedback: Optional[Feedback] = None) -> Iterator
     scheduler is left running. The dashboard link is reported.
     """
     fb = ensure_feedback(feedback)
-    dist = _distributed()
+    dist = import_distributed()
     with ExitStack() as stack:
         if scheduler == "local":
             n = max(1, min(LOCAL_WORKERS, os.cpu_count() or 1))
@@ -190,7 +194,7 @@ def _on_cluster(client: Any, task: Callable[..., Any], jobs: Sequence[Any],
     At most :func:`_in_flight` tasks are submitted or waiting to be taken at a time, so
     finished tiles never pile up on the workers or here beyond that window.
     """
-    dist = _distributed()
+    dist = import_distributed()
     scattered = [client.scatter(s, broadcast=True) for s in shared]
     done = dist.as_completed(with_results=True)
     index: Dict[Any, int] = {}
@@ -265,5 +269,5 @@ def task_bytes(tile: int, overlap: int, bytes_per_cell: float) -> int:
     return int(side * side * float(bytes_per_cell))
 
 
-__all__ = ["INSTALL_HINT", "LOCAL_WORKERS", "check_scheduler", "dask_client", "map_tiles",
-           "task_bytes"]
+__all__ = ["INSTALL_HINT", "LOCAL_WORKERS", "check_scheduler", "dask_client",
+           "import_distributed", "map_tiles", "task_bytes"]
