@@ -1024,9 +1024,9 @@
             <translation>Zuordnungsfenster [px] (fbm_lsm)</translation>
         </message>
         <message>
-            <source>Side of the window of the robust consistency. Default: the preset's.</source>
+            <source>Side of the window of the robust consistency. Default: the preset's (1.5 × on convergent drone and oblique pairs).</source>
             <extracomment>match_model.fbm_window: help</extracomment>
-            <translation>Seitenlänge des Fensters der robusten Konsistenzprüfung. Standard: laut Vorgabe.</translation>
+            <translation>Seitenlänge des Fensters der robusten Konsistenzprüfung. Standard: laut Vorgabe (1,5-fach bei konvergenten Drohnen- und Schrägbildpaaren).</translation>
         </message>
         <message>
             <source>Minimum correlation (fbm_lsm)</source>
@@ -5114,6 +5114,10 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>Side of the window of the robust consistency. Default: the preset's.</source>
+            <translation type="vanished">Seitenlänge des Fensters der robusten Konsistenzprüfung. Standard: laut Vorgabe.</translation>
         </message>
         <message>
             <source>tiny: 224×288 px images (tests); small: 704×1000 px (demo); medium: 1408×2000 px; large: 2400×3400 px (≈ 8 Mpx); aerial: three wide-angle film frames in one strip (11500 px, c = 153 mm, B/H 0.6, base 4600 px, H ≈ 1150 m) of which a 1024×1024 px window over the common ground patch is rendered — for height accuracy in ‰ of H.</source>
