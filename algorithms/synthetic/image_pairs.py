@@ -250,7 +250,7 @@ def image_pair_case(folder: PathLike, seed: int = 0, width: int = 1000, height: 
     half = max(0.5 * n_ref * gsd, 0.5 * math.hypot(width, height) * 1.25 * gsd
                + float(np.abs(shift).max())) + 4 * gsd
     cell = gsd / 2
-    n_fine = math.ceil(2 * half / cell)
+    n_fine = 2 * math.ceil(half / cell)  # even: the reference pixels are whole 2 × 2 cells
     grid = Grid(centre[0] - n_fine * cell / 2, centre[1] + n_fine * cell / 2, cell, n_fine,
                 n_fine)
     land = make_landscape(rng, grid)
