@@ -331,6 +331,7 @@ def match_image(grey_img: Array, grey_ref: Array, kind: str = "affine",
     ref8, ref_mask = to_byte(grey_ref)
     M, counts = keypoint_fit(img8, img_mask, ref8, ref_mask, kind, detector)
     fb.check()
+    fb.progress(60)
     n_inl = counts["inliers_mirrored" if counts["mirrored"] else "inliers"]
     fb.info(f"Keypoints ({counts['detector']}): {counts['keypoints_image']} in the image, "
             f"{counts['keypoints_reference']} in the reference; {counts['matches']} / "
@@ -342,6 +343,7 @@ def match_image(grey_img: Array, grey_ref: Array, kind: str = "affine",
     # the keypoint fit is good to a few detection-level pixels
     radius = int(np.ceil(4 * 2.0 ** max(counts["pyramid_levels"])))
     km = refine(grey_img, grey_ref, M, kind, radius)
+    fb.progress(90)
     km.counts = {**counts, **km.counts}
     if len(km.image_xy) < MIN_PATCHES:
         raise GeometryError(f"only {len(km.image_xy)} image patches agree with the keypoint "
