@@ -24,6 +24,7 @@ from .area import area_search, boundary_search, grid_control_points
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform, inverse_for_resampling
 from .invariants import object_features
+from .keypoints import DETECTORS, keypoint_result
 from .products import summary, write_outputs
 from .reference_layer import (
     is_raster,
@@ -45,8 +46,9 @@ PathLike = Union[str, Path]
 
 #: Fewest verified pairs for a result (fewer: the failure report, not a wrong answer).
 MIN_PAIRS = 3
-#: Search modes: object-based, area-based, or objects with the area-based fallback.
-SEARCH_MODES = ("auto", "objects", "area")
+#: Search modes: object-based, area-based, keypoints (raster references), or ``auto``:
+#: keypoints then objects for a raster, objects then the area-based search for polygons.
+SEARCH_MODES = ("auto", "objects", "area", "keypoints")
 #: Smallest ECC correlation of an area-based result (below: the boundary-orientation search,
 #: then the failure report). Correct synthetic results reach 0.6–0.85; wrong ones stayed
 #: below 0.17 with PyPI's OpenCV, but one reached 0.28 with Debian's OpenCV 4.6 (a Voronoi
@@ -114,10 +116,14 @@ class GeorefOptions:
         Image band used (1-based; ``None``: the mean of the bands).
     gcp_mode : str
         Where control points are taken (``"outline"``: along the outlines).
-    search : {"auto", "objects", "area"}
+    search : {"auto", "objects", "area", "keypoints"}
         ``objects``: the object-based chain only; ``area``: the area-based global search
-        only (:mod:`.area`, polygon layers only); ``auto``: objects, and the area-based
-        search when the objects give no result.
+        only (:mod:`.area`, polygon layers only); ``keypoints``: the keypoint stage only
+        (:mod:`.keypoints`, raster references only); ``auto``: for a raster reference the
+        keypoint stage and the object chain when it gives no result, for polygons the
+        objects and the area-based search when they give no result.
+    detector : {"auto", "sift", "akaze", "orb"}
+        Keypoint detector of the keypoint stage (``auto``: SIFT, else AKAZE, else ORB).
     """
 
     class_field: Optional[str] = None
@@ -137,6 +143,7 @@ class GeorefOptions:
     band: Optional[int] = None
     gcp_mode: str = "outline"
     search: str = "auto"
+    detector: str = "auto"
 
     def check(self) -> List[float]:
         """Refuse unknown transform and search names; returns the parsed thresholds."""
@@ -146,6 +153,9 @@ class GeorefOptions:
                              "or poly2.")
         if self.search not in SEARCH_MODES:
             raise InputError(f"Unknown search '{self.search}'; use {', '.join(SEARCH_MODES)}.")
+        if self.detector not in ("auto", *DETECTORS):
+            raise InputError(f"Unknown keypoint detector '{self.detector}'; use auto, "
+                             f"{', '.join(DETECTORS)}.")
         return thr
 
     def report(self, thresholds: List[float], pyramid_level: Optional[int]) -> Dict[str, Any]:
@@ -156,7 +166,8 @@ class GeorefOptions:
                 "max_gcps": self.max_gcps, "transform": self.transform,
                 "smooth": self.smooth, "merge": self.merge, "gcp_mode": self.gcp_mode,
                 "class_field": self.class_field, "class_value": self.class_value,
-                "search": self.search, "pyramid_level": pyramid_level}
+                "search": self.search, "pyramid_level": pyramid_level,
+                "detector": self.detector}
 
 
 def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefOptions] = None,
@@ -191,6 +202,9 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
     if ref_kind == "raster" and opts.search == "area":
         raise InputError("The area-based search needs a polygon layer as reference, not a "
                          "raster; use search = objects or auto.")
+    if ref_kind == "vector" and opts.search == "keypoints":
+        raise InputError("The keypoint search needs a georeferenced raster as reference, "
+                         "not a polygon layer; use search = objects, area or auto.")
     ref = None
     if ref_kind == "vector":  # first: a bad layer or class fails before any work
         ref = reference_objects_from_vector(reference, opts.class_field, opts.class_value,
@@ -199,6 +213,8 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
     run = _Run(opts, thr, grey, img_info, fb, t0)
     if opts.search == "area":
         return _area_stage(run, ref, None)
+    if ref_kind == "raster" and opts.search in ("auto", "keypoints"):
+        return _keypoint_stage(run, reference)
     try:
         return _object_stage(run, reference, ref_kind, ref)
     except GeometryError as exc:
@@ -221,6 +237,27 @@ class _Run:
     image_info: Dict[str, Any]
     fb: Feedback
     t0: float
+
+
+def _keypoint_stage(run: _Run, reference: PathLike) -> GeorefResult:
+    """A raster reference: the keypoint stage (:mod:`.keypoints`) first; when it finds too
+    few inliers (``search = auto``) the object chain, and when that fails too, one message
+    with the figures of both."""
+    opts, fb = run.options, run.fb
+    try:
+        return keypoint_result(run.grey, run.image_info, reference, opts.transform,
+                               opts.detector, opts.max_gcps, opts.report(run.thresholds, None),
+                               run.t0, StepFeedback(fb, 5, 85))
+    except GeometryError as exc:
+        if opts.search == "keypoints":
+            _fail(exc.counts, f"keypoint stage: {exc}")
+        kp_why, kp_counts = str(exc), exc.counts
+    fb.info(f"Keypoint stage: {kp_why} — trying the object stage.")
+    try:
+        return _object_stage(run, reference, "raster", None)
+    except GeometryError as exc:
+        raise GeometryError(f"{exc} Before it, the keypoint stage found no result: {kp_why} "
+                            f"({_detail(kp_counts)}).", {**kp_counts, **exc.counts}) from exc
 
 
 def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
@@ -455,11 +492,15 @@ def _boundary_stage(grey: np.ndarray, ref_objs: Sequence[Any], ecc: float,
 
 def _fail(counts: Dict[str, Any], why: str) -> None:
     """Raise the failure message; the exception's ``counts`` keep the figures as data."""
-    detail = ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
     raise GeometryError(
-        f"Georeferencing failed: {why} ({detail}). Check that image and reference show the "
-        "same objects completely (class field/value), try other thresholds or a larger "
-        "relative difference.", counts)
+        f"Georeferencing failed: {why} ({_detail(counts)}). Check that image and reference "
+        "show the same objects completely (class field/value), try other thresholds or a "
+        "larger relative difference.", counts)
+
+
+def _detail(counts: Dict[str, Any]) -> str:
+    """The figures of a failure message: "image objects 12, hypotheses 0, …"."""
+    return ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
 
 
 def _hull_share(xy: np.ndarray, shape: Sequence[int]) -> float:

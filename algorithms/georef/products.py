@@ -222,9 +222,11 @@ def overlay_png(path: PathLike, result: GeorefResult) -> Path:
         ax.plot(g[:, 0], g[:, 1], "+", color="yellow", ms=4)
     ax.set_xlim(-0.5, W - 0.5)
     ax.set_ylim(H - 0.5, -0.5)
-    ax.set_title("reference polygons through the area-based transform (red); control points "
-                 "(+)" if result.stage == "area" else
-                 "matched objects: image (green), reference (red); control points (+)")
+    ax.set_title({"area": "reference polygons through the area-based transform (red); "
+                          "control points (+)",
+                  "keypoints": "control points: image patches located in the reference "
+                               "raster (+)"}.get(
+        result.stage, "matched objects: image (green), reference (red); control points (+)"))
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     return Path(path)
@@ -400,6 +402,11 @@ def report_html(rep: Dict[str, Any], name: str) -> str:
                else f"ECC correlation {c.get('area_ecc')}")
         source = (f"{c.get('gcps')} control points on a grid through the affine of the "
                   f"area-based search ({how}; {c.get('reference_objects')} reference objects)")
+    elif rep["stage"] == "keypoints":
+        source = (f"{c.get('gcps')} control points from {c.get('patches_agreeing')} image "
+                  f"patches located in the reference raster, after {c.get('detector')} "
+                  f"keypoints ({c.get('inlier_share', 0) * 100:.0f} % of the matches inliers"
+                  f"{', image mirrored' if c.get('mirrored') else ''})")
     else:
         source = (f"{c.get('gcps')} control points from {c.get('verified_pairs')} verified "
                   f"object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} "

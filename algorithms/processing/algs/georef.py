@@ -43,8 +43,9 @@ class GeoreferencePolygons(Algorithm):
         Parameter("reference", "file", "Reference (polygon layer or orthophoto)",
                   extensions=(".gpkg", ".shp", ".geojson", ".json", ".tif", ".tiff"),
                   help="A polygon layer in any CRS (matched in its projected CRS, or the UTM "
-                       "zone of its centre), or a georeferenced raster segmented like the "
-                       "image."),
+                       "zone of its centre), or a georeferenced raster (an orthophoto or "
+                       "satellite scene in a projected CRS): matched by keypoints first, else "
+                       "segmented like the image."),
         Parameter("class_field", "string", "Class attribute", optional=True,
                   help="Attribute selecting the polygons to match (e.g. landuse); empty = all "
                        "polygons."),
@@ -66,14 +67,17 @@ class GeoreferencePolygons(Algorithm):
         Parameter("max_depth", "integer", "Search depth [pairs]", default=6, minimum=2,
                   maximum=20),
         Parameter("search", "enum", "Search", default="auto",
-                  options=("auto", "objects", "area"),
+                  options=("auto", "objects", "area", "keypoints"),
                   help="objects: match image regions to the polygons as objects; area: "
                        "compare the whole image with the rasterised polygons (rotation and "
                        "scale by Fourier–Mellin, shift by correlation, refined by ECC), and "
                        "when that fails the polygons' individual outlines with the image's "
                        "edge directions — for objects that are not homogeneous in the image, "
-                       "such as glaciers; auto: objects, and the area-based search when they "
-                       "give no result. Polygon layers only."),
+                       "such as glaciers (polygon layers only); keypoints: SIFT keypoints of "
+                       "the image and the mirrored image matched to a raster reference, "
+                       "refined by correlating image patches (raster references only); auto: "
+                       "for polygons objects, then the area-based search; for a raster "
+                       "keypoints, then objects."),
         Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
                   minimum=0.1, maximum=50.0, unit="px",
                   help="Control points are accepted (best first) while the RMS of their "
