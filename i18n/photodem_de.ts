@@ -2284,9 +2284,9 @@
             <translation>Referenz (Polygonlayer oder Orthophoto)</translation>
         </message>
         <message>
-            <source>A polygon layer in any CRS (matched in its projected CRS, or the UTM zone of its centre), or a georeferenced raster segmented like the image.</source>
+            <source>A polygon layer in any CRS (matched in its projected CRS, or the UTM zone of its centre), or a georeferenced raster (an orthophoto or satellite scene in a projected CRS): matched by keypoints first, else segmented like the image.</source>
             <extracomment>georeference_polygons.reference: help</extracomment>
-            <translation>Ein Polygonlayer in beliebigem KBS (zugeordnet in seinem projizierten KBS oder in der UTM-Zone seiner Mitte) oder ein georeferenziertes Raster, das wie das Bild segmentiert wird.</translation>
+            <translation>Ein Polygonlayer in beliebigem KBS (zugeordnet in seinem projizierten KBS oder in der UTM-Zone seiner Mitte) oder ein georeferenziertes Raster (ein Orthophoto oder eine Satellitenszene in einem projizierten KBS): zuerst über Merkmalspunkte zugeordnet, sonst wie das Bild segmentiert.</translation>
         </message>
         <message>
             <source>Class attribute</source>
@@ -2369,9 +2369,9 @@
             <translation>Suche</translation>
         </message>
         <message>
-            <source>objects: match image regions to the polygons as objects; area: compare the whole image with the rasterised polygons (rotation and scale by Fourier–Mellin, shift by correlation, refined by ECC), and when that fails the polygons' individual outlines with the image's edge directions — for objects that are not homogeneous in the image, such as glaciers; auto: objects, and the area-based search when they give no result. Polygon layers only.</source>
+            <source>objects: match image regions to the polygons as objects; area: compare the whole image with the rasterised polygons (rotation and scale by Fourier–Mellin, shift by correlation, refined by ECC), and when that fails the polygons' individual outlines with the image's edge directions — for objects that are not homogeneous in the image, such as glaciers (polygon layers only); keypoints: SIFT keypoints of the image and the mirrored image matched to a raster reference, refined by correlating image patches (raster references only); auto: for polygons objects, then the area-based search; for a raster keypoints, then objects.</source>
             <extracomment>georeference_polygons.search: help</extracomment>
-            <translation>objects: Bildregionen als Objekte den Polygonen zuordnen; area: das ganze Bild mit den gerasterten Polygonen vergleichen (Drehung und Maßstab nach Fourier–Mellin, Verschiebung durch Korrelation, Verfeinerung mit ECC) und, wenn das scheitert, die einzelnen Umrisse der Polygone mit den Kantenrichtungen des Bildes — für Objekte, die im Bild nicht homogen sind, etwa Gletscher; auto: Objekte, und die flächenbasierte Suche, wenn sie kein Ergebnis liefern. Nur für Polygonlayer.</translation>
+            <translation>objects: Bildregionen als Objekte den Polygonen zuordnen; area: das ganze Bild mit den gerasterten Polygonen vergleichen (Drehung und Maßstab nach Fourier–Mellin, Verschiebung durch Korrelation, Verfeinerung mit ECC) und, wenn das scheitert, die einzelnen Umrisse der Polygone mit den Kantenrichtungen des Bildes — für Objekte, die im Bild nicht homogen sind, etwa Gletscher (nur Polygonlayer); keypoints: SIFT-Merkmalspunkte des Bildes und des gespiegelten Bildes einem Referenzraster zugeordnet, verfeinert durch Korrelation von Bildausschnitten (nur Referenzraster); auto: bei Polygonen Objekte, dann die flächenbasierte Suche; bei einem Raster Merkmalspunkte, dann Objekte.</translation>
         </message>
         <message>
             <source>objects</source>
@@ -2382,6 +2382,11 @@
             <source>area</source>
             <extracomment>georeference_polygons.search: option</extracomment>
             <translation>Fläche</translation>
+        </message>
+        <message>
+            <source>keypoints</source>
+            <extracomment>georeference_polygons.search: option</extracomment>
+            <translation>Merkmalspunkte</translation>
         </message>
         <message>
             <source>Control point tolerance σ_NP [px]</source>
@@ -5114,6 +5119,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>A polygon layer in any CRS (matched in its projected CRS, or the UTM zone of its centre), or a georeferenced raster segmented like the image.</source>
+            <translation type="vanished">Ein Polygonlayer in beliebigem KBS (zugeordnet in seinem projizierten KBS oder in der UTM-Zone seiner Mitte) oder ein georeferenziertes Raster, das wie das Bild segmentiert wird.</translation>
+        </message>
+        <message>
+            <source>objects: match image regions to the polygons as objects; area: compare the whole image with the rasterised polygons (rotation and scale by Fourier–Mellin, shift by correlation, refined by ECC), and when that fails the polygons' individual outlines with the image's edge directions — for objects that are not homogeneous in the image, such as glaciers; auto: objects, and the area-based search when they give no result. Polygon layers only.</source>
+            <translation type="vanished">objects: Bildregionen als Objekte den Polygonen zuordnen; area: das ganze Bild mit den gerasterten Polygonen vergleichen (Drehung und Maßstab nach Fourier–Mellin, Verschiebung durch Korrelation, Verfeinerung mit ECC) und, wenn das scheitert, die einzelnen Umrisse der Polygone mit den Kantenrichtungen des Bildes — für Objekte, die im Bild nicht homogen sind, etwa Gletscher; auto: Objekte, und die flächenbasierte Suche, wenn sie kein Ergebnis liefern. Nur für Polygonlayer.</translation>
         </message>
         <message>
             <source>Side of the window of the robust consistency. Default: the preset's.</source>
