@@ -21,6 +21,7 @@ from ..errors import GeometryError, InputError
 from ..feedback import Feedback, StepFeedback
 from ..output_policy import PRODUCT_MARKER
 from .area import area_search, boundary_search, grid_control_points
+from .buildings import is_buildings, match_buildings
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .fit import fit_transform, inverse_for_resampling
 from .invariants import object_features
@@ -47,6 +48,8 @@ PathLike = Union[str, Path]
 MIN_PAIRS = 3
 #: Search modes: object-based, area-based, or objects with the area-based fallback.
 SEARCH_MODES = ("auto", "objects", "area")
+#: Kinds of reference polygons (:attr:`GeorefOptions.objects`).
+OBJECT_KINDS = ("auto", "areas", "buildings")
 #: Smallest ECC correlation of an area-based result (below: the boundary-orientation search,
 #: then the failure report). Correct synthetic results reach 0.6–0.85; wrong ones stayed
 #: below 0.17 with PyPI's OpenCV, but one reached 0.28 with Debian's OpenCV 4.6 (a Voronoi
@@ -118,6 +121,11 @@ class GeorefOptions:
         ``objects``: the object-based chain only; ``area``: the area-based global search
         only (:mod:`.area`, polygon layers only); ``auto``: objects, and the area-based
         search when the objects give no result.
+    objects : {"auto", "areas", "buildings"}
+        Kind of reference polygons: ``buildings`` (many small footprints: the buildings mode
+        of :mod:`.buildings`, then the stages of ``search``), ``areas`` (forests, fields,
+        lakes, glaciers: the stages of ``search``), ``auto``: buildings when the layer has
+        many small polygons (:func:`.buildings.is_buildings`).
     """
 
     class_field: Optional[str] = None
@@ -137,6 +145,7 @@ class GeorefOptions:
     band: Optional[int] = None
     gcp_mode: str = "outline"
     search: str = "auto"
+    objects: str = "auto"
 
     def check(self) -> List[float]:
         """Refuse unknown transform and search names; returns the parsed thresholds."""
@@ -146,6 +155,9 @@ class GeorefOptions:
                              "or poly2.")
         if self.search not in SEARCH_MODES:
             raise InputError(f"Unknown search '{self.search}'; use {', '.join(SEARCH_MODES)}.")
+        if self.objects not in OBJECT_KINDS:
+            raise InputError(f"Unknown objects '{self.objects}'; use "
+                             f"{', '.join(OBJECT_KINDS)}.")
         return thr
 
     def report(self, thresholds: List[float], pyramid_level: Optional[int]) -> Dict[str, Any]:
@@ -156,7 +168,8 @@ class GeorefOptions:
                 "max_gcps": self.max_gcps, "transform": self.transform,
                 "smooth": self.smooth, "merge": self.merge, "gcp_mode": self.gcp_mode,
                 "class_field": self.class_field, "class_value": self.class_value,
-                "search": self.search, "pyramid_level": pyramid_level}
+                "search": self.search, "pyramid_level": pyramid_level,
+                "objects": self.objects}
 
 
 def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefOptions] = None,
@@ -197,6 +210,17 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
                                             feedback=fb)
     fb.progress(5)
     run = _Run(opts, thr, grey, img_info, fb, t0)
+    buildings_failure = None
+    if ref is not None and (opts.objects == "buildings"
+                            or (opts.objects == "auto" and is_buildings(ref[0]))):
+        try:
+            return _buildings_stage(run, ref)
+        except GeometryError as exc:
+            buildings_failure = str(exc).replace("Georeferencing failed: ", "").split(
+                ". Check that")[0]
+            fb.info(f"Buildings mode: {buildings_failure} — trying the other stages.")
+            if opts.search != "objects":  # the object stage: no better on many small ones
+                return _area_stage(run, ref, f"buildings mode: {buildings_failure}")
     if opts.search == "area":
         return _area_stage(run, ref, None)
     try:
@@ -279,6 +303,44 @@ def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
         reference_kind=ref_kind, image_info=run.image_info, grey=run.grey, warnings=warnings,
         seconds=time.perf_counter() - run.t0, stage="objects",
         parameters=opts.report(thr, level))
+
+
+def _buildings_stage(run: _Run, ref: tuple) -> GeorefResult:
+    """The buildings mode (:mod:`.buildings`): consensus of many footprints, then the
+    verified pairs through the object stage's ICP and control points."""
+    ref_objs, crs, ref_info = ref
+    opts, fb = run.options, run.fb
+    fb.info(f"Buildings mode: {len(ref_objs)} footprints.")
+    m = match_buildings(run.grey, ref_objs, feedback=StepFeedback(fb, 5, 55))
+    counts = dict(m.counts)
+    if m.transform is None:
+        _fail(counts, m.reason)
+    if len(m.pairs) < MIN_PAIRS:
+        _fail(counts, f"only {len(m.pairs)} roof(s) verified (at least {MIN_PAIRS} needed)")
+    matched = _Matched(m.img_features, m.ref_features, m.pairs, m.overlaps, m.transform, 0)
+    refined, icp_stats = _pair_icp(matched, fb)
+    T, joint_rms, offset_px = _joint_icp(matched, opts.transform, fb)
+    counts.update(joint_icp_rms_px=joint_rms / matched.px, outline_offset_px=offset_px)
+    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
+    fb.progress(75)
+    fit, inverse_fit, gcps, used_xy = _outline_fit(refined, matched.px, opts, counts)
+    warnings = []
+    hull_share = _hull_share(used_xy, run.grey.shape)
+    if hull_share < 0.25:
+        warnings.append(f"The control points cover only {100 * hull_share:.0f} % of the "
+                        "image (convex hull): expect larger errors towards the image corners.")
+    for w in warnings:
+        fb.warning(w)
+    fb.info(f"{len(m.pairs)} verified roofs, {counts['gcps']} control points, "
+            f"RMSE {fit.rmse_px:.2f} px ({fit.rmse_map:.2f} m).")
+    return GeorefResult(
+        fit=fit, inverse_fit=inverse_fit, gcps=gcps, crs=crs, global_transform=m.transform,
+        joint=T, search=m.transform, pairs=m.pairs, img_features=m.img_features,
+        ref_features=m.ref_features, counts=counts, icp=icp_stats,
+        segmentation={"level": 0, "buildings": True}, reference=ref_info,
+        reference_kind="vector", image_info=run.image_info, grey=run.grey, warnings=warnings,
+        seconds=time.perf_counter() - run.t0, stage="buildings",
+        parameters=opts.report(run.thresholds, 0))
 
 
 @dataclass

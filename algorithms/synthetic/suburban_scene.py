@@ -166,7 +166,7 @@ def make_town(seed: int = 0, extent: Optional[Tuple[float, float, float, float]]
     road_zone = prep(roads.buffer(2.0))
     taken: List[Any] = []  # buffered buildings placed so far
     fps, fpb, roofs, heights, kinds = [], [], [], [], []
-    for bid in range(n):
+    for _ in range(n):
         for _ in range(60):
             c = np.array([rng.uniform(x0 + 15, x1 - 15), rng.uniform(y0 + 15, y1 - 15)])
             ang = angle + rng.choice([0, math.pi / 2]) + rng.normal(0, 0.05) \
@@ -438,10 +438,10 @@ def suburban_case(folder: PathLike, seed: int = 0, width: int = 900, height: int
     share = width * height * abs(np.linalg.det(T[:2, :2])) / (
         (extent[2] - extent[0]) * (extent[3] - extent[1]))
     n_img = int(rng.integers(30, 81)) if n_buildings is None else int(n_buildings)
-    town = make_town(seed, extent, n_buildings=int(round(n_img / max(share, 0.2))))
+    n_town = round(n_img / max(share, 0.2))
+    town = make_town(seed, extent, n_buildings=n_town)
     img = render_town(town, T, width, height, seed=seed, noise=noise)
-    ref_town = town if town_seed is None else make_town(
-        town_seed, extent, n_buildings=int(round(n_img / max(share, 0.2))))
+    ref_town = town if town_seed is None else make_town(town_seed, extent, n_buildings=n_town)
     ref = write_footprints(ref_town, folder / "buildings.gpkg")
     image = write_image(folder / "image.tif", to_dtype(img, bits))
     return {"reference": str(ref), "image": str(image), "truth": T, "width": width,
