@@ -232,7 +232,8 @@ class _Canvas:
     shift: Array  # (buildings, 2) roof displacement in samples (x, y)
 
 
-def _canvas(T: Array, width: int, height: int, ss: int, town: Town) -> _Canvas:
+def _canvas(T: Array, width: int, height: int, ss: int, town: Town,
+            relief_px: float = MAX_RELIEF_PX) -> _Canvas:
     Tinv = np.linalg.inv(T)
     a, b, c, d = Tinv[0, 0], Tinv[0, 1], Tinv[1, 0], Tinv[1, 1]
     e, f = Tinv[0, 2] + 0.5, Tinv[1, 2] + 0.5  # pixel centres at integers
@@ -253,7 +254,7 @@ def _canvas(T: Array, width: int, height: int, ss: int, town: Town) -> _Canvas:
             continue
         m = np.mean(parts, axis=0)
         pix = (Tinv @ np.array([m[0], m[1], 1.0]))[:2]
-        shift[k] = (pix - centre) / rmax * MAX_RELIEF_PX * town.heights[k] / hmax * ss
+        shift[k] = (pix - centre) / rmax * relief_px * town.heights[k] / hmax * ss
     return _Canvas(X, Y, to_sample, ss, (height * ss, width * ss), shift)
 
 
@@ -318,12 +319,13 @@ def _fixtures(town: Town, rng: np.random.Generator) -> List[Tuple[Any, float]]:
 
 def render_town(town: Town, T: Array, width: int, height: int, seed: int = 0,
                 sun_azimuth: float = 150.0, sun_elevation: float = 40.0, noise: float = 0.008,
-                supersample: int = 2) -> Array:
+                supersample: int = 2, relief_px: float = MAX_RELIEF_PX) -> Array:
     """Render the town into an image whose pixels map by ``T`` (image → map, pixel centres
-    at integers). Returns reflectance-like values (about 0–1), noise included."""
+    at integers). Returns reflectance-like values (about 0–1), noise included. ``relief_px``:
+    the roof displacement of the tallest building at an image corner."""
     rng = np.random.default_rng(seed + 2000)
     ss = supersample
-    cv = _canvas(T, width, height, ss, town)
+    cv = _canvas(T, width, height, ss, town, relief_px)
     az, el = math.radians(sun_azimuth), math.radians(sun_elevation)
     sun = np.array([math.sin(az), math.cos(az), 0.0]) * math.cos(el)
     sun[2] = math.sin(el)
@@ -366,9 +368,10 @@ def _roof_labels(cv: _Canvas, town: Town, T: Array) -> NDArray[np.int32]:
     return _burn(cv, shapes, dtype="int32")
 
 
-def roof_mask(town: Town, T: Array, width: int, height: int) -> NDArray[np.bool_]:
+def roof_mask(town: Town, T: Array, width: int, height: int,
+              relief_px: float = MAX_RELIEF_PX) -> NDArray[np.bool_]:
     """Pixels whose centre lies on a roof (as rendered, with the relief displacement)."""
-    return _roof_labels(_canvas(T, width, height, 1, town), town, T) > 0
+    return _roof_labels(_canvas(T, width, height, 1, town, relief_px), town, T) > 0
 
 
 def _map_offset(T: Array, d_px: Array) -> Array:
@@ -418,14 +421,16 @@ def suburban_case(folder: PathLike, seed: int = 0, width: int = 900, height: int
                   bits: int = 8, town_seed: Optional[int] = None,
                   scale_range: Tuple[float, float] = (0.5, 2.0), shear: float = 0.15,
                   mirror: Optional[bool] = None, n_buildings: Optional[int] = None,
-                  noise: float = 0.008) -> Dict[str, Any]:
+                  noise: float = 0.008, relief_px: float = MAX_RELIEF_PX) -> Dict[str, Any]:
     """One synthetic suburban case: footprints GeoPackage, image, truth (image → map, 3 × 3).
 
     The town covers the image footprint (plus 20 m): 30–80 buildings (``n_buildings``) per
     image whatever the scale. ``town_seed``: the footprints of a *different* town (the image
     still shows the town of ``seed``; the case must fail). ``mirror``: None = half of the
-    seeds. Returns the keys of :func:`.polygon_scene.georef_case` plus ``bits``, ``town``
-    (the rendered town) and ``mirrored``.
+    seeds. ``relief_px``: roof displacement of the tallest building at an image corner
+    (0: roofs exactly over their footprints). Returns the keys of
+    :func:`.polygon_scene.georef_case` plus ``bits``, ``town`` (the rendered town),
+    ``mirrored`` and ``relief_corner_px`` (the mean roof displacement at an image corner).
     """
     folder = Path(folder)
     rng = np.random.default_rng(seed)
@@ -440,10 +445,12 @@ def suburban_case(folder: PathLike, seed: int = 0, width: int = 900, height: int
     n_img = int(rng.integers(30, 81)) if n_buildings is None else int(n_buildings)
     n_town = round(n_img / max(share, 0.2))
     town = make_town(seed, extent, n_buildings=n_town)
-    img = render_town(town, T, width, height, seed=seed, noise=noise)
+    img = render_town(town, T, width, height, seed=seed, noise=noise, relief_px=relief_px)
     ref_town = town if town_seed is None else make_town(town_seed, extent, n_buildings=n_town)
     ref = write_footprints(ref_town, folder / "buildings.gpkg")
     image = write_image(folder / "image.tif", to_dtype(img, bits))
     return {"reference": str(ref), "image": str(image), "truth": T, "width": width,
             "height": height, "crs": CRS, "bits": bits, "town": town,
-            "mirrored": bool(np.linalg.det(T[:2, :2]) > 0)}
+            "mirrored": bool(np.linalg.det(T[:2, :2]) > 0),
+            # the mean roof displacement at an image corner: a fit to roofs is biased by it
+            "relief_corner_px": relief_px * float(np.mean(town.heights)) / max(town.heights)}
