@@ -123,9 +123,10 @@ class GeorefOptions:
         search when the objects give no result.
     objects : {"auto", "areas", "buildings"}
         Kind of reference polygons: ``buildings`` (many small footprints: the buildings mode
-        of :mod:`.buildings`, then the stages of ``search``), ``areas`` (forests, fields,
+        of :mod:`.buildings` alone), ``areas`` (forests, fields,
         lakes, glaciers: the stages of ``search``), ``auto``: buildings when the layer has
-        many small polygons (:func:`.buildings.is_buildings`).
+        many small polygons (:func:`.buildings.is_buildings`), and when it fails the stages
+        of ``search`` (the area-based ones; with ``search = objects`` the object stage).
     """
 
     class_field: Optional[str] = None
@@ -218,6 +219,8 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
         except GeometryError as exc:
             buildings_failure = str(exc).replace("Georeferencing failed: ", "").split(
                 ". Check that")[0]
+            if opts.objects == "buildings":  # asked for: no other stage
+                raise
             fb.info(f"Buildings mode: {buildings_failure} — trying the other stages.")
             if opts.search != "objects":  # the object stage: no better on many small ones
                 return _area_stage(run, ref, f"buildings mode: {buildings_failure}")
