@@ -51,6 +51,11 @@ AUTO_MIN_POLYGONS = 15
 #: Building footprints: 0.003–0.07 % (a 450 m town: 150 m² of 200 000 m²); the synthetic
 #: forest/field/lake maps of the polygon bench: 0.5–2 %.
 AUTO_MAX_MEDIAN_SHARE = 0.002
+#: ... at most this large (map units², m²: buildings, not glaciers — the 39 RGI glaciers of the
+#: Everest bench have a median of 0.02 % of their extent but of square kilometres) ...
+AUTO_MAX_AREA = 5000.0
+#: ... and rectangular (median area / minimum bounding rectangle; footprints ≈ 0.9–1).
+AUTO_RECTANGULARITY = 0.7
 #: Gradient thresholds (× the median gradient magnitude after a σ = 1 px smoothing).
 GRADIENT_THRESHOLDS = (3.5, 7.0, 14.0)
 #: Zones darker on average than this percentile of the image are shadows, not roofs.
@@ -77,14 +82,17 @@ MIN_LEAD = 1.5
 
 
 def is_buildings(ref_objs: Sequence[PolygonObject]) -> bool:
-    """True when the reference looks like building footprints: many small polygons
-    (:data:`AUTO_MIN_POLYGONS`, :data:`AUTO_MAX_MEDIAN_SHARE`)."""
+    """True when the reference looks like building footprints: many small rectangular
+    polygons (:data:`AUTO_MIN_POLYGONS`, :data:`AUTO_MAX_MEDIAN_SHARE`,
+    :data:`AUTO_MAX_AREA`, :data:`AUTO_RECTANGULARITY`)."""
     if len(ref_objs) < AUTO_MIN_POLYGONS:
         return False
     pts = np.vstack([o.ring for o in ref_objs])
     extent = float(np.prod(pts.max(axis=0) - pts.min(axis=0)))
     med = float(np.median([o.area for o in ref_objs]))
-    return extent > 0 and med < AUTO_MAX_MEDIAN_SHARE * extent
+    if not (extent > 0 and med < AUTO_MAX_MEDIAN_SHARE * extent and med <= AUTO_MAX_AREA):
+        return False
+    return float(np.median([_shape_ok(o.ring)[1] for o in ref_objs])) >= AUTO_RECTANGULARITY
 
 
 # -- candidates ---------------------------------------------------------------------------------
