@@ -189,7 +189,8 @@ def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOL
                 objs.append(_candidate(ring - 0.5, k, t, sa + sb, rect, len(objs),
                                        merged=True))
                 n_merged += 1
-        runs.append({"gradient": t, "zones": n, "single": n_single, "merged": n_merged})
+        runs.append({"gradient": round(float(t), 3), "zones": n, "single": n_single,
+                     "merged": n_merged})
     return objs, {"runs": runs}
 
 
@@ -426,7 +427,7 @@ def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
     hyps = _hypotheses(fi, shapes, sites, site_of, cr, base_tol, sources,
                        float(grey.size))
     counts.update(sites=len(sites), hypotheses=len(hyps),
-                  best_support=hyps[0][0] if hyps else 0)
+                  best_support=round(float(hyps[0][0]), 3) if hyps else 0)
     fb.progress(50)
     # targets of the growth: footprint centroids and roof-half centroids (a site is often one
     # half of a gabled roof); a footprint counts once
