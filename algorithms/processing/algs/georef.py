@@ -78,6 +78,13 @@ class GeoreferencePolygons(Algorithm):
                        "refined by correlating image patches (raster references only); auto: "
                        "for polygons objects, then the area-based search; for a raster "
                        "keypoints, then objects."),
+        Parameter("objects", "enum", "Reference objects", default="auto",
+                  options=("auto", "areas", "buildings"),
+                  help="buildings: many small footprints (cadastre, OpenStreetMap) matched "
+                       "by the configuration of neighbouring buildings; areas: forests, "
+                       "fields, lakes, glaciers; auto: buildings when the layer has at least "
+                       "15 mostly rectangular polygons whose median area is below 0.2 % of the "
+                       "layer's extent and below 5000 m²."),
         Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
                   minimum=0.1, maximum=50.0, unit="px",
                   help="Control points are accepted (best first) while the RMS of their "
@@ -108,7 +115,8 @@ class GeoreferencePolygons(Algorithm):
             rd=float(params.get("relative_difference", 3.0)) / 100.0,
             max_depth=int(params.get("max_depth", 6)),
             sigma_np_px=float(params.get("sigma_np", 2.0)),
-            search=params.get("search") or "auto")
+            search=params.get("search") or "auto",
+            objects=params.get("objects") or "auto")
         return run_georeference_polygons(params["image"], params["reference"],
                                          params["output"], options, feedback)
 

@@ -1,0 +1,471 @@
+"""Buildings mode of the polygon georeferencing: many small footprints (issue 23).
+
+Building footprints (cadastre, OpenStreetMap) are small, many and alike, and a footprint is not
+a homogeneous image region: a gabled roof has a sunlit and a shaded half, roofs carry chimneys,
+shadows and trees cut them, relief displacement moves them. One pair says little; the
+*configuration* of neighbouring buildings carries the information. The chain:
+
+1. **Candidates** (:func:`roof_candidates`): flat zones of the smoothed image (gradient below a
+   threshold, several thresholds — a multiple segmentation), grown back over their edge band;
+   pairs of adjacent zones whose union is rectangular are added (the two halves of a gabled roof
+   merged across the ridge); size window and shape filters (rectangularity, elongation).
+2. **One-pair hypotheses**: every (candidate, footprint) pair of plausible size gives the 8
+   affine maps of the standard positions (:mod:`.invariants`; a rectangle's standard position is
+   a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
+   other candidate sites mapped by it must land on footprint centroids (tolerance grows with
+   the distance) — the affine-invariant constellation of the neighbours, tested directly.
+3. **Consensus** (:func:`match_buildings`): the best-supported hypotheses are grown over the
+   whole image (map all sites, nearest footprint within a tolerance, one-to-one, affine fit,
+   repeated with a shrinking tolerance). Accepted only when at least :data:`MIN_MATCHES` pairs
+   and :data:`MIN_SHARE` of the footprints inside the image agree, well ahead of any different
+   placement (:data:`MIN_LEAD`).
+4. The matched candidates become verified pairs for the usual ICP and control points.
+
+Relief displacement (roofs 0–3 px from their footprints, radial from the image centre ∝ height)
+is a per-building offset; its radial mean is a scale about the image centre that no transform
+fitted to roofs can tell from the true scale (see the bench notes).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from ..feedback import Feedback
+from .correspondence import Hypothesis, affine_from_points, apply, verify
+from .invariants import _D4, ObjectFeatures, min_bounding_rectangle, object_features
+from .objects import IMAGE, PolygonObject, orient_ring
+from .regions import label_rings
+
+Array = NDArray[np.float64]
+
+#: Automatic buildings mode: at least this many reference polygons ...
+AUTO_MIN_POLYGONS = 15
+#: ... whose median area is below this share of the reference extent (bounding box).
+#: Building footprints: 0.003–0.07 % (a 450 m town: 150 m² of 200 000 m²); the synthetic
+#: forest/field/lake maps of the polygon bench: 0.5–2 %.
+AUTO_MAX_MEDIAN_SHARE = 0.002
+#: ... at most this large (map units², m²: buildings, not glaciers — the 39 RGI glaciers of the
+#: Everest bench have a median of 0.02 % of their extent but of square kilometres) ...
+AUTO_MAX_AREA = 5000.0
+#: ... and rectangular (median area / minimum bounding rectangle; footprints ≈ 0.9–1).
+AUTO_RECTANGULARITY = 0.7
+#: Gradient thresholds (× the median gradient magnitude after a σ = 1 px smoothing).
+GRADIENT_THRESHOLDS = (3.5, 7.0, 14.0)
+#: Zones darker on average than this percentile of the image are shadows, not roofs.
+SHADOW_PERCENTILE = 6.0
+#: Size window of candidates: px² and share of the image.
+MIN_CANDIDATE_PX = 16
+MAX_CANDIDATE_SHARE = 0.02
+#: Shape filter: area / area of the minimum bounding rectangle, and its longer / shorter side.
+MIN_RECTANGULARITY = 0.55
+MAX_ELONGATION = 10.0
+#: Share of a candidate's outline area its own pixels fill (holes: not a roof).
+MIN_FILL = 0.92
+#: Candidates at least this rectangular are neighbours (sites) in the hypothesis scoring.
+SITE_RECTANGULARITY = 0.7
+#: Candidates at least this rectangular seed hypotheses (all are neighbours).
+SOURCE_RECTANGULARITY = 0.8
+#: Neighbours scored per hypothesis.
+NEIGHBOURS = 8
+#: Acceptance: matched pairs, share of the footprints inside the image, lead over the best
+#: different placement (ratio of matched pairs).
+MIN_MATCHES = 6
+MIN_SHARE = 0.25
+MIN_LEAD = 1.5
+
+
+def is_buildings(ref_objs: Sequence[PolygonObject]) -> bool:
+    """True when the reference looks like building footprints: many small rectangular
+    polygons (:data:`AUTO_MIN_POLYGONS`, :data:`AUTO_MAX_MEDIAN_SHARE`,
+    :data:`AUTO_MAX_AREA`, :data:`AUTO_RECTANGULARITY`)."""
+    if len(ref_objs) < AUTO_MIN_POLYGONS:
+        return False
+    pts = np.vstack([o.ring for o in ref_objs])
+    extent = float(np.prod(pts.max(axis=0) - pts.min(axis=0)))
+    med = float(np.median([o.area for o in ref_objs]))
+    if not (extent > 0 and med < AUTO_MAX_MEDIAN_SHARE * extent and med <= AUTO_MAX_AREA):
+        return False
+    return float(np.median([_shape_ok(o.ring)[1] for o in ref_objs])) >= AUTO_RECTANGULARITY
+
+
+# -- candidates ---------------------------------------------------------------------------------
+def _flat_zones(grey: Array, threshold: float, gm: Array, valid: NDArray[np.bool_]
+                ) -> NDArray[np.int32]:
+    """Connected zones of gradient < ``threshold``, grown over the edge band (≤ 2 px)."""
+    lab, _ = ndimage.label((gm < threshold) & valid)
+    dist, (ri, ci) = ndimage.distance_transform_edt(lab == 0, return_indices=True)
+    grown = lab[ri, ci]
+    grown[(dist > 2.0) | ~valid] = 0
+    return grown.astype(np.int32)
+
+
+def _ring_area(ring: Array) -> float:
+    x, y = ring[:, 0], ring[:, 1]
+    return 0.5 * abs(float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
+
+
+def _shape_ok(ring: Array) -> Tuple[bool, float]:
+    """Rectangularity and elongation filter; returns (passes, rectangularity)."""
+    area = _ring_area(ring)
+    _, _, half = min_bounding_rectangle(ring)
+    mbr = 4.0 * half[0] * half[1]
+    if mbr <= 0 or min(half) <= 0:
+        return False, 0.0
+    rect = area / mbr
+    elong = max(half) / min(half)
+    return rect >= MIN_RECTANGULARITY and elong <= MAX_ELONGATION, rect
+
+
+def _adjacent_pairs(lab: NDArray[np.int32], keep: NDArray[np.bool_]
+                    ) -> List[Tuple[int, int, int]]:
+    """Pairs of kept labels touching (4-neighbours) with the length of the shared border."""
+    pairs: Dict[Tuple[int, int], int] = {}
+    for a, b in ((lab[:, :-1], lab[:, 1:]), (lab[:-1, :], lab[1:, :])):
+        m = (a != b) & (a > 0) & (b > 0)
+        m &= keep[a] & keep[b]
+        lo, hi = np.minimum(a[m], b[m]), np.maximum(a[m], b[m])
+        key = lo.astype(np.int64) * (int(lab.max()) + 1) + hi
+        vals, counts = np.unique(key, return_counts=True)
+        for v, c in zip(vals, counts):
+            k = (int(v // (int(lab.max()) + 1)), int(v % (int(lab.max()) + 1)))
+            pairs[k] = pairs.get(k, 0) + int(c)
+    return [(a, b, c) for (a, b), c in pairs.items()]
+
+
+def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOLDS,
+                    feedback: Optional[Feedback] = None) -> Tuple[List[PolygonObject],
+                                                                  Dict[str, Any]]:
+    """Image objects that may be roofs (module notes, step 1), level-0 image coordinates
+    (pixel centres at integers). Returns the objects and figures per threshold."""
+    fb = feedback or Feedback()
+    valid = np.isfinite(grey)
+    g = ndimage.gaussian_filter(np.where(valid, grey, np.nanmean(grey)), 1.0)
+    gm = np.hypot(ndimage.sobel(g, 0), ndimage.sobel(g, 1)) / 8.0
+    lo, hi = MIN_CANDIDATE_PX, MAX_CANDIDATE_SHARE * grey.size
+    # in units of the median gradient (noise and texture of the open ground): the same
+    # zones for 8-bit data and for stretched 11/12-bit data with a different noise level
+    unit = max(float(np.median(gm[valid])), 1e-3)
+    dark = float(np.percentile(g[valid], SHADOW_PERCENTILE))
+    objs: List[PolygonObject] = []
+    runs = []
+    for k, t in enumerate(np.asarray(thresholds, float) * unit):
+        fb.check()
+        lab = _flat_zones(grey, t, gm, valid)
+        n = int(lab.max())
+        size = np.bincount(lab.ravel(), minlength=n + 1)
+        keep = (size >= lo) & (size <= hi)
+        # shadow: the darkest zones (a shaded roof half joined to its cast shadow would pull
+        # the roof's centroid away from the sun)
+        mean = np.bincount(lab.ravel(), weights=g.ravel(), minlength=n + 1) / np.maximum(size, 1)
+        keep &= mean > dark
+        keep[0] = False
+        n_single = 0
+        for value, ring in label_rings(lab, keep):
+            ok, rect = _shape_ok(ring)
+            # holes (a lawn block around houses, not a roof) fail the fill share
+            if ok and size[value] >= MIN_FILL * _ring_area(ring):
+                objs.append(_candidate(ring - 0.5, k, t, int(size[value]), rect, len(objs)))
+                n_single += 1
+        # halves of a gabled roof (or roof and dormer side): merge pairs of adjacent zones
+        n_merged = 0
+        for a, b, border in _adjacent_pairs(lab, keep):
+            sa, sb = int(size[a]), int(size[b])
+            if min(sa, sb) < 0.2 * (sa + sb) or sa + sb > hi:
+                continue
+            if border < 1.5 * math.sqrt(min(sa, sb)):  # a long shared edge: the ridge
+                continue
+            ring = _union_ring(lab, a, b)
+            if ring is None:
+                continue
+            ok, rect = _shape_ok(ring)
+            if ok and rect >= 0.7:
+                objs.append(_candidate(ring - 0.5, k, t, sa + sb, rect, len(objs),
+                                       merged=True))
+                n_merged += 1
+        runs.append({"gradient": round(float(t), 3), "zones": n, "single": n_single,
+                     "merged": n_merged})
+    return objs, {"runs": runs}
+
+
+def _candidate(ring: Array, run: int, t: float, pixels: int, rect: float, ident: int,
+               merged: bool = False) -> PolygonObject:
+    return PolygonObject(id=ident, ring=ring, source=IMAGE, run=run, threshold=float(t),
+                         attributes={"pixels": pixels, "rectangularity": round(rect, 3),
+                                     "merged": merged})
+
+
+def _union_ring(lab: NDArray[np.int32], a: int, b: int) -> Optional[Array]:
+    """Outer ring of the union of labels ``a`` and ``b`` (full-image corner coordinates)."""
+    m = (lab == a) | (lab == b)
+    rows, cols = np.nonzero(m)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    sub = m[r0:r1, c0:c1].astype(np.int32)
+    sub_lab, n = ndimage.label(sub)
+    if n != 1:
+        return None
+    rings = label_rings(sub_lab)
+    if not rings:
+        return None
+    return rings[0][1] + np.array([c0, r0], float)
+
+
+# -- hypotheses and consensus -------------------------------------------------------------------
+@dataclass
+class BuildingMatch:
+    """The consensus of the buildings mode."""
+
+    transform: Optional[Array]  #: 3 × 3 image → map (None: no consensus)
+    pairs: List[Hypothesis]  #: verified (candidate, footprint) pairs
+    overlaps: List[float]
+    img_features: List[ObjectFeatures]
+    ref_features: List[ObjectFeatures]
+    counts: Dict[str, Any] = field(default_factory=dict)
+    reason: str = ""  #: why there is no result
+
+
+def _sites(fi: Sequence[ObjectFeatures], radius: float, use: Sequence[bool]
+           ) -> Tuple[Array, NDArray[np.int64]]:
+    """Centroids of the candidates in ``use`` merged within ``radius`` px (the runs segment
+    one roof several times): site centroids and the site of every candidate (-1: none)."""
+    c = np.array([f.centroid if u else [np.nan, np.nan] for f, u in zip(fi, use)])
+    c = np.where(np.isfinite(c), c, 1e12)
+    tree = cKDTree(c)
+    site = -np.ones(len(c), np.int64)
+    centres = []
+    for k in np.argsort([-f.area for f in fi]):
+        if site[k] >= 0 or not use[k]:
+            continue
+        near = [j for j in tree.query_ball_point(c[k], radius) if site[j] < 0]
+        site[near] = len(centres)
+        centres.append(c[k])
+    return np.array(centres), site
+
+
+def roof_halves(ref_objs: Sequence[PolygonObject]) -> Tuple[List[PolygonObject], List[int]]:
+    """The two halves of every footprint's minimum bounding rectangle split along its long
+    axis: what one side of a gabled or hipped roof looks like. Returns the half rectangles and
+    the footprint (index) each belongs to."""
+    out, owner = [], []
+    for j, o in enumerate(ref_objs):
+        c, ax, half = min_bounding_rectangle(o.ring)
+        u, v = (ax[0], ax[1]) if half[0] >= half[1] else (ax[1], ax[0])
+        a, b = max(half), min(half)
+        for side in (-1.0, 1.0):
+            cc = c + side * 0.5 * b * v
+            ring = np.array([cc + s * a * u + t * 0.5 * b * v
+                             for s, t in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+            out.append(PolygonObject(id=len(out), ring=orient_ring(ring), source=o.source))
+            owner.append(j)
+    return out, owner
+
+
+@dataclass
+class _Shapes:
+    """Reference shapes a candidate may be: footprints and their roof halves, with the
+    footprint each belongs to."""
+
+    normaliser_inv: Array  # (m, 2, 2)
+    centroid: Array  # (m, 2)
+    area: Array  # (m,)
+    owner: NDArray[np.int64]  # (m,)
+
+
+def _shapes(fr: Sequence[ObjectFeatures], fh: Sequence[ObjectFeatures],
+            owner_h: Sequence[int]) -> _Shapes:
+    both = list(fr) + list(fh)
+    return _Shapes(np.linalg.inv(np.array([f.normaliser for f in both])),
+                   np.array([f.centroid for f in both]), np.array([f.area for f in both]),
+                   np.array(list(range(len(fr))) + list(owner_h), np.int64))
+
+
+def _hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array,
+                site_of: NDArray[np.int64], cr: Array, base_tol: float,
+                sources: Sequence[int], image_area: float
+                ) -> List[Tuple[float, Array, Array]]:
+    """(support, transform, map position) of every one-pair hypothesis with support ≥ 2
+    (module notes, step 2); ``sources``: the candidates tried.
+
+    The support counts the footprint's k nearest neighbouring footprints that, mapped into
+    the image by the hypothesis, land on distinct candidate sites: the footprints are clean
+    (no clutter), so their constellation is the one to test; the image has clutter besides
+    the roofs, which only adds a few chance hits.
+    """
+    stree = cKDTree(sites)
+    k = min(NEIGHBOURS + 1, len(cr))
+    _, rn = cKDTree(cr).query(cr, k)
+    W = cr[rn[:, 1:]] - cr[:, None, :]  # (n_ref, k-1, 2) vectors to the neighbours
+    D4 = np.array(_D4)
+    density = len(sites) / image_area
+    out = []
+    for i in sources:
+        f = fi[i]
+        # L = N_shape⁻¹ D N_i for every shape and D4 element: (m, 8, 2, 2)
+        L = np.einsum("mab,dbc,ce->mdae", shapes.normaliser_inv, D4, f.base)
+        det = np.abs(np.linalg.det(L))
+        ratio = det * f.area / shapes.area[:, None]
+        mi, di = np.nonzero((ratio > 0.6) & (ratio < 1.6))
+        if not len(mi):
+            continue
+        Ls = L[mi, di]  # (h, 2, 2)
+        own = shapes.owner[mi]
+        # the footprint's neighbours relative to the shape's centroid, into the image
+        Wh = W[own] + (cr[own] - shapes.centroid[mi])[:, None, :]
+        img = f.centroid + np.einsum("hab,hnb->hna", np.linalg.inv(Ls), Wh)
+        tol = (base_tol + 0.06 * np.linalg.norm(Wh, axis=2)) / np.sqrt(det[mi, di])[:, None]
+        d, j = stree.query(img.reshape(-1, 2), distance_upper_bound=float(tol.max()))
+        j = j.reshape(tol.shape)
+        hit = (d.reshape(tol.shape) <= tol) & (j != site_of[i])
+        # minus the hits expected by chance (the sites' density over the tolerance discs)
+        chance = np.minimum(1.0, density * np.pi * tol**2).sum(axis=1)
+        support = _distinct(np.where(hit, j, -1)) - chance
+        for h in np.nonzero(support >= 2)[0]:
+            T = np.eye(3)
+            T[:2, :2] = Ls[h]
+            T[:2, 2] = shapes.centroid[mi[h]] - Ls[h] @ f.centroid
+            out.append((float(support[h]), T, shapes.centroid[mi[h]]))
+    out.sort(key=lambda t: -t[0])
+    return out
+
+
+def _distinct(j: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Distinct non-negative values per row (neighbours landing on the same footprint count
+    once: a collapsed map sends them all to one place)."""
+    js = np.sort(j, axis=1)
+    new = np.ones_like(js, bool)
+    new[:, 1:] = js[:, 1:] != js[:, :-1]
+    return np.sum(new & (js >= 0), axis=1)
+
+
+def _grow(T: Array, sites: Array, cr: Array, rtree: cKDTree, base_tol: float,
+          seed_xy: Array) -> Tuple[Array, NDArray[np.int64], NDArray[np.int64]]:
+    """Grow one hypothesis over the whole image: nearest footprint per site, one-to-one,
+    robust affine refit; the tolerance is ``base_tol`` plus a share of the distance from
+    ``seed_xy`` (map) shrinking from 6 % to 1 %, repeated until the matches stop changing.
+    Returns the transform and the matched site and target indices."""
+    si = rj = np.zeros(0, np.int64)
+    # the tolerance grows with the distance from the seed: an affine slightly off in scale
+    # or shear misplaces far buildings most
+    schedule = [0.06, 0.04, 0.03, 0.02] + [0.01] * 12
+    prev: Optional[set] = None
+    for k, f in enumerate(schedule):
+        mapped = apply(T, sites)
+        tol = base_tol + f * np.linalg.norm(mapped - seed_xy, axis=1)
+        d, j = rtree.query(mapped, distance_upper_bound=float(tol.max()))
+        ok = d <= tol
+        order = np.argsort(d[ok])
+        s_ok, j_ok = np.nonzero(ok)[0][order], j[ok][order]
+        _, first = np.unique(j_ok, return_index=True)  # one site per footprint (nearest)
+        si, rj = s_ok[first], j_ok[first]
+        if len(si) < 3:
+            break
+        T2 = _robust_affine(sites[si], cr[rj])
+        if T2 is None:
+            break
+        T = T2
+        now = set(zip(si.tolist(), rj.tolist()))
+        if k >= 3 and now == prev:
+            break
+        prev = now
+    return T, si, rj
+
+
+def _robust_affine(src: Array, dst: Array) -> Optional[Array]:
+    """Least-squares affine, refitted without the pairs beyond 2.5 × the median residual."""
+    T = affine_from_points(src, dst)
+    if T is None or len(src) < 6:
+        return T
+    r = np.linalg.norm(apply(T, src) - dst, axis=1)
+    keep = r <= 2.5 * max(float(np.median(r)), 1e-9)
+    return affine_from_points(src[keep], dst[keep]) if keep.sum() >= 3 else T
+
+
+def _inside_count(T: Array, cr: Array, shape: Tuple[int, int]) -> int:
+    """Footprints whose centroid falls inside the image under ``T``."""
+    p = apply(np.linalg.inv(T), cr)
+    return int(np.sum((p[:, 0] >= 0) & (p[:, 1] >= 0) & (p[:, 0] <= shape[1] - 1)
+                      & (p[:, 1] <= shape[0] - 1)))
+
+
+def _same_placement(si: NDArray[np.int64], rj: NDArray[np.int64], sk: NDArray[np.int64],
+                    rk: NDArray[np.int64]) -> bool:
+    """Two consensus sets describe the same placement: most sites both matched go to the
+    same footprint (growths from different seeds end a few pixels apart, with other sites)."""
+    a = dict(zip(si.tolist(), rj.tolist()))
+    common = [(a[s], r) for s, r in zip(sk.tolist(), rk.tolist()) if s in a]
+    return bool(common) and sum(x == y for x, y in common) >= 0.5 * len(common)
+
+
+def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
+                    feedback: Optional[Feedback] = None, max_tries: int = 40) -> BuildingMatch:
+    """Candidates, hypotheses and consensus (module notes, steps 1–3)."""
+    fb = feedback or Feedback()
+    cands, cinfo = roof_candidates(grey, feedback=fb)
+    counts_runs = cinfo["runs"]
+    counts: Dict[str, Any] = {"image_objects": len(cands), "reference_objects": len(ref_objs),
+                              "candidate_runs": counts_runs}
+    fr = object_features(ref_objs)
+    if len(cands) < MIN_MATCHES:
+        return BuildingMatch(None, [], [], [], fr, counts, f"only {len(cands)} roof "
+                             "candidates in the image")
+    fi = object_features(cands)
+    fb.progress(30)
+    sites, site_of = _sites(fi, 3.0, [c.attributes["rectangularity"] >= SITE_RECTANGULARITY
+                                       for c in cands])
+    cr = np.array([f.centroid for f in fr])
+    base_tol = 0.25 * math.sqrt(float(np.median([f.area for f in fr])))
+    halves, owner = roof_halves(ref_objs)
+    shapes = _shapes(fr, object_features(halves), owner)
+    sources = [i for i, c in enumerate(cands)
+               if c.attributes["rectangularity"] >= SOURCE_RECTANGULARITY]
+    hyps = _hypotheses(fi, shapes, sites, site_of, cr, base_tol, sources,
+                       float(grey.size))
+    counts.update(sites=len(sites), hypotheses=len(hyps),
+                  best_support=round(float(hyps[0][0]), 3) if hyps else 0)
+    fb.progress(50)
+    # targets of the growth: footprint centroids and roof-half centroids (a site is often one
+    # half of a gabled roof); a footprint counts once
+    ttree = cKDTree(shapes.centroid)
+    best: List[Tuple[int, Array, NDArray[np.int64], NDArray[np.int64]]] = []
+    for _, T0, xy in hyps[:max_tries]:
+        fb.check()
+        T, si, tj = _grow(T0, sites, shapes.centroid, ttree, base_tol, xy)
+        rj = shapes.owner[tj]
+        n = len(np.unique(rj))
+        if n >= 3:
+            best.append((n, T, si, rj))
+    best.sort(key=lambda t: -t[0])
+    if not best:
+        return BuildingMatch(None, [], [], fi, fr, counts,
+                             "no hypothesis is supported by its neighbours")
+    n, T, si, rj = best[0]
+    runner = max([b[0] for b in best[1:] if not _same_placement(b[2], b[3], si, rj)] or [0])
+    inside = _inside_count(T, cr, grey.shape)
+    counts.update(consensus_pairs=n, footprints_inside=inside, runner_up_pairs=runner)
+    if n < MIN_MATCHES or n < MIN_SHARE * inside or n < MIN_LEAD * runner:
+        why = (f"the best placement matches {n} footprint(s) of {inside} inside the image "
+               f"(needs ≥ {MIN_MATCHES} and ≥ {100 * MIN_SHARE:.0f} %), the best different "
+               f"one {runner} (needs a lead of ×{MIN_LEAD:g})")
+        return BuildingMatch(None, [], [], fi, fr, counts, why)
+    return _verified(T, fi, fr, sites, site_of, counts, base_tol)
+
+
+def _verified(T: Array, fi: Sequence[ObjectFeatures], fr: Sequence[ObjectFeatures],
+              sites: Array, site_of: NDArray[np.int64], counts: Dict[str, Any],
+              base_tol: float) -> BuildingMatch:
+    """Candidates against footprints under the refined ``T``: the existing verification
+    (overlap, one partner each) picks the candidate shape of each footprint (for the review's
+    overlay and the per-pair figures)."""
+    cr = np.array([f.centroid for f in fr])
+    d, j = cKDTree(cr).query(apply(T, np.array([f.centroid for f in fi])))
+    hyps = [Hypothesis(i=i, j=int(j[i]), transform=T, q=1.0, w=1.0, d=0.0)
+            for i in range(len(fi)) if d[i] <= base_tol]
+    ver = verify(hyps, fi, fr, T, min_overlap=0.5, reestimate=False)
+    counts.update(verified_pairs=len(ver.pairs))
+    return BuildingMatch(T, ver.pairs, ver.overlaps, list(fi), list(fr), counts)
