@@ -1540,7 +1540,7 @@
         </message>
         <message>
             <source>auto</source>
-            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; georeference_polygons.search: option</extracomment>
+            <extracomment>filter_linear_prediction.preset: option; filter_lowpass.preset: option; georeference_polygons.objects: option; georeference_polygons.search: option</extracomment>
             <translation>automatisch</translation>
         </message>
         <message>
@@ -2387,6 +2387,26 @@
             <source>keypoints</source>
             <extracomment>georeference_polygons.search: option</extracomment>
             <translation>Merkmalspunkte</translation>
+        </message>
+        <message>
+            <source>Reference objects</source>
+            <extracomment>georeference_polygons.objects: description</extracomment>
+            <translation>Referenzobjekte</translation>
+        </message>
+        <message>
+            <source>buildings: many small footprints (cadastre, OpenStreetMap) matched by the configuration of neighbouring buildings; areas: forests, fields, lakes, glaciers; auto: buildings when the layer has at least 15 mostly rectangular polygons whose median area is below 0.2 % of the layer's extent and below 5000 m².</source>
+            <extracomment>georeference_polygons.objects: help</extracomment>
+            <translation>buildings: viele kleine Gebäudegrundrisse (Kataster, OpenStreetMap), zugeordnet über die Anordnung benachbarter Gebäude; areas: Wälder, Felder, Seen, Gletscher; auto: Gebäude, wenn die Ebene mindestens 15 überwiegend rechteckige Polygone hat, deren mittlere Fläche (Median) unter 0,2 % der Ausdehnung der Ebene und unter 5000 m² liegt.</translation>
+        </message>
+        <message>
+            <source>areas</source>
+            <extracomment>georeference_polygons.objects: option</extracomment>
+            <translation>Flächen</translation>
+        </message>
+        <message>
+            <source>buildings</source>
+            <extracomment>georeference_polygons.objects: option</extracomment>
+            <translation>Gebäude</translation>
         </message>
         <message>
             <source>Control point tolerance σ_NP [px]</source>
