@@ -87,6 +87,8 @@ def evidence_html(report: Dict[str, Any]) -> str:
     local = [f"{v:.1f}" for v in ev.get("local_offsets_px") or [] if v is not None]
     if local:
         parts.append(tr("quadrant offsets {0} px").format(", ".join(local)))
+    if ev.get("corner_misfit_px") is not None:
+        parts.append(tr("corner misfit {0} px").format(f"{ev['corner_misfit_px']:.1f}"))
     return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
 
 
