@@ -111,10 +111,12 @@ class Evidence:
     seconds: float = 0.0
 
     def to_json(self) -> Dict[str, Any]:
-        """JSON-ready (rounded) figures for report.json."""
+        """JSON-ready (rounded) figures for report.json (not the seconds: reports of the same
+        inputs stay byte-identical)."""
         def r(v: Any) -> Any:
             return round(float(v), 4) if isinstance(v, (float, np.floating)) else v
         d = asdict(self)
+        d.pop("seconds")
         return {k: ([r(x) for x in v] if isinstance(v, list) and k != "reasons" else r(v))
                 for k, v in d.items()}
 

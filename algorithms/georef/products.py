@@ -444,7 +444,7 @@ def _evidence_html(rep: Dict[str, Any]) -> str:
                       if v is not None) or "none"
     return (f"<h2>Evidence</h2>{head}{html.escape(evidence_text(ev))}.</p>"
             f"<p>Agreement peak offsets per quadrant: {html.escape(local)}; "
-            f"{ev.get('points')} control points; assessed in {ev.get('seconds', 0):.1f} s.</p>")
+            f"{ev.get('points')} control points.</p>")
 
 
 def _independent_html(review: Dict[str, Any]) -> str:
