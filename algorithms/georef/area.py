@@ -38,6 +38,7 @@ through it (:func:`grid_control_points`).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -356,7 +357,8 @@ def refine_ecc(grey: Array, rings: Sequence[Array], T: Array, sigma: float = 1.5
 
 
 def area_search(grey: Array, rings: Sequence[Array], sigma: float = 1.5,
-                cells: int = SEARCH_CELLS, peaks: int = PEAKS) -> AreaResult:
+                cells: int = SEARCH_CELLS, peaks: int = PEAKS,
+                deadline: float = math.inf) -> AreaResult:
     """Image → map affine from the image and the reference polygons alone.
 
     Parameters
@@ -372,6 +374,9 @@ def area_search(grey: Array, rings: Sequence[Array], sigma: float = 1.5,
         image for the global search.
     peaks : int
         Fourier–Mellin peaks tried per handedness (each with its 180° twin).
+    deadline : float
+        ``time.perf_counter()`` time after which no further candidate is scored nor refined
+        (the result then has correlation 0).
 
     Returns
     -------
@@ -391,6 +396,8 @@ def area_search(grey: Array, rings: Sequence[Array], sigma: float = 1.5,
         v = valid[:, ::-1] if mirrored else valid
         for angle, scale, peak in rotation_scale_candidates(f, ref, n, peaks):
             for a in (angle, angle + math.pi):
+                if time.perf_counter() >= deadline:
+                    break
                 S, ncc = score_candidate(f, v, rings, to_cell, similarity(a, scale), sigma)
                 cands.append({"angle_deg": round(math.degrees(a) % 360, 3),
                               "scale": round(scale, 5), "mirrored": mirrored,
@@ -398,7 +405,8 @@ def area_search(grey: Array, rings: Sequence[Array], sigma: float = 1.5,
                 if best is None or ncc > best[0]:
                     F = flip if mirrored else np.eye(3)
                     best = (ncc, np.linalg.inv(to_cell) @ np.linalg.inv(S) @ F @ L, mirrored)
-    assert best is not None
+    if best is None or time.perf_counter() >= deadline:  # out of time: no result
+        return AreaResult(np.eye(3) if best is None else best[1], 0.0, 0.0, False, cands)
     T, cc = refine_ecc(grey, rings, best[1], sigma, cells)
     return AreaResult(T, best[0], cc, best[2], cands)
 
@@ -571,8 +579,8 @@ class OrientationCandidate:
 
 def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIENT_CELLS,
                        extent_ratio: Tuple[float, float] = EXTENT_RATIO,
-                       step: float = ORIENT_STEP, keep: int = 5, smooth: float = 1.0
-                       ) -> List[OrientationCandidate]:
+                       step: float = ORIENT_STEP, keep: int = 5, smooth: float = 1.0,
+                       deadline: float = math.inf) -> List[OrientationCandidate]:
     """Brute-force similarity search of the image against the outlines' directions.
 
     Every rotation (both handednesses) and scale on a grid whose steps move the image corners
@@ -597,6 +605,9 @@ def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = OR
     extent_ratio : (low, high)
         Scales searched: the image's diagonal is ``low``–``high`` times the reference
         extent's diagonal.
+    deadline : float
+        ``time.perf_counter()`` time after which no further rotation/scale is tried (the
+        placements found so far are returned).
 
     Returns
     -------
@@ -626,7 +637,7 @@ def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = OR
                         [0.0, rows - 1.0]])
     found: List[OrientationCandidate] = []
     q = q_lo
-    while q <= q_hi * (1 + 1e-9) or not found:
+    while (q <= q_hi * (1 + 1e-9) or not found) and time.perf_counter() < deadline:
         r = q * half_img
         # the fine field averaged over a cell (Gaussian of half a cell before the warp)
         zf = [(ndimage.gaussian_filter(p, 0.5 / q) if q < 1 else p).astype(np.float32)
@@ -635,6 +646,8 @@ def orientation_search(grey: Array, boundaries: Sequence[Array], cells: int = OR
         for mirrored in (False, True):
             F = np.diag([-1.0, 1.0, 1.0]) if mirrored else np.eye(3)
             for k in range(n_rot):
+                if time.perf_counter() >= deadline:  # out of time: the placements so far
+                    break
                 a = 2 * math.pi * k / n_rot
                 A = similarity(a, q) @ F
                 c = apply(A, corners)
@@ -770,7 +783,7 @@ class BoundaryResult:
 
 
 def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIENT_CELLS,
-                    screen: int = SCREEN) -> BoundaryResult:
+                    screen: int = SCREEN, deadline: float = math.inf) -> BoundaryResult:
     """Image → map affine from the image's edge directions and the individual outlines.
 
     :func:`orientation_search` proposes the ``screen`` best placements; each is refined at
@@ -781,10 +794,11 @@ def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIEN
     (at an image corner) are refined too, and the best final score wins. The runner-up is
     the best coarse-refined placement farther away: the gap between the two says whether
     the choice is unique (a fit to unrelated outlines reaches similar scores at several
-    places).
+    places). ``deadline``: ``time.perf_counter()`` time after which no further placement is
+    refined (out of time before any: score 0).
     """
-    cands = orientation_search(grey, boundaries, cells, keep=screen)
-    if not cands:
+    cands = orientation_search(grey, boundaries, cells, keep=screen, deadline=deadline)
+    if not cands or time.perf_counter() >= deadline:
         return BoundaryResult(np.eye(3), 0.0, 0.0, 0.0, 0.0, False)
     rows, cols = grey.shape
     corners = np.array([[0.0, 0.0], [cols - 1.0, 0.0], [0.0, rows - 1.0],
@@ -792,6 +806,8 @@ def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIEN
     fields: Dict[float, NDArray[np.complex128]] = {}  # gradient fields per σ, computed once
     screened = []
     for c in cands:
+        if screened and time.perf_counter() >= deadline:
+            break
         T, sc = refine_orientation(grey, boundaries, c.transform, sigmas=(8.0, 4.0),
                                    spacing=2.0, model="similarity", fields=fields)
         screened.append((sc, T, c))

@@ -24,6 +24,7 @@
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -183,7 +184,8 @@ def weighted_mean_transform(pairs: Sequence[Hypothesis]) -> NDArray[np.float64]:
 def consistent_interpretation(hyps: Sequence[Hypothesis], img: Sequence[ObjectFeatures],
                               ref: Sequence[ObjectFeatures], max_depth: int = 6,
                               min_overlap: float = 0.7, budget: int = 20000,
-                              same_object_overlap: float = 0.5) -> Interpretation:
+                              same_object_overlap: float = 0.5,
+                              deadline: float = math.inf) -> Interpretation:
     """Depth-first interpretation-tree search (module notes, step 2).
 
     Parameters
@@ -197,6 +199,8 @@ def consistent_interpretation(hyps: Sequence[Hypothesis], img: Sequence[ObjectFe
     same_object_overlap : float
         Image objects (of different runs) overlapping each other by more than this share of
         the smaller are the same ground object: at most one of them per interpretation.
+    deadline : float
+        ``time.perf_counter()`` time at which the search stops as at the node budget.
     """
     n = len(hyps)
     if n == 0:
@@ -256,7 +260,7 @@ def consistent_interpretation(hyps: Sequence[Hypothesis], img: Sequence[ObjectFe
         if len(chosen) >= max_depth:
             return True
         for pos, k in enumerate(cands.tolist()):
-            if state["nodes"] >= budget:
+            if state["nodes"] >= budget or time.perf_counter() >= deadline:
                 return False
             state["nodes"] += 1
             h = hyps[k]
@@ -279,7 +283,7 @@ def consistent_interpretation(hyps: Sequence[Hypothesis], img: Sequence[ObjectFe
     order = np.arange(n)
     found = False
     for k in order.tolist():
-        if state["nodes"] >= budget:
+        if state["nodes"] >= budget or time.perf_counter() >= deadline:
             break
         state["nodes"] += 1
         rest = order[k + 1:]

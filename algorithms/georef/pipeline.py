@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, StepFeedback
@@ -23,6 +22,8 @@ from ..output_policy import PRODUCT_MARKER
 from .area import area_search, boundary_search, grid_control_points
 from .buildings import is_buildings, match_buildings
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
+from .evidence import assess
+from .evidence import hull_share as _hull_share
 from .fit import fit_transform, inverse_for_resampling
 from .invariants import object_features
 from .keypoints import DETECTORS, keypoint_result
@@ -67,6 +68,10 @@ MIN_ECC = 0.4
 #: synthetic tilings against unrelated tilings 0.58–0.72, but with gaps ≤ 0.06.
 MIN_ORIENTATION = 0.55
 MIN_GAP = 0.08
+#: Default time budget of the search (s): a hopeless run says so by then (issue 23). Not 30 s:
+#: right Everest results (boundary-orientation stage, 0.5 Mpx) took 73–110 s on the shared
+#: 2-core test machine (docs/decisions.md).
+DEFAULT_TIME_LIMIT_S = 180.0
 
 
 def parse_thresholds(text: Union[str, Sequence[float], None]) -> List[float]:
@@ -136,6 +141,12 @@ class GeorefOptions:
         lakes, glaciers: the stages of ``search``), ``auto``: buildings when the layer has
         many small polygons (:func:`.buildings.is_buildings`), and when it fails the stages
         of ``search`` (the area-based ones; with ``search = objects`` the object stage).
+    unverified : bool
+        Return a result the independent evidence does not support (:mod:`.evidence`),
+        marked ``verified=False`` with a warning, instead of failing.
+    time_limit_s : float
+        Time budget of the search (s; 0: none): the stages stop when it is spent and the
+        run fails with the figures found so far.
     """
 
     class_field: Optional[str] = None
@@ -157,6 +168,8 @@ class GeorefOptions:
     search: str = "auto"
     detector: str = "auto"
     objects: str = "auto"
+    unverified: bool = False
+    time_limit_s: float = DEFAULT_TIME_LIMIT_S
 
     def check(self) -> List[float]:
         """Refuse unknown transform and search names; returns the parsed thresholds."""
@@ -172,6 +185,8 @@ class GeorefOptions:
         if self.objects not in OBJECT_KINDS:
             raise InputError(f"Unknown objects '{self.objects}'; use "
                              f"{', '.join(OBJECT_KINDS)}.")
+        if not self.time_limit_s >= 0:
+            raise InputError(f"The time limit must be ≥ 0 s (0: none), not {self.time_limit_s}.")
         return thr
 
     def report(self, thresholds: List[float], pyramid_level: Optional[int]) -> Dict[str, Any]:
@@ -183,7 +198,8 @@ class GeorefOptions:
                 "smooth": self.smooth, "merge": self.merge, "gcp_mode": self.gcp_mode,
                 "class_field": self.class_field, "class_value": self.class_value,
                 "search": self.search, "pyramid_level": pyramid_level,
-                "detector": self.detector, "objects": self.objects}
+                "detector": self.detector, "objects": self.objects,
+                "unverified": self.unverified, "time_limit_s": self.time_limit_s}
 
 
 def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefOptions] = None,
@@ -226,7 +242,16 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
         ref = reference_objects_from_vector(reference, opts.class_field, opts.class_value,
                                             feedback=fb)
     fb.progress(5)
-    run = _Run(opts, thr, grey, img_info, fb, t0)
+    limit = opts.time_limit_s
+    run = _Run(opts, thr, grey, img_info, fb, t0, t0 + limit if limit > 0 else float("inf"))
+    result = _search(run, reference, ref_kind, ref)
+    return _gate(run, result, reference, ref)
+
+
+def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple]
+            ) -> GeorefResult:
+    """The stages in their order; the first result wins."""
+    opts, fb = run.options, run.fb
     buildings_failure = None
     if ref is not None and (opts.objects == "buildings"
                             or (opts.objects == "auto" and is_buildings(ref[0]))):
@@ -247,7 +272,7 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
     try:
         return _object_stage(run, reference, ref_kind, ref)
     except GeometryError as exc:
-        if opts.search == "objects" or ref_kind == "raster":
+        if opts.search == "objects" or ref_kind == "raster" or run.expired():
             raise
         # the reason and counts only: the advice at the end is repeated by the area stage
         why = str(exc).replace("Georeferencing failed: ", "").split(". Check that")[0]
@@ -255,10 +280,40 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
         return _area_stage(run, ref, why)
 
 
+def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tuple]
+          ) -> GeorefResult:
+    """The acceptance gate (:mod:`.evidence`): a result the independent evidence does not
+    support fails with the figures — or, with ``unverified``, is returned marked."""
+    fb = run.fb
+    fb.check()
+    if ref is not None:
+        source: Any = [b for o in ref[0] for b in o.attributes.get("outlines", [o.ring])]
+    else:
+        source = reference
+    ev = assess(result, source)
+    result.evidence, result.verified = ev, ev.verified
+    result.counts["verified"] = ev.verified
+    fb.info(f"Evidence ({ev.seconds:.1f} s): {ev.text()}.")
+    if not ev.verified:
+        why = "; ".join(ev.reasons)
+        if not run.options.unverified:
+            raise GeometryError(
+                f"Georeferencing failed: the {result.stage} stage's result is not verified: "
+                f"{why} (RMSE {result.fit.rmse_px:.2f} px of {ev.points} control points; "
+                f"{ev.text()}). No result is better than a wrong one: check that image and "
+                "reference show the same area, or write the result marked unverified.",
+                {**result.counts, "evidence": ev.to_json()})
+        warning = f"UNVERIFIED result (written on request): {why}."
+        result.warnings.append(warning)
+        fb.warning(warning)
+    result.seconds = time.perf_counter() - run.t0
+    return result
+
+
 @dataclass
 class _Run:
-    """What both stages share: the options, the parsed thresholds, the image, the feedback
-    and the start time."""
+    """What the stages share: the options, the parsed thresholds, the image, the feedback,
+    the start time and the time budget's end."""
 
     options: GeorefOptions
     thresholds: List[float]
@@ -266,6 +321,15 @@ class _Run:
     image_info: Dict[str, Any]
     fb: Feedback
     t0: float
+    deadline: float = float("inf")  #: perf_counter time when the budget is spent
+
+    def expired(self) -> bool:
+        """Whether the time budget is spent."""
+        return time.perf_counter() >= self.deadline
+
+    def left(self) -> float:
+        """Seconds left of the time budget (inf: none)."""
+        return self.deadline - time.perf_counter()
 
 
 def _keypoint_stage(run: _Run, reference: PathLike) -> GeorefResult:
@@ -311,11 +375,12 @@ def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
     fb.info(f"{len(img_objs)} image objects, {len(ref_objs)} reference objects, "
             f"{len(hyps)} hypotheses (invariants within {100 * opts.rd:g} %).")
     interp = consistent_interpretation(hyps, fi, fr, max_depth=opts.max_depth,
-                                       min_overlap=opts.min_overlap)
+                                       min_overlap=opts.min_overlap, deadline=run.deadline)
     fb.progress(55)
     counts = {"image_objects": len(img_objs), "reference_objects": len(ref_objs),
               "hypotheses": len(hyps), "consistent_pairs": len(interp.pairs),
               "search_nodes": interp.nodes, "depth_reached": interp.depth_reached}
+    _check_time(run, counts, "the consistency search")
     if interp.transform is None or len(interp.pairs) < 2:
         _fail(counts, "no two hypotheses are geometrically consistent")
     ver = verify(hyps, fi, fr, interp.transform, min_overlap=opts.verify_overlap)
@@ -494,17 +559,18 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefR
     grey, fb = run.grey, run.fb
     fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
     fb.progress(40)
-    res = area_search(grey, [o.ring for o in ref_objs])
+    res = area_search(grey, [o.ring for o in ref_objs], deadline=run.deadline)
     fb.progress(60)
     counts: Dict[str, Any] = {"reference_objects": len(ref_objs),
                               "area_candidates": len(res.candidates),
                               "area_ncc": round(res.ncc, 4), "area_ecc": round(res.ecc, 4),
                               "verified_pairs": 0}
+    _check_time(run, counts, "the area-based search", object_failure)
     area_info: Dict[str, Any] = {"method": "ecc", "ncc": res.ncc, "ecc": res.ecc,
                                  "mirrored": res.mirrored, "candidates": res.candidates}
     T = res.transform
     if res.ecc < MIN_ECC:
-        T, area_info = _boundary_stage(grey, ref_objs, res.ecc, counts, object_failure, fb)
+        T, area_info = _boundary_stage(run, ref_objs, res.ecc, counts, object_failure)
     fb.progress(75)
     gcps = grid_control_points(T, np.isfinite(grey))
     img_xy = np.array([g.image for g in gcps])
@@ -531,20 +597,22 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefR
         parameters=run.options.report(run.thresholds, None))
 
 
-def _boundary_stage(grey: np.ndarray, ref_objs: Sequence[Any], ecc: float,
-                    counts: Dict[str, Any], object_failure: Optional[str],
-                    fb: Feedback) -> Tuple[np.ndarray, Dict[str, Any]]:
+def _boundary_stage(run: _Run, ref_objs: Sequence[Any], ecc: float,
+                    counts: Dict[str, Any], object_failure: Optional[str]
+                    ) -> Tuple[np.ndarray, Dict[str, Any]]:
     """The individual polygons' outlines against the image's edge directions, when the ECC
     correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. Returns the
     transform and the description of the search for the report."""
+    grey, fb = run.grey, run.fb
     fb.info(f"ECC correlation {ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
             "(individual outlines against edge directions).")
     outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
-    bres = boundary_search(grey, outlines)
+    bres = boundary_search(grey, outlines, deadline=run.deadline)
     counts.update(boundary_outlines=len(outlines),
                   boundary_score=round(bres.score, 4),
                   boundary_screen=round(bres.screen, 4),
                   boundary_runner_up=round(bres.runner_up, 4))
+    _check_time(run, counts, "the boundary-orientation search", object_failure)
     if bres.score < MIN_ORIENTATION or bres.gap < MIN_GAP:
         why = (f"the area-based search found no alignment (ECC correlation {ecc:.2f} "
                f"< {MIN_ECC:g}; boundary-orientation score {bres.score:.2f}, needs "
@@ -561,6 +629,20 @@ def _boundary_stage(grey: np.ndarray, ref_objs: Sequence[Any], ecc: float,
     return bres.transform, info
 
 
+def _check_time(run: _Run, counts: Dict[str, Any], where: str,
+                before: Optional[str] = None) -> None:
+    """Fail with the figures found so far when the time budget is spent (``counts`` gets
+    the seconds; ``before``: an earlier stage's failure, named in the message)."""
+    if not run.expired():
+        return
+    counts["seconds"] = round(time.perf_counter() - run.t0, 1)
+    why = (f"the time limit of {run.options.time_limit_s:g} s was reached in {where} "
+           "without a result")
+    if before:
+        why += f"; before it, the object stage: {before}"
+    _fail(counts, why)
+
+
 def _fail(counts: Dict[str, Any], why: str) -> None:
     """Raise the failure message; the exception's ``counts`` keep the figures as data."""
     raise GeometryError(
@@ -572,16 +654,6 @@ def _fail(counts: Dict[str, Any], why: str) -> None:
 def _detail(counts: Dict[str, Any]) -> str:
     """The figures of a failure message: "image objects 12, hypotheses 0, …"."""
     return ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
-
-
-def _hull_share(xy: np.ndarray, shape: Sequence[int]) -> float:
-    """Share of the image area inside the convex hull of ``xy`` (0 for fewer than 3)."""
-    if len(xy) < 3:
-        return 0.0
-    try:
-        return float(ConvexHull(xy).volume / (shape[0] * shape[1]))
-    except Exception:
-        return 0.0
 
 
 def run_georeference_polygons(image: PathLike, reference: PathLike, output: PathLike,

@@ -35,6 +35,7 @@ from ..jsonable import json_ready
 from ..quality.report import new_figure
 from ..raster.io import atomic_output, gtiff_profile, open_image, overview_factors, staged_folder
 from .correspondence import apply
+from .evidence import evidence_text
 from .fit import TransformFit, points_summary
 from .result import GeorefResult
 
@@ -254,6 +255,8 @@ def report_dict(result: GeorefResult) -> Dict[str, Any]:
         "parameters": result.parameters, "warnings": result.warnings,
         "stage": result.stage,
         "area_search": result.area,
+        "verified": result.verified,
+        "evidence": None if result.evidence is None else result.evidence.to_json(),
         "extensions": ["area-based global search" if result.stage == "area" else None,
                        "smoothing before segmentation" if result.parameters["smooth"]
                        else None,
@@ -411,14 +414,17 @@ def report_html(rep: Dict[str, Any], name: str) -> str:
         source = (f"{c.get('gcps')} control points from {c.get('verified_pairs')} verified "
                   f"object pairs ({c.get('hypotheses')} hypotheses, {c.get('image_objects')} "
                   f"image and {c.get('reference_objects')} reference objects)")
+    unverified = (' — <span style="color:#b00">UNVERIFIED</span>'
+                  if rep.get("verified") is False else "")
     page = f"""<!doctype html><html><head><meta charset="utf-8">
 <title>Georeferencing {html.escape(name)}</title>
 <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 8px;text-align:right}}
 table{{border-collapse:collapse}}tr:nth-child(even){{background:#eee}}</style></head><body>
-<h1>Georeferencing of {html.escape(name)}</h1>
+<h1>Georeferencing of {html.escape(name)}{unverified}</h1>
 <p>Transform: <b>{rep['transform']['kind']}</b> into {html.escape(rep['transform']['crs'])}.
 RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
 {rep['pixel_size_m']:.3f} m); {source}.</p>{reviewed}
+{_evidence_html(rep)}
 <h2>Warnings</h2><ul>{warn}</ul>
 <img src="overlay.png" style="max-width:100%">
 <h2>Residuals</h2><img src="residuals.png" style="max-width:100%">
@@ -427,6 +433,25 @@ RMSE <b>{rep['rmse_px']:.3f} px</b> = {rep['rmse_m']:.3f} m (pixel size
 <th>residual m</th><th>leave-one-out m</th><th>used</th></tr>{rows}</table>
 </body></html>"""
     return page
+
+
+def _evidence_html(rep: Dict[str, Any]) -> str:
+    """The report's evidence section: the verdict (UNVERIFIED in red) and its figures."""
+    ev = rep.get("evidence")
+    if ev is None:
+        return ""
+    if rep.get("verified"):
+        head = "<p><b>Verified</b> by independent evidence: "
+    else:
+        head = ('<p style="color:#b00"><b>UNVERIFIED</b> — written on request; the '
+                "independent evidence does not support it: "
+                + html.escape("; ".join(ev.get("reasons", []))) + ". Figures: ")
+    names = ("top left", "top right", "bottom left", "bottom right")
+    local = ", ".join(f"{n} {v:.2f} px" for n, v in zip(names, ev.get("local_offsets_px") or [])
+                      if v is not None) or "none"
+    return (f"<h2>Evidence</h2>{head}{html.escape(evidence_text(ev))}.</p>"
+            f"<p>Agreement peak offsets per quadrant: {html.escape(local)}; "
+            f"{ev.get('points')} control points.</p>")
 
 
 def _independent_html(review: Dict[str, Any]) -> str:
@@ -485,7 +510,13 @@ def summary(result: GeorefResult, paths: Dict[str, Any]) -> Dict[str, Any]:
             "rmse_m": float(fit.rmse_map), "gcps": paths["points"],
             "gcps_gpkg": paths["gcps"], "image": paths["image"], "report": paths["report"],
             "n_pairs": int(result.counts["verified_pairs"]),
-            "n_gcps": int(result.counts["gcps"])}
+            "n_gcps": int(result.counts["gcps"]),
+            "verified": verified_word(result.verified)}
+
+
+def verified_word(verified: Optional[bool]) -> str:
+    """"yes", "no" (UNVERIFIED) or "not assessed" for a result's or report's verdict."""
+    return {True: "yes", False: "no"}.get(verified, "not assessed")  # type: ignore[arg-type]
 
 
 def points_list(result: GeorefResult) -> List[Dict[str, Any]]:

@@ -46,3 +46,7 @@ class GeorefResult:
     parameters: Dict[str, Any] = field(default_factory=dict)  #: see GeorefOptions.report
     area: Optional[Dict[str, Any]] = None  #: the area-based search, when it gave the result
     reference_rings: List[Any] = field(default_factory=list)  #: drawn in the overlay (area)
+    #: independent evidence (:class:`.evidence.Evidence`; ``None``: not assessed)
+    evidence: Optional[Any] = None
+    #: the acceptance gate's verdict (``None``: not assessed; False: written as unverified)
+    verified: Optional[bool] = None

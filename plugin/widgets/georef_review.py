@@ -59,6 +59,39 @@ def role_text(role: str) -> str:
             "independent": tr("check (independent)")}.get(role, role)
 
 
+def evidence_html(report: Dict[str, Any]) -> str:
+    """The automatic result's independent evidence (report.json ``evidence``) for the
+    dialog: the verdict (UNVERIFIED in red) and its figures; '' for results without it."""
+    ev = report.get("evidence")
+    if not ev:
+        return ""
+    if report.get("verified"):
+        verdict = f"<b>{tr('Verified: yes')}</b>"
+    else:
+        reasons = "; ".join(ev.get("reasons") or [])
+        verdict = f"<b style='color:#c0392b'>{tr('UNVERIFIED')}</b> — {reasons}"
+    parts = []
+    if ev.get("independent_points", True) and ev.get("hull_share") is not None:
+        parts.append(tr("control points cover {0} % of the image, {1} of 4 quadrants").format(
+            f"{100 * ev['hull_share']:.0f}", ev.get("quadrants")))
+        if ev.get("corner_disagreement_px") is not None:
+            parts.append(tr("corners disagree by {0} px between halves").format(
+                f"{ev['corner_disagreement_px']:.2f}"))
+    elif not ev.get("independent_points", True):
+        parts.append(tr("control points from a grid through the search transform"))
+    if ev.get("peak") is not None:
+        what = (tr("edge peak ratio {0}") if ev.get("agreement") == "edges"
+                else tr("correlation peak margin {0}"))
+        parts.append(what.format(f"{ev['peak']:.2f}") + " "
+                     + tr("at {0} px").format(f"{ev['offset_px']:.1f}"))
+    local = [f"{v:.1f}" for v in ev.get("local_offsets_px") or [] if v is not None]
+    if local:
+        parts.append(tr("quadrant offsets {0} px").format(", ".join(local)))
+    if ev.get("corner_misfit_px") is not None:
+        parts.append(tr("corner misfit {0} px").format(f"{ev['corner_misfit_px']:.1f}"))
+    return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
+
+
 class AddPointDialog(QtWidgets.QDialog):
     """Asks for a manual control point: image column/row and map X/Y."""
 
@@ -131,6 +164,9 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         self.summary = QtWidgets.QLabel(self)
         self.summary.setTextFormat(QtCore.Qt.RichText)
         self.summary.setWordWrap(True)
+        self.evidence_label = QtWidgets.QLabel(evidence_html(self.review.report), self)
+        self.evidence_label.setTextFormat(QtCore.Qt.RichText)
+        self.evidence_label.setWordWrap(True)
         top = QtWidgets.QHBoxLayout()
         top.addWidget(QtWidgets.QLabel(tr("Transform:"), self))
         top.addWidget(self.kind_combo)
@@ -180,6 +216,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         layout = QtWidgets.QVBoxLayout(self)
         layout.addLayout(top)
         layout.addWidget(self.summary)
+        layout.addWidget(self.evidence_label)
         layout.addWidget(splitter, 1)
         layout.addLayout(buttons)
 

@@ -194,3 +194,22 @@ def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path) -> 
         dialog.dirty = False
     finally:
         i18n.remove_translator()
+
+
+def test_review_shows_the_evidence(qtbot, folder) -> None:
+    """The automatic result's evidence above the tables: verified, then marked UNVERIFIED."""
+    dialog = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(dialog)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    text = dialog.evidence_label.text()
+    assert "Verified: yes" in text and "% of the image, 4 of 4 quadrants" in text
+    assert "corners disagree by" in text and "edge peak ratio" in text
+    dialog.grab().save("/tmp/photodem_georef_review_evidence.png")
+    rep = json.loads((folder / "report.json").read_text())
+    rep["verified"] = False
+    rep["evidence"]["reasons"] = ["the corners disagree by 5.3 px between halves"]
+    (folder / "report.json").write_text(json.dumps(rep))
+    marked = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(marked)
+    assert "UNVERIFIED</b> — the corners disagree by 5.3 px" in marked.evidence_label.text()

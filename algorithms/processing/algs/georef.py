@@ -89,6 +89,16 @@ class GeoreferencePolygons(Algorithm):
                   minimum=0.1, maximum=50.0, unit="px",
                   help="Control points are accepted (best first) while the RMS of their "
                        "outline distances stays below this."),
+        Parameter("unverified", "bool", "Write an unverified result", default=False,
+                  help="A result is accepted only when independent evidence supports it: "
+                       "control points spread over the image, halves of them agreeing at the "
+                       "image corners, image and reference agreeing best at the result. "
+                       "Without that the run fails with the figures; with this option the "
+                       "result is written marked UNVERIFIED instead."),
+        Parameter("time_limit", "number", "Time limit [s]", default=180.0, minimum=0.0,
+                  maximum=3600.0, unit="s",
+                  help="The search stops when this time is spent and the run fails with the "
+                       "figures found so far (0: no limit)."),
     )
     outputs = (
         Output("transform", "json", "Transform (kind, 3 × 3 matrix image col/row → map)"),
@@ -100,6 +110,7 @@ class GeoreferencePolygons(Algorithm):
         Output("report", "file", "Report (JSON; HTML beside it)"),
         Output("n_pairs", "number", "Verified object pairs"),
         Output("n_gcps", "number", "Control points used"),
+        Output("verified", "string", "Verified by independent evidence (yes/no)"),
     )
 
     def run(self, params: Dict[str, Any], feedback: Feedback) -> Dict[str, Any]:
@@ -116,7 +127,9 @@ class GeoreferencePolygons(Algorithm):
             max_depth=int(params.get("max_depth", 6)),
             sigma_np_px=float(params.get("sigma_np", 2.0)),
             search=params.get("search") or "auto",
-            objects=params.get("objects") or "auto")
+            objects=params.get("objects") or "auto",
+            unverified=bool(params.get("unverified", False)),
+            time_limit_s=float(params.get("time_limit", 180.0)))
         return run_georeference_polygons(params["image"], params["reference"],
                                          params["output"], options, feedback)
 

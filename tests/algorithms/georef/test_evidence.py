@@ -1,0 +1,156 @@
+"""The acceptance gate (issue 23): right results verified, wrong ones rejected with the figures,
+``unverified`` writes marked products, a hopeless run fails within its time budget."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from photodem.algorithms.errors import GeometryError
+from photodem.algorithms.georef import evidence
+from photodem.algorithms.georef.evidence import assess
+from photodem.algorithms.georef.fit import corner_error, fit_transform, inverse_for_resampling
+from photodem.algorithms.georef.pipeline import georeference
+from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
+from photodem.algorithms.georef.refinement import ControlPoint
+from photodem.algorithms.processing import registry
+from photodem.algorithms.synthetic.polygon_scene import georef_case, ortho_case
+
+pytestmark = pytest.mark.slow
+
+SIZE = 600
+
+
+def _outlines(path):
+    objs, _, _ = reference_objects_from_vector(path)
+    return [b for o in objs for b in o.attributes.get("outlines", [o.ring])]
+
+
+@pytest.fixture(scope="module")
+def right(tmp_path_factory):
+    """A right result of the object stage (600 × 600 px) and its case."""
+    case = georef_case(tmp_path_factory.mktemp("evidence") / "case", seed=5, width=SIZE,
+                       height=SIZE)
+    return georeference(case["image"], case["reference"]), case
+
+
+def _refit(res, img, mp):
+    fit = fit_transform(img, mp, res.fit.kind)
+    gcps = [ControlPoint(tuple(i), tuple(m), 0.0, 0, False) for i, m in zip(img, mp)]
+    return replace(res, fit=fit, gcps=gcps,
+                   inverse_fit=inverse_for_resampling(fit, img[fit.used], mp[fit.used]))
+
+
+def _corner_perturbed(res, d, size=SIZE):
+    """The result with its transform scaled about the top-left corner so that the
+    bottom-right corner moves by ``d`` px; the control points moved with it (a consistently
+    wrong result)."""
+    s = 1 + d / math.hypot(size, size)
+    img = np.array([g.image for g in res.gcps])
+    mp = np.array([g.map for g in res.gcps])
+    moved = res.fit.forward(-0.5 + s * (img + 0.5)) - (res.fit.forward(img) - mp)
+    return _refit(res, img, moved)
+
+
+def _clustered(res, box, noise):
+    """Only the control points in the top-left ``box`` share of the image, with noise (px)."""
+    img = np.array([g.image for g in res.gcps])[res.fit.used]
+    mp = np.array([g.map for g in res.gcps])[res.fit.used]
+    keep = (img[:, 0] < box * SIZE) & (img[:, 1] < box * SIZE)
+    noisy = mp[keep] + np.random.default_rng(1).normal(0, noise * res.fit.pixel_size,
+                                                        (keep.sum(), 2))
+    return _refit(res, img[keep], noisy)
+
+
+def test_right_result_is_verified_and_reported(right, tmp_path) -> None:
+    res, case = right
+    assert res.verified is True and res.evidence.verified and not res.evidence.reasons
+    ev = res.evidence
+    assert corner_error(res.fit, case["truth"], SIZE, SIZE).max() < 0.5
+    assert ev.hull_share > evidence.MIN_HULL and ev.quadrants == 4
+    assert ev.corner_disagreement_px < 1.0 and ev.offset_px < 1.0
+    assert ev.agreement == "edges" and ev.peak > evidence.MIN_EDGE_PEAK
+    text = ev.text()
+    assert "% of the image" in text and "edge peak ratio" in text
+
+
+@pytest.mark.parametrize("d", [3.0, 6.0])
+def test_corner_perturbed_result_is_rejected(right, d) -> None:
+    res, case = right
+    wrong = _corner_perturbed(res, d)
+    assert corner_error(wrong.fit, case["truth"], SIZE, SIZE).max() > d - 0.5
+    ev = assess(wrong, _outlines(case["reference"]))
+    assert not ev.verified
+    assert any("agree best" in r for r in ev.reasons), ev.reasons
+
+
+def test_clustered_points_are_rejected(right) -> None:
+    res, case = right
+    ev = assess(_clustered(res, 0.35, 1.0), _outlines(case["reference"]))
+    assert not ev.verified and ev.hull_share < evidence.MIN_HULL
+    assert any("cover" in r for r in ev.reasons)
+    assert ev.corner_disagreement_px > evidence.MAX_CORNER_PX
+
+
+def test_different_scene_is_rejected(right, tmp_path) -> None:
+    res, _case = right
+    other = georef_case(tmp_path / "other", seed=5, scene_seed=105, width=SIZE, height=SIZE)
+    ev = assess(res, _outlines(other["reference"]))
+    assert not ev.verified
+    assert ev.agreement is None or ev.peak < evidence.MIN_EDGE_PEAK
+
+
+def test_raster_reference_agreement(tmp_path) -> None:
+    """Against an orthophoto: the true transform (control points on a grid through it) is
+    verified by the correlation, the same perturbed at a corner is not."""
+    from photodem.algorithms.georef.correspondence import apply
+    from photodem.algorithms.georef.regions import load_image
+    from photodem.algorithms.georef.result import GeorefResult
+
+    c = ortho_case(tmp_path / "ortho", seed=1, size_px=500)
+    grey, _ = load_image(c["image"])
+    cc, rr = np.meshgrid(np.linspace(0, c["width"] - 1, 8), np.linspace(0, c["height"] - 1, 8))
+    img = np.column_stack([cc.ravel(), rr.ravel()])
+    mp = apply(c["truth"], img)
+    fit = fit_transform(img, mp, "affine")
+    res = GeorefResult(fit=fit, inverse_fit=inverse_for_resampling(fit, img, mp),
+                       gcps=[ControlPoint(tuple(i), tuple(m), 0.0, 0, False)
+                             for i, m in zip(img, mp)], crs=None, grey=grey)
+    ev = assess(res, c["reference"])
+    assert ev.verified and ev.agreement == "correlation", ev.reasons
+    assert ev.peak > evidence.MIN_NCC_MARGIN and ev.corner_misfit_px < 0.5
+    wrong = assess(_corner_perturbed(res, 6.0, c["width"]), c["reference"])
+    assert not wrong.verified and wrong.corner_misfit_px > 3.0
+
+
+def test_unverified_option_writes_marked_products(right, tmp_path, monkeypatch) -> None:
+    _res, case = right
+    monkeypatch.setattr(evidence, "MIN_EDGE_PEAK", 1e6)  # no result can pass
+    with pytest.raises(GeometryError, match="not verified: image and reference do not agree"):
+        georeference(case["image"], case["reference"])
+    out = tmp_path / "unverified"
+    summary = registry.run("georeference_polygons", {
+        "image": case["image"], "reference": case["reference"], "output": str(out),
+        "unverified": True})
+    assert summary["verified"] == "no"
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["verified"] is False and rep["evidence"]["reasons"]
+    assert any(w.startswith("UNVERIFIED") for w in rep["warnings"])
+    assert "UNVERIFIED" in (out / "report.html").read_text()
+
+
+def test_hopeless_run_fails_within_the_time_limit(right, tmp_path) -> None:
+    """Image against an unrelated map: the failure comes within the budget (plus the step
+    that was running: a segmentation is not interrupted)."""
+    _res, case = right
+    other = georef_case(tmp_path / "other", seed=6, scene_seed=17, width=SIZE, height=SIZE)
+    t0 = time.perf_counter()
+    with pytest.raises(GeometryError, match=r"Georeferencing failed") as info:
+        georeference(case["image"], other["reference"], time_limit_s=5.0)
+    assert time.perf_counter() - t0 < 15.0
+    assert "time limit of 5 s" in str(info.value) or "not verified" in str(info.value)
