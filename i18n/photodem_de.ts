@@ -2419,6 +2419,26 @@
             <translation>Passpunkte werden (beste zuerst) übernommen, solange der RMS ihrer Konturabstände darunter bleibt.</translation>
         </message>
         <message>
+            <source>Write an unverified result</source>
+            <extracomment>georeference_polygons.unverified: description</extracomment>
+            <translation>Unbestätigtes Ergebnis schreiben</translation>
+        </message>
+        <message>
+            <source>A result is accepted only when independent evidence supports it: control points spread over the image, halves of them agreeing at the image corners, image and reference agreeing best at the result. Without that the run fails with the figures; with this option the result is written marked UNVERIFIED instead.</source>
+            <extracomment>georeference_polygons.unverified: help</extracomment>
+            <translation>Ein Ergebnis wird nur angenommen, wenn unabhängige Belege es stützen: über das Bild verteilte Passpunkte, an den Bildecken übereinstimmende Transformationen aus je einer Hälfte der Passpunkte, beste Übereinstimmung von Bild und Referenz genau beim Ergebnis. Fehlt das, bricht der Lauf mit den Kennzahlen ab; mit dieser Option wird das Ergebnis stattdessen als UNBESTÄTIGT gekennzeichnet geschrieben.</translation>
+        </message>
+        <message>
+            <source>Time limit [s]</source>
+            <extracomment>georeference_polygons.time_limit: description</extracomment>
+            <translation>Zeitlimit [s]</translation>
+        </message>
+        <message>
+            <source>The search stops when this time is spent and the run fails with the figures found so far (0: no limit).</source>
+            <extracomment>georeference_polygons.time_limit: help</extracomment>
+            <translation>Die Suche endet, wenn diese Zeit verbraucht ist, und der Lauf bricht mit den bis dahin gefundenen Kennzahlen ab (0: kein Limit).</translation>
+        </message>
+        <message>
             <source>Transform (kind, 3 × 3 matrix image col/row → map)</source>
             <extracomment>georeference_polygons output transform</extracomment>
             <translation>Transformation (Art, 3 × 3-Matrix Bildspalte/-zeile → Karte)</translation>
@@ -2462,6 +2482,11 @@
             <source>Control points used</source>
             <extracomment>georeference_polygons output n_gcps</extracomment>
             <translation>Verwendete Passpunkte</translation>
+        </message>
+        <message>
+            <source>Verified by independent evidence (yes/no)</source>
+            <extracomment>georeference_polygons output verified</extracomment>
+            <translation>Durch unabhängige Belege bestätigt (ja/nein)</translation>
         </message>
         <message>
             <source>QC area</source>
@@ -2610,7 +2635,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:748; plugin/widgets/georef_review.py:328; plugin/widgets/georef_review.py:499; plugin/widgets/georef_review.py:504; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:748; plugin/widgets/georef_review.py:365; plugin/widgets/georef_review.py:536; plugin/widgets/georef_review.py:541; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -3520,12 +3545,12 @@
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:255; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:476; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:255; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:513; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:256; plugin/widgets/georef_review.py:172</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:256; plugin/widgets/georef_review.py:208</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
@@ -3942,7 +3967,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:168</extracomment>
+            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:204</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
@@ -4081,68 +4106,83 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Konvergiert</translation>
         </message>
         <message>
+            <source>edge peak ratio {0}</source>
+            <extracomment>plugin/widgets/georef_review.py:83</extracomment>
+            <translation>Kantenspitzenverhältnis {0}</translation>
+        </message>
+        <message>
+            <source>correlation peak margin {0}</source>
+            <extracomment>plugin/widgets/georef_review.py:84</extracomment>
+            <translation>Korrelationsvorsprung der Spitze {0}</translation>
+        </message>
+        <message>
+            <source>Evidence of the automatic result:</source>
+            <extracomment>plugin/widgets/georef_review.py:92</extracomment>
+            <translation>Belege des automatischen Ergebnisses:</translation>
+        </message>
+        <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:100</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
             <source>Drop outliers (&gt; 3 σ0)</source>
-            <extracomment>plugin/widgets/georef_review.py:129</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
             <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:189</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:154</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:190</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:161</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:197</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:198</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:163</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:199</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:167</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:203</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:169</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:205</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:475</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:512</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:521</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:558</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:552</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:589</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:552</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:589</extracomment>
             <translation>nein</translation>
         </message>
         <message>
@@ -4171,88 +4211,128 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Kontrollpunkt (unabhängig)</translation>
         </message>
         <message>
+            <source>Verified: yes</source>
+            <extracomment>plugin/widgets/georef_review.py:69</extracomment>
+            <translation>Bestätigt: ja</translation>
+        </message>
+        <message>
+            <source>UNVERIFIED</source>
+            <extracomment>plugin/widgets/georef_review.py:72</extracomment>
+            <translation>UNBESTÄTIGT</translation>
+        </message>
+        <message>
+            <source>control points from a grid through the search transform</source>
+            <extracomment>plugin/widgets/georef_review.py:81</extracomment>
+            <translation>Passpunkte aus einem Raster durch die Transformation der Suche</translation>
+        </message>
+        <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:70</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:103</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:71</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:104</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:72</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:105</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:73</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:106</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
             <source>Transform:</source>
-            <extracomment>plugin/widgets/georef_review.py:135</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:171</extracomment>
             <translation>Transformation:</translation>
         </message>
         <message>
             <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:339</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:376</extracomment>
             <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:394</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:431</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:541</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
+            <source>control points cover {0} % of the image, {1} of 4 quadrants</source>
+            <extracomment>plugin/widgets/georef_review.py:75</extracomment>
+            <translation>Passpunkte überdecken {0} % des Bildes, {1} von 4 Quadranten</translation>
+        </message>
+        <message>
+            <source>quadrant offsets {0} px</source>
+            <extracomment>plugin/widgets/georef_review.py:89</extracomment>
+            <translation>Versätze je Quadrant {0} px</translation>
+        </message>
+        <message>
+            <source>corner misfit {0} px</source>
+            <extracomment>plugin/widgets/georef_review.py:91</extracomment>
+            <translation>Fehlanpassung an den Ecken {0} px</translation>
+        </message>
+        <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:79</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:112</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
             <source>Review georeferencing — {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:121</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:154</extracomment>
             <translation>Georeferenzierung prüfen — {0}</translation>
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:314</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:351</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:315</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:352</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
             <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:377</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:414</extracomment>
             <translation>manuell</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:398</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:435</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:400</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:437</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:404</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:441</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
+            <source>corners disagree by {0} px between halves</source>
+            <extracomment>plugin/widgets/georef_review.py:78</extracomment>
+            <translation>Ecken weichen zwischen den Hälften um {0} px ab</translation>
+        </message>
+        <message>
+            <source>at {0} px</source>
+            <extracomment>plugin/widgets/georef_review.py:86</extracomment>
+            <translation>bei {0} px</translation>
+        </message>
+        <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:437</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:474</extracomment>
             <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>
