@@ -59,13 +59,18 @@ def test_recovers_corners(tmp_path, seed, bits):
     """Rotation (any angle), mirroring (seed 1) and 12-bit data in uint16, 900 × 900 px.
 
     Goal of issue 23: 1 px. Measured: 2.26 px (seed 0), 1.90 px (seed 1) — the tolerance
-    here is what the mode reaches today (see the bench), not the goal."""
+    here is what the mode reaches today (see the bench), not the goal. The acceptance gate
+    refuses seed 0 (control points over 13 % of the image, halves of them 2.2 px apart at the
+    corners) and passes seed 1 (1.9 px: the roofs' relief displacement is a scale about the
+    centre that the image evidence cannot see), so the placement is checked with
+    ``unverified``."""
     case = suburban_case(tmp_path, seed=seed, bits=bits)
     assert case["mirrored"] == (seed == 1)
-    res = georeference(case["image"], case["reference"], objects="buildings")
+    res = georeference(case["image"], case["reference"], objects="buildings", unverified=True)
     assert res.stage == "buildings"
     assert len(res.pairs) >= 3 and res.img_features and res.ref_features
-    assert _corners(res, case) <= CORNER_PX
+    err = _corners(res, case)
+    assert err <= CORNER_PX
 
 
 @pytest.mark.slow
