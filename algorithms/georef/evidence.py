@@ -66,7 +66,7 @@ SHIFT_PX = 5
 FAR_PX = 3.0
 #: Smallest edge peak ratio (polygons) / correlation peak margin (raster) of the whole image.
 MIN_EDGE_PEAK = 1.3
-MIN_NCC_MARGIN = 0.2
+MIN_NCC_MARGIN = 0.08
 #: Largest offset (px) of the agreement peak: whole image, and each quadrant with a clear peak.
 MAX_OFFSET_PX = 1.0
 MAX_LOCAL_OFFSET_PX = 1.5
