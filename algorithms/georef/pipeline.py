@@ -435,11 +435,7 @@ def _buildings_stage(run: _Run, ref: tuple) -> GeorefResult:
     refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
     fb.progress(75)
     fit, inverse_fit, gcps, used_xy = _outline_fit(refined, matched.px, opts, counts)
-    warnings = []
-    hull_share = _hull_share(used_xy, run.grey.shape)
-    if hull_share < 0.25:
-        warnings.append(f"The control points cover only {100 * hull_share:.0f} % of the "
-                        "image (convex hull): expect larger errors towards the image corners.")
+    warnings = _spread_warnings(used_xy, run.grey.shape)
     for w in warnings:
         fb.warning(w)
     fb.info(f"{len(m.pairs)} verified roofs, {counts['gcps']} control points, "
@@ -538,14 +534,19 @@ def _outline_fit(refined: List[tuple], px: float, opts: GeorefOptions,
     return fit, inverse_fit, gcps, img_xy[fit.used]
 
 
+def _spread_warnings(used_xy: np.ndarray, shape: Sequence[int]) -> List[str]:
+    """The warning of control points bunched together (convex hull < 25 % of the image)."""
+    hull_share = _hull_share(used_xy, shape)
+    if hull_share >= 0.25:
+        return []
+    return [f"The control points cover only {100 * hull_share:.0f} % of the image (convex "
+            "hull): expect larger errors towards the image corners."]
+
+
 def _object_warnings(used_xy: np.ndarray, shape: Sequence[int], interp: Any,
                      max_depth: int) -> List[str]:
     """Warnings of the object stage: control points bunched together, a shallow search."""
-    warnings = []
-    hull_share = _hull_share(used_xy, shape)
-    if hull_share < 0.25:
-        warnings.append(f"The control points cover only {100 * hull_share:.0f} % of the image "
-                        "(convex hull): expect larger errors towards the image corners.")
+    warnings = _spread_warnings(used_xy, shape)
     if not interp.depth_reached:
         warnings.append(f"The search did not reach depth {max_depth} "
                         f"({len(interp.pairs)} consistent pairs).")
