@@ -389,15 +389,7 @@ def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
     if len(ver.pairs) < MIN_PAIRS:
         _fail(counts, f"only {len(ver.pairs)} pair(s) verified (at least {MIN_PAIRS} needed)")
     matched = _Matched(fi, fr, ver.pairs, ver.overlaps, ver.transform, level)
-    refined, icp_stats = _pair_icp(matched, fb)
-    fb.progress(70)
-    T, joint_rms, offset_px = _joint_icp(matched, opts.transform, fb)
-    counts["joint_icp_rms_px"] = joint_rms / matched.px
-    counts["outline_offset_px"] = offset_px
-    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
-    fb.progress(75)
-    fit, inverse_fit, gcps, used_xy = _outline_fit(refined, matched.px, opts, counts)
-    fb.progress(85)
+    icp_stats, T, (fit, inverse_fit, gcps, used_xy) = _icp_and_fit(matched, opts, counts, fb)
     warnings = _object_warnings(used_xy, run.grey.shape, interp, opts.max_depth)
     for w in warnings:
         fb.warning(w)
@@ -425,16 +417,8 @@ def _buildings_stage(run: _Run, ref: tuple) -> GeorefResult:
     if len(m.pairs) < MIN_PAIRS:
         _fail(counts, f"only {len(m.pairs)} roof(s) verified (at least {MIN_PAIRS} needed)")
     matched = _Matched(m.img_features, m.ref_features, m.pairs, m.overlaps, m.transform, 0)
-    refined, icp_stats = _pair_icp(matched, fb)
-    T, joint_rms, offset_px = _joint_icp(matched, opts.transform, fb)
-    counts.update(joint_icp_rms_px=joint_rms / matched.px, outline_offset_px=offset_px)
-    if joint_rms / matched.px > MAX_BUILDINGS_ICP_RMS_PX:
-        _fail(counts, f"the verified roofs do not fit their footprints (joint ICP RMS "
-                      f"{joint_rms / matched.px:.2f} px, at most "
-                      f"{MAX_BUILDINGS_ICP_RMS_PX:g} px)")
-    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
-    fb.progress(75)
-    fit, inverse_fit, gcps, used_xy = _outline_fit(refined, matched.px, opts, counts)
+    icp_stats, T, (fit, inverse_fit, gcps, used_xy) = _icp_and_fit(
+        matched, opts, counts, fb, max_rms_px=MAX_BUILDINGS_ICP_RMS_PX)
     warnings = _spread_warnings(used_xy, run.grey.shape)
     for w in warnings:
         fb.warning(w)
@@ -465,6 +449,28 @@ class _Matched:
     def px(self) -> float:
         """Map units per level-0 pixel of ``G``."""
         return float(np.sqrt(abs(np.linalg.det(self.G[:2, :2]))))
+
+
+def _icp_and_fit(m: _Matched, opts: GeorefOptions, counts: Dict[str, Any], fb: Feedback,
+                 max_rms_px: Optional[float] = None) -> tuple:
+    """The verified pairs to the final fit, shared by the object stage and the buildings
+    mode: per-pair ICP, joint ICP (``counts`` gets its RMS and the outline offset), control
+    points on the refined outlines. ``max_rms_px``: fail when the joint ICP RMS is larger
+    (the outlines do not fit). Returns the per-pair ICP figures, the joint transform and
+    :func:`_outline_fit`'s tuple."""
+    refined, icp_stats = _pair_icp(m, fb)
+    fb.progress(70)
+    T, joint_rms, offset_px = _joint_icp(m, opts.transform, fb)
+    rms_px = joint_rms / m.px
+    counts.update(joint_icp_rms_px=rms_px, outline_offset_px=offset_px)
+    if max_rms_px is not None and rms_px > max_rms_px:
+        _fail(counts, f"the verified roofs do not fit their footprints (joint ICP RMS "
+                      f"{rms_px:.2f} px, at most {max_rms_px:g} px)")
+    refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
+    fb.progress(75)
+    fitted = _outline_fit(refined, m.px, opts, counts)
+    fb.progress(85)
+    return icp_stats, T, fitted
 
 
 def _pair_icp(m: _Matched, fb: Feedback) -> Tuple[List[tuple], List[Dict[str, Any]]]:
