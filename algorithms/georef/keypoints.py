@@ -28,16 +28,14 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import cv2
 import numpy as np
-import pyproj
-import rasterio
 from numpy.typing import NDArray
 
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback
 from .correspondence import apply
-from .fit import centre_matrix, fit_matrix, fit_transform, inverse_for_resampling
+from .fit import fit_matrix, fit_transform, inverse_for_resampling
+from .reference_layer import load_reference
 from .refinement import ControlPoint
-from .regions import load_image
 from .result import GeorefResult
 
 PathLike = Union[str, Path]
@@ -349,22 +347,6 @@ def match_image(grey_img: Array, grey_ref: Array, kind: str = "affine",
         raise GeometryError(f"only {len(km.image_xy)} image patches agree with the keypoint "
                             f"transform (at least {MIN_PATCHES} needed)", km.counts)
     return km
-
-
-def load_reference(path: PathLike, band: Optional[int] = None
-                   ) -> Tuple[Array, Array, Any, Dict[str, Any]]:
-    """A georeferenced reference raster: grey level 0, reference pixel → map (3 × 3), the
-    CRS (pyproj) and what the report says about it."""
-    with rasterio.open(path) as src:
-        if src.crs is None or src.transform.is_identity:
-            raise InputError(f"The reference raster '{Path(path).name}' has no georeference; "
-                             "a raster reference must be georeferenced (an orthophoto).")
-        transform, crs = src.transform, pyproj.CRS.from_user_input(src.crs.to_wkt())
-    if not crs.is_projected:
-        raise InputError(f"The reference raster '{Path(path).name}' is in a geographic CRS; "
-                         "reproject it to a projected CRS first.")
-    grey, info = load_image(path, band)
-    return grey, centre_matrix(transform), crs, {**info, "crs": crs.to_string()}
 
 
 def keypoint_result(grey: Array, image_info: Dict[str, Any], reference: PathLike,

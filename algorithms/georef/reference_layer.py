@@ -196,6 +196,28 @@ def _outlines(geoms: Any) -> List[np.ndarray]:
     return out
 
 
+def load_reference(path: PathLike, band: Optional[int] = None
+                   ) -> Tuple[np.ndarray, np.ndarray, Any, Dict[str, Any]]:
+    """A georeferenced reference raster: grey level 0, reference pixel → map (3 × 3; pixel
+    centres at integers), the CRS (pyproj) and what the report says about it.
+
+    Raises
+    ------
+    InputError
+        The raster has no georeference or a geographic CRS.
+    """
+    with rasterio.open(path) as src:
+        if src.crs is None or src.transform.is_identity:
+            raise InputError(f"The reference raster '{Path(path).name}' has no georeference; "
+                             "a raster reference must be georeferenced (an orthophoto).")
+        transform, crs = src.transform, pyproj.CRS.from_user_input(src.crs.to_wkt())
+    if not crs.is_projected:
+        raise InputError(f"The reference raster '{Path(path).name}' is in a geographic CRS; "
+                         "reproject it to a projected CRS first.")
+    grey, info = load_image(path, band)
+    return grey, centre_matrix(transform), crs, {**info, "crs": crs.to_string()}
+
+
 def reference_objects_from_raster(path: PathLike, thresholds: Sequence[float],
                                   min_area: float = 0.0003, max_area: float = 0.05,
                                   pyramid_level: Union[int, str] = "auto",
@@ -208,18 +230,9 @@ def reference_objects_from_raster(path: PathLike, thresholds: Sequence[float],
     Regions are outlined in the raster's pixel frame and taken to map coordinates with its
     geotransform (pixel centres at integers: map = transform · (x + 0.5, y + 0.5)).
     """
-    with rasterio.open(path) as src:
-        if src.crs is None or src.transform.is_identity:
-            raise InputError(f"The reference raster '{Path(path).name}' has no georeference; "
-                             "a raster reference must be georeferenced (an orthophoto).")
-        transform, crs = src.transform, pyproj.CRS.from_user_input(src.crs.to_wkt())
-    grey, _ = load_image(path, band)
+    grey, to_map, crs, _ = load_reference(path, band)
     objs, info = image_objects(grey, thresholds, min_area, max_area, pyramid_level,
                                smooth=smooth, merge=merge, feedback=feedback)
-    if not crs.is_projected:
-        raise InputError(f"The reference raster '{Path(path).name}' is in a geographic CRS; "
-                         "reproject it to a projected CRS first.")
-    to_map = centre_matrix(transform)
     out = []
     for o in objs:
         ring = apply(to_map, o.ring)
