@@ -148,11 +148,9 @@ class ReliefCorrection:
     map_xy: Array = field(default_factory=lambda: np.zeros((0, 2)))
 
     def counts(self) -> Dict[str, Any]:
-        """The figures for a report's counts."""
+        """The figures for a report's counts (numbers only: they also go into messages)."""
         return {"relief_px_corner": _round(self.relief_px_corner),
-                "relief_se_px": _round(self.relief_se_px), "relief_edges": self.edges,
-                "relief_edges_measured": self.edges_measured,
-                "relief_applied": self.applied, "relief_reason": self.reason}
+                "relief_edges": self.edges, "relief_applied": self.applied}
 
 
 def _round(x: float) -> Optional[float]:
