@@ -34,7 +34,8 @@ The chain (:func:`correct_relief`):
    footprints' edges — blur, eaves). ρ minimises the sum of the capped misfit curves over all
    edges (grid search, δ profiled out): a global estimate, no edge has to be decided on its
    own. T' = T·S with S the scale by 1 + ρ/rmax about the nadir.
-5. **Decision**: T changes only when enough edges on enough footprints agree with ρ (their
+5. **Decision**: T changes only when the roofs sit on the mapped footprints (the start fits:
+   :data:`MIN_ROOF_SHARE`), enough edges on enough footprints agree with ρ (their
    misfit ≤ 1 there), ρ > 0 lowers the summed misfit by at least :data:`MIN_GAIN` against
    ρ = 0, and ρ stays below the plausible limit; otherwise T is returned with the reason.
    Without relief the ground edges coincide with the roof edges and ρ = 0 wins.
@@ -73,6 +74,8 @@ STEP_SIGMA = 0.6
 MIN_STRIP_PX = 0.3
 #: ... a wider one costs this much (σ² per px): two more unknowns.
 WALL_PENALTY = 6.0
+#: The model's resolution as a share of the roof edge's step (σ floor of the misfit).
+MODEL_PRECISION = 0.01
 #: An edge's misfit counts up to this (σ² per px): one edge cannot outweigh many.
 CHI_CAP = 9.0
 #: An edge whose misfit over the ground edge positions rises by less is not informative.
@@ -85,6 +88,10 @@ END_MARGIN_PX = 1.5
 #: At least this many edges on at least this many footprints.
 MIN_EDGES = 12
 MIN_BUILDINGS = 6
+#: The roof-fitted start must fit: at least this share of the profiled edges has its roof edge
+#: within 0.5 px of the mapped footprint edge (measured: 53–75 % with the right footprints,
+#: 22–30 % with footprints of another place).
+MIN_ROOF_SHARE = 0.4
 #: Largest plausible relief displacement at the image corner (px); a larger estimate is not
 #: relief (inconsistent evidence).
 MAX_RELIEF_PX = 6.0
@@ -95,7 +102,8 @@ class EdgeMeasurement:
     """One footprint edge facing the nadir: its mapped midpoint and unit normal towards the
     nadir (image px), its distance from the nadir along the normal (px), the ground edge grid
     ``gs`` (px along the normal from the mapped edge) with the misfit ``chi`` of each (σ² per
-    px above the best), the footprint number and the map end points of the edge."""
+    px above the best), the footprint number, the map end points of the edge and the roof edge
+    of the best fit (px along the normal)."""
 
     mid: Array
     normal: Array
@@ -104,6 +112,7 @@ class EdgeMeasurement:
     chi: Array
     footprint: int
     map_edge: Array
+    roof: float = 0.0
 
     def at(self, g: float) -> float:
         """The misfit of a ground edge at ``g`` (linear between the grid's; capped)."""
@@ -242,18 +251,20 @@ def profile_offsets(max_strip: float) -> Array:
     return np.arange(-max_strip - 2.5, 2 * max_strip + 3.5 + 1e-9, 0.1)
 
 
-def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5) -> float:
-    """Position of the largest step of the profile in [lo, hi]: the difference of the means
-    ``half`` px on either side."""
+def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
+               ) -> Tuple[float, float]:
+    """Position and size of the largest step of the profile in [lo, hi]: the difference of
+    the means ``half`` px on either side (NaN, 0 when the range is empty)."""
     c = np.concatenate([[0.0], np.cumsum(P)])
     n = round(half / float(ts[1] - ts[0]))
     k = np.arange(n, len(P) - n + 1)  # step between samples k − 1 and k
-    jump = (c[k + n] - c[k]) - (c[k] - c[k - n])
+    jump = ((c[k + n] - c[k]) - (c[k] - c[k - n])) / n
     pos = ts[k] - 0.5 * float(ts[1] - ts[0])
     ok = (pos >= lo) & (pos <= hi)
     if not ok.any():
-        return float("nan")
-    return float(pos[ok][int(np.argmax(np.abs(jump[ok])))])
+        return float("nan"), 0.0
+    j = int(np.argmax(np.abs(jump[ok])))
+    return float(pos[ok][j]), float(abs(jump[ok][j]))
 
 
 def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
@@ -271,7 +282,7 @@ def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
     ``inf`` where g is impossible), and e of the best fit; None for a profile without a step.
     """
     P = np.asarray(profile, float)
-    e0 = _main_step(P, ts, -0.5 * max_strip - 0.5, 0.5 * max_strip + 0.5)
+    e0, jump = _main_step(P, ts, -0.5 * max_strip - 0.5, 0.5 * max_strip + 0.5)
     if not np.isfinite(e0):
         return None
     keep = ts >= e0 - 1.5
@@ -286,9 +297,14 @@ def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
         return None
     E, G, F = E[ok], G[ok], F[ok]
     sse = _fit_grid(P, ts, E, G, F)
-    sigma2 = max(float(sse.min()) / len(P), 1e-12)
+    # σ²: the best fit's mean square, at least that of the model's own resolution (a step
+    # placed 0.1 px off leaves about 1 % of its size)
+    sigma2 = max(float(sse.min()) / len(P), (MODEL_PRECISION * jump) ** 2, 1e-12)
     # a wall is two more unknowns (its level and width): it must pay for them, else every
-    # profile prefers some wall (the model without one is a special case of it)
+    # profile prefers some wall (the model without one is a special case of it). A wall of
+    # 1 px or more is also explained by no wall and a step beyond: the penalty makes "no
+    # wall" the edge's own preference, and the edges together (the scatter of the roof edges
+    # against the alignment of the ground edges) decide
     sse = sse + (G - E >= MIN_STRIP_PX - 1e-6) * WALL_PENALTY * per_px * sigma2
     gi = np.round((G - G_MIN) / GRID_STEP).astype(int)
     by_g = np.full(len(gs), np.inf)
@@ -321,7 +337,8 @@ def measure_edges(grey: Array, T: Array, footprints: Sequence[Array], centre: Ar
             if curve is None:
                 continue
             out.append(EdgeMeasurement(mid, n, r, curve[0], curve[1], f,
-                                       np.array([ring[k], ring[(k + 1) % len(ring)]])))
+                                       np.array([ring[k], ring[(k + 1) % len(ring)]]),
+                                       curve[2]))
     return out, tried
 
 
@@ -432,6 +449,12 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     if len(info) < min_edges:
         return ReliefCorrection(**base, reason=(
             f"too few ground edges: {len(info)} profiled (at least {min_edges} needed)"))
+    roof_share = float(np.mean([abs(m.roof) < 0.5 for m in info]))
+    if roof_share < MIN_ROOF_SHARE:
+        return ReliefCorrection(**base, reason=(
+            f"the roofs do not sit on the mapped footprints ({100 * roof_share:.0f} % of the "
+            f"edges within 0.5 px, at least {100 * MIN_ROOF_SHARE:.0f} % needed): the start "
+            "transform or the footprints do not fit"))
     rho_grid, total, deltas = search_relief(info, rmax, max_relief_px)
     rho = _refine_rho(rho_grid, total)
     delta = float(deltas[int(np.argmin(total))])
