@@ -25,9 +25,10 @@ The chain (:func:`correct_relief`):
    (e, g, f) of a grid; for each ground edge position g the best residual sum of squares,
    in σ² per px above the best. The roof edge is anchored at the profile's largest step near
    the mapped edge (so roof structure further in does not count); a wall (g − e ≥ 0.3 px)
-   pays for its two unknowns, else every profile would prefer some wall. Where the wall is as
-   bright as the ground beside it the curve stays flat: such an edge says nothing, and is not
-   forced to say something.
+   pays for its two unknowns, else every profile would prefer some wall. An edge therefore
+   prefers "no wall" (g = e) unless a wall is seen; a wall of 1 px or more is also explained
+   as no wall and a ground step beyond — the edges together decide (step 4). The bias is
+   towards no correction.
 4. **Relief** (:func:`search_relief`): one scale about the nadir explains all edges: the ground
    edge of an edge at distance r from the nadir (along its normal) lies at g = ρ·r/rmax + δ
    (ρ: the relief at the farthest corner, δ: a common offset between the image's and the
