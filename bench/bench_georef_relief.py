@@ -82,7 +82,8 @@ def _setting(tmp: Path, relief: float, noise: float, n: int) -> Tuple[Dict[str, 
         changed += int(rc.applied)
         notes.append(f"relief {relief:g}, noise {noise:g}, seed {seed}: {before[-1]:.2f} → "
                      f"{after[-1]:.2f} px, ρ {rc.relief_px_corner:.2f} px (truth "
-                     f"{c['relief_corner_px']:.2f}), {rc.edges} edges"
+                     f"{c['relief_corner_px']:.2f}), {rc.edges} of {rc.edges_measured} edges, "
+                     f"gain {rc.gain:.1f}"
                      + ("" if rc.applied else f", unchanged: {rc.reason}"))
     b, a = np.array(before), np.array(after)
     row = {"case": f"relief {relief:g} px, roof noise {noise:g} px, {n} scenes",
