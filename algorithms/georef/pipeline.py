@@ -42,6 +42,7 @@ from .refinement import (
     trimmed_icp,
 )
 from .regions import DEFAULT_THRESHOLDS, image_objects, load_image
+from .relief import correct_relief, scale_about
 from .result import GeorefResult
 
 PathLike = Union[str, Path]
@@ -287,7 +288,8 @@ def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tu
     fb = run.fb
     fb.check()
     if ref is not None:
-        source: Any = [b for o in ref[0] for b in o.attributes.get("outlines", [o.ring])]
+        source: Any = _roof_level(result, [b for o in ref[0]
+                                           for b in o.attributes.get("outlines", [o.ring])])
     else:
         source = reference
     ev = assess(result, source)
@@ -417,8 +419,12 @@ def _buildings_stage(run: _Run, ref: tuple) -> GeorefResult:
     if len(m.pairs) < MIN_PAIRS:
         _fail(counts, f"only {len(m.pairs)} roof(s) verified (at least {MIN_PAIRS} needed)")
     matched = _Matched(m.img_features, m.ref_features, m.pairs, m.overlaps, m.transform, 0)
-    icp_stats, T, (fit, inverse_fit, gcps, used_xy) = _icp_and_fit(
-        matched, opts, counts, fb, max_rms_px=MAX_BUILDINGS_ICP_RMS_PX)
+    icp_stats, T, fitted = _icp_and_fit(matched, opts, counts, fb,
+                                        max_rms_px=MAX_BUILDINGS_ICP_RMS_PX)
+    # every footprint, not only the verified ones: the transform is known to a few px by now,
+    # and footprints without a visible wall base do not sway the estimate
+    (fit, inverse_fit, gcps, used_xy), relief = _relief_fit(
+        run, [o.ring for o in ref_objs], T, fitted, counts)
     warnings = _spread_warnings(used_xy, run.grey.shape)
     for w in warnings:
         fb.warning(w)
@@ -428,10 +434,57 @@ def _buildings_stage(run: _Run, ref: tuple) -> GeorefResult:
         fit=fit, inverse_fit=inverse_fit, gcps=gcps, crs=crs, global_transform=m.transform,
         joint=T, search=m.transform, pairs=m.pairs, img_features=m.img_features,
         ref_features=m.ref_features, counts=counts, icp=icp_stats,
-        segmentation={"level": 0, "buildings": True}, reference=ref_info,
+        segmentation={"level": 0, "buildings": True, **relief}, reference=ref_info,
         reference_kind="vector", image_info=run.image_info, grey=run.grey, warnings=warnings,
         seconds=time.perf_counter() - run.t0, stage="buildings",
         parameters=opts.report(run.thresholds, 0))
+
+
+def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple,
+                counts: Dict[str, Any]) -> Tuple[tuple, Dict[str, Any]]:
+    """The fit from the ground, not the roofs (:mod:`.relief`): when the walls facing the
+    nadir show a relief displacement, the control points (on the roof outlines) are moved by
+    it — the scale about the nadir that the roof fit absorbed — and refitted. ``counts`` gets
+    the relief at the image corner and the ground edges that agree. Returns the tuple of
+    :func:`_outline_fit` and, when corrected, the scale and its centre (image px) for the
+    agreement test of the gate (:func:`_roof_level`)."""
+    fit, gcps = fitted[0], fitted[2]
+    start = fit.matrix if fit.matrix is not None else T
+    rc = correct_relief(run.grey, start, rings)
+    counts.update(rc.counts())
+    if not rc.applied:
+        run.fb.info(f"Relief displacement: none corrected ({rc.reason}).")
+        return fitted, {}
+    run.fb.info(f"Relief displacement: {rc.relief_px_corner:.2f} px at the image corner "
+                f"from {rc.edges} wall bases; control points moved to the ground.")
+    back = np.linalg.inv(rc.correction)
+    gcps = [replace(g, image=tuple(float(v) for v in apply(back, np.array([g.image]))[0]))
+            for g in gcps]
+    img_xy = np.array([g.image for g in gcps])
+    map_xy = np.array([g.map for g in gcps])
+    fit = fit_transform(img_xy, map_xy, run.options.transform)
+    inverse_fit = inverse_for_resampling(fit, img_xy[fit.used], map_xy[fit.used])
+    counts["gcps"] = int(fit.used.sum())
+    h, w = run.grey.shape
+    return (fit, inverse_fit, gcps, img_xy[fit.used]), {
+        "relief_scale": float(rc.correction[0, 0]),
+        "relief_centre": [(w - 1) / 2.0, (h - 1) / 2.0]}
+
+
+def _roof_level(result: GeorefResult, rings: List[Any]) -> List[Any]:
+    """The footprints where the roofs are seen, for the gate's image–reference agreement:
+    after a relief correction the result maps the ground, while the image's edges are mostly
+    roof edges, displaced by the relief (the scale about the nadir) — unchanged without one."""
+    scale = result.segmentation.get("relief_scale")
+    if not scale:
+        return rings
+    C = scale_about(np.asarray(result.segmentation["relief_centre"], float), float(scale))
+    fit = result.fit
+    if fit.matrix is not None:
+        F = fit.matrix @ C @ np.linalg.inv(fit.matrix)
+        return [apply(F, np.asarray(r, float)[:, :2]) for r in rings]
+    return [fit.forward(apply(C, result.inverse_fit.forward(np.asarray(r, float)[:, :2])))
+            for r in rings]
 
 
 @dataclass

@@ -1,0 +1,104 @@
+"""Relief displacement from the ground edges (:mod:`photodem.algorithms.georef.relief`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from photodem.algorithms.georef.fit import corner_error
+from photodem.algorithms.georef.relief import (
+    correct_relief,
+    edge_curve,
+    facing_edges,
+    profile_offsets,
+    scale_about,
+)
+from photodem.bench.bench_georef_relief import truth_case
+
+
+def _corner(T, case) -> float:
+    return float(np.max(corner_error(T, case["truth"], case["width"], case["height"])))
+
+
+@pytest.fixture(scope="module")
+def relief_scenes(tmp_path_factory):
+    """Seed 1 (12-bit) with relief 3 px and 0 px, seed 2 (8-bit) with relief 3 px plus
+    ± 0.5 px noise on the roof vertices of the start: truth-start cases of the bench."""
+    tmp = tmp_path_factory.mktemp("relief")
+    return {"r3": truth_case(tmp / "r3", 1, 3.0), "r0": truth_case(tmp / "r0", 1, 0.0),
+            "r3n": truth_case(tmp / "r3n", 2, 3.0, noise_px=0.5)}
+
+
+def test_facing_edges_either_orientation():
+    square = np.array([[10.0, 10.0], [20.0, 10.0], [20.0, 20.0], [10.0, 20.0]])
+    for ring in (square, square[::-1]):
+        edges = facing_edges(ring, np.array([0.0, 15.0]))
+        assert len(edges) == 1
+        _, mid, n = edges[0]
+        assert np.allclose(mid, [10.0, 15.0]) and np.allclose(n, [-1.0, 0.0])
+
+
+def _profile(ts, e, g, levels=(0.6, 0.28, 0.33), sigma=0.5):
+    from scipy.special import erf
+
+    def step(x):
+        return 0.5 * (1 + erf((ts - x) / (sigma * np.sqrt(2))))
+    r, w, o = levels
+    rng = np.random.default_rng(0)
+    return r + (w - r) * step(e) + (o - w) * step(g) + rng.normal(0, 0.002, len(ts))
+
+
+def test_edge_curve_finds_the_wall_base():
+    ts = profile_offsets(3.0)
+    # no wall: the ground edge is the roof edge
+    gs, chi, _ = edge_curve(_profile(ts, 0.3, 0.3), ts, 3.0)
+    assert abs(gs[np.argmin(chi)] - 0.3) <= 0.25  # e on a 0.2 px grid
+    # the wall as bright as the ground: nothing shows a wall, the edge prefers none
+    gs, chi, _ = edge_curve(_profile(ts, -0.2, 1.4, levels=(0.6, 0.33, 0.33)), ts, 3.0)
+    assert abs(gs[np.argmin(chi)] + 0.2) <= 0.25
+    assert np.min(chi[gs > 0.5]) >= 4.0
+
+
+@pytest.mark.slow
+def test_relief_recovered_from_the_truth_start(relief_scenes):
+    for key in ("r3", "r3n"):
+        case = relief_scenes[key]
+        before = _corner(case["start"], case)
+        rc = correct_relief(case["grey"], case["start"], case["rings"])
+        assert before > 1.5
+        assert rc.applied, rc.reason
+        assert _corner(rc.transform, case) <= 1.0
+        assert abs(rc.relief_px_corner - case["relief_corner_px"]) < 0.8
+        assert rc.edges >= 12 and len(rc.image_xy) == rc.edges == len(rc.map_xy)
+        # the control points lie on the ground edges: within 1 px of the true footprints
+        truth_img = np.linalg.inv(case["truth"])
+        on_ground = rc.map_xy @ truth_img[:2, :2].T + truth_img[:2, 2]
+        assert np.median(np.hypot(*(rc.image_xy - on_ground).T)) < 1.0
+        assert np.allclose(rc.transform, case["start"] @ rc.correction)
+
+
+@pytest.mark.slow
+def test_no_relief_no_change(relief_scenes):
+    case = relief_scenes["r0"]
+    rc = correct_relief(case["grey"], case["start"], case["rings"])
+    assert not rc.applied and "no significant relief" in rc.reason
+    assert np.array_equal(rc.transform, case["start"])
+    assert abs(rc.relief_px_corner) < 0.3
+
+
+@pytest.mark.slow
+def test_weak_evidence_leaves_the_transform(relief_scenes):
+    case = relief_scenes["r3"]
+    rc = correct_relief(case["grey"], case["start"], case["rings"][:3])
+    assert not rc.applied and "too few ground edges" in rc.reason
+    assert np.array_equal(rc.transform, case["start"])
+    # footprints of another place: nothing agrees
+    moved = [r + np.array([37.0, -23.0]) for r in case["rings"]]
+    rc = correct_relief(case["grey"], case["start"], moved)
+    assert not rc.applied
+
+
+def test_scale_about_keeps_the_centre():
+    C = scale_about(np.array([449.5, 449.5]), 1.003)
+    assert np.allclose(C @ [449.5, 449.5, 1.0], [449.5, 449.5, 1.0])
+    assert np.allclose(C @ [0.0, 449.5, 1.0], [449.5 - 1.003 * 449.5, 449.5, 1.0])
