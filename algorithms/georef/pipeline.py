@@ -19,7 +19,13 @@ import numpy as np
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, StepFeedback
 from ..output_policy import PRODUCT_MARKER
-from .area import area_search, boundary_search, grid_control_points
+from .area import (
+    ORIENT_CELLS,
+    SEARCH_CELLS,
+    area_search,
+    boundary_search,
+    grid_control_points,
+)
 from .buildings import is_buildings, match_buildings
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .evidence import assess
@@ -68,6 +74,19 @@ MIN_ECC = 0.4
 #: synthetic tilings against unrelated tilings 0.58–0.72, but with gaps ≤ 0.06.
 MIN_ORIENTATION = 0.55
 MIN_GAP = 0.08
+#: Cells of the area-based and the boundary-orientation search after a failed buildings mode
+#: (half of :data:`.area.SEARCH_CELLS` and :data:`.area.ORIENT_CELLS`: the candidates' FFTs
+#: cost ∝ cells², the orientation search ∝ cells⁴ — 21 s → ~1.5 s on a 0.8 Mpx suburban
+#: scene). Footprints are no tiling whose shared boundaries the orientation search needs: on
+#: the synthetic suburban scenes the fallback found no result at the full resolution either.
+FALLBACK_AREA_CELLS = 256
+FALLBACK_ORIENT_CELLS = 64
+#: Time budget of the area-based stages after a failed buildings mode, counted from the start
+#: of the run: this many seconds per Mpx of the image, at least :data:`FALLBACK_MIN_S` (a run
+#: that cannot succeed says so within 30 s on 1 Mpx, issue 23; the step running at the
+#: deadline finishes first). On 20 synthetic suburban scenes no fallback found a result.
+FALLBACK_S_PER_MPX = 25.0
+FALLBACK_MIN_S = 10.0
 #: Default time budget of the search (s): a hopeless run says so by then (issue 23). Not 30 s:
 #: right Everest results (boundary-orientation stage, 0.5 Mpx) took 73–110 s on the shared
 #: 2-core test machine (docs/decisions.md).
@@ -264,7 +283,8 @@ def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple]
                 raise
             fb.info(f"Buildings mode: {buildings_failure} — trying the other stages.")
             if opts.search != "objects":  # the object stage: no better on many small ones
-                return _area_stage(run, ref, f"buildings mode: {buildings_failure}")
+                return _area_stage(_fallback_run(run), ref,
+                                   f"buildings mode: {buildings_failure}", coarse=True)
     if opts.search == "area":
         return _area_stage(run, ref, None)
     if ref_kind == "raster" and opts.search in ("auto", "keypoints"):
@@ -322,6 +342,8 @@ class _Run:
     fb: Feedback
     t0: float
     deadline: float = float("inf")  #: perf_counter time when the budget is spent
+    #: what the budget is, for the message when it is spent ("": the option's time limit)
+    budget: str = ""
 
     def expired(self) -> bool:
         """Whether the time budget is spent."""
@@ -330,6 +352,17 @@ class _Run:
     def left(self) -> float:
         """Seconds left of the time budget (inf: none)."""
         return self.deadline - time.perf_counter()
+
+
+def _fallback_run(run: _Run) -> _Run:
+    """``run`` with the deadline of the stages after a failed buildings mode
+    (:data:`FALLBACK_S_PER_MPX`), when it comes before the option's time limit."""
+    seconds = max(FALLBACK_MIN_S, FALLBACK_S_PER_MPX * run.grey.size / 1e6)
+    if run.t0 + seconds >= run.deadline:
+        return run
+    return replace(run, deadline=run.t0 + seconds,
+                   budget=f"the time budget of {seconds:.0f} s after a failed buildings mode "
+                          f"({FALLBACK_S_PER_MPX:g} s per Mpx of the image)")
 
 
 def _keypoint_stage(run: _Run, reference: PathLike) -> GeorefResult:
@@ -559,14 +592,18 @@ def _object_warnings(used_xy: np.ndarray, shape: Sequence[int], interp: Any,
     return warnings
 
 
-def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefResult:
+def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str],
+                coarse: bool = False) -> GeorefResult:
     """The area-based global search (:mod:`.area`) and the same result layout as the object
-    chain; its control points are a grid of image points through the refined affine."""
+    chain; its control points are a grid of image points through the refined affine.
+    ``coarse``: both searches at half their resolution (:data:`FALLBACK_AREA_CELLS`,
+    :data:`FALLBACK_ORIENT_CELLS`; the fallback after a failed buildings mode)."""
     ref_objs, crs, ref_info = ref
     grey, fb = run.grey, run.fb
     fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
     fb.progress(40)
-    res = area_search(grey, [o.ring for o in ref_objs], deadline=run.deadline)
+    res = area_search(grey, [o.ring for o in ref_objs], deadline=run.deadline,
+                      cells=FALLBACK_AREA_CELLS if coarse else SEARCH_CELLS)
     fb.progress(60)
     counts: Dict[str, Any] = {"reference_objects": len(ref_objs),
                               "area_candidates": len(res.candidates),
@@ -577,7 +614,8 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefR
                                  "mirrored": res.mirrored, "candidates": res.candidates}
     T = res.transform
     if res.ecc < MIN_ECC:
-        T, area_info = _boundary_stage(run, ref_objs, res.ecc, counts, object_failure)
+        T, area_info = _boundary_stage(run, ref_objs, res.ecc, counts, object_failure,
+                                       FALLBACK_ORIENT_CELLS if coarse else ORIENT_CELLS)
     fb.progress(75)
     gcps = grid_control_points(T, np.isfinite(grey))
     img_xy = np.array([g.image for g in gcps])
@@ -605,16 +643,17 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str]) -> GeorefR
 
 
 def _boundary_stage(run: _Run, ref_objs: Sequence[Any], ecc: float,
-                    counts: Dict[str, Any], object_failure: Optional[str]
-                    ) -> Tuple[np.ndarray, Dict[str, Any]]:
+                    counts: Dict[str, Any], object_failure: Optional[str],
+                    cells: int = ORIENT_CELLS) -> Tuple[np.ndarray, Dict[str, Any]]:
     """The individual polygons' outlines against the image's edge directions, when the ECC
-    correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. Returns the
-    transform and the description of the search for the report."""
+    correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. ``cells``: the
+    search raster's cells along the reference extent. Returns the transform and the
+    description of the search for the report."""
     grey, fb = run.grey, run.fb
     fb.info(f"ECC correlation {ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
             "(individual outlines against edge directions).")
     outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
-    bres = boundary_search(grey, outlines, deadline=run.deadline)
+    bres = boundary_search(grey, outlines, cells=cells, deadline=run.deadline)
     counts.update(boundary_outlines=len(outlines),
                   boundary_score=round(bres.score, 4),
                   boundary_screen=round(bres.screen, 4),
@@ -643,8 +682,8 @@ def _check_time(run: _Run, counts: Dict[str, Any], where: str,
     if not run.expired():
         return
     counts["seconds"] = round(time.perf_counter() - run.t0, 1)
-    why = (f"the time limit of {run.options.time_limit_s:g} s was reached in {where} "
-           "without a result")
+    budget = run.budget or f"the time limit of {run.options.time_limit_s:g} s"
+    why = f"{budget} was reached in {where} without a result"
     if before:
         why += f"; before it, the object stage: {before}"
     _fail(counts, why)
@@ -659,8 +698,16 @@ def _fail(counts: Dict[str, Any], why: str) -> None:
 
 
 def _detail(counts: Dict[str, Any]) -> str:
-    """The figures of a failure message: "image objects 12, hypotheses 0, …"."""
-    return ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
+    """The figures of a failure message: "image objects 12, hypotheses 0, …" — scalars as
+    they are, lists and dicts by their length ("candidate runs 3"; the exception's
+    ``counts`` keep them whole)."""
+    def short(v: Any) -> Any:
+        if isinstance(v, (list, tuple, dict)):
+            return len(v)
+        if isinstance(v, (float, np.floating)):
+            return f"{float(v):.4g}"
+        return v
+    return ", ".join(f"{k.replace('_', ' ')} {short(v)}" for k, v in counts.items())
 
 
 def run_georeference_polygons(image: PathLike, reference: PathLike, output: PathLike,
