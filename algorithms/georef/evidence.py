@@ -8,10 +8,12 @@ independent sides:
 1. **Spread** of the control points used: the share of the image inside their convex hull and
    the number of image quadrants that hold at least :data:`QUADRANT_POINTS` of them.
 2. **Held-out check**: the points are split at their median column (left/right halves) and at
-   their median row (top/bottom); each half gets its own transform, and the two halves'
-   transforms are compared at the image corners (px). Points bunched in one part of the image
-   extrapolate differently from each half: the corners disagree. Each quadrant's points are
-   also predicted by the transform of the other quadrants' points (held-out RMSE, px).
+   their median row (top/bottom); each half gets its own transform of the result's kind (a
+   poly2 result: poly2 where each half holds ≥ :data:`POLY2_SUBSET_POINTS` points, else
+   projective), and the two halves' transforms are compared at the image corners (px).
+   Points bunched in one part of the image extrapolate differently from each half: the
+   corners disagree. Each quadrant's points are also predicted by the transform of the other
+   quadrants' points (held-out RMSE, px).
 3. **Image–reference agreement** after resampling with the final fit, compared with the same
    at wrong shifts of up to :data:`SHIFT_PX` px (a peak test), for the whole image and each
    quadrant (a local misfit in one corner shows as that quadrant's peak away from zero):
@@ -28,6 +30,10 @@ disagreements ≤ 0.69 px and hulls ≥ 34 %; results perturbed by 2–8 px at a
 misfits of 1.8–8.9 px, control points bunched in a corner hulls ≤ 18 %.
 Stages whose control points come from a grid through a search transform (the area stage) give
 no independent spread or held-out figures: there, the agreement alone decides.
+
+The reasons of a refusal are (key, figures) pairs (:attr:`Evidence.reason_items`, keys of
+:data:`REASON_TEXTS`) and English sentences made from them (:attr:`Evidence.reasons`): the
+faces translate the keys with the same figures.
 """
 
 from __future__ import annotations

@@ -153,7 +153,11 @@ def evidence_html(report: Dict[str, Any]) -> str:
         parts.append(tr("quadrant offsets {0} px").format(", ".join(local)))
     if ev.get("corner_misfit_px") is not None:
         parts.append(tr("corner misfit {0} px").format(f"{ev['corner_misfit_px']:.1f}"))
-    return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
+    if report.get("verified"):
+        return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
+    # the reasons first, the figures on their own line: both are lists joined by "; "
+    return (f"{tr('Evidence of the automatic result:')} {verdict}.<br>{tr('Figures:')} "
+            f"{'; '.join(parts)}")
 
 
 class AddPointDialog(QtWidgets.QDialog):
