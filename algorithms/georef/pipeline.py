@@ -19,13 +19,7 @@ import numpy as np
 from ..errors import GeometryError, InputError
 from ..feedback import Feedback, StepFeedback
 from ..output_policy import PRODUCT_MARKER
-from .area import (
-    ORIENT_CELLS,
-    SEARCH_CELLS,
-    area_search,
-    boundary_search,
-    grid_control_points,
-)
+from .area import area_search, boundary_search, grid_control_points
 from .buildings import is_buildings, match_buildings
 from .correspondence import apply, consistent_interpretation, find_hypotheses, verify
 from .evidence import assess
@@ -74,17 +68,12 @@ MIN_ECC = 0.4
 #: synthetic tilings against unrelated tilings 0.58–0.72, but with gaps ≤ 0.06.
 MIN_ORIENTATION = 0.55
 MIN_GAP = 0.08
-#: Cells of the area-based and the boundary-orientation search after a failed buildings mode
-#: (half of :data:`.area.SEARCH_CELLS` and :data:`.area.ORIENT_CELLS`: the candidates' FFTs
-#: cost ∝ cells², the orientation search ∝ cells⁴ — 21 s → ~1.5 s on a 0.8 Mpx suburban
-#: scene). Footprints are no tiling whose shared boundaries the orientation search needs: on
-#: the synthetic suburban scenes the fallback found no result at the full resolution either.
-FALLBACK_AREA_CELLS = 256
-FALLBACK_ORIENT_CELLS = 64
-#: Time budget of the area-based stages after a failed buildings mode, counted from the start
-#: of the run: this many seconds per Mpx of the image, at least :data:`FALLBACK_MIN_S` (a run
-#: that cannot succeed says so within 30 s on 1 Mpx, issue 23; the step running at the
-#: deadline finishes first). On 20 synthetic suburban scenes no fallback found a result.
+#: Time budget of the area-based search after a failed buildings mode (the
+#: boundary-orientation search is not tried on footprints: :func:`_area_stage`), counted from
+#: the start of the run: this many seconds per Mpx of the image, at least
+#: :data:`FALLBACK_MIN_S` (a run that cannot succeed says so within 30 s on 1 Mpx, issue 23;
+#: the step running at the deadline finishes first). On 20 synthetic suburban scenes the
+#: fallback found no right result.
 FALLBACK_S_PER_MPX = 25.0
 FALLBACK_MIN_S = 10.0
 #: Default time budget of the search (s): a hopeless run says so by then (issue 23). Not 30 s:
@@ -284,7 +273,7 @@ def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple]
             fb.info(f"Buildings mode: {buildings_failure} — trying the other stages.")
             if opts.search != "objects":  # the object stage: no better on many small ones
                 return _area_stage(_fallback_run(run), ref,
-                                   f"buildings mode: {buildings_failure}", coarse=True)
+                                   f"buildings mode: {buildings_failure}", tiling=False)
     if opts.search == "area":
         return _area_stage(run, ref, None)
     if ref_kind == "raster" and opts.search in ("auto", "keypoints"):
@@ -593,17 +582,18 @@ def _object_warnings(used_xy: np.ndarray, shape: Sequence[int], interp: Any,
 
 
 def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str],
-                coarse: bool = False) -> GeorefResult:
+                tiling: bool = True) -> GeorefResult:
     """The area-based global search (:mod:`.area`) and the same result layout as the object
     chain; its control points are a grid of image points through the refined affine.
-    ``coarse``: both searches at half their resolution (:data:`FALLBACK_AREA_CELLS`,
-    :data:`FALLBACK_ORIENT_CELLS`; the fallback after a failed buildings mode)."""
+    ``tiling``: whether the polygons may tile the terrain (the boundary-orientation search
+    when ECC does not confirm the area search); ``False`` after a failed buildings mode:
+    building footprints are no tiling — on a synthetic town the search at half its resolution
+    placed an image 1943 px off with a score of 0.557 and the gate passed it."""
     ref_objs, crs, ref_info = ref
     grey, fb = run.grey, run.fb
     fb.info("Area-based search: Fourier–Mellin rotation/scale, NCC translation, ECC.")
     fb.progress(40)
-    res = area_search(grey, [o.ring for o in ref_objs], deadline=run.deadline,
-                      cells=FALLBACK_AREA_CELLS if coarse else SEARCH_CELLS)
+    res = area_search(grey, [o.ring for o in ref_objs], deadline=run.deadline)
     fb.progress(60)
     counts: Dict[str, Any] = {"reference_objects": len(ref_objs),
                               "area_candidates": len(res.candidates),
@@ -613,9 +603,13 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str],
     area_info: Dict[str, Any] = {"method": "ecc", "ncc": res.ncc, "ecc": res.ecc,
                                  "mirrored": res.mirrored, "candidates": res.candidates}
     T = res.transform
+    if res.ecc < MIN_ECC and not tiling:
+        _fail(counts, f"the area-based search found no alignment (ECC correlation "
+                      f"{res.ecc:.2f} < {MIN_ECC:g}; the boundary-orientation search needs "
+                      f"polygons that tile the terrain, not building footprints); before it, "
+                      f"the object stage: {object_failure}")
     if res.ecc < MIN_ECC:
-        T, area_info = _boundary_stage(run, ref_objs, res.ecc, counts, object_failure,
-                                       FALLBACK_ORIENT_CELLS if coarse else ORIENT_CELLS)
+        T, area_info = _boundary_stage(run, ref_objs, res.ecc, counts, object_failure)
     fb.progress(75)
     gcps = grid_control_points(T, np.isfinite(grey))
     img_xy = np.array([g.image for g in gcps])
@@ -643,17 +637,16 @@ def _area_stage(run: _Run, ref: tuple, object_failure: Optional[str],
 
 
 def _boundary_stage(run: _Run, ref_objs: Sequence[Any], ecc: float,
-                    counts: Dict[str, Any], object_failure: Optional[str],
-                    cells: int = ORIENT_CELLS) -> Tuple[np.ndarray, Dict[str, Any]]:
+                    counts: Dict[str, Any], object_failure: Optional[str]
+                    ) -> Tuple[np.ndarray, Dict[str, Any]]:
     """The individual polygons' outlines against the image's edge directions, when the ECC
-    correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. ``cells``: the
-    search raster's cells along the reference extent. Returns the transform and the
-    description of the search for the report."""
+    correlation stayed below :data:`MIN_ECC`; ``counts`` gets its figures. Returns the
+    transform and the description of the search for the report."""
     grey, fb = run.grey, run.fb
     fb.info(f"ECC correlation {ecc:.2f} < {MIN_ECC:g}: boundary-orientation search "
             "(individual outlines against edge directions).")
     outlines = [b for o in ref_objs for b in o.attributes.get("outlines", [o.ring])]
-    bres = boundary_search(grey, outlines, cells=cells, deadline=run.deadline)
+    bres = boundary_search(grey, outlines, deadline=run.deadline)
     counts.update(boundary_outlines=len(outlines),
                   boundary_score=round(bres.score, 4),
                   boundary_screen=round(bres.screen, 4),

@@ -184,9 +184,10 @@ def test_batch_over_image_files_flags_failures_and_goes_on(case, tmp_path) -> No
 @pytest.mark.slow
 def test_different_town_fails_fast_with_a_short_message(tmp_path) -> None:
     """Footprints of another town, default options: the buildings mode fails, the area-based
-    fallback (coarser searches within a budget of 25 s per Mpx, at least 10 s) fails too —
-    well within the issue's 30 s for 1 Mpx on this 0.36 Mpx scene, and the message lists the
-    figures, not the buildings mode's nested candidate runs."""
+    fallback (ECC only, no boundary-orientation search on footprints, within a budget of 25 s
+    per Mpx, at least 10 s) fails too — well within the issue's 30 s for 1 Mpx on this
+    0.36 Mpx scene, and the message lists the figures, not the buildings mode's nested
+    candidate runs."""
     import time
 
     from photodem.algorithms.synthetic.suburban_scene import suburban_case
@@ -201,6 +202,7 @@ def test_different_town_fails_fast_with_a_short_message(tmp_path) -> None:
     assert "buildings mode" in text and "candidate runs 3" in text
     assert "[{" not in text and "{'" not in text
     assert "area_ecc" in info.value.counts  # the fallback's figures as data
+    assert "boundary_score" not in info.value.counts
 
 
 def test_failure_detail_summarises_lists_and_dicts() -> None:
