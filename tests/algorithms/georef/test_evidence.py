@@ -175,13 +175,13 @@ def test_reason_texts() -> None:
 
 
 def test_poly2_result_judged_with_its_own_kind(right) -> None:
-    """A poly2 result with many control points: its halves and held-out quadrants are fitted
-    with poly2 (not projective) and the right result stays verified."""
+    """A poly2 result with many control points: its held-out quadrants are predicted by a
+    poly2 fit (not a projective one) and the right result stays verified."""
     _res, case = right
     poly = georeference(case["image"], case["reference"], transform="poly2")
     ev = poly.evidence
-    assert poly.fit.kind == "poly2" and ev.subset_kind == "poly2"
+    assert poly.fit.kind == "poly2" and ev.holdout_kind == "poly2"
     assert ev.verified, ev.reasons
     assert corner_error(poly.fit, case["truth"], SIZE, SIZE).max() < 1.0
-    assert evidence.subset_kind("poly2", 2 * evidence.POLY2_SUBSET_POINTS - 1) == "projective"
-    assert evidence.subset_kind("affine", 8) == "affine"
+    assert evidence.holdout_kind("poly2", evidence.POLY2_SUBSET_POINTS) == "projective"
+    assert evidence.holdout_kind("affine", 8) == "affine"
