@@ -198,7 +198,9 @@ def test_different_town_fails_fast_with_a_short_message(tmp_path) -> None:
         georeference(case["image"], case["reference"])
     seconds = time.perf_counter() - t0
     text = str(info.value)
-    assert seconds < 20.0, seconds
+    # 7–15 s alone on the 2-core test machine; 30 s leaves room for a loaded CI (before:
+    # 34 s under load with the boundary-orientation search after the buildings mode)
+    assert seconds < 30.0, seconds
     assert "buildings mode" in text and "candidate runs 3" in text
     assert "[{" not in text and "{'" not in text
     assert "area_ecc" in info.value.counts  # the fallback's figures as data
