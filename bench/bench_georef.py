@@ -201,9 +201,9 @@ def _everest(tmp: Path, n: int = 20, bands: str = "B4") -> Dict[str, Any]:
                     "failed": int((~np.isfinite(e)).sum()), "goal_pct": 90.0,
                     "seconds_per_case": float(np.mean(times))},
             "notes": [f"Everest {bands}, unperturbed image: " + (
-                f"{res0['stage']} stage, corner error "
-                f"{corner_error(res0['fit'], T0, W, H).max():.2f} px, RMSE "
-                f"{res0['fit'].rmse_px:.2f} px" if res0 is not None else why0)
+                f"{res0.stage} stage, corner error "
+                f"{corner_error(res0.fit, T0, W, H).max():.2f} px, RMSE "
+                f"{res0.fit.rmse_px:.2f} px" if res0 is not None else why0)
                 + f" ({dt0:.1f} s)",
                       f"Everest {bands} corner errors (px, inf = failure message): "
                       + ", ".join(f"{x:.2f}" for x in e),

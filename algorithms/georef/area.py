@@ -318,7 +318,8 @@ def score_candidate(feat: Array, valid: NDArray[np.bool_], rings: Sequence[Array
 
 
 def refine_ecc(grey: Array, rings: Sequence[Array], T: Array, sigma: float = 1.5,
-               cells: int = SEARCH_CELLS, rounds: int = 2) -> Tuple[Array, float]:
+               cells: int = SEARCH_CELLS, rounds: int = 2,
+               deadline: float = math.inf) -> Tuple[Array, float]:
     """Affine refinement of image → map ``T`` by ECC, coarse (≈ ``cells`` px) to full size.
 
     The polygons are rendered in the image geometry of the current ``T`` each round (no
@@ -330,7 +331,8 @@ def refine_ecc(grey: Array, rings: Sequence[Array], T: Array, sigma: float = 1.5
     T : (3, 3) array
         Refined level-0 image pixel → map.
     cc : float
-        ECC correlation coefficient of the last (full-size) round; 0 when ECC failed.
+        ECC correlation coefficient of the last (full-size) round; 0 when ECC failed or
+        ``deadline`` (``time.perf_counter()`` time) passed before the last round.
     """
     # a coarse level first widens ECC's capture range for the search's ~1° / 2 % steps
     factors = sorted({max(1.0, max(grey.shape) / c) for c in (cells // 4, cells)} | {1.0},
@@ -342,6 +344,8 @@ def refine_ecc(grey: Array, rings: Sequence[Array], T: Array, sigma: float = 1.5
         feat = edge_feature(small, sigma, valid).astype(np.float32)
         core = _core(valid, sigma).astype(np.uint8)  # the feature's own no-data margin
         for _ in range(rounds):
+            if time.perf_counter() >= deadline:  # out of time: no confirmed result
+                return T, 0.0
             to_pixel = L @ np.linalg.inv(T)
             ref = edge_feature(render_mask(rings, to_pixel, small.shape), sigma,
                                np.ones(small.shape, bool)).astype(np.float32)
@@ -407,7 +411,7 @@ def area_search(grey: Array, rings: Sequence[Array], sigma: float = 1.5,
                     best = (ncc, np.linalg.inv(to_cell) @ np.linalg.inv(S) @ F @ L, mirrored)
     if best is None or time.perf_counter() >= deadline:  # out of time: no result
         return AreaResult(np.eye(3) if best is None else best[1], 0.0, 0.0, False, cands)
-    T, cc = refine_ecc(grey, rings, best[1], sigma, cells)
+    T, cc = refine_ecc(grey, rings, best[1], sigma, cells, deadline=deadline)
     return AreaResult(T, best[0], cc, best[2], cands)
 
 
@@ -813,6 +817,8 @@ def boundary_search(grey: Array, boundaries: Sequence[Array], cells: int = ORIEN
         screened.append((sc, T, c))
     screened.sort(key=lambda t: -t[0])
     sc0, T0, best = screened[0]
+    if time.perf_counter() >= deadline:  # out of time before the full refinement: score 0
+        return BoundaryResult(T0, 0.0, sc0, 0.0, best.score, best.mirrored)
     # placements within three search cells of the best are the same one (local optima of
     # the coarse refinement): each is refined in full, the best final score wins; the
     # runner-up is the best placement elsewhere

@@ -63,8 +63,14 @@ from .refinement import ControlPoint
 from .result import GeorefResult
 
 PathLike = Union[str, Path]
-#: Pair index of a control point the operator added by hand.
+#: Pair index of a control point without an object pair: added by hand, or found by a stage
+#: without pairs (keypoints, the area search's grid); :attr:`ReviewPoint.origin` tells which.
 MANUAL = -1
+#: Where a control point comes from: a verified object ``pair``, the keypoint stage's matched
+#: patches (``keypoints``), the area-based search's ``grid``, or the operator (``manual``).
+ORIGINS = ("pair", "keypoints", "grid", "manual")
+#: The origin of the automatic points without a pair, by the stage that found them.
+STAGE_ORIGINS = {"keypoints": "keypoints", "area": "grid"}
 
 #: Header names (lower case) of a check-point file's columns. ``col``/``row``: this project's
 #: image convention (pixel centres at integers, rows downwards); ``corner``: pixel corners at 0
@@ -86,13 +92,15 @@ class ReviewPoint:
 
     image: Tuple[float, float]
     map: Tuple[float, float]
-    pair: int = MANUAL  # the verified object pair it comes from; MANUAL = added by hand
+    pair: int = MANUAL  # the verified object pair it comes from; MANUAL: none
     sharp: bool = False
     enabled: bool = True  # the operator's switch
+    origin: str = "manual"  # one of ORIGINS
 
     @property
     def manual(self) -> bool:
-        return self.pair == MANUAL
+        """Added by the operator (not a keypoint or grid point, which have no pair either)."""
+        return self.origin == "manual"
 
 
 @dataclass
@@ -189,6 +197,7 @@ class Review:
                 role = "control" if r["used"] else "outlier"
             rows.append({"id": k, "col": p.image[0], "row": p.image[1], "x": p.map[0],
                          "y": p.map[1], "pair": p.pair, "manual": p.manual,
+                         "origin": p.origin,
                          "enabled": p.enabled, "role": role,
                          "dx_px": r["dx_map"] / fit.pixel_size,
                          "dy_px": r["dy_map"] / fit.pixel_size,
@@ -382,6 +391,17 @@ def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
     return inside, [p.id for p, k in zip(points, ok) if not k]
 
 
+def _origin(pair: int, manual: bool, stage: Optional[str]) -> str:
+    """The origin of a stored point (:data:`ORIGINS`): its pair, the saved review's list of
+    manual points, else the stage that wrote the result (points without a pair of the
+    keypoint stage and the area search; of other stages: added by hand)."""
+    if pair != MANUAL:
+        return "pair"
+    if manual:
+        return "manual"
+    return STAGE_ORIGINS.get(stage or "", "manual")
+
+
 def load_review(folder: PathLike) -> Review:
     """The review state of a ``georeference_polygons`` output folder.
 
@@ -400,9 +420,11 @@ def load_review(folder: PathLike) -> Review:
     try:
         rep = json.loads(report_path.read_text(encoding="utf-8"))
         crs_wkt = points_crs(points[0].read_text(encoding="utf-8")) or ""
+        manual = set(rep.get("review", {}).get("manual", []))
         pts = [ReviewPoint(tuple(g["image"]), tuple(g["map"]), int(g.get("pair", 0)),
-                           bool(g.get("sharp", False)), bool(g.get("enabled", True)))
-               for g in rep["gcps"]]
+                           bool(g.get("sharp", False)), bool(g.get("enabled", True)),
+                           _origin(int(g.get("pair", 0)), k in manual, rep.get("stage")))
+               for k, g in enumerate(rep["gcps"])]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError(f"Cannot read the georeferencing result in '{folder}': {exc}") from exc
     state = rep.get("review", {})

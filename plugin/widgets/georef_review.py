@@ -36,6 +36,9 @@ from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
 #: Tint of the independent check points' table rows.
 INDEPENDENT_TINT = "#efe6f7"
+#: Colour of the control points without an object pair that a stage found (keypoints, the
+#: area search's grid) on the residual map: not the operator's manual points.
+STAGE_POINT_COLOUR = "tab:cyan"
 
 
 def point_columns() -> List[str]:
@@ -59,6 +62,68 @@ def role_text(role: str) -> str:
             "independent": tr("check (independent)")}.get(role, role)
 
 
+def origin_text(origin: str) -> str:
+    """The operator's word for the origin of a control point without an object pair."""
+    return {"manual": tr("manual"), "keypoints": tr("keypoints"),
+            "grid": tr("search grid")}.get(origin, origin)
+
+
+def reason_texts() -> Dict[str, str]:
+    """The evidence gate's reasons (keys of
+    :data:`~photodem.algorithms.georef.evidence.REASON_TEXTS`) as translated format strings
+    with the same named figures."""
+    return {
+        "spread": tr("the control points cover {hull_pct:.0f} % of the image (needs "
+                     "≥ {min_hull_pct:.0f} %) and {quadrants} of 4 quadrants (needs "
+                     "≥ {min_quadrants})"),
+        "no_holdout": tr("too few control points for a held-out check"),
+        "halves": tr("the corners disagree by {corner_px:.1f} px between transforms of halves "
+                     "of the control points (at most {max_px:g} px)"),
+        "holdout": tr("control points held out quadrant by quadrant are predicted with an "
+                      "RMSE of {rmse_px:.1f} px (at most {max_px:g} px)"),
+        "no_agreement": tr("no image–reference agreement could be measured (the reference "
+                           "does not reach into the image)"),
+        "edge_peak": tr("image and reference do not agree: edge peak ratio {peak:.2f} (needs "
+                        "≥ {need:g})"),
+        "correlation_peak": tr("image and reference do not agree: correlation peak margin "
+                               "{peak:.2f} (needs ≥ {need:g})"),
+        "offset": tr("image and reference agree best {offset_px:.1f} px away from the result "
+                     "(at most {max_px:g} px)"),
+        "corner_misfit": tr("image and reference agree best {misfit_px:.1f} px away from the "
+                            "result at an image corner (extrapolated from the quadrants; at "
+                            "most {max_px:g} px)"),
+        "local_offsets": tr("image and reference agree best away from the result in the "
+                            "{quadrants} (at most {max_px:g} px)"),
+    }
+
+
+def reason_text(key: str, values: Dict[str, Any]) -> Optional[str]:
+    """One reason of the evidence gate in the operator's language; ``None`` for a key this
+    version does not know (the caller shows the core's English sentence)."""
+    template = reason_texts().get(key)
+    if template is None:
+        return None
+    if key == "local_offsets":
+        names = (tr("top left quadrant ({0} px)"), tr("top right quadrant ({0} px)"),
+                 tr("bottom left quadrant ({0} px)"), tr("bottom right quadrant ({0} px)"))
+        values = {**values, "quadrants": ", ".join(names[int(k)].format(f"{o:.1f}")
+                                                   for k, o in values["quadrants"])}
+    try:
+        return template.format(**values)
+    except (KeyError, ValueError, IndexError, TypeError):  # a translation that lost a figure
+        return None
+
+
+def _reasons(ev: Dict[str, Any]) -> str:
+    """The gate's reasons of an evidence dict, translated where the report has their keys
+    (reports written before the keys: the core's English sentences)."""
+    items = ev.get("reason_items")
+    english = list(ev.get("reasons") or [])
+    if not items or len(items) != len(english):
+        return "; ".join(english)
+    return "; ".join(reason_text(k, v) or text for (k, v), text in zip(items, english))
+
+
 def evidence_html(report: Dict[str, Any]) -> str:
     """The automatic result's independent evidence (report.json ``evidence``) for the
     dialog: the verdict (UNVERIFIED in red) and its figures; '' for results without it."""
@@ -68,8 +133,7 @@ def evidence_html(report: Dict[str, Any]) -> str:
     if report.get("verified"):
         verdict = f"<b>{tr('Verified: yes')}</b>"
     else:
-        reasons = "; ".join(ev.get("reasons") or [])
-        verdict = f"<b style='color:#c0392b'>{tr('UNVERIFIED')}</b> — {reasons}"
+        verdict = f"<b style='color:#c0392b'>{tr('UNVERIFIED')}</b> — {_reasons(ev)}"
     parts = []
     if ev.get("independent_points", True) and ev.get("hull_share") is not None:
         parts.append(tr("control points cover {0} % of the image, {1} of 4 quadrants").format(
@@ -89,7 +153,11 @@ def evidence_html(report: Dict[str, Any]) -> str:
         parts.append(tr("quadrant offsets {0} px").format(", ".join(local)))
     if ev.get("corner_misfit_px") is not None:
         parts.append(tr("corner misfit {0} px").format(f"{ev['corner_misfit_px']:.1f}"))
-    return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
+    if report.get("verified"):
+        return f"{tr('Evidence of the automatic result:')} {verdict}: {'; '.join(parts)}"
+    # the reasons first, the figures on their own line: both are lists joined by "; "
+    return (f"{tr('Evidence of the automatic result:')} {verdict}.<br>{tr('Figures:')} "
+            f"{'; '.join(parts)}")
 
 
 class AddPointDialog(QtWidgets.QDialog):
@@ -411,7 +479,8 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         table.setUpdatesEnabled(False)
         for r, row in enumerate(self.rows):
             values = (row["id"], role_text(row["role"]),
-                      tr("manual") if row["manual"] else row["pair"], row["col"], row["row"],
+                      row["pair"] if row["origin"] == "pair" else origin_text(row["origin"]),
+                      row["col"], row["row"],
                       row["x"], row["y"], row["dx_px"], row["dy_px"], row["residual_px"],
                       row["residual_map"], row["loo_map"])
             for c, v in enumerate(values, start=1):
@@ -463,9 +532,10 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             span = float(np.ptp(np.vstack([xy, ind_xy]), axis=0).max())
             k = residual_scale(np.vstack([res, ind_res]), span, share=0.08)
             for role, colour in ROLE_COLOURS.items():
-                sel = np.array([r["role"] == role for r in self.rows])
+                sel = np.array([r["role"] == role and not _stage_point(r) for r in self.rows])
                 if sel.any():
                     draw_residuals(ax, xy[sel], res[sel], k, colour, label=role_text(role))
+            self._draw_stage_points(xy, res, k)
             if len(ind_xy):
                 draw_residuals(ax, ind_xy, ind_res, k, INDEPENDENT_COLOUR, marker="^",
                                size=6, width=0.004, mec="black", mew=0.5,
@@ -482,6 +552,16 @@ class GeorefReviewDialog(QtWidgets.QDialog):
             ax.set_xlim(-0.5, w * self.thumb_factor - 0.5)
             ax.set_ylim(h * self.thumb_factor - 0.5, -0.5)
         self._show_selection()
+
+    def _draw_stage_points(self, xy: np.ndarray, res: np.ndarray, k: float) -> None:
+        """The control points a stage found without object pairs (keypoints, the area
+        search's grid): their own colour and legend entry, apart from manual points."""
+        for origin in ("keypoints", "grid"):
+            sel = np.array([_stage_point(r) and r["origin"] == origin for r in self.rows])
+            if sel.any():
+                draw_residuals(self.axes, xy[sel], res[sel], k, STAGE_POINT_COLOUR,
+                               marker="s", size=4,
+                               label=tr("control point ({0})").format(origin_text(origin)))
 
     def _show_selection(self) -> None:
         """Ring the selected table rows' points on the map."""
@@ -580,6 +660,11 @@ def _thumbnail(path: Path, max_side: int = 800) -> tuple:
         return data.astype(np.float32).mean(axis=0), src.width / shape[2]
     except Exception:  # a missing or unreadable copy: the review works without the picture
         return None, 1
+
+
+def _stage_point(row: Dict[str, Any]) -> bool:
+    """A point row in the fit that a stage found without an object pair (keypoints, grid)."""
+    return row["role"] == "control" and row["origin"] in ("keypoints", "grid")
 
 
 def _fmt(value: Any) -> str:

@@ -95,6 +95,13 @@ def test_clustered_points_are_rejected(right) -> None:
     assert not ev.verified and ev.hull_share < evidence.MIN_HULL
     assert any("cover" in r for r in ev.reasons)
     assert ev.corner_disagreement_px > evidence.MAX_CORNER_PX
+    # the reasons as keys and figures (the faces translate them), in step with the sentences
+    keys = [k for k, _ in ev.reason_items]
+    assert "spread" in keys and "halves" in keys and len(keys) == len(ev.reasons)
+    assert ev.reasons == [evidence.reason_text(k, v) for k, v in ev.reason_items]
+    spread = dict(ev.reason_items)["spread"]
+    assert spread["hull_pct"] == pytest.approx(100 * ev.hull_share, abs=0.1)
+    assert json.loads(json.dumps(ev.to_json()))["reason_items"][0][0] == keys[0]
 
 
 def test_different_scene_is_rejected(right, tmp_path) -> None:
@@ -154,3 +161,27 @@ def test_hopeless_run_fails_within_the_time_limit(right, tmp_path) -> None:
         georeference(case["image"], other["reference"], time_limit_s=5.0)
     assert time.perf_counter() - t0 < 15.0
     assert "time limit of 5 s" in str(info.value) or "not verified" in str(info.value)
+
+
+def test_reason_texts() -> None:
+    """Every reason key has its sentence; the quadrants of ``local_offsets`` are named."""
+    text = evidence.reason_text("local_offsets", {"quadrants": [[0, 2.31], [3, 1.84]],
+                                                  "max_px": 1.5})
+    assert text == ("image and reference agree best away from the result in the top left "
+                    "quadrant (2.3 px), bottom right quadrant (1.8 px) (at most 1.5 px)")
+    assert evidence.reason_text("halves", {"corner_px": 2.24, "max_px": 1.5}) == (
+        "the corners disagree by 2.2 px between transforms of halves of the control points "
+        "(at most 1.5 px)")
+
+
+def test_poly2_result_judged_with_its_own_kind(right) -> None:
+    """A poly2 result with many control points: its held-out quadrants are predicted by a
+    poly2 fit (not a projective one) and the right result stays verified."""
+    _res, case = right
+    poly = georeference(case["image"], case["reference"], transform="poly2")
+    ev = poly.evidence
+    assert poly.fit.kind == "poly2" and ev.holdout_kind == "poly2"
+    assert ev.verified, ev.reasons
+    assert corner_error(poly.fit, case["truth"], SIZE, SIZE).max() < 1.0
+    assert evidence.holdout_kind("poly2", evidence.POLY2_SUBSET_POINTS) == "projective"
+    assert evidence.holdout_kind("affine", 8) == "affine"

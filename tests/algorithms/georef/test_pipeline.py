@@ -179,3 +179,43 @@ def test_batch_over_image_files_flags_failures_and_goes_on(case, tmp_path) -> No
     assert not (tmp_path / "products" / "blank").exists()
     report = json.loads((tmp_path / "products" / "a_scene" / "report.json").read_text())
     assert report["rmse_px"] < 0.5
+
+
+@pytest.mark.slow
+def test_different_town_fails_fast_with_a_short_message(tmp_path) -> None:
+    """Footprints of another town, default options: the buildings mode fails, the area-based
+    fallback (ECC only, no boundary-orientation search on footprints, within a budget of 25 s
+    per Mpx, at least 10 s) fails too — well within the issue's 30 s for 1 Mpx on this
+    0.36 Mpx scene, and the message lists the figures, not the buildings mode's nested
+    candidate runs."""
+    import time
+
+    from photodem.algorithms.synthetic.suburban_scene import suburban_case
+
+    case = suburban_case(tmp_path, seed=3, width=600, height=600, town_seed=103)
+    t0 = time.perf_counter()
+    with pytest.raises(GeometryError, match="Georeferencing failed") as info:
+        georeference(case["image"], case["reference"])
+    seconds = time.perf_counter() - t0
+    text = str(info.value)
+    # 7–15 s alone on the 2-core test machine; 30 s leaves room for a loaded CI (before:
+    # 34 s under load with the boundary-orientation search after the buildings mode)
+    assert seconds < 30.0, seconds
+    assert "buildings mode" in text and "candidate runs 3" in text
+    assert "[{" not in text and "{'" not in text
+    assert "area_ecc" in info.value.counts  # the fallback's figures as data
+    assert "boundary_score" not in info.value.counts
+
+
+def test_failure_detail_summarises_lists_and_dicts() -> None:
+    from photodem.algorithms.georef.pipeline import _fail
+
+    counts = {"image_objects": 443, "candidate_runs": [{"gradient": 3.3, "zones": 1299}] * 3,
+              "evidence": {"hull_share": 0.1, "reasons": ["a"]}, "best_support": 4.73912,
+              "depth_reached": False}
+    with pytest.raises(GeometryError) as info:
+        _fail(counts, "no placement")
+    text = str(info.value)
+    assert ("(image objects 443, candidate runs 3, evidence 2, best support 4.739, "
+            "depth reached False)") in text
+    assert info.value.counts["candidate_runs"][0]["zones"] == 1299  # the data stay whole
