@@ -1580,7 +1580,7 @@
         </message>
         <message>
             <source>Iterations</source>
-            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:52</extracomment>
+            <extracomment>filter_lowpass.iterations: description; plugin/widgets/georef_review.py:55</extracomment>
             <translation>Iterationen</translation>
         </message>
         <message>
@@ -2385,7 +2385,7 @@
         </message>
         <message>
             <source>keypoints</source>
-            <extracomment>georeference_polygons.search: option</extracomment>
+            <extracomment>georeference_polygons.search: option; plugin/widgets/georef_review.py:67</extracomment>
             <translation>Merkmalspunkte</translation>
         </message>
         <message>
@@ -2635,7 +2635,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:748; plugin/widgets/georef_review.py:365; plugin/widgets/georef_review.py:536; plugin/widgets/georef_review.py:541; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:748; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -3545,12 +3545,12 @@
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:255; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:513; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:255; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:593; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:256; plugin/widgets/georef_review.py:208</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:256; plugin/widgets/georef_review.py:276</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
@@ -3630,7 +3630,7 @@
         </message>
         <message>
             <source>Overlap</source>
-            <extracomment>plugin/widgets/batch_dialog.py:138; plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:138; plugin/widgets/georef_review.py:54</extracomment>
             <translation>Überlappung</translation>
         </message>
         <message>
@@ -3967,7 +3967,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:204</extracomment>
+            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:272</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
@@ -4022,318 +4022,403 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Use</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Verwenden</translation>
         </message>
         <message>
             <source>Role</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Rolle</translation>
         </message>
         <message>
             <source>Pair</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Paar</translation>
         </message>
         <message>
             <source>Column</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Spalte</translation>
         </message>
         <message>
             <source>Row</source>
-            <extracomment>plugin/widgets/georef_review.py:43</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:46</extracomment>
             <translation>Zeile</translation>
         </message>
         <message>
             <source>dX [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>dX [px]</translation>
         </message>
         <message>
             <source>dY [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>dY [px]</translation>
         </message>
         <message>
             <source>Residual [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>Restfehler [px]</translation>
         </message>
         <message>
             <source>Residual [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:44</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:47</extracomment>
             <translation>Restfehler [m]</translation>
         </message>
         <message>
             <source>Leave-one-out [m]</source>
-            <extracomment>plugin/widgets/georef_review.py:45</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:48</extracomment>
             <translation>Ohne diesen Punkt [m]</translation>
         </message>
         <message>
             <source>Reject</source>
-            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Verwerfen</translation>
         </message>
         <message>
             <source>Image object</source>
-            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Bildobjekt</translation>
         </message>
         <message>
             <source>Reference object</source>
-            <extracomment>plugin/widgets/georef_review.py:50</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:53</extracomment>
             <translation>Referenzobjekt</translation>
         </message>
         <message>
             <source>Segmentation run</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
             <translation>Segmentierungslauf</translation>
         </message>
         <message>
             <source>Threshold [DN]</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
             <translation>Schwellwert [GW]</translation>
         </message>
         <message>
             <source>ICP RMS [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:51</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:54</extracomment>
             <translation>ICP-RMS [px]</translation>
         </message>
         <message>
             <source>Converged</source>
-            <extracomment>plugin/widgets/georef_review.py:52</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:55</extracomment>
             <translation>Konvergiert</translation>
         </message>
         <message>
+            <source>the control points cover {hull_pct:.0f} % of the image (needs ≥ {min_hull_pct:.0f} %) and {quadrants} of 4 quadrants (needs ≥ {min_quadrants})</source>
+            <extracomment>plugin/widgets/georef_review.py:76</extracomment>
+            <translation>die Passpunkte überdecken {hull_pct:.0f} % des Bildes (nötig ≥ {min_hull_pct:.0f} %) und {quadrants} von 4 Quadranten (nötig ≥ {min_quadrants})</translation>
+        </message>
+        <message>
+            <source>too few control points for a held-out check</source>
+            <extracomment>plugin/widgets/georef_review.py:79</extracomment>
+            <translation>zu wenige Passpunkte für eine Prüfung mit zurückgehaltenen Punkten</translation>
+        </message>
+        <message>
+            <source>the corners disagree by {corner_px:.1f} px between transforms of halves of the control points (at most {max_px:g} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:80</extracomment>
+            <translation>die Ecken weichen zwischen den Transformationen aus je einer Hälfte der Passpunkte um {corner_px:.1f} px ab (höchstens {max_px:g} px)</translation>
+        </message>
+        <message>
+            <source>control points held out quadrant by quadrant are predicted with an RMSE of {rmse_px:.1f} px (at most {max_px:g} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:82</extracomment>
+            <translation>Quadrant für Quadrant zurückgehaltene Passpunkte werden mit einem RMSE von {rmse_px:.1f} px vorhergesagt (höchstens {max_px:g} px)</translation>
+        </message>
+        <message>
+            <source>no image–reference agreement could be measured (the reference does not reach into the image)</source>
+            <extracomment>plugin/widgets/georef_review.py:84</extracomment>
+            <translation>keine Übereinstimmung von Bild und Referenz messbar (die Referenz reicht nicht ins Bild)</translation>
+        </message>
+        <message>
+            <source>image and reference do not agree: edge peak ratio {peak:.2f} (needs ≥ {need:g})</source>
+            <extracomment>plugin/widgets/georef_review.py:86</extracomment>
+            <translation>Bild und Referenz stimmen nicht überein: Kantenspitzenverhältnis {peak:.2f} (nötig ≥ {need:g})</translation>
+        </message>
+        <message>
+            <source>image and reference do not agree: correlation peak margin {peak:.2f} (needs ≥ {need:g})</source>
+            <extracomment>plugin/widgets/georef_review.py:88</extracomment>
+            <translation>Bild und Referenz stimmen nicht überein: Korrelationsvorsprung der Spitze {peak:.2f} (nötig ≥ {need:g})</translation>
+        </message>
+        <message>
+            <source>image and reference agree best {offset_px:.1f} px away from the result (at most {max_px:g} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:90</extracomment>
+            <translation>Bild und Referenz stimmen {offset_px:.1f} px neben dem Ergebnis am besten überein (höchstens {max_px:g} px)</translation>
+        </message>
+        <message>
+            <source>image and reference agree best {misfit_px:.1f} px away from the result at an image corner (extrapolated from the quadrants; at most {max_px:g} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:92</extracomment>
+            <translation>Bild und Referenz stimmen an einer Bildecke {misfit_px:.1f} px neben dem Ergebnis am besten überein (aus den Quadranten extrapoliert; höchstens {max_px:g} px)</translation>
+        </message>
+        <message>
+            <source>image and reference agree best away from the result in the {quadrants} (at most {max_px:g} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:95</extracomment>
+            <translation>Bild und Referenz stimmen neben dem Ergebnis am besten überein im {quadrants} (höchstens {max_px:g} px)</translation>
+        </message>
+        <message>
+            <source>top left quadrant ({0} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:107</extracomment>
+            <translation>Quadranten oben links ({0} px)</translation>
+        </message>
+        <message>
+            <source>top right quadrant ({0} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:107</extracomment>
+            <translation>Quadranten oben rechts ({0} px)</translation>
+        </message>
+        <message>
+            <source>bottom left quadrant ({0} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:108</extracomment>
+            <translation>Quadranten unten links ({0} px)</translation>
+        </message>
+        <message>
+            <source>bottom right quadrant ({0} px)</source>
+            <extracomment>plugin/widgets/georef_review.py:108</extracomment>
+            <translation>Quadranten unten rechts ({0} px)</translation>
+        </message>
+        <message>
             <source>edge peak ratio {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:83</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:147</extracomment>
             <translation>Kantenspitzenverhältnis {0}</translation>
         </message>
         <message>
             <source>correlation peak margin {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:84</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:148</extracomment>
             <translation>Korrelationsvorsprung der Spitze {0}</translation>
         </message>
         <message>
             <source>Evidence of the automatic result:</source>
-            <extracomment>plugin/widgets/georef_review.py:92</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:157; plugin/widgets/georef_review.py:159</extracomment>
             <translation>Belege des automatischen Ergebnisses:</translation>
         </message>
         <message>
+            <source>Figures:</source>
+            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
+            <translation>Kennzahlen:</translation>
+        </message>
+        <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:100</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
             <source>Drop outliers (&gt; 3 σ0)</source>
-            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:230</extracomment>
             <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:189</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:257</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:190</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:258</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:197</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:265</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:198</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:266</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:199</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:267</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:203</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:271</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:205</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:273</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:512</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:592</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:558</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:638</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:589</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:674</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:589</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:674</extracomment>
             <translation>nein</translation>
         </message>
         <message>
             <source>control point</source>
-            <extracomment>plugin/widgets/georef_review.py:57</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:60</extracomment>
             <translation>Passpunkt</translation>
         </message>
         <message>
             <source>outlier (dropped)</source>
-            <extracomment>plugin/widgets/georef_review.py:57</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:60</extracomment>
             <translation>Ausreißer (entfernt)</translation>
         </message>
         <message>
             <source>check point (off)</source>
-            <extracomment>plugin/widgets/georef_review.py:58</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:61</extracomment>
             <translation>Kontrollpunkt (aus)</translation>
         </message>
         <message>
             <source>pair rejected</source>
-            <extracomment>plugin/widgets/georef_review.py:58</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:61</extracomment>
             <translation>Paar verworfen</translation>
         </message>
         <message>
             <source>check (independent)</source>
-            <extracomment>plugin/widgets/georef_review.py:59</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:62</extracomment>
             <translation>Kontrollpunkt (unabhängig)</translation>
         </message>
         <message>
+            <source>manual</source>
+            <extracomment>plugin/widgets/georef_review.py:67</extracomment>
+            <translation>manuell</translation>
+        </message>
+        <message>
+            <source>search grid</source>
+            <extracomment>plugin/widgets/georef_review.py:68</extracomment>
+            <translation>Suchraster</translation>
+        </message>
+        <message>
             <source>Verified: yes</source>
-            <extracomment>plugin/widgets/georef_review.py:69</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:134</extracomment>
             <translation>Bestätigt: ja</translation>
         </message>
         <message>
             <source>UNVERIFIED</source>
-            <extracomment>plugin/widgets/georef_review.py:72</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:136</extracomment>
             <translation>UNBESTÄTIGT</translation>
         </message>
         <message>
             <source>control points from a grid through the search transform</source>
-            <extracomment>plugin/widgets/georef_review.py:81</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:145</extracomment>
             <translation>Passpunkte aus einem Raster durch die Transformation der Suche</translation>
         </message>
         <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:103</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:171</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:104</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:172</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:105</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:173</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:106</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:174</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
             <source>Transform:</source>
-            <extracomment>plugin/widgets/georef_review.py:171</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:239</extracomment>
             <translation>Transformation:</translation>
         </message>
         <message>
             <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:376</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:444</extracomment>
             <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:431</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:500</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:541</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:621</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
             <source>control points cover {0} % of the image, {1} of 4 quadrants</source>
-            <extracomment>plugin/widgets/georef_review.py:75</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:139</extracomment>
             <translation>Passpunkte überdecken {0} % des Bildes, {1} von 4 Quadranten</translation>
         </message>
         <message>
             <source>quadrant offsets {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:89</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
             <translation>Versätze je Quadrant {0} px</translation>
         </message>
         <message>
             <source>corner misfit {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:91</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:155</extracomment>
             <translation>Fehlanpassung an den Ecken {0} px</translation>
         </message>
         <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:112</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:180</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
             <source>Review georeferencing — {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:154</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:222</extracomment>
             <translation>Georeferenzierung prüfen — {0}</translation>
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:351</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:419</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:352</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:420</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
-            <source>manual</source>
-            <extracomment>plugin/widgets/georef_review.py:414</extracomment>
-            <translation>manuell</translation>
-        </message>
-        <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:435</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:504</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:437</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:506</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:441</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:510</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>corners disagree by {0} px between halves</source>
-            <extracomment>plugin/widgets/georef_review.py:78</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:142</extracomment>
             <translation>Ecken weichen zwischen den Hälften um {0} px ab</translation>
         </message>
         <message>
             <source>at {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:86</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
             <translation>bei {0} px</translation>
         </message>
         <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:474</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:544</extracomment>
             <translation>Restfehler (×{0:g})</translation>
+        </message>
+        <message>
+            <source>control point ({0})</source>
+            <extracomment>plugin/widgets/georef_review.py:564</extracomment>
+            <translation>Passpunkt ({0})</translation>
         </message>
         <message>
             <source>Z draped</source>
