@@ -95,6 +95,9 @@ NEIGHBOURS = 8
 MIN_MATCHES = 6
 MIN_SHARE = 0.25
 MIN_LEAD = 1.5
+#: Overlap of a verified roof with its footprint (min of both shares): a roof half (0.5)
+#: or a roof with its shadow would pull the ICP's outlines apart.
+VERIFY_OVERLAP = 0.8
 #: Rounds of verification and refit of the consensus on the verified roofs.
 REFINE_ROUNDS = 4
 
@@ -548,7 +551,7 @@ def _verified(T: Array, fi: Sequence[ObjectFeatures], fr: Sequence[ObjectFeature
         d, j = rtree.query(apply(T, ci))
         hyps = [Hypothesis(i=i, j=int(j[i]), transform=T, q=1.0, w=1.0, d=0.0)
                 for i in range(len(fi)) if d[i] <= base_tol]
-        v = verify(hyps, fi, fr, T, min_overlap=0.5, reestimate=False)
+        v = verify(hyps, fi, fr, T, min_overlap=VERIFY_OVERLAP, reestimate=False)
         if ver is not None and len(v.pairs) <= len(ver.pairs):
             break
         ver = v
