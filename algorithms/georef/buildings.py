@@ -95,9 +95,9 @@ NEIGHBOURS = 8
 MIN_MATCHES = 6
 MIN_SHARE = 0.25
 MIN_LEAD = 1.5
-#: Overlap of a verified roof with its footprint (min of both shares): a roof half (0.5)
+#: Overlap of a verified roof with its footprint (min of both shares): a roof half (≤ 0.5)
 #: or a roof with its shadow would pull the ICP's outlines apart.
-VERIFY_OVERLAP = 0.8
+VERIFY_OVERLAP = 0.6
 #: Rounds of verification and refit of the consensus on the verified roofs.
 REFINE_ROUNDS = 4
 
