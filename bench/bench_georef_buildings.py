@@ -5,8 +5,9 @@ buildings per image, 900 × 900 px (0.8 Mpx), random affine maps (rotation 0–3
 0.5–2 of a 0.5 m pixel, shear, mirroring in half of them), relief displacement of the roofs
 0–3 px; even seeds 8-bit, odd seeds 12-bit data in uint16. Rows: share within 1 px (and 2 px)
 at the image corners (goal ≥ 90 % within 1 px), wrong results (a corner > 3 px off returned as
-a success; goal 0), failures, median and max seconds (goal ≤ 30 s). Then three "different
-town" cases (the footprints of another seed): each must fail.
+a success; goal 0), failures, median and max seconds (goal ≤ 30 s). Then seeds 0–9 without
+relief displacement (the roof candidates and the consensus alone) and three "different town"
+cases (the footprints of another seed): each must fail.
 """
 
 from __future__ import annotations
