@@ -5,10 +5,13 @@ a homogeneous image region: a gabled roof has a sunlit and a shaded half, roofs 
 shadows and trees cut them, relief displacement moves them. One pair says little; the
 *configuration* of neighbouring buildings carries the information. The chain:
 
-1. **Candidates** (:func:`roof_candidates`): flat zones of the smoothed image (gradient below a
-   threshold, several thresholds — a multiple segmentation), grown back over their edge band;
-   pairs of adjacent zones whose union is rectangular are added (the two halves of a gabled roof
-   merged across the ridge); size window and shape filters (rectangularity, elongation).
+1. **Candidates** (:func:`roof_candidates`): segments of a graph-based segmentation
+   (Felzenszwalb & Huttenlocher, two scales — a multiple segmentation) whose outline stands
+   out (mean gradient along it); segments below a minimum size (chimneys, dormers, gravel)
+   join a neighbour, so a roof half carrying spots stays one segment and narrow halves keep
+   their exact outline (no gradient band); pairs of adjacent segments whose union is
+   rectangular are added (the two halves of a gabled roof merged across the ridge); size
+   window and shape filters (rectangularity, elongation, no holes).
 2. **One-pair hypotheses**: every (candidate, footprint) pair of plausible size gives the 8
    affine maps of the standard positions (:mod:`.invariants`; a rectangle's standard position is
    a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
@@ -19,7 +22,11 @@ shadows and trees cut them, relief displacement moves them. One pair says little
    repeated with a shrinking tolerance). Accepted only when at least :data:`MIN_MATCHES` pairs
    and :data:`MIN_SHARE` of the footprints inside the image agree, well ahead of any different
    placement (:data:`MIN_LEAD`).
-4. The matched candidates become verified pairs for the usual ICP and control points.
+4. **Refinement** (:func:`_refine`): the growth pairs centroids by distance only (a roof
+   half taken for the whole roof leaves it a few pixels off); the consensus is refitted on
+   candidates that cover a footprint or a roof half under it (best overlap per shape), then
+   the verified whole roofs (overlap, one partner each) refit it again while their number
+   grows; they become the pairs for the usual ICP and control points.
 
 Relief displacement (roofs 0–3 px from their footprints, radial from the image centre ∝ height)
 is a per-building offset; its radial mean is a scale about the image centre that no transform
@@ -36,9 +43,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
+from skimage.measure import label as label_connected
+from skimage.segmentation import felzenszwalb
 
 from ..feedback import Feedback
-from .correspondence import Hypothesis, affine_from_points, apply, verify
+from .correspondence import Hypothesis, affine_from_points, apply, overlap, verify
 from .invariants import _D4, ObjectFeatures, min_bounding_rectangle, object_features
 from .objects import IMAGE, PolygonObject, orient_ring
 from .regions import label_rings
@@ -56,8 +65,15 @@ AUTO_MAX_MEDIAN_SHARE = 0.002
 AUTO_MAX_AREA = 5000.0
 #: ... and rectangular (median area / minimum bounding rectangle; footprints ≈ 0.9–1).
 AUTO_RECTANGULARITY = 0.7
-#: Gradient thresholds (× the median gradient magnitude after a σ = 1 px smoothing).
-GRADIENT_THRESHOLDS = (3.5, 7.0, 14.0)
+#: Scales of the graph-based segmentation (Felzenszwalb & Huttenlocher; image standardised
+#: to mean 0, standard deviation 1): larger → larger segments. Two runs: one that keeps roof
+#: halves apart, one that joins weakly separated parts.
+SEGMENT_SCALES = (300.0, 1000.0)
+#: Smallest segment (px): smaller ones (chimneys, dormers, gravel, noise) join a neighbour.
+MIN_SEGMENT_PX = 25
+#: A candidate's mean gradient along its outline, × the median gradient magnitude (σ = 1 px):
+#: the pieces of an over-segmented lawn or road edge have weak outlines.
+MIN_BORDER_CONTRAST = 5.0
 #: Zones darker on average than this percentile of the image are shadows, not roofs.
 SHADOW_PERCENTILE = 6.0
 #: Size window of candidates: px² and share of the image.
@@ -79,6 +95,11 @@ NEIGHBOURS = 8
 MIN_MATCHES = 6
 MIN_SHARE = 0.25
 MIN_LEAD = 1.5
+#: Overlap of a verified roof with its footprint (min of both shares): a roof half (≤ 0.5)
+#: or a roof with its shadow would pull the ICP's outlines apart.
+VERIFY_OVERLAP = 0.6
+#: Rounds of verification and refit of the consensus on the verified roofs.
+REFINE_ROUNDS = 4
 
 
 def is_buildings(ref_objs: Sequence[PolygonObject]) -> bool:
@@ -96,14 +117,29 @@ def is_buildings(ref_objs: Sequence[PolygonObject]) -> bool:
 
 
 # -- candidates ---------------------------------------------------------------------------------
-def _flat_zones(grey: Array, threshold: float, gm: Array, valid: NDArray[np.bool_]
-                ) -> NDArray[np.int32]:
-    """Connected zones of gradient < ``threshold``, grown over the edge band (≤ 2 px)."""
-    lab, _ = ndimage.label((gm < threshold) & valid)
-    dist, (ri, ci) = ndimage.distance_transform_edt(lab == 0, return_indices=True)
-    grown = lab[ri, ci]
-    grown[(dist > 2.0) | ~valid] = 0
-    return grown.astype(np.int32)
+def _segments(image: Array, scale: float, valid: NDArray[np.bool_]) -> NDArray[np.int32]:
+    """4-connected segments of the graph-based segmentation (Felzenszwalb & Huttenlocher) of
+    ``image`` (standardised) at ``scale``; 0 outside ``valid``."""
+    seg = felzenszwalb(image, scale=scale, sigma=0.5, min_size=MIN_SEGMENT_PX) + 1
+    # its segments are 8-connected: split them so that every label has one outline
+    lab = label_connected(seg, connectivity=1).astype(np.int32)
+    lab[~valid] = 0
+    return lab
+
+
+def _border_contrast(lab: NDArray[np.int32], gm: Array, n: int) -> Array:
+    """Mean gradient magnitude on every label's border pixels (a 4-neighbour of another
+    label): a roof stands out along its outline, a piece of an over-segmented lawn does not."""
+    border = np.zeros(lab.shape, bool)
+    dh = lab[:, :-1] != lab[:, 1:]
+    dv = lab[:-1, :] != lab[1:, :]
+    border[:, :-1] |= dh
+    border[:, 1:] |= dh
+    border[:-1, :] |= dv
+    border[1:, :] |= dv
+    lb = lab[border]
+    cnt = np.bincount(lb, minlength=n + 1)
+    return np.bincount(lb, weights=gm[border], minlength=n + 1) / np.maximum(cnt, 1)
 
 
 def _ring_area(ring: Array) -> float:
@@ -139,25 +175,28 @@ def _adjacent_pairs(lab: NDArray[np.int32], keep: NDArray[np.bool_]
     return [(a, b, c) for (a, b), c in pairs.items()]
 
 
-def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOLDS,
+def roof_candidates(grey: Array, scales: Sequence[float] = SEGMENT_SCALES,
                     feedback: Optional[Feedback] = None) -> Tuple[List[PolygonObject],
                                                                   Dict[str, Any]]:
     """Image objects that may be roofs (module notes, step 1), level-0 image coordinates
-    (pixel centres at integers). Returns the objects and figures per threshold."""
+    (pixel centres at integers). Returns the objects and figures per segmentation scale."""
     fb = feedback or Feedback()
     valid = np.isfinite(grey)
-    g = ndimage.gaussian_filter(np.where(valid, grey, np.nanmean(grey)), 1.0)
+    filled = np.where(valid, grey, np.nanmean(grey))
+    g = ndimage.gaussian_filter(filled, 1.0)
     gm = np.hypot(ndimage.sobel(g, 0), ndimage.sobel(g, 1)) / 8.0
     lo, hi = MIN_CANDIDATE_PX, MAX_CANDIDATE_SHARE * grey.size
     # in units of the median gradient (noise and texture of the open ground): the same
-    # zones for 8-bit data and for stretched 11/12-bit data with a different noise level
+    # contrast for 8-bit data and for stretched 11/12-bit data with a different noise level
     unit = max(float(np.median(gm[valid])), 1e-3)
     dark = float(np.percentile(g[valid], SHADOW_PERCENTILE))
+    # standardised: the segmentation scale means the same for 8-bit and 11/12-bit data
+    std = (filled - float(np.mean(filled))) / max(float(np.std(filled)), 1e-9)
     objs: List[PolygonObject] = []
     runs = []
-    for k, t in enumerate(np.asarray(thresholds, float) * unit):
+    for k, t in enumerate(scales):
         fb.check()
-        lab = _flat_zones(grey, t, gm, valid)
+        lab = _segments(std, float(t), valid)
         n = int(lab.max())
         size = np.bincount(lab.ravel(), minlength=n + 1)
         keep = (size >= lo) & (size <= hi)
@@ -165,6 +204,7 @@ def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOL
         # the roof's centroid away from the sun)
         mean = np.bincount(lab.ravel(), weights=g.ravel(), minlength=n + 1) / np.maximum(size, 1)
         keep &= mean > dark
+        keep &= _border_contrast(lab, gm, n) >= MIN_BORDER_CONTRAST * unit
         keep[0] = False
         n_single = 0
         for value, ring in label_rings(lab, keep):
@@ -175,13 +215,14 @@ def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOL
                 n_single += 1
         # halves of a gabled roof (or roof and dormer side): merge pairs of adjacent zones
         n_merged = 0
+        boxes = ndimage.find_objects(lab)
         for a, b, border in _adjacent_pairs(lab, keep):
             sa, sb = int(size[a]), int(size[b])
             if min(sa, sb) < 0.2 * (sa + sb) or sa + sb > hi:
                 continue
             if border < 1.5 * math.sqrt(min(sa, sb)):  # a long shared edge: the ridge
                 continue
-            ring = _union_ring(lab, a, b)
+            ring = _union_ring(lab, a, b, boxes)
             if ring is None:
                 continue
             ok, rect = _shape_ok(ring)
@@ -189,7 +230,7 @@ def roof_candidates(grey: Array, thresholds: Sequence[float] = GRADIENT_THRESHOL
                 objs.append(_candidate(ring - 0.5, k, t, sa + sb, rect, len(objs),
                                        merged=True))
                 n_merged += 1
-        runs.append({"gradient": round(float(t), 3), "zones": n, "single": n_single,
+        runs.append({"scale": float(t), "segments": n, "single": n_single,
                      "merged": n_merged})
     return objs, {"runs": runs}
 
@@ -201,12 +242,15 @@ def _candidate(ring: Array, run: int, t: float, pixels: int, rect: float, ident:
                                      "merged": merged})
 
 
-def _union_ring(lab: NDArray[np.int32], a: int, b: int) -> Optional[Array]:
-    """Outer ring of the union of labels ``a`` and ``b`` (full-image corner coordinates)."""
-    m = (lab == a) | (lab == b)
-    rows, cols = np.nonzero(m)
-    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    sub = m[r0:r1, c0:c1].astype(np.int32)
+def _union_ring(lab: NDArray[np.int32], a: int, b: int, boxes: Sequence[Any]
+                ) -> Optional[Array]:
+    """Outer ring of the union of labels ``a`` and ``b`` (full-image corner coordinates);
+    ``boxes``: :func:`scipy.ndimage.find_objects` of ``lab`` (only the pair's box is read)."""
+    sa, sb = boxes[a - 1], boxes[b - 1]
+    r0, r1 = min(sa[0].start, sb[0].start), max(sa[0].stop, sb[0].stop)
+    c0, c1 = min(sa[1].start, sb[1].start), max(sa[1].stop, sb[1].stop)
+    win = lab[r0:r1, c0:c1]
+    sub = ((win == a) | (win == b)).astype(np.int32)
     sub_lab, n = ndimage.label(sub)
     if n != 1:
         return None
@@ -453,7 +497,44 @@ def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
                f"(needs ≥ {MIN_MATCHES} and ≥ {100 * MIN_SHARE:.0f} %), the best different "
                f"one {runner} (needs a lead of ×{MIN_LEAD:g})")
         return BuildingMatch(None, [], [], fi, fr, counts, why)
+    T = _refine(T, fi, shapes, [o.ring for o in ref_objs] + [h.ring for h in halves], base_tol)
     return _verified(T, fi, fr, sites, site_of, counts, base_tol)
+
+
+def _refine(T: Array, fi: Sequence[ObjectFeatures], shapes: _Shapes,
+            rings: Sequence[Array], base_tol: float) -> Array:
+    """Refit the consensus on candidates that cover a footprint or a roof half under ``T``
+    (overlap ≥ 0.5, best per shape, one shape per candidate): the growth pairs site and
+    shape centroids by distance only, so a half taken for a whole roof (or one candidate of a
+    cluster for another) leaves the consensus a few pixels off."""
+    ci = np.array([f.centroid for f in fi])
+    stree = cKDTree(shapes.centroid)
+    k = min(3, len(shapes.centroid))
+    for _ in range(REFINE_ROUNDS):
+        d, j = stree.query(apply(T, ci), k)
+        scored = []
+        for i, m in zip(*np.nonzero(d <= base_tol)):
+            shape = int(j[i, m])
+            ov = overlap(apply(T, fi[i].obj.ring), rings[shape])
+            if ov >= 0.5:
+                scored.append((ov, int(i), shape))
+        scored.sort(reverse=True)
+        used_i, used_s, src, dst = set(), set(), [], []
+        for _, i, shape in scored:
+            if i in used_i or shape in used_s:
+                continue
+            used_i.add(i)
+            used_s.add(shape)
+            src.append(ci[i])
+            dst.append(shapes.centroid[shape])
+        T2 = _robust_affine(np.array(src), np.array(dst)) if len(src) >= 6 else None
+        if T2 is None:
+            break
+        moved = float(np.max(np.abs(apply(T2, ci) - apply(T, ci))))
+        T = T2
+        if moved < 0.01 * base_tol:
+            break
+    return T
 
 
 def _verified(T: Array, fi: Sequence[ObjectFeatures], fr: Sequence[ObjectFeatures],
@@ -463,9 +544,25 @@ def _verified(T: Array, fi: Sequence[ObjectFeatures], fr: Sequence[ObjectFeature
     (overlap, one partner each) picks the candidate shape of each footprint (for the review's
     overlay and the per-pair figures)."""
     cr = np.array([f.centroid for f in fr])
-    d, j = cKDTree(cr).query(apply(T, np.array([f.centroid for f in fi])))
-    hyps = [Hypothesis(i=i, j=int(j[i]), transform=T, q=1.0, w=1.0, d=0.0)
-            for i in range(len(fi)) if d[i] <= base_tol]
-    ver = verify(hyps, fi, fr, T, min_overlap=0.5, reestimate=False)
+    ci = np.array([f.centroid for f in fi])
+    rtree = cKDTree(cr)
+    ver = None
+    for _ in range(REFINE_ROUNDS):
+        d, j = rtree.query(apply(T, ci))
+        hyps = [Hypothesis(i=i, j=int(j[i]), transform=T, q=1.0, w=1.0, d=0.0)
+                for i in range(len(fi)) if d[i] <= base_tol]
+        v = verify(hyps, fi, fr, T, min_overlap=VERIFY_OVERLAP, reestimate=False)
+        if ver is not None and len(v.pairs) <= len(ver.pairs):
+            break
+        ver = v
+        # the consensus is fitted to roof-half and footprint centroids (a few px off); the
+        # verified whole roofs give a better affine for the next round
+        T2 = _robust_affine(ci[[h.i for h in v.pairs]], cr[[h.j for h in v.pairs]]) \
+            if len(v.pairs) >= 6 else None
+        if T2 is None:
+            break
+        T = T2
+    assert ver is not None
     counts.update(verified_pairs=len(ver.pairs))
+    T = ver.transform
     return BuildingMatch(T, ver.pairs, ver.overlaps, list(fi), list(fr), counts)

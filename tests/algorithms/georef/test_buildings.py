@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from shapely.geometry import Polygon
 
 from photodem.algorithms.errors import GeometryError, InputError
 from photodem.algorithms.georef.buildings import is_buildings, roof_candidates
+from photodem.algorithms.georef.correspondence import apply
 from photodem.algorithms.georef.fit import corner_error
 from photodem.algorithms.georef.pipeline import georeference
 from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
@@ -33,18 +35,39 @@ def test_auto_detection(tmp_path):
     assert not is_buildings(ref)
 
 
+def _found(cands, ref, truth, width: int, height: int):
+    """Footprints inside the image with a whole-roof candidate (IoU > 0.6) and with a
+    roof-half candidate (30–70 % of the footprint, centroid inside): (inside, whole, half)."""
+    Ti = np.linalg.inv(truth)
+    polys = [Polygon(c.ring).buffer(0) for c in cands]
+    boxes = np.array([c.bounds for c in polys])  # (minx, miny, maxx, maxy)
+    inside = whole = half = 0
+    for o in ref:
+        p = Polygon(apply(Ti, o.ring))
+        if not (0 < p.centroid.x < width - 1 and 0 < p.centroid.y < height - 1):
+            continue
+        inside += 1
+        x0, y0, x1, y1 = p.bounds  # shapely 1.8 and 2: no STRtree (its query differs)
+        near = [polys[k] for k in np.nonzero((boxes[:, 0] <= x1) & (boxes[:, 2] >= x0)
+                                             & (boxes[:, 1] <= y1) & (boxes[:, 3] >= y0))[0]]
+        whole += any(p.intersection(c).area / p.union(c).area > 0.6 for c in near)
+        half += any(0.3 < c.area / p.area < 0.7 and p.contains(c.centroid) for c in near)
+    return inside, whole, half
+
+
 def test_candidates_find_the_roofs(tmp_path):
-    case = suburban_case(tmp_path, seed=4, width=500, height=500)
+    """Seed 2 (8-bit), 500 × 500 px, no relief displacement. Measured: 71 footprints inside,
+    20 with a whole-roof candidate, 47 with a half, 535 candidates (at 900 × 900 px the former
+    flat-zone candidates found 5 and 30 of 73, the segments 21 and 46)."""
+    case = suburban_case(tmp_path, seed=2, width=500, height=500, relief_px=0.0)
     grey, _ = load_image(case["image"])
     cands, info = roof_candidates(grey)
-    assert len(info["runs"]) == 3 and any(r["merged"] for r in info["runs"])
+    assert len(info["runs"]) == 2 and any(r["merged"] for r in info["runs"])
     ref, _, _ = reference_objects_from_vector(case["reference"])
-    Ti = np.linalg.inv(case["truth"])
-    cent = np.array([(Ti @ np.r_[o.ring.mean(axis=0), 1.0])[:2] for o in ref])
-    inside = (cent >= 0).all(axis=1) & (cent <= 499).all(axis=1)
-    cc = np.array([c.ring.mean(axis=0) for c in cands])
-    near = [np.min(np.hypot(*(cc - p).T)) < 6 for p in cent[inside]]
-    assert np.mean(near) >= 0.5  # measured: 0.59 (seed 4)
+    inside, whole, half = _found(cands, ref, case["truth"], 500, 500)
+    assert inside >= 50
+    assert whole >= 0.2 * inside and half >= 0.5 * inside
+    assert len(cands) <= 15 * inside  # clutter stays bounded
 
 
 def test_bad_objects_option(tmp_path):
@@ -58,12 +81,10 @@ def test_bad_objects_option(tmp_path):
 def test_recovers_corners(tmp_path, seed, bits):
     """Rotation (any angle), mirroring (seed 1) and 12-bit data in uint16, 900 × 900 px.
 
-    Goal of issue 23: 1 px. Measured: 2.26 px (seed 0), 1.90 px (seed 1) — the tolerance
-    here is what the mode reaches today (see the bench), not the goal. The acceptance gate
-    refuses seed 0 (control points over 13 % of the image, halves of them 2.2 px apart at the
-    corners) and passes seed 1 (1.9 px: the roofs' relief displacement is a scale about the
-    centre that the image evidence cannot see), so the placement is checked with
-    ``unverified``."""
+    Goal of issue 23: 1 px. Measured: 1.27 px (seed 0), 2.20 px (seed 1) — the tolerance
+    here is what the mode reaches with the roofs' relief displacement (a scale about the
+    centre that a fit to roofs cannot see; relief 0: 0.25 / 0.23 px), not the goal; the
+    placement is checked with ``unverified``."""
     case = suburban_case(tmp_path, seed=seed, bits=bits)
     assert case["mirrored"] == (seed == 1)
     res = georeference(case["image"], case["reference"], objects="buildings", unverified=True)
@@ -71,6 +92,17 @@ def test_recovers_corners(tmp_path, seed, bits):
     assert len(res.pairs) >= 3 and res.img_features and res.ref_features
     err = _corners(res, case)
     assert err <= CORNER_PX
+
+
+@pytest.mark.slow
+def test_relief0_within_1px(tmp_path):
+    """Roofs exactly over their footprints (no relief displacement): the candidates and the
+    consensus alone place the image within 1 px at the corners, verified. Measured: seed 0
+    (8-bit, 900 × 900 px) 0.10 px."""
+    case = suburban_case(tmp_path, seed=0, relief_px=0.0)
+    res = georeference(case["image"], case["reference"], objects="buildings")
+    assert res.stage == "buildings" and res.verified
+    assert _corners(res, case) <= 1.0
 
 
 @pytest.mark.slow
