@@ -482,13 +482,8 @@ def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple
     back = np.linalg.inv(rc.correction)
     gcps = [replace(g, image=tuple(float(v) for v in apply(back, np.array([g.image]))[0]))
             for g in gcps]
-    img_xy = np.array([g.image for g in gcps])
-    map_xy = np.array([g.map for g in gcps])
-    fit = fit_transform(img_xy, map_xy, run.options.transform)
-    inverse_fit = inverse_for_resampling(fit, img_xy[fit.used], map_xy[fit.used])
-    counts["gcps"] = int(fit.used.sum())
     h, w = run.grey.shape
-    return (fit, inverse_fit, gcps, img_xy[fit.used]), {
+    return _fit_gcps(gcps, run.options.transform, counts), {
         "relief_scale": float(rc.correction[0, 0]),
         "relief_centre": [(w - 1) / 2.0, (h - 1) / 2.0]}
 
@@ -606,9 +601,16 @@ def _outline_fit(refined: List[tuple], px: float, opts: GeorefOptions,
     if len(gcps) < {"affine": 3, "projective": 4, "poly2": 6}[opts.transform] + 2:
         _fail(counts, f"only {len(gcps)} control points within σ_NP = "
                       f"{opts.sigma_np_px:g} px")
+    return _fit_gcps(gcps, opts.transform, counts)
+
+
+def _fit_gcps(gcps: List[Any], transform: str, counts: Dict[str, Any]) -> tuple:
+    """The final fit of the control points (``counts`` gets ``gcps`` and ``gcps_sharp``).
+    Returns the fit, its inverse, the control points and the image coordinates of the ones
+    used."""
     img_xy = np.array([g.image for g in gcps])
     map_xy = np.array([g.map for g in gcps])
-    fit = fit_transform(img_xy, map_xy, opts.transform)
+    fit = fit_transform(img_xy, map_xy, transform)
     inverse_fit = inverse_for_resampling(fit, img_xy[fit.used], map_xy[fit.used])
     counts["gcps"] = int(fit.used.sum())
     counts["gcps_sharp"] = int(sum(g.sharp for g, u in zip(gcps, fit.used) if u))
