@@ -200,9 +200,9 @@ def test_a_ring_of_holes_round_the_building_is_filled_with_the_ground(scene, tmp
 
 def test_an_ortho_on_a_coarser_dsm_with_sharp_walls_matches_the_truth(scene, tmp_path) -> None:
     # the true DSM at twice the cell (0.4 m, walls kept sharp: every other cell, no
-    # averaging), as a matcher's DSM at the DSM spacing of fbm_lsm; measured F1 0.91, precision 0.91, recall
-    # 0.91 (the ortho's cells beyond the coarse grid's outermost cell centres have no height
-    # and are not occluded in the truth either)
+    # averaging), as a matcher's DSM at the DSM spacing of fbm_lsm; measured F1 0.91,
+    # precision 0.91, recall 0.91 (the ortho's cells beyond the coarse grid's outermost cell
+    # centres have no height and are not occluded in the truth either)
     grid = scene["grid"]
     with rasterio.open(scene["root"] / "dsm.tif") as src:
         dsm = src.read(1)
