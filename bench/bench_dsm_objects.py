@@ -151,7 +151,8 @@ def _row(block: Dict[str, Any], model: str, method: str, dsm: str, seconds: floa
         a = _ortho_f1(block, model, dsm, out, area)
         row.update(ortho_f1=a["f1"], ortho_occluded_pct=a["ortho_occluded_pct"],
                    truth_occluded_pct=a["truth_occluded_pct"],
-                   ortho_no_height_pct=a["no_height_pct"])
+                   ortho_no_height_pct=a["no_height_pct"],
+                   ortho_f1_with_height=a["f1_with_height"])
     row["goals"] = _goals(method, row)
     row["pass"] = "–" if row["goals"] == "–" else ("pass" if "✗" not in row["goals"]
                                                     else "fail")
@@ -220,7 +221,8 @@ def run() -> dict:
               "ortho_f1 (small block): the model's two images as true orthos on the DSM, "
               "occlusion mask against the truth visibility from the true DSM, pooled over "
               "every cell of the model's measuring area whose true point lies in the image; a "
-              "cell without a DSM height counts as not occluded (ortho_no_height_pct of them)",
+              "cell without a DSM height counts as not occluded (ortho_no_height_pct of them; "
+              "ortho_f1_with_height leaves out the hidden ones among them)",
               "the terrain goals are the issue's figures on seed 1 of the aerial block "
               "(bench_dsm_accuracy); on held-out seed 11 they are a guide, not a like-for-like "
               "comparison"]

@@ -25,7 +25,10 @@ Which cells are judged: with the image's camera and orientation, every cell whos
 surface point projects into the image — a cell the ortho left at 0 because its DSM had no
 height there then counts as *not occluded* in the ortho (``no_height`` counts them), so a DSM
 with holes where the occlusions are cannot look good. Without them, the cells the ortho marked
-1 or 2 (holes of the DSM cannot be told from cells outside the image). The raster is processed
+1 or 2 (holes of the DSM cannot be told from cells outside the image). ``f1_with_height`` is
+F1 without the truly occluded cells the ortho had no height for (``no_height_occluded``): it
+tells the DSM's coverage (holes the ortho could not fill) from its shape (walls, crowns); the
+headline figure stays ``f1``. The raster is processed
 in windows of ``window_size`` cells (plus a ring of one cell for the opening); the truth DSM is
 read per window with the march margin, never whole.
 """
@@ -56,7 +59,7 @@ from .rectify import (
 )
 
 PathLike = Union[str, Path]
-COUNT_KEYS = ("cells", "tp", "fp", "fn", "tn", "no_height")
+COUNT_KEYS = ("cells", "tp", "fp", "fn", "tn", "no_height", "no_height_occluded")
 
 
 def ortho_centre(ortho: PathLike) -> NDArray[np.float64]:
@@ -112,20 +115,23 @@ def _window_counts(vis: NDArray[np.uint8], truth_occ: NDArray[np.bool_],
     o, t = (vis == 2) & judged, truth_occ & judged
     return {"cells": int(judged.sum()), "tp": int((o & t).sum()), "fp": int((o & ~t).sum()),
             "fn": int((~o & t).sum()), "tn": int((judged & ~o & ~t).sum()),
-            "no_height": int((judged & (vis == 0)).sum())}
+            "no_height": int((judged & (vis == 0)).sum()),
+            "no_height_occluded": int((t & (vis == 0)).sum())}
 
 
 def agreement_from_counts(counts: Dict[str, int]) -> Dict[str, Any]:
-    """Precision, recall, F1 and the occluded shares (%) from summed counts (None where a
-    ratio has no cells)."""
+    """Precision, recall, F1 (also over the cells with a height, ``f1_with_height``) and the
+    occluded shares (%) from summed counts (None where a ratio has no cells)."""
     counts = {k: int(counts.get(k, 0)) for k in COUNT_KEYS}
     tp, fp, fn, n = (counts[k] for k in ("tp", "fp", "fn", "cells"))
+    fn_height = fn - counts["no_height_occluded"]
 
     def ratio(a: int, b: int) -> Optional[float]:
         return a / b if b else None
 
     return {**counts, "precision": ratio(tp, tp + fp),
             "recall": ratio(tp, tp + fn), "f1": ratio(2 * tp, 2 * tp + fp + fn),
+            "f1_with_height": ratio(2 * tp, 2 * tp + fp + fn_height),
             "ortho_occluded_pct": 100.0 * ratio(tp + fp, n) if n else None,
             "truth_occluded_pct": 100.0 * ratio(tp + fn, n) if n else None,
             "no_height_pct": 100.0 * ratio(counts["no_height"], n) if n else None}
@@ -171,9 +177,10 @@ def occlusion_agreement(visibility: PathLike, truth_dsm: PathLike, *,
     Returns
     -------
     dict
-        ``cells`` (judged), ``tp``, ``fp``, ``fn``, ``tn``, ``no_height``, ``precision``,
-        ``recall``, ``f1``, ``ortho_occluded_pct``, ``truth_occluded_pct``, ``no_height_pct``
-        (see the module notes), ``image``.
+        ``cells`` (judged), ``tp``, ``fp``, ``fn``, ``tn``, ``no_height``,
+        ``no_height_occluded``, ``precision``, ``recall``, ``f1``, ``f1_with_height``,
+        ``ortho_occluded_pct``, ``truth_occluded_pct``, ``no_height_pct`` (see the module
+        notes), ``image``.
     """
     fb = ensure_feedback(feedback)
     visibility = Path(visibility)

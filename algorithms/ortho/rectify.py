@@ -85,8 +85,9 @@ RESAMPLING = ("nearest", "bilinear", "cubic")
 OUTSIDE, VISIBLE, OCCLUDED = 0, 1, 2
 #: cells of one output raster at most (a typo in the GSD must not fill the disk)
 MAX_CELLS = 2_000_000_000
-#: A true ortho fills the DSM's holes up to this size (m, across) from below: the ground behind
-#: walls that the matcher could not see gets a height, and the occlusion test finds it hidden.
+#: A true ortho fills the DSM's holes from below, each hole cell from valid cells up to this
+#: far (m) along its row and column: the ground behind walls that the matcher could not see
+#: gets a height, and the occlusion test finds it hidden.
 TRUE_ORTHO_FILL_M = 20.0
 
 
@@ -757,9 +758,9 @@ def _rectify_tile(interpolation: int, source: _ImageSource, camera: Camera,
 def _tile_heights(dem_ds: Any, bounds: Extent, xe: Array, ye: Array, true_ortho: bool
                   ) -> Array:
     """Heights of the cell centres ``xe`` × ``ye`` (bilinear on the DEM). In a true ortho the
-    DSM's holes up to :data:`TRUE_ORTHO_FILL_M` across are filled from below first
-    (:func:`.visibility.fill_from_below`), from a window that reaches that far beyond the tile,
-    so that every tiling gives the same heights."""
+    DSM's holes are filled from below first (:func:`.visibility.fill_from_below`, looking up to
+    :data:`TRUE_ORTHO_FILL_M` along rows and columns), from a window that reaches that far
+    beyond the tile, so that every tiling gives the same heights."""
     size = 0
     if true_ortho:
         res = min(abs(dem_ds.transform.a), abs(dem_ds.transform.e))

@@ -42,7 +42,6 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from affine import Affine
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 from scipy.ndimage import maximum_filter
 
 from ..raster.sample import bilinear_grid
@@ -81,25 +80,52 @@ def _max_filters(dsm: Array, levels: Sequence[int]) -> Tuple[Tuple[int, Array], 
     return tuple(out)
 
 
-def fill_from_below(dsm: ArrayLike, max_size: int, quantile: float = 10.0) -> Array:
-    """Fill the holes of a matched DSM with a low height of their border.
+def _nearest_valid(z: Array, valid: NDArray[np.bool_], axis: int, reverse: bool,
+                   max_size: int) -> Tuple[Array, NDArray[np.bool_]]:
+    """Height of the nearest valid cell in one direction along ``axis`` (towards higher
+    indices with ``reverse``, else towards lower ones) at most ``max_size`` cells away, and
+    where there is one.
+
+    A running maximum of the valid cells' indices finds them for all cells in one pass.
+    """
+    n = valid.shape[axis]
+    shape = [1, 1]
+    shape[axis] = n
+    idx = np.arange(n).reshape(shape)
+    if reverse:  # scan the flipped array and map its indices back
+        last = np.flip(np.maximum.accumulate(np.flip(np.where(valid, n - 1 - idx, -1), axis),
+                                             axis=axis), axis)
+        near = np.where(last >= 0, n - 1 - last, -1)
+    else:
+        near = np.maximum.accumulate(np.where(valid, idx, -1), axis=axis)
+    found = (near >= 0) & (np.abs(idx - near) <= max_size)
+    near = np.where(found, near, 0)
+    heights = np.take_along_axis(z, near, axis=axis)
+    return heights, found
+
+
+def fill_from_below(dsm: ArrayLike, max_size: int) -> Array:
+    """Fill the holes of a matched DSM from their low side.
 
     A matcher leaves the ground behind a wall empty: one camera cannot see it. For a true
-    ortho that ground still needs a height, so that the occlusion test can find it hidden. A
-    hole that touches a wall is bordered by the roof on one side and by the ground on the
-    others; the ``quantile`` % of its border heights is the ground's (a hole inside a roof gets
-    the roof's height). Each hole is filled with one height.
+    ortho that ground still needs a height, so that the occlusion test can find it hidden.
+    Such holes often run round a building as a ring (the occlusions of both images and the
+    eroded wall edges), so they are judged locally, not as a whole: every hole cell looks for
+    the nearest valid cell in the four axis directions (up to ``max_size`` cells away) and
+    takes the lowest of those it finds — the ground beyond the hole, not the roof on its
+    other side; a hole inside a roof finds the roof all round and keeps its height. A cell is
+    filled only when it is enclosed (a valid cell found on both sides along one axis), so the
+    DSM is never extended beyond its outer border.
 
     Parameters
     ----------
     dsm : array_like, shape (rows, cols)
         Heights, NaN = hole.
     max_size : int
-        Holes whose bounding box is larger than this (cells) in either direction, and holes
-        that touch the array's edge, stay empty: a window that reaches ``max_size`` cells
-        beyond the cells of interest then fills them the same whatever the window.
-    quantile : float
-        Percentile of the border heights (a few low outliers of the border do not count).
+        Farthest a hole cell looks for valid cells (cells). The result at a cell depends only
+        on the cells within ``max_size`` along its row and column, so a window that reaches
+        ``max_size`` cells beyond the cells of interest fills them the same whatever the
+        window.
 
     Returns
     -------
@@ -110,26 +136,17 @@ def fill_from_below(dsm: ArrayLike, max_size: int, quantile: float = 10.0) -> Ar
     hole = ~np.isfinite(z)
     if not hole.any() or hole.all() or max_size < 1:
         return z
-    labels, n = ndimage.label(hole)
-    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
-    keep = np.ones(n + 1, dtype=bool)
-    keep[0] = False
-    keep[edge] = False
-    for k, sl in enumerate(ndimage.find_objects(labels), start=1):
-        if sl is not None and max(sl[0].stop - sl[0].start, sl[1].stop - sl[1].start) > max_size:
-            keep[k] = False
-    if not keep.any():
-        return z
-    # the border cells of each hole (a cell between two holes goes to the higher label)
-    grown = ndimage.grey_dilation(np.where(keep[labels], labels, 0), size=3)
-    border = np.isfinite(z) & (grown > 0)
-    ids = np.flatnonzero(keep)
-    low = ndimage.labeled_comprehension(
-        z[border], grown[border], ids, lambda v: np.percentile(v, quantile), float, np.nan)
-    height = np.full(n + 1, np.nan)
-    height[ids] = low
-    fill = hole & keep[labels]
-    z[fill] = height[labels[fill]]
+    valid = ~hole
+    low = np.full(z.shape, np.inf)
+    found = []
+    for axis in (0, 1):
+        for reverse in (False, True):
+            heights, ok = _nearest_valid(z, valid, axis, reverse, max_size)
+            low = np.where(ok, np.minimum(low, heights), low)
+            found.append(ok)
+    # enclosed: valid cells on both sides along a column or a row
+    fill = hole & ((found[0] & found[1]) | (found[2] & found[3]))
+    z[fill] = low[fill]
     return z
 
 
@@ -233,4 +250,4 @@ def occluded(
     return result.reshape(shape)
 
 
-__all__ = ["march_margin", "occluded"]
+__all__ = ["fill_from_below", "march_margin", "occluded"]

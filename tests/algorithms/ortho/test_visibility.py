@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from affine import Affine
 
-from photodem.algorithms.ortho.visibility import march_margin, occluded
+from photodem.algorithms.ortho.visibility import fill_from_below, march_margin, occluded
 
 CELL = 0.1
 X0, Y1 = 1000.0, 2000.0
@@ -99,3 +99,52 @@ def test_rotated_window_is_rejected() -> None:
     with pytest.raises(ValueError):
         occluded([0.0], [0.0], [0.0], [0.0, 0.0, 10.0], np.zeros((3, 3)),
                  Affine(1.0, 0.1, 0.0, 0.1, -1.0, 0.0))
+
+
+def _ringed(ring: int = 30, hole_in_roof: bool = True) -> np.ndarray:
+    """The block of :func:`_scene` on a ground sloping 1 % to the east, with a ring of
+    ``ring`` cells of holes round it (what a matcher leaves: the occlusions of both images)
+    and a small hole inside the roof."""
+    _, gx, _, inside, dsm = _scene()
+    dsm = dsm + 0.01 * (gx - X0)
+    grown = np.zeros_like(inside)
+    r, c = np.nonzero(inside)
+    grown[r.min() - ring:r.max() + ring + 1, c.min() - ring:c.max() + ring + 1] = True
+    out = np.where(grown & ~inside, np.nan, dsm)
+    if hole_in_roof:
+        out[r.min() + 40:r.min() + 50, c.min() + 40:c.min() + 50] = np.nan
+    return out
+
+
+def test_fill_from_below_gives_a_ring_of_holes_the_ground_and_a_roof_hole_the_roof() -> None:
+    _, gx, _, inside, dsm = _scene()
+    ground = GROUND + 0.01 * (gx - X0)
+    holed = _ringed()
+    filled = fill_from_below(holed, 200)
+    ring = ~np.isfinite(holed) & ~inside
+    # the ring (a hole 3 m wide whose bounding box is 16 m × 18 m) takes the ground, never
+    # the roof on its other side: the lowest ground along its row or column, so at most the
+    # slope across the ring's 16 m below the ground under it
+    assert np.isfinite(filled[ring]).all()
+    dz = filled[ring] - ground[ring]
+    assert dz.max() < 1e-9 and dz.min() > -0.01 * 16.0 - 1e-9
+    # the hole inside the roof keeps the roof's height
+    roof_hole = ~np.isfinite(holed) & inside
+    roof = dsm + 0.01 * (gx - X0)
+    assert roof_hole.any() and np.abs(filled[roof_hole] - roof[roof_hole]).max() < 0.011
+    # valid cells are unchanged
+    ok = np.isfinite(holed)
+    assert np.array_equal(filled[ok], holed[ok])
+
+
+def test_fill_from_below_is_local_and_never_extends_the_border() -> None:
+    holed = _ringed()
+    holed[:, :50] = np.nan  # the DSM ends 5 m into the window
+    full = fill_from_below(holed, 40)
+    assert np.isnan(full[:, :50]).all()  # beyond the outer border: no valid cell on one side
+    # a window reaching max_size cells beyond the cells of interest fills them the same
+    r0, r1, c0, c1 = 250, 350, 150, 250
+    part = fill_from_below(holed[r0 - 40:r1 + 40, c0 - 40:c1 + 40], 40)
+    assert np.array_equal(part[40:-40, 40:-40], full[r0:r1, c0:c1], equal_nan=True)
+    # holes farther than max_size from valid cells on every side stay empty
+    assert np.isnan(fill_from_below(_ringed(ring=30), 10)[~np.isfinite(_ringed())]).any()
