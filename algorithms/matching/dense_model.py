@@ -65,8 +65,12 @@ PathLike = Union[str, Path]
 #: such holes get no roof fill: SGM spreads roofs over those walls (synthetic ``aerial`` block,
 #: wide angle, base 4 px per metre of height: open cells within 0.5 m of an object > 1 m off
 #: 42 % → 8 %; the ``small`` block's walls stay narrower and keep the rules above).
+#: Holes of planar object segments of the left image are filled from the planes of SGM's
+#: winners before the consistency filters (``segments``, :func:`.dense_fill.segment_fill`):
+#: aerial block object interior within 0.5 m +3.5 / +8.2 points on seeds 1 / 2 (issue 19,
+#: part A in docs/decisions.md).
 _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0, "segment_px": 300,
-                                   "edge_reach": 15, "wall_px": 20.0}
+                                   "edge_reach": 15, "wall_px": 20.0, "segments": True}
 #: The rule against roofs spilling over walls one camera sees (``wall_view``, part D4 in
 #: docs/decisions.md) is off: on the aerial block it removes the spill (open cells with no
 #: margin: RMS 0.54 → 0.12 m) but also half of the roofs (object interior 44 → 27 % on seed 1,
