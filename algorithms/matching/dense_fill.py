@@ -65,12 +65,16 @@ _RING = np.ones((3, 3), bool)
 WALL_SPREAD = 0.33
 #: Segment fill: graph-segmentation scale and smallest segment (px) of the left image, least
 #: share of a segment's pixels with a disparity and of those on its plane (±1 px), and the
-#: half window (px) of its ground test.
+#: half window (px) of its ground test (a rise of ``SEGMENT_RISE`` steps: sloped ground
+#: rises by one step over that window already); no pixel is filled within ``SEGMENT_EDGE`` px of a
+#: valid disparity lower by the step (the roof would spill over walls and occlusions).
 SEGMENT_SCALE = 100.0
 SEGMENT_MIN_PX = 50
 SEGMENT_MIN_VALID = 0.3
 SEGMENT_INLIERS = 0.7
-SEGMENT_REACH = 80
+SEGMENT_REACH = 50
+SEGMENT_RISE = 2.0
+SEGMENT_EDGE = 10
 WALL_ROW = 64
 
 
@@ -423,6 +427,21 @@ def _robust_planes(labels: Array, disp: Array, valid: Array, n: int) -> Tuple[Ar
     return planes, inl
 
 
+def _enclosed(labels: Array, inliers: Array) -> Array:
+    """Pixels whose nearest inlier to the left and to the right along the row (epipolar
+    line) lie in their own segment: a segment's plane is not carried past its last support
+    into an occlusion."""
+    h, w = labels.shape
+    cols = np.arange(w)[None, :]
+    rows = np.arange(h)[:, None]
+    left = np.maximum.accumulate(np.where(inliers, cols, -1), axis=1)
+    right = np.flip(np.minimum.accumulate(np.flip(np.where(inliers, cols, w), axis=1), axis=1),
+                    axis=1)
+    ok_l = (left >= 0) & (labels[rows, np.clip(left, 0, w - 1)] == labels)
+    ok_r = (right < w) & (labels[rows, np.clip(right, 0, w - 1)] == labels)
+    return ok_l & ok_r
+
+
 def segment_fill(disp: Array, masked: Array, grey: Array, jump: float,
                  candidates: Optional[Array] = None, min_valid: Optional[float] = None,
                  min_inliers: Optional[float] = None, reach: Optional[int] = None,
@@ -479,12 +498,16 @@ def segment_fill(disp: Array, masked: Array, grey: Array, jump: float,
     # an object segment: its plane stands above the lowest disparity around it
     ground = ndimage.minimum_filter(np.where(valid, disp, np.inf), size=2 * int(reach) + 1)
     with np.errstate(invalid="ignore"):
-        high = np.isfinite(ground) & (plane - ground > jump)
+        high = np.isfinite(ground) & (plane - ground > SEGMENT_RISE * jump)
     nhigh = np.bincount(labels.ravel(), weights=high.ravel().astype(float), minlength=n + 1)
     good = ((nval >= min_valid * size) & (ninl >= min_inliers * np.maximum(nval, 1.0))
             & (nval >= 20) & (nhigh >= 0.5 * size) & np.isfinite(planes).all(axis=1))
     good[0] = False
-    todo = ~valid & ~masked & good[labels] & high  # never the ground part of a segment
+    # never the ground part of a segment, nor next to lower ground (walls, occlusions)
+    todo = ~valid & ~masked & good[labels] & high & _enclosed(labels, inl)
+    near = ndimage.minimum_filter(np.where(valid, disp, np.inf), size=2 * SEGMENT_EDGE + 1)
+    with np.errstate(invalid="ignore"):
+        todo &= ~(plane - near > jump)
     out[todo] = plane[todo]
     return out
 
