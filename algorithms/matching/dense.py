@@ -250,6 +250,7 @@ class _TileMatcher:
     wall_view: Optional[Tuple[float, float]] = None
     wall_px: float = 20.0
     segments: bool = False
+    wall_erosion: bool = True
 
     def _matcher(self, lo: int, n_d: int) -> Any:
         """SGBM for ``n_d`` disparities from ``lo``.
@@ -289,7 +290,7 @@ class _TileMatcher:
                             int(self.edge_erosion), float(self.range_guard),
                             float(self.edge_jump), float(self.plane_fill),
                             int(self.segment_px), int(self.edge_reach), walls, float(self.wall_px),
-                            bool(self.segments))
+                            bool(self.segments), bool(self.wall_erosion))
         return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
 
 
@@ -407,6 +408,7 @@ def iter_disparity_tiles(
     wall_view: Optional[Tuple[float, float]] = None,
     wall_px: float = 20.0,
     segments: bool = False,
+    wall_erosion: bool = True,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -463,6 +465,9 @@ def iter_disparity_tiles(
         With ``edge_jump``: fill the holes of object segments of the left image (tone
         segments standing above their ground) from each segment's robust plane
         (:func:`.dense_fill.segment_fill`; method "sgm").
+    wall_erosion : bool
+        With ``wall_view``: the erosion follows the wall rule too (roof edges near such holes
+        eroded); False = only the plane fill does (no roof in those holes).
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size, margin : int
@@ -486,7 +491,8 @@ def iter_disparity_tiles(
     match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
                          lr_max_diff, normalise_window, speckle_window, speckle_range,
                          fill_max_width, edge_erosion, range_guard, edge_jump, plane_fill,
-                         segment_px, edge_reach, wall_view, wall_px, segments)
+                         segment_px, edge_reach, wall_view, wall_px, segments,
+                         wall_erosion)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
@@ -587,10 +593,11 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
                  edge_erosion: int = 0, range_guard: float = 0.0, edge_jump: float = 0.0,
                  plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0,
                  wall_share: Optional[Array] = None, wall_px: float = 20.0,
-                 segments: bool = False) -> Array:
+                 segments: bool = False, wall_erosion: bool = True) -> Array:
     """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape);
     ``wall_share`` (per frame column), ``wall_px`` as :func:`.dense_fill.erode_lower_side`;
-    ``segments``: :func:`.dense_fill.segment_fill` after the plane fill."""
+    ``segments``: :func:`.dense_fill.segment_fill` after the plane fill; ``wall_erosion``:
+    the erosion takes ``wall_share`` too (else only the plane fill)."""
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
     if ours and normalise_window > 1:
@@ -639,7 +646,7 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
         # only the occluded (lower) side of a step, so that roof edges stay
         small = _small_segments(cv2, disp, segment_px, 1.0) if segment_px > 0 else None
         disp = erode_lower_side(disp, lmask, int(edge_erosion), edge_jump, small, edge_reach,
-                                wall_share, wall_px)
+                                wall_share if wall_erosion else None, wall_px)
     elif ours and edge_erosion > 0:
         # the frame outside the image is masked (NaN), so image borders are eroded too
         ok = (np.isfinite(disp) & ~lmask).astype(np.uint8)

@@ -221,7 +221,9 @@ def _occluded(hole: Array, disp: Array, split: float, window: int = 0,
     the whole run where the left camera sees a wall wider than ``wall = (share, px)`` (share
     per column × the step > px: the roof's border already lies on the wall there). Where
     that holds, a row run with an upper left and a lower right border (no occlusion in the
-    left image: SGM's fattening of the roof, eroded) is not roof either."""
+    left image: SGM's fattening of the roof, eroded) is not roof either, nor a run with an
+    unknown border (the frame's edge or a mask: an occlusion whose ground border the tile
+    cut off) where the hole's whole step makes such a wall."""
     h, w = hole.shape
     cols = np.arange(w)[None, :]
     stop = ~hole
@@ -236,6 +238,10 @@ def _occluded(hole: Array, disp: Array, split: float, window: int = 0,
         if wall is not None:
             wide = wall[0] * np.abs(rv - lv) > wall[1]
             occ |= hole & wide & (((lv < split) & (rv > split)) | ((lv > split) & (rv < split)))
+            # a run with a border unknown (the frame's edge, a mask) may be an occlusion cut
+            # off: as wide as the hole's step
+            step = float(np.nanmax(disp) - np.nanmin(disp))
+            occ |= hole & ~(np.isfinite(lv) & np.isfinite(rv)) & (wall[0] * step > wall[1])
         return occ
 
 

@@ -90,18 +90,33 @@ _JUMP_M = 1.5
 #: 22; 9 → 15 px alone: 44.4 %, 31 px: 47.5 %; uniqueness 5, LR 2 px, other P1/P2: ±2 %).
 #: Nadir models keep the defaults.
 _CONVERGENT_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "block_size": 7}
+#: Wide-base models (B/H ≥ :data:`WIDE_BASE`, e.g. the synthetic ``aerial`` block's wide-angle
+#: model, B/H 0.61) see slanted roofs at clearly different scales in the two images: the 9 px
+#: normalisation then compares striped roof textures at different phases and SGM loses the
+#: gabled roofs (aerial seed 1: 6–10 % of two gabled roofs right). A 21 px normalisation keeps
+#: them (object interior 43.9 → 52.1 % on seed 1, 34.9 → 38.7 % on seed 2); the left camera
+#: sees the walls there, so the plane fill takes the wall rule (no roof in those holes) but the
+#: erosion does not (with it the roofs go, part D4; issue 19, part A in docs/decisions.md).
+#: Narrow-base models (the ``small`` block, B/H 0.36) keep the defaults: there the 21 px
+#: window cost 3.6 points of interior on held-out seed 11.
+WIDE_BASE = 0.5
+_WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
 
 
 def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
     """Matching options of the DSM path for one model: :data:`_DENSE_DEFAULTS` and the height
     step of 1.5 m in px of the model's parallax (1 px = GSD·H/B m) as ``edge_jump``; for
-    convergent models :data:`_CONVERGENT_OPTIONS`; with
-    :data:`_WALL_RULE` also the epipolar principal points as ``wall_view`` (where the left
-    camera sees the walls of the objects in its occlusions)."""
+    convergent models :data:`_CONVERGENT_OPTIONS`; for wide-base models (B/H ≥
+    :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; with :data:`_WALL_RULE` or a wide base also
+    the epipolar principal points as ``wall_view`` (where the left camera sees the walls of
+    the objects in its occlusions)."""
     jump = _JUMP_M * setup.pair.base / (float(setup.gsd) * setup.flying_height)
     cx = setup.pair.cx
-    view = (float(cx[0]), float(cx[1])) if _WALL_RULE else None
+    wide = setup.pair.base / setup.flying_height >= WIDE_BASE
+    view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
     options = dict(_DENSE_DEFAULTS, edge_jump=jump, wall_view=view)
+    if wide:
+        options.update(_WIDE_BASE_OPTIONS)
     if setup.convergent:
         options.update(_CONVERGENT_OPTIONS)
     return options
