@@ -657,7 +657,7 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     if ours and plane_fill > 0:
         disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
                                 window=block, wall_share=wall_share,
-                                wall_px=wall_px)
+                                wall_px=wall_px, far_side=wall_erosion)
     if ours and segments and edge_jump > 0:
         disp = segment_fill(disp, lmask, lg, edge_jump, cand)
     if ours and fill_max_width > 0:

@@ -94,9 +94,11 @@ _CONVERGENT_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "block_size": 7}
 #: model, B/H 0.61) see slanted roofs at clearly different scales in the two images: the 9 px
 #: normalisation then compares striped roof textures at different phases and SGM loses the
 #: gabled roofs (aerial seed 1: 6–10 % of two gabled roofs right). A 21 px normalisation keeps
-#: them (object interior 43.9 → 52.1 % on seed 1, 34.9 → 38.7 % on seed 2); the left camera
-#: sees the walls there, so the plane fill takes the wall rule (no roof in those holes) but the
-#: erosion does not (with it the roofs go, part D4; issue 19, part A in docs/decisions.md).
+#: them (object interior 43.9 → 52.3 % on seed 1, 34.9 → 39.3 % on seed 2, held-out seed 11
+#: 44.2 → 50.0 %); the left camera sees the walls there, so the plane fill takes the wall rule
+#: (no roof in occlusions) but the erosion does not (with it the roofs go, part D4): without
+#: the rule roofs filled over such walls put 11 m onto the terrain of seed 1 (0.076 ‰ H).
+#: Issue 19, part A in docs/decisions.md.
 #: Narrow-base models (the ``small`` block, B/H 0.36) keep the defaults: there the 21 px
 #: window cost 3.6 points of interior on held-out seed 11.
 WIDE_BASE = 0.5
