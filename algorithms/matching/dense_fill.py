@@ -1,5 +1,6 @@
-"""Disparity filters of dense matching that keep objects: one-sided edge erosion and
-plane fill of holes within segments bounded by discontinuities (issue 19).
+"""Disparity filters of dense matching that keep objects: one-sided edge erosion,
+plane fill of holes within segments bounded by discontinuities, and the segment fill
+(issue 19).
 
 One-sided edge erosion
 ----------------------
@@ -50,6 +51,19 @@ In the DSM path only the upper (object) part of a mixed hole is filled: holes wi
 and the ground part are left to the gridding's gap interpolation as before, because filling
 them from planes made open terrain worse (synthetic ``aerial`` block, terrain RMS 0.10 against
 0.05 m) while roofs gained nothing from it (``fill_lower`` fills them too).
+
+Segment fill
+------------
+An option (:func:`segment_fill`, ``segments`` of :func:`.dense.iter_disparity_tiles`), off in
+the DSM path. The left image is segmented by tone (graph-based, :func:`grey_segments`); each
+segment gets a robust plane of SGM's winners *before* the left–right check and the speckle
+filter (which weakly textured roofs fail although they lie on the roof's plane); where enough
+of the segment has such a disparity and most of them lie on the plane, the plane fills the
+segment's holes — only where it stands two steps above the lowest disparity around, not next
+to lower ground, and between plane inliers of the same segment along the row (a segment that
+runs from a roof into an occlusion does not carry the roof there). On the synthetic blocks it
+gained little on held-out seeds and spilled roofs onto open land of the tiny block
+(docs/decisions.md, issue 19 part A).
 """
 
 from __future__ import annotations
