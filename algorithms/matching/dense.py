@@ -383,32 +383,23 @@ def _tiles(match: _TileMatcher, search: _SearchRange, shape: Tuple[int, int], si
 
 
 def iter_disparity_tiles(
-    left: GreySource,
-    right: GreySource,
-    left_shape: Tuple[int, int],
-    right_shape: Tuple[int, int],
-    min_disparity: int,
-    max_disparity: int,
+    left: GreySource, right: GreySource,
+    left_shape: Tuple[int, int], right_shape: Tuple[int, int],
+    min_disparity: int, max_disparity: int,
     method: str = "sgm",
     block_size: int = 5,
-    p1: Optional[int] = None,
-    p2: Optional[int] = None,
+    p1: Optional[int] = None, p2: Optional[int] = None,
     uniqueness: int = 10,
     lr_max_diff: float = 1.0,
     normalise_window: int = 9,
-    speckle_window: int = 100,
-    speckle_range: int = 2,
+    speckle_window: int = 100, speckle_range: int = 2,
     fill_max_width: int = 0,
     edge_erosion: int = 0,
     range_guard: float = 0.0,
-    edge_jump: float = 0.0,
-    plane_fill: float = 0.0,
-    segment_px: int = 0,
-    edge_reach: int = 0,
-    wall_view: Optional[Tuple[float, float]] = None,
-    wall_px: float = 20.0,
-    segments: bool = False,
-    wall_erosion: bool = True,
+    edge_jump: float = 0.0, plane_fill: float = 0.0,
+    segment_px: int = 0, edge_reach: int = 0,
+    wall_view: Optional[Tuple[float, float]] = None, wall_px: float = 20.0,
+    segments: bool = False, wall_erosion: bool = True,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -461,13 +452,10 @@ def iter_disparity_tiles(
         Epipolar principal points (columns) of the left and right image: with ``edge_reach``,
         where the left camera sees a wall wider than ``wall_px`` in an occlusion, roof edges
         near holes are eroded and such holes get no roof (:mod:`.dense_fill`).
-    segments : bool
-        With ``edge_jump``: fill the holes of object segments of the left image (tone
-        segments standing above their ground) from each segment's robust plane
-        (:func:`.dense_fill.segment_fill`; method "sgm").
-    wall_erosion : bool
-        With ``wall_view``: the erosion follows the wall rule too (roof edges near such holes
-        eroded); False = only the plane fill does (no roof in those holes).
+    segments, wall_erosion : bool
+        ``segments``: fill the holes of planar object segments of the left image
+        (:func:`.dense_fill.segment_fill`); ``wall_erosion`` False: the wall rule of
+        ``wall_view`` applies to the plane fill only.
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size, margin : int
