@@ -537,6 +537,34 @@ def dense_causes(et: EpiTruth, grey: Dict[str, np.ndarray], disp: Dict[str, np.n
             "by_texture": by_tex}
 
 
+def dense_range(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray]) -> Dict[str, Any]:
+    """The search range: its width, whether the coarse pass narrows it, and the interior
+    pixels whose true disparity lies outside it (or outside its coarse narrowing)."""
+    lo, hi = setup.min_d, setup.max_d
+    inter = et.cls == 1
+    with np.errstate(invalid="ignore"):
+        outside = (et.d < lo) | (et.d > hi)
+    out = {"search_range_px": [int(lo), int(hi)],
+           "coarse_narrowing": bool(dense_mod._num_disparities(lo, hi) > dense_mod.COARSE_ABOVE),
+           "interior_true_d_outside_range_pct": _pct(outside, inter)}
+    if out["coarse_narrowing"]:
+        factor = dense_mod._coarse_factor(dense_mod._num_disparities(lo, hi))
+        src_l, shape_l = dense_mod.array_source(grey["left"])
+        src_r, shape_r = dense_mod.array_source(grey["right"])
+        coarse = dense_mod._coarse_disparity(
+            src_l, src_r, shape_l, shape_r, lo, hi, factor,
+            {"block_size": 5, "margin": 48}, Feedback())
+        # the coarse disparities at the pixel's block, ± the slack of a tile's range
+        cz = np.kron(coarse, np.ones((factor, factor)))[:et.d.shape[0], :et.d.shape[1]]
+        with np.errstate(invalid="ignore"):
+            dz = np.abs(cz - et.d)
+        out["coarse_factor"] = factor
+        out["interior_coarse_valid_pct"] = _pct(np.isfinite(cz), inter)
+        out["interior_coarse_right_2px_pct"] = _pct(dz <= 2.0 * factor, inter)
+        out["open_coarse_right_2px_pct"] = _pct(dz <= 2.0 * factor, et.cls == 3)
+    return out
+
+
 def dense_gridding(setup: Any, truth: Truth, disp: np.ndarray) -> List[Dict[str, Any]]:
     """Median per cell, outlier test and gap limit switched on one after the other."""
     grid, pair = setup.grid, setup.pair
@@ -580,36 +608,48 @@ def _md(rows: List[Dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
-def _products(block: Path, out: Path, truth: Truth, gsd: float) -> List[Dict[str, Any]]:
-    """match_model for terrain, urban and dense; the issue's table rows."""
+def _products(block: Path, out: Path, truth: Truth, gsd: float, model: str = MODEL,
+              heights: Optional[Dict] = None, dense_only: bool = False
+              ) -> List[Dict[str, Any]]:
+    """match_model for terrain, urban (unless ``dense_only``) and dense; the issue's rows."""
     rows = []
-    for name, params in (("fbm_lsm terrain", {"preset": "terrain"}),
-                         ("fbm_lsm urban", {"preset": "urban"}),
-                         ("dense", {"method": "dense"})):
-        r = registry.run("match_model", {"project": str(block), "model": MODEL,
+    methods = (("fbm_lsm terrain", {"preset": "terrain"}),
+               ("fbm_lsm urban", {"preset": "urban"}), ("dense", {"method": "dense"}))
+    for name, params in methods[2:] if dense_only else methods:
+        r = registry.run("match_model", {"project": str(block), "model": model,
                                          "output": str(out / name.replace(" ", "_")),
-                                         **params})
+                                         **(heights or {}), **params})
         rows.append(dsm_row(name, on_truth_grid(Path(r["dsm"]), truth), truth, gsd))
     return rows
 
 
-def diagnose(block: Path, work: Path) -> Dict[str, Any]:
-    """All tables of the diagnosis (see the module text)."""
+def truth_heights(block: Path) -> Dict[str, float]:
+    """The truth DSM's height range widened by 5 m (as the benches match the aerial block)."""
+    z, _, _ = _read(block / "truth" / "dsm.tif")
+    return {"min_height": float(np.nanmin(z)) - 5.0, "max_height": float(np.nanmax(z)) + 5.0}
+
+
+def diagnose(block: Path, work: Path, model: str = MODEL, heights: Optional[Dict] = None,
+             dense_only: bool = False) -> Dict[str, Any]:
+    """All tables of the diagnosis (see the module text); ``heights`` = min/max height of the
+    matching (default the project's); ``dense_only`` skips fbm_lsm."""
     t0 = time.perf_counter()
-    setup = prepare_model(block, MODEL, spacing_gsd=fbm_model.SPACING_GSD)
-    setup_dense = prepare_model(block, MODEL, spacing_gsd=1.0)
+    heights = heights or {}
+    setup = prepare_model(block, model, spacing_gsd=fbm_model.SPACING_GSD, **heights)
+    setup_dense = prepare_model(block, model, spacing_gsd=1.0, **heights)
     truth = load_truth(block, setup)
-    products = _products(block, work, truth, float(setup.gsd))
+    products = _products(block, work, truth, float(setup.gsd), model, heights, dense_only)
     et = epipolar_truth(setup, truth)
     grey, mask, barriers = fbm_model._grey_epipolar(setup, Feedback())
     levels, chains = [], []
-    for preset in ("terrain", "urban"):
+    for preset in () if dense_only else ("terrain", "urban"):
         levels += fbm_levels(setup, et, grey, mask, barriers, preset)
         chains.append(fbm_chain(setup, truth, et, grey, mask, barriers, preset))
     steps, disp = dense_steps(setup_dense, et, grey)
     causes = dense_causes(et, grey, disp, float(setup.gsd))
+    causes.update(dense_range(setup_dense, et, grey))
     gridding = dense_gridding(setup_dense, truth, disp["prod"])
-    return {"block": str(block), "model": MODEL, "gsd_m": float(setup.gsd),
+    return {"block": str(block), "model": model, "gsd_m": float(setup.gsd),
             "flying_height_m": float(setup.flying_height),
             "buildings_in_area": int(truth.heights.size),
             "interior_share_of_area_pct": _pct(truth.interior, truth.area),
@@ -624,7 +664,7 @@ def report(res: Dict[str, Any]) -> str:
     causes = dict(res["dense_causes"])
     by_tex = causes.pop("by_texture")
     by_edge = causes.pop("by_edge_distance")
-    chain = res["fbm_chain"]
+    chain = res["fbm_chain"] or [{"preset": "–"}]
     parts = [f"block {res['block']}, model {res['model']}, GSD {res['gsd_m']:.3f} m, "
              f"H {res['flying_height_m']:.0f} m; {res['buildings_in_area']} buildings inside "
              f"the area; objects {res['objects_share_of_area_pct']:.1f} %, interior "
@@ -644,6 +684,12 @@ def main(argv: List[str]) -> int:
     ap.add_argument("--json", help="write all numbers to this JSON file")
     ap.add_argument("--seed", type=int, default=1, help="seed of a generated block (default 1, "
                                                         "as make demo)")
+    ap.add_argument("--model", default=MODEL, help=f"stereo model (default {MODEL}; the "
+                                                   "aerial block's is 0101_0102)")
+    ap.add_argument("--truth-heights", action="store_true",
+                    help="match over the truth DSM's height range ± 5 m (as the benches do "
+                         "on the aerial block)")
+    ap.add_argument("--dense-only", action="store_true", help="skip fbm_lsm")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="diagnose-objects-") as tmp:
         block = Path(args.block) if args.block else None
@@ -651,7 +697,8 @@ def main(argv: List[str]) -> int:
             block = Path(tmp) / "small"
             registry.run("synthetic_block", {"size": "small", "seed": args.seed,
                                              "output": str(block)})
-        res = diagnose(block, Path(tmp))
+        heights = truth_heights(block) if args.truth_heights else None
+        res = diagnose(block, Path(tmp), args.model, heights, args.dense_only)
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1, default=float))
     print(report(res))

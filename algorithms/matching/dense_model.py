@@ -65,8 +65,13 @@ PathLike = Union[str, Path]
 #: such holes get no roof fill: SGM spreads roofs over those walls (synthetic ``aerial`` block,
 #: wide angle, base 4 px per metre of height: open cells within 0.5 m of an object > 1 m off
 #: 42 % → 8 %; the ``small`` block's walls stay narrower and keep the rules above).
+#: The segment fill (``segments``, :func:`.dense_fill.segment_fill`: holes of planar object
+#: segments from the planes of SGM's winners before the consistency filters) is off: on the
+#: aerial block it adds +2.4 / +6.2 points of object interior on seeds 1 / 2 but only +0.7 on
+#: held-out seed 11, and on the tiny test block it spills roofs onto open land (open RMS
+#: 0.125 → 0.200 m; issue 19, part A in docs/decisions.md).
 _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0, "segment_px": 300,
-                                   "edge_reach": 15, "wall_px": 20.0}
+                                   "edge_reach": 15, "wall_px": 20.0, "segments": False}
 #: The rule against roofs spilling over walls one camera sees (``wall_view``, part D4 in
 #: docs/decisions.md) is off: on the aerial block it removes the spill (open cells with no
 #: margin: RMS 0.54 → 0.12 m) but also half of the roofs (object interior 44 → 27 % on seed 1,
@@ -85,18 +90,35 @@ _JUMP_M = 1.5
 #: 22; 9 → 15 px alone: 44.4 %, 31 px: 47.5 %; uniqueness 5, LR 2 px, other P1/P2: ±2 %).
 #: Nadir models keep the defaults.
 _CONVERGENT_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "block_size": 7}
+#: Wide-base models (B/H ≥ :data:`WIDE_BASE`, e.g. the synthetic ``aerial`` block's wide-angle
+#: model, B/H 0.61) see slanted roofs at clearly different scales in the two images: the 9 px
+#: normalisation then compares striped roof textures at different phases and SGM loses the
+#: gabled roofs (aerial seed 1: 6–10 % of two gabled roofs right). A 21 px normalisation keeps
+#: them (object interior 43.9 → 52.3 % on seed 1, 34.9 → 39.3 % on seed 2, held-out seed 11
+#: 44.2 → 50.0 %); the left camera sees the walls there, so the plane fill takes the wall rule
+#: (no roof in occlusions) but the erosion does not (with it the roofs go, part D4): without
+#: the rule roofs filled over such walls put 11 m onto the terrain of seed 1 (0.076 ‰ H).
+#: Issue 19, part A in docs/decisions.md.
+#: Narrow-base models (the ``small`` block, B/H 0.36) keep the defaults: there the 21 px
+#: window cost 3.6 points of interior on held-out seed 11.
+WIDE_BASE = 0.5
+_WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
 
 
 def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
     """Matching options of the DSM path for one model: :data:`_DENSE_DEFAULTS` and the height
     step of 1.5 m in px of the model's parallax (1 px = GSD·H/B m) as ``edge_jump``; for
-    convergent models :data:`_CONVERGENT_OPTIONS`; with
-    :data:`_WALL_RULE` also the epipolar principal points as ``wall_view`` (where the left
-    camera sees the walls of the objects in its occlusions)."""
+    convergent models :data:`_CONVERGENT_OPTIONS`; for wide-base models (B/H ≥
+    :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; with :data:`_WALL_RULE` or a wide base also
+    the epipolar principal points as ``wall_view`` (where the left camera sees the walls of
+    the objects in its occlusions)."""
     jump = _JUMP_M * setup.pair.base / (float(setup.gsd) * setup.flying_height)
     cx = setup.pair.cx
-    view = (float(cx[0]), float(cx[1])) if _WALL_RULE else None
+    wide = setup.pair.base / setup.flying_height >= WIDE_BASE
+    view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
     options = dict(_DENSE_DEFAULTS, edge_jump=jump, wall_view=view)
+    if wide:
+        options.update(_WIDE_BASE_OPTIONS)
     if setup.convergent:
         options.update(_CONVERGENT_OPTIONS)
     return options
