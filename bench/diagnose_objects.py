@@ -314,7 +314,8 @@ def fbm_levels(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray], mask: Any,
                barriers: Any, preset: str, seeds: Optional[np.ndarray] = None
                ) -> List[Dict[str, Any]]:
     """Points of every pyramid level (keep_coarse) on object pixels and their heights."""
-    opts, _ = fbm_model._options(preset, {"keep_coarse": True})
+    opts, surface = fbm_model._options(preset, {"keep_coarse": True})
+    opts = fbm_model._object_search(opts, surface, setup)  # as match_model: per model
     m = fbm_model.match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d,
                                          setup.max_d, seeds=seeds, mask=mask,
                                          barriers=barriers, options=opts)
@@ -393,6 +394,7 @@ def fbm_chain(setup: Any, truth: Truth, et: EpiTruth, grey: Dict[str, np.ndarray
               ) -> Dict[str, Any]:
     """The production chain of fbm_lsm, stage by stage, with the object points followed."""
     opts, surface = fbm_model._options(preset, {})
+    opts = fbm_model._object_search(opts, surface, setup)
     matches = fbm_model.match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d,
                                                setup.max_d, seeds=seeds, mask=mask,
                                                barriers=barriers, options=opts)
