@@ -248,6 +248,14 @@ def _object_search(opts: FbmLsmOptions, surface: Dict[str, Any], setup: ModelSet
     return replace(opts, object_search=float(height) * parallax_per_metre(setup))
 
 
+def _model_options(preset: str, overrides: Dict[str, Any], setup: ModelSetup
+                   ) -> Tuple[FbmLsmOptions, Dict[str, Any]]:
+    """:func:`_options` for a prepared model: its convergence, and the object search in px
+    of its parallax (:func:`_object_search`)."""
+    opts, surface = _options(preset, overrides, convergent=setup.convergent)
+    return _object_search(opts, surface, setup), surface
+
+
 def _on_surface(pair: Any, col: np.ndarray, row: np.ndarray, min_d: float, max_d: float,
                 z_grid: np.ndarray, grid: Any, steps: int = 128) -> np.ndarray:
     """Ground position (n, 2) of left epipolar pixels: where their ray meets the DSM.
@@ -663,8 +671,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     _options(preset, overrides)  # bad presets and options fail before the model is set up
     setup = prepare_model(project, model, spacing=spacing, spacing_gsd=SPACING_GSD,
                           min_height=min_height, max_height=max_height)
-    opts, surface = _options(preset, overrides, convergent=setup.convergent)
-    opts = _object_search(opts, surface, setup)
+    opts, surface = _model_options(preset, overrides, setup)
     project, m, grid = setup.project, setup.model, setup.grid
     cell = _groundel_size(groundel, surface, setup)
     max_gap = None if max_gap is None or max_gap <= 0 else float(max_gap)
