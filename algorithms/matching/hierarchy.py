@@ -1119,7 +1119,7 @@ def _node_matches(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, lo: NDArra
                   hi: NDArray, opt: FbmLsmOptions, lsm_window: int, st: Dict[str, Any],
                   above: Optional[NDArray] = None, window: Optional[int] = None,
                   bidir_tol: Optional[float] = None, back_half: Optional[NDArray] = None
-                  ) -> Tuple[NDArray, Any]:
+                  ) -> Tuple[NDArray, Optional[_Lsm]]:
     """NCC search of nodes within [lo, hi] (px), LSM, then the right→left search over the
     same interval; the accepted nodes and the LSM result (indexed like the nodes).
 
@@ -1148,8 +1148,8 @@ def _node_matches(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, lo: NDArra
     st["lsm_ok"] = st.get("lsm_ok", 0) + int(acc.sum())
     tol = opt.bidir_tol if bidir_tol is None else bidir_tol
     if acc.any() and tol is not None and np.isfinite(tol):
-        # right → left over the same interval: occlusions and repetitive texture give a
-        # different best match back (the bidirectional check of the FBM points, seed §2.8)
+        # right → left: occlusions and repetitive texture give a different best match back
+        # (the bidirectional check of the FBM points, seed §2.8)
         gi = np.flatnonzero(acc)
         dd = cc[ok[gi]] - lsm.cols[gi]
         if back_half is None:
@@ -1162,11 +1162,8 @@ def _node_matches(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, lo: NDArra
         acc[gi[~agree]] = False
     good[ok[acc]] = True
     st["accepted"] = st.get("accepted", 0) + int(acc.sum())
-    full = _Lsm(np.full(n, np.nan), np.full(n, np.nan, np.float32),
-                np.full(n, np.nan, np.float32))
-    full.cols[ok] = lsm.cols
-    full.sigma[ok] = lsm.sigma_col
-    full.corr[ok] = lsm.corr
+    full = _empty_lsm(n)
+    full.cols[ok], full.sigma[ok], full.corr[ok] = lsm.cols, lsm.sigma_col, lsm.corr
     return good, full
 
 
@@ -1182,6 +1179,12 @@ class _Lsm:
         """These results with ``other``'s at the nodes ``sel``."""
         return _Lsm(np.where(sel, other.cols, self.cols),
                     np.where(sel, other.sigma, self.sigma), np.where(sel, other.corr, self.corr))
+
+
+def _empty_lsm(n: int) -> _Lsm:
+    """LSM results of ``n`` nodes, none matched."""
+    return _Lsm(np.full(n, np.nan), np.full(n, np.nan, np.float32),
+                np.full(n, np.nan, np.float32))
 
 
 def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
@@ -1220,7 +1223,7 @@ def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
 
 def _upper_nodes(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray, p: NDArray,
                  todo: NDArray, opt: FbmLsmOptions, lsm_window: int, st: Dict[str, Any]
-                 ) -> Tuple[NDArray, Any]:
+                 ) -> Tuple[NDArray, Optional[_Lsm]]:
     """Nodes ``todo`` searched from ``d − p`` to ``d + object_search`` px, kept when the
     best peak lies above ``d + p/2``.
 
@@ -1233,8 +1236,6 @@ def _upper_nodes(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray,
     idx = np.flatnonzero(todo & (float(opt.object_search) > p))
     sub: Dict[str, Any] = {"nodes": int(idx.size)}
     st["upper"] = sub
-    full = _Lsm(np.full(cc.size, np.nan), np.full(cc.size, np.nan, np.float32),
-                np.full(cc.size, np.nan, np.float32))
     if idx.size == 0:
         return out, None
     # the whole interval, plane included: the peak above must be the best and unambiguous
@@ -1244,8 +1245,8 @@ def _upper_nodes(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray,
     good, lsm = _node_matches(Lf, Rf, cc[idx], rr[idx], lo, hi, opt, lsm_window, sub,
                               above=d[idx] + 0.5 * p[idx],
                               window=int(opt.refine_window) + UPPER_WINDOW_ADD)
+    full = _empty_lsm(cc.size) if lsm is None else _scatter(lsm, idx, cc.size)
     if lsm is not None:
-        full = full.merged(_scatter(lsm, idx, cc.size), _mask(idx, cc.size))
         gi = idx[good]
         own = _own_pixel_upper(Lf, Rf, cc[gi], rr[gi], cc[gi] - full.cols[gi], d[gi], p[gi],
                                opt)
@@ -1269,16 +1270,9 @@ def _drop_rim(cc: NDArray, rr: NDArray, out: NDArray, full: _Lsm, step: int) -> 
     return int((~inner).sum())
 
 
-def _mask(idx: NDArray, n: int) -> NDArray:
-    """Boolean mask of length ``n`` true at ``idx``."""
-    m = np.zeros(n, bool)
-    m[idx] = True
-    return m
-
-
-def _scatter(lsm: Any, idx: NDArray, n: int) -> _Lsm:
+def _scatter(lsm: _Lsm, idx: NDArray, n: int) -> _Lsm:
     """LSM results of the nodes ``idx`` placed into arrays of all ``n`` nodes (NaN elsewhere)."""
-    out = _Lsm(np.full(n, np.nan), np.full(n, np.nan, np.float32), np.full(n, np.nan, np.float32))
+    out = _empty_lsm(n)
     out.cols[idx], out.sigma[idx], out.corr[idx] = lsm.cols, lsm.sigma, lsm.corr
     return out
 
@@ -1311,6 +1305,7 @@ def _grow_upper(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray, 
     i, j = i - i.min() + 1, j - j.min() + 1
     shape = (int(i.max()) + 2, int(j.max()) + 2)
     tried = ~todo | out
+    tol = None if opt.bidir_tol is None else max(float(opt.bidir_tol), UPPER_GROW_BIDIR_PX)
     grown = 0
     for _ in range(UPPER_GROW_ROUNDS):
         disp = np.full(shape, np.nan)
@@ -1327,7 +1322,7 @@ def _grow_upper(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray, 
                                   pred + UPPER_GROW_PX, opt, lsm_window, sub,
                                   above=d[cand] + 0.5 * p[cand],
                                   window=int(opt.refine_window) + UPPER_WINDOW_ADD,
-                                  bidir_tol=max(float(opt.bidir_tol), UPPER_GROW_BIDIR_PX))
+                                  bidir_tol=tol)
         if lsm is None or not good.any():
             break
         new = _scatter(lsm, cand, cc.size)
