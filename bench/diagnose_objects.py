@@ -24,10 +24,13 @@ On a synthetic block with truth (default: the ``small`` block as ``make demo`` b
 
 Usage (from the repository root)::
 
-    .venv/bin/python -m bench.diagnose_objects [BLOCK_DIR] [--seed N] [--json OUT.json]
+    .venv/bin/python -m bench.diagnose_objects [BLOCK_DIR] [--seed N] [--size small|aerial]
+        [--fbm-only] [--json OUT.json]
 
-Without ``BLOCK_DIR`` a ``small`` block (seed ``N``, default 1) is generated in a temporary
-folder. Not part of
+Without ``BLOCK_DIR`` a block of ``--size`` (default ``small``; seed ``N``, default 1) is
+generated in a temporary folder. An ``aerial`` block (model 0101_0102, one start point, the
+truth's height range, as ``bench_dsm_objects``) is recognised by its project name; ``--fbm-only``
+skips the dense tables. Not part of
 ``make bench`` (about 2 minutes); the numbers go to ``docs/decisions.md`` (issue 19).
 """
 
@@ -64,6 +67,8 @@ from photodem.algorithms.surface.gridding import GridAccumulator, finish_grid
 from photodem.algorithms.surface.groundel import reduce_groundels
 
 MODEL = "0102_0103"
+#: the model of an ``aerial`` block (as ``bench_dsm_objects``)
+AERIAL_MODEL = "0101_0102"
 TOL = 0.5  # m: a height is "right" within this of the truth
 
 
@@ -167,7 +172,9 @@ def dsm_row(name: str, dsm: np.ndarray, truth: Truth, gsd: float) -> Dict[str, A
     c = completeness(dsm, truth.dsm, {"interior": truth.interior & a,
                                       "objects": truth.objects & a, "open": truth.open & a,
                                       "interior_st": truth.interior & st,
-                                      "open_st": truth.open & st})
+                                      "open_st": truth.open & st,
+                                      "roof": truth.interior & a & (truth.landcover == 3),
+                                      "tree": truth.interior & a & (truth.landcover == 4)})
     ndsm_true = truth.dsm - truth.dtm
     tall = truth.objects & a & (ndsm_true >= 5.0)
     out = outline_metrics(np.where(a, dsm, np.nan), truth.dtm, truth.dsm,
@@ -180,6 +187,10 @@ def dsm_row(name: str, dsm: np.ndarray, truth: Truth, gsd: float) -> Dict[str, A
         "interior_0_5_pct": 100 * c["interior"]["within_0_5"],
         "interior_1_pct": 100 * c["interior"]["within_1"],
         "interior_measured_pct": 100 * c["interior"]["measured"],
+        # interior on buildings (land cover 3) and on tree crowns (4)
+        "roof_0_5_pct": 100 * c["roof"]["within_0_5"],
+        "tree_0_5_pct": 100 * c["tree"]["within_0_5"],
+        "tree_share_of_interior_pct": _pct(truth.landcover == 4, truth.interior & a),
         "objects_0_5_pct": 100 * c["objects"]["within_0_5"],
         "objects_measured_pct": 100 * c["objects"]["measured"],
         "open_0_5_pct": 100 * c["open"]["within_0_5"],
@@ -300,12 +311,14 @@ def _pct(a: np.ndarray, b: Optional[np.ndarray] = None) -> float:
 
 
 def fbm_levels(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray], mask: Any,
-               barriers: Any, preset: str) -> List[Dict[str, Any]]:
+               barriers: Any, preset: str, seeds: Optional[np.ndarray] = None
+               ) -> List[Dict[str, Any]]:
     """Points of every pyramid level (keep_coarse) on object pixels and their heights."""
-    opts, _ = fbm_model._options(preset, {"keep_coarse": True})
+    opts, surface = fbm_model._options(preset, {"keep_coarse": True})
+    opts = fbm_model._object_search(opts, surface, setup)  # as match_model: per model
     m = fbm_model.match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d,
-                                         setup.max_d, mask=mask, barriers=barriers,
-                                         options=opts)
+                                         setup.max_d, seeds=seeds, mask=mask,
+                                         barriers=barriers, options=opts)
     j = judge(setup, et, m.col, m.row, m.disparity)
     area_int = _pct(et.cls == 1, et.cls > 0)
     rows = []
@@ -314,6 +327,8 @@ def fbm_levels(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray], mask: Any,
         on = sel & (j["cls"] == 1)
         rows.append({"preset": preset, "level": k, "points": int(sel.sum()),
                      "on_interior": int(on.sum()),
+                     "on_roof": int(np.sum(on & (j["lc"] == 3))),
+                     "on_tree": int(np.sum(on & (j["lc"] == 4))),
                      "on_interior_pct": _pct(j["cls"][sel] == 1),
                      "interior_area_pct": area_int,
                      "interior_right_pct": _pct(j["right"], on),
@@ -375,12 +390,14 @@ def _features(grey: Dict[str, np.ndarray], et: EpiTruth, preset: str) -> Dict[st
 
 
 def fbm_chain(setup: Any, truth: Truth, et: EpiTruth, grey: Dict[str, np.ndarray], mask: Any,
-              barriers: Any, preset: str) -> Dict[str, Any]:
+              barriers: Any, preset: str, seeds: Optional[np.ndarray] = None
+              ) -> Dict[str, Any]:
     """The production chain of fbm_lsm, stage by stage, with the object points followed."""
     opts, surface = fbm_model._options(preset, {})
+    opts = fbm_model._object_search(opts, surface, setup)
     matches = fbm_model.match_epipolar_fbm_lsm(grey["left"], grey["right"], setup.min_d,
-                                               setup.max_d, mask=mask, barriers=barriers,
-                                               options=opts)
+                                               setup.max_d, seeds=seeds, mask=mask,
+                                               barriers=barriers, options=opts)
     mp = fbm_model._intersect(setup, matches)
     k = mp.keep
     j = judge(setup, et, matches.col[k], matches.row[k], matches.disparity[k])
@@ -405,6 +422,13 @@ def fbm_chain(setup: Any, truth: Truth, et: EpiTruth, grey: Dict[str, np.ndarray
         "interior_area_pct": _pct(et.cls == 1, et.cls > 0),
         "points_on_interior": int(on.sum()), "points_on_interior_pct": _pct(on),
         "points_on_roof_interior": int(np.sum(on & (j["lc"] == 3))),
+        "points_on_tree_interior": int(np.sum(on & (j["lc"] == 4))),
+        "points_per_1000px_roof": 1000.0 * float(np.sum(on & (j["lc"] == 3)))
+        / max(int(et.roof().sum()), 1),
+        "points_per_1000px_tree": 1000.0 * float(np.sum(on & (j["lc"] == 4)))
+        / max(int(et.tree().sum()), 1),
+        "points_per_1000px_open": 1000.0 * float(np.sum(j["cls"] == 3))
+        / max(int(np.sum(et.cls == 3)), 1),
         "roof_area_pct": _pct(et.roof(), et.cls > 0),
         "interior_points_right_pct": _pct(j["right"], on),
         "roof_points_right_pct": _pct(j["right"], on & (j["lc"] == 3)),
@@ -608,47 +632,64 @@ def _md(rows: List[Dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
-def _products(block: Path, out: Path, truth: Truth, gsd: float, model: str = MODEL,
-              heights: Optional[Dict] = None, dense_only: bool = False
+def _products(block: Path, out: Path, truth: Truth, gsd: float, model: str,
+              heights: Dict[str, float], fbm_only: bool = False, dense_only: bool = False
               ) -> List[Dict[str, Any]]:
-    """match_model for terrain, urban (unless ``dense_only``) and dense; the issue's rows."""
+    """match_model for terrain, general, urban (unless ``dense_only``) and dense (unless
+    ``fbm_only``); the issue's table rows."""
     rows = []
-    methods = (("fbm_lsm terrain", {"preset": "terrain"}),
-               ("fbm_lsm urban", {"preset": "urban"}), ("dense", {"method": "dense"}))
-    for name, params in methods[2:] if dense_only else methods:
+    runs = [] if dense_only else [("fbm_lsm terrain", {"preset": "terrain"}),
+                                  ("fbm_lsm general", {"preset": "general"}),
+                                  ("fbm_lsm urban", {"preset": "urban"})]
+    if not fbm_only:
+        runs.append(("dense", {"method": "dense"}))
+    for name, params in runs:
         r = registry.run("match_model", {"project": str(block), "model": model,
                                          "output": str(out / name.replace(" ", "_")),
-                                         **(heights or {}), **params})
+                                         **heights, **params})
         rows.append(dsm_row(name, on_truth_grid(Path(r["dsm"]), truth), truth, gsd))
     return rows
 
 
-def truth_heights(block: Path) -> Dict[str, float]:
-    """The truth DSM's height range widened by 5 m (as the benches match the aerial block)."""
+def model_and_heights(block: Path) -> Tuple[str, Dict[str, float]]:
+    """The diagnosed model of a block and its height range: the ``small`` block's model with
+    the default range, or an ``aerial`` block's model with the truth's range ± 5 m (as
+    ``bench_dsm_objects``; the default ± 0.3 H would be a range of 690 m there)."""
+    from photodem.algorithms.project.model import Project  # lazy: one use
+
+    project = Project.load(block)
+    names = {m.name for m in project.models}
+    if "aerial" not in project.name or AERIAL_MODEL not in names:
+        return MODEL, {}
     z, _, _ = _read(block / "truth" / "dsm.tif")
-    return {"min_height": float(np.nanmin(z)) - 5.0, "max_height": float(np.nanmax(z)) + 5.0}
+    return AERIAL_MODEL, {"min_height": float(np.nanmin(z)) - 5.0,
+                          "max_height": float(np.nanmax(z)) + 5.0}
 
 
-def diagnose(block: Path, work: Path, model: str = MODEL, heights: Optional[Dict] = None,
-             dense_only: bool = False) -> Dict[str, Any]:
-    """All tables of the diagnosis (see the module text); ``heights`` = min/max height of the
-    matching (default the project's); ``dense_only`` skips fbm_lsm."""
+def diagnose(block: Path, work: Path, fbm_only: bool = False, dense_only: bool = False
+             ) -> Dict[str, Any]:
+    """All tables of the diagnosis (see the module text); ``fbm_only`` / ``dense_only`` skip
+    the other matcher."""
     t0 = time.perf_counter()
-    heights = heights or {}
+    model, heights = model_and_heights(block)
     setup = prepare_model(block, model, spacing_gsd=fbm_model.SPACING_GSD, **heights)
-    setup_dense = prepare_model(block, model, spacing_gsd=1.0, **heights)
     truth = load_truth(block, setup)
-    products = _products(block, work, truth, float(setup.gsd), model, heights, dense_only)
+    products = _products(block, work, truth, float(setup.gsd), model, heights, fbm_only,
+                           dense_only)
     et = epipolar_truth(setup, truth)
     grey, mask, barriers = fbm_model._grey_epipolar(setup, Feedback())
+    seeds = fbm_model.start_point_seeds(setup)
     levels, chains = [], []
-    for preset in () if dense_only else ("terrain", "urban"):
-        levels += fbm_levels(setup, et, grey, mask, barriers, preset)
-        chains.append(fbm_chain(setup, truth, et, grey, mask, barriers, preset))
-    steps, disp = dense_steps(setup_dense, et, grey)
-    causes = dense_causes(et, grey, disp, float(setup.gsd))
-    causes.update(dense_range(setup_dense, et, grey))
-    gridding = dense_gridding(setup_dense, truth, disp["prod"])
+    for preset in () if dense_only else ("terrain", "general", "urban"):
+        levels += fbm_levels(setup, et, grey, mask, barriers, preset, seeds)
+        chains.append(fbm_chain(setup, truth, et, grey, mask, barriers, preset, seeds))
+    steps, causes, gridding = [], {}, []
+    if not fbm_only:
+        setup_dense = prepare_model(block, model, spacing_gsd=1.0, **heights)
+        steps, disp = dense_steps(setup_dense, et, grey)
+        causes = dense_causes(et, grey, disp, float(setup.gsd))
+        causes.update(dense_range(setup_dense, et, grey))
+        gridding = dense_gridding(setup_dense, truth, disp["prod"])
     return {"block": str(block), "model": model, "gsd_m": float(setup.gsd),
             "flying_height_m": float(setup.flying_height),
             "buildings_in_area": int(truth.heights.size),
@@ -661,9 +702,6 @@ def diagnose(block: Path, work: Path, model: str = MODEL, heights: Optional[Dict
 
 def report(res: Dict[str, Any]) -> str:
     """The tables as Markdown."""
-    causes = dict(res["dense_causes"])
-    by_tex = causes.pop("by_texture")
-    by_edge = causes.pop("by_edge_distance")
     chain = res["fbm_chain"] or [{"preset": "–"}]
     parts = [f"block {res['block']}, model {res['model']}, GSD {res['gsd_m']:.3f} m, "
              f"H {res['flying_height_m']:.0f} m; {res['buildings_in_area']} buildings inside "
@@ -671,11 +709,24 @@ def report(res: Dict[str, Any]) -> str:
              f"{res['interior_share_of_area_pct']:.1f} % of the area",
              "DSMs:", _md(res["products"]), "fbm_lsm points per level:", _md(res["fbm_levels"]),
              "fbm_lsm chain:", _md([{"key": k, **{c["preset"]: c[k] for c in chain}}
-                                   for k in chain[0] if k != "preset"]),
-             "dense filter steps:", _md(res["dense_steps"]),
-             "dense causes: " + json.dumps(causes), _md(by_tex), _md(by_edge),
-             "dense gridding:", _md(res["dense_gridding"])]
+                                   for k in chain[0] if k != "preset"])]
+    if res["dense_steps"]:
+        causes = dict(res["dense_causes"])
+        by_tex = causes.pop("by_texture")
+        by_edge = causes.pop("by_edge_distance")
+        parts += ["dense filter steps:", _md(res["dense_steps"]),
+                  "dense causes: " + json.dumps(causes), _md(by_tex), _md(by_edge),
+                  "dense gridding:", _md(res["dense_gridding"])]
     return "\n\n".join(parts)
+
+
+def _aerial_start_point(block: Path) -> None:
+    """One start point at the true terrain height, as ``bench_dsm_objects`` gives it."""
+    from .bench_dsm_accuracy import _start_point  # lazy: only generated aerial blocks
+
+    truth = {k: str(block / "truth" / f"{k}.tif") for k in ("dsm", "dtm")}
+    _, heights = model_and_heights(block)
+    _start_point(block, truth, heights["min_height"], heights["max_height"])
 
 
 def main(argv: List[str]) -> int:
@@ -684,21 +735,23 @@ def main(argv: List[str]) -> int:
     ap.add_argument("--json", help="write all numbers to this JSON file")
     ap.add_argument("--seed", type=int, default=1, help="seed of a generated block (default 1, "
                                                         "as make demo)")
-    ap.add_argument("--model", default=MODEL, help=f"stereo model (default {MODEL}; the "
-                                                   "aerial block's is 0101_0102)")
-    ap.add_argument("--truth-heights", action="store_true",
-                    help="match over the truth DSM's height range ± 5 m (as the benches do "
-                         "on the aerial block)")
-    ap.add_argument("--dense-only", action="store_true", help="skip fbm_lsm")
+    ap.add_argument("--size", default="small", choices=("small", "aerial"),
+                    help="size of a generated block (default small)")
+    only = ap.add_mutually_exclusive_group()
+    only.add_argument("--fbm-only", action="store_true", help="fbm_lsm tables only (no dense)")
+    only.add_argument("--dense-only", action="store_true", help="dense tables only (no fbm_lsm)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="diagnose-objects-") as tmp:
         block = Path(args.block) if args.block else None
         if block is None:
-            block = Path(tmp) / "small"
-            registry.run("synthetic_block", {"size": "small", "seed": args.seed,
-                                             "output": str(block)})
-        heights = truth_heights(block) if args.truth_heights else None
-        res = diagnose(block, Path(tmp), args.model, heights, args.dense_only)
+            block = Path(tmp) / args.size
+            params = {"size": args.size, "seed": args.seed, "output": str(block)}
+            if args.size == "aerial":
+                params["terrain"] = "gentle"  # as bench_dsm_objects
+            registry.run("synthetic_block", params)
+            if args.size == "aerial":
+                _aerial_start_point(block)
+        res = diagnose(block, Path(tmp), fbm_only=args.fbm_only, dense_only=args.dense_only)
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1, default=float))
     print(report(res))

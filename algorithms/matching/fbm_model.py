@@ -218,13 +218,42 @@ def _options(preset: str, overrides: Dict[str, Any], convergent: bool = False
         values = _convergent_values(values)
     values.update({k: v for k, v in overrides.items() if v is not None})
     names = {f.name for f in fields(FbmLsmOptions)}
-    surface_keys = ("groundel_gsd", "reduction", "smoothing", "objects")
+    surface_keys = ("groundel_gsd", "reduction", "smoothing", "objects", "object_height_m",
+                    "wall_offset_gsd")
     unknown = set(values) - names - set(surface_keys)
     if unknown:
         raise InputError(f"Unknown matching option(s): {', '.join(sorted(unknown))}.")
     options = replace(FbmLsmOptions(), **{k: v for k, v in values.items() if k in names})
     surface = {k: values[k] for k in surface_keys if k in values}
     return options, surface
+
+
+def parallax_per_metre(setup: ModelSetup) -> float:
+    """Disparity (px) of one metre of height at the model's terrain: base (px) / H."""
+    return float(setup.pair.base * setup.pair.focal_px) / float(setup.flying_height) ** 2
+
+
+def _object_search(opts: FbmLsmOptions, surface: Dict[str, Any], setup: ModelSetup
+                   ) -> FbmLsmOptions:
+    """The grid densification's upward band from the preset's object height (m), in px of
+    this model's parallax (explicit ``object_search`` wins).
+
+    Why per model: the same 8 m roof is ≈ 15 px of parallax on the ``small`` block (B/H 0.36,
+    GSD 0.2 m) but ≈ 33 px on the wide-angle ``aerial`` block (B/H 0.6, GSD 0.15 m), beyond
+    the 20 px pull-in there (issue 19).
+    """
+    height = surface.get("object_height_m")
+    if opts.object_search is not None or not height:
+        return opts
+    return replace(opts, object_search=float(height) * parallax_per_metre(setup))
+
+
+def _model_options(preset: str, overrides: Dict[str, Any], setup: ModelSetup
+                   ) -> Tuple[FbmLsmOptions, Dict[str, Any]]:
+    """:func:`_options` for a prepared model: its convergence, and the object search in px
+    of its parallax (:func:`_object_search`)."""
+    opts, surface = _options(preset, overrides, convergent=setup.convergent)
+    return _object_search(opts, surface, setup), surface
 
 
 def _on_surface(pair: Any, col: np.ndarray, row: np.ndarray, min_d: float, max_d: float,
@@ -381,7 +410,8 @@ OBJECT_MIN_SLOPE = 1.0
 OBJECT_LONE = 1
 
 
-def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
+def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = None
+                    ) -> Tuple[np.ndarray, List[Any]]:
     """Inliers that keep consistent upper surfaces, and breaklines at the height jumps.
 
     A groundel outlier with :data:`OBJECT_MIN_SUPPORT` agreeing neighbours (a roof in a
@@ -395,6 +425,9 @@ def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
         Raw points (x, y, z in m; any consistent units, e.g. disparity as z).
     red : GroundelResult
         Their groundel reduction (:func:`..surface.groundel.reduce_groundels`).
+    wall_offset : float, optional
+        Breaklines this far (m) from the upper point of each jump instead of halfway
+        (``upper_offset`` of :func:`..surface.jumps.jump_breaklines`).
 
     Returns
     -------
@@ -411,7 +444,7 @@ def object_surfaces(pts: np.ndarray, red: Any) -> Tuple[np.ndarray, List[Any]]:
     inlier = (~red.outlier & (support >= OBJECT_LONE)) | supported
     idx = np.flatnonzero(inlier)
     lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
-                            OBJECT_MIN_SLOPE, supported=supported[idx])
+                            OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset)
     return inlier, lines
 
 
@@ -421,7 +454,9 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
     grid, inlier, pts = setup.grid, ~red.outlier, mp.xyz
     breaklines = list(setup.breaklines)
     if surface.get("objects"):
-        inlier, auto = object_surfaces(mp.xyz, red)
+        offset = surface.get("wall_offset_gsd")
+        inlier, auto = object_surfaces(mp.xyz, red,
+                                       None if offset is None else float(offset) * setup.gsd)
         breaklines += auto
     if interpolation == "fe":
         # a point's weight: its matching σ_Z and the scatter of the points about the local
@@ -636,7 +671,7 @@ def match_model_fbm_lsm(project: Any, model: str, output_dir: PathLike,
     _options(preset, overrides)  # bad presets and options fail before the model is set up
     setup = prepare_model(project, model, spacing=spacing, spacing_gsd=SPACING_GSD,
                           min_height=min_height, max_height=max_height)
-    opts, surface = _options(preset, overrides, convergent=setup.convergent)
+    opts, surface = _model_options(preset, overrides, setup)
     project, m, grid = setup.project, setup.model, setup.grid
     cell = _groundel_size(groundel, surface, setup)
     max_gap = None if max_gap is None or max_gap <= 0 else float(max_gap)

@@ -57,6 +57,14 @@ search returns to it (:data:`FLAG_GRID`); seed §3.1 "good points in regularly d
 sub-images". This gives the 24 m DSM of mountainous terrain ~5 % of the pixels as points
 instead of ~0.3 %.
 
+**Objects above the plane** (``object_search``, issue 19): grid nodes not kept near their
+component's plane search the interval from ``d − pull`` to ``d + object_search`` px and are kept
+when the best, unambiguous NCC peak lies above ``d + pull/2`` and passes LSM and the right→left
+search, when their own pixel prefers it (shiftable windows, :func:`_own_pixel_upper`), and
+after a one-node opening of the upper nodes (:func:`_inner_nodes`) — ground beside a wall that
+matched the roof's edge goes; from the kept nodes the roof is grown node by node with a narrow
+search (:func:`_grow_upper`), and opened again (:data:`FLAG_UPPER`).
+
 Point flags (bits of ``EpipolarMatches.flags``):
 
 =====  ==========================  ============================================================
@@ -70,6 +78,7 @@ bit    name                        meaning
 32     :data:`FLAG_RETRY`          window matched in a later wave from its neighbours'
                                    predictions (came back from another side)
 64     :data:`FLAG_GRID`           grid densification point (LSM)
+128    :data:`FLAG_UPPER`          grid point found above the plane (``object_search``)
 =====  ==========================  ============================================================
 
 Only accepted points are returned (bidirectional failures and outliers are counted in
@@ -123,8 +132,9 @@ FLAG_ENLARGED = 8
 FLAG_DENSIFIED = 16
 FLAG_RETRY = 32
 FLAG_GRID = 64
+FLAG_UPPER = 128
 __all__ = ["FLAG_DENSIFIED", "FLAG_ENLARGED", "FLAG_FEATURE_SUBPIXEL", "FLAG_GRID", "FLAG_LSM",
-           "FLAG_LSM_FAILED", "FLAG_RETRY", "EpipolarMatches", "FbmLsmOptions",
+           "FLAG_LSM_FAILED", "FLAG_RETRY", "FLAG_UPPER", "EpipolarMatches", "FbmLsmOptions",
            "match_epipolar_fbm_lsm"]
 
 
@@ -215,6 +225,11 @@ class FbmLsmOptions:
         need not fit rough terrain) and then by LSM; only nodes passing the LSM thresholds
         are kept (:data:`FLAG_GRID`). Seed §3.1: "good points in regularly densified
         sub-images" (Hannah) and "match many points, then select the locally best".
+    object_search : float, optional
+        With ``grid_step``: grid nodes the search around the plane did not keep search again
+        up to this many px *above* the plane (objects stand on the ground: a roof of a given
+        height in px of the model's parallax, issue 19; see "Objects above the plane" in the
+        module notes). None or 0: off.
     """
 
     levels: Optional[int] = None
@@ -253,6 +268,7 @@ class FbmLsmOptions:
     object_pull_in: Optional[float] = None
     neighbour_tol: float = 2.0
     grid_step: int = 4
+    object_search: Optional[float] = None
 
 
 @dataclass
@@ -1074,19 +1090,12 @@ def _overlap_mask(valid_right: Optional[NDArray], right_shape: Tuple[int, int],
     return out
 
 
-def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
-                 pull: NDArray, excl: Optional[NDArray], valid: Optional[NDArray],
-                 margin: int, step: int, opt: FbmLsmOptions, lsm_window: int
-                 ) -> Tuple[Optional[Tuple[NDArray, ...]], Dict[str, Any]]:
-    """Level-0 grid densification (see ``FbmLsmOptions.grid_step``).
-
-    Nodes ``(step/2 + i·step)`` of components with a plane (NaN rows: none), away from
-    no-data, exclusions, barriers and the image border; prediction = the component's plane;
-    NCC search (``refine_window``) within ± ``pull[component]`` px, peak ρ ≥ ``rho_min`` and
-    ambiguity ≤ 0.9; then epipolar LSM, kept only when valid (σ_px, ρ, convergence).
-    """
+def _grid_nodes(Lf: NDArray, grouping: Grouping, plane: NDArray, pull: NDArray,
+                excl: Optional[NDArray], valid: Optional[NDArray], margin: int, step: int
+                ) -> Tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Grid nodes ``(step/2 + i·step)`` of components with a plane, away from no-data,
+    exclusions, barriers and the image border: columns, rows, plane disparity, pull-in."""
     h, w = Lf.shape
-    st: Dict[str, Any] = {"nodes": 0, "ncc_ok": 0, "accepted": 0}
     ok_px = np.ones((h, w), bool)
     if excl is not None:
         ok_px &= ~excl
@@ -1103,41 +1112,292 @@ def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
     g = grouping.of(cc, rr)
     d = eval_planes(plane, grouping, g, cc, rr)
     sel = np.isfinite(d)
-    rr, cc, d, p = rr[sel], cc[sel], d[sel], pull[g[sel]]
+    return cc[sel], rr[sel], d[sel], pull[g[sel]]
+
+
+def _node_matches(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, lo: NDArray,
+                  hi: NDArray, opt: FbmLsmOptions, lsm_window: int, st: Dict[str, Any],
+                  above: Optional[NDArray] = None, window: Optional[int] = None,
+                  bidir_tol: Optional[float] = None, back_half: Optional[NDArray] = None
+                  ) -> Tuple[NDArray, Optional[_Lsm]]:
+    """NCC search of nodes within [lo, hi] (px), LSM, then the right→left search over the
+    same interval; the accepted nodes and the LSM result (indexed like the nodes).
+
+    ``above``: the NCC peak must lie at or above this disparity (else the node is not kept);
+    ``window``: the NCC window (default ``refine_window``); ``bidir_tol``: the right→left
+    tolerance (default the option's); ``back_half``: the right→left search spans ± this
+    around the found disparity (default: the interval [lo, hi] itself).
+    ``st`` gets the counts ``ncc_ok``, ``lsm_ok`` and ``accepted`` added.
+    """
+    n = cc.size
+    good = np.zeros(n, bool)
+    win = int(opt.refine_window if window is None else window)
+    res = ncc_epipolar(Lf, Rf, cc, rr, np.floor(lo), np.ceil(hi), window=win,
+                       min_ncc=opt.rho_min, max_ratio=0.9)
+    found = res.valid & np.isfinite(res.cols)
+    if above is not None:
+        found &= res.disparity >= above
+    ok = np.flatnonzero(found)
+    st["ncc_ok"] = st.get("ncc_ok", 0) + int(ok.size)
+    if ok.size == 0:
+        return good, None
+    lsm = lsm_match(Lf, Rf, cc[ok], rr[ok], res.cols[ok], None, window=lsm_window,
+                    model="epipolar", max_iter=opt.lsm_max_iter, max_shift=opt.lsm_pull_in,
+                    min_corr=opt.lsm_min_rho, max_sigma=opt.lsm_max_sigma)
+    acc = lsm.valid & np.isfinite(lsm.cols)
+    st["lsm_ok"] = st.get("lsm_ok", 0) + int(acc.sum())
+    tol = opt.bidir_tol if bidir_tol is None else bidir_tol
+    if acc.any() and tol is not None and np.isfinite(tol):
+        # right → left: occlusions and repetitive texture give a different best match back
+        # (the bidirectional check of the FBM points, seed §2.8)
+        gi = np.flatnonzero(acc)
+        dd = cc[ok[gi]] - lsm.cols[gi]
+        if back_half is None:
+            b_lo, b_hi = np.floor(-hi[ok[gi]]), np.ceil(-lo[ok[gi]])
+        else:
+            b_lo, b_hi = np.floor(-dd - back_half[ok[gi]]), np.ceil(-dd + back_half[ok[gi]])
+        back = ncc_epipolar(Rf, Lf, lsm.cols[gi], rr[ok[gi]], b_lo, b_hi, window=win,
+                            min_ncc=opt.rho_min, max_ratio=1.0)
+        agree = back.valid & (np.abs(-back.disparity - dd) <= tol)
+        acc[gi[~agree]] = False
+    good[ok[acc]] = True
+    st["accepted"] = st.get("accepted", 0) + int(acc.sum())
+    full = _empty_lsm(n)
+    full.cols[ok], full.sigma[ok], full.corr[ok] = lsm.cols, lsm.sigma_col, lsm.corr
+    return good, full
+
+
+@dataclass
+class _Lsm:
+    """LSM results of grid nodes (right column, σ, ρ; NaN where not matched)."""
+
+    cols: NDArray
+    sigma: NDArray
+    corr: NDArray
+
+    def merged(self, other: _Lsm, sel: NDArray) -> _Lsm:
+        """These results with ``other``'s at the nodes ``sel``."""
+        return _Lsm(np.where(sel, other.cols, self.cols),
+                    np.where(sel, other.sigma, self.sigma), np.where(sel, other.corr, self.corr))
+
+
+def _empty_lsm(n: int) -> _Lsm:
+    """LSM results of ``n`` nodes, none matched."""
+    return _Lsm(np.full(n, np.nan), np.full(n, np.nan, np.float32),
+                np.full(n, np.nan, np.float32))
+
+
+def _grid_points(Lf: NDArray, Rf: NDArray, grouping: Grouping, plane: NDArray,
+                 pull: NDArray, excl: Optional[NDArray], valid: Optional[NDArray],
+                 margin: int, step: int, opt: FbmLsmOptions, lsm_window: int
+                 ) -> Tuple[Optional[Tuple[NDArray, ...]], Dict[str, Any]]:
+    """Level-0 grid densification (see ``FbmLsmOptions.grid_step``).
+
+    Nodes (:func:`_grid_nodes`); prediction = the component's plane; NCC search
+    (``refine_window``) within ± ``pull[component]`` px, peak ρ ≥ ``rho_min`` and ambiguity
+    ≤ 0.9; then epipolar LSM, kept only when valid (σ_px, ρ, convergence) and the right→left
+    search returns. With ``object_search``, nodes not kept search again *above* the plane
+    (:func:`_upper_nodes`): objects stand on the ground, their disparity is larger.
+    """
+    st: Dict[str, Any] = {"nodes": 0, "ncc_ok": 0, "lsm_ok": 0, "accepted": 0}
+    cc, rr, d, p = _grid_nodes(Lf, grouping, plane, pull, excl, valid, margin, step)
     st["nodes"] = int(rr.size)
     if rr.size == 0:
         return None, st
-    res = ncc_epipolar(Lf, Rf, cc, rr, np.floor(d - p), np.ceil(d + p),
-                       window=opt.refine_window, min_ncc=opt.rho_min, max_ratio=0.9)
-    good_ncc = res.valid & np.isfinite(res.cols)
-    st["ncc_ok"] = int(good_ncc.sum())
-    rr, cc, cr = rr[good_ncc], cc[good_ncc], res.cols[good_ncc]
-    if rr.size == 0:
-        return None, st
-    lsm = lsm_match(Lf, Rf, cc, rr, cr, None, window=lsm_window, model="epipolar",
-                    max_iter=opt.lsm_max_iter, max_shift=opt.lsm_pull_in,
-                    min_corr=opt.lsm_min_rho, max_sigma=opt.lsm_max_sigma)
-    good = lsm.valid & np.isfinite(lsm.cols)
-    st["lsm_ok"] = int(good.sum())
-    if good.any() and opt.bidir_tol is not None and np.isfinite(opt.bidir_tol):
-        # right → left over the same interval: occlusions and repetitive texture give a
-        # different best match back (the bidirectional check of the FBM points, seed §2.8)
-        gi = np.flatnonzero(good)
-        dd = cc[gi] - lsm.cols[gi]
-        pg = p[good_ncc][gi]
-        back = ncc_epipolar(Rf, Lf, lsm.cols[gi], rr[gi], np.floor(-dd - pg),
-                            np.ceil(-dd + pg), window=opt.refine_window,
-                            min_ncc=opt.rho_min, max_ratio=1.0)
-        agree = back.valid & (np.abs(-back.disparity - dd) <= opt.bidir_tol)
-        good[gi[~agree]] = False
-    st["accepted"] = int(good.sum())
+    good, lsm = _node_matches(Lf, Rf, cc, rr, d - p, d + p, opt, lsm_window, st, back_half=p)
+    flags = np.full(cc.size, FLAG_GRID | FLAG_LSM, np.uint8)
+    if opt.object_search:
+        up, lsm_up = _upper_nodes(Lf, Rf, cc, rr, d, p, ~good, opt, lsm_window, st)
+        if up.any():
+            lsm = lsm_up if lsm is None else lsm.merged(lsm_up, up)
+            good |= up
+            flags[up] |= FLAG_UPPER
     if not good.any():
         return None, st
     n = int(good.sum())
     parts = (cc[good], rr[good], cc[good] - lsm.cols[good],
-             lsm.sigma_col[good].astype(np.float32), lsm.corr[good].astype(np.float32),
-             np.full(n, FLAG_GRID | FLAG_LSM, np.uint8), np.zeros(n, np.int8))
+             lsm.sigma[good].astype(np.float32), lsm.corr[good].astype(np.float32),
+             flags[good], np.zeros(n, np.int8))
     return parts, st
+
+
+def _upper_nodes(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray, p: NDArray,
+                 todo: NDArray, opt: FbmLsmOptions, lsm_window: int, st: Dict[str, Any]
+                 ) -> Tuple[NDArray, Optional[_Lsm]]:
+    """Nodes ``todo`` searched from ``d − p`` to ``d + object_search`` px, kept when the
+    best peak lies above ``d + p/2``.
+
+    A roof several metres above the ground plane of its windows lies beyond the pull-in of
+    the wide-angle aerial models (≈ 4 px per metre of height, issue 19); on open terrain the
+    node was matched near the plane already and is not searched again, so the wide band only
+    meets the nodes the plane could not explain.
+    """
+    out = np.zeros(cc.size, bool)
+    idx = np.flatnonzero(todo & (float(opt.object_search) > p))
+    sub: Dict[str, Any] = {"nodes": int(idx.size)}
+    st["upper"] = sub
+    if idx.size == 0:
+        return out, None
+    # the whole interval, plane included: the peak above must be the best and unambiguous
+    # (repetitive field texture has a second peak of about the same ρ near the plane)
+    lo = d[idx] - p[idx]
+    hi = d[idx] + float(opt.object_search)
+    good, lsm = _node_matches(Lf, Rf, cc[idx], rr[idx], lo, hi, opt, lsm_window, sub,
+                              above=d[idx] + 0.5 * p[idx],
+                              window=int(opt.refine_window) + UPPER_WINDOW_ADD)
+    full = _empty_lsm(cc.size) if lsm is None else _scatter(lsm, idx, cc.size)
+    if lsm is not None:
+        gi = idx[good]
+        own = _own_pixel_upper(Lf, Rf, cc[gi], rr[gi], cc[gi] - full.cols[gi], d[gi], p[gi],
+                               opt)
+        out[gi[own]] = True
+        sub["own_pixel_rejected"] = int((~own).sum())
+    # the rim goes before the growing (a clean start) and after it (what grew past a wall)
+    sub["rim_rejected"] = _drop_rim(cc, rr, out, full, int(opt.grid_step))
+    _grow_upper(Lf, Rf, cc, rr, d, p, todo, out, full, opt, lsm_window, sub)
+    sub["rim_rejected"] += _drop_rim(cc, rr, out, full, int(opt.grid_step))
+    return out, full
+
+
+def _drop_rim(cc: NDArray, rr: NDArray, out: NDArray, full: _Lsm, step: int) -> int:
+    """Upper nodes ``out`` (in place) that the opening (:func:`_inner_nodes`) removes; their
+    number."""
+    up = np.flatnonzero(out)
+    if up.size == 0:
+        return 0
+    inner = _inner_nodes(cc[up], rr[up], cc[up] - full.cols[up], step)
+    out[up[~inner]] = False
+    return int((~inner).sum())
+
+
+def _scatter(lsm: _Lsm, idx: NDArray, n: int) -> _Lsm:
+    """LSM results of the nodes ``idx`` placed into arrays of all ``n`` nodes (NaN elsewhere)."""
+    out = _empty_lsm(n)
+    out.cols[idx], out.sigma[idx], out.corr[idx] = lsm.cols, lsm.sigma, lsm.corr
+    return out
+
+
+#: Region growing of the upper nodes: rounds, and half width (px) of the search around the
+#: mean disparity of a node's upper neighbours.
+UPPER_GROW_ROUNDS = 8
+UPPER_GROW_PX = 3.0
+#: Right→left tolerance of a grown node (px): the narrow search is bound to its neighbours
+#: already; weakly textured roofs put the back search's NCC peak up to a pixel off the LSM
+#: value (with ``urban``'s 0.5 px four of five roof candidates failed there).
+UPPER_GROW_BIDIR_PX = 1.0
+
+
+def _grow_upper(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d: NDArray, p: NDArray,
+                todo: NDArray, out: NDArray, full: _Lsm, opt: FbmLsmOptions,
+                lsm_window: int, sub: Dict[str, Any]) -> None:
+    """Grow the upper nodes (``out``, ``full``; in place) over their roof: a node of ``todo``
+    beside an upper node is searched within ± :data:`UPPER_GROW_PX` of its upper neighbours'
+    mean disparity, with the same acceptance (above the plane, LSM, right→left, own pixel).
+
+    The wide search of :func:`_upper_nodes` finds about a third of the roof nodes on the
+    aerial block (weak roof texture gives other NCC peaks over 80 px); from a found node its
+    neighbours need only a narrow, unambiguous search — the roof plane of the issue's "grid
+    densification on the roof plane".
+    """
+    step = int(opt.grid_step)
+    i = np.floor(rr / step).astype(np.int64)
+    j = np.floor(cc / step).astype(np.int64)
+    i, j = i - i.min() + 1, j - j.min() + 1
+    shape = (int(i.max()) + 2, int(j.max()) + 2)
+    tried = ~todo | out
+    tol = None if opt.bidir_tol is None else max(float(opt.bidir_tol), UPPER_GROW_BIDIR_PX)
+    grown = 0
+    for _ in range(UPPER_GROW_ROUNDS):
+        disp = np.full(shape, np.nan)
+        up = np.flatnonzero(out)
+        disp[i[up], j[up]] = cc[up] - full.cols[up]
+        nb = np.stack([disp[i + di, j + dj] for di, dj in ((0, 1), (0, -1), (1, 0), (-1, 0))])
+        has = np.isfinite(nb).any(axis=0)
+        cand = np.flatnonzero(has & ~tried)
+        if cand.size == 0:
+            break
+        tried[cand] = True
+        pred = np.nanmean(nb[:, cand], axis=0)
+        good, lsm = _node_matches(Lf, Rf, cc[cand], rr[cand], pred - UPPER_GROW_PX,
+                                  pred + UPPER_GROW_PX, opt, lsm_window, sub,
+                                  above=d[cand] + 0.5 * p[cand],
+                                  window=int(opt.refine_window) + UPPER_WINDOW_ADD,
+                                  bidir_tol=tol)
+        if lsm is None or not good.any():
+            break
+        new = _scatter(lsm, cand, cc.size)
+        gi = cand[good]
+        own = _own_pixel_upper(Lf, Rf, cc[gi], rr[gi], cc[gi] - new.cols[gi], d[gi], p[gi],
+                               opt)
+        gi = gi[own]
+        full.cols[gi], full.sigma[gi], full.corr[gi] = new.cols[gi], new.sigma[gi], new.corr[gi]
+        out[gi] = True
+        grown += int(gi.size)
+    sub["grown"] = grown
+
+
+#: Disparity difference (px) within which neighbouring upper nodes belong to one surface.
+UPPER_NEIGHBOUR_PX = 2.0
+#: Grow the eroded upper population back by one node (:func:`_inner_nodes`).
+UPPER_REOPEN = True
+#: The upward search's NCC window is this much larger than ``refine_window`` (px).
+UPPER_WINDOW_ADD = 4
+
+
+def _inner_nodes(cc: NDArray, rr: NDArray, disp: NDArray, step: int,
+                 reopen: bool = UPPER_REOPEN) -> NDArray:
+    """Upper nodes whose four grid neighbours are upper nodes of the same surface (within
+    :data:`UPPER_NEIGHBOUR_PX`): the upper population eroded by one node, and (``reopen``)
+    grown back by one node onto upper nodes of the same surface (a morphological opening).
+
+    Ground nodes beside a wall that still match the roof (fattening, on the aerial block in
+    lines along the walls, consistent with each other) form the rim of the population and
+    touch no inner node; the roof's own rim touches its inner nodes and comes back.
+    """
+    if cc.size == 0:
+        return np.zeros(0, bool)
+    i = np.floor(rr / step).astype(np.int64)  # nodes at step/2 + k·step
+    j = np.floor(cc / step).astype(np.int64)
+    i, j = i - i.min() + 1, j - j.min() + 1
+    shape = (int(i.max()) + 2, int(j.max()) + 2)
+    grid = np.full(shape, np.nan)
+    grid[i, j] = disp
+    four = ((0, 1), (0, -1), (1, 0), (-1, 0))
+    keep = np.ones(cc.size, bool)
+    for di, dj in four:
+        keep &= np.abs(grid[i + di, j + dj] - disp) <= UPPER_NEIGHBOUR_PX  # NaN fails
+    if not reopen:
+        return keep
+    inner = np.full(shape, np.nan)
+    inner[i[keep], j[keep]] = disp[keep]
+    out = keep.copy()
+    for di, dj in four:
+        out |= np.abs(inner[i + di, j + dj] - disp) <= UPPER_NEIGHBOUR_PX
+    return out
+
+
+def _own_pixel_upper(Lf: NDArray, Rf: NDArray, cc: NDArray, rr: NDArray, d_up: NDArray,
+                     d: NDArray, p: NDArray, opt: FbmLsmOptions) -> NDArray:
+    """Upper matches whose own pixel is upper too (shiftable windows).
+
+    A ground node within half a matching window of a roof edge matches the roof: the edge's
+    contrast fills the window (foreground fattening). Windows ending at the node on its left,
+    centred on it and ending on its right are correlated at the upper disparity and around
+    the plane; the node stays upper only if the best of the six is an upper one — beside a
+    wall the window on the far side of the edge sees ground only and prefers the plane.
+    """
+    win = max(3, int(opt.refine_window) - 2) | 1
+    best_near = np.full(cc.size, -1.0)
+    best_up = np.full(cc.size, -1.0)
+    for shift in (-(win // 2), 0, win // 2):
+        cs = cc + shift
+        near = ncc_epipolar(Lf, Rf, cs, rr, np.floor(d - p), np.ceil(d + p), window=win,
+                            min_ncc=-1.0, max_ratio=1.0)
+        up = ncc_epipolar(Lf, Rf, cs, rr, np.floor(d_up) - 1, np.ceil(d_up) + 1, window=win,
+                          min_ncc=-1.0, max_ratio=1.0)
+        best_near = np.fmax(best_near, np.nan_to_num(near.ncc, nan=-1.0))
+        best_up = np.fmax(best_up, np.nan_to_num(up.ncc, nan=-1.0))
+    return best_up > best_near
 
 
 def _no_points() -> InterestPoints:

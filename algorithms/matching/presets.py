@@ -10,7 +10,10 @@ from typing import Any, Dict, Optional, Tuple
 
 #: Strategy presets (seed-000 §3.1: empirical parameter sets per terrain type). Keys are
 #: fields of :class:`.hierarchy.FbmLsmOptions` or the surface options of
-#: :func:`.fbm_model.match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``).
+#: :func:`.fbm_model.match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``,
+#: ``objects``; ``object_height_m``: the grid densification's upward search in metres,
+#: converted per model into ``object_search`` px; ``wall_offset_gsd``: automatic breaklines
+#: this far from the upper point of a jump).
 PRESETS: Dict[str, Dict[str, Any]] = {
     # terrain only (was "flat"): large windows and groundels, L1 planes, smooth surface — a
     # DTM-like surface: buildings and trees are reduced away as outliers (issue 19)
@@ -29,9 +32,14 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # smoothing; groundel outliers that form a consistent upper surface stay,
     # and height jumps between points become breaklines (``objects``), so roofs and walls stay;
     # a level-0 pull-in of 20 px reaches roofs about 10 m above the ground plane of a window
-    # at B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity)
+    # at B/H ≈ 0.35 (issue 19: with the default 4–8 px roof points took the ground's disparity);
+    # grid nodes not matched near the plane search up to 15 m above it in px of the model's
+    # parallax (≈ 62 px on the wide-angle aerial block, where 20 px is only ≈ 5 m), and the
+    # breaklines lie 8 GSD from the upper point of a jump (the ground behind a wall is hidden
+    # from one image; halfway put walls 2–3 m out)
     "urban": {"fbm_window": 16, "bidir_tol": 0.5, "object_pull_in": 20.0, "groundel_gsd": 10.0,
-              "reduction": "median", "smoothing": 0.05, "objects": True},
+              "reduction": "median", "smoothing": 0.05, "objects": True,
+              "object_height_m": 15.0, "wall_offset_gsd": 8.0},
     # vegetation: the lower envelope of the points of a groundel is taken as the terrain
     "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
                "smoothing": 0.3},

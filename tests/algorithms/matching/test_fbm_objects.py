@@ -6,6 +6,7 @@ name is still accepted."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Dict, Tuple
 
 import numpy as np
@@ -28,7 +29,7 @@ def _texture(rng: np.random.Generator, shape: Tuple[int, int], sigma: float, amp
     return amp * ndimage.gaussian_filter(rng.normal(size=shape), sigma)
 
 
-def _scene(seed: int = 5) -> Dict[str, np.ndarray]:
+def _scene(seed: int = 5, roof: float = 15.0) -> Dict[str, np.ndarray]:
     """An epipolar pair with a textured flat roof (+15 px, about 8 m at B/H 0.35 and GSD
     0.2 m) and a gabled roof (+12 px at the eaves to +20 px at the ridge) with two-tone, weakly
     textured faces; true disparity (a height in disparity units) and labels (1 flat, 2 gabled).
@@ -38,7 +39,7 @@ def _scene(seed: int = 5) -> Dict[str, np.ndarray]:
     d = np.full((h, w), GROUND)
     label = np.zeros((h, w), np.int32)
     label[40:110, 50:130] = 1
-    d[40:110, 50:130] = GROUND + 15.0
+    d[40:110, 50:130] = GROUND + roof
     label[130:210, 160:260] = 2
     cols = np.arange(160, 260)
     d[130:210, 160:260] = GROUND + 12.0 + 8.0 * (1.0 - np.abs(cols - 209.5) / 50.0)[None, :]
@@ -68,12 +69,20 @@ def _scene(seed: int = 5) -> Dict[str, np.ndarray]:
             "label": label}
 
 
-def _surface(scene: Dict[str, np.ndarray], preset: str) -> np.ndarray:
-    """The fbm_lsm chain of a preset in disparity space: matching, groundels (10 px), object
-    surfaces and automatic breaklines (general, urban), FE surface on a 2 px grid → disparity per
-    pixel (x = column, y = −row)."""
+#: Parallax per metre of height of the scene (px): +15 px ≈ 8 m as on the ``small`` block.
+PX_PER_M = 15.0 / 8.0
+
+
+def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER_M,
+             max_d: float = 47.0) -> np.ndarray:
+    """The fbm_lsm chain of a preset in disparity space: matching (the preset's object search
+    in px at ``px_per_m``), groundels (10 px), object surfaces and automatic breaklines
+    (general, urban; the preset's wall offset), FE surface on a 2 px grid → disparity per pixel
+    (x = column, y = −row)."""
     opts, surface = _options(preset, {})
-    m = match_epipolar_fbm_lsm(scene["left"], scene["right"], 0.0, 47.0, options=opts)
+    if surface.get("object_height_m"):
+        opts = replace(opts, object_search=float(surface["object_height_m"]) * px_per_m)
+    m = match_epipolar_fbm_lsm(scene["left"], scene["right"], 0.0, max_d, options=opts)
     h, w = scene["d"].shape
     pts = np.column_stack([m.col, -m.row, m.disparity])
     cell = float(surface["groundel_gsd"])  # 1 px = 1 GSD
@@ -81,7 +90,8 @@ def _surface(scene: Dict[str, np.ndarray], preset: str) -> np.ndarray:
                            mode=surface["reduction"])
     inlier, lines = ~red.outlier, []
     if surface.get("objects"):
-        inlier, lines = object_surfaces(pts, red)
+        offset = surface.get("wall_offset_gsd")
+        inlier, lines = object_surfaces(pts, red, None if offset is None else float(offset))
     grid = Grid.from_bounds(0.0, -float(h), float(w), 0.0, SPACING_GSD)
     z, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                           smoothing=float(surface["smoothing"]), breaklines=lines)
@@ -115,15 +125,30 @@ def scene() -> Dict[str, np.ndarray]:
 @pytest.mark.parametrize("preset", ["general", "urban"])
 def test_object_presets_keep_roofs_and_walls(scene, preset) -> None:
     dsm = _surface(scene, preset)
-    # measured: urban flat 96.2 % / 4 px, gabled 97.6 % / 7 px, open 97.9 %; general (the
-    # default) 95.9 % / 4 px, 97.6 % / 6 px, open 98.0 %. The walls miss the goal of 1 GSD: the
-    # automatic breakline lies halfway between the last roof and the first ground point, and
-    # the ground beside a wall is partly occluded (few points)
+    # measured: urban flat 96.2 % / 4 px, gabled 97.4 % / 6 px, open 97.9 % (breaklines 8 px
+    # from the roof points, upward search 28 px); general (the default) 95.9 % / 4 px,
+    # 97.6 % / 6 px, open 98.0 %. The walls miss the goal of 1 GSD: the ground beside a wall
+    # is partly occluded (few points)
     for k, wall_max in ((1, 6.0), (2, 9.0)):
         c, wall = _building(dsm, scene, k)
         assert c >= 0.9 and wall <= wall_max, (k, c, wall)
     open_ = ndimage.distance_transform_edt(scene["label"] == 0) > 10
     assert (np.abs(dsm - scene["d"]) <= 1.0)[open_].mean() >= 0.95
+
+
+def test_urban_keeps_a_roof_beyond_the_pull_in() -> None:
+    """A flat roof 40 px above the ground (≈ 10 m at the aerial block's 4.1 px per metre),
+    twice the 20 px finest-level pull-in: the upward search of the grid densification finds
+    it, the shiftable-window and rim tests keep the ground beside it, and the breaklines next
+    to the roof points keep its walls."""
+    scene = _scene(seed=7, roof=40.0)
+    dsm = _surface(scene, "urban", px_per_m=4.1, max_d=GROUND + 60.0)
+    # measured: flat roof 99.3 % within 1 px, wall 4 px, open 93.8 %; without the upward
+    # search 0 % (the roof is reduced away as the ground plane's outlier)
+    c, wall = _building(dsm, scene, 1)
+    assert c >= 0.95 and wall <= 6.0, (c, wall)
+    open_ = ndimage.distance_transform_edt(scene["label"] == 0) > 10
+    assert (np.abs(dsm - scene["d"]) <= 1.0)[open_].mean() >= 0.92
 
 
 def test_terrain_removes_roofs(scene) -> None:
@@ -154,3 +179,62 @@ def test_flat_is_an_alias_of_terrain() -> None:
     assert DEFAULT_PRESET == "general"
     assert resolve_preset("flat")[0] == "terrain" and resolve_preset("flat")[1]
     assert resolve_preset("urban") == ("urban", None)
+
+
+def test_jump_breaklines_beside_the_upper_points() -> None:
+    """A roof with a 4 m gap of no points on one side (the ground a wall hides from one
+    image): halfway puts that wall 2 m out; ``upper_offset`` puts it next to the roof."""
+    rng = np.random.default_rng(1)
+    x, y = rng.uniform(0, 24, (2, 2500))
+    roof = (np.abs(x - 12) < 4) & (np.abs(y - 12) < 4)
+    hidden = (x > 16) & (x < 20) & (np.abs(y - 12) < 4)  # no ground points east of the roof
+    keep = ~hidden
+    x, y, z = x[keep], y[keep], np.where(roof[keep], 8.0, 0.0)
+    east = {}
+    for name, offset in (("halfway", None), ("upper", 0.3)):
+        lines = jump_breaklines(x, y, z, min_step=1.5, upper_offset=offset)
+        assert len(lines) == 1
+        seg = np.array([np.asarray(g.coords) for g in lines[0].geoms]).reshape(-1, 2)
+        side = (seg[:, 0] > 14) & (np.abs(seg[:, 1] - 12) < 3)
+        east[name] = float(np.median(seg[side, 0]))
+    # measured: halfway 17.8 m, upper 16.2 m (true wall at 16 m)
+    assert east["halfway"] > 17.0
+    assert abs(east["upper"] - 16.0) < 0.5
+
+
+def test_inner_nodes_drop_the_rim_beside_a_roof() -> None:
+    """Upper grid nodes: a 6 × 6-node roof and, one failed column apart, a line of nodes at
+    the roof's disparity (ground beside a wall matched to the roof's edge): the opening keeps
+    the roof but its four corners and drops the line; the plain erosion keeps the inner 4 × 4."""
+    from photodem.algorithms.matching.hierarchy import _inner_nodes
+
+    step = 4
+    ii, jj = np.mgrid[0:6, 0:6]
+    i = np.concatenate([ii.ravel(), np.arange(6)])
+    j = np.concatenate([jj.ravel(), np.full(6, 7)])
+    d = np.concatenate([np.full(36, 40.0), np.full(6, 40.5)])
+    cc, rr = step / 2 + j * step, step / 2 + i * step
+    opened = _inner_nodes(cc, rr, d, step)
+    eroded = _inner_nodes(cc, rr, d, step, reopen=False)
+    corners = np.zeros(36, bool)
+    corners[[0, 5, 30, 35]] = True
+    assert (opened[:36] == ~corners).all() and not opened[36:].any()
+    assert eroded[:36].sum() == 16 and not eroded[36:].any()
+
+
+def test_object_height_in_px_of_the_model() -> None:
+    """The preset's object height (m) becomes the upward search in px of each model:
+    base (px) / H per metre; an explicit ``object_search`` wins."""
+    from types import SimpleNamespace
+
+    from photodem.algorithms.matching.fbm_model import _object_search, parallax_per_metre
+
+    pair = SimpleNamespace(base=690.0, focal_px=7650.0)  # aerial: B/H ≈ 0.6, f 153 mm
+    setup = SimpleNamespace(pair=pair, flying_height=1148.0)
+    assert parallax_per_metre(setup) == pytest.approx(690.0 * 7650.0 / 1148.0 ** 2)
+    opts, surface = _options("urban", {})
+    found = _object_search(opts, surface, setup)
+    assert found.object_search == pytest.approx(15.0 * parallax_per_metre(setup))
+    assert _object_search(replace(opts, object_search=7.0), surface, setup).object_search == 7.0
+    general, surface_g = _options("general", {})
+    assert _object_search(general, surface_g, setup).object_search is None
