@@ -24,10 +24,12 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # 32 px windows, 20-GSD groundels and ρ ≥ 0.55 — on open aerial terrain urban's 16 px
     # windows with the 20 px pull-in find clusters of wrong, mutually agreeing points
     # (0.21 ‰ H against 0.044 here); on the roofs of the small blocks as good (tuning table in
-    # docs/decisions.md, "fbm_lsm keeps objects")
+    # docs/decisions.md, "fbm_lsm keeps objects"); urban's upward search and wall placement
+    # (below) as well: on the wide-angle aerial block the pull-in alone reaches no roof
+    # (object interior 0.3 % on seed 1)
     "general": {"fbm_window": 32, "bidir_tol": 0.5, "object_pull_in": 20.0, "rho_min": 0.55,
                 "groundel_gsd": 20.0, "reduction": "median", "smoothing": 0.05,
-                "objects": True},
+                "objects": True, "object_height_m": 15.0, "wall_offset_gsd": 8.0},
     # buildings: small windows, tight bidirectional check, small groundels, median, little
     # smoothing; groundel outliers that form a consistent upper surface stay,
     # and height jumps between points become breaklines (``objects``), so roofs and walls stay;
