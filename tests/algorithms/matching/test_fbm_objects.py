@@ -236,5 +236,8 @@ def test_object_height_in_px_of_the_model() -> None:
     found = _object_search(opts, surface, setup)
     assert found.object_search == pytest.approx(15.0 * parallax_per_metre(setup))
     assert _object_search(replace(opts, object_search=7.0), surface, setup).object_search == 7.0
-    general, surface_g = _options("general", {})
-    assert _object_search(general, surface_g, setup).object_search is None
+    general, surface_g = _options("general", {})  # the default searches as urban does
+    assert _object_search(general, surface_g, setup).object_search == pytest.approx(
+        found.object_search)
+    terrain, surface_t = _options("terrain", {})  # a terrain model looks for no objects
+    assert _object_search(terrain, surface_t, setup).object_search is None
