@@ -11,7 +11,11 @@ shadows and trees cut them, relief displacement moves them. One pair says little
    join a neighbour, so a roof half carrying spots stays one segment and narrow halves keep
    their exact outline (no gradient band); pairs of adjacent segments whose union is
    rectangular are added (the two halves of a gabled roof merged across the ridge); size
-   window and shape filters (rectangularity, elongation, no holes).
+   window and shape filters (rectangularity, elongation, no holes). A single segment
+   elongated like a roof half also gives its rectangle mirrored across either long side
+   (:func:`mirrored_wholes`): the shaded half often runs into its cast shadow, so the sunlit
+   half alone must stand for the whole roof. Mirrored wholes never seed hypotheses and are
+   neighbour sites only when the segments' own sites give no consensus.
 2. **One-pair hypotheses**: every (candidate, footprint) pair of plausible size gives the 8
    affine maps of the standard positions (:mod:`.invariants`; a rectangle's standard position is
    a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
