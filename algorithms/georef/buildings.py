@@ -11,7 +11,11 @@ shadows and trees cut them, relief displacement moves them. One pair says little
    join a neighbour, so a roof half carrying spots stays one segment and narrow halves keep
    their exact outline (no gradient band); pairs of adjacent segments whose union is
    rectangular are added (the two halves of a gabled roof merged across the ridge); size
-   window and shape filters (rectangularity, elongation, no holes).
+   window and shape filters (rectangularity, elongation, no holes). A single segment
+   elongated like a roof half also gives its rectangle mirrored across either long side
+   (:func:`mirrored_wholes`): the shaded half often runs into its cast shadow, so the sunlit
+   half alone must stand for the whole roof. Mirrored wholes never seed hypotheses and are
+   neighbour sites only when the segments' own sites give no consensus.
 2. **One-pair hypotheses**: every (candidate, footprint) pair of plausible size gives the 8
    affine maps of the standard positions (:mod:`.invariants`; a rectangle's standard position is
    a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
@@ -84,6 +88,12 @@ MIN_RECTANGULARITY = 0.55
 MAX_ELONGATION = 10.0
 #: Share of a candidate's outline area its own pixels fill (holes: not a roof).
 MIN_FILL = 0.92
+#: A single segment at least this rectangular and elongated (long / short side) may be one
+#: half of a gabled roof (a whole roof no longer than wide has halves of 2:1): its mirror
+#: images across either long side are added as whole-roof candidates (the shaded half often
+#: runs into its cast shadow and has no outline of its own).
+MIRROR_RECTANGULARITY = MIN_RECTANGULARITY
+MIRROR_MIN_ELONGATION = 1.8
 #: Candidates at least this rectangular are neighbours (sites) in the hypothesis scoring.
 SITE_RECTANGULARITY = 0.7
 #: Candidates at least this rectangular seed hypotheses (all are neighbours).
@@ -96,8 +106,10 @@ MIN_MATCHES = 6
 MIN_SHARE = 0.25
 MIN_LEAD = 1.5
 #: Overlap of a verified roof with its footprint (min of both shares): a roof half (≤ 0.5)
-#: or a roof with its shadow would pull the ICP's outlines apart.
-VERIFY_OVERLAP = 0.6
+#: or a roof with its shadow would pull the ICP's outlines apart. 0.7 since the mirrored
+#: wholes (0.6 before: with whole roofs for half the footprints the stricter choice leaves
+#: enough roofs and a lower ICP RMS; seeds 0–9 at relief 3: 6 instead of 4 within 1 px).
+VERIFY_OVERLAP = 0.7
 #: Rounds of verification and refit of the consensus on the verified roofs.
 REFINE_ROUNDS = 4
 
@@ -206,13 +218,18 @@ def roof_candidates(grey: Array, scales: Sequence[float] = SEGMENT_SCALES,
         keep &= mean > dark
         keep &= _border_contrast(lab, gm, n) >= MIN_BORDER_CONTRAST * unit
         keep[0] = False
-        n_single = 0
+        n_single = n_mirrored = 0
         for value, ring in label_rings(lab, keep):
             ok, rect = _shape_ok(ring)
             # holes (a lawn block around houses, not a roof) fail the fill share
             if ok and size[value] >= MIN_FILL * _ring_area(ring):
                 objs.append(_candidate(ring - 0.5, k, t, int(size[value]), rect, len(objs)))
                 n_single += 1
+                if rect >= MIRROR_RECTANGULARITY:
+                    for whole in mirrored_wholes(ring - 0.5, int(size[value]), max_area=hi):
+                        objs.append(_candidate(whole, k, t, 2 * int(size[value]), 1.0,
+                                               len(objs), mirrored=True))
+                        n_mirrored += 1
         # halves of a gabled roof (or roof and dormer side): merge pairs of adjacent zones
         n_merged = 0
         boxes = ndimage.find_objects(lab)
@@ -231,15 +248,39 @@ def roof_candidates(grey: Array, scales: Sequence[float] = SEGMENT_SCALES,
                                        merged=True))
                 n_merged += 1
         runs.append({"scale": float(t), "segments": n, "single": n_single,
-                     "merged": n_merged})
+                     "merged": n_merged, "mirrored": n_mirrored})
     return objs, {"runs": runs}
 
 
+def mirrored_wholes(ring: Array, pixels: float, max_area: float = np.inf) -> List[Array]:
+    """Whole-roof rectangles of a segment that may be one roof half: its rectangle doubled
+    across each of its long sides (the ridge is one of them; which one the footprints decide).
+    The rectangle is the minimum bounding rectangle of the pixel outline shrunk by a common
+    margin to the segment's ``pixels`` (the staircase outline of a rotated edge lies up to
+    half a pixel outside it). None when the segment is not elongated enough
+    (:data:`MIRROR_MIN_ELONGATION`) or the whole would exceed ``max_area`` (px²)."""
+    c, ax, half = min_bounding_rectangle(ring)
+    i = int(np.argmax(half))
+    a, b = float(half[i]), float(half[1 - i])
+    # (2a − 2d)(2b − 2d) = pixels, the smaller root
+    d = 0.5 * ((a + b) - math.sqrt(max((a - b) ** 2 + pixels, 0.0)))
+    a, b = a - max(d, 0.0), b - max(d, 0.0)
+    if b <= 0 or a / b < MIRROR_MIN_ELONGATION or 8.0 * a * b > max_area:
+        return []
+    u, v = ax[i], ax[1 - i]
+    corners = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)], float)
+    out = []
+    for side in (-1.0, 1.0):
+        cc = c + side * b * v
+        out.append(orient_ring(cc + corners[:, :1] * a * u + corners[:, 1:] * 2.0 * b * v))
+    return out
+
+
 def _candidate(ring: Array, run: int, t: float, pixels: int, rect: float, ident: int,
-               merged: bool = False) -> PolygonObject:
+               merged: bool = False, mirrored: bool = False) -> PolygonObject:
     return PolygonObject(id=ident, ring=ring, source=IMAGE, run=run, threshold=float(t),
                          attributes={"pixels": pixels, "rectangularity": round(rect, 3),
-                                     "merged": merged})
+                                     "merged": merged, "mirrored": mirrored})
 
 
 def _union_ring(lab: NDArray[np.int32], a: int, b: int, boxes: Sequence[Any]
@@ -460,19 +501,46 @@ def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
                              "candidates in the image")
     fi = object_features(cands)
     fb.progress(30)
-    sites, site_of = _sites(fi, 3.0, [c.attributes["rectangularity"] >= SITE_RECTANGULARITY
-                                       for c in cands])
     cr = np.array([f.centroid for f in fr])
     base_tol = 0.25 * math.sqrt(float(np.median([f.area for f in fr])))
     halves, owner = roof_halves(ref_objs)
     shapes = _shapes(fr, object_features(halves), owner)
-    sources = [i for i, c in enumerate(cands)
-               if c.attributes["rectangularity"] >= SOURCE_RECTANGULARITY]
+    mirrored = [bool(c.attributes.get("mirrored")) for c in cands]
+    rect = [c.attributes["rectangularity"] for c in cands]
+    # the mirrored wholes never seed a hypothesis (two per half, one of them wrong: they
+    # flood the tries with false seeds); as neighbour sites they are tried only when the
+    # segments' own sites give no consensus — their wrong halves add chance matches that
+    # favour placements at a wrong scale
+    sources = [i for i in range(len(cands)) if rect[i] >= SOURCE_RECTANGULARITY
+               and not mirrored[i]]
+    T, why = None, ""
+    for with_mirrored in (False, True):
+        use = [r >= SITE_RECTANGULARITY and (with_mirrored or not m)
+               for r, m in zip(rect, mirrored)]
+        T, why = _consensus(fi, use, shapes, cr, base_tol, sources, grey.shape, counts,
+                            max_tries, fb)
+        counts["consensus_mirrored_sites"] = with_mirrored
+        if T is not None or not any(mirrored):
+            break
+    fb.progress(50)
+    if T is None:
+        return BuildingMatch(None, [], [], fi, fr, counts, why)
+    T = _refine(T, fi, shapes, [o.ring for o in ref_objs] + [h.ring for h in halves], base_tol)
+    return _verified(T, fi, fr, counts, base_tol)
+
+
+def _consensus(fi: Sequence[ObjectFeatures], use: Sequence[bool], shapes: _Shapes, cr: Array,
+               base_tol: float, sources: Sequence[int], shape: Tuple[int, int],
+               counts: Dict[str, Any], max_tries: int, fb: Feedback
+               ) -> Tuple[Optional[Array], str]:
+    """Hypotheses on the sites of the candidates in ``use``, grown over the image (module
+    notes, steps 2–3). Returns the accepted consensus transform, or None and why not;
+    ``counts`` gets the figures."""
+    sites, site_of = _sites(fi, 3.0, use)
     hyps = _hypotheses(fi, shapes, sites, site_of, cr, base_tol, sources,
-                       float(grey.size))
+                       float(shape[0] * shape[1]))
     counts.update(sites=len(sites), hypotheses=len(hyps),
                   best_support=round(float(hyps[0][0]), 3) if hyps else 0)
-    fb.progress(50)
     # targets of the growth: footprint centroids and roof-half centroids (a site is often one
     # half of a gabled roof); a footprint counts once
     ttree = cKDTree(shapes.centroid)
@@ -486,19 +554,16 @@ def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
             best.append((n, T, si, rj))
     best.sort(key=lambda t: -t[0])
     if not best:
-        return BuildingMatch(None, [], [], fi, fr, counts,
-                             "no hypothesis is supported by its neighbours")
+        return None, "no hypothesis is supported by its neighbours"
     n, T, si, rj = best[0]
     runner = max([b[0] for b in best[1:] if not _same_placement(b[2], b[3], si, rj)] or [0])
-    inside = _inside_count(T, cr, grey.shape)
+    inside = _inside_count(T, cr, shape)
     counts.update(consensus_pairs=n, footprints_inside=inside, runner_up_pairs=runner)
     if n < MIN_MATCHES or n < MIN_SHARE * inside or n < MIN_LEAD * runner:
-        why = (f"the best placement matches {n} footprint(s) of {inside} inside the image "
-               f"(needs ≥ {MIN_MATCHES} and ≥ {100 * MIN_SHARE:.0f} %), the best different "
-               f"one {runner} (needs a lead of ×{MIN_LEAD:g})")
-        return BuildingMatch(None, [], [], fi, fr, counts, why)
-    T = _refine(T, fi, shapes, [o.ring for o in ref_objs] + [h.ring for h in halves], base_tol)
-    return _verified(T, fi, fr, sites, site_of, counts, base_tol)
+        return None, (f"the best placement matches {n} footprint(s) of {inside} inside the "
+                      f"image (needs ≥ {MIN_MATCHES} and ≥ {100 * MIN_SHARE:.0f} %), the best "
+                      f"different one {runner} (needs a lead of ×{MIN_LEAD:g})")
+    return T, ""
 
 
 def _refine(T: Array, fi: Sequence[ObjectFeatures], shapes: _Shapes,
@@ -538,8 +603,7 @@ def _refine(T: Array, fi: Sequence[ObjectFeatures], shapes: _Shapes,
 
 
 def _verified(T: Array, fi: Sequence[ObjectFeatures], fr: Sequence[ObjectFeatures],
-              sites: Array, site_of: NDArray[np.int64], counts: Dict[str, Any],
-              base_tol: float) -> BuildingMatch:
+              counts: Dict[str, Any], base_tol: float) -> BuildingMatch:
     """Candidates against footprints under the refined ``T``: the existing verification
     (overlap, one partner each) picks the candidate shape of each footprint (for the review's
     overlay and the per-pair figures)."""
