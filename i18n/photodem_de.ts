@@ -989,9 +989,9 @@
             <translation>Strategievorgabe (fbm_lsm)</translation>
         </message>
         <message>
-            <source>general (default): keeps buildings and trees with sharp walls (a DSM) and open terrain as accurate as terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <source>general (default): keeps buildings and trees (a DSM; roofs are searched up to 15 m above the ground), open terrain nearly as accurate as with terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
             <extracomment>match_model.preset: help</extracomment>
-            <translation>allgemein (Standard): behält Gebäude und Bäume mit scharfen Wänden (ein DOM) und offenes Gelände so genau wie Gelände; städtisch: kleinere Fenster und Geländeelemente für bebaute Gebiete; Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
+            <translation>allgemein (Standard): behält Gebäude und Bäume (ein DOM; Dächer werden bis 15 m über dem Boden gesucht), offenes Gelände fast so genau wie mit Gelände; städtisch: kleinere Fenster und Geländeelemente für bebaute Gebiete; Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>terrain</source>
@@ -5304,6 +5304,10 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>general (default): keeps buildings and trees with sharp walls (a DSM) and open terrain as accurate as terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>
+            <translation type="vanished">allgemein (Standard): behält Gebäude und Bäume mit scharfen Wänden (ein DOM) und offenes Gelände so genau wie Gelände; städtisch: kleinere Fenster und Geländeelemente für bebaute Gebiete; Gelände (früher flach): große Fenster und Geländeelemente, glatte Fläche ohne Objekte (fast ein DGM); hügelig: mittlere; Wald: untere Einhüllende der Punkte je Geländeelement. Die unten angegebenen Optionen überschreiben die Vorgabe.</translation>
         </message>
         <message>
             <source>A polygon layer in any CRS (matched in its projected CRS, or the UTM zone of its centre), or a georeferenced raster segmented like the image.</source>

@@ -120,8 +120,9 @@ class MatchModel(Algorithm):
                        "fbm_lsm, 10 × spacing for dense."),
         Parameter("preset", "enum", "Strategy preset (fbm_lsm)", default=DEFAULT_PRESET,
                   options=PRESET_NAMES, aliases=tuple(PRESET_ALIASES),
-                  help="general (default): keeps buildings and trees with sharp walls (a "
-                       "DSM) and open terrain as accurate as terrain; urban: smaller windows "
+                  help="general (default): keeps buildings and trees (a DSM; roofs are "
+                       "searched up to 15 m above the ground), open terrain nearly as accurate "
+                       "as with terrain; urban: smaller windows "
                        "and groundels for built-up areas; terrain (formerly flat): large windows "
                        "and groundels, smooth surface without objects (nearly a DTM); hilly: "
                        "medium; forest: lower envelope of the points per groundel. The options "
