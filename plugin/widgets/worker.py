@@ -10,7 +10,7 @@ check and discards its staged outputs.
 from __future__ import annotations
 
 import traceback
-from typing import Any, Dict, Optional
+from typing import Any, Callable, Dict, Optional
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.feedback import Feedback
@@ -82,12 +82,18 @@ class AlgorithmWorker(QObject):
             self.done.emit()
 
 
-def start_in_thread(worker: AlgorithmWorker, parent: Optional[QObject] = None) -> QThread:
+def start_in_thread(worker: AlgorithmWorker, parent: Optional[QObject] = None,
+                    on_finished: Optional[Callable[[], None]] = None) -> QThread:
     """Move ``worker`` to a new QThread, start it, and clean both up when the run is done.
 
     The caller keeps references to the worker and the returned thread until ``done``.
+    ``on_finished`` is connected to the thread's ``finished`` *before* the thread starts: a
+    run that fails at once can end its thread before a connection made after ``start()``,
+    and its end would never be seen.
     """
     thread = QThread(parent)
+    if on_finished is not None:
+        thread.finished.connect(on_finished)
     worker.moveToThread(thread)
     thread.started.connect(worker.run)
     # Direct: quit() is thread-safe, and the thread then ends even while the GUI thread is
