@@ -257,7 +257,7 @@ def mirrored_wholes(ring: Array, pixels: float, max_area: float = np.inf) -> Lis
     across each of its long sides (the ridge is one of them; which one the footprints decide).
     The rectangle is the minimum bounding rectangle of the pixel outline shrunk by a common
     margin to the segment's ``pixels`` (the staircase outline of a rotated edge lies up to
-    half a pixel outside it). None when the segment is not elongated enough
+    half a pixel outside it). Empty when the segment is not elongated enough
     (:data:`MIRROR_MIN_ELONGATION`) or the whole would exceed ``max_area`` (px²)."""
     c, ax, half = min_bounding_rectangle(ring)
     i = int(np.argmax(half))
