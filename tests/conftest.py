@@ -3,12 +3,33 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("PHOTODEM_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+
+#: Seconds after which a test counts as hung and ends the run (``SIGALRM``'s default action,
+#: which needs no Python, so it works even when a deadlock holds the GIL). pytest's
+#: ``faulthandler_timeout`` (pyproject.toml, 600 s) has printed every thread's stack by then:
+#: a hang costs minutes and says where it is, instead of running into CI's time limit silently.
+HUNG_TEST_S = int(os.environ.get("PHOTODEM_HUNG_TEST_S", "660"))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """Arm the hang alarm for one test (setup, call and teardown)."""
+    armed = hasattr(signal, "alarm") and HUNG_TEST_S > 0
+    if armed:
+        signal.alarm(HUNG_TEST_S)
+    try:
+        yield
+    finally:
+        if armed:
+            signal.alarm(0)
 
 
 def shared_data(name: str) -> Path:

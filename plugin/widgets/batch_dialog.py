@@ -27,8 +27,9 @@ from ...algorithms.processing import batch, batch_setup
 from ...algorithms.processing.batch_setup import BatchChoices
 from ..i18n import tr
 from ..qt import QSettings, Qt, QtCore, QtGui, QtWidgets, QUrl, pyqtSignal
-from .batch_runner import BatchWorker, start_batch_thread
+from .batch_runner import BatchWorker
 from .parameter_form import SETTINGS_PROJECT, PathEdit
+from .worker import start_in_thread
 
 #: Settings keys (``QSettings`` standalone, ``QgsSettings`` in QGIS: the same API).
 SETTINGS_PREFIX = "PhotoDEM/batch/"
@@ -509,7 +510,7 @@ class BatchDialog(QtWidgets.QDialog):
         if self.start_worker is not None:
             self._handle = self.start_worker(worker)
         else:
-            self._handle = start_batch_thread(worker, self)
+            self._handle = start_in_thread(worker)
         self._update_buttons()
         self.batch_started.emit(str(path))
         return True

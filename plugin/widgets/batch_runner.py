@@ -4,7 +4,8 @@ The worker plans the batch with :func:`~photodem.algorithms.processing.batch.loa
 it with :func:`~photodem.algorithms.processing.batch.run_batch` — the same state folder, lock and
 resume rules as ``photodem batch FILE``. Its feedback turns the runner's per-task hooks into Qt
 signals (queued across threads: widgets are touched only in the GUI thread). QGIS runs the same
-:meth:`BatchWorker.execute` inside a ``QgsTask`` (``plugin/qgis/batch_actions.py``).
+:meth:`BatchWorker.execute` inside a ``QgsTask`` (``plugin/qgis/batch_actions.py``); standalone,
+:func:`~.worker.start_in_thread` runs it in a QThread.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Any, Dict, Optional, Sequence
 from ...algorithms.errors import PhotodemError
 from ...algorithms.feedback import Feedback
 from ...algorithms.processing import batch, batch_setup
-from ..qt import QObject, Qt, QThread, pyqtSignal, pyqtSlot
+from ..qt import QObject, pyqtSignal, pyqtSlot
 
 
 class _BatchFeedback(Feedback):
@@ -111,19 +112,4 @@ class BatchWorker(QObject):
             self.done.emit()
 
 
-def start_batch_thread(worker: BatchWorker, parent: Optional[QObject] = None) -> QThread:
-    """Move ``worker`` to a new QThread and start it; both are deleted when the run is done.
-
-    The caller keeps references to both until ``done`` (a QThread dropped while it runs
-    aborts the process).
-    """
-    thread = QThread(parent)
-    worker.moveToThread(thread)
-    thread.started.connect(worker.run)
-    worker.done.connect(thread.quit, Qt.DirectConnection)  # ends even while the GUI waits
-    thread.finished.connect(thread.deleteLater)
-    thread.start()
-    return thread
-
-
-__all__ = ["BatchWorker", "start_batch_thread"]
+__all__ = ["BatchWorker"]

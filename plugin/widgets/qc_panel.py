@@ -459,7 +459,7 @@ class QcPanel(QtWidgets.QWidget):
         worker.done.connect(self._done)
         self._set_busy(True)
         self.status.setText(text)
-        self._thread = start_in_thread(worker, self)
+        self._thread = start_in_thread(worker)
         return True
 
     def _set_busy(self, busy: bool) -> None:

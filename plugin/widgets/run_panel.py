@@ -143,7 +143,7 @@ class RunPanel(QtWidgets.QWidget):
         # The panel owns the thread: dropping the Python reference to a thread that is still
         # winding down would destroy it while it runs, which aborts the process. The run counts
         # as finished only once the thread has ended, so a new run can start right away.
-        self._thread = start_in_thread(worker, self, on_finished=self._on_done)
+        self._thread = start_in_thread(worker, on_finished=self._on_done)
         return worker
 
     def cancel(self) -> None:

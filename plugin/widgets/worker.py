@@ -10,7 +10,7 @@ check and discards its staged outputs.
 from __future__ import annotations
 
 import traceback
-from typing import Any, Callable, Dict, Optional
+from typing import Any, Callable, Dict, Optional, Set
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.feedback import Feedback
@@ -82,24 +82,41 @@ class AlgorithmWorker(QObject):
             self.done.emit()
 
 
-def start_in_thread(worker: AlgorithmWorker, parent: Optional[QObject] = None,
-                    on_finished: Optional[Callable[[], None]] = None) -> QThread:
+#: Threads started by :func:`start_in_thread` that have not been joined yet. None of them is
+#: the child of a widget: a widget deleted while its run winds down would delete the QThread
+#: with it, and ``~QThread`` then waits for the thread while holding the GIL that the thread
+#: needs to delete its Python worker — a deadlock (it hung a CI run once).
+_LIVE: Set[QThread] = set()
+
+
+def start_in_thread(worker: QObject, on_finished: Optional[Callable[[], None]] = None
+                    ) -> QThread:
     """Move ``worker`` to a new QThread, start it, and clean both up when the run is done.
 
-    The caller keeps references to the worker and the returned thread until ``done``.
-    ``on_finished`` is connected to the thread's ``finished`` *before* the thread starts: a
-    run that fails at once can end its thread before a connection made after ``start()``,
-    and its end would never be seen.
+    ``worker`` is a QObject with a ``run`` slot and a ``done`` signal emitted last
+    (:class:`AlgorithmWorker`, the batch worker). Qt deletes it in its own thread after
+    ``done``; the thread is joined in the GUI thread and then deleted. ``on_finished`` is
+    called in the GUI thread once the thread has ended — joined, so whatever the caller does
+    next (delete its widget, start the next run) cannot meet a thread still winding down. It
+    is connected before the thread starts: a run that fails at once can end its thread before
+    a connection made after ``start()``.
     """
-    thread = QThread(parent)
-    if on_finished is not None:
-        thread.finished.connect(on_finished)
+    thread = QThread()  # no parent: see _LIVE
+    _LIVE.add(thread)
+
+    def ended() -> None:
+        thread.wait()  # returns at once; releases the GIL the thread needs to delete its worker
+        _LIVE.discard(thread)
+        thread.deleteLater()
+        if on_finished is not None:
+            on_finished()
+
+    thread.finished.connect(ended)
     worker.moveToThread(thread)
     thread.started.connect(worker.run)
     # Direct: quit() is thread-safe, and the thread then ends even while the GUI thread is
     # blocked in QThread.wait() (a queued quit would only run after that wait timed out).
     worker.done.connect(thread.quit, Qt.DirectConnection)
     worker.done.connect(worker.deleteLater)
-    thread.finished.connect(thread.deleteLater)
     thread.start()
     return thread
