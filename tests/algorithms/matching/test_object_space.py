@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import rasterio
+from _three_frames import BASE, CRS, FLY, GSD, X0, Y0, ZT, write_three_frames
 from affine import Affine
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, InputError
 from photodem.algorithms.feedback import Feedback
-from photodem.algorithms.geometry.camera import Camera
 from photodem.algorithms.geometry.orientation import ExteriorOrientation
 from photodem.algorithms.matching.object_space import refine_object_space
 from photodem.algorithms.matching.object_space_window import (
@@ -29,17 +29,9 @@ from photodem.algorithms.matching.object_space_window import (
     _visibility,
 )
 from photodem.algorithms.processing import registry
-from photodem.algorithms.project.edits import add_features, create_edits
+from photodem.algorithms.project.edits import add_features
 from photodem.algorithms.project.model import ImageRecord, Project
 from photodem.algorithms.raster.io import write_raster
-from photodem.algorithms.synthetic.render import Renderer, render_image
-from photodem.algorithms.synthetic.terrain import Grid, band_noise
-
-CRS = "EPSG:25832"
-X0, Y0, ZT = 500000.0, 5500000.0, 100.0
-GSD, NPX = 0.2, 240
-FLY = GSD * NPX  # principal distance = NPX px → H = 48 m
-BASE = 12.0
 
 
 def truth(x, y):
@@ -54,27 +46,7 @@ def start_error(u, v):
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory):
     root = tmp_path_factory.mktemp("object_space") / "project"
-    cell, half = 0.1, 40.0
-    n = int(2 * half / cell)
-    grid = Grid(X0 - half, Y0 + half, cell, n, n)
-    dsm = truth(grid.xs, grid.ys) * np.ones((n, n))
-    rng = np.random.default_rng(1)
-    alb = np.clip(0.45 + 0.14 * band_noise(rng, grid, 1.2) + 0.07 * band_noise(rng, grid, 0.5),
-                  0.05, 0.95).astype(np.float32)
-    renderer = Renderer(grid, dsm, np.stack([alb, alb, alb]), np.zeros((0, 3)), 1.0)
-    cam = Camera("cam", NPX, NPX, focal_length=NPX * 0.01, pixel_size=(0.01, 0.01))
-    (root / "images").mkdir(parents=True)
-    seqs = np.random.SeedSequence(7).spawn(3)
-    recs = []
-    for k, dx in enumerate((-BASE, 0.0, BASE)):
-        eo = ExteriorOrientation.from_opk([X0 + dx, Y0, ZT + FLY], 0.5 * (k - 1), -0.3 * k,
-                                          1.0 * k)
-        img, _ = render_image(renderer, cam, eo, 2, 1 << 18, seqs[k], 0.1)
-        write_raster(root / "images" / f"img{k}.tif", img)
-        recs.append(ImageRecord(f"img{k}", f"images/img{k}.tif", "cam", eo))
-    Project(root=root, name="os", crs=CRS, cameras={"cam": cam}, images=recs,
-            terrain_height=ZT).save()
-    create_edits(root / "edits.gpkg", CRS)
+    write_three_frames(root, truth, "os")
     # start DSM: 24 m × 24 m at 0.4 m, truth + smooth error
     spacing, half_dsm = 0.4, 12.0
     m = int(2 * half_dsm / spacing)
