@@ -20,7 +20,8 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
-   cells; ``t = outlier_threshold``, default the height of 1 px of parallax ``GSD·H/B``).
+   cells; ``t = outlier_threshold``, default the height of 1 px of parallax ``GSD·H/B``,
+   :attr:`~.model_setup.ModelSetup.parallax_per_metre`).
 5. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
    barriers of the gap interpolation (gaps up to ``max_gap`` m), which also re-fills the
    rejected cells.
@@ -107,12 +108,13 @@ _WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": Fa
 
 def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
     """Matching options of the DSM path for one model: :data:`_DENSE_DEFAULTS` and the height
-    step of 1.5 m in px of the model's parallax (1 px = GSD·H/B m) as ``edge_jump``; for
+    step of 1.5 m in px of the model's parallax
+    (:attr:`~.model_setup.ModelSetup.parallax_per_metre`) as ``edge_jump``; for
     convergent models :data:`_CONVERGENT_OPTIONS`; for wide-base models (B/H ≥
     :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; with :data:`_WALL_RULE` or a wide base also
     the epipolar principal points as ``wall_view`` (where the left camera sees the walls of
     the objects in its occlusions)."""
-    jump = _JUMP_M * setup.pair.base / (float(setup.gsd) * setup.flying_height)
+    jump = _JUMP_M * setup.parallax_per_metre
     cx = setup.pair.cx
     wide = setup.pair.base / setup.flying_height >= WIDE_BASE
     view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
@@ -319,7 +321,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
     outliers = _Outliers(5.0 * spacing if outlier_radius is None else float(outlier_radius),
                          # 1 px of parallax in height
-                         float(setup.gsd) * setup.flying_height / pair.base
+                         1.0 / setup.parallax_per_metre
                          if outlier_threshold is None else outlier_threshold, outlier_k)
     for key, value in dsm_dense_options(setup).items():
         dense_options.setdefault(key, value)

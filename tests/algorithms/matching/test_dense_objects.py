@@ -246,10 +246,12 @@ def test_wide_base_models_get_the_wide_normalisation_and_the_fill_wall_rule() ->
 
     def setup(base: float) -> SimpleNamespace:
         pair = SimpleNamespace(base=base, cx=(-3986.0, 696.0))
-        return SimpleNamespace(pair=pair, gsd=0.15, flying_height=1148.0, convergent=False)
+        return SimpleNamespace(pair=pair, flying_height=1148.0, convergent=False,
+                               parallax_per_metre=base * 7650.0 / 1148.0 ** 2)
 
     wide = dsm_dense_options(setup(700.0))  # B/H 0.61, the aerial block
     assert wide["normalise_window"] == 21 and wide["wall_view"] == (-3986.0, 696.0)
     assert wide["wall_erosion"] is False
+    assert wide["edge_jump"] == pytest.approx(1.5 * 700.0 * 7650.0 / 1148.0 ** 2)  # 1.5 m
     narrow = dsm_dense_options(setup(400.0))  # B/H 0.35
     assert "normalise_window" not in narrow and narrow["wall_view"] is None
