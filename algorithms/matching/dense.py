@@ -59,7 +59,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..input_errors import warn_input
 from ..memory import check_allocation
-from .dense_fill import erode_lower_side, segment_fill, wall_share_columns
+from .dense_fill import erode_lower_side, wall_share_columns
 from .dense_fill import plane_fill as plane_fill_holes
 
 #: Matching methods; the first is the default.
@@ -249,7 +249,6 @@ class _TileMatcher:
     edge_reach: int = 0
     wall_view: Optional[Tuple[float, float]] = None
     wall_px: float = 20.0
-    segments: bool = False
     wall_erosion: bool = True
 
     def _matcher(self, lo: int, n_d: int) -> Any:
@@ -290,7 +289,7 @@ class _TileMatcher:
                             int(self.edge_erosion), float(self.range_guard),
                             float(self.edge_jump), float(self.plane_fill),
                             int(self.segment_px), int(self.edge_reach), walls, float(self.wall_px),
-                            bool(self.segments), bool(self.wall_erosion))
+                            bool(self.wall_erosion))
         return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
 
 
@@ -399,7 +398,7 @@ def iter_disparity_tiles(
     edge_jump: float = 0.0, plane_fill: float = 0.0,
     segment_px: int = 0, edge_reach: int = 0,
     wall_view: Optional[Tuple[float, float]] = None, wall_px: float = 20.0,
-    segments: bool = False, wall_erosion: bool = True,
+    wall_erosion: bool = True,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -452,10 +451,8 @@ def iter_disparity_tiles(
         Epipolar principal points (columns) of the left and right image: with ``edge_reach``,
         where the left camera sees a wall wider than ``wall_px`` in an occlusion, roof edges
         near holes are eroded and such holes get no roof (:mod:`.dense_fill`).
-    segments, wall_erosion : bool
-        ``segments``: fill the holes of planar object segments of the left image
-        (:func:`.dense_fill.segment_fill`); ``wall_erosion`` False: the wall rule of
-        ``wall_view`` applies to the plane fill only.
+    wall_erosion : bool
+        False: the wall rule of ``wall_view`` applies to the plane fill only.
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size, margin : int
@@ -479,8 +476,7 @@ def iter_disparity_tiles(
     match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
                          lr_max_diff, normalise_window, speckle_window, speckle_range,
                          fill_max_width, edge_erosion, range_guard, edge_jump, plane_fill,
-                         segment_px, edge_reach, wall_view, wall_px, segments,
-                         wall_erosion)
+                         segment_px, edge_reach, wall_view, wall_px, wall_erosion)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
@@ -581,11 +577,10 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
                  edge_erosion: int = 0, range_guard: float = 0.0, edge_jump: float = 0.0,
                  plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0,
                  wall_share: Optional[Array] = None, wall_px: float = 20.0,
-                 segments: bool = False, wall_erosion: bool = True) -> Array:
+                 wall_erosion: bool = True) -> Array:
     """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape);
     ``wall_share`` (per frame column), ``wall_px`` as :func:`.dense_fill.erode_lower_side`;
-    ``segments``: :func:`.dense_fill.segment_fill` after the plane fill; ``wall_erosion``:
-    the erosion takes ``wall_share`` too (else only the plane fill)."""
+    ``wall_erosion``: the erosion takes ``wall_share`` too (else only the plane fill)."""
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
     if ours and normalise_window > 1:
@@ -596,8 +591,6 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     invalid16 = (min_d - 1) * 16
     raw = matcher.compute(l8, r8)
     bad = raw == invalid16
-    # SGM's winners before the consistency filters: the planes of the segment fill
-    cand = np.where(bad, np.nan, raw.astype(np.float32) / 16.0) if segments else None
     h, w = raw.shape
     cols = np.arange(w)[None, :]
     rows = np.arange(h)[:, None]
@@ -646,8 +639,6 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
         disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
                                 window=block, wall_share=wall_share,
                                 wall_px=wall_px, far_side=wall_erosion)
-    if ours and segments and edge_jump > 0:
-        disp = segment_fill(disp, lmask, lg, edge_jump, cand)
     if ours and fill_max_width > 0:
         disp = fill_holes_rows(disp, lmask, fill_max_width)
     disp[lmask] = np.nan

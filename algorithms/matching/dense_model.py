@@ -66,13 +66,8 @@ PathLike = Union[str, Path]
 #: such holes get no roof fill: SGM spreads roofs over those walls (synthetic ``aerial`` block,
 #: wide angle, base 4 px per metre of height: open cells within 0.5 m of an object > 1 m off
 #: 42 % → 8 %; the ``small`` block's walls stay narrower and keep the rules above).
-#: The segment fill (``segments``, :func:`.dense_fill.segment_fill`: holes of planar object
-#: segments from the planes of SGM's winners before the consistency filters) is off: on the
-#: aerial block it adds +2.4 / +6.2 points of object interior on seeds 1 / 2 but only +0.7 on
-#: held-out seed 11, and on the tiny test block it spills roofs onto open land (open RMS
-#: 0.125 → 0.200 m; issue 19, part A in docs/decisions.md).
 _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0, "segment_px": 300,
-                                   "edge_reach": 15, "wall_px": 20.0, "segments": False}
+                                   "edge_reach": 15, "wall_px": 20.0}
 #: The rule against roofs spilling over walls one camera sees (``wall_view``, part D4 in
 #: docs/decisions.md) is off: on the aerial block it removes the spill (open cells with no
 #: margin: RMS 0.54 → 0.12 m) but also half of the roofs (object interior 44 → 27 % on seed 1,

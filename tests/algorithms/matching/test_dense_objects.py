@@ -10,7 +10,7 @@ import pytest
 from scipy import ndimage
 
 from photodem.algorithms.matching.dense import sgm_disparity
-from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill, segment_fill
+from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill
 
 GROUND = 8.0  # px
 #: the DSM path's filters (dense_model._DENSE_DEFAULTS)
@@ -170,43 +170,6 @@ def test_wall_share_is_zero_below_the_left_and_one_below_the_right_camera() -> N
 
     f = wall_share_columns(np.array([100.0, 600.0]), 20.0, (100.0, 580.0))
     assert np.allclose(f, [0.0, 1.0])
-
-
-def test_segment_fill_completes_a_weakly_textured_gabled_roof() -> None:
-    s = _scene(gable_texture=4.0)
-    without = sgm_disparity(s["left"], s["right"], 0, 47, **DSM)
-    with_ = sgm_disparity(s["left"], s["right"], 0, 47, **DSM, segments=True)
-    # measured: gabled roof 85.3 % → 87.6 % within 1 px, wall error 1.5 px both; the flat
-    # roof 100 % and open ground (86.9 %, no wrong pixel) unchanged
-    c_without, _ = _metrics(without, s, 2)
-    c_with, wall = _metrics(with_, s, 2)
-    assert c_with >= 0.86 and c_with >= c_without + 0.015
-    assert wall <= 1.5
-    assert _metrics(with_, s, 1)[0] >= 0.99
-    open_ = ndimage.distance_transform_edt(s["label"] == 0) > 8
-    ok = np.abs(with_ - s["d"]) <= 1.0
-    assert ok[open_].mean() >= 0.85
-    assert (np.isfinite(with_) & ~ok)[open_].mean() <= 0.001
-
-
-def test_segment_fill_takes_raised_planar_segments_only() -> None:
-    h, w = 60, 90
-    xx = np.mgrid[0:h, 0:w][1]
-    labels = np.ones((h, w), np.int64)  # ground
-    labels[10:50, 10:40] = 2  # a sloped roof
-    labels[10:50, 50:80] = 3  # a segment across a wall: half roof, half ground
-    disp = np.full((h, w), 5.0)
-    disp[labels == 2] = 20.0 + 0.1 * xx[labels == 2]
-    disp[10:50, 50:65] = 20.0
-    disp[0:5, 0:5] = np.nan  # a ground hole
-    holes = np.zeros((h, w), bool)
-    holes[20:30, 20:30] = holes[20:30, 55:75] = True
-    disp[holes] = np.nan
-    masked = np.zeros((h, w), bool)
-    out = segment_fill(disp, masked, np.zeros((h, w)), 2.0, labels=labels)
-    np.testing.assert_allclose(out[20:30, 20:30], 20.0 + 0.1 * xx[20:30, 20:30], atol=1e-6)
-    assert np.isnan(out[20:30, 55:75]).all()  # two populations: no plane
-    assert np.isnan(out[0:5, 0:5]).all()  # ground stays to the gridding
 
 
 def test_wide_normalisation_keeps_a_striped_gabled_roof() -> None:
