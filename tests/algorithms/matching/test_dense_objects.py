@@ -3,20 +3,21 @@ synthetic epipolar pair with a flat and a gabled building of known heights (disp
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Dict, Tuple
 
 import numpy as np
 import pytest
 from scipy import ndimage
 
-from photodem.algorithms.matching.dense import sgm_disparity
+from photodem.algorithms.matching.dense import DenseOptions, sgm_disparity
 from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill
 
 GROUND = 8.0  # px
 #: the DSM path's filters (dense_model._DENSE_DEFAULTS)
-DSM = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0, "segment_px": 300,
-       "edge_reach": 15}
-OLD = {"edge_erosion": 2}
+DSM = DenseOptions(edge_erosion=2, edge_jump=2.0, plane_fill=100.0, segment_px=300,
+                   edge_reach=15)
+OLD = DenseOptions(edge_erosion=2)
 
 
 def _texture(rng: np.random.Generator, shape: Tuple[int, int], sigma: float, amp: float
@@ -99,8 +100,8 @@ def _metrics(disp: np.ndarray, s: Dict[str, np.ndarray], k: int) -> Tuple[float,
 
 
 def test_roofs_filled_and_walls_in_place(scene) -> None:
-    new = sgm_disparity(scene["left"], scene["right"], 0, 47, **DSM)
-    old = sgm_disparity(scene["left"], scene["right"], 0, 47, **OLD)
+    new = sgm_disparity(scene["left"], scene["right"], 0, 47, options=DSM)
+    old = sgm_disparity(scene["left"], scene["right"], 0, 47, options=OLD)
     # measured: flat (textured) 100 % / 0 px, gabled (weak two-tone texture) 98.8 % / 1 px,
     # open 86.9 % (ground holes are left to the gridding), 100 % of the measured open pixels
     # right; the two-sided erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px, open 86.9 %
@@ -178,8 +179,9 @@ def test_wide_normalisation_keeps_a_striped_gabled_roof() -> None:
     # models (dense_model._WIDE_BASE_OPTIONS) keeps it. Measured: 0.3 % → 82.4 % of the
     # gabled roof within 1 px (wall error 99 → 2 px); the flat roof 100 % either way
     s = _scene(stripes=6.0)
-    narrow = sgm_disparity(s["left"], s["right"], 0, 47, **DSM)
-    wide = sgm_disparity(s["left"], s["right"], 0, 47, **DSM, normalise_window=21)
+    narrow = sgm_disparity(s["left"], s["right"], 0, 47, options=DSM)
+    wide = sgm_disparity(s["left"], s["right"], 0, 47,
+                         options=replace(DSM, normalise_window=21))
     c_wide, wall = _metrics(wide, s, 2)
     assert c_wide >= 0.78 and c_wide >= _metrics(narrow, s, 2)[0] + 0.5
     assert wall <= 3.0
@@ -205,6 +207,7 @@ def test_wall_rule_fills_no_roof_into_a_run_the_tile_cut_off() -> None:
 def test_wide_base_models_get_the_wide_normalisation_and_the_fill_wall_rule() -> None:
     from types import SimpleNamespace
 
+    from photodem.algorithms.errors import InputError
     from photodem.algorithms.matching.dense_model import dsm_dense_options
 
     def setup(base: float) -> SimpleNamespace:
@@ -213,8 +216,14 @@ def test_wide_base_models_get_the_wide_normalisation_and_the_fill_wall_rule() ->
                                parallax_per_metre=base * 7650.0 / 1148.0 ** 2)
 
     wide = dsm_dense_options(setup(700.0))  # B/H 0.61, the aerial block
-    assert wide["normalise_window"] == 21 and wide["wall_view"] == (-3986.0, 696.0)
-    assert wide["wall_erosion"] is False
-    assert wide["edge_jump"] == pytest.approx(1.5 * 700.0 * 7650.0 / 1148.0 ** 2)  # 1.5 m
+    assert wide.normalise_window == 21 and wide.wall_view == (-3986.0, 696.0)
+    assert wide.wall_erosion is False
+    assert wide.edge_jump == pytest.approx(1.5 * 700.0 * 7650.0 / 1148.0 ** 2)  # 1.5 m
     narrow = dsm_dense_options(setup(400.0))  # B/H 0.35
-    assert "normalise_window" not in narrow and narrow["wall_view"] is None
+    assert narrow.normalise_window == 9 and narrow.wall_view is None
+    assert (narrow.edge_erosion, narrow.plane_fill, narrow.segment_px, narrow.edge_reach) == (
+        2, 100.0, 300, 15)
+    # the operator's values win; a name that is no option is refused before any work
+    assert dsm_dense_options(setup(700.0), normalise_window=15).normalise_window == 15
+    with pytest.raises(InputError, match="segments"):
+        dsm_dense_options(setup(400.0), segments=True)
