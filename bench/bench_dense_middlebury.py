@@ -19,18 +19,19 @@ import numpy as np
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "middlebury_motorcycle"
 
-#: name → (method, options of sgm_disparity); "opencv" is the plain OpenCV call below.
+#: name → (method, fields of DenseOptions, tiling of sgm_disparity); "opencv" is the plain
+#: OpenCV call below.
 VARIANTS = {
-    "OpenCV StereoSGBM (issue settings)": ("opencv", {}),
-    "PhotoDEM sgm, no gap filling": ("sgm", {"fill_max_width": 0}),
-    "PhotoDEM sgm, defaults (gaps ≤ 32 px)": ("sgm", {"fill_max_width": 32}),
-    "PhotoDEM sgm, all gaps filled": ("sgm", {"fill_max_width": 10000}),
-    "PhotoDEM sgm, all gaps filled, 16 MB tiles": ("sgm", {"fill_max_width": 10000,
-                                                           "max_memory_mb": 16}),
+    "OpenCV StereoSGBM (issue settings)": ("opencv", {}, {}),
+    "PhotoDEM sgm, no gap filling": ("sgm", {"fill_max_width": 0}, {}),
+    "PhotoDEM sgm, defaults (gaps ≤ 32 px)": ("sgm", {"fill_max_width": 32}, {}),
+    "PhotoDEM sgm, all gaps filled": ("sgm", {"fill_max_width": 10000}, {}),
+    "PhotoDEM sgm, all gaps filled, 16 MB tiles": ("sgm", {"fill_max_width": 10000},
+                                                   {"max_memory_mb": 16}),
     # the DSM path's filters (issue 19): one-sided edge erosion, plane fill of holes
     "PhotoDEM sgm, DSM filters (upper-side erosion, plane fill)": (
         "sgm", {"fill_max_width": 0, "edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0,
-                "segment_px": 300, "edge_reach": 15}),
+                "segment_px": 300, "edge_reach": 15}, {}),
 }
 
 
@@ -54,10 +55,10 @@ def _worker(name: str) -> dict:
     import cv2
 
     # imported before the baseline: the figure is the matcher's memory, not the libraries'
-    from photodem.algorithms.matching.dense import sgm_disparity
+    from photodem.algorithms.matching.dense import DenseOptions, sgm_disparity
 
     left, right, gt = _load()
-    method, options = VARIANTS[name]
+    method, options, tiling = VARIANTS[name]
     base = _rss_mb()
     best = np.inf
     for _ in range(3):
@@ -70,7 +71,8 @@ def _worker(name: str) -> dict:
             disp = raw.astype(np.float32) / 16.0
             disp[raw < 0] = np.nan  # OpenCV's invalid value is (minDisparity − 1)·16
         else:
-            disp = sgm_disparity(left, right, 0, 63, **options)
+            disp = sgm_disparity(left, right, 0, 63, options=DenseOptions.from_values(options),
+                                 **tiling)
         best = min(best, time.perf_counter() - t)
     peak = _rss_mb() - base
     has = np.isfinite(gt)

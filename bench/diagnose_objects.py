@@ -486,10 +486,12 @@ def dense_steps(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray]
     rr, cc = np.mgrid[0:h, 0:w]
     inter, open_, roof, tree = et.cls == 1, et.cls == 3, et.roof(), et.tree()
     for name, over in DENSE_STEPS:
-        opt = dict(dsm_dense_options(setup), **over)  # the DSM path's options
+        tiling = {k: v for k, v in over.items() if k == "coarse_above"}
+        # the DSM path's options
+        opt = dsm_dense_options(setup, **{k: v for k, v in over.items() if k not in tiling})
         t0 = time.perf_counter()
         d = dense_mod.sgm_disparity(grey["left"], grey["right"], setup.min_d, setup.max_d,
-                                    **opt)
+                                    options=opt, **tiling)
         ok = np.isfinite(d)
         z = setup.pair.disparity_to_world(np.where(ok, d, np.nan))[..., 2]
         with np.errstate(invalid="ignore"):
@@ -576,8 +578,8 @@ def dense_range(setup: Any, et: EpiTruth, grey: Dict[str, np.ndarray]) -> Dict[s
         src_l, shape_l = dense_mod.array_source(grey["left"])
         src_r, shape_r = dense_mod.array_source(grey["right"])
         coarse = dense_mod._coarse_disparity(
-            src_l, src_r, shape_l, shape_r, lo, hi, factor,
-            {"block_size": 5, "margin": 48}, Feedback())
+            src_l, src_r, shape_l, shape_r, lo, hi, factor, dense_mod.DenseOptions(),
+            Feedback(), margin=48)
         # the coarse disparities at the pixel's block, ± the slack of a tile's range
         cz = np.kron(coarse, np.ones((factor, factor)))[:et.d.shape[0], :et.d.shape[1]]
         with np.errstate(invalid="ignore"):

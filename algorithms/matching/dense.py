@@ -49,8 +49,8 @@ without coarse disparities takes the range of a growing neighbourhood, finally t
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Callable, Iterator, Optional, Tuple
+from dataclasses import dataclass, fields, replace
+from typing import Any, Callable, Iterator, Mapping, Optional, Tuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -59,7 +59,7 @@ from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..input_errors import warn_input
 from ..memory import check_allocation
-from .dense_fill import erode_lower_side, segment_fill, wall_share_columns
+from .dense_fill import erode_lower_side, wall_share_columns
 from .dense_fill import plane_fill as plane_fill_holes
 
 #: Matching methods; the first is the default.
@@ -73,6 +73,128 @@ Array = NDArray[Any]
 #: A grey image source: ``source(row0, row1, col0, col1)`` → float32 block, NaN = masked.
 #: Rows/columns outside the image are returned as NaN.
 GreySource = Callable[[int, int, int, int], Array]
+
+
+@dataclass(frozen=True)
+class DenseOptions:
+    """Matching options of :func:`iter_disparity_tiles` (px = pixels of the epipolar images).
+
+    The defaults are those of a plain disparity raster (``stereo_disparity``); the DSM path
+    sets its filters per model (:func:`.dense_model.dsm_dense_options`). Build one from a
+    mapping with :meth:`from_values` (unknown names are refused).
+
+    Attributes
+    ----------
+    method : {"sgm", "opencv_sgbm"}
+        "sgm" (default): our pipeline of the module notes; "opencv_sgbm": plain OpenCV
+        StereoSGBM (5 paths, no normalisation, left–right check or filters), for comparison.
+    block_size : int
+        Matching window side (px, made odd); default 5 (aerial block, issue 19 part A: 3 px
+        raised the terrain error, 7 and 9 px lost roof interior); 7 on convergent models.
+    p1, p2 : int, optional
+        SGM penalties for disparity steps of 1 and of more than 1 px; default ``8·b²`` and
+        ``32·b²`` (OpenCV's advice for ``b`` = ``block_size``); ``p2`` must exceed ``p1``.
+    uniqueness : int
+        Percent by which the best aggregated cost must beat the second best; default 10
+        (0 or 5 kept no more roof interior, issue 19 part D).
+    lr_max_diff : float
+        Left–right check tolerance (px); default 1; < 0 off.
+    normalise_window : int
+        Side (px) of the local z-score that removes gain and offset between the images;
+        default 9 (nadir models; 21 on wide-base and convergent ones, whose images see
+        slanted faces at different scales); 0 or 1 off.
+    speckle_window, speckle_range : int
+        Speckle filter: disparity regions smaller than ``speckle_window`` px (default 100;
+        300 removed a blunder patch of the aerial block but also roofs, issue 19 part D)
+        with steps ≤ ``speckle_range`` px (default 2) inside are removed.
+    fill_max_width : int
+        Widest invalid run along a row that is filled from its farther neighbour (px);
+        default 0 = none (the DSM path leaves gaps to the gridding's interpolation;
+        ``stereo_disparity`` fills up to 32 px).
+    edge_erosion : int
+        Disparities within this many px (chessboard) of an invalid or masked pixel are
+        removed before filling (foreground fattening at occlusions); default 0 = off, 2 in
+        the DSM path (3 cost open terrain and roofs, issue 19 part D; method "sgm").
+    range_guard : float
+        Disparities within this many px of the search range's ends are removed (a minimum
+        at the range limit is usually cut off); default 0 = off.
+    edge_jump : float
+        With ``edge_erosion``: erode only the lower side of disparity steps larger than this
+        (px) and the borders of masks (:func:`.dense_fill.erode_lower_side`); default 0 =
+        erode every border; the DSM path uses 1.5 m of height in px of the model's parallax.
+    plane_fill : float
+        Holes up to this inscribed diameter (px) are filled from planes of their bordering
+        surfaces split at steps of ``edge_jump`` (2 px without one;
+        :func:`.dense_fill.plane_fill`; method "sgm"); default 0 = off, 100 in the DSM path.
+    segment_px, edge_reach : int
+        With ``edge_jump``: a pixel near a hole is kept only in a disparity segment of at
+        least ``segment_px`` px (blunder patches go) and, if ``edge_reach`` > 0, only on the
+        upper side of a step (a disparity within ``edge_reach`` px lower by more than
+        ``edge_jump``); default 0 = off, 300 and 15 in the DSM path.
+    wall_view : (float, float), optional
+        Epipolar principal points (columns) of the left and right image: with
+        ``edge_reach``, where the left camera sees a wall wider than ``wall_px`` in an
+        occlusion, roof edges near holes are eroded and such holes get no roof
+        (:mod:`.dense_fill`); default None = no wall rule (the DSM path sets it on wide-base
+        models).
+    wall_px : float
+        Narrowest wall (px) the wall rule acts on; default 20 (the ``small`` block's walls
+        stay narrower and keep the plain rules).
+    wall_erosion : bool
+        False: the wall rule of ``wall_view`` applies to the plane fill only, not to the
+        erosion (wide-base models: with it the roofs go); default True.
+    """
+
+    method: str = "sgm"
+    block_size: int = 5
+    p1: Optional[int] = None
+    p2: Optional[int] = None
+    uniqueness: int = 10
+    lr_max_diff: float = 1.0
+    normalise_window: int = 9
+    speckle_window: int = 100
+    speckle_range: int = 2
+    fill_max_width: int = 0
+    edge_erosion: int = 0
+    range_guard: float = 0.0
+    edge_jump: float = 0.0
+    plane_fill: float = 0.0
+    segment_px: int = 0
+    edge_reach: int = 0
+    wall_view: Optional[Tuple[float, float]] = None
+    wall_px: float = 20.0
+    wall_erosion: bool = True
+
+    @classmethod
+    def from_values(cls, values: Mapping[str, Any]) -> DenseOptions:
+        """Options from a mapping of field names (the others keep their defaults).
+
+        Raises
+        ------
+        InputError
+            For a name that is no option.
+        """
+        names = {f.name for f in fields(cls)}
+        unknown = set(values) - names
+        if unknown:
+            raise InputError(f"Unknown dense matching option(s): {', '.join(sorted(unknown))};"
+                             f" known are {', '.join(sorted(names))}.")
+        return cls(**dict(values))
+
+    @property
+    def ours(self) -> bool:
+        """Our pipeline (method "sgm"), not plain OpenCV."""
+        return self.method == "sgm"
+
+    def coarse(self) -> DenseOptions:
+        """The options of the coarse pass: the same SGM, normalisation, left–right check and
+        speckle filter, none of the border, range and fill filters."""
+        return DenseOptions(method=self.method, block_size=self.block_size, p1=self.p1,
+                            p2=self.p2, uniqueness=self.uniqueness,
+                            lr_max_diff=self.lr_max_diff,
+                            normalise_window=self.normalise_window,
+                            speckle_window=self.speckle_window,
+                            speckle_range=self.speckle_range)
 
 
 def _cv2() -> Any:
@@ -225,32 +347,16 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
 
 @dataclass
 class _TileMatcher:
-    """Disparities of tile cores: one SGBM set-up per tile, its margin as context."""
+    """Disparities of tile cores: one SGBM set-up per tile, its margin as context.
+
+    ``options`` are resolved (:func:`_checked_settings`): odd block, penalties set.
+    """
 
     cv2: Any
     left: GreySource
     right: GreySource
     margin: int
-    block: int
-    p1: int
-    p2: int
-    uniqueness: int
-    ours: bool
-    lr_max_diff: float
-    normalise_window: int
-    speckle_window: int
-    speckle_range: int
-    fill_max_width: int
-    edge_erosion: int
-    range_guard: float
-    edge_jump: float = 0.0
-    plane_fill: float = 0.0
-    segment_px: int = 0
-    edge_reach: int = 0
-    wall_view: Optional[Tuple[float, float]] = None
-    wall_px: float = 20.0
-    segments: bool = False
-    wall_erosion: bool = True
+    options: DenseOptions
 
     def _matcher(self, lo: int, n_d: int) -> Any:
         """SGBM for ``n_d`` disparities from ``lo``.
@@ -258,15 +364,16 @@ class _TileMatcher:
         Our speckle filter runs after the LR check (on 1/16 px); OpenCV's own only for the
         plain mode.
         """
-        cv2, ours = self.cv2, self.ours
+        cv2, o = self.cv2, self.options
+        ours = o.ours
         mode = cv2.STEREO_SGBM_MODE_HH if ours else cv2.STEREO_SGBM_MODE_SGBM
-        sp_range = int(self.speckle_range) * (16 if ours else 1)  # 1/16-px values in SGBM
-        return _sgbm(cv2, lo, n_d, self.block, self.p1, self.p2, self.uniqueness,
-                     0 if ours else self.speckle_window, sp_range if not ours else 0, mode)
+        sp_range = int(o.speckle_range) * (16 if ours else 1)  # 1/16-px values in SGBM
+        return _sgbm(cv2, lo, n_d, o.block_size, o.p1, o.p2, o.uniqueness,
+                     0 if ours else o.speckle_window, sp_range if not ours else 0, mode)
 
     def __call__(self, r0: int, r1: int, c0: int, c1: int, lo: int, hi: int) -> Array:
         """Disparities of the tile core rows r0:r1, cols c0:c1 searched in lo..hi."""
-        margin, block = self.margin, self.block
+        margin, block, view = self.margin, self.options.block_size, self.options.wall_view
         R0, R1 = r0 - margin, r1 + margin
         C0, C1 = c0 - margin, c1 + margin
         lwin = self.left(R0, R1, C0, C1)
@@ -282,15 +389,9 @@ class _TileMatcher:
         lg = np.full((R1 - R0, f1 - f0), np.nan, np.float32)
         lg[:, C0 - f0:C1 - f0] = lwin
         rg = self.right(R0, R1, f0, f1)
-        walls = (None if self.wall_view is None else wall_share_columns(
-            np.arange(f0, f1)[None, :], 0.5 * (lo + hi), self.wall_view))
-        disp = _match_frame(self.cv2, matcher, lg, rg, lo, hi, n_d, self.ours, block,
-                            self.lr_max_diff, self.normalise_window, self.speckle_window,
-                            int(self.speckle_range), self.fill_max_width,
-                            int(self.edge_erosion), float(self.range_guard),
-                            float(self.edge_jump), float(self.plane_fill),
-                            int(self.segment_px), int(self.edge_reach), walls, float(self.wall_px),
-                            bool(self.segments), bool(self.wall_erosion))
+        walls = (None if view is None else wall_share_columns(
+            np.arange(f0, f1)[None, :], 0.5 * (lo + hi), view))
+        disp = _match_frame(self.cv2, matcher, lg, rg, (lo, hi, n_d), self.options, walls)
         return disp[r0 - R0:r1 - R0, c0 - f0:c1 - f0]  # back to the tile core
 
 
@@ -314,20 +415,20 @@ class _SearchRange:
                                   self.full, self.slack)
 
 
-def _checked_settings(method: str, min_disparity: int, max_disparity: int,
+def _checked_settings(options: DenseOptions, min_disparity: int, max_disparity: int,
                       left_shape: Tuple[int, int], right_shape: Tuple[int, int], margin: int,
-                      disparity_parameter: str, coarse_above: int, block_size: int,
-                      p1: Optional[int], p2: Optional[int]) -> Tuple[int, int, int, int, int]:
-    """Method, range (cut to possible disparities) and penalties checked: min_d, max_d,
-    block, p1, p2.
+                      disparity_parameter: str, coarse_above: int
+                      ) -> Tuple[int, int, DenseOptions]:
+    """Method, range (cut to possible disparities) and penalties checked: min_d, max_d and
+    the options resolved (odd block, ``p1``/``p2`` set, each field of its type).
 
     Raises
     ------
     InputError
         Unknown method, empty range, or P2 ≤ P1.
     """
-    if method not in METHODS:
-        raise InputError(f"Unknown dense matching method '{method}'; use one of "
+    if options.method not in METHODS:
+        raise InputError(f"Unknown dense matching method '{options.method}'; use one of "
                          f"{', '.join(METHODS)}.")
     min_d, max_d = int(min_disparity), int(max_disparity)
     if max_d < min_d:
@@ -336,12 +437,18 @@ def _checked_settings(method: str, min_disparity: int, max_disparity: int,
     min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
                                          disparity_parameter,
                                          quiet=coarse_above == 0)  # the coarse pass's own cut
-    block = int(block_size) | 1
-    p1 = int(8 * block * block if p1 is None else p1)
-    p2 = int(32 * block * block if p2 is None else p2)
+    o = options
+    block = int(o.block_size) | 1
+    p1 = int(8 * block * block if o.p1 is None else o.p1)
+    p2 = int(32 * block * block if o.p2 is None else o.p2)
     if p2 <= p1:
         raise InputError(f"P2 ({p2}) must be larger than P1 ({p1}).")
-    return min_d, max_d, block, p1, p2
+    return min_d, max_d, replace(
+        o, block_size=block, p1=p1, p2=p2, speckle_range=int(o.speckle_range),
+        edge_erosion=int(o.edge_erosion), range_guard=float(o.range_guard),
+        edge_jump=float(o.edge_jump), plane_fill=float(o.plane_fill),
+        segment_px=int(o.segment_px), edge_reach=int(o.edge_reach), wall_px=float(o.wall_px),
+        wall_erosion=bool(o.wall_erosion))
 
 
 def _coarse_factor(num_d: int) -> int:
@@ -386,20 +493,8 @@ def iter_disparity_tiles(
     left: GreySource, right: GreySource,
     left_shape: Tuple[int, int], right_shape: Tuple[int, int],
     min_disparity: int, max_disparity: int,
-    method: str = "sgm",
-    block_size: int = 5,
-    p1: Optional[int] = None, p2: Optional[int] = None,
-    uniqueness: int = 10,
-    lr_max_diff: float = 1.0,
-    normalise_window: int = 9,
-    speckle_window: int = 100, speckle_range: int = 2,
-    fill_max_width: int = 0,
-    edge_erosion: int = 0,
-    range_guard: float = 0.0,
-    edge_jump: float = 0.0, plane_fill: float = 0.0,
-    segment_px: int = 0, edge_reach: int = 0,
-    wall_view: Optional[Tuple[float, float]] = None, wall_px: float = 20.0,
-    segments: bool = False, wall_erosion: bool = True,
+    options: Optional[DenseOptions] = None,
+    *,
     max_memory_mb: float = 256.0,
     tile_size: Optional[int] = None,
     margin: int = 48,
@@ -417,45 +512,8 @@ def iter_disparity_tiles(
         (height, width) of the two epipolar images; rows correspond.
     min_disparity, max_disparity : int
         Search range of ``d = x_left − x_right`` (px); negative values are allowed.
-    method : {"sgm", "opencv_sgbm"}
-        See the module docstring.
-    block_size : int
-        Odd matching window side (px).
-    p1, p2 : int, optional
-        SGM penalties for disparity steps of 1 and > 1 px (default ``8·b²``, ``32·b²``).
-    uniqueness : int
-        Percent by which the best cost must beat the second best.
-    lr_max_diff, normalise_window : float, int
-        Left–right check tolerance (px; < 0 = off); local radiometric normalisation (px; 0 off).
-    speckle_window, speckle_range : int
-        Speckle filter: region size (px) and disparity step (px) within a region.
-    fill_max_width : int
-        Widest invalid run along a row that is filled (px); 0 = no filling.
-    edge_erosion : int
-        Disparities within this many px (chessboard) of an invalid or masked pixel are removed
-        before filling (method "sgm"); 0 = off.
-    range_guard : float
-        Disparities within this many px of the range's ends are removed; 0 = off.
-    edge_jump : float
-        With ``edge_erosion``: erode only the lower side of disparity steps larger than this
-        (px) and the borders of masks (:func:`.dense_fill.erode_lower_side`); 0 = erode every
-        border of a valid region.
-    plane_fill : float
-        Holes up to this inscribed diameter (px) are filled from planes of their bordering
-        surfaces split at steps of ``edge_jump`` (default 2 px) (:func:`.dense_fill.plane_fill`;
-        method "sgm"); 0 = off.
-    segment_px, edge_reach : int
-        With ``edge_jump``: a pixel near a hole is kept only in a disparity segment of at least
-        ``segment_px`` px (blunder patches go) and, if ``edge_reach`` > 0, only on the upper
-        side of a step (a disparity within ``edge_reach`` px lower by > ``edge_jump``). 0 = off.
-    wall_view, wall_px : (float, float), optional; float
-        Epipolar principal points (columns) of the left and right image: with ``edge_reach``,
-        where the left camera sees a wall wider than ``wall_px`` in an occlusion, roof edges
-        near holes are eroded and such holes get no roof (:mod:`.dense_fill`).
-    segments, wall_erosion : bool
-        ``segments``: fill the holes of planar object segments of the left image
-        (:func:`.dense_fill.segment_fill`); ``wall_erosion`` False: the wall rule of
-        ``wall_view`` applies to the plane fill only.
+    options : DenseOptions, optional
+        The matching options (:class:`DenseOptions`; default its defaults).
     max_memory_mb : float
         Memory budget of one tile's matching; sets the tile size unless ``tile_size`` is given.
     tile_size, margin : int
@@ -471,27 +529,18 @@ def iter_disparity_tiles(
     """
     cv2 = _cv2()
     feedback = ensure_feedback(feedback)
-    min_d, max_d, block, p1, p2 = _checked_settings(
-        method, min_disparity, max_disparity, left_shape, right_shape, margin,
-        disparity_parameter, coarse_above, block_size, p1, p2)
+    min_d, max_d, opts = _checked_settings(
+        DenseOptions() if options is None else options, min_disparity, max_disparity,
+        left_shape, right_shape, margin, disparity_parameter, coarse_above)
     num_d = _num_disparities(min_d, max_d)
     # the right source pads with NaN outside its own right_shape
-    match = _TileMatcher(cv2, left, right, margin, block, p1, p2, uniqueness, method == "sgm",
-                         lr_max_diff, normalise_window, speckle_window, speckle_range,
-                         fill_max_width, edge_erosion, range_guard, edge_jump, plane_fill,
-                         segment_px, edge_reach, wall_view, wall_px, segments,
-                         wall_erosion)
+    match = _TileMatcher(cv2, left, right, margin, opts)
     coarse = None
     factor = 1
     if coarse_above > 0 and num_d > coarse_above:
         factor = _coarse_factor(num_d)
-        options = {"method": method, "block_size": block, "p1": p1, "p2": p2,
-                   "uniqueness": uniqueness, "lr_max_diff": lr_max_diff,
-                   "normalise_window": normalise_window, "speckle_window": speckle_window,
-                   "speckle_range": speckle_range, "max_memory_mb": max_memory_mb,
-                   "margin": margin}
         coarse = _coarse_disparity(left, right, left_shape, right_shape, min_d, max_d, factor,
-                                   options, feedback)
+                                   opts.coarse(), feedback, max_memory_mb, margin)
     search = _SearchRange(coarse, factor, margin, (min_d, max_d))
     if tile_size:
         side = int(tile_size)
@@ -527,7 +576,8 @@ def block_mean_source(source: GreySource, shape: Tuple[int, int], factor: int,
 
 def _coarse_disparity(left: GreySource, right: GreySource, left_shape: Tuple[int, int],
                       right_shape: Tuple[int, int], min_d: int, max_d: int, factor: int,
-                      options: dict, feedback: Feedback) -> Array:
+                      options: DenseOptions, feedback: Feedback, max_memory_mb: float = 256.0,
+                      margin: int = 48) -> Array:
     """Disparities (full-resolution px) of the pair reduced by ``factor``; NaN = none."""
     cl, cr = (block_mean_source(src, shape, factor)
               for src, shape in ((left, left_shape), (right, right_shape)))
@@ -537,7 +587,8 @@ def _coarse_disparity(left: GreySource, right: GreySource, left_shape: Tuple[int
     # block means of both images over the same pixel blocks: d_coarse = d / factor exactly
     for r0, c0, blk in iter_disparity_tiles(
             src_l, src_r, shape_l, shape_r, math.floor(min_d / factor) - 1,
-            math.ceil(max_d / factor) + 1, coarse_above=0, **options):
+            math.ceil(max_d / factor) + 1, options, coarse_above=0,
+            max_memory_mb=max_memory_mb, margin=margin):
         out[r0:r0 + blk.shape[0], c0:c0 + blk.shape[1]] = blk
         feedback.check()
     return out * np.float32(factor)
@@ -575,33 +626,30 @@ def _small_segments(cv2: Any, disp: Array, area: int, step: float) -> Array:
     return before & (d16 == bad)
 
 
-def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d: int,
-                 num_d: int, ours: bool, block: int, lr_max_diff: float, normalise_window: int,
-                 speckle_window: int, speckle_range: int, fill_max_width: int,
-                 edge_erosion: int = 0, range_guard: float = 0.0, edge_jump: float = 0.0,
-                 plane_fill: float = 0.0, segment_px: int = 0, edge_reach: int = 0,
-                 wall_share: Optional[Array] = None, wall_px: float = 20.0,
-                 segments: bool = False, wall_erosion: bool = True) -> Array:
-    """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape);
-    ``wall_share`` (per frame column), ``wall_px`` as :func:`.dense_fill.erode_lower_side`;
-    ``segments``: :func:`.dense_fill.segment_fill` after the plane fill; ``wall_erosion``:
-    the erosion takes ``wall_share`` too (else only the plane fill)."""
+def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, search: Tuple[int, int, int],
+                 options: DenseOptions, wall_share: Optional[Array] = None) -> Array:
+    """Disparity (float32, NaN invalid) of the left frame ``lg`` against ``rg`` (same shape).
+
+    ``search`` is ``(min_d, max_d, num_d)`` of ``matcher``; ``options`` resolved
+    (:func:`_checked_settings`); ``wall_share`` (per frame column) as
+    :func:`.dense_fill.erode_lower_side`, taken by the erosion only with ``wall_erosion``.
+    """
+    min_d, max_d, num_d = search
+    o, ours, block = options, options.ours, options.block_size
     lmask = ~np.isfinite(lg)
     rmask = ~np.isfinite(rg)
-    if ours and normalise_window > 1:
-        l8 = normalise_local(lg, normalise_window)
-        r8 = normalise_local(rg, normalise_window)
+    if ours and o.normalise_window > 1:
+        l8 = normalise_local(lg, o.normalise_window)
+        r8 = normalise_local(rg, o.normalise_window)
     else:
         l8, r8 = _to_uint8(lg), _to_uint8(rg)
     invalid16 = (min_d - 1) * 16
     raw = matcher.compute(l8, r8)
     bad = raw == invalid16
-    # SGM's winners before the consistency filters: the planes of the segment fill
-    cand = np.where(bad, np.nan, raw.astype(np.float32) / 16.0) if segments else None
     h, w = raw.shape
     cols = np.arange(w)[None, :]
     rows = np.arange(h)[:, None]
-    if ours and lr_max_diff >= 0:
+    if ours and o.lr_max_diff >= 0:
         # Right-to-left on mirrored images. SGBM leaves its first min_d + num_d columns without
         # disparity; mirrored, those are where the content lies, so pad them away first.
         pad = num_d + block + abs(min_d)
@@ -614,12 +662,12 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
         inside = (xr >= 0) & (xr < w)
         xr = np.clip(xr, 0, w - 1)
         d_r = rraw[rows, xr].astype(np.float32) / 16.0
-        consistent = inside & ~rbad[rows, xr] & (np.abs(d - d_r) <= lr_max_diff)
+        consistent = inside & ~rbad[rows, xr] & (np.abs(d - d_r) <= o.lr_max_diff)
         bad |= ~consistent
-    if ours and speckle_window > 0:
+    if ours and o.speckle_window > 0:
         cleaned = raw.copy()
         cleaned[bad] = invalid16
-        cv2.filterSpeckles(cleaned, invalid16, int(speckle_window), int(speckle_range) * 16)
+        cv2.filterSpeckles(cleaned, invalid16, int(o.speckle_window), int(o.speckle_range) * 16)
         bad |= cleaned == invalid16
     disp = raw.astype(np.float32) / 16.0
     disp[bad | (disp > max_d) | (disp < min_d)] = np.nan
@@ -627,29 +675,28 @@ def _match_frame(cv2: Any, matcher: Any, lg: Array, rg: Array, min_d: int, max_d
     near = cv2.dilate(rmask.astype(np.uint8), np.ones((1, block), np.uint8)).astype(bool)
     xr = np.clip(np.rint(cols - np.nan_to_num(disp)).astype(np.int64), 0, w - 1)
     disp[near[rows, xr]] = np.nan
-    if range_guard > 0:
+    if o.range_guard > 0:
         with np.errstate(invalid="ignore"):
-            disp[(disp < min_d + range_guard) | (disp > max_d - range_guard)] = np.nan
-    if ours and edge_erosion > 0 and edge_jump > 0:
+            disp[(disp < min_d + o.range_guard) | (disp > max_d - o.range_guard)] = np.nan
+    if ours and o.edge_erosion > 0 and o.edge_jump > 0:
         # only the occluded (lower) side of a step, so that roof edges stay
-        small = _small_segments(cv2, disp, segment_px, 1.0) if segment_px > 0 else None
-        disp = erode_lower_side(disp, lmask, int(edge_erosion), edge_jump, small, edge_reach,
-                                wall_share if wall_erosion else None, wall_px)
-    elif ours and edge_erosion > 0:
+        small = _small_segments(cv2, disp, o.segment_px, 1.0) if o.segment_px > 0 else None
+        disp = erode_lower_side(disp, lmask, o.edge_erosion, o.edge_jump, small, o.edge_reach,
+                                wall_share if o.wall_erosion else None, o.wall_px)
+    elif ours and o.edge_erosion > 0:
         # the frame outside the image is masked (NaN), so image borders are eroded too
         ok = (np.isfinite(disp) & ~lmask).astype(np.uint8)
-        k = 2 * int(edge_erosion) + 1
+        k = 2 * o.edge_erosion + 1
         ok = cv2.erode(ok, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT,
                        borderValue=0)
         disp[ok == 0] = np.nan
-    if ours and plane_fill > 0:
-        disp = plane_fill_holes(disp, lmask, plane_fill, edge_jump if edge_jump > 0 else 2.0, lg,
-                                window=block, wall_share=wall_share,
-                                wall_px=wall_px, far_side=wall_erosion)
-    if ours and segments and edge_jump > 0:
-        disp = segment_fill(disp, lmask, lg, edge_jump, cand)
-    if ours and fill_max_width > 0:
-        disp = fill_holes_rows(disp, lmask, fill_max_width)
+    if ours and o.plane_fill > 0:
+        disp = plane_fill_holes(disp, lmask, o.plane_fill,
+                                o.edge_jump if o.edge_jump > 0 else 2.0, lg, window=block,
+                                wall_share=wall_share, wall_px=o.wall_px,
+                                far_side=o.wall_erosion)
+    if ours and o.fill_max_width > 0:
+        disp = fill_holes_rows(disp, lmask, o.fill_max_width)
     disp[lmask] = np.nan
     return disp
 
@@ -660,12 +707,14 @@ def sgm_disparity(
     min_disparity: int,
     max_disparity: int,
     feedback: Optional[Feedback] = None,
-    **options: Any,
+    options: Optional[DenseOptions] = None,
+    **tiling: Any,
 ) -> Array:
     """Disparity ``x_left − x_right`` of two in-memory grey images (NaN = masked).
 
-    ``options`` are those of :func:`iter_disparity_tiles`. Returns a float32 array of the left
-    image's shape, NaN where invalid.
+    ``options`` (:class:`DenseOptions`) and ``tiling`` (``max_memory_mb``, ``tile_size``,
+    ``margin``, ``coarse_above``) as :func:`iter_disparity_tiles`. Returns a float32 array of
+    the left image's shape, NaN where invalid.
     """
     left = np.asarray(left, np.float32)
     right = np.asarray(right, np.float32)
@@ -675,6 +724,7 @@ def sgm_disparity(
     src_r, shape_r = array_source(right)
     out = np.full(shape_l, np.nan, np.float32)
     for r0, c0, block in iter_disparity_tiles(src_l, src_r, shape_l, shape_r, min_disparity,
-                                              max_disparity, feedback=feedback, **options):
+                                              max_disparity, options, feedback=feedback,
+                                              **tiling):
         out[r0:r0 + block.shape[0], c0:c0 + block.shape[1]] = block
     return out

@@ -1,6 +1,5 @@
-"""Disparity filters of dense matching that keep objects: one-sided edge erosion,
-plane fill of holes within segments bounded by discontinuities, and the segment fill
-(issue 19).
+"""Disparity filters of dense matching that keep objects: one-sided edge erosion and
+plane fill of holes within segments bounded by discontinuities (issue 19).
 
 One-sided edge erosion
 ----------------------
@@ -51,19 +50,6 @@ In the DSM path only the upper (object) part of a mixed hole is filled: holes wi
 and the ground part are left to the gridding's gap interpolation as before, because filling
 them from planes made open terrain worse (synthetic ``aerial`` block, terrain RMS 0.10 against
 0.05 m) while roofs gained nothing from it (``fill_lower`` fills them too).
-
-Segment fill
-------------
-An option (:func:`segment_fill`, ``segments`` of :func:`.dense.iter_disparity_tiles`), off in
-the DSM path. The left image is segmented by tone (graph-based, :func:`grey_segments`); each
-segment gets a robust plane of SGM's winners *before* the left–right check and the speckle
-filter (which weakly textured roofs fail although they lie on the roof's plane); where enough
-of the segment has such a disparity and most of them lie on the plane, the plane fills the
-segment's holes — only where it stands two steps above the lowest disparity around, not next
-to lower ground, and between plane inliers of the same segment along the row (a segment that
-runs from a roof into an occlusion does not carry the roof there). On the synthetic blocks it
-gained little on held-out seeds and spilled roofs onto open land of the tiny block
-(docs/decisions.md, issue 19 part A).
 """
 
 from __future__ import annotations
@@ -77,18 +63,6 @@ from scipy import ndimage
 Array = NDArray[Any]
 _RING = np.ones((3, 3), bool)
 WALL_SPREAD = 0.33
-#: Segment fill: graph-segmentation scale and smallest segment (px) of the left image, least
-#: share of a segment's pixels with a disparity and of those on its plane (±1 px), and the
-#: half window (px) of its ground test (a rise of ``SEGMENT_RISE`` steps: sloped ground
-#: rises by one step over that window already); no pixel is filled within ``SEGMENT_EDGE`` px of a
-#: valid disparity lower by the step (the roof would spill over walls and occlusions).
-SEGMENT_SCALE = 100.0
-SEGMENT_MIN_PX = 50
-SEGMENT_MIN_VALID = 0.3
-SEGMENT_INLIERS = 0.7
-SEGMENT_REACH = 50
-SEGMENT_RISE = 2.0
-SEGMENT_EDGE = 10
 WALL_ROW = 64
 
 
@@ -395,149 +369,4 @@ def plane_fill(disp: Array, masked: Array, max_size: float, jump: float,
     return out
 
 
-def grey_segments(grey: Array, masked: Array, scale: float = SEGMENT_SCALE,
-                  min_px: int = SEGMENT_MIN_PX) -> Array:
-    """Segments of the left image by tone (graph-based, Felzenszwalb–Huttenlocher):
-    labels ≥ 1, 0 on masked pixels; only the columns with image data are segmented."""
-    from skimage.segmentation import felzenszwalb  # lazy: only the DSM path segments
-
-    labels = np.zeros(grey.shape, np.int64)
-    cols = np.nonzero((~masked).any(axis=0))[0]
-    if cols.size == 0:
-        return labels
-    c0, c1 = int(cols[0]), int(cols[-1]) + 1
-    g = np.nan_to_num(grey[:, c0:c1], nan=0.0).astype(np.float64)
-    labels[:, c0:c1] = felzenszwalb(g, scale=scale, sigma=0.8, min_size=int(min_px)) + 1
-    labels[masked] = 0
-    return labels
-
-
-def _segment_planes(labels: Array, disp: Array, keep: Array, n: int) -> Array:
-    """Least-squares planes ``d = a + b·x + c·y`` (x, y in 100 px) of the pixels ``keep`` of
-    every segment, as rows ``(a, b, c)``; NaN rows where the fit is degenerate."""
-    h, w = disp.shape
-    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64) / 100.0
-    lab, x, y, d = labels[keep], xx[keep], yy[keep], disp[keep].astype(np.float64)
-
-    def s(v: Optional[Array] = None) -> Array:
-        return np.bincount(lab, weights=v, minlength=n + 1)
-
-    one, sx, sy, sd = s(), s(x), s(y), s(d)
-    a = np.stack([np.stack([one, sx, sy], -1), np.stack([sx, s(x * x), s(x * y)], -1),
-                  np.stack([sy, s(x * y), s(y * y)], -1)], -2)
-    b = np.stack([sd, s(x * d), s(y * d)], -1)
-    det = np.linalg.det(a)
-    ok = np.abs(det) > 1e-9 * np.maximum(one, 1.0) ** 3
-    out = np.full((n + 1, 3), np.nan)
-    if ok.any():
-        out[ok] = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
-    return out
-
-
-def _plane_at(planes: Array, labels: Array) -> Array:
-    """Every pixel's disparity on its segment's plane."""
-    h, w = labels.shape
-    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64) / 100.0
-    p = planes[labels]
-    return p[..., 0] + p[..., 1] * xx + p[..., 2] * yy
-
-
-def _robust_planes(labels: Array, disp: Array, valid: Array, n: int) -> Tuple[Array, Array]:
-    """Every segment's plane of its ``valid`` disparities, refitted twice on the pixels within
-    1 px of it (a few wrong disparities do not tilt it); the planes and the inliers."""
-    planes = _segment_planes(labels, disp, valid & (labels > 0), n)
-    for _ in range(3):
-        with np.errstate(invalid="ignore"):
-            inl = valid & (np.abs(_plane_at(planes, labels) - disp) <= 1.0) & (labels > 0)
-        if _ < 2:
-            planes = _segment_planes(labels, disp, inl, n)
-    return planes, inl
-
-
-def _enclosed(labels: Array, inliers: Array) -> Array:
-    """Pixels whose nearest inlier to the left and to the right along the row (epipolar
-    line) lie in their own segment: a segment's plane is not carried past its last support
-    into an occlusion."""
-    h, w = labels.shape
-    cols = np.arange(w)[None, :]
-    rows = np.arange(h)[:, None]
-    left = np.maximum.accumulate(np.where(inliers, cols, -1), axis=1)
-    right = np.flip(np.minimum.accumulate(np.flip(np.where(inliers, cols, w), axis=1), axis=1),
-                    axis=1)
-    ok_l = (left >= 0) & (labels[rows, np.clip(left, 0, w - 1)] == labels)
-    ok_r = (right < w) & (labels[rows, np.clip(right, 0, w - 1)] == labels)
-    return ok_l & ok_r
-
-
-def segment_fill(disp: Array, masked: Array, grey: Array, jump: float,
-                 candidates: Optional[Array] = None, min_valid: Optional[float] = None,
-                 min_inliers: Optional[float] = None, reach: Optional[int] = None,
-                 labels: Optional[Array] = None) -> Array:
-    """Fill the holes of planar object segments from each segment's robust plane (module
-    notes).
-
-    Parameters
-    ----------
-    disp : array
-        Disparities after all filters (NaN invalid); not changed.
-    masked : array of bool
-        Pixels never filled (no image data).
-    grey : array
-        Grey values of the left image (NaN = masked), segmented by :func:`grey_segments`.
-    jump : float
-        Disparity step (px) by which a segment's plane must stand above the lowest valid
-        disparity within ``reach`` px to count as an object (roof): open terrain stays empty.
-    candidates : array, optional
-        Disparities the planes are fitted to (default ``disp``): SGM's winners before the
-        left–right check and the speckle filter, which weakly textured roofs fail although
-        they lie on the roof's plane.
-    min_valid, min_inliers : float, optional
-        Share of a segment's pixels that must hold a candidate, and share of those within
-        1 px of its plane, for the plane to fill the rest (a segment across a wall fails);
-        default :data:`SEGMENT_MIN_VALID`, :data:`SEGMENT_INLIERS`.
-    reach : int, optional
-        Half side (px) of the window of the ground test; default :data:`SEGMENT_REACH`.
-    labels : array, optional
-        Segments (≥ 1; 0 = none) instead of :func:`grey_segments`.
-
-    Returns
-    -------
-    array
-        A copy with the holes of planar object segments filled.
-    """
-    min_valid = SEGMENT_MIN_VALID if min_valid is None else min_valid
-    min_inliers = SEGMENT_INLIERS if min_inliers is None else min_inliers
-    reach = SEGMENT_REACH if reach is None else reach
-    out = disp.copy()
-    valid = np.isfinite(disp) & ~masked
-    if not valid.any() or valid.all():
-        return out
-    cand = disp if candidates is None else candidates
-    cvalid = np.isfinite(cand) & ~masked
-    if labels is None:
-        labels = grey_segments(grey, masked, SEGMENT_SCALE, SEGMENT_MIN_PX)
-    n = int(labels.max())
-    planes, inl = _robust_planes(labels, cand, cvalid, n)
-    plane = _plane_at(planes, labels)
-    size = np.bincount(labels.ravel(), minlength=n + 1).astype(float)
-    nval = np.bincount(labels[cvalid], minlength=n + 1).astype(float)
-    ninl = np.bincount(labels[inl], minlength=n + 1).astype(float)
-    # an object segment: its plane stands above the lowest disparity around it
-    ground = ndimage.minimum_filter(np.where(valid, disp, np.inf), size=2 * int(reach) + 1)
-    with np.errstate(invalid="ignore"):
-        high = np.isfinite(ground) & (plane - ground > SEGMENT_RISE * jump)
-    nhigh = np.bincount(labels.ravel(), weights=high.ravel().astype(float), minlength=n + 1)
-    good = ((nval >= min_valid * size) & (ninl >= min_inliers * np.maximum(nval, 1.0))
-            & (nval >= 20) & (nhigh >= 0.5 * size) & np.isfinite(planes).all(axis=1))
-    good[0] = False
-    # never the ground part of a segment, nor next to lower ground (walls, occlusions)
-    todo = ~valid & ~masked & good[labels] & high & _enclosed(labels, inl)
-    near = ndimage.minimum_filter(np.where(valid, disp, np.inf), size=2 * SEGMENT_EDGE + 1)
-    with np.errstate(invalid="ignore"):
-        todo &= ~(plane - near > jump)
-    out[todo] = plane[todo]
-    return out
-
-
-__all__ = ["erode_lower_side", "grey_segments", "plane_fill", "segment_fill",
-           "wall_share_columns"]
+__all__ = ["erode_lower_side", "plane_fill", "wall_share_columns"]

@@ -6,21 +6,24 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    (:meth:`EpipolarPair.disparity_range`), widened by ``disparity_margin`` px and by 10 % for
    the variation of depth across the image. Default heights: the project's terrain height
    ``Z_t`` and the flying height above ground ``H`` as ``Z_t − 0.3·H … Z_t + 0.3·H``.
-3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`); every valid disparity of a
-   tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and streamed into a
-   :class:`~..surface.gridding.GridAccumulator` (median per cell). Disparities within 2 px
-   of a mask or the image border (half windows), and within 2 px of a hole unless on the
-   *upper* side of a height step of 1.5 m (``edge_jump`` in px of this model's parallax; a
-   lower disparity within ``edge_reach`` px) in a segment of ≥ ``segment_px`` px, are dropped
-   first (``edge_erosion``: foreground fattening at occlusions and depth steps); roof edges
-   stay, hole borders on open terrain and blunder patches go.
+3. Tiled semi-global matching (:func:`.dense.iter_disparity_tiles`, with one
+   :class:`~.dense.DenseOptions` built per model by :func:`dsm_dense_options`); every valid
+   disparity of a tile is triangulated at once (:meth:`EpipolarPair.disparity_to_world`) and
+   streamed into a :class:`~..surface.gridding.GridAccumulator` (median per cell).
+   Disparities within 2 px of a mask or the image border (half windows), and within 2 px of a
+   hole unless on the *upper* side of a height step of 1.5 m (``edge_jump`` in px of this
+   model's parallax; a lower disparity within ``edge_reach`` px) in a segment of
+   ≥ ``segment_px`` px, are dropped first (``edge_erosion``: foreground fattening at
+   occlusions and depth steps); roof edges stay, hole borders on open terrain and blunder
+   patches go.
    Holes with a step on their border get their upper (object) border's heights, by inverse
    distance, where that is nearer and alike in tone (``plane_fill``, :mod:`.dense_fill`); the
    ground part of holes is left to the gap interpolation (issue 19).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
-   cells; ``t = outlier_threshold``, default the height of 1 px of parallax ``GSD·H/B``).
+   cells; ``t = outlier_threshold``, default the height of 1 px of parallax ``GSD·H/B``,
+   :attr:`~.model_setup.ModelSetup.parallax_per_metre`).
 5. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
    barriers of the gap interpolation (gaps up to ``max_gap`` m), which also re-fills the
    rejected cells.
@@ -35,7 +38,7 @@ boundary, outside exclusions) that hold a height.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Dict, Optional, Tuple, Union
 
@@ -46,7 +49,7 @@ from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import GridAccumulator, finish_grid, polygon_mask, write_grid
-from .dense import GreySource, iter_disparity_tiles
+from .dense import DenseOptions, GreySource, iter_disparity_tiles
 from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
 
@@ -65,18 +68,13 @@ PathLike = Union[str, Path]
 #: such holes get no roof fill: SGM spreads roofs over those walls (synthetic ``aerial`` block,
 #: wide angle, base 4 px per metre of height: open cells within 0.5 m of an object > 1 m off
 #: 42 % → 8 %; the ``small`` block's walls stay narrower and keep the rules above).
-#: The segment fill (``segments``, :func:`.dense_fill.segment_fill`: holes of planar object
-#: segments from the planes of SGM's winners before the consistency filters) is off: on the
-#: aerial block it adds +2.4 / +6.2 points of object interior on seeds 1 / 2 but only +0.7 on
-#: held-out seed 11, and on the tiny test block it spills roofs onto open land (open RMS
-#: 0.125 → 0.200 m; issue 19, part A in docs/decisions.md).
 _DENSE_DEFAULTS: Dict[str, Any] = {"edge_erosion": 2, "plane_fill": 100.0, "segment_px": 300,
-                                   "edge_reach": 15, "wall_px": 20.0, "segments": False}
+                                   "edge_reach": 15, "wall_px": 20.0}
 #: The rule against roofs spilling over walls one camera sees (``wall_view``, part D4 in
 #: docs/decisions.md) is off: on the aerial block it removes the spill (open cells with no
 #: margin: RMS 0.54 → 0.12 m) but also half of the roofs (object interior 44 → 27 % on seed 1,
 #: 44 → 16 % on held-out seed 11; walls 4.3 → 10.9 GSD), so by the issue's own measures it
-#: does more harm than good. It stays an option of :func:`.dense.match_dense`.
+#: does more harm than good. It stays an option (``wall_view`` of :class:`.dense.DenseOptions`).
 _WALL_RULE = False
 #: Height step (m) that separates an object from its ground for the one-sided erosion and the
 #: plane fill (objects count from 2.5 m; ground slopes within a hole stay below it).
@@ -105,23 +103,31 @@ WIDE_BASE = 0.5
 _WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
 
 
-def dsm_dense_options(setup: ModelSetup) -> Dict[str, Any]:
-    """Matching options of the DSM path for one model: :data:`_DENSE_DEFAULTS` and the height
-    step of 1.5 m in px of the model's parallax (1 px = GSD·H/B m) as ``edge_jump``; for
-    convergent models :data:`_CONVERGENT_OPTIONS`; for wide-base models (B/H ≥
-    :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; with :data:`_WALL_RULE` or a wide base also
-    the epipolar principal points as ``wall_view`` (where the left camera sees the walls of
-    the objects in its occlusions)."""
-    jump = _JUMP_M * setup.pair.base / (float(setup.gsd) * setup.flying_height)
+def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
+    """The matching options of the DSM path for one model, built once.
+
+    :data:`_DENSE_DEFAULTS` and the height step of 1.5 m in px of the model's parallax
+    (:attr:`~.model_setup.ModelSetup.parallax_per_metre`) as ``edge_jump``; for wide-base
+    models (B/H ≥ :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; for convergent models
+    :data:`_CONVERGENT_OPTIONS`; with :data:`_WALL_RULE` or a wide base also the epipolar
+    principal points as ``wall_view`` (where the left camera sees the walls of the objects in
+    its occlusions). ``overrides`` (fields of :class:`~.dense.DenseOptions`) win.
+
+    Raises
+    ------
+    InputError
+        For an override that is no dense matching option.
+    """
     cx = setup.pair.cx
     wide = setup.pair.base / setup.flying_height >= WIDE_BASE
     view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
-    options = dict(_DENSE_DEFAULTS, edge_jump=jump, wall_view=view)
+    values = dict(_DENSE_DEFAULTS, edge_jump=_JUMP_M * setup.parallax_per_metre, wall_view=view)
     if wide:
-        options.update(_WIDE_BASE_OPTIONS)
+        values.update(_WIDE_BASE_OPTIONS)
     if setup.convergent:
-        options.update(_CONVERGENT_OPTIONS)
-    return options
+        values.update(_CONVERGENT_OPTIONS)
+    values.update(overrides)
+    return DenseOptions.from_values(values)
 
 
 def _write_grey(pair: EpipolarPair, side: str, image: np.ndarray, path: Path,
@@ -163,8 +169,7 @@ class _MatchCounts:
 
 
 def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
-                memory_mb: float, dense_options: Dict[str, Any],
-                feedback: Feedback) -> _MatchCounts:
+                memory_mb: float, options: DenseOptions, feedback: Feedback) -> _MatchCounts:
     """Tiled SGM of the scratch epipolar images; every tile's points into ``acc``.
 
     The time of the matching (the tile generator) is told apart from the triangulation.
@@ -175,8 +180,8 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
         left, shape_l = _window_source(src_l)
         right, shape_r = _window_source(src_r)
         tiles = iter_disparity_tiles(left, right, shape_l, shape_r, setup.min_d, setup.max_d,
-                                     max_memory_mb=memory_mb,
-                                     feedback=feedback.step(20, 85), **dense_options)
+                                     options, max_memory_mb=memory_mb,
+                                     feedback=feedback.step(20, 85))
         while True:
             t1 = time.perf_counter()
             try:
@@ -255,13 +260,13 @@ def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap:
     return res
 
 
-def _report(setup: ModelSetup, metrics: Dict[str, Any], dense_options: Dict[str, Any],
+def _report(setup: ModelSetup, metrics: Dict[str, Any], options: DenseOptions,
             timings: Dict[str, float]) -> Dict[str, Any]:
     """The content of report.json (keys in the order of the report)."""
     recs = setup.records
     report = {"model": setup.model.name, "images": [recs[0].name, recs[1].name],
               "method": "dense", "crs": setup.project.crs, "metrics": metrics,
-              "options": {k: v for k, v in dense_options.items() if v is not None},
+              "options": {k: v for k, v in asdict(options).items() if v is not None},
               "seconds": timings}
     report["flying_height_m"] = setup.flying_height
     return report
@@ -303,7 +308,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     outlier_k : float
         Multiple of the local robust spread (1.4826 · MAD) a rejected deviation must exceed.
     **dense_options
-        Options of :func:`.dense.iter_disparity_tiles` (method, block_size, p1, p2, …).
+        Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
+        the DSM path's values for this model (:func:`dsm_dense_options`).
 
     Returns
     -------
@@ -319,10 +325,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     max_gap = 10.0 * spacing if max_gap is None else float(max_gap)
     outliers = _Outliers(5.0 * spacing if outlier_radius is None else float(outlier_radius),
                          # 1 px of parallax in height
-                         float(setup.gsd) * setup.flying_height / pair.base
+                         1.0 / setup.parallax_per_metre
                          if outlier_threshold is None else outlier_threshold, outlier_k)
-    for key, value in dsm_dense_options(setup).items():
-        dense_options.setdefault(key, value)
+    options = dsm_dense_options(setup, **dense_options)
     feedback.info(f"Model {m.name}: heights {setup.z_min:.1f}…{setup.z_max:.1f} m → "
                   f"disparities {setup.min_d}…{setup.max_d} px; DSM {grid.width}×{grid.height} "
                   f"cells at {spacing:.3f} m.")
@@ -340,7 +345,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         timings["epipolar"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
-        counts = _match_into(setup, grey, acc, memory_mb, dense_options, feedback)
+        counts = _match_into(setup, grey, acc, memory_mb, options, feedback)
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
@@ -348,7 +353,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         metrics = _metrics(setup, acc, res, counts, max_gap, outliers)
         timings["gridding"] = time.perf_counter() - t0
         timings["total"] = time.perf_counter() - t_start
-        write_model_report(tmp, _report(setup, metrics, dense_options, timings),
+        write_model_report(tmp, _report(setup, metrics, options, timings),
                            dsm=tmp / "dsm.tif", count=tmp / "count.tif",
                            exclusions=setup.exclusions)
         feedback.progress(100.0)

@@ -21,7 +21,7 @@ from rasterio.windows import Window
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..raster.io import atomic_output, gtiff_profile, open_image
-from .dense import METHODS, Array, GreySource, iter_disparity_tiles
+from .dense import METHODS, Array, DenseOptions, GreySource, iter_disparity_tiles
 
 PathLike = Union[str, Path]
 
@@ -147,11 +147,12 @@ def run_stereo_disparity(left: PathLike, right: PathLike, output: PathLike,
         if src_l.crs is not None:  # keep a georeference if the left image has one
             profile.update(crs=src_l.crs, transform=src_l.transform)
         with atomic_output(output) as tmp, open_image(tmp, "w", **profile) as dst:
-            tiles = iter_disparity_tiles(
-                read_l, read_r, shape_l, shape_r, min_disparity, max_disparity,
-                method=method, block_size=block_size, p1=p1, p2=p2, uniqueness=uniqueness,
-                lr_max_diff=lr_max_diff, fill_max_width=fill_max_width,
-                max_memory_mb=memory_mb, feedback=feedback)
+            options = DenseOptions(method=method, block_size=block_size, p1=p1, p2=p2,
+                                   uniqueness=uniqueness, lr_max_diff=lr_max_diff,
+                                   fill_max_width=fill_max_width)
+            tiles = iter_disparity_tiles(read_l, read_r, shape_l, shape_r, min_disparity,
+                                         max_disparity, options, max_memory_mb=memory_mb,
+                                         feedback=feedback)
             stats = _write_tiles(dst, tiles)
     share = stats.n_valid / float(max(h * w, 1))
     feedback.info(f"Disparity for {100.0 * share:.1f} % of the pixels.")

@@ -228,11 +228,6 @@ def _options(preset: str, overrides: Dict[str, Any], convergent: bool = False
     return options, surface
 
 
-def parallax_per_metre(setup: ModelSetup) -> float:
-    """Disparity (px) of one metre of height at the model's terrain: base (px) / H."""
-    return float(setup.pair.base * setup.pair.focal_px) / float(setup.flying_height) ** 2
-
-
 def _object_search(opts: FbmLsmOptions, surface: Dict[str, Any], setup: ModelSetup
                    ) -> FbmLsmOptions:
     """The grid densification's upward band from the preset's object height (m), in px of
@@ -245,7 +240,7 @@ def _object_search(opts: FbmLsmOptions, surface: Dict[str, Any], setup: ModelSet
     height = surface.get("object_height_m")
     if opts.object_search is not None or not height:
         return opts
-    return replace(opts, object_search=float(height) * parallax_per_metre(setup))
+    return replace(opts, object_search=float(height) * setup.parallax_per_metre)
 
 
 def _model_options(preset: str, overrides: Dict[str, Any], setup: ModelSetup

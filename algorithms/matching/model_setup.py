@@ -70,6 +70,17 @@ class ModelSetup:
         and oblique pairs): the matchers use their convergent options."""
         return self.convergence > CONVERGENT_DEG
 
+    @property
+    def parallax_per_metre(self) -> float:
+        """Parallax (px of the epipolar images) of one metre of height at the terrain.
+
+        ``B·c / H²`` (``B`` the base, m; ``c`` the epipolar focal length, px; ``H`` the flying
+        height above ground, m): the derivative of the normal-case parallax ``p = B·c / Z``
+        at the depth ``Z = H``, i.e. the base in pixels per metre of flying height. Its
+        inverse is the height of one pixel of parallax, ``GSD·H / B`` with ``GSD = H / c``.
+        """
+        return float(self.pair.base * self.pair.focal_px) / float(self.flying_height) ** 2
+
     def measuring_area(self) -> Any:
         """The stereo overlap at the mid height, inside the boundaries."""
         area = self.overlap

@@ -12,6 +12,7 @@ from scipy import ndimage
 from photodem.algorithms.errors import Cancelled, InputError
 from photodem.algorithms.feedback import Feedback
 from photodem.algorithms.matching.dense import (
+    DenseOptions,
     fill_holes_rows,
     sgm_disparity,
 )
@@ -135,8 +136,8 @@ def test_negative_disparities() -> None:
 def test_gain_offset_needs_normalisation(pair) -> None:
     """Without the local normalisation the gain/offset change costs accuracy or coverage."""
     ours = _score(sgm_disparity(pair["left"], pair["right"], 0, 31), pair["truth"])
-    raw = _score(sgm_disparity(pair["left"], pair["right"], 0, 31, normalise_window=0),
-                 pair["truth"])
+    raw = _score(sgm_disparity(pair["left"], pair["right"], 0, 31,
+                               options=DenseOptions(normalise_window=0)), pair["truth"])
     assert ours[1] >= raw[1] - 0.01
 
 
@@ -166,7 +167,7 @@ def test_masks_honoured(pair) -> None:
     left, right = pair["left"].copy(), pair["right"].copy()
     left[40:70, 30:90] = np.nan  # no data in the left image
     right[100:130, 150:200] = np.nan  # no data in the right image
-    disp = sgm_disparity(left, right, 0, 31, fill_max_width=50)
+    disp = sgm_disparity(left, right, 0, 31, options=DenseOptions(fill_max_width=50))
     assert np.isnan(disp[40:70, 30:90]).all()
     # left pixels whose partner lies in the masked right area have no disparity
     cols = np.mgrid[100:130, 0:W][1]
@@ -181,7 +182,7 @@ def test_edge_erosion_and_range_guard(pair) -> None:
     left = pair["left"].copy()
     left[40:70, 100:140] = np.nan  # a masked area: its rim loses 2 px of disparities
     plain = sgm_disparity(left, pair["right"], 0, 31)
-    eroded = sgm_disparity(left, pair["right"], 0, 31, edge_erosion=2)
+    eroded = sgm_disparity(left, pair["right"], 0, 31, options=DenseOptions(edge_erosion=2))
     ok = np.isfinite(eroded)
     assert np.array_equal(eroded[ok], plain[ok])  # only removes, never changes
     assert np.isnan(eroded[38:72, 98:142]).all()
@@ -190,7 +191,8 @@ def test_edge_erosion_and_range_guard(pair) -> None:
     rms_e, valid_e = _score(eroded, pair["truth"])
     assert rms_e <= rms_p + 1e-6 and valid_e > 0.85
     # the guard removes disparities near the range ends: here all below 6 and above 25
-    guarded = sgm_disparity(pair["left"], pair["right"], 0, 31, range_guard=6.0)
+    guarded = sgm_disparity(pair["left"], pair["right"], 0, 31,
+                            options=DenseOptions(range_guard=6.0))
     g = guarded[np.isfinite(guarded)]
     assert g.size and g.min() >= 6.0 and g.max() <= 25.0
 

@@ -3,20 +3,21 @@ synthetic epipolar pair with a flat and a gabled building of known heights (disp
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Dict, Tuple
 
 import numpy as np
 import pytest
 from scipy import ndimage
 
-from photodem.algorithms.matching.dense import sgm_disparity
-from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill, segment_fill
+from photodem.algorithms.matching.dense import DenseOptions, sgm_disparity
+from photodem.algorithms.matching.dense_fill import erode_lower_side, plane_fill
 
 GROUND = 8.0  # px
 #: the DSM path's filters (dense_model._DENSE_DEFAULTS)
-DSM = {"edge_erosion": 2, "edge_jump": 2.0, "plane_fill": 100.0, "segment_px": 300,
-       "edge_reach": 15}
-OLD = {"edge_erosion": 2}
+DSM = DenseOptions(edge_erosion=2, edge_jump=2.0, plane_fill=100.0, segment_px=300,
+                   edge_reach=15)
+OLD = DenseOptions(edge_erosion=2)
 
 
 def _texture(rng: np.random.Generator, shape: Tuple[int, int], sigma: float, amp: float
@@ -99,8 +100,8 @@ def _metrics(disp: np.ndarray, s: Dict[str, np.ndarray], k: int) -> Tuple[float,
 
 
 def test_roofs_filled_and_walls_in_place(scene) -> None:
-    new = sgm_disparity(scene["left"], scene["right"], 0, 47, **DSM)
-    old = sgm_disparity(scene["left"], scene["right"], 0, 47, **OLD)
+    new = sgm_disparity(scene["left"], scene["right"], 0, 47, options=DSM)
+    old = sgm_disparity(scene["left"], scene["right"], 0, 47, options=OLD)
     # measured: flat (textured) 100 % / 0 px, gabled (weak two-tone texture) 98.8 % / 1 px,
     # open 86.9 % (ground holes are left to the gridding), 100 % of the measured open pixels
     # right; the two-sided erosion without filling: 98.5 % / 2 px, 89.3 % / 2 px, open 86.9 %
@@ -172,51 +173,15 @@ def test_wall_share_is_zero_below_the_left_and_one_below_the_right_camera() -> N
     assert np.allclose(f, [0.0, 1.0])
 
 
-def test_segment_fill_completes_a_weakly_textured_gabled_roof() -> None:
-    s = _scene(gable_texture=4.0)
-    without = sgm_disparity(s["left"], s["right"], 0, 47, **DSM)
-    with_ = sgm_disparity(s["left"], s["right"], 0, 47, **DSM, segments=True)
-    # measured: gabled roof 85.3 % → 87.6 % within 1 px, wall error 1.5 px both; the flat
-    # roof 100 % and open ground (86.9 %, no wrong pixel) unchanged
-    c_without, _ = _metrics(without, s, 2)
-    c_with, wall = _metrics(with_, s, 2)
-    assert c_with >= 0.86 and c_with >= c_without + 0.015
-    assert wall <= 1.5
-    assert _metrics(with_, s, 1)[0] >= 0.99
-    open_ = ndimage.distance_transform_edt(s["label"] == 0) > 8
-    ok = np.abs(with_ - s["d"]) <= 1.0
-    assert ok[open_].mean() >= 0.85
-    assert (np.isfinite(with_) & ~ok)[open_].mean() <= 0.001
-
-
-def test_segment_fill_takes_raised_planar_segments_only() -> None:
-    h, w = 60, 90
-    xx = np.mgrid[0:h, 0:w][1]
-    labels = np.ones((h, w), np.int64)  # ground
-    labels[10:50, 10:40] = 2  # a sloped roof
-    labels[10:50, 50:80] = 3  # a segment across a wall: half roof, half ground
-    disp = np.full((h, w), 5.0)
-    disp[labels == 2] = 20.0 + 0.1 * xx[labels == 2]
-    disp[10:50, 50:65] = 20.0
-    disp[0:5, 0:5] = np.nan  # a ground hole
-    holes = np.zeros((h, w), bool)
-    holes[20:30, 20:30] = holes[20:30, 55:75] = True
-    disp[holes] = np.nan
-    masked = np.zeros((h, w), bool)
-    out = segment_fill(disp, masked, np.zeros((h, w)), 2.0, labels=labels)
-    np.testing.assert_allclose(out[20:30, 20:30], 20.0 + 0.1 * xx[20:30, 20:30], atol=1e-6)
-    assert np.isnan(out[20:30, 55:75]).all()  # two populations: no plane
-    assert np.isnan(out[0:5, 0:5]).all()  # ground stays to the gridding
-
-
 def test_wide_normalisation_keeps_a_striped_gabled_roof() -> None:
     # roof tiles across the epipolar lines on a slanted face: the 9 px normalisation compares
     # the stripes at different phases and SGM loses the roof; the 21 px one of wide-base
     # models (dense_model._WIDE_BASE_OPTIONS) keeps it. Measured: 0.3 % → 82.4 % of the
     # gabled roof within 1 px (wall error 99 → 2 px); the flat roof 100 % either way
     s = _scene(stripes=6.0)
-    narrow = sgm_disparity(s["left"], s["right"], 0, 47, **DSM)
-    wide = sgm_disparity(s["left"], s["right"], 0, 47, **DSM, normalise_window=21)
+    narrow = sgm_disparity(s["left"], s["right"], 0, 47, options=DSM)
+    wide = sgm_disparity(s["left"], s["right"], 0, 47,
+                         options=replace(DSM, normalise_window=21))
     c_wide, wall = _metrics(wide, s, 2)
     assert c_wide >= 0.78 and c_wide >= _metrics(narrow, s, 2)[0] + 0.5
     assert wall <= 3.0
@@ -242,14 +207,23 @@ def test_wall_rule_fills_no_roof_into_a_run_the_tile_cut_off() -> None:
 def test_wide_base_models_get_the_wide_normalisation_and_the_fill_wall_rule() -> None:
     from types import SimpleNamespace
 
+    from photodem.algorithms.errors import InputError
     from photodem.algorithms.matching.dense_model import dsm_dense_options
 
     def setup(base: float) -> SimpleNamespace:
         pair = SimpleNamespace(base=base, cx=(-3986.0, 696.0))
-        return SimpleNamespace(pair=pair, gsd=0.15, flying_height=1148.0, convergent=False)
+        return SimpleNamespace(pair=pair, flying_height=1148.0, convergent=False,
+                               parallax_per_metre=base * 7650.0 / 1148.0 ** 2)
 
     wide = dsm_dense_options(setup(700.0))  # B/H 0.61, the aerial block
-    assert wide["normalise_window"] == 21 and wide["wall_view"] == (-3986.0, 696.0)
-    assert wide["wall_erosion"] is False
+    assert wide.normalise_window == 21 and wide.wall_view == (-3986.0, 696.0)
+    assert wide.wall_erosion is False
+    assert wide.edge_jump == pytest.approx(1.5 * 700.0 * 7650.0 / 1148.0 ** 2)  # 1.5 m
     narrow = dsm_dense_options(setup(400.0))  # B/H 0.35
-    assert "normalise_window" not in narrow and narrow["wall_view"] is None
+    assert narrow.normalise_window == 9 and narrow.wall_view is None
+    assert (narrow.edge_erosion, narrow.plane_fill, narrow.segment_px, narrow.edge_reach) == (
+        2, 100.0, 300, 15)
+    # the operator's values win; a name that is no option is refused before any work
+    assert dsm_dense_options(setup(700.0), normalise_window=15).normalise_window == 15
+    with pytest.raises(InputError, match="segments"):
+        dsm_dense_options(setup(400.0), segments=True)

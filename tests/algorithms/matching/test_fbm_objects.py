@@ -227,14 +227,13 @@ def test_object_height_in_px_of_the_model() -> None:
     base (px) / H per metre; an explicit ``object_search`` wins."""
     from types import SimpleNamespace
 
-    from photodem.algorithms.matching.fbm_model import _object_search, parallax_per_metre
+    from photodem.algorithms.matching.fbm_model import _object_search
 
-    pair = SimpleNamespace(base=690.0, focal_px=7650.0)  # aerial: B/H ≈ 0.6, f 153 mm
-    setup = SimpleNamespace(pair=pair, flying_height=1148.0)
-    assert parallax_per_metre(setup) == pytest.approx(690.0 * 7650.0 / 1148.0 ** 2)
+    ppm = 690.0 * 7650.0 / 1148.0 ** 2  # aerial: B/H ≈ 0.6, f 153 mm
+    setup = SimpleNamespace(parallax_per_metre=ppm)
     opts, surface = _options("urban", {})
     found = _object_search(opts, surface, setup)
-    assert found.object_search == pytest.approx(15.0 * parallax_per_metre(setup))
+    assert found.object_search == pytest.approx(15.0 * ppm)
     assert _object_search(replace(opts, object_search=7.0), surface, setup).object_search == 7.0
     general, surface_g = _options("general", {})  # the default searches as urban does
     assert _object_search(general, surface_g, setup).object_search == pytest.approx(
