@@ -34,7 +34,10 @@ from .reference_layer import (
     reference_objects_from_vector,
 )
 from .refinement import (
+    Keep,
+    border_pairs,
     control_points,
+    frame_mask,
     grow_ring,
     joint_icp,
     outline_offset,
@@ -49,6 +52,10 @@ PathLike = Union[str, Path]
 
 #: Fewest verified pairs for a result (fewer: the failure report, not a wrong answer).
 MIN_PAIRS = 3
+#: Outline points of objects cut by the image border closer to it than this (pixels of the
+#: segmentation level) are left out: the region runs along the border there, and the
+#: smoothing before the segmentation reaches about two pixels.
+BORDER_MARGIN = 3.0
 #: Search modes: object-based, area-based, keypoints (raster references), or ``auto``:
 #: keypoints then objects for a raster, objects then the area-based search for polygons.
 SEARCH_MODES = ("auto", "objects", "area", "keypoints")
@@ -412,7 +419,9 @@ def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
                   reestimated=ver.reestimated)
     if len(ver.pairs) < MIN_PAIRS:
         _fail(counts, f"only {len(ver.pairs)} pair(s) verified (at least {MIN_PAIRS} needed)")
-    matched = _Matched(fi, fr, ver.pairs, ver.overlaps, ver.transform, level)
+    matched = _with_border_pairs(
+        _Matched(fi, fr, ver.pairs, ver.overlaps, ver.transform, level), run.grey.shape,
+        counts)
     icp_stats, T, (fit, inverse_fit, gcps, used_xy) = _icp_and_fit(matched, opts, counts, fb)
     warnings = _object_warnings(used_xy, run.grey.shape, interp, opts.max_depth)
     for w in warnings:
@@ -421,7 +430,7 @@ def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
             f"RMSE {fit.rmse_px:.2f} px ({fit.rmse_map:.2f} m).")
     return GeorefResult(
         fit=fit, inverse_fit=inverse_fit, gcps=gcps, crs=crs, global_transform=ver.transform,
-        joint=T, search=interp.transform, pairs=ver.pairs, img_features=fi, ref_features=fr,
+        joint=T, search=interp.transform, pairs=matched.pairs, img_features=fi, ref_features=fr,
         counts=counts, icp=icp_stats, segmentation=seg, reference=ref_info,
         reference_kind=ref_kind, image_info=run.image_info, grey=run.grey, warnings=warnings,
         seconds=time.perf_counter() - run.t0, stage="objects",
@@ -514,11 +523,27 @@ class _Matched:
     overlaps: List[float]  #: overlap share of each pair after the verification
     G: np.ndarray  #: 3 × 3 image → map transform of the verification
     level: int  #: pyramid level of the segmentation
+    #: the image points that are outline (None: all; objects cut by the image border: the
+    #: points off the border)
+    keep: Optional[Keep] = None
 
     @property
     def px(self) -> float:
         """Map units per level-0 pixel of ``G``."""
         return float(np.sqrt(abs(np.linalg.det(self.G[:2, :2]))))
+
+
+def _with_border_pairs(m: _Matched, shape: Sequence[int], counts: Dict[str, Any]
+                       ) -> _Matched:
+    """``m`` with the objects cut by the image border paired under the verified transform
+    (:func:`.refinement.border_pairs`; ``counts`` gets ``border_pairs``): a few whole objects
+    bunched in one part of the image leave the corners to extrapolation, the cut ones reach
+    out to the border."""
+    keep = frame_mask(shape, BORDER_MARGIN * 2**m.level)
+    extra = border_pairs(m.fi, m.fr, m.G, shape, m.pairs, keep)
+    counts["border_pairs"] = len(extra)
+    return replace(m, pairs=list(m.pairs) + [h for h, _ in extra],
+                   overlaps=list(m.overlaps) + [ov for _, ov in extra], keep=keep)
 
 
 def _icp_and_fit(m: _Matched, opts: GeorefOptions, counts: Dict[str, Any], fb: Feedback,
@@ -538,7 +563,7 @@ def _icp_and_fit(m: _Matched, opts: GeorefOptions, counts: Dict[str, Any], fb: F
                       f"{rms_px:.2f} px, at most {max_rms_px:g} px)")
     refined = [(grow_ring(a, offset_px), b, T) for a, b, _ in refined]
     fb.progress(75)
-    fitted = _outline_fit(refined, m.px, opts, counts)
+    fitted = _outline_fit(refined, m.px, opts, counts, m.keep)
     fb.progress(85)
     return icp_stats, T, fitted
 
@@ -553,7 +578,7 @@ def _pair_icp(m: _Matched, fb: Feedback) -> Tuple[List[tuple], List[Dict[str, An
         fb.check()
         ring_img = simplify_ring(fi[h.i].obj.ring, 0.5 * 2**level)
         res = trimmed_icp(apply(m.G, ring_img), fr[h.j].obj.ring, spacing=px * 2**level,
-                          model="affine")
+                          model="affine", keep=_map_keep(m))
         refined.append((fi[h.i].obj.ring, fr[h.j].obj.ring, res.transform @ m.G))
         icp_stats.append({"pair": k, "image_object": fi[h.i].obj.id,
                           "reference_object": fr[h.j].obj.id, "run": fi[h.i].obj.run,
@@ -564,6 +589,14 @@ def _pair_icp(m: _Matched, fb: Feedback) -> Tuple[List[tuple], List[Dict[str, An
                           "iterations": res.iterations, "converged": res.converged,
                           "kept": res.kept})
     return refined, icp_stats
+
+
+def _map_keep(m: _Matched) -> Optional[Keep]:
+    """``m.keep`` for points in map coordinates (mapped back by the verified transform)."""
+    if m.keep is None:
+        return None
+    keep, inv = m.keep, np.linalg.inv(m.G)
+    return lambda xy: keep(apply(inv, xy))
 
 
 def _joint_icp(m: _Matched, transform: str, fb: Feedback) -> Tuple[np.ndarray, float, float]:
@@ -582,9 +615,9 @@ def _joint_icp(m: _Matched, transform: str, fb: Feedback) -> Tuple[np.ndarray, f
     for _ in range(3):
         fb.check()
         moved = [(grow_ring(a, offset_px), b) for a, b in rings]
-        joint = joint_icp(moved, T, spacing=float(2**level), model=model)
+        joint = joint_icp(moved, T, spacing=float(2**level), model=model, keep=m.keep)
         T = joint.transform
-        step = outline_offset(moved, T, float(2**level)) / px
+        step = outline_offset(moved, T, float(2**level), keep=m.keep) / px
         offset_px += step
         if abs(step) < 0.02:
             break
@@ -592,12 +625,12 @@ def _joint_icp(m: _Matched, transform: str, fb: Feedback) -> Tuple[np.ndarray, f
 
 
 def _outline_fit(refined: List[tuple], px: float, opts: GeorefOptions,
-                 counts: Dict[str, Any]) -> tuple:
-    """Control points on the refined outlines and the final fit (``counts`` gets ``gcps``
-    and ``gcps_sharp``). Returns the fit, its inverse, the control points and the image
-    coordinates of the ones used."""
+                 counts: Dict[str, Any], keep: Optional[Keep] = None) -> tuple:
+    """Control points on the refined outlines (``keep``: the image points that are outline)
+    and the final fit (``counts`` gets ``gcps`` and ``gcps_sharp``). Returns the fit, its
+    inverse, the control points and the image coordinates of the ones used."""
     gcps = control_points(refined, alpha_min=opts.alpha_min, sigma_np=opts.sigma_np_px * px,
-                          max_count=opts.max_gcps, spacing=px, mode=opts.gcp_mode)
+                          max_count=opts.max_gcps, spacing=px, mode=opts.gcp_mode, keep=keep)
     if len(gcps) < {"affine": 3, "projective": 4, "poly2": 6}[opts.transform] + 2:
         _fail(counts, f"only {len(gcps)} control points within σ_NP = "
                       f"{opts.sigma_np_px:g} px")

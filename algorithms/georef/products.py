@@ -244,6 +244,9 @@ def report_dict(result: GeorefResult) -> Dict[str, Any]:
         "pairs": [{"image_object": fi[h.i].obj.id, "reference_object": fr[h.j].obj.id,
                    "run": fi[h.i].obj.run, "threshold": fi[h.i].obj.threshold,
                    "q": h.q, "d4_alternative": h.alternative,
+                   # paired under the verified transform, not by invariants (cut by the
+                   # image border: refinement.border_pairs)
+                   "cut_by_border": bool(fi[h.i].obj.touches_border),
                    "reference_features": fr[h.j].obj.attributes.get("features")}
                   for h in result.pairs],
         "icp": result.icp,

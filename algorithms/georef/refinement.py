@@ -13,12 +13,17 @@ image outline; all pairs pooled, sorted by residual, accepted while the RMS of t
 residuals stays below σ_NP (or up to a maximum count). The image coordinates are the closest
 point taken back through the pair's inverse transform. Extension (reported): an outline without
 enough sharp vertices (smooth forest edges) contributes points at equal spacing along it.
+
+Objects cut by the image border (extension): once the verified pairs give the transform, image
+objects that touch the border are paired with the part of a reference object inside the image
+(:func:`border_pairs`); their outline points on the image border are not object outlines and
+are left out of the ICP and the control points (the ``keep`` masks, :func:`frame_mask`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 from matplotlib.path import Path as MplPath
@@ -26,9 +31,28 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from shapely.geometry import Polygon
 
-from .correspondence import apply
+from .correspondence import Hypothesis, apply, overlap
 from .fit import fit_matrix
 from .objects import orient_ring
+
+#: A mask function: (n, 2) points → (n,) bool, True for the points to use.
+Keep = Callable[[NDArray[np.float64]], NDArray[np.bool_]]
+
+
+def frame_mask(shape: Sequence[int], margin: float) -> Keep:
+    """The image points (level-0 px, pixel centres at integers) at least ``margin`` px inside
+    the image frame: outlines of objects cut by the border run along it there."""
+    rows, cols = int(shape[0]), int(shape[1])
+
+    def keep(xy: NDArray[np.float64]) -> NDArray[np.bool_]:
+        xy = np.asarray(xy, float).reshape(-1, 2)
+        return ((xy[:, 0] >= margin - 0.5) & (xy[:, 0] <= cols - 0.5 - margin)
+                & (xy[:, 1] >= margin - 0.5) & (xy[:, 1] <= rows - 0.5 - margin))
+    return keep
+
+
+def _kept(pts: NDArray[np.float64], keep: Optional[Keep]) -> NDArray[np.float64]:
+    return pts if keep is None else pts[keep(pts)]
 
 
 def simplify_ring(ring: NDArray[np.float64], tolerance: float) -> NDArray[np.float64]:
@@ -137,10 +161,12 @@ class IcpResult:
 
 
 def trimmed_icp(source: NDArray[np.float64], target: NDArray[np.float64], spacing: float,
-                f: float = 2.0, model: str = "affine", max_iter: int = 50, tol: float = 1e-4
-                ) -> IcpResult:
-    """Register the ``source`` outline onto the ``target`` outline (both in map units)."""
+                f: float = 2.0, model: str = "affine", max_iter: int = 50, tol: float = 1e-4,
+                keep: Optional[Keep] = None) -> IcpResult:
+    """Register the ``source`` outline onto the ``target`` outline (both in map units).
+    ``keep``: the sampled source points that are outline (default: all)."""
     pts = sample_ring(source, spacing)
+    pts = _kept(pts, keep)
     T = np.eye(3)
     rms, kept, iters = float("nan"), 0.0, 0
     converged = False
@@ -149,14 +175,14 @@ def trimmed_icp(source: NDArray[np.float64], target: NDArray[np.float64], spacin
         cur = apply(T, pts)
         q, d = closest_on_ring(cur, target)
         sigma = float(np.sqrt(np.mean(d * d)))
-        keep = d <= f * max(sigma, 1e-12)
-        if keep.sum() < (8 if model == "projective" else 6):
+        near = d <= f * max(sigma, 1e-12)
+        if near.sum() < (8 if model == "projective" else 6):
             break
-        U = estimate(cur[keep], q[keep], model)
+        U = estimate(cur[near], q[near], model)
         if U is None:
             break
         T = U @ T
-        rms, kept = float(np.sqrt(np.mean(d[keep] ** 2))), float(keep.mean())
+        rms, kept = float(np.sqrt(np.mean(d[near] ** 2))), float(near.mean())
         # parameter change as the largest movement of the sampled points
         move = float(np.max(np.hypot(*(apply(U, cur) - cur).T)))
         if move < tol * spacing:
@@ -189,7 +215,8 @@ def control_points(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
                                          NDArray[np.float64]]],
                    alpha_min: float = 30.0, sigma_np: float = float("inf"),
                    max_count: int = 500, min_per_pair: int = 4, spacing: float = 1.0,
-                   mode: str = "outline", per_pair: int = 24) -> List[ControlPoint]:
+                   mode: str = "outline", per_pair: int = 24, keep: Optional[Keep] = None
+                   ) -> List[ControlPoint]:
     """Control points of refined pairs.
 
     Parameters
@@ -211,6 +238,9 @@ def control_points(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
         published). ``"outline"`` (default, extension): ``per_pair`` points at equal spacing
         along each reference outline — segmented outlines round off sharp corners, so corner
         vertices pair with points cut inside the corner (a bias of ~1 px on synthetic data).
+    keep : callable, optional
+        The image points (level-0 px) that are outline; others are no candidates (default:
+        all).
     """
     cands: List[ControlPoint] = []
     for k, (img_ring, ref_ring, T) in enumerate(pairs):
@@ -229,7 +259,8 @@ def control_points(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
                 sharp = False
         q, d = closest_on_ring(pts, mapped)
         back = apply(np.linalg.inv(T), q)
-        for p, b, r in zip(pts, back, d):
+        ok = np.ones(len(back), bool) if keep is None else keep(back)
+        for p, b, r in zip(pts[ok], back[ok], d[ok]):
             cands.append(ControlPoint((float(b[0]), float(b[1])), (float(p[0]), float(p[1])),
                                       float(r), k, sharp))
     cands.sort(key=lambda c: (c.residual, c.pair, c.map))
@@ -247,7 +278,8 @@ def control_points(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64
 
 def joint_icp(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64]]],
               start: NDArray[np.float64], spacing: float, f: float = 2.0,
-              model: str = "affine", max_iter: int = 50, tol: float = 1e-4) -> IcpResult:
+              model: str = "affine", max_iter: int = 50, tol: float = 1e-4,
+              keep: Optional[Keep] = None) -> IcpResult:
     """One image → map transform registering all verified outlines at once.
 
     ``pairs`` holds (image ring in image coordinates, reference ring in map units);
@@ -256,8 +288,9 @@ def joint_icp(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64]]],
     them. A segmentation that shrinks or grows every object a little moves each outline
     towards or away from its own centroid — per-pair transforms absorb that as scale and pass
     it into the control points; one transform for all objects cannot, and averages it out.
+    ``keep``: the sampled image points that are outline (default: all).
     """
-    pts = [sample_ring(r, spacing) for r, _ in pairs]
+    pts = [_kept(sample_ring(r, spacing), keep) for r, _ in pairs]
     owner = np.concatenate([np.full(len(p), k) for k, p in enumerate(pts)])
     src = np.vstack(pts)
     T = np.asarray(start, float).copy()
@@ -271,13 +304,13 @@ def joint_icp(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64]]],
             m = owner == k
             q[m], d[m] = closest_on_ring(cur[m], ref)
         sigma = float(np.sqrt(np.mean(d * d)))
-        keep = d <= f * max(sigma, 1e-12)
-        U = estimate(src[keep], q[keep], model)
+        near = d <= f * max(sigma, 1e-12)
+        U = estimate(src[near], q[near], model)
         if U is None:
             break
         move = float(np.max(np.hypot(*(apply(U, src) - cur).T)))
         T = U
-        rms, kept = float(np.sqrt(np.mean(d[keep] ** 2))), float(keep.mean())
+        rms, kept = float(np.sqrt(np.mean(d[near] ** 2))), float(near.mean())
         if move < tol * spacing * float(np.sqrt(abs(np.linalg.det(T[:2, :2])))):
             converged = True
             break
@@ -285,19 +318,24 @@ def joint_icp(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64]]],
 
 
 def outline_offset(pairs: Sequence[Tuple[NDArray[np.float64], NDArray[np.float64]]],
-                   T: NDArray[np.float64], spacing: float) -> float:
+                   T: NDArray[np.float64], spacing: float, keep: Optional[Keep] = None
+                   ) -> float:
     """Mean signed distance (map units) of the image outlines mapped by ``T`` from their
-    partners' outlines: positive when the image objects are smaller (lie inside)."""
+    partners' outlines: positive when the image objects are smaller (lie inside).
+    ``keep``: the sampled image points that are outline (default: all)."""
     total, n = 0.0, 0
     for img_ring, ref_ring in pairs:
-        cur = apply(T, sample_ring(img_ring, spacing))
+        pts = _kept(sample_ring(img_ring, spacing), keep)
+        if len(pts) == 0:
+            continue
+        cur = apply(T, pts)
         _, d = closest_on_ring(cur, ref_ring)
         inside = MplPath(ref_ring).contains_points(cur)
         s = np.where(inside, d, -d)
         sigma = float(np.sqrt(np.mean(d * d)))
-        keep = d <= 2.0 * max(sigma, 1e-12)
-        total += float(np.sum(s[keep]))
-        n += int(keep.sum())
+        near = d <= 2.0 * max(sigma, 1e-12)
+        total += float(np.sum(s[near]))
+        n += int(near.sum())
     return total / n if n else 0.0
 
 
@@ -310,3 +348,92 @@ def grow_ring(ring: NDArray[np.float64], distance: float) -> NDArray[np.float64]
         p = max(p.geoms, key=lambda g: g.area)
 
     return orient_ring(np.asarray(p.exterior.coords, float))
+
+
+def border_pairs(img: Sequence[Any], ref: Sequence[Any], T: NDArray[np.float64],
+                 shape: Sequence[int], taken: Sequence[Hypothesis], keep: Keep,
+                 min_overlap: float = 0.8, max_px: float = 2.0, min_share: float = 0.8,
+                 min_samples: int = 100) -> List[Tuple[Hypothesis, float]]:
+    """Pairs of image objects cut by the image border with reference objects, under the
+    verified transform ``T`` (image → map).
+
+    Their invariants are not valid, so no hypothesis pairs them; but once ``T`` is known, the
+    image object and the part of a reference object inside the mapped image frame must cover
+    the same ground (:func:`.correspondence.overlap` ≥ ``min_overlap``) and the image outline
+    off the border (``keep``, sampled every pixel, ≥ ``min_samples`` points) must lie on the
+    reference outline: ≥ ``min_share`` of it within ``max_px`` px. Objects of ``taken`` pairs
+    are not paired again; at most one partner per object, the largest overlap first. Slivers
+    cut off at an image corner (< ``min_samples`` px of outline) are left out: on a bench map
+    four of them (2–7 control points each) were 0.4–0.55 px off and pulled that corner.
+
+    Parameters
+    ----------
+    img, ref : sequence of ObjectFeatures
+        Image and reference object features (``.obj`` holds the ring).
+    T : (3, 3) array
+        Image → map transform of the verified pairs.
+    shape : (rows, cols)
+        Image size (level-0 px).
+    taken : sequence of Hypothesis
+        The verified pairs.
+    keep : callable
+        The image points that are outline (:func:`frame_mask`).
+
+    Returns
+    -------
+    list of (Hypothesis, overlap)
+        The pairs (transform ``T``, q = w = d = 0), largest overlap first.
+    """
+    rows, cols = int(shape[0]), int(shape[1])
+    frame = Polygon(apply(T, np.array([[-0.5, -0.5], [cols - 0.5, -0.5],
+                                       [cols - 0.5, rows - 0.5], [-0.5, rows - 0.5]])))
+    px = float(np.sqrt(abs(np.linalg.det(T[:2, :2]))))
+    used_i = {h.i for h in taken}
+    used_j = {h.j for h in taken}
+    clipped = {j: _clip(f.obj.ring, frame) for j, f in enumerate(ref) if j not in used_j}
+    scored = []
+    for i, f in enumerate(img):
+        if not f.obj.touches_border or i in used_i:
+            continue
+        mapped = apply(T, f.obj.ring)
+        box = Polygon(mapped).envelope
+        for j, part in clipped.items():
+            if part is None or not box.intersects(part.envelope):
+                continue
+            ov = overlap(mapped, np.asarray(part.exterior.coords, float)[:-1])
+            if ov >= min_overlap and _on_outline(f.obj.ring, ref[j].obj.ring, T, keep,
+                                                 px * max_px, min_share, min_samples):
+                scored.append((ov, i, j))
+    scored.sort(key=lambda t: (-t[0], t[2], t[1]))
+    out = []
+    for ov, i, j in scored:
+        if i in used_i or j in used_j:
+            continue
+        used_i.add(i)
+        used_j.add(j)
+        out.append((Hypothesis(i, j, np.asarray(T, float).copy(), 0.0, 0.0, 0.0), ov))
+    return out
+
+
+def _clip(ring: NDArray[np.float64], frame: Polygon) -> Optional[Polygon]:
+    """The part of a reference polygon inside the mapped image frame (``None``: none, or
+    several parts)."""
+    try:
+        p = Polygon(ring)
+        if not p.is_valid:
+            p = p.buffer(0)
+        part = p.intersection(frame)
+    except Exception:  # a degenerate polygon
+        return None
+    return part if part.geom_type == "Polygon" and part.area > 0 else None
+
+
+def _on_outline(img_ring: NDArray[np.float64], ref_ring: NDArray[np.float64],
+                T: NDArray[np.float64], keep: Keep, max_dist: float, min_share: float,
+                min_samples: int) -> bool:
+    """Whether the image outline off the border lies on the reference outline under ``T``."""
+    pts = _kept(sample_ring(img_ring, 1.0), keep)
+    if len(pts) < min_samples:
+        return False
+    _, d = closest_on_ring(apply(T, pts), ref_ring)
+    return bool(np.mean(d <= max_dist) >= min_share)

@@ -7,10 +7,12 @@ import pytest
 from _shapes import blob
 from shapely.geometry import LineString, Polygon
 
-from photodem.algorithms.georef.correspondence import apply
+from photodem.algorithms.georef.correspondence import Hypothesis, apply
 from photodem.algorithms.georef.fit import corner_error, fit_transform
 from photodem.algorithms.georef.refinement import (
+    border_pairs,
     control_points,
+    frame_mask,
     grow_ring,
     outline_offset,
     simplify_ring,
@@ -109,3 +111,57 @@ def test_outline_offset_is_measured_and_undone() -> None:
     assert off == pytest.approx(2.0, abs=0.15)
     back = grow_ring(shrunk, off)
     assert Polygon(back).symmetric_difference(Polygon(ring)).area < 0.02 * Polygon(ring).area
+
+
+def _cut_scene(T: np.ndarray, shape=(200, 300)):
+    """Reference blobs (map units) and the image objects an image of ``shape`` px through
+    ``T`` (image → map) shows: whole ones, and ones cut by the image frame (clipped)."""
+    from types import SimpleNamespace
+
+    rows, cols = shape
+    frame = Polygon([(-0.5, -0.5), (cols - 0.5, -0.5), (cols - 0.5, rows - 0.5),
+                     (-0.5, rows - 0.5)])
+    centres = [(150, 100), (10, 60), (290, 150), (150, 195), (80, 150)]  # image px
+    ref, img = [], []
+    for k, c in enumerate(centres):
+        ring_img = blob(30 + k, 160) * 30 + np.array(c, float)
+        ref.append(SimpleNamespace(obj=SimpleNamespace(ring=apply(T, ring_img))))
+        part = Polygon(ring_img).intersection(frame)
+        img.append(SimpleNamespace(obj=SimpleNamespace(
+            ring=np.asarray(part.exterior.coords, float)[:-1],
+            touches_border=not frame.buffer(-1.0).contains(Polygon(ring_img)))))
+    return img, ref
+
+
+def test_objects_cut_by_the_border_pair_with_their_partners_only() -> None:
+    T = _affine(0.4, 2.0, (5000.0, 3000.0))
+    img, ref = _cut_scene(T)
+    cut = [k for k, f in enumerate(img) if f.obj.touches_border]
+    assert cut == [1, 2, 3]
+    keep = frame_mask((200, 300), 3.0)
+    taken = [Hypothesis(0, 0, T, 1.0, 1.0, 0.0)]
+    pairs = border_pairs(img, ref, T, (200, 300), taken, keep)
+    assert sorted((h.i, h.j) for h, _ in pairs) == [(1, 1), (2, 2), (3, 3)]
+    assert all(ov > 0.95 for _, ov in pairs)
+    # a transform 6 px off: the cut outlines no longer lie on the reference outlines
+    off = T @ _affine(0.0, 1.0, (6.0, 0.0))
+    assert border_pairs(img, ref, off, (200, 300), taken, keep) == []
+
+
+def test_outline_points_on_the_image_border_are_left_out() -> None:
+    T = _affine(0.4, 2.0, (5000.0, 3000.0))
+    img, ref = _cut_scene(T)
+    keep = frame_mask((200, 300), 3.0)
+    assert keep(np.array([[2.6, 50.0], [2.4, 50.0], [296.4, 100.0], [296.6, 100.0]])).tolist() \
+        == [True, False, True, False]
+    pairs = [(img[k].obj.ring, ref[k].obj.ring, T) for k in (1, 2, 3)]
+    gcps = control_points(pairs, spacing=2.0, keep=keep)
+    xy = np.array([g.image for g in gcps])
+    assert len(gcps) >= 20 and keep(xy).all()
+    # every point lies on its true position: no point of the border runs is paired
+    err = np.hypot(*(apply(T, xy) - np.array([g.map for g in gcps])).T) / 2.0
+    assert err.max() < 0.01
+    both = control_points(pairs, spacing=2.0)
+    err_all = np.hypot(*(apply(T, np.array([g.image for g in both]))
+                         - np.array([g.map for g in both])).T) / 2.0
+    assert err_all.max() > 1.0  # without the mask, border runs pair with reference outlines
