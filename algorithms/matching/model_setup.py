@@ -72,14 +72,25 @@ class ModelSetup:
 
     @property
     def parallax_per_metre(self) -> float:
-        """Parallax (px of the epipolar images) of one metre of height at the terrain.
+        """Parallax (px of the epipolar images) of one metre of height in the model's middle.
 
-        ``B·c / H²`` (``B`` the base, m; ``c`` the epipolar focal length, px; ``H`` the flying
-        height above ground, m): the derivative of the normal-case parallax ``p = B·c / Z``
-        at the depth ``Z = H``, i.e. the base in pixels per metre of flying height. Its
-        inverse is the height of one pixel of parallax, ``GSD·H / B`` with ``GSD = H / c``.
+        Measured on the pair: the disparity of the overlap's centre 0.5 m above the mid height
+        minus that 0.5 m below it. For a nadir pair this is ``B·c / H²`` (``B`` the base, m;
+        ``c`` the epipolar focal length, px; ``H`` the flying height above ground, m; the
+        derivative of ``p = B·c / Z`` at ``Z = H``), whose inverse is the height of one pixel
+        of parallax, ``GSD·H / B``. For convergent pairs neither closed form holds: on the
+        synthetic drone block (seed 1, 15 pairs) ``B·c / H²`` was 1.02–1.57× and ``B / (GSD·H)``
+        0.85–1.14× the measured value. Without an overlap (set-ups built by hand) the nadir
+        closed form.
         """
-        return float(self.pair.base * self.pair.focal_px) / float(self.flying_height) ** 2
+        if self.overlap is None or self.overlap.is_empty:
+            return float(self.pair.base * self.pair.focal_px) / float(self.flying_height) ** 2
+        centre = self.overlap.centroid
+        points = np.array([[centre.x, centre.y, self.z_mid - 0.5],
+                           [centre.x, centre.y, self.z_mid + 0.5]])
+        col_l, _ = self.pair.world_to_epipolar(points, "left")
+        col_r, _ = self.pair.world_to_epipolar(points, "right")
+        return float(abs((col_l[1] - col_r[1]) - (col_l[0] - col_r[0])))
 
     def measuring_area(self) -> Any:
         """The stereo overlap at the mid height, inside the boundaries."""
