@@ -22,14 +22,20 @@ class Message:
     """An English template with named values; ``str()`` is the English sentence.
 
     Values are shown with ``str.format`` (format specs such as ``{number:g}`` allowed); a value
-    that is itself a :class:`Message` is a phrase the GUIs translate too.
+    that is itself a :class:`Message` is a phrase the GUIs translate too. A template without
+    values is shown as it is (it may be a text with braces, e.g. a parameter description).
     """
 
     template: str
     values: Dict[str, Any] = field(default_factory=dict)
 
     def __str__(self) -> str:
-        return self.template.format(**self.values)
+        return fill(self.template, self.values)
+
+
+def fill(template: str, values: Dict[str, Any]) -> str:
+    """``template`` with ``values`` filled in; a template without values as it is."""
+    return template.format(**values) if values else template
 
 
 def msg(template: str, **values: Any) -> Message:

@@ -185,8 +185,9 @@ class Parameter:
             elif self.optional:
                 return None
             else:
+                # the description is a spec string: the GUIs translate it like the form does
                 raise InputError.of("Parameter '{name}' ({description}) is required.",
-                                    name=self.name, description=self.description)
+                                    name=self.name, description=Message(self.description))
         try:
             if self.is_input_path or self.is_output:
                 return self._path_text(value)

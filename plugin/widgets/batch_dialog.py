@@ -25,7 +25,7 @@ from typing import Any, Callable, Dict, List, Optional
 from ...algorithms.errors import PhotodemError
 from ...algorithms.processing import batch, batch_setup
 from ...algorithms.processing.batch_setup import BatchChoices
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QSettings, Qt, QtCore, QtGui, QtWidgets, QUrl, pyqtSignal
 from .batch_runner import BatchWorker
 from .parameter_form import SETTINGS_PROJECT, PathEdit
@@ -333,7 +333,7 @@ class BatchDialog(QtWidgets.QDialog):
         try:
             rows = batch_setup.model_rows(folder)
         except PhotodemError as exc:
-            self.file_label.setText(tr("The project cannot be read: {0}").format(exc))
+            self.file_label.setText(tr("The project cannot be read: {0}").format(error_text(exc)))
             self._update_buttons()
             return
         for model in rows:
@@ -415,7 +415,7 @@ class BatchDialog(QtWidgets.QDialog):
         try:
             plan = batch.load_batch(path)
         except PhotodemError as exc:
-            self.report(tr("The batch file cannot be used: {0}").format(exc))
+            self.report(tr("The batch file cannot be used: {0}").format(error_text(exc)))
             return False
         self.project_edit.blockSignals(True)
         self.project_edit.setText(str(plan.project or ""))

@@ -29,8 +29,10 @@ class AlgorithmWorker(QObject):
         ``(level, message)``; level ``info``, ``warning`` or ``error``.
     finished(object)
         The JSON-ready output dict.
-    failed(str, bool)
-        The message and whether it is an operator error (``False``: a bug, with traceback).
+    failed(str, bool, object)
+        The English message, whether it is an operator error (``False``: a bug, with
+        traceback) and the error's :class:`~photodem.algorithms.errors.Message` (template and
+        values, which the GUI translates with :func:`..i18n.error_text`) or ``None``.
     cancelled(str)
         The run was cancelled; no output was left behind.
     done()
@@ -40,7 +42,7 @@ class AlgorithmWorker(QObject):
     progress = pyqtSignal(float)
     log = pyqtSignal(str, str)
     finished = pyqtSignal(object)
-    failed = pyqtSignal(str, bool)
+    failed = pyqtSignal(str, bool, object)
     cancelled = pyqtSignal(str)
     done = pyqtSignal()
 
@@ -73,9 +75,9 @@ class AlgorithmWorker(QObject):
         except Cancelled as exc:
             self.cancelled.emit(str(exc))
         except PhotodemError as exc:
-            self.failed.emit(str(exc), True)
+            self.failed.emit(str(exc), True, exc.message)
         except Exception:  # a bug: show the traceback, keep the GUI alive
-            self.failed.emit(traceback.format_exc(), False)
+            self.failed.emit(traceback.format_exc(), False, None)
         else:
             self.finished.emit(result)
         finally:
