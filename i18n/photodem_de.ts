@@ -5456,108 +5456,158 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Parameter '{name}': '{path}' existiert nicht.</translation>
         </message>
         <message>
+            <source>camera</source>
+            <extracomment>algorithms/project/model.py:77</extracomment>
+            <translation>Kamera</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <extracomment>algorithms/project/model.py:77</extracomment>
+            <translation>Bild</translation>
+        </message>
+        <message>
+            <source>stereo model</source>
+            <extracomment>algorithms/project/model.py:78</extracomment>
+            <translation>Stereomodell</translation>
+        </message>
+        <message>
+            <source>{where}: the {what} name {shown} cannot be used: {problem}. Names become folder names; use letters, digits, '-' and '_'.</source>
+            <extracomment>algorithms/project/model.py:107</extracomment>
+            <translation>{where}: Der {what}name {shown} kann nicht verwendet werden: {problem}. Namen werden zu Ordnernamen; verwenden Sie Buchstaben, Ziffern, '-' und '_'.</translation>
+        </message>
+        <message>
             <source>{where}: 'format_version' is {version} but this PhotoDEM reads format_version {supported} only: {why}.</source>
-            <extracomment>algorithms/project/model.py:496</extracomment>
+            <extracomment>algorithms/project/model.py:505</extracomment>
             <translation>{where}: 'format_version' ist {version}, diese PhotoDEM-Version liest aber nur format_version {supported}: {why}.</translation>
         </message>
         <message>
+            <source>it must be text, not {type}</source>
+            <extracomment>algorithms/project/model.py:60</extracomment>
+            <translation>er muss Text sein, nicht {type}</translation>
+        </message>
+        <message>
+            <source>it is empty</source>
+            <extracomment>algorithms/project/model.py:62</extracomment>
+            <translation>er ist leer</translation>
+        </message>
+        <message>
+            <source>it contains a path separator ('/' or '\')</source>
+            <extracomment>algorithms/project/model.py:64</extracomment>
+            <translation>er enthält einen Pfadtrenner ('/' oder '\')</translation>
+        </message>
+        <message>
+            <source>'.' and '..' name folders</source>
+            <extracomment>algorithms/project/model.py:66</extracomment>
+            <translation>'.' und '..' bezeichnen Ordner</translation>
+        </message>
+        <message>
+            <source>it starts with a dot</source>
+            <extracomment>algorithms/project/model.py:68</extracomment>
+            <translation>er beginnt mit einem Punkt</translation>
+        </message>
+        <message>
+            <source>it contains a control character</source>
+            <extracomment>algorithms/project/model.py:70</extracomment>
+            <translation>er enthält ein Steuerzeichen</translation>
+        </message>
+        <message>
+            <source>it is not valid UTF-8 text</source>
+            <extracomment>algorithms/project/model.py:72</extracomment>
+            <translation>er ist kein gültiger UTF-8-Text</translation>
+        </message>
+        <message>
             <source>it was written by a newer PhotoDEM; update PhotoDEM to open it</source>
-            <extracomment>algorithms/project/model.py:494</extracomment>
+            <extracomment>algorithms/project/model.py:503</extracomment>
             <translation>die Datei stammt von einer neueren PhotoDEM-Version; aktualisieren Sie PhotoDEM, um sie zu öffnen</translation>
         </message>
         <message>
             <source>no PhotoDEM wrote it; fix the value</source>
-            <extracomment>algorithms/project/model.py:495</extracomment>
+            <extracomment>algorithms/project/model.py:504</extracomment>
             <translation>keine PhotoDEM-Version hat sie geschrieben; korrigieren Sie den Wert</translation>
         </message>
         <message>
             <source>{where}: '{key}' {problem}; fix it in the project file.</source>
-            <extracomment>algorithms/project/model.py:544</extracomment>
+            <extracomment>algorithms/project/model.py:553</extracomment>
             <translation>{where}: '{key}' {problem}; korrigieren Sie dies in der Projektdatei.</translation>
         </message>
         <message>
             <source>'{path}' is not a PhotoDEM project: {file} not found. Create one with project_create or synthetic_block.</source>
-            <extracomment>algorithms/project/model.py:399</extracomment>
+            <extracomment>algorithms/project/model.py:405</extracomment>
             <translation>'{path}' ist kein PhotoDEM-Projekt: {file} wurde nicht gefunden. Legen Sie eines mit project_create oder synthetic_block an.</translation>
         </message>
         <message>
-            <source>{where} has no [project] table ({state}); restore it from a copy or create the project again with project_create.</source>
-            <extracomment>algorithms/project/model.py:418</extracomment>
-            <translation>{where} hat keine Tabelle [project] ({state}); stellen Sie die Datei aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
+            <source>{where} has no [project] table (it is not a PhotoDEM project file); restore it from a copy or create the project again with project_create.</source>
+            <extracomment>algorithms/project/model.py:427</extracomment>
+            <translation>{where} hat keine Tabelle [project] (es ist keine PhotoDEM-Projektdatei); stellen Sie die Datei aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
         </message>
         <message>
             <source>{where} is not UTF-8 text (byte 0x{byte:02x} at position {position}); save it as UTF-8.</source>
-            <extracomment>algorithms/project/model.py:406</extracomment>
+            <extracomment>algorithms/project/model.py:412</extracomment>
             <translation>{where} ist kein UTF-8-Text (Byte 0x{byte:02x} an Position {position}); speichern Sie die Datei als UTF-8.</translation>
         </message>
         <message>
             <source>{where} is not valid TOML ({error}); fix the line it names.</source>
-            <extracomment>algorithms/project/model.py:410</extracomment>
+            <extracomment>algorithms/project/model.py:416</extracomment>
             <translation>{where} ist kein gültiges TOML ({error}); korrigieren Sie die genannte Zeile.</translation>
         </message>
         <message>
             <source>Cannot read {where}: {error}.</source>
-            <extracomment>algorithms/project/model.py:413</extracomment>
+            <extracomment>algorithms/project/model.py:419</extracomment>
             <translation>{where} kann nicht gelesen werden: {error}.</translation>
         </message>
         <message>
-            <source>it is empty</source>
-            <extracomment>algorithms/project/model.py:417</extracomment>
-            <translation>die Datei ist leer</translation>
-        </message>
-        <message>
-            <source>it is not a PhotoDEM project file</source>
-            <extracomment>algorithms/project/model.py:417</extracomment>
-            <translation>es ist keine PhotoDEM-Projektdatei</translation>
+            <source>{where} has no [project] table (it is empty); restore it from a copy or create the project again with project_create.</source>
+            <extracomment>algorithms/project/model.py:424</extracomment>
+            <translation>{where} hat keine Tabelle [project] (die Datei ist leer); stellen Sie sie aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
         </message>
         <message>
             <source>{where}: {error}</source>
-            <extracomment>algorithms/project/model.py:426; algorithms/project/model.py:640</extracomment>
+            <extracomment>algorithms/project/model.py:435; algorithms/project/model.py:649</extracomment>
             <translation>{where}: {error}</translation>
         </message>
         <message>
             <source>is missing</source>
-            <extracomment>algorithms/project/model.py:551</extracomment>
+            <extracomment>algorithms/project/model.py:560</extracomment>
             <translation>fehlt</translation>
         </message>
         <message>
             <source>must be text in quotes, not {value}</source>
-            <extracomment>algorithms/project/model.py:559</extracomment>
+            <extracomment>algorithms/project/model.py:568</extracomment>
             <translation>muss Text in Anführungszeichen sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a number, not {value}</source>
-            <extracomment>algorithms/project/model.py:569</extracomment>
+            <extracomment>algorithms/project/model.py:578</extracomment>
             <translation>muss eine Zahl sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a whole number, not {value}</source>
-            <extracomment>algorithms/project/model.py:576</extracomment>
+            <extracomment>algorithms/project/model.py:585</extracomment>
             <translation>muss eine ganze Zahl sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a list of {length} numbers, not {value}</source>
-            <extracomment>algorithms/project/model.py:587</extracomment>
+            <extracomment>algorithms/project/model.py:596</extracomment>
             <translation>muss eine Liste von {length} Zahlen sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a table ([{key}]), not {value}</source>
-            <extracomment>algorithms/project/model.py:595</extracomment>
+            <extracomment>algorithms/project/model.py:604</extracomment>
             <translation>muss eine Tabelle ([{key}]) sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be an array of tables ([[{key}]]), not {value}</source>
-            <extracomment>algorithms/project/model.py:604</extracomment>
+            <extracomment>algorithms/project/model.py:613</extracomment>
             <translation>muss eine Liste von Tabellen ([[{key}]]) sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a table, not {value}</source>
-            <extracomment>algorithms/project/model.py:613</extracomment>
+            <extracomment>algorithms/project/model.py:622</extracomment>
             <translation>muss eine Tabelle sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be 2 rows of 3 numbers, not {value}</source>
-            <extracomment>algorithms/project/model.py:635</extracomment>
+            <extracomment>algorithms/project/model.py:644</extracomment>
             <translation>muss aus 2 Zeilen mit je 3 Zahlen bestehen, nicht {value}</translation>
         </message>
         <message>

@@ -48,7 +48,7 @@ FORMAT_VERSION = 1
 _SEPARATORS = ("/", "\\")
 
 
-def identifier_problem(name: Any) -> Optional[str]:
+def identifier_problem(name: Any) -> Optional[Message]:
     """Why ``name`` cannot be an identifier that becomes a path part, or ``None`` if it can.
 
     Model, image, camera and batch step names become folder and file names
@@ -57,20 +57,25 @@ def identifier_problem(name: Any) -> Optional[str]:
     characters.
     """
     if not isinstance(name, str):
-        return f"it must be text, not {type(name).__name__}"
+        return msg("it must be text, not {type}", type=type(name).__name__)
     if not name.strip():
-        return "it is empty"
+        return msg("it is empty")
     if any(sep in name for sep in _SEPARATORS):
-        return "it contains a path separator ('/' or '\\')"
+        return msg("it contains a path separator ('/' or '\\')")
     if name in (".", ".."):
-        return "'.' and '..' name folders"
+        return msg("'.' and '..' name folders")
     if name.startswith("."):
-        return "it starts with a dot"
+        return msg("it starts with a dot")
     if any(ord(c) < 32 or ord(c) == 127 or 0x80 <= ord(c) < 0xA0 for c in name):
-        return "it contains a control character"
+        return msg("it contains a control character")
     if any(0xD800 <= ord(c) <= 0xDFFF for c in name):
-        return "it is not valid UTF-8 text"
+        return msg("it is not valid UTF-8 text")
     return None
+
+
+#: The items whose names :func:`check_identifier` checks, as words the GUIs translate.
+_ITEM_WORDS = {"camera": msg("camera"), "image": msg("image"),
+               "stereo model": msg("stereo model")}
 
 
 def check_identifier(name: Any, what: str, where: str = "") -> str:
@@ -93,14 +98,15 @@ def check_identifier(name: Any, what: str, where: str = "") -> str:
     problem = identifier_problem(name)
     if problem is None:
         return name
-    prefix = f"{where}: " if where else ""
     shown = repr(name) if not isinstance(name, str) else "'" + name.encode(
         "utf-8", "surrogateescape").decode("utf-8", "backslashreplace").encode(
         "unicode_escape").decode("ascii") + "'"
-    raise InputError(
-        f"{prefix}the {what} name {shown} cannot be used: {problem}. Names become folder names; "
-        "use letters, digits, '-' and '_'."
-    )
+    if not where:  # a part of a longer message (identifier_errors)
+        raise InputError(f"the {what} name {shown} cannot be used: {problem}. Names become "
+                         "folder names; use letters, digits, '-' and '_'.")
+    raise InputError.of("{where}: the {what} name {shown} cannot be used: {problem}. Names "
+                        "become folder names; use letters, digits, '-' and '_'.", where=where,
+                        what=_ITEM_WORDS.get(what, what), shown=shown, problem=problem)
 
 
 def identifier_errors(project: Project) -> List[str]:
@@ -414,10 +420,13 @@ class Project:
                                 error=exc.strerror or exc) from None
         top = _Table(data, where, "")
         if "project" not in data:
-            state = msg("it is empty") if not data else msg("it is not a PhotoDEM project file")
-            raise InputError.of("{where} has no [project] table ({state}); restore it from a "
-                                "copy or create the project again with project_create.",
-                                where=where, state=state)
+            if not data:
+                raise InputError.of("{where} has no [project] table (it is empty); restore it "
+                                    "from a copy or create the project again with "
+                                    "project_create.", where=where)
+            raise InputError.of("{where} has no [project] table (it is not a PhotoDEM project "
+                                "file); restore it from a copy or create the project again "
+                                "with project_create.", where=where)
         head = top.table("project")
         _check_format_version(head)
         try:

@@ -19,6 +19,7 @@ if str(FAKES) not in sys.path:
 import _fake_algs  # noqa: E402
 
 from photodem.algorithms.errors import InputError, Message, msg  # noqa: E402
+from photodem.algorithms.project.model import check_identifier  # noqa: E402
 from photodem.plugin import i18n  # noqa: E402
 from photodem.plugin.app.main_window import ToolboxWindow  # noqa: E402
 from photodem.plugin.widgets.worker import AlgorithmWorker, start_in_thread  # noqa: E402
@@ -65,6 +66,12 @@ def test_german_text_of_nested_messages(qapp, german):
     required = InputError.of("Parameter '{name}' ({description}) is required.", name="extent",
                              description=Message("Extent"))  # a spec string, as the form
     assert i18n.error_text(required) == "Parameter 'extent' (Ausdehnung) muss angegeben werden."
+    with pytest.raises(InputError) as info:  # a name that is no valid path part
+        check_identifier("../x", "stereo model", "'p.toml' [[models]] #1")
+    assert i18n.error_text(info.value) == (
+        "'p.toml' [[models]] #1: Der Stereomodellname '../x' kann nicht verwendet werden: er "
+        "enthält einen Pfadtrenner ('/' oder '\\'). Namen werden zu Ordnernamen; verwenden "
+        "Sie Buchstaben, Ziffern, '-' und '_'.")
 
 
 def test_a_broken_translation_falls_back_to_english(monkeypatch):
