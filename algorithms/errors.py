@@ -32,6 +32,23 @@ class Message:
     def __str__(self) -> str:
         return fill(self.template, self.values)
 
+    def to_dict(self) -> Dict[str, Any]:
+        """JSON-ready form (batch records): nested messages as dicts, other values that JSON
+        cannot hold (paths) as their text."""
+        def plain(value: Any) -> Any:
+            if isinstance(value, Message):
+                return value.to_dict()
+            return value if isinstance(value, (str, int, float, bool, type(None))) else str(value)
+        return {"template": self.template,
+                "values": {key: plain(value) for key, value in self.values.items()}}
+
+    @classmethod
+    def from_dict(cls, data: Dict[str, Any]) -> Message:
+        """The message of :meth:`to_dict`."""
+        values = {key: cls.from_dict(value) if isinstance(value, dict) else value
+                  for key, value in dict(data.get("values") or {}).items()}
+        return cls(str(data.get("template", "")), values)
+
 
 def fill(template: str, values: Dict[str, Any]) -> str:
     """``template`` with ``values`` filled in; a template without values as it is."""

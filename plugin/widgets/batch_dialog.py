@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
-from ...algorithms.errors import PhotodemError
+from ...algorithms.errors import Message, PhotodemError
 from ...algorithms.processing import batch, batch_setup
 from ...algorithms.processing.batch_setup import BatchChoices
 from ..i18n import error_text, tr
@@ -47,6 +47,14 @@ def state_text(state: str) -> str:
     return {"done": tr("done"), "failed": tr("failed"), "not run": tr("not run"),
             "skipped": tr("skipped"), "cancelled": tr("cancelled"), "running": tr("running"),
             "waiting": tr("waiting")}.get(state, state)
+
+
+def record_error(record: Dict[str, Any]) -> str:
+    """A failed task's error in the operator's language (its ``error_message``), else the
+    record's English ``error``."""
+    data = record.get("error_message")
+    message = Message.from_dict(data) if isinstance(data, dict) else None
+    return error_text(str(record.get("error") or ""), message)
 
 
 class _Row:
@@ -607,7 +615,7 @@ class BatchDialog(QtWidgets.QDialog):
         failed = [row.records[i] for i in row.tasks
                   if row.records.get(i, {}).get("status") == "failed"]
         if failed:
-            reason = str(failed[0].get("error") or "").strip().splitlines()
+            reason = record_error(failed[0]).strip().splitlines()
             self._set_state(row, "failed", reason[0] if reason else "")
         elif any(s is None for s in statuses):
             if not self.is_running():

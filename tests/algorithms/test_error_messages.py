@@ -114,3 +114,23 @@ def test_every_error_template_is_extracted_and_translated():
     for template in found:
         assert german.get(template), f"untranslated: {template}"
         assert fields(german[template]) == fields(template), template
+
+
+def test_batch_records_carry_the_message_as_json(tmp_path):
+    """A failed batch task keeps its message in the record (summary.json) for the GUIs."""
+    import json
+
+    from photodem.algorithms.processing.batch import execute_task
+
+    missing = tmp_path / "none.tif"
+    result = execute_task("dem_compare", {"dem": str(missing), "reference": str(missing),
+                                          "output": str(tmp_path / "out")},
+                          tmp_path / "task.log", lambda: False)
+    assert result["status"] == "failed"
+    data = json.loads(json.dumps(result["error_message"]))
+    assert data["template"] == "Parameter '{name}': '{path}' does not exist."
+    assert str(Message.from_dict(data)) == result["error"]
+    nested = InputError.of("{label} holds {what}.", label=msg("'{path}'", path=tmp_path),
+                           what=msg("files PhotoDEM did not write"))
+    back = Message.from_dict(json.loads(json.dumps(nested.message.to_dict())))
+    assert str(back) == str(nested) and isinstance(back.values["what"], Message)

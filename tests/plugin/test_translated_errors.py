@@ -74,6 +74,16 @@ def test_german_text_of_nested_messages(qapp, german):
         "Sie Buchstaben, Ziffern, '-' und '_'.")
 
 
+def test_batch_dialog_shows_a_failed_task_in_german(qapp, german):
+    from photodem.plugin.widgets.batch_dialog import record_error
+
+    german()
+    error = InputError.of(MISSING, name="dem", path="/x.tif")
+    record = {"status": "failed", "error": str(error), "error_message": error.message.to_dict()}
+    assert record_error(record) == "Parameter 'dem': '/x.tif' existiert nicht."
+    assert record_error({"status": "failed", "error": "old record"}) == "old record"
+
+
 def test_a_broken_translation_falls_back_to_english(monkeypatch):
     monkeypatch.setattr(i18n, "tr", lambda text: "Parameter '{nam}' fehlt.")
     exc = InputError.of(MISSING, name="dem", path="/x.tif")
