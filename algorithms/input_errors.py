@@ -309,7 +309,8 @@ def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
             try:
                 check_encodable(value, "output")
             except InputError as exc:
-                raise InputError(f"Parameter '{name}': {exc}") from None
+                raise InputError.of("Parameter '{name}': {error}", name=name, error=exc
+                                    ) from None
             continue
         paths = list(value) if kind == "multiple_rasters" else [value]
         if kind == "file":
@@ -322,7 +323,8 @@ def check_raster_parameters(parameters: Iterable[object], values: dict) -> None:
             try:
                 check_raster(path)
             except InputError as exc:
-                raise InputError(f"Parameter '{name}': {exc}") from exc.__cause__
+                raise InputError.of("Parameter '{name}': {error}", name=name, error=exc
+                                    ) from exc.__cause__
 
 
 def _opens_as_raster(path: PathLike) -> bool:

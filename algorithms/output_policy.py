@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Dict, Iterable, Iterator, List, Optional, Sequence, Union
 
-from .errors import InputError
+from .errors import InputError, Message, msg
 
 PathLike = Union[str, Path]
 
@@ -92,8 +92,9 @@ def contained(path: PathLike, folder: PathLike, what: str) -> Path:
     """
     resolved, base = Path(path).resolve(), Path(folder).resolve()
     if resolved == base or base not in resolved.parents:
-        raise InputError(f"{what} leads to '{path}', outside '{folder}'; rename it (names may "
-                         "not contain '/', '\\' or '..').")
+        raise InputError.of("{what} leads to '{path}', outside '{folder}'; rename it (names "
+                            "may not contain '/', '\\' or '..').", what=what, path=path,
+                            folder=folder)
     return Path(path)
 
 
@@ -239,71 +240,81 @@ def check_targets(algorithm: str, targets: Sequence[Target], inputs: Iterable[Pa
     cwd = Path.cwd().resolve()
     for target in targets:
         out = target.path.resolve()
-        label = f"Parameter '{target.name}': the output '{target.path}'"
+        label = msg("Parameter '{name}': the output '{path}'", name=target.name,
+                    path=target.path)
         if out == cwd or out == Path(out.anchor) or out == Path.home().resolve():
-            raise InputError(f"{label} is the working, home or root folder; name a new folder "
-                             "or file inside it.")
+            raise InputError.of("{label} is the working, home or root folder; name a new folder "
+                                "or file inside it.", label=label)
         _check_parent(out, label)
         _check_kind(out, target.kind, label)
         _check_project(out, label)
         for inp in inputs_r + protected_r:
             if out == inp or out in inp.parents:
-                raise InputError(f"{label} is or contains the input '{inp}'; PhotoDEM never "
-                                 "overwrites its inputs. Choose another output.")
+                raise InputError.of("{label} is or contains the input '{input}'; PhotoDEM "
+                                    "never overwrites its inputs. Choose another output.",
+                                    label=label, input=inp)
         if not target.reuse:
             _check_existing(out, target, algorithm, label)
 
 
-def _check_parent(out: Path, label: str) -> None:
+def _check_parent(out: Path, label: Message) -> None:
     for parent in out.parents:
         if parent.exists():
             if not parent.is_dir():
-                raise InputError(f"{label} lies below '{parent}', which is a file; choose a "
-                                 "path in a folder.")
+                raise InputError.of("{label} lies below '{parent}', which is a file; choose "
+                                    "a path in a folder.", label=label, parent=parent)
             return
 
 
-def _check_kind(out: Path, kind: str, label: str) -> None:
+def _check_kind(out: Path, kind: str, label: Message) -> None:
     if kind == "file" and out.is_dir():
-        raise InputError(f"{label} is a folder, but a file is expected; give a file name.")
+        raise InputError.of("{label} is a folder, but a file is expected; give a file name.",
+                            label=label)
     if kind == "folder" and out.exists() and not out.is_dir():
-        raise InputError(f"{label} is a file, but a folder is expected; give a folder name.")
+        raise InputError.of("{label} is a file, but a folder is expected; give a folder name.",
+                            label=label)
 
 
-def _check_project(out: Path, label: str) -> None:
+def _check_project(out: Path, label: Message) -> None:
     if out.is_dir() and _holds_project(out):
-        raise InputError(f"{label} is or contains a PhotoDEM project; choose a folder outside "
-                         "it (e.g. below its products/ folder).")
+        raise InputError.of("{label} is or contains a PhotoDEM project; choose a folder "
+                            "outside it (e.g. below its products/ folder).", label=label)
     root = project_root(out.parent)
     if root is not None:
         rel = out.relative_to(root)
         if rel.parts and rel.parts[0] in PROJECT_PARTS:
-            raise InputError(f"{label} is part of the project '{root}' ({rel.parts[0]}); "
-                             "write products below its products/ folder.")
+            raise InputError.of("{label} is part of the project '{root}' ({part}); write "
+                                "products below its products/ folder.", label=label, root=root,
+                                part=rel.parts[0])
 
 
-def _check_existing(out: Path, target: Target, algorithm: str, label: str) -> None:
+def _check_existing(out: Path, target: Target, algorithm: str, label: Message) -> None:
     if not out.exists():
         return
     if out.is_dir():
         if not any(out.iterdir()) or folder_product(out) == algorithm:
             return
         other = folder_product(out)
-        what = f"a product of '{other}'" if other else "files PhotoDEM did not write"
-        raise InputError(f"{label} holds {what}; only an earlier '{algorithm}' result is "
-                         "replaced. Choose an empty or new folder.")
+        what = (msg("a product of '{other}'", other=other) if other
+                else msg("files PhotoDEM did not write"))
+        raise InputError.of("{label} holds {what}; only an earlier '{algorithm}' result is "
+                            "replaced. Choose an empty or new folder.", label=label, what=what,
+                            algorithm=algorithm)
     if target.owner is not None:
         owner = target.owner.resolve()
         if owner.exists() and _is_product(owner, algorithm):
             return
-        raise InputError(f"{label} exists and does not belong to an earlier '{algorithm}' "
-                         f"result '{target.owner}'; move it or choose another output name.")
+        raise InputError.of("{label} exists and does not belong to an earlier '{algorithm}' "
+                            "result '{owner}'; move it or choose another output name.",
+                            label=label, algorithm=algorithm, owner=target.owner)
     other = file_product(out)
     if other == algorithm:
         return
-    what = f"a product of '{other}'" if other else "a file PhotoDEM did not write"
-    raise InputError(f"{label} exists and is {what}; only an earlier '{algorithm}' result is "
-                     "replaced. Choose another file name.")
+    what = (msg("a product of '{other}'", other=other) if other
+            else msg("a file PhotoDEM did not write"))
+    raise InputError.of("{label} exists and is {what}; only an earlier '{algorithm}' result is "
+                        "replaced. Choose another file name.", label=label, what=what,
+                        algorithm=algorithm)
 
 
 # -- staging names and leftovers -----------------------------------------------------------------

@@ -3070,7 +3070,7 @@
         </message>
         <message>
             <source>Surface</source>
-            <extracomment>plugin/qgis/editing_toolbar.py:127; plugin/widgets/qc_panel.py:631</extracomment>
+            <extracomment>plugin/qgis/editing_toolbar.py:127; plugin/widgets/qc_panel.py:632</extracomment>
             <translation>Oberfläche</translation>
         </message>
         <message>
@@ -3505,12 +3505,12 @@
         </message>
         <message>
             <source>Open</source>
-            <extracomment>plugin/widgets/batch_dialog.py:223; plugin/widgets/run_panel.py:237</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:223; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Öffnen</translation>
         </message>
         <message>
             <source>Show in folder</source>
-            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:237</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Im Ordner zeigen</translation>
         </message>
         <message>
@@ -4927,22 +4927,22 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Searching blunders…</source>
-            <extracomment>plugin/widgets/qc_panel.py:505</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:506</extracomment>
             <translation>Suche grobe Fehler…</translation>
         </message>
         <message>
             <source>CSV (*.csv)</source>
-            <extracomment>plugin/widgets/qc_panel.py:614</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:615</extracomment>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
             <source>PNG image (*.png)</source>
-            <extracomment>plugin/widgets/qc_panel.py:614</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:615</extracomment>
             <translation>PNG-Bild (*.png)</translation>
         </message>
         <message>
             <source>Export profile</source>
-            <extracomment>plugin/widgets/qc_panel.py:615</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:616</extracomment>
             <translation>Profil exportieren</translation>
         </message>
         <message>
@@ -4987,27 +4987,27 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Select a blunder in the list first.</source>
-            <extracomment>plugin/widgets/qc_panel.py:524</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:525</extracomment>
             <translation>Wählen Sie zuerst einen groben Fehler in der Liste.</translation>
         </message>
         <message>
             <source>Open a project with an edits.gpkg first: the edit goes into it.</source>
-            <extracomment>plugin/widgets/qc_panel.py:531</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:532</extracomment>
             <translation>Öffnen Sie zuerst ein Projekt mit edits.gpkg: Die Bearbeitung wird dort gespeichert.</translation>
         </message>
         <message>
             <source>The reference has no height at the spot's centre.</source>
-            <extracomment>plugin/widgets/qc_panel.py:569</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:570</extracomment>
             <translation>Die Referenz hat in der Mitte der Stelle keine Höhe.</translation>
         </message>
         <message>
             <source>Choose the surfaces first.</source>
-            <extracomment>plugin/widgets/qc_panel.py:579; plugin/widgets/qc_panel.py:625</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:580; plugin/widgets/qc_panel.py:626</extracomment>
             <translation>Wählen Sie zuerst die Oberflächen.</translation>
         </message>
         <message>
             <source>Height [m]</source>
-            <extracomment>plugin/widgets/qc_panel.py:631; plugin/widgets/qc_plots.py:170</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:632; plugin/widgets/qc_plots.py:170</extracomment>
             <translation>Höhe [m]</translation>
         </message>
         <message>
@@ -5027,22 +5027,22 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>{0} blunder spots (|Δh − median| &gt; {1:.2f} m).</source>
-            <extracomment>plugin/widgets/qc_panel.py:510</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:511</extracomment>
             <translation>{0} Stellen mit groben Fehlern (|Δh − Median| &gt; {1:.2f} m).</translation>
         </message>
         <message>
             <source>Written to {0}.</source>
-            <extracomment>plugin/widgets/qc_panel.py:542</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:543</extracomment>
             <translation>In {0} geschrieben.</translation>
         </message>
         <message>
             <source>{0} stations, {1} breakline crossings, {2} check points</source>
-            <extracomment>plugin/widgets/qc_panel.py:593</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:594</extracomment>
             <translation>{0} Stationen, {1} Kreuzungen mit Bruchkanten, {2} Kontrollpunkte</translation>
         </message>
         <message>
             <source>At x = {0:.2f}, y = {1:.2f}</source>
-            <extracomment>plugin/widgets/qc_panel.py:638</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:639</extracomment>
             <translation>Bei x = {0:.2f}, y = {1:.2f}</translation>
         </message>
         <message>
@@ -5052,12 +5052,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Internal error: {0}</source>
-            <extracomment>plugin/widgets/qc_panel.py:477</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:478</extracomment>
             <translation>Interner Fehler: {0}</translation>
         </message>
         <message>
             <source>Profile written to {0}.</source>
-            <extracomment>plugin/widgets/qc_panel.py:619</extracomment>
+            <extracomment>plugin/widgets/qc_panel.py:620</extracomment>
             <translation>Profil nach {0} geschrieben.</translation>
         </message>
         <message>
@@ -5257,7 +5257,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Show on map</source>
-            <extracomment>plugin/widgets/run_panel.py:232</extracomment>
+            <extracomment>plugin/widgets/run_panel.py:233</extracomment>
             <translation>Auf Karte zeigen</translation>
         </message>
         <message>
@@ -5304,6 +5304,331 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>All edits saved.</source>
             <extracomment>plugin/widgets/undo_history.py:103</extracomment>
             <translation>Alle Bearbeitungen gespeichert.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': {error}</source>
+            <extracomment>algorithms/input_errors.py:312; algorithms/input_errors.py:326</extracomment>
+            <translation>Parameter '{name}': {error}</translation>
+        </message>
+        <message>
+            <source>{label} exists and is {what}; only an earlier '{algorithm}' result is replaced. Choose another file name.</source>
+            <extracomment>algorithms/output_policy.py:315</extracomment>
+            <translation>{label} existiert bereits und ist {what}; ersetzt wird nur ein früheres Ergebnis von '{algorithm}'. Wählen Sie einen anderen Dateinamen.</translation>
+        </message>
+        <message>
+            <source>{what} leads to '{path}', outside '{folder}'; rename it (names may not contain '/', '\' or '..').</source>
+            <extracomment>algorithms/output_policy.py:95</extracomment>
+            <translation>{what} führt zu '{path}', außerhalb von '{folder}'; benennen Sie es um (Namen dürfen weder '/', '\' noch '..' enthalten).</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': the output '{path}'</source>
+            <extracomment>algorithms/output_policy.py:243</extracomment>
+            <translation>Parameter '{name}': Die Ausgabe '{path}'</translation>
+        </message>
+        <message>
+            <source>{label} is a folder, but a file is expected; give a file name.</source>
+            <extracomment>algorithms/output_policy.py:271</extracomment>
+            <translation>{label} ist ein Ordner, erwartet wird aber eine Datei; geben Sie einen Dateinamen an.</translation>
+        </message>
+        <message>
+            <source>{label} is a file, but a folder is expected; give a folder name.</source>
+            <extracomment>algorithms/output_policy.py:274</extracomment>
+            <translation>{label} ist eine Datei, erwartet wird aber ein Ordner; geben Sie einen Ordnernamen an.</translation>
+        </message>
+        <message>
+            <source>{label} is or contains a PhotoDEM project; choose a folder outside it (e.g. below its products/ folder).</source>
+            <extracomment>algorithms/output_policy.py:280</extracomment>
+            <translation>{label} ist oder enthält ein PhotoDEM-Projekt; wählen Sie einen Ordner außerhalb davon (z. B. unterhalb seines Ordners products/).</translation>
+        </message>
+        <message>
+            <source>{label} holds {what}; only an earlier '{algorithm}' result is replaced. Choose an empty or new folder.</source>
+            <extracomment>algorithms/output_policy.py:300</extracomment>
+            <translation>{label} enthält {what}; ersetzt wird nur ein früheres Ergebnis von '{algorithm}'. Wählen Sie einen leeren oder neuen Ordner.</translation>
+        </message>
+        <message>
+            <source>{label} exists and does not belong to an earlier '{algorithm}' result '{owner}'; move it or choose another output name.</source>
+            <extracomment>algorithms/output_policy.py:307</extracomment>
+            <translation>{label} existiert bereits und gehört nicht zu einem früheren Ergebnis '{owner}' von '{algorithm}'; verschieben Sie die Datei oder wählen Sie einen anderen Ausgabenamen.</translation>
+        </message>
+        <message>
+            <source>a product of '{other}'</source>
+            <extracomment>algorithms/output_policy.py:298; algorithms/output_policy.py:313; algorithms/raster/io.py:236</extracomment>
+            <translation>ein Produkt von '{other}'</translation>
+        </message>
+        <message>
+            <source>a file PhotoDEM did not write</source>
+            <extracomment>algorithms/output_policy.py:314</extracomment>
+            <translation>eine Datei, die nicht von PhotoDEM stammt</translation>
+        </message>
+        <message>
+            <source>{label} is the working, home or root folder; name a new folder or file inside it.</source>
+            <extracomment>algorithms/output_policy.py:246</extracomment>
+            <translation>{label} ist der Arbeits-, Benutzer- oder Stammordner; geben Sie darin einen neuen Ordner oder eine neue Datei an.</translation>
+        </message>
+        <message>
+            <source>{label} is part of the project '{root}' ({part}); write products below its products/ folder.</source>
+            <extracomment>algorithms/output_policy.py:286</extracomment>
+            <translation>{label} gehört zum Projekt '{root}' ({part}); schreiben Sie Produkte unterhalb seines Ordners products/.</translation>
+        </message>
+        <message>
+            <source>files PhotoDEM did not write</source>
+            <extracomment>algorithms/output_policy.py:299; algorithms/raster/io.py:237</extracomment>
+            <translation>Dateien, die nicht von PhotoDEM stammen</translation>
+        </message>
+        <message>
+            <source>{label} is or contains the input '{input}'; PhotoDEM never overwrites its inputs. Choose another output.</source>
+            <extracomment>algorithms/output_policy.py:253</extracomment>
+            <translation>{label} ist oder enthält die Eingabe '{input}'; PhotoDEM überschreibt niemals seine Eingaben. Wählen Sie eine andere Ausgabe.</translation>
+        </message>
+        <message>
+            <source>{label} lies below '{parent}', which is a file; choose a path in a folder.</source>
+            <extracomment>algorithms/output_policy.py:264</extracomment>
+            <translation>{label} liegt unterhalb von '{parent}', das eine Datei ist; wählen Sie einen Pfad in einem Ordner.</translation>
+        </message>
+        <message>
+            <source>No algorithm '{algorithm}'. Known algorithms: {known}.</source>
+            <extracomment>algorithms/processing/registry.py:94</extracomment>
+            <translation>Es gibt keinen Algorithmus '{algorithm}'. Bekannte Algorithmen: {known}.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': the output '{path}' is or contains the run folder '{folder}', where the batch writes its logs; choose another output.</source>
+            <extracomment>algorithms/processing/registry.py:182</extracomment>
+            <translation>Parameter '{name}': Die Ausgabe '{path}' ist oder enthält den Laufordner '{folder}', in den der Batch seine Protokolle schreibt; wählen Sie eine andere Ausgabe.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': {value} is not a valid {expected}.</source>
+            <extracomment>algorithms/processing/spec.py:210</extracomment>
+            <translation>Parameter '{name}': {value} ist kein gültiger Wert vom Typ „{expected}“.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': {value} is not one of {options}.</source>
+            <extracomment>algorithms/processing/spec.py:261</extracomment>
+            <translation>Parameter '{name}': {value} ist keiner der zulässigen Werte {options}.</translation>
+        </message>
+        <message>
+            <source>{algorithm}: unknown parameter(s) {unknown}; known are {known}.</source>
+            <extracomment>algorithms/processing/spec.py:421</extracomment>
+            <translation>{algorithm}: unbekannte(r) Parameter {unknown}; bekannt sind {known}.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}' must be a finite number, not {number}.</source>
+            <extracomment>algorithms/processing/spec.py:241</extracomment>
+            <translation>Parameter '{name}' muss eine endliche Zahl sein, nicht {number}.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}' = {number:g}{unit} is outside the allowed range {low:g}…{high:g}{unit}.</source>
+            <extracomment>algorithms/processing/spec.py:247</extracomment>
+            <translation>Parameter '{name}' = {number:g}{unit} liegt außerhalb des zulässigen Bereichs {low:g}…{high:g}{unit}.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}' ({description}) is required.</source>
+            <extracomment>algorithms/processing/spec.py:189</extracomment>
+            <translation>Parameter '{name}' ({description}) muss angegeben werden.</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': the path '{path}' is not valid UTF-8; rename it (GDAL reads and writes UTF-8 names only).</source>
+            <extracomment>algorithms/processing/spec.py:222</extracomment>
+            <translation>Parameter '{name}': Der Pfad '{path}' ist kein gültiges UTF-8; benennen Sie ihn um (GDAL liest und schreibt nur UTF-8-Namen).</translation>
+        </message>
+        <message>
+            <source>number</source>
+            <extracomment>algorithms/processing/spec.py:267</extracomment>
+            <translation>Zahl</translation>
+        </message>
+        <message>
+            <source>whole number</source>
+            <extracomment>algorithms/processing/spec.py:268</extracomment>
+            <translation>ganze Zahl</translation>
+        </message>
+        <message>
+            <source>yes/no value (true/false)</source>
+            <extracomment>algorithms/processing/spec.py:269</extracomment>
+            <translation>Ja/Nein-Wert (true/false)</translation>
+        </message>
+        <message>
+            <source>extent 'xmin,ymin,xmax,ymax'</source>
+            <extracomment>algorithms/processing/spec.py:270</extracomment>
+            <translation>Ausdehnung 'xmin,ymin,xmax,ymax'</translation>
+        </message>
+        <message>
+            <source>Parameter '{name}': '{path}' does not exist.</source>
+            <extracomment>algorithms/processing/spec.py:429</extracomment>
+            <translation>Parameter '{name}': '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>camera</source>
+            <extracomment>algorithms/project/model.py:77</extracomment>
+            <translation>Kamera</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <extracomment>algorithms/project/model.py:77</extracomment>
+            <translation>Bild</translation>
+        </message>
+        <message>
+            <source>stereo model</source>
+            <extracomment>algorithms/project/model.py:78</extracomment>
+            <translation>Stereomodell</translation>
+        </message>
+        <message>
+            <source>{where}: the {what} name {shown} cannot be used: {problem}. Names become folder names; use letters, digits, '-' and '_'.</source>
+            <extracomment>algorithms/project/model.py:107</extracomment>
+            <translation>{where}: Der {what}name {shown} kann nicht verwendet werden: {problem}. Namen werden zu Ordnernamen; verwenden Sie Buchstaben, Ziffern, '-' und '_'.</translation>
+        </message>
+        <message>
+            <source>{where}: 'format_version' is {version} but this PhotoDEM reads format_version {supported} only: {why}.</source>
+            <extracomment>algorithms/project/model.py:505</extracomment>
+            <translation>{where}: 'format_version' ist {version}, diese PhotoDEM-Version liest aber nur format_version {supported}: {why}.</translation>
+        </message>
+        <message>
+            <source>it must be text, not {type}</source>
+            <extracomment>algorithms/project/model.py:60</extracomment>
+            <translation>er muss Text sein, nicht {type}</translation>
+        </message>
+        <message>
+            <source>it is empty</source>
+            <extracomment>algorithms/project/model.py:62</extracomment>
+            <translation>er ist leer</translation>
+        </message>
+        <message>
+            <source>it contains a path separator ('/' or '\')</source>
+            <extracomment>algorithms/project/model.py:64</extracomment>
+            <translation>er enthält einen Pfadtrenner ('/' oder '\')</translation>
+        </message>
+        <message>
+            <source>'.' and '..' name folders</source>
+            <extracomment>algorithms/project/model.py:66</extracomment>
+            <translation>'.' und '..' bezeichnen Ordner</translation>
+        </message>
+        <message>
+            <source>it starts with a dot</source>
+            <extracomment>algorithms/project/model.py:68</extracomment>
+            <translation>er beginnt mit einem Punkt</translation>
+        </message>
+        <message>
+            <source>it contains a control character</source>
+            <extracomment>algorithms/project/model.py:70</extracomment>
+            <translation>er enthält ein Steuerzeichen</translation>
+        </message>
+        <message>
+            <source>it is not valid UTF-8 text</source>
+            <extracomment>algorithms/project/model.py:72</extracomment>
+            <translation>er ist kein gültiger UTF-8-Text</translation>
+        </message>
+        <message>
+            <source>it was written by a newer PhotoDEM; update PhotoDEM to open it</source>
+            <extracomment>algorithms/project/model.py:503</extracomment>
+            <translation>die Datei stammt von einer neueren PhotoDEM-Version; aktualisieren Sie PhotoDEM, um sie zu öffnen</translation>
+        </message>
+        <message>
+            <source>no PhotoDEM wrote it; fix the value</source>
+            <extracomment>algorithms/project/model.py:504</extracomment>
+            <translation>keine PhotoDEM-Version hat sie geschrieben; korrigieren Sie den Wert</translation>
+        </message>
+        <message>
+            <source>{where}: '{key}' {problem}; fix it in the project file.</source>
+            <extracomment>algorithms/project/model.py:553</extracomment>
+            <translation>{where}: '{key}' {problem}; korrigieren Sie dies in der Projektdatei.</translation>
+        </message>
+        <message>
+            <source>'{path}' is not a PhotoDEM project: {file} not found. Create one with project_create or synthetic_block.</source>
+            <extracomment>algorithms/project/model.py:405</extracomment>
+            <translation>'{path}' ist kein PhotoDEM-Projekt: {file} wurde nicht gefunden. Legen Sie eines mit project_create oder synthetic_block an.</translation>
+        </message>
+        <message>
+            <source>{where} has no [project] table (it is not a PhotoDEM project file); restore it from a copy or create the project again with project_create.</source>
+            <extracomment>algorithms/project/model.py:427</extracomment>
+            <translation>{where} hat keine Tabelle [project] (es ist keine PhotoDEM-Projektdatei); stellen Sie die Datei aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
+        </message>
+        <message>
+            <source>{where} is not UTF-8 text (byte 0x{byte:02x} at position {position}); save it as UTF-8.</source>
+            <extracomment>algorithms/project/model.py:412</extracomment>
+            <translation>{where} ist kein UTF-8-Text (Byte 0x{byte:02x} an Position {position}); speichern Sie die Datei als UTF-8.</translation>
+        </message>
+        <message>
+            <source>{where} is not valid TOML ({error}); fix the line it names.</source>
+            <extracomment>algorithms/project/model.py:416</extracomment>
+            <translation>{where} ist kein gültiges TOML ({error}); korrigieren Sie die genannte Zeile.</translation>
+        </message>
+        <message>
+            <source>Cannot read {where}: {error}.</source>
+            <extracomment>algorithms/project/model.py:419</extracomment>
+            <translation>{where} kann nicht gelesen werden: {error}.</translation>
+        </message>
+        <message>
+            <source>{where} has no [project] table (it is empty); restore it from a copy or create the project again with project_create.</source>
+            <extracomment>algorithms/project/model.py:424</extracomment>
+            <translation>{where} hat keine Tabelle [project] (die Datei ist leer); stellen Sie sie aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
+        </message>
+        <message>
+            <source>{where}: {error}</source>
+            <extracomment>algorithms/project/model.py:435; algorithms/project/model.py:649</extracomment>
+            <translation>{where}: {error}</translation>
+        </message>
+        <message>
+            <source>is missing</source>
+            <extracomment>algorithms/project/model.py:560</extracomment>
+            <translation>fehlt</translation>
+        </message>
+        <message>
+            <source>must be text in quotes, not {value}</source>
+            <extracomment>algorithms/project/model.py:568</extracomment>
+            <translation>muss Text in Anführungszeichen sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be a number, not {value}</source>
+            <extracomment>algorithms/project/model.py:578</extracomment>
+            <translation>muss eine Zahl sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be a whole number, not {value}</source>
+            <extracomment>algorithms/project/model.py:585</extracomment>
+            <translation>muss eine ganze Zahl sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be a list of {length} numbers, not {value}</source>
+            <extracomment>algorithms/project/model.py:596</extracomment>
+            <translation>muss eine Liste von {length} Zahlen sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be a table ([{key}]), not {value}</source>
+            <extracomment>algorithms/project/model.py:604</extracomment>
+            <translation>muss eine Tabelle ([{key}]) sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be an array of tables ([[{key}]]), not {value}</source>
+            <extracomment>algorithms/project/model.py:613</extracomment>
+            <translation>muss eine Liste von Tabellen ([[{key}]]) sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be a table, not {value}</source>
+            <extracomment>algorithms/project/model.py:622</extracomment>
+            <translation>muss eine Tabelle sein, nicht {value}</translation>
+        </message>
+        <message>
+            <source>must be 2 rows of 3 numbers, not {value}</source>
+            <extracomment>algorithms/project/model.py:644</extracomment>
+            <translation>muss aus 2 Zeilen mit je 3 Zahlen bestehen, nicht {value}</translation>
+        </message>
+        <message>
+            <source>The output '{path}' is a file, not a folder; choose a folder.</source>
+            <extracomment>algorithms/raster/io.py:223</extracomment>
+            <translation>Die Ausgabe '{path}' ist eine Datei, kein Ordner; wählen Sie einen Ordner.</translation>
+        </message>
+        <message>
+            <source>The output folder '{path}' is a PhotoDEM project; choose another folder (a project is never replaced).</source>
+            <extracomment>algorithms/raster/io.py:228</extracomment>
+            <translation>Der Ausgabeordner '{path}' ist ein PhotoDEM-Projekt; wählen Sie einen anderen Ordner (ein Projekt wird nie ersetzt).</translation>
+        </message>
+        <message>
+            <source>The output folder '{path}' exists and is not empty; choose a new folder (PhotoDEM does not overwrite earlier results here).</source>
+            <extracomment>algorithms/raster/io.py:231</extracomment>
+            <translation>Der Ausgabeordner '{path}' existiert bereits und ist nicht leer; wählen Sie einen neuen Ordner (PhotoDEM überschreibt hier keine früheren Ergebnisse).</translation>
+        </message>
+        <message>
+            <source>The output folder '{path}' holds {what}; choose an empty or new folder (PhotoDEM only replaces earlier results of the same algorithm).</source>
+            <extracomment>algorithms/raster/io.py:238</extracomment>
+            <translation>Der Ausgabeordner '{path}' enthält {what}; wählen Sie einen leeren oder neuen Ordner (PhotoDEM ersetzt nur frühere Ergebnisse desselben Algorithmus).</translation>
         </message>
         <message>
             <source>general (default): keeps buildings and trees with sharp walls (a DSM) and open terrain as accurate as terrain; urban: smaller windows and groundels for built-up areas; terrain (formerly flat): large windows and groundels, smooth surface without objects (nearly a DTM); hilly: medium; forest: lower envelope of the points per groundel. The options below override it.</source>

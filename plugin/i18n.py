@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
+from ..algorithms.errors import Message, fill
 from .qt import QCoreApplication, QLocale, QTranslator
 
 #: Translation context of every PhotoDEM string (plugin and algorithm specs alike).
@@ -29,6 +30,28 @@ def tr(text: str) -> str:
     if not text:
         return text
     return QCoreApplication.translate(CONTEXT, text)
+
+
+def message_text(message: Message) -> str:
+    """A core message (:class:`~photodem.algorithms.errors.Message`) in the operator's language.
+
+    The template is translated and filled with the same values; values that are messages
+    themselves are translated first. A translation that lost or misspelt a value falls back
+    to the English sentence, which is better than no message at all.
+    """
+    values = {key: message_text(value) if isinstance(value, Message) else value
+              for key, value in message.values.items()}
+    try:
+        return fill(tr(message.template), values)
+    except (KeyError, IndexError, ValueError, TypeError, AttributeError):
+        return str(message)
+
+
+def error_text(error: Any, message: Optional[Message] = None) -> str:
+    """The text of an operator error for the GUIs: its translated :class:`Message` when it has
+    one (``message``, else ``error.message``), else ``str(error)`` as the core wrote it."""
+    message = message if message is not None else getattr(error, "message", None)
+    return message_text(message) if isinstance(message, Message) else str(error)
 
 
 def language(locale: Optional[str] = None) -> str:

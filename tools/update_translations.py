@@ -4,7 +4,9 @@ Sources of strings (all in the translation context ``photodem``):
 
 * the algorithm registry: display names, groups, help, parameter descriptions and help, enum
   options, output descriptions (translated at run time by the QGIS provider and the GUIs);
-* literal ``tr("…")`` / ``QCoreApplication.translate("photodem", "…")`` calls in ``plugin/``.
+* literal ``tr("…")`` / ``QCoreApplication.translate("photodem", "…")`` calls in ``plugin/``;
+* the templates of translatable operator errors in ``algorithms/``: the literal first argument
+  of ``<Name>Error.of("…", …)`` and ``msg("…", …)`` (see ``algorithms/errors.py``).
 
 Existing translations are kept; new strings get ``type="unfinished"``; strings that disappeared
 are kept as ``type="vanished"`` (so a renamed-back string finds its translation again).
@@ -88,10 +90,34 @@ def source_strings(folder: Path) -> List[Tuple[str, str]]:
     return found
 
 
+def _is_error_template(node: ast.Call) -> bool:
+    """``XxxError.of(…)`` or ``msg(…)``: the markers of a translatable error message."""
+    func = node.func
+    if isinstance(func, ast.Name):
+        return func.id == "msg"
+    return (isinstance(func, ast.Attribute) and func.attr == "of"
+            and isinstance(func.value, ast.Name) and func.value.id.endswith("Error"))
+
+
+def error_templates(folder: Path) -> List[Tuple[str, str]]:
+    """(template, where) of every translatable error message and phrase in ``folder``."""
+    found: List[Tuple[str, str]] = []
+    for path in sorted(folder.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.Call) and node.args and _is_error_template(node)):
+                continue
+            text = node.args[0]
+            if isinstance(text, ast.Constant) and isinstance(text.value, str) and text.value:
+                found.append((text.value, f"{path.relative_to(ROOT).as_posix()}:{node.lineno}"))
+    return found
+
+
 def collect() -> Dict[str, List[str]]:
     """Source text → places it comes from, in first-seen order."""
     strings: Dict[str, List[str]] = {}
-    for text, where in [*registry_strings(), *source_strings(ROOT / "plugin")]:
+    for text, where in [*registry_strings(), *source_strings(ROOT / "plugin"),
+                        *error_templates(ROOT / "algorithms")]:
         strings.setdefault(text, []).append(where)
     return strings
 

@@ -670,8 +670,9 @@ def execute_task(algorithm: str, params: Dict[str, Any], log_path: PathLike,
                  on_progress: Optional[Callable[[float], None]] = None) -> Dict[str, Any]:
     """Run one task through :func:`.registry.run`, logging to ``log_path``.
 
-    Returns ``{"status", "outputs", "duration_s", "error", "warnings"}``; never raises for
-    errors of the algorithm (they become status ``failed``; cancellation ``cancelled``).
+    Returns ``{"status", "outputs", "duration_s", "error", "warnings"}`` and, for an operator
+    error with a template, ``error_message`` (:meth:`~..errors.Message.to_dict`); never raises
+    for errors of the algorithm (they become status ``failed``; cancellation ``cancelled``).
     """
     log_path = Path(log_path)
     log_path.parent.mkdir(parents=True, exist_ok=True)
@@ -686,6 +687,8 @@ def execute_task(algorithm: str, params: Dict[str, Any], log_path: PathLike,
             result.update(status="cancelled", error=str(exc))
         except PhotodemError as exc:
             result.update(status="failed", error=str(exc))
+            if exc.message is not None:  # the GUIs show it in the operator's language
+                result["error_message"] = exc.message.to_dict()
         except Exception as exc:  # a bug: keep the traceback in the task log
             result.update(status="failed", error=f"{type(exc).__name__}: {exc}")
             log.write(traceback.format_exc())
@@ -829,6 +832,8 @@ class _Hooks:
         record.update({k: result.get(k) for k in ("status", "outputs", "duration_s", "error")})
         if result.get("warnings"):
             record["warnings"] = result["warnings"]
+        if result.get("error_message"):
+            record["error_message"] = result["error_message"]
         if record["status"] != "cancelled":
             self.progress.set(task.index, 100.0)
         _notify(self.feedback, "task_finished", task.index, dict(record))

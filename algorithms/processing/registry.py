@@ -91,9 +91,8 @@ def get(algorithm_id: str) -> Algorithm:
     key = algorithm_id.split(":", 1)[1] if algorithm_id.startswith("photodem:") else algorithm_id
     algs = algorithms()
     if key not in algs:
-        raise InputError(
-            f"No algorithm '{algorithm_id}'. Known algorithms: {', '.join(algs)}."
-        )
+        raise InputError.of("No algorithm '{algorithm}'. Known algorithms: {known}.",
+                            algorithm=algorithm_id, known=", ".join(algs))
     return algs[key]
 
 
@@ -180,9 +179,10 @@ def _check_planned_outputs(alg: Algorithm, values: Dict[str, Any],
     for target in targets:
         out = target.path.resolve()
         if out == run_folder or out in run_folder.parents:
-            raise InputError(f"Parameter '{target.name}': the output '{target.path}' is or "
-                             f"contains the run folder '{run_folder}', where the batch writes "
-                             "its logs; choose another output.")
+            raise InputError.of("Parameter '{name}': the output '{path}' is or contains the "
+                                "run folder '{folder}', where the batch writes its logs; "
+                                "choose another output.", name=target.name, path=target.path,
+                                folder=run_folder)
     # The project files as Algorithm.input_paths lists them, but listed and resolved once
     # per project, and only those an output is or contains (the only ones compared).
     inputs, protected = alg.input_paths({**values, **dict.fromkeys(projects)})

@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
-from ..errors import InputError
+from ..errors import InputError, Message, msg
 from ..feedback import Feedback
 from ..input_errors import display_path
 from ..output_policy import PROJECT_FILE, PROJECT_PARTS, Target, contained
@@ -185,7 +185,9 @@ class Parameter:
             elif self.optional:
                 return None
             else:
-                raise InputError(f"Parameter '{self.name}' ({self.description}) is required.")
+                # the description is a spec string: the GUIs translate it like the form does
+                raise InputError.of("Parameter '{name}' ({description}) is required.",
+                                    name=self.name, description=Message(self.description))
         try:
             if self.is_input_path or self.is_output:
                 return self._path_text(value)
@@ -205,7 +207,8 @@ class Parameter:
             raise
         except (TypeError, ValueError, OverflowError):  # OverflowError: int(inf)
             pass
-        raise InputError(f"Parameter '{self.name}': {value!r} is not a valid {self._expected()}.")
+        raise InputError.of("Parameter '{name}': {value} is not a valid {expected}.",
+                            name=self.name, value=repr(value), expected=self._expected())
 
     def _path_text(self, value: Any) -> str:
         """A path as ``str``. Output names that are not valid UTF-8 are refused: GDAL writes
@@ -216,9 +219,10 @@ class Parameter:
             try:
                 text.encode("utf-8")
             except UnicodeEncodeError:
-                raise InputError(
-                    f"Parameter '{self.name}': the path '{display_path(text)}' is not valid "
-                    "UTF-8; rename it (GDAL reads and writes UTF-8 names only).") from None
+                raise InputError.of(
+                    "Parameter '{name}': the path '{path}' is not valid UTF-8; rename it (GDAL "
+                    "reads and writes UTF-8 names only).", name=self.name, path=display_path(text)
+                ) from None
         return text
 
     def _to_number(self, value: Any) -> Any:
@@ -234,15 +238,16 @@ class Parameter:
 
     def _check_range(self, number: float) -> None:
         if not math.isfinite(number):
-            raise InputError(f"Parameter '{self.name}' must be a finite number, not {number}.")
+            raise InputError.of("Parameter '{name}' must be a finite number, not {number}.",
+                                name=self.name, number=number)
         low = -math.inf if self.minimum is None else self.minimum
         high = math.inf if self.maximum is None else self.maximum
         if not low <= number <= high:
             unit = f" {self.unit}" if self.unit else ""
-            raise InputError(
-                f"Parameter '{self.name}' = {number:g}{unit} is outside the allowed range "
-                f"{low:g}…{high:g}{unit}."
-            )
+            raise InputError.of(
+                "Parameter '{name}' = {number:g}{unit} is outside the allowed range "
+                "{low:g}…{high:g}{unit}.", name=self.name, number=number, unit=unit, low=low,
+                high=high)
 
     def _to_option(self, value: Any) -> str:
         if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -253,16 +258,16 @@ class Parameter:
         for option in self.options + self.aliases:
             if option.lower() == text:
                 return option
-        raise InputError(
-            f"Parameter '{self.name}': {value!r} is not one of {', '.join(self.options)}."
-        )
+        raise InputError.of("Parameter '{name}': {value} is not one of {options}.",
+                            name=self.name, value=repr(value), options=", ".join(self.options))
 
-    def _expected(self) -> str:
+    def _expected(self) -> Union[Message, str]:
+        """What a value of this kind is: a phrase the GUIs translate, else the kind."""
         return {
-            "number": "number",
-            "integer": "whole number",
-            "bool": "yes/no value (true/false)",
-            "extent": "extent 'xmin,ymin,xmax,ymax'",
+            "number": msg("number"),
+            "integer": msg("whole number"),
+            "bool": msg("yes/no value (true/false)"),
+            "extent": msg("extent 'xmin,ymin,xmax,ymax'"),
         }.get(self.kind, self.kind)
 
     def to_dict(self) -> Dict[str, Any]:
@@ -413,16 +418,16 @@ def prepare_parameters(algorithm: Algorithm, values: Dict[str, Any]) -> Dict[str
     known = {p.name for p in algorithm.parameters}
     unknown = sorted(set(values) - known)
     if unknown:
-        raise InputError(
-            f"{algorithm.id}: unknown parameter(s) {', '.join(unknown)}; "
-            f"known are {', '.join(sorted(known))}."
-        )
+        raise InputError.of("{algorithm}: unknown parameter(s) {unknown}; known are {known}.",
+                            algorithm=algorithm.id, unknown=", ".join(unknown),
+                            known=", ".join(sorted(known)))
     params = {p.name: p.convert(values.get(p.name)) for p in algorithm.parameters}
     for p in algorithm.parameters:
         if p.is_input_path or p.is_list:
             for path in p.paths(params[p.name]):
                 if not Path(path).exists():
-                    raise InputError(f"Parameter '{p.name}': '{path}' does not exist.")
+                    raise InputError.of("Parameter '{name}': '{path}' does not exist.",
+                                        name=p.name, path=path)
     return params
 
 

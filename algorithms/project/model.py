@@ -32,7 +32,7 @@ from typing import Any, Dict, List, Optional, Union
 import numpy as np
 from rasterio.enums import ColorInterp
 
-from ..errors import InputError
+from ..errors import InputError, Message, msg
 from ..geometry.camera import Camera
 from ..geometry.orientation import ExteriorOrientation, check_angle_unit
 from ..input_errors import check_encodable, reading
@@ -48,7 +48,7 @@ FORMAT_VERSION = 1
 _SEPARATORS = ("/", "\\")
 
 
-def identifier_problem(name: Any) -> Optional[str]:
+def identifier_problem(name: Any) -> Optional[Message]:
     """Why ``name`` cannot be an identifier that becomes a path part, or ``None`` if it can.
 
     Model, image, camera and batch step names become folder and file names
@@ -57,20 +57,25 @@ def identifier_problem(name: Any) -> Optional[str]:
     characters.
     """
     if not isinstance(name, str):
-        return f"it must be text, not {type(name).__name__}"
+        return msg("it must be text, not {type}", type=type(name).__name__)
     if not name.strip():
-        return "it is empty"
+        return msg("it is empty")
     if any(sep in name for sep in _SEPARATORS):
-        return "it contains a path separator ('/' or '\\')"
+        return msg("it contains a path separator ('/' or '\\')")
     if name in (".", ".."):
-        return "'.' and '..' name folders"
+        return msg("'.' and '..' name folders")
     if name.startswith("."):
-        return "it starts with a dot"
+        return msg("it starts with a dot")
     if any(ord(c) < 32 or ord(c) == 127 or 0x80 <= ord(c) < 0xA0 for c in name):
-        return "it contains a control character"
+        return msg("it contains a control character")
     if any(0xD800 <= ord(c) <= 0xDFFF for c in name):
-        return "it is not valid UTF-8 text"
+        return msg("it is not valid UTF-8 text")
     return None
+
+
+#: The items whose names :func:`check_identifier` checks, as words the GUIs translate.
+_ITEM_WORDS = {"camera": msg("camera"), "image": msg("image"),
+               "stereo model": msg("stereo model")}
 
 
 def check_identifier(name: Any, what: str, where: str = "") -> str:
@@ -93,14 +98,15 @@ def check_identifier(name: Any, what: str, where: str = "") -> str:
     problem = identifier_problem(name)
     if problem is None:
         return name
-    prefix = f"{where}: " if where else ""
     shown = repr(name) if not isinstance(name, str) else "'" + name.encode(
         "utf-8", "surrogateescape").decode("utf-8", "backslashreplace").encode(
         "unicode_escape").decode("ascii") + "'"
-    raise InputError(
-        f"{prefix}the {what} name {shown} cannot be used: {problem}. Names become folder names; "
-        "use letters, digits, '-' and '_'."
-    )
+    if not where:  # a part of a longer message (identifier_errors)
+        raise InputError(f"the {what} name {shown} cannot be used: {problem}. Names become "
+                         "folder names; use letters, digits, '-' and '_'.")
+    raise InputError.of("{where}: the {what} name {shown} cannot be used: {problem}. Names "
+                        "become folder names; use letters, digits, '-' and '_'.", where=where,
+                        what=_ITEM_WORDS.get(what, what), shown=shown, problem=problem)
 
 
 def identifier_errors(project: Project) -> List[str]:
@@ -396,32 +402,37 @@ class Project:
         p = Path(path)
         file = p / PROJECT_FILE if p.is_dir() else p
         if not file.is_file():
-            raise InputError(
-                f"'{path}' is not a PhotoDEM project: {PROJECT_FILE} not found. "
-                "Create one with project_create or synthetic_block."
-            )
+            raise InputError.of("'{path}' is not a PhotoDEM project: {file} not found. Create "
+                                "one with project_create or synthetic_block.", path=path,
+                                file=PROJECT_FILE)
         where = f"'{file}'"
         try:
             data = toml_io.loads(file.read_text(encoding="utf-8"))
         except UnicodeDecodeError as exc:
-            raise InputError(f"{where} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
-                             f"position {exc.start}); save it as UTF-8.") from None
+            raise InputError.of("{where} is not UTF-8 text (byte 0x{byte:02x} at position "
+                                "{position}); save it as UTF-8.", where=where,
+                                byte=exc.object[exc.start], position=exc.start) from None
         except toml_io.tomllib.TOMLDecodeError as exc:
-            raise InputError(f"{where} is not valid TOML ({exc}); fix the line it names."
-                             ) from None
+            raise InputError.of("{where} is not valid TOML ({error}); fix the line it names.",
+                                where=where, error=exc) from None
         except OSError as exc:
-            raise InputError(f"Cannot read {where}: {exc.strerror or exc}.") from None
+            raise InputError.of("Cannot read {where}: {error}.", where=where,
+                                error=exc.strerror or exc) from None
         top = _Table(data, where, "")
         if "project" not in data:
-            state = "it is empty" if not data else "it is not a PhotoDEM project file"
-            raise InputError(f"{where} has no [project] table ({state}); restore it from a copy "
-                             "or create the project again with project_create.")
+            if not data:
+                raise InputError.of("{where} has no [project] table (it is empty); restore it "
+                                    "from a copy or create the project again with "
+                                    "project_create.", where=where)
+            raise InputError.of("{where} has no [project] table (it is not a PhotoDEM project "
+                                "file); restore it from a copy or create the project again "
+                                "with project_create.", where=where)
         head = top.table("project")
         _check_format_version(head)
         try:
             unit = check_angle_unit(head.text("angle_unit", "degrees"))
         except InputError as exc:
-            raise InputError(f"{head.where}: {exc}") from None
+            raise InputError.of("{where}: {error}", where=head.where, error=exc) from None
         cameras = {}
         for cam_name, cam in top.table("cameras").tables_by_name():
             check_identifier(cam_name, "camera", where)
@@ -489,10 +500,11 @@ def _check_format_version(head: _Table) -> None:
     version = head.integer("format_version", FORMAT_VERSION)
     if version == FORMAT_VERSION:
         return
-    why = ("it was written by a newer PhotoDEM; update PhotoDEM to open it"
-           if version > FORMAT_VERSION else "no PhotoDEM wrote it; fix the value")
-    raise InputError(f"{head.where}: 'format_version' is {version} but this PhotoDEM reads "
-                     f"format_version {FORMAT_VERSION} only: {why}.")
+    why = (msg("it was written by a newer PhotoDEM; update PhotoDEM to open it")
+           if version > FORMAT_VERSION else msg("no PhotoDEM wrote it; fix the value"))
+    raise InputError.of("{where}: 'format_version' is {version} but this PhotoDEM reads "
+                        "format_version {supported} only: {why}.", where=head.where,
+                        version=version, supported=FORMAT_VERSION, why=why)
 
 
 def _check_unique(name: str, what: str, entry: _Table, seen: Dict[str, str]) -> None:
@@ -537,14 +549,15 @@ class _Table:
         """The same table, its messages naming it by ``label`` instead of its position."""
         return _Table(self.data, self.file, label)
 
-    def _fail(self, key: str, problem: str) -> InputError:
-        return InputError(f"{self.where}: '{key}' {problem}; fix it in the project file.")
+    def _fail(self, key: str, problem: Message) -> InputError:
+        return InputError.of("{where}: '{key}' {problem}; fix it in the project file.",
+                             where=self.where, key=key, problem=problem)
 
     def _get(self, key: str, default: Any) -> Any:
         if key in self.data:
             return self.data[key]
         if default is _MISSING:
-            raise self._fail(key, "is missing")
+            raise self._fail(key, msg("is missing"))
         return default
 
     def text(self, key: str, default: Any = _MISSING) -> str:
@@ -552,7 +565,8 @@ class _Table:
         written without quotes change their meaning (``left = 101`` is not image "0101")."""
         value = self._get(key, default)
         if not isinstance(value, str):
-            raise self._fail(key, f"must be text in quotes, not {_shown(value)}")
+            raise self._fail(key, msg("must be text in quotes, not {value}",
+                                      value=_shown(value)))
         return value
 
     def number(self, key: str, default: Any = _MISSING) -> Any:
@@ -561,14 +575,15 @@ class _Table:
         if value is default and default is not _MISSING:
             return default
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self._fail(key, f"must be a number, not {_shown(value)}")
+            raise self._fail(key, msg("must be a number, not {value}", value=_shown(value)))
         return float(value)
 
     def integer(self, key: str, default: Any = _MISSING) -> int:
         """A whole number."""
         value = self.number(key, default)
         if value is None or value != int(value):
-            raise self._fail(key, f"must be a whole number, not {_shown(self.data.get(key))}")
+            raise self._fail(key, msg("must be a whole number, not {value}",
+                                      value=_shown(self.data.get(key))))
         return int(value)
 
     def numbers(self, key: str, length: int, default: Any = _MISSING) -> List[float]:
@@ -578,14 +593,16 @@ class _Table:
             return default
         if (not isinstance(value, list) or len(value) != length
                 or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
-            raise self._fail(key, f"must be a list of {length} numbers, not {_shown(value)}")
+            raise self._fail(key, msg("must be a list of {length} numbers, not {value}",
+                                      length=length, value=_shown(value)))
         return [float(v) for v in value]
 
     def table(self, key: str) -> _Table:
         """A sub-table (empty when absent)."""
         value = self._get(key, {})
         if not isinstance(value, dict):
-            raise self._fail(key, f"must be a table ([{key}]), not {_shown(value)}")
+            raise self._fail(key, msg("must be a table ([{key}]), not {value}", key=key,
+                                      value=_shown(value)))
         label = self.where[len(self.file):].strip()
         return _Table(value, self.file, f"{label} [{key}]".strip())
 
@@ -593,7 +610,8 @@ class _Table:
         """An array of tables (``[[key]]``; empty when absent)."""
         value = self._get(key, [])
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-            raise self._fail(key, f"must be an array of tables ([[{key}]]), not {_shown(value)}")
+            raise self._fail(key, msg("must be an array of tables ([[{key}]]), not {value}",
+                                      key=key, value=_shown(value)))
         return [_Table(v, self.file, f"[[{key}]] #{i + 1}") for i, v in enumerate(value)]
 
     def tables_by_name(self) -> List[Any]:
@@ -601,7 +619,8 @@ class _Table:
         out = []
         for name, value in self.data.items():
             if not isinstance(value, dict):
-                raise self._fail(name, f"must be a table, not {_shown(value)}")
+                raise self._fail(name, msg("must be a table, not {value}",
+                                           value=_shown(value)))
             out.append((name, _Table(value, self.file, f"camera '{name}'")))
         return out
 
@@ -622,12 +641,12 @@ class _Table:
                     isinstance(r, list) and len(r) == 3
                     and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in r)
                     for r in rows):
-                raise self._fail("fiducial_affine", "must be 2 rows of 3 numbers, not "
-                                 + _shown(fid))
+                raise self._fail("fiducial_affine", msg("must be 2 rows of 3 numbers, not "
+                                                        "{value}", value=_shown(fid)))
         try:
             return Camera.from_dict(name, d)
         except InputError as exc:
-            raise InputError(f"{self.where}: {exc}") from None
+            raise InputError.of("{where}: {error}", where=self.where, error=exc) from None
 
 
 def _shown(value: Any) -> str:

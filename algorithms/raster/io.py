@@ -26,7 +26,7 @@ from rasterio.errors import NotGeoreferencedWarning
 from rasterio.shutil import copy as gdal_copy
 
 from .. import output_policy
-from ..errors import InputError
+from ..errors import InputError, msg
 from ..output_policy import PRODUCT_MARKER as PRODUCT_MARKER  # re-exported
 from ..output_policy import PRODUCT_TAG
 
@@ -220,24 +220,25 @@ def staged_folder(path: PathLike, replace: bool = False, product: str = "") -> I
 def _check_staged_target(path: Path, replace: bool, product: str) -> None:
     """The second line of defence of :func:`staged_folder` (the first is the registry's)."""
     if path.exists() and not path.is_dir():
-        raise InputError(f"The output '{path}' is a file, not a folder; choose a folder.")
+        raise InputError.of("The output '{path}' is a file, not a folder; choose a folder.",
+                            path=path)
     if not (path.exists() and any(path.iterdir())):
         return
     if (path / output_policy.PROJECT_FILE).exists():
-        raise InputError(f"The output folder '{path}' is a PhotoDEM project; choose another "
-                         "folder (a project is never replaced).")
+        raise InputError.of("The output folder '{path}' is a PhotoDEM project; choose "
+                            "another folder (a project is never replaced).", path=path)
     if not replace:
-        raise InputError(
-            f"The output folder '{path}' exists and is not empty; choose a new folder "
-            "(PhotoDEM does not overwrite earlier results here)."
-        )
+        raise InputError.of(
+            "The output folder '{path}' exists and is not empty; choose a new folder "
+            "(PhotoDEM does not overwrite earlier results here).", path=path)
     found = output_policy.folder_product(path)
     if found is None or (product and found != product):
-        what = f"a product of '{found}'" if found else "files PhotoDEM did not write"
-        raise InputError(
-            f"The output folder '{path}' holds {what}; choose an empty or new folder "
-            f"(PhotoDEM only replaces earlier results of the same algorithm)."
-        )
+        what = (msg("a product of '{other}'", other=found) if found
+                else msg("files PhotoDEM did not write"))
+        raise InputError.of(
+            "The output folder '{path}' holds {what}; choose an empty or new folder "
+            "(PhotoDEM only replaces earlier results of the same algorithm).", path=path,
+            what=what)
 
 
 def _swap_in(tmp: Path, path: Path) -> None:

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Iterable, List, Optional
 
 from ...algorithms.errors import InputError
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtCore, QtGui, QtWidgets
 from ..widgets.map_layer import MapLayer
 from ..widgets.map_layers import LayerList
@@ -182,7 +182,7 @@ class MapWindowMixin:
         except MixedCoordinatesError as exc:
             return self._raster_alone_or_with_map(path, kind, name, georeferenced_view, exc)
         except InputError as exc:  # GDAL can't open it: the message names the file
-            self.report(str(exc))
+            self.report(error_text(exc))
             return None
         except Exception as exc:  # GDAL/rasterio errors of a broken file
             LOG.exception("raster %s", path)
@@ -217,7 +217,7 @@ class MapWindowMixin:
         try:
             layer = view.add_raster(path, kind=kind, name=name)
         except InputError:
-            self.report(str(exc))
+            self.report(error_text(exc))
             return None
         view.zoom_to_layer(layer)
         if georeferenced_view:
@@ -370,7 +370,7 @@ class MapWindowMixin:
         try:
             project = Project.load(path)
         except InputError as exc:
-            self.report(str(exc))
+            self.report(error_text(exc))
             return False
         if not self.close_project():
             return False

@@ -29,7 +29,7 @@ from ...algorithms.project.model_runs import (
     filter_dsm_parameters,
     match_model_parameters,
 )
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtCore, QtWidgets
 
 #: The map layer kind of the stereo models (as in QGIS's workspace).
@@ -158,7 +158,7 @@ class ModelMenu(QtCore.QObject):
         try:
             params = match_model_parameters(self._root(), model)
         except PhotodemError as exc:
-            self.window.report(str(exc))
+            self.window.report(error_text(exc))
             return None
         return self.show_form("match_model", params)
 
@@ -171,7 +171,7 @@ class ModelMenu(QtCore.QObject):
         try:
             params = epipolar_pair_parameters(self._root(), model)
         except PhotodemError as exc:
-            window.report(str(exc))
+            window.report(error_text(exc))
             return None
         form = self.show_form("epipolar_pair", params)
         window.run_current()
@@ -186,7 +186,7 @@ class ModelMenu(QtCore.QObject):
                                   "first.").format(exc.model, exc.dsm), warning=False)
             return None
         except PhotodemError as exc:
-            self.window.report(str(exc))
+            self.window.report(error_text(exc))
             return None
         return self.show_form("filter_lowpass", params)
 

@@ -58,7 +58,7 @@ from ...algorithms.feedback import Feedback
 from ...algorithms.processing import registry
 from ...algorithms.processing.spec import Algorithm, Output, Parameter
 from ...algorithms.project.products import Product, classify
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QIcon
 from .workspace import layer_uri, place_output_layer, product_label
 
@@ -398,7 +398,7 @@ class PhotodemAlgorithm(QgsProcessingAlgorithm):
         try:
             result = registry.run(self.spec.id, raw, adapter)
         except PhotodemError as exc:  # operator errors: message only, no traceback
-            raise QgsProcessingException(str(exc)) from exc
+            raise QgsProcessingException(error_text(exc)) from exc
         load_on_completion(self.spec, result, context)
         return result
 

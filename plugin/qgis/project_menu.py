@@ -16,7 +16,7 @@ from qgis.PyQt.QtWidgets import QFileDialog, QMenu
 
 from ...algorithms.errors import PhotodemError
 from ...algorithms.project.model import PROJECT_FILE
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QAction
 from .workspace import (
     MESSAGE_TITLE,
@@ -144,7 +144,7 @@ class ProjectMenu:
         try:
             workspace = open_workspace(self.iface, path)
         except PhotodemError as exc:
-            self.iface.messageBar().pushMessage(MESSAGE_TITLE, str(exc), Qgis.Critical, 10)
+            self.iface.messageBar().pushMessage(MESSAGE_TITLE, error_text(exc), Qgis.Critical, 10)
             return None
         remember_project(workspace.root)
         self.fill_recent_menu()

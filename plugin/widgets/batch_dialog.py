@@ -22,10 +22,10 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
-from ...algorithms.errors import PhotodemError
+from ...algorithms.errors import Message, PhotodemError
 from ...algorithms.processing import batch, batch_setup
 from ...algorithms.processing.batch_setup import BatchChoices
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QSettings, Qt, QtCore, QtGui, QtWidgets, QUrl, pyqtSignal
 from .batch_runner import BatchWorker
 from .parameter_form import SETTINGS_PROJECT, PathEdit
@@ -47,6 +47,14 @@ def state_text(state: str) -> str:
     return {"done": tr("done"), "failed": tr("failed"), "not run": tr("not run"),
             "skipped": tr("skipped"), "cancelled": tr("cancelled"), "running": tr("running"),
             "waiting": tr("waiting")}.get(state, state)
+
+
+def record_error(record: Dict[str, Any]) -> str:
+    """A failed task's error in the operator's language (its ``error_message``), else the
+    record's English ``error``."""
+    data = record.get("error_message")
+    message = Message.from_dict(data) if isinstance(data, dict) else None
+    return error_text(str(record.get("error") or ""), message)
 
 
 class _Row:
@@ -333,7 +341,7 @@ class BatchDialog(QtWidgets.QDialog):
         try:
             rows = batch_setup.model_rows(folder)
         except PhotodemError as exc:
-            self.file_label.setText(tr("The project cannot be read: {0}").format(exc))
+            self.file_label.setText(tr("The project cannot be read: {0}").format(error_text(exc)))
             self._update_buttons()
             return
         for model in rows:
@@ -415,7 +423,7 @@ class BatchDialog(QtWidgets.QDialog):
         try:
             plan = batch.load_batch(path)
         except PhotodemError as exc:
-            self.report(tr("The batch file cannot be used: {0}").format(exc))
+            self.report(tr("The batch file cannot be used: {0}").format(error_text(exc)))
             return False
         self.project_edit.blockSignals(True)
         self.project_edit.setText(str(plan.project or ""))
@@ -607,7 +615,7 @@ class BatchDialog(QtWidgets.QDialog):
         failed = [row.records[i] for i in row.tasks
                   if row.records.get(i, {}).get("status") == "failed"]
         if failed:
-            reason = str(failed[0].get("error") or "").strip().splitlines()
+            reason = record_error(failed[0]).strip().splitlines()
             self._set_state(row, "failed", reason[0] if reason else "")
         elif any(s is None for s in statuses):
             if not self.is_running():

@@ -17,7 +17,7 @@ from matplotlib.colors import ListedColormap
 from ...algorithms.errors import PhotodemError
 from ...algorithms.filtering.presets import PRESET_NAMES
 from ...algorithms.filtering.review import accept_refilter, refilter_area
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtWidgets, pyqtSignal
 from .qc_plots import PlotCanvas
 from .qc_worker import FunctionWorker
@@ -155,7 +155,7 @@ class FilterReviewTab(QtWidgets.QWidget):
         try:
             written = accept_refilter(dtm, self.review)
         except PhotodemError as exc:
-            self.panel._report("error", str(exc))
+            self.panel._report("error", error_text(exc))
             return False
         self.accept_button.setEnabled(False)
         self.panel._report("info", tr("The area was written into {0}.").format(written["dtm"]))

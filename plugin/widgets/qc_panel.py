@@ -30,7 +30,7 @@ from ...algorithms.project.edits import EXCLUSION_ACTIONS, add_features
 from ...algorithms.quality import qc_blunders, qc_profile, qc_stats
 from ...algorithms.quality.names import distinct_names
 from ...algorithms.quality.profile import parse_coordinates
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtCore, QtWidgets, pyqtSignal
 from .qc_filter import FilterReviewTab
 from .qc_plots import (
@@ -473,8 +473,9 @@ class QcPanel(QtWidgets.QWidget):
         if self._on_result is not None:
             self._on_result(result)
 
-    def _failed(self, text: str, operator_error: bool) -> None:
-        self._report("error", text if operator_error else tr("Internal error: {0}").format(text))
+    def _failed(self, text: str, operator_error: bool, parts: Any = None) -> None:
+        self._report("error", error_text(text, parts) if operator_error
+                     else tr("Internal error: {0}").format(text))
 
     def _done(self) -> None:
         self._worker, self._on_result = None, None

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 from .worker import AlgorithmWorker, start_in_thread
 
@@ -28,7 +28,7 @@ class RunPanel(QtWidgets.QWidget):
         The Run button was pressed (the owner collects the parameters and calls :meth:`start`).
     run_finished(str, object)
         ``(status, payload)`` with status ``done`` (payload: output dict), ``failed``
-        (message), ``cancelled`` (message).
+        (message, in the operator's language), ``cancelled`` (message).
     show_on_map(str)
         *Show on map* of an output raster or vector (its path).
     """
@@ -182,12 +182,13 @@ class RunPanel(QtWidgets.QWidget):
         self.show_result(result)
         self.append_log("ok", tr("Finished."))
 
-    def _on_failed(self, message: str, operator_error: bool) -> None:
-        self._status, self._payload = "failed", message
+    def _on_failed(self, message: str, operator_error: bool, parts: Any = None) -> None:
         if operator_error:
+            message = error_text(message, parts)
             self.append_log("error", tr("Error: ") + message)
         else:
             self.append_log("error", tr("Unexpected error (please report it):") + "\n" + message)
+        self._status, self._payload = "failed", message
 
     def _on_cancelled(self, message: str) -> None:
         self._status, self._payload = "cancelled", message

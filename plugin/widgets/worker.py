@@ -10,7 +10,7 @@ check and discards its staged outputs.
 from __future__ import annotations
 
 import traceback
-from typing import Any, Callable, Dict, Optional, Set
+from typing import Any, Callable, Dict, Optional
 
 from ...algorithms.errors import Cancelled, PhotodemError
 from ...algorithms.feedback import Feedback
@@ -29,8 +29,10 @@ class AlgorithmWorker(QObject):
         ``(level, message)``; level ``info``, ``warning`` or ``error``.
     finished(object)
         The JSON-ready output dict.
-    failed(str, bool)
-        The message and whether it is an operator error (``False``: a bug, with traceback).
+    failed(str, bool, object)
+        The English message, whether it is an operator error (``False``: a bug, with
+        traceback) and the error's :class:`~photodem.algorithms.errors.Message` (template and
+        values, which the GUI translates with :func:`..i18n.error_text`) or ``None``.
     cancelled(str)
         The run was cancelled; no output was left behind.
     done()
@@ -40,7 +42,7 @@ class AlgorithmWorker(QObject):
     progress = pyqtSignal(float)
     log = pyqtSignal(str, str)
     finished = pyqtSignal(object)
-    failed = pyqtSignal(str, bool)
+    failed = pyqtSignal(str, bool, object)
     cancelled = pyqtSignal(str)
     done = pyqtSignal()
 
@@ -73,9 +75,9 @@ class AlgorithmWorker(QObject):
         except Cancelled as exc:
             self.cancelled.emit(str(exc))
         except PhotodemError as exc:
-            self.failed.emit(str(exc), True)
+            self.failed.emit(str(exc), True, exc.message)
         except Exception:  # a bug: show the traceback, keep the GUI alive
-            self.failed.emit(traceback.format_exc(), False)
+            self.failed.emit(traceback.format_exc(), False, None)
         else:
             self.finished.emit(result)
         finally:
@@ -85,8 +87,11 @@ class AlgorithmWorker(QObject):
 #: Threads started by :func:`start_in_thread` that have not been joined yet. None of them is
 #: the child of a widget: a widget deleted while its run winds down would delete the QThread
 #: with it, and ``~QThread`` then waits for the thread while holding the GIL that the thread
-#: needs to delete its Python worker — a deadlock (it hung a CI run once).
-_LIVE: Set[QThread] = set()
+#: needs to delete its Python worker — a deadlock (it hung a CI run once). Each keeps its
+#: worker referenced until it has ended: a worker nobody else holds (``Feedback`` makes it a
+#: reference cycle) would otherwise be collected by Python's garbage collector, its QObject
+#: deleted before ``run`` and the thread never told to quit (a test hung 1 run in 4).
+_LIVE: Dict[QThread, QObject] = {}
 
 
 def start_in_thread(worker: QObject, on_finished: Optional[Callable[[], None]] = None
@@ -102,11 +107,11 @@ def start_in_thread(worker: QObject, on_finished: Optional[Callable[[], None]] =
     a connection made after ``start()``.
     """
     thread = QThread()  # no parent: see _LIVE
-    _LIVE.add(thread)
+    _LIVE[thread] = worker
 
     def ended() -> None:
         thread.wait()  # returns at once; releases the GIL the thread needs to delete its worker
-        _LIVE.discard(thread)
+        _LIVE.pop(thread, None)  # the worker was deleted in its thread after ``done``
         thread.deleteLater()
         if on_finished is not None:
             on_finished()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import os
 import threading
 
@@ -44,6 +45,16 @@ def test_the_end_comes_once_the_thread_is_gone(qtbot) -> None:
             _Instant("none", {}), on_finished=lambda b=box: seen.append(b["thread"].wait(0)))
         qtbot.waitUntil(lambda n=run: len(seen) == n, timeout=5000)
     assert seen == [True] * 10
+
+
+def test_a_worker_nobody_holds_is_not_collected_before_it_ran(qtbot) -> None:
+    # The worker is a reference cycle (its Feedback calls back into it): a garbage collection
+    # right after the start used to delete it before run(), and the thread never ended.
+    ended: list = []
+    for run in range(1, 6):
+        start_in_thread(_Instant("none", {}), on_finished=lambda: ended.append(1))
+        gc.collect()
+        qtbot.waitUntil(lambda n=run: len(ended) == n, timeout=5000)
 
 
 def test_deleting_the_owner_while_the_run_goes_on(qtbot) -> None:
