@@ -10,7 +10,7 @@
         </message>
         <message>
             <source>Project</source>
-            <extracomment>plugin/widgets/batch_dialog.py:133; plugin/widgets/qc_panel.py:128; project_create: group; project_info: group; stereo_models: group</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:141; plugin/widgets/qc_panel.py:128; project_create: group; project_info: group; stereo_models: group</extracomment>
             <translation>Projekt</translation>
         </message>
         <message>
@@ -380,7 +380,7 @@
         </message>
         <message>
             <source>Epipolar pair</source>
-            <extracomment>epipolar_pair: name; plugin/app/model_menu.py:107; plugin/qgis/model_actions.py:128; plugin/widgets/batch_dialog.py:139; plugin/widgets/batch_dialog.py:162</extracomment>
+            <extracomment>epipolar_pair: name; plugin/app/model_menu.py:107; plugin/qgis/model_actions.py:128; plugin/widgets/batch_dialog.py:147; plugin/widgets/batch_dialog.py:170</extracomment>
             <translation>Epipolarbildpaar</translation>
         </message>
         <message>
@@ -770,7 +770,7 @@
         </message>
         <message>
             <source>Matching</source>
-            <extracomment>match_model: group; plugin/widgets/batch_dialog.py:140; plugin/widgets/batch_dialog.py:162; stereo_disparity: group</extracomment>
+            <extracomment>match_model: group; plugin/widgets/batch_dialog.py:148; plugin/widgets/batch_dialog.py:170; stereo_disparity: group</extracomment>
             <translation>Bildzuordnung</translation>
         </message>
         <message>
@@ -1155,7 +1155,7 @@
         </message>
         <message>
             <source>Merge DSMs</source>
-            <extracomment>dsm_merge: name; plugin/widgets/batch_dialog.py:163</extracomment>
+            <extracomment>dsm_merge: name; plugin/widgets/batch_dialog.py:171</extracomment>
             <translation>DOMs zusammenführen</translation>
         </message>
         <message>
@@ -1815,7 +1815,7 @@
         </message>
         <message>
             <source>Orthophotos</source>
-            <extracomment>mosaic: group; ortho_displacement: group; orthorectify: group; plugin/widgets/batch_dialog.py:165</extracomment>
+            <extracomment>mosaic: group; ortho_displacement: group; orthorectify: group; plugin/widgets/batch_dialog.py:173</extracomment>
             <translation>Orthofotos</translation>
         </message>
         <message>
@@ -2635,7 +2635,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:749; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:757; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -2875,7 +2875,7 @@
         </message>
         <message>
             <source>Batch {0}: {1}; summary in {2}</source>
-            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:639</extracomment>
+            <extracomment>plugin/qgis/batch_actions.py:116; plugin/widgets/batch_dialog.py:647</extracomment>
             <translation>Batch {0}: {1}; Zusammenfassung in {2}</translation>
         </message>
         <message>
@@ -3115,7 +3115,7 @@
         </message>
         <message>
             <source>The project cannot be read: {0}</source>
-            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:336</extracomment>
+            <extracomment>plugin/qgis/model_widget.py:68; plugin/widgets/batch_dialog.py:344</extracomment>
             <translation>Das Projekt ist nicht lesbar: {0}</translation>
         </message>
         <message>
@@ -3395,7 +3395,7 @@
         </message>
         <message>
             <source>Products</source>
-            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:238</extracomment>
+            <extracomment>plugin/qgis/workspace.py:143; plugin/widgets/batch_dialog.py:246</extracomment>
             <translation>Produkte</translation>
         </message>
         <message>
@@ -3450,132 +3450,132 @@
         </message>
         <message>
             <source>Batch over stereo models</source>
-            <extracomment>plugin/widgets/batch_dialog.py:96</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:104</extracomment>
             <translation>Batch über Stereomodelle</translation>
         </message>
         <message>
             <source>project folder (with project.toml)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:130; plugin/widgets/parameter_form.py:151</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:138; plugin/widgets/parameter_form.py:151</extracomment>
             <translation>Projektordner (mit project.toml)</translation>
         </message>
         <message>
             <source>Open batch file…</source>
-            <extracomment>plugin/widgets/batch_dialog.py:131</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:139</extracomment>
             <translation>Batch-Datei öffnen…</translation>
         </message>
         <message>
             <source>Double-click a row to open its log.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:145</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:153</extracomment>
             <translation>Doppelklick auf eine Zeile öffnet ihr Protokoll.</translation>
         </message>
         <message>
             <source>Steps</source>
-            <extracomment>plugin/widgets/batch_dialog.py:159</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:167</extracomment>
             <translation>Schritte</translation>
         </message>
         <message>
             <source>Refine in object space</source>
-            <extracomment>plugin/widgets/batch_dialog.py:164</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:172</extracomment>
             <translation>Im Objektraum verfeinern</translation>
         </message>
         <message>
             <source>DTM filter</source>
-            <extracomment>plugin/widgets/batch_dialog.py:165; plugin/widgets/batch_dialog.py:181</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:173; plugin/widgets/batch_dialog.py:189</extracomment>
             <translation>DGM-Filter</translation>
         </message>
         <message>
             <source>Worker processes (default: cores − 1)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:193</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:201</extracomment>
             <translation>Worker-Prozesse (Vorgabe: Kerne − 1)</translation>
         </message>
         <message>
             <source>empty = this machine</source>
-            <extracomment>plugin/widgets/batch_dialog.py:198</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:206</extracomment>
             <translation>leer = dieser Rechner</translation>
         </message>
         <message>
             <source>Address of a Dask scheduler (tcp://host:8786) whose workers run the batch; the project must be on storage every worker sees at the same path.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:199</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:207</extracomment>
             <translation>Adresse eines Dask-Schedulers (tcp://host:8786), dessen Worker den Batch ausführen; das Projekt muss auf einem Speicher liegen, den jeder Worker unter demselben Pfad sieht.</translation>
         </message>
         <message>
             <source>The log of the batch appears here.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:220</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:228</extracomment>
             <translation>Hier erscheint das Protokoll des Batches.</translation>
         </message>
         <message>
             <source>Open</source>
-            <extracomment>plugin/widgets/batch_dialog.py:223; plugin/widgets/run_panel.py:238</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:231; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Öffnen</translation>
         </message>
         <message>
             <source>Show in folder</source>
-            <extracomment>plugin/widgets/batch_dialog.py:224; plugin/widgets/run_panel.py:238</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:232; plugin/widgets/run_panel.py:238</extracomment>
             <translation>Im Ordner zeigen</translation>
         </message>
         <message>
             <source>Log</source>
-            <extracomment>plugin/widgets/batch_dialog.py:237; plugin/widgets/run_panel.py:93</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:245; plugin/widgets/run_panel.py:93</extracomment>
             <translation>Protokoll</translation>
         </message>
         <message>
             <source>Run</source>
-            <extracomment>plugin/widgets/batch_dialog.py:250; plugin/widgets/run_panel.py:48</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:258; plugin/widgets/run_panel.py:48</extracomment>
             <translation>Ausführen</translation>
         </message>
         <message>
             <source>Write the batch file of these choices and run it</source>
-            <extracomment>plugin/widgets/batch_dialog.py:252</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:260</extracomment>
             <translation>Die Batch-Datei dieser Auswahl schreiben und ausführen</translation>
         </message>
         <message>
             <source>Resume</source>
-            <extracomment>plugin/widgets/batch_dialog.py:253</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:261</extracomment>
             <translation>Fortsetzen</translation>
         </message>
         <message>
             <source>Run the batch file again; finished tasks are skipped</source>
-            <extracomment>plugin/widgets/batch_dialog.py:254</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:262</extracomment>
             <translation>Die Batch-Datei erneut ausführen; fertige Aufgaben werden übersprungen</translation>
         </message>
         <message>
             <source>Re-run failed</source>
-            <extracomment>plugin/widgets/batch_dialog.py:255</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:263</extracomment>
             <translation>Fehlgeschlagene erneut ausführen</translation>
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:256; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:593; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:264; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:593; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:257; plugin/widgets/georef_review.py:276</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:265; plugin/widgets/georef_review.py:276</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
             <source>Batch is running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:716</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:724</extracomment>
             <translation>Batch läuft</translation>
         </message>
         <message>
             <source>The batch is still running. Cancel it, or keep it running in the background?</source>
-            <extracomment>plugin/widgets/batch_dialog.py:717</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:725</extracomment>
             <translation>Der Batch läuft noch. Abbrechen oder im Hintergrund weiterlaufen lassen?</translation>
         </message>
         <message>
             <source>Cancel the batch</source>
-            <extracomment>plugin/widgets/batch_dialog.py:719</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:727</extracomment>
             <translation>Batch abbrechen</translation>
         </message>
         <message>
             <source>Keep running</source>
-            <extracomment>plugin/widgets/batch_dialog.py:720</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:728</extracomment>
             <translation>Weiterlaufen lassen</translation>
         </message>
         <message>
             <source>Back</source>
-            <extracomment>plugin/widgets/batch_dialog.py:721</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:729</extracomment>
             <translation>Zurück</translation>
         </message>
         <message>
@@ -3615,129 +3615,129 @@
         </message>
         <message>
             <source>Model</source>
-            <extracomment>plugin/widgets/batch_dialog.py:139</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:147</extracomment>
             <translation>Modell</translation>
         </message>
         <message>
             <source>Kind</source>
-            <extracomment>plugin/widgets/batch_dialog.py:139; plugin/widgets/edit_forms.py:128</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:147; plugin/widgets/edit_forms.py:128</extracomment>
             <translation>Art</translation>
         </message>
         <message>
             <source>B/H</source>
-            <extracomment>plugin/widgets/batch_dialog.py:139</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:147</extracomment>
             <translation>B/H</translation>
         </message>
         <message>
             <source>Overlap</source>
-            <extracomment>plugin/widgets/batch_dialog.py:139; plugin/widgets/georef_review.py:54</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:147; plugin/widgets/georef_review.py:54</extracomment>
             <translation>Überlappung</translation>
         </message>
         <message>
             <source>Progress</source>
-            <extracomment>plugin/widgets/batch_dialog.py:140</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:148</extracomment>
             <translation>Fortschritt</translation>
         </message>
         <message>
             <source>State</source>
-            <extracomment>plugin/widgets/batch_dialog.py:140</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:148</extracomment>
             <translation>Zustand</translation>
         </message>
         <message>
             <source>Matching method</source>
-            <extracomment>plugin/widgets/batch_dialog.py:179</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:187</extracomment>
             <translation>Zuordnungsverfahren</translation>
         </message>
         <message>
             <source>Matching preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:180</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:188</extracomment>
             <translation>Voreinstellung der Zuordnung</translation>
         </message>
         <message>
             <source>Filter preset</source>
-            <extracomment>plugin/widgets/batch_dialog.py:182</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:190</extracomment>
             <translation>Voreinstellung des Filters</translation>
         </message>
         <message>
             <source>Single orthophotos or a mosaic</source>
-            <extracomment>plugin/widgets/batch_dialog.py:183</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:191</extracomment>
             <translation>Einzelne Orthofotos oder ein Mosaik</translation>
         </message>
         <message>
             <source>Workers</source>
-            <extracomment>plugin/widgets/batch_dialog.py:194</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:202</extracomment>
             <translation>Worker</translation>
         </message>
         <message>
             <source>Scheduler</source>
-            <extracomment>plugin/widgets/batch_dialog.py:202</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:210</extracomment>
             <translation>Scheduler</translation>
         </message>
         <message>
             <source>Choose a project folder, or open a batch file.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:330</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:338</extracomment>
             <translation>Wählen Sie einen Projektordner oder öffnen Sie eine Batch-Datei.</translation>
         </message>
         <message>
             <source>Choose a project folder (with project.toml) first.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:395</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:403</extracomment>
             <translation>Wählen Sie zuerst einen Projektordner (mit project.toml).</translation>
         </message>
         <message>
             <source>Cancelling …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:523; plugin/widgets/run_panel.py:154</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:531; plugin/widgets/run_panel.py:154</extracomment>
             <translation>Wird abgebrochen …</translation>
         </message>
         <message>
             <source>No log yet: the task has not started.</source>
-            <extracomment>plugin/widgets/batch_dialog.py:697</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:705</extracomment>
             <translation>Noch kein Protokoll: die Aufgabe hat noch nicht begonnen.</translation>
         </message>
         <message>
             <source>Run writes the batch file into {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:342</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:350</extracomment>
             <translation>Ausführen schreibt die Batch-Datei nach {0}</translation>
         </message>
         <message>
             <source>Open batch file</source>
-            <extracomment>plugin/widgets/batch_dialog.py:412</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:420</extracomment>
             <translation>Batch-Datei öffnen</translation>
         </message>
         <message>
             <source>Batch files (*.toml)</source>
-            <extracomment>plugin/widgets/batch_dialog.py:412</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:420</extracomment>
             <translation>Batch-Dateien (*.toml)</translation>
         </message>
         <message>
             <source>Running batch file {0} …</source>
-            <extracomment>plugin/widgets/batch_dialog.py:509</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:517</extracomment>
             <translation>Batch-Datei {0} läuft …</translation>
         </message>
         <message>
             <source>elapsed {0} · remaining {1}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:625</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:633</extracomment>
             <translation>vergangen {0} · verbleibend {1}</translation>
         </message>
         <message>
             <source>Warning: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:629; plugin/widgets/run_panel.py:174</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:637; plugin/widgets/run_panel.py:174</extracomment>
             <translation>Warnung: </translation>
         </message>
         <message>
             <source>Error: </source>
-            <extracomment>plugin/widgets/batch_dialog.py:629; plugin/widgets/run_panel.py:188</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:637; plugin/widgets/run_panel.py:188</extracomment>
             <translation>Fehler: </translation>
         </message>
         <message>
             <source>Batch file: {0}
 Run it again with: photodem batch {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:445</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:453</extracomment>
             <translation>Batch-Datei: {0}
 Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The batch file cannot be used: {0}</source>
-            <extracomment>plugin/widgets/batch_dialog.py:418</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:426</extracomment>
             <translation>Die Batch-Datei kann nicht verwendet werden: {0}</translation>
         </message>
         <message>
