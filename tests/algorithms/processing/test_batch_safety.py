@@ -6,6 +6,7 @@ import datetime as dt
 import json
 import os
 import random
+import re
 import signal
 import socket
 import subprocess
@@ -125,6 +126,33 @@ def _start_cli_batch(file, *args):
                             env=_env())
 
 
+_LOG_RECORD = re.compile(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d")
+
+
+def _without_dask_records(err: str) -> str:
+    """``err`` without the records of Dask's own loggers (``… - distributed.<name> - …`` and
+    the lines that follow up to the next record): on a loaded machine a worker's missed
+    heartbeat is logged with a traceback, which is no failure of the batch."""
+    kept, dask = [], False
+    for line in err.splitlines(keepends=True):
+        if _LOG_RECORD.match(line):
+            dask = " - distributed." in line
+        if not dask:
+            kept.append(line)
+    return "".join(kept)
+
+
+
+def test_dask_log_records_are_told_from_our_tracebacks():
+    dask = ("2026-11-27 03:10:11,123 - distributed.worker - ERROR - Failed to communicate with "
+            "scheduler during heartbeat.\nTraceback (most recent call last):\n  File \"x\"\n"
+            "OSError: Timed out\n")
+    ours = "Traceback (most recent call last):\n  File \"batch.py\"\nKeyError: 'a'\n"
+    assert _without_dask_records(dask) == ""
+    assert _without_dask_records("photodem: 4 tasks\n" + dask) == "photodem: 4 tasks\n"
+    assert "Traceback" in _without_dask_records(ours + dask)
+
+
 def _write_batch(project, run, step, workers=2):
     file = project.parent / "b.toml"
     params = "".join(f"{k} = {json.dumps(v)}\n" for k, v in step["params"].items())
@@ -190,7 +218,7 @@ def test_a_worker_killed_from_outside_is_replaced(fake_algs, project4, tmp_path,
     os.kill(victim, sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
-    assert "Traceback" not in err
+    assert "Traceback" not in _without_dask_records(err)
     summary = json.loads((run / "summary.json").read_text())
     assert summary["status"] == "done" and summary["counts"]["done"] == 4
     text = (run / "batch.log").read_text()
@@ -450,7 +478,7 @@ def test_ctrl_c_at_a_random_moment_leaves_what_the_summary_says(fake_algs, proje
     family = _descendants(proc.pid)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
-    assert "Traceback" not in err
+    assert "Traceback" not in _without_dask_records(err)
     products = project4 / "products" / "sleep"
     on_disk = set(_files(products)) if products.exists() else set()
     if (run / "summary.json").exists():
@@ -636,7 +664,7 @@ def test_two_batches_started_together_run_each_task_once(fake_algs, project4, tm
     codes = sorted(code for code, _ in results)
     assert codes in ([0, 0], [0, 2]), results
     for code, err in results:
-        assert "Traceback" not in err
+        assert "Traceback" not in _without_dask_records(err)
         if code == 2:
             assert "another batch (pid " in err and err.count("\n") == 1
     runs = sorted((project4 / "runs").iterdir())
