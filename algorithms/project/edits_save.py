@@ -77,7 +77,7 @@ def blob_to_geometry(blob: Optional[bytes]) -> Any:
         return None
     blob = bytes(blob)
     if blob[:2] != b"GP":
-        raise InputError("A geometry of edits.gpkg is not a GeoPackage geometry blob.")
+        raise InputError.of("A geometry of edits.gpkg is not a GeoPackage geometry blob.")
     flags = blob[3]
     if flags & 0x10:  # the empty flag
         return None
@@ -196,11 +196,12 @@ def read_edits(path: PathLike) -> EditsContent:
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"The edits file '{path}' does not exist.")
+        raise InputError.of("The edits file '{path}' does not exist.", path=path)
     try:
         con = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=2.0)
     except sqlite3.Error as exc:
-        raise InputError(f"Cannot open the edits file '{path}': {exc}") from exc
+        raise InputError.of("Cannot open the edits file '{path}': {error}", path=path,
+                            error=exc) from exc
     try:
         tables = _tables(con)
         content = EditsContent(crs_wkt=_crs_wkt(con, tables))
@@ -210,11 +211,11 @@ def read_edits(path: PathLike) -> EditsContent:
                 content.columns[name] = list(tables[name].columns)
         return content
     except (sqlite3.Error, ValueError, struct.error) as exc:  # also shapely's WKB errors
-        raise InputError(f"The edits file '{path}' is not a readable GeoPackage ({exc}); it "
-                         "is damaged or not a GeoPackage.") from exc
+        raise InputError.of("The edits file '{path}' is not a readable GeoPackage ({error}); "
+                            "it is damaged or not a GeoPackage.", path=path, error=exc) from exc
     except Exception as exc:  # shapely.errors.GEOSException and kin: a damaged geometry
-        raise InputError(f"The edits file '{path}' holds a geometry that cannot be read "
-                         f"({exc}).") from exc
+        raise InputError.of("The edits file '{path}' holds a geometry that cannot be read "
+                            "({error}).", path=path, error=exc) from exc
     finally:
         con.close()
 
