@@ -79,7 +79,8 @@ def check_encodable(path: PathLike, what: str = "file") -> None:
 #: article after "als", so one template serves every role).
 _ROLES = {m.template: m for m in (
     msg("file"), msg("raster"), msg("image"), msg("DEM"), msg("surface"), msg("output"),
-    msg("vector file"), msg("text file"), msg("GeoPackage"), msg("project file"))}
+    msg("vector file"), msg("text file"), msg("GeoPackage"), msg("project file"),
+    msg("seamline file"))}
 
 
 def role(what: str) -> Union[Message, str]:

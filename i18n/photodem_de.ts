@@ -5511,18 +5511,98 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Kanal {band} existiert nicht: '{name}' hat {count} Kanal/Kanäle.</translation>
         </message>
         <message>
+            <source>The check-point file '{path}' does not exist.</source>
+            <extracomment>algorithms/georef/review.py:295</extracomment>
+            <translation>Die Kontrollpunktdatei '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>The check-point file '{name}' holds no check points.</source>
+            <extracomment>algorithms/georef/review.py:299</extracomment>
+            <translation>Die Kontrollpunktdatei '{name}' enthält keine Kontrollpunkte.</translation>
+        </message>
+        <message>
+            <source>The check-point file '{name}' has a header but no check points.</source>
+            <extracomment>algorithms/georef/review.py:306</extracomment>
+            <translation>Die Kontrollpunktdatei '{name}' hat eine Kopfzeile, aber keine Kontrollpunkte.</translation>
+        </message>
+        <message>
+            <source>'{name}' has no header line; the first line must name the columns, e.g. col,row,x,y or pixel,line,mapX,mapY.</source>
+            <extracomment>algorithms/georef/review.py:321</extracomment>
+            <translation>'{name}' hat keine Kopfzeile; die erste Zeile muss die Spalten benennen, z. B. col,row,x,y oder pixel,line,mapX,mapY.</translation>
+        </message>
+        <message>
+            <source>The header of '{name}' lacks {missing} (found: {found}); name the columns col,row,x,y or pixel,line,mapX,mapY.</source>
+            <extracomment>algorithms/georef/review.py:330</extracomment>
+            <translation>In der Kopfzeile von '{name}' fehlt {missing} (gefunden: {found}); benennen Sie die Spalten col,row,x,y oder pixel,line,mapX,mapY.</translation>
+        </message>
+        <message>
+            <source>'{name}': the line column mixes positive and negative values; a QGIS .points file has negative lines, a GDAL list positive ones.</source>
+            <extracomment>algorithms/georef/review.py:367</extracomment>
+            <translation>'{name}': Die Zeilenspalte mischt positive und negative Werte; eine .points-Datei von QGIS hat negative Zeilen, eine GDAL-Liste positive.</translation>
+        </message>
+        <message>
+            <source>'{name}' is in another CRS than the georeferencing result; export the check points in the result's CRS.</source>
+            <extracomment>algorithms/georef/review.py:381</extracomment>
+            <translation>'{name}' liegt in einem anderen KBS als das Ergebnis der Georeferenzierung; exportieren Sie die Kontrollpunkte im KBS des Ergebnisses.</translation>
+        </message>
+        <message>
+            <source>None of the {count} check points in '{name}' lies in the image ({width} × {height} pixels); col,row count pixel centres from 0, pixel,line are QGIS .points coordinates.</source>
+            <extracomment>algorithms/georef/review.py:394</extracomment>
+            <translation>Keiner der {count} Kontrollpunkte in '{name}' liegt im Bild ({width} × {height} Pixel); col,row zählen Pixelmitten ab 0, pixel,line sind Koordinaten einer .points-Datei von QGIS.</translation>
+        </message>
+        <message>
+            <source>'{folder}' holds no georeferencing result (report.json and a .points file); choose the output folder of 'Georeference image against polygons'.</source>
+            <extracomment>algorithms/georef/review.py:424</extracomment>
+            <translation>'{folder}' enthält kein Ergebnis einer Georeferenzierung (report.json und eine .points-Datei); wählen Sie den Ausgabeordner von 'Bild an Polygonen georeferenzieren'.</translation>
+        </message>
+        <message>
+            <source>'{name}' is missing in '{folder}'; the review resamples that copy of the image. Run the georeferencing again.</source>
+            <extracomment>algorithms/georef/review.py:474</extracomment>
+            <translation>'{name}' fehlt in '{folder}'; die Prüfung tastet diese Kopie des Bildes um. Führen Sie die Georeferenzierung erneut aus.</translation>
+        </message>
+        <message>
+            <source>A control point needs four finite numbers: column, row, X, Y.</source>
+            <extracomment>algorithms/georef/review.py:148</extracomment>
+            <translation>Ein Passpunkt braucht vier endliche Zahlen: Spalte, Zeile, X, Y.</translation>
+        </message>
+        <message>
+            <source>Unknown transform '{value}'; use {options}.</source>
+            <extracomment>algorithms/georef/review.py:169</extracomment>
+            <translation>Unbekannte Transformation '{value}'; verwenden Sie {options}.</translation>
+        </message>
+        <message>
+            <source>The {kind} transform needs at least {need} active control points; {count} are switched on.</source>
+            <extracomment>algorithms/georef/review.py:174</extracomment>
+            <translation>Die Transformation {kind} braucht mindestens {need} aktive Passpunkte; eingeschaltet sind {count}.</translation>
+        </message>
+        <message>
+            <source>Cannot read the georeferencing result in '{folder}': {error}</source>
+            <extracomment>algorithms/georef/review.py:436</extracomment>
+            <translation>Das Ergebnis der Georeferenzierung in '{folder}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>The active control points do not determine a {kind} transform ({error}); switch on points spread over the image.</source>
+            <extracomment>algorithms/georef/review.py:181</extracomment>
+            <translation>Die aktiven Passpunkte bestimmen keine Transformation {kind} ({error}); schalten Sie über das Bild verteilte Punkte ein.</translation>
+        </message>
+        <message>
+            <source>'{name}' line {number}: {column} '{token}' is not a number.</source>
+            <extracomment>algorithms/georef/review.py:352</extracomment>
+            <translation>'{name}' Zeile {number}: {column} '{token}' ist keine Zahl.</translation>
+        </message>
+        <message>
             <source>The {what} name '{name}' is not valid UTF-8 text; GDAL cannot open it. Rename the file (or its folder) with UTF-8 characters only.</source>
-            <extracomment>algorithms/input_errors.py:93</extracomment>
+            <extracomment>algorithms/input_errors.py:94</extracomment>
             <translation>Der Name '{name}' ({what}) ist kein gültiger UTF-8-Text; GDAL kann die Datei nicht öffnen. Benennen Sie die Datei (oder ihren Ordner) nur mit UTF-8-Zeichen um.</translation>
         </message>
         <message>
             <source>Cannot use {shown}: {reason}.</source>
-            <extracomment>algorithms/input_errors.py:181</extracomment>
+            <extracomment>algorithms/input_errors.py:182</extracomment>
             <translation>Zugriff auf {shown} nicht möglich: {reason}.</translation>
         </message>
         <message>
             <source>An input file cannot be read ({detail}). Check the file it names (replace a truncated or damaged copy).</source>
-            <extracomment>algorithms/input_errors.py:187</extracomment>
+            <extracomment>algorithms/input_errors.py:188</extracomment>
             <translation>Eine Eingabedatei kann nicht gelesen werden ({detail}). Prüfen Sie die genannte Datei (ersetzen Sie eine abgeschnittene oder beschädigte Kopie).</translation>
         </message>
         <message>
@@ -5571,33 +5651,38 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Projektdatei</translation>
         </message>
         <message>
+            <source>seamline file</source>
+            <extracomment>algorithms/input_errors.py:83</extracomment>
+            <translation>Schnittliniendatei</translation>
+        </message>
+        <message>
             <source>A file name that is not valid UTF-8 text could not be written into a report; rename the file with UTF-8 characters only.</source>
-            <extracomment>algorithms/input_errors.py:172</extracomment>
+            <extracomment>algorithms/input_errors.py:173</extracomment>
             <translation>Ein Dateiname, der kein gültiger UTF-8-Text ist, konnte nicht in einen Bericht geschrieben werden; benennen Sie die Datei nur mit UTF-8-Zeichen um.</translation>
         </message>
         <message>
             <source>'{path}'</source>
-            <extracomment>algorithms/input_errors.py:178</extracomment>
+            <extracomment>algorithms/input_errors.py:179</extracomment>
             <translation>'{path}'</translation>
         </message>
         <message>
             <source>the {what}</source>
-            <extracomment>algorithms/input_errors.py:179</extracomment>
+            <extracomment>algorithms/input_errors.py:180</extracomment>
             <translation>die Eingabe ({what})</translation>
         </message>
         <message>
             <source>'{path}' is not a readable {what} ({detail}).</source>
-            <extracomment>algorithms/input_errors.py:185</extracomment>
+            <extracomment>algorithms/input_errors.py:186</extracomment>
             <translation>'{path}' kann nicht als {what} gelesen werden ({detail}).</translation>
         </message>
         <message>
             <source>'{path}' is an empty raster (no band or no cells).</source>
-            <extracomment>algorithms/input_errors.py:284</extracomment>
+            <extracomment>algorithms/input_errors.py:285</extracomment>
             <translation>'{path}' ist ein leeres Raster (kein Kanal oder keine Zellen).</translation>
         </message>
         <message>
             <source>Parameter '{name}': {error}</source>
-            <extracomment>algorithms/input_errors.py:332; algorithms/input_errors.py:346</extracomment>
+            <extracomment>algorithms/input_errors.py:333; algorithms/input_errors.py:347</extracomment>
             <translation>Parameter '{name}': {error}</translation>
         </message>
         <message>
@@ -6033,7 +6118,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         <message>
             <source>The layer '{layer}' has no heights to re-drape; use one of {layers}.</source>
             <extracomment>algorithms/project/edit_tools.py:357</extracomment>
-            <translation>Der Layer '{layer}' hat keine Höhen, die neu übernommen werden können; verwenden Sie einen von {layers}.</translation>
+            <translation>Der Layer '{layer}' hat keine Höhen, die neu abgegriffen werden können; verwenden Sie einen von {layers}.</translation>
         </message>
         <message>
             <source>The snapping tolerance must be positive, got {tolerance}.</source>
@@ -6072,7 +6157,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>'{layer}' is not an edit layer; use one of {layers}.</source>
-            <extracomment>algorithms/project/edits.py:303</extracomment>
+            <extracomment>algorithms/project/edits.py:303; algorithms/project/edits_save.py:361</extracomment>
             <translation>'{layer}' ist kein Bearbeitungslayer; verwenden Sie einen von {layers}.</translation>
         </message>
         <message>
@@ -6116,6 +6201,16 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Die Bearbeitungsdatei '{path}' existiert nicht.</translation>
         </message>
         <message>
+            <source>Two features of one edit layer have the same fid.</source>
+            <extracomment>algorithms/project/edits_save.py:241</extracomment>
+            <translation>Zwei Objekte eines Bearbeitungslayers haben dieselbe fid.</translation>
+        </message>
+        <message>
+            <source>Layer '{layer}' of edits.gpkg has no field(s) {fields}.</source>
+            <extracomment>algorithms/project/edits_save.py:257</extracomment>
+            <translation>Der Layer '{layer}' von edits.gpkg hat kein(e) Feld(er) {fields}.</translation>
+        </message>
+        <message>
             <source>Cannot open the edits file '{path}': {error}</source>
             <extracomment>algorithms/project/edits_save.py:203</extracomment>
             <translation>Die Bearbeitungsdatei '{path}' kann nicht geöffnet werden: {error}</translation>
@@ -6129,6 +6224,31 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>The edits file '{path}' holds a geometry that cannot be read ({error}).</source>
             <extracomment>algorithms/project/edits_save.py:217</extracomment>
             <translation>Die Bearbeitungsdatei '{path}' enthält eine Geometrie, die nicht gelesen werden kann ({error}).</translation>
+        </message>
+        <message>
+            <source>The new edits.gpkg holds {count} features in '{layer}' instead of {expected}; the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:325</extracomment>
+            <translation>Die neue edits.gpkg enthält {count} Objekte in '{layer}' statt {expected}; die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>Cannot write '{path}': {error}; the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:380</extracomment>
+            <translation>'{path}' kann nicht geschrieben werden: {error}; die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>The new edits.gpkg cannot be read back ({error}); the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:322</extracomment>
+            <translation>Die neue edits.gpkg kann nicht zurückgelesen werden ({error}); die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>'{path}' does not exist and no CRS was given to create it.</source>
+            <extracomment>algorithms/project/edits_save.py:369</extracomment>
+            <translation>'{path}' existiert nicht, und zum Anlegen wurde kein KBS angegeben.</translation>
+        </message>
+        <message>
+            <source>edits.gpkg has no layer '{layer}' to write.</source>
+            <extracomment>algorithms/project/edits_save.py:308</extracomment>
+            <translation>edits.gpkg hat keinen Layer '{layer}' zum Schreiben.</translation>
         </message>
         <message>
             <source>camera</source>
@@ -6294,6 +6414,11 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>must be 2 rows of 3 numbers, not {value}</source>
             <extracomment>algorithms/project/model.py:646</extracomment>
             <translation>muss aus 2 Zeilen mit je 3 Zahlen bestehen, nicht {value}</translation>
+        </message>
+        <message>
+            <source>Cannot read the {what} '{name}': {error}</source>
+            <extracomment>algorithms/project/vector_io.py:61</extracomment>
+            <translation>'{name}' kann nicht als {what} gelesen werden: {error}</translation>
         </message>
         <message>
             <source>The output '{path}' is a file, not a folder; choose a folder.</source>

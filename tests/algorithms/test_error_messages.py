@@ -261,3 +261,28 @@ def test_filter_input_messages_are_unchanged_and_translatable(tmp_path):
     template = "The filter input '{path}' does not exist or is not a file."
     assert exc.message.template == template
     assert str(exc) == template.format(path=tmp_path / "none.tif")
+
+
+def test_georeferencing_review_messages_are_unchanged_and_translatable(tmp_path):
+    from photodem.algorithms.georef.review import load_review, read_check_points
+
+    exc = _failure(load_review, tmp_path)
+    assert str(exc) == (f"'{tmp_path}' holds no georeferencing result (report.json and a "
+                        ".points file); choose the output folder of 'Georeference image "
+                        "against polygons'.")
+    points = tmp_path / "check.csv"
+    points.write_text("col,row,x,y\n1,2,three,4\n", encoding="utf-8")
+    exc = _failure(read_check_points, points)
+    assert str(exc) == "'check.csv' line 2: x 'three' is not a number."
+    assert exc.message.values == {"name": "check.csv", "number": 2, "column": "x",
+                                  "token": "three"}
+
+
+def test_an_unreadable_vector_file_names_its_role(tmp_path):
+    from photodem.algorithms.project.vector_io import read_features
+
+    bad = tmp_path / "seams.gpkg"
+    bad.write_bytes(b"no geopackage")
+    exc = _failure(read_features, bad, None, "seamline file")
+    assert str(exc).startswith("Cannot read the seamline file 'seams.gpkg': ")
+    assert exc.message.values["what"] == Message("seamline file")
