@@ -164,3 +164,14 @@ def test_errors_of_the_main_algorithms_in_german(qapp, german, tmp_path, chain_p
                         "dürfen sich weder kreuzen noch berühren — korrigieren Sie sie in "
                         "edits.gpkg.")
     assert texts[6].startswith("Batch-Datei: unbekannte(r) Schlüssel colour in Schritt 1; ")
+
+
+def test_georeferencing_review_reports_in_german(qapp, german, tmp_path):
+    from photodem.plugin.widgets.georef_review import open_review
+
+    german()
+    got: list = []
+    assert open_review(None, str(tmp_path), message_boxes=False, on_error=got.append) is None
+    assert got == [f"'{tmp_path}' enthält kein Ergebnis einer Georeferenzierung (report.json "
+                   "und eine .points-Datei); wählen Sie den Ausgabeordner von 'Bild an "
+                   "Polygonen georeferenzieren'."]
