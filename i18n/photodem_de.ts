@@ -5897,17 +5897,17 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Batch file: step '{step}' needs files = ["&lt;pattern or path&gt;", …] (the values of its parameter '{parameter}').</source>
-            <extracomment>algorithms/processing/batch.py:556</extracomment>
+            <extracomment>algorithms/processing/batch.py:559</extracomment>
             <translation>Batch-Datei: Schritt '{step}' braucht files = ["&lt;Muster oder Pfad&gt;", …] (die Werte seines Parameters '{parameter}').</translation>
         </message>
         <message>
             <source>Batch file: step '{step}': files must be a pattern or a list of patterns/paths.</source>
-            <extracomment>algorithms/processing/batch.py:561</extracomment>
+            <extracomment>algorithms/processing/batch.py:564</extracomment>
             <translation>Batch-Datei: Schritt '{step}': files muss ein Muster oder eine Liste von Mustern/Pfaden sein.</translation>
         </message>
         <message>
             <source>Batch file: step '{step}' uses {{{key}}}, but it does not run per {key}.</source>
-            <extracomment>algorithms/processing/batch.py:611</extracomment>
+            <extracomment>algorithms/processing/batch.py:614</extracomment>
             <translation>Batch-Datei: Schritt '{step}' verwendet {{{key}}}, läuft aber nicht je {key}.</translation>
         </message>
         <message>
@@ -5937,22 +5937,22 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Batch file: {named} (where the batch writes its logs): {error}</source>
-            <extracomment>algorithms/processing/batch.py:488</extracomment>
+            <extracomment>algorithms/processing/batch.py:490</extracomment>
             <translation>Batch-Datei: {named} (dort schreibt der Batch seine Protokolle): {error}</translation>
         </message>
         <message>
             <source>Batch file: {where}: {error}</source>
-            <extracomment>algorithms/processing/batch.py:515</extracomment>
+            <extracomment>algorithms/processing/batch.py:518</extracomment>
             <translation>Batch-Datei: {where}: {error}</translation>
         </message>
         <message>
             <source>Batch file: step '{step}': '{first}' and '{second}' have the same name; {{file}} must name one file (rename one).</source>
-            <extracomment>algorithms/processing/batch.py:584</extracomment>
+            <extracomment>algorithms/processing/batch.py:587</extracomment>
             <translation>Batch-Datei: Schritt '{step}': '{first}' und '{second}' haben denselben Namen; {{file}} muss eine einzige Datei bezeichnen (benennen Sie eine um).</translation>
         </message>
         <message>
             <source>Batch file: step '{step}' uses {{project}}, but the batch has no project (set project = "…" in [batch]).</source>
-            <extracomment>algorithms/processing/batch.py:609</extracomment>
+            <extracomment>algorithms/processing/batch.py:612</extracomment>
             <translation>Batch-Datei: Schritt '{step}' verwendet {{project}}, aber der Batch hat kein Projekt (setzen Sie project = "…" in [batch]).</translation>
         </message>
         <message>
@@ -5982,12 +5982,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Batch file: step '{step}': no file matches '{pattern}'.</source>
-            <extracomment>algorithms/processing/batch.py:572</extracomment>
+            <extracomment>algorithms/processing/batch.py:575</extracomment>
             <translation>Batch-Datei: Schritt '{step}': Keine Datei passt zu '{pattern}'.</translation>
         </message>
         <message>
             <source>Batch file: step '{step}': file '{pattern}' does not exist.</source>
-            <extracomment>algorithms/processing/batch.py:578</extracomment>
+            <extracomment>algorithms/processing/batch.py:581</extracomment>
             <translation>Batch-Datei: Schritt '{step}': Die Datei '{pattern}' existiert nicht.</translation>
         </message>
         <message>

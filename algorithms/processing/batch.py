@@ -337,12 +337,12 @@ def _timestamped(parent: Path, now: Optional[_dt.datetime]) -> Path:
 
 def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
                base_dir: Path) -> None:
-    where = msg("step {number}", number=number)
-    _check_keys(step, _STEP_KEYS, where)
+    at = msg("step {number}", number=number)
+    _check_keys(step, _STEP_KEYS, at)
     if "algorithm" not in step:
         raise InputError.of("Batch file: step {number} needs algorithm = \"id\".", number=number)
     for key in ("algorithm", "name"):
-        _text(step, key, where)
+        _text(step, key, at)
     alg = registry.get(step["algorithm"])
     name = step.get("name") or alg.id
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
@@ -458,7 +458,8 @@ def _check_params(alg: Any, params: Dict[str, Any], step: str) -> Dict[str, Any]
     return values
 
 
-def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
+def _check_run_folder(run: Path, project: Optional[Path], named: Union[str, Message]
+                      ) -> None:
     """Refuse a run folder the output policy forbids, before anything is written.
 
     The batch writes its logs and summary into the run folder but never replaces it, so a
@@ -472,8 +473,9 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
         The resolved run folder.
     project : Path, optional
         The batch project, whose files no run folder may be or contain.
-    named : str
-        Where the run folder comes from, for the message (``[batch] output``).
+    named : str or Message
+        Where the run folder comes from, for the message (``[batch] output``, "the run
+        folder").
 
     Raises
     ------
@@ -489,7 +491,8 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
                             named=named, error=exc) from None
 
 
-def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str) -> None:
+def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path,
+                        where: Union[str, Message]) -> None:
     """Check a task's outputs while planning (:func:`.registry.check_outputs` with the run
     folder): a forbidden output stops the batch before its first task.
 
@@ -501,7 +504,7 @@ def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str)
         The task's converted values (from :func:`_check_params`).
     run : Path
         The resolved run folder: no output may be or contain it.
-    where : str
+    where : str or Message
         ``step 'name' (algorithm)[, model 'name']`` for the message.
 
     Raises
