@@ -34,7 +34,7 @@ from rasterio._err import CPLE_FileIOError, CPLE_OpenFailedError
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.windows import Window
 
-from .errors import InputError, PhotodemError
+from .errors import InputError, Message, PhotodemError, msg
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -72,10 +72,28 @@ def check_encodable(path: PathLike, what: str = "file") -> None:
     try:
         os.fspath(path).encode("utf-8") if not isinstance(path, bytes) else path.decode("utf-8")
     except (UnicodeEncodeError, UnicodeDecodeError):
-        raise InputError(
-            f"The {what} name '{display_path(path)}' is not valid UTF-8 text; GDAL cannot open "
-            "it. Rename the file (or its folder) with UTF-8 characters only."
-        ) from None
+        raise _not_utf8_name(what, display_path(path)) from None
+
+
+#: The roles of input files named in messages, as translatable phrases (German needs no
+#: article after "als", so one template serves every role).
+_ROLES = {m.template: m for m in (
+    msg("file"), msg("raster"), msg("image"), msg("DEM"), msg("surface"), msg("output"),
+    msg("vector file"), msg("text file"), msg("GeoPackage"), msg("project file"),
+    msg("seamline file"))}
+
+
+def role(what: str) -> Union[Message, str]:
+    """``what`` (the role of a file: "raster", "image", …) as a translatable phrase when it is
+    one of the known roles, else as it is."""
+    return _ROLES.get(what, what)
+
+
+def _not_utf8_name(what: str, name: str) -> InputError:
+    """The error for a file name GDAL cannot be given."""
+    return InputError.of("The {what} name '{name}' is not valid UTF-8 text; GDAL cannot open "
+                         "it. Rename the file (or its folder) with UTF-8 characters only.",
+                         what=role(what), name=name)
 
 
 def _library_errors() -> Tuple[Type[BaseException], ...]:
@@ -152,21 +170,23 @@ def _translate(exc: BaseException, path: Optional[PathLike], what: str) -> Optio
     if isinstance(exc, UnicodeEncodeError) and "surrogates not allowed" in str(exc):
         name = display_path(path if path is not None else exc.object)
         if path is None and ("\n" in name or len(name) > 4096):  # a text, not a name
-            return InputError("A file name that is not valid UTF-8 text could not be written "
-                              "into a report; rename the file with UTF-8 characters only.")
-        return InputError(f"The {what} name '{name}' is not valid UTF-8 text; GDAL cannot open "
-                          "it. Rename the file (or its folder) with UTF-8 characters only.")
+            return InputError.of("A file name that is not valid UTF-8 text could not be "
+                                 "written into a report; rename the file with UTF-8 "
+                                 "characters only.")
+        return _not_utf8_name(what, name)
     if isinstance(exc, OSError) and exc.errno in _OPERATOR_ERRNOS:
         name = exc.filename if exc.filename is not None else path
-        shown = f"'{display_path(name)}'" if name is not None else f"the {what}"
-        reason = exc.strerror or str(exc)
-        return InputError(f"Cannot use {shown}: {reason}.")
+        shown = (msg("'{path}'", path=display_path(name)) if name is not None
+                 else msg("the {what}", what=role(what)))
+        reason = exc.strerror or str(exc)  # the system's words (its own locale)
+        return InputError.of("Cannot use {shown}: {reason}.", shown=shown, reason=reason)
     if isinstance(exc, _library_errors()):
-        detail = describe(exc)
+        detail = describe(exc)  # GDAL's, OGR's or the parser's own words stay as they are
         if path is not None:
-            return InputError(f"'{display_path(path)}' is not a readable {what} ({detail}).")
-        return InputError(f"An input file cannot be read ({detail}). Check the file it names "
-                          "(replace a truncated or damaged copy).")
+            return InputError.of("'{path}' is not a readable {what} ({detail}).",
+                                 path=display_path(path), what=role(what), detail=detail)
+        return InputError.of("An input file cannot be read ({detail}). Check the file it names "
+                             "(replace a truncated or damaged copy).", detail=detail)
     return None
 
 
@@ -262,7 +282,8 @@ def check_raster(path: PathLike, what: str = "raster") -> None:
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
         with rasterio.open(p) as src:
             if src.count < 1 or src.width < 1 or src.height < 1:
-                raise InputError(f"'{display_path(p)}' is an empty raster (no band or no cells).")
+                raise InputError.of("'{path}' is an empty raster (no band or no cells).",
+                                    path=display_path(p))
             bh, bw = src.block_shapes[0]
             bw, bh = min(bw, src.width), min(bh, src.height)
             src.read(1, window=Window(0, 0, bw, bh))
@@ -359,5 +380,6 @@ __all__ = [
     "display_path",
     "operator_errors",
     "reading",
+    "role",
     "warn_input",
 ]

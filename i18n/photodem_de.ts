@@ -1270,7 +1270,7 @@
         </message>
         <message>
             <source>DEM</source>
-            <extracomment>interpolate_dem output dem; interpolate_dem.output: description; plugin/qgis/qc_dock.py:192; plugin/widgets/qc_panel.py:130</extracomment>
+            <extracomment>algorithms/input_errors.py:81; interpolate_dem output dem; interpolate_dem.output: description; plugin/qgis/qc_dock.py:192; plugin/widgets/qc_panel.py:130</extracomment>
             <translation>DHM</translation>
         </message>
         <message>
@@ -2160,7 +2160,7 @@
         </message>
         <message>
             <source>none</source>
-            <extracomment>mosaic.balance: option</extracomment>
+            <extracomment>algorithms/processing/batch.py:403; mosaic.balance: option</extracomment>
             <translation>keiner</translation>
         </message>
         <message>
@@ -3777,7 +3777,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Every vertex of a breakline needs a height.</source>
-            <extracomment>plugin/widgets/edit_flow.py:161</extracomment>
+            <extracomment>algorithms/project/edit_rules.py:186; plugin/widgets/edit_flow.py:161</extracomment>
             <translation>Jeder Stützpunkt einer Bruchkante braucht eine Höhe.</translation>
         </message>
         <message>
@@ -5306,9 +5306,424 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Alle Bearbeitungen gespeichert.</translation>
         </message>
         <message>
+            <source>Fewer than 10 DSM cells are left for the linear prediction (all no data or inside 'remove' exclusion areas); check the input and the exclusion areas.</source>
+            <extracomment>algorithms/filtering/linear_prediction.py:721</extracomment>
+            <translation>Für die lineare Prädiktion bleiben weniger als 10 DOM-Zellen (alle ohne Daten oder in Ausschlussflächen mit 'remove'); prüfen Sie die Eingabe und die Ausschlussflächen.</translation>
+        </message>
+        <message>
+            <source>The DSM holds no height (every cell is nodata).</source>
+            <extracomment>algorithms/filtering/lowpass.py:567; algorithms/filtering/lowpass.py:646</extracomment>
+            <translation>Das DOM enthält keine Höhe (jede Zelle ist NoData).</translation>
+        </message>
+        <message>
+            <source>Unknown preset '{name}'; use one of {options}.</source>
+            <extracomment>algorithms/filtering/presets.py:200</extracomment>
+            <translation>Unbekannte Voreinstellung '{name}'; verwenden Sie eine von {options}.</translation>
+        </message>
+        <message>
+            <source>The DSM '{name}' holds no height (every cell is nodata); check the input.</source>
+            <extracomment>algorithms/filtering/surface_input.py:199</extracomment>
+            <translation>Das DOM '{name}' enthält keine Höhe (jede Zelle ist NoData); prüfen Sie die Eingabe.</translation>
+        </message>
+        <message>
+            <source>The DSM '{name}' has only {count} cells with a height; a filter needs at least {minimum}.</source>
+            <extracomment>algorithms/filtering/surface_input.py:202</extracomment>
+            <translation>Das DOM '{name}' hat nur {count} Zellen mit einer Höhe; ein Filter braucht mindestens {minimum}.</translation>
+        </message>
+        <message>
+            <source>'{name}' has only {count} valid point(s); a filter needs at least {minimum}.</source>
+            <extracomment>algorithms/filtering/surface_input.py:302</extracomment>
+            <translation>'{name}' hat nur {count} gültige(n) Punkt(e); ein Filter braucht mindestens {minimum}.</translation>
+        </message>
+        <message>
+            <source>A {spacing:g} m grid over the points of '{name}' would have more than 400 million cells; give a larger spacing.</source>
+            <extracomment>algorithms/filtering/surface_input.py:323</extracomment>
+            <translation>Ein Gitter von {spacing:g} m über die Punkte von '{name}' hätte mehr als 400 Millionen Zellen; geben Sie eine größere Gitterweite an.</translation>
+        </message>
+        <message>
+            <source>The filter input '{path}' does not exist or is not a file.</source>
+            <extracomment>algorithms/filtering/surface_input.py:355</extracomment>
+            <translation>Die Filtereingabe '{path}' existiert nicht oder ist keine Datei.</translation>
+        </message>
+        <message>
+            <source>The filter input has no CRS and neither has the project; give the CRS of the input (e.g. --crs EPSG:25832) so the edits can be placed.</source>
+            <extracomment>algorithms/filtering/surface_input.py:411</extracomment>
+            <translation>Weder die Filtereingabe noch das Projekt hat ein KBS; geben Sie das KBS der Eingabe an (z. B. --crs EPSG:25832), damit die Bearbeitungen platziert werden können.</translation>
+        </message>
+        <message>
+            <source>Unknown CRS '{crs}': give an EPSG code (e.g. EPSG:25832), WKT or a PROJ string ({error}).</source>
+            <extracomment>algorithms/filtering/surface_input.py:162</extracomment>
+            <translation>Unbekanntes KBS '{crs}': Geben Sie einen EPSG-Code (z. B. EPSG:25832), WKT oder eine PROJ-Zeichenkette an ({error}).</translation>
+        </message>
+        <message>
+            <source>Cannot read '{name}' as a DSM raster or a points file: {error}</source>
+            <extracomment>algorithms/filtering/surface_input.py:193</extracomment>
+            <translation>'{name}' kann weder als DOM-Raster noch als Punktdatei gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>Cannot read the LAS/LAZ file '{name}': {error}</source>
+            <extracomment>algorithms/filtering/surface_input.py:218</extracomment>
+            <translation>Die LAS/LAZ-Datei '{name}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>The DSM '{name}' is rotated or not north-up; warp it to a north-up grid first (e.g. gdalwarp).</source>
+            <extracomment>algorithms/filtering/surface_input.py:180</extracomment>
+            <translation>Das DOM '{name}' ist gedreht oder nicht nordausgerichtet; transformieren Sie es zuerst auf ein nordausgerichtetes Gitter (z. B. gdalwarp).</translation>
+        </message>
+        <message>
+            <source>The DSM '{name}' has non-square cells ({width:g} × {height:g}); resample it to square cells first.</source>
+            <extracomment>algorithms/filtering/surface_input.py:183</extracomment>
+            <translation>Das DOM '{name}' hat nicht quadratische Zellen ({width:g} × {height:g}); tasten Sie es zuerst auf quadratische Zellen um.</translation>
+        </message>
+        <message>
+            <source>Cannot read '{name}' as points: {error}</source>
+            <extracomment>algorithms/filtering/surface_input.py:293</extracomment>
+            <translation>'{name}' kann nicht als Punkte gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>Unknown keypoint detector '{value}'; use auto, {options}.</source>
+            <extracomment>algorithms/georef/keypoints.py:127; algorithms/georef/pipeline.py:201</extracomment>
+            <translation>Unbekannter Merkmalsdetektor '{value}'; verwenden Sie auto, {options}.</translation>
+        </message>
+        <message>
+            <source>The image has no valid pixels.</source>
+            <extracomment>algorithms/georef/keypoints.py:84; algorithms/georef/regions.py:278</extracomment>
+            <translation>Das Bild hat keine gültigen Pixel.</translation>
+        </message>
+        <message>
+            <source>Thresholds must be positive grey-value differences, e.g. 5,6,7,8.</source>
+            <extracomment>algorithms/georef/pipeline.py:106</extracomment>
+            <translation>Die Schwellen müssen positive Grauwertdifferenzen sein, z. B. 5,6,7,8.</translation>
+        </message>
+        <message>
+            <source>The area-based search needs a polygon layer as reference, not a raster; use search = objects or auto.</source>
+            <extracomment>algorithms/georef/pipeline.py:254</extracomment>
+            <translation>Die flächenbasierte Suche braucht einen Polygonlayer als Referenz, kein Raster; verwenden Sie search = objects oder auto.</translation>
+        </message>
+        <message>
+            <source>The keypoint search needs a georeferenced raster as reference, not a polygon layer; use search = objects, area or auto.</source>
+            <extracomment>algorithms/georef/pipeline.py:257</extracomment>
+            <translation>Die Merkmalspunktsuche braucht ein georeferenziertes Raster als Referenz, keinen Polygonlayer; verwenden Sie search = objects, area oder auto.</translation>
+        </message>
+        <message>
+            <source>Georeferencing failed: {why} ({detail}). Check that image and reference show the same objects completely (class field/value), try other thresholds or a larger relative difference.</source>
+            <extracomment>algorithms/georef/pipeline.py:781</extracomment>
+            <translation>Die Georeferenzierung ist fehlgeschlagen: {why} ({detail}). Prüfen Sie, ob Bild und Referenz dieselben Objekte vollständig zeigen (Klassenfeld/-wert), versuchen Sie andere Schwellen oder eine größere relative Differenz.</translation>
+        </message>
+        <message>
+            <source>The output folder '{path}' holds files PhotoDEM did not write; choose an empty or new folder.</source>
+            <extracomment>algorithms/georef/pipeline.py:819</extracomment>
+            <translation>Der Ausgabeordner '{path}' enthält Dateien, die PhotoDEM nicht geschrieben hat; wählen Sie einen leeren oder neuen Ordner.</translation>
+        </message>
+        <message>
+            <source>Unknown transform '{value}'; use affine, projective or poly2.</source>
+            <extracomment>algorithms/georef/pipeline.py:195</extracomment>
+            <translation>Unbekannte Transformation '{value}'; verwenden Sie affine, projective oder poly2.</translation>
+        </message>
+        <message>
+            <source>Unknown search '{value}'; use {options}.</source>
+            <extracomment>algorithms/georef/pipeline.py:198</extracomment>
+            <translation>Unbekannte Suche '{value}'; verwenden Sie {options}.</translation>
+        </message>
+        <message>
+            <source>Unknown objects '{value}'; use {options}.</source>
+            <extracomment>algorithms/georef/pipeline.py:204</extracomment>
+            <translation>Unbekannte Objekte '{value}'; verwenden Sie {options}.</translation>
+        </message>
+        <message>
+            <source>The time limit must be ≥ 0 s (0: none), not {value}.</source>
+            <extracomment>algorithms/georef/pipeline.py:207</extracomment>
+            <translation>Das Zeitlimit muss ≥ 0 s sein (0: keines), nicht {value}.</translation>
+        </message>
+        <message>
+            <source>Thresholds '{text}': give numbers separated by commas, e.g. 5,6,7,8.</source>
+            <extracomment>algorithms/georef/pipeline.py:101</extracomment>
+            <translation>Schwellen '{text}': Geben Sie durch Kommas getrennte Zahlen an, z. B. 5,6,7,8.</translation>
+        </message>
+        <message>
+            <source>Georeferencing failed: the {stage} stage's result is not verified: {why} (RMSE {rmse:.2f} px of {points} control points; {evidence}). No result is better than a wrong one: check that image and reference show the same area, or write the result marked unverified.</source>
+            <extracomment>algorithms/georef/pipeline.py:321</extracomment>
+            <translation>Die Georeferenzierung ist fehlgeschlagen: Das Ergebnis der Stufe {stage} ist nicht bestätigt: {why} (RMSE {rmse:.2f} px aus {points} Passpunkten; {evidence}). Kein Ergebnis ist besser als ein falsches: Prüfen Sie, ob Bild und Referenz dasselbe Gebiet zeigen, oder schreiben Sie das Ergebnis als unbestätigt markiert.</translation>
+        </message>
+        <message>
+            <source>{error} Before it, the keypoint stage found no result: {why} ({detail}).</source>
+            <extracomment>algorithms/georef/pipeline.py:387</extracomment>
+            <translation>{error} Zuvor hat die Merkmalspunktstufe kein Ergebnis gefunden: {why} ({detail}).</translation>
+        </message>
+        <message>
+            <source>Reference layer '{path}' not found.</source>
+            <extracomment>algorithms/georef/reference_layer.py:120</extracomment>
+            <translation>Referenzlayer '{path}' nicht gefunden.</translation>
+        </message>
+        <message>
+            <source>No polygons in the reference layer '{name}' ({count} features read); check the class field and value.</source>
+            <extracomment>algorithms/georef/reference_layer.py:155</extracomment>
+            <translation>Keine Polygone im Referenzlayer '{name}' ({count} Objekte gelesen); prüfen Sie Klassenfeld und -wert.</translation>
+        </message>
+        <message>
+            <source>The reference layer '{name}' has no CRS; assign one in QGIS first.</source>
+            <extracomment>algorithms/georef/reference_layer.py:159</extracomment>
+            <translation>Der Referenzlayer '{name}' hat kein KBS; weisen Sie ihm zuerst in QGIS eines zu.</translation>
+        </message>
+        <message>
+            <source>The reference raster '{name}' is in a geographic CRS; reproject it to a projected CRS first.</source>
+            <extracomment>algorithms/georef/reference_layer.py:223</extracomment>
+            <translation>Das Referenzraster '{name}' liegt in einem geographischen KBS; projizieren Sie es zuerst in ein projiziertes KBS um.</translation>
+        </message>
+        <message>
+            <source>Cannot read the reference layer '{path}': {error}</source>
+            <extracomment>algorithms/georef/reference_layer.py:124</extracomment>
+            <translation>Der Referenzlayer '{path}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>The reference layer '{name}' has no attribute '{field}'; its attributes are: {fields}.</source>
+            <extracomment>algorithms/georef/reference_layer.py:129</extracomment>
+            <translation>Der Referenzlayer '{name}' hat kein Attribut '{field}'; seine Attribute sind: {fields}.</translation>
+        </message>
+        <message>
+            <source>No polygons with {field} = {value} in the reference layer '{name}' ({count} features read); check the class field and value.</source>
+            <extracomment>algorithms/georef/reference_layer.py:151</extracomment>
+            <translation>Keine Polygone mit {field} = {value} im Referenzlayer '{name}' ({count} Objekte gelesen); prüfen Sie Klassenfeld und -wert.</translation>
+        </message>
+        <message>
+            <source>The reference raster '{name}' has no georeference; a raster reference must be georeferenced (an orthophoto).</source>
+            <extracomment>algorithms/georef/reference_layer.py:218</extracomment>
+            <translation>Das Referenzraster '{name}' hat keine Georeferenz; eine Rasterreferenz muss georeferenziert sein (ein Orthofoto).</translation>
+        </message>
+        <message>
+            <source>Unknown scan start corner '{value}'; use one of {options}.</source>
+            <extracomment>algorithms/georef/regions.py:49</extracomment>
+            <translation>Unbekannte Startecke '{value}'; verwenden Sie eine von {options}.</translation>
+        </message>
+        <message>
+            <source>Image '{path}' not found.</source>
+            <extracomment>algorithms/georef/regions.py:427</extracomment>
+            <translation>Bild '{path}' nicht gefunden.</translation>
+        </message>
+        <message>
+            <source>Cannot read image '{path}': {error}</source>
+            <extracomment>algorithms/georef/regions.py:442</extracomment>
+            <translation>Das Bild '{path}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>Band {band} does not exist: '{name}' has {count} band(s).</source>
+            <extracomment>algorithms/georef/regions.py:431</extracomment>
+            <translation>Kanal {band} existiert nicht: '{name}' hat {count} Kanal/Kanäle.</translation>
+        </message>
+        <message>
+            <source>The check-point file '{path}' does not exist.</source>
+            <extracomment>algorithms/georef/review.py:295</extracomment>
+            <translation>Die Kontrollpunktdatei '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>The check-point file '{name}' holds no check points.</source>
+            <extracomment>algorithms/georef/review.py:299</extracomment>
+            <translation>Die Kontrollpunktdatei '{name}' enthält keine Kontrollpunkte.</translation>
+        </message>
+        <message>
+            <source>The check-point file '{name}' has a header but no check points.</source>
+            <extracomment>algorithms/georef/review.py:306</extracomment>
+            <translation>Die Kontrollpunktdatei '{name}' hat eine Kopfzeile, aber keine Kontrollpunkte.</translation>
+        </message>
+        <message>
+            <source>'{name}' has no header line; the first line must name the columns, e.g. col,row,x,y or pixel,line,mapX,mapY.</source>
+            <extracomment>algorithms/georef/review.py:321</extracomment>
+            <translation>'{name}' hat keine Kopfzeile; die erste Zeile muss die Spalten benennen, z. B. col,row,x,y oder pixel,line,mapX,mapY.</translation>
+        </message>
+        <message>
+            <source>The header of '{name}' lacks {missing} (found: {found}); name the columns col,row,x,y or pixel,line,mapX,mapY.</source>
+            <extracomment>algorithms/georef/review.py:330</extracomment>
+            <translation>In der Kopfzeile von '{name}' fehlt {missing} (gefunden: {found}); benennen Sie die Spalten col,row,x,y oder pixel,line,mapX,mapY.</translation>
+        </message>
+        <message>
+            <source>'{name}': the line column mixes positive and negative values; a QGIS .points file has negative lines, a GDAL list positive ones.</source>
+            <extracomment>algorithms/georef/review.py:367</extracomment>
+            <translation>'{name}': Die Zeilenspalte mischt positive und negative Werte; eine .points-Datei von QGIS hat negative Zeilen, eine GDAL-Liste positive.</translation>
+        </message>
+        <message>
+            <source>'{name}' is in another CRS than the georeferencing result; export the check points in the result's CRS.</source>
+            <extracomment>algorithms/georef/review.py:381</extracomment>
+            <translation>'{name}' liegt in einem anderen KBS als das Ergebnis der Georeferenzierung; exportieren Sie die Kontrollpunkte im KBS des Ergebnisses.</translation>
+        </message>
+        <message>
+            <source>None of the {count} check points in '{name}' lies in the image ({width} × {height} pixels); col,row count pixel centres from 0, pixel,line are QGIS .points coordinates.</source>
+            <extracomment>algorithms/georef/review.py:394</extracomment>
+            <translation>Keiner der {count} Kontrollpunkte in '{name}' liegt im Bild ({width} × {height} Pixel); col,row zählen Pixelmitten ab 0, pixel,line sind Koordinaten einer .points-Datei von QGIS.</translation>
+        </message>
+        <message>
+            <source>'{folder}' holds no georeferencing result (report.json and a .points file); choose the output folder of 'Georeference image against polygons'.</source>
+            <extracomment>algorithms/georef/review.py:424</extracomment>
+            <translation>'{folder}' enthält kein Ergebnis einer Georeferenzierung (report.json und eine .points-Datei); wählen Sie den Ausgabeordner von 'Bild an Polygonen georeferenzieren'.</translation>
+        </message>
+        <message>
+            <source>'{name}' is missing in '{folder}'; the review resamples that copy of the image. Run the georeferencing again.</source>
+            <extracomment>algorithms/georef/review.py:474</extracomment>
+            <translation>'{name}' fehlt in '{folder}'; die Prüfung tastet diese Kopie des Bildes um. Führen Sie die Georeferenzierung erneut aus.</translation>
+        </message>
+        <message>
+            <source>A control point needs four finite numbers: column, row, X, Y.</source>
+            <extracomment>algorithms/georef/review.py:148</extracomment>
+            <translation>Ein Passpunkt braucht vier endliche Zahlen: Spalte, Zeile, X, Y.</translation>
+        </message>
+        <message>
+            <source>Unknown transform '{value}'; use {options}.</source>
+            <extracomment>algorithms/georef/review.py:169</extracomment>
+            <translation>Unbekannte Transformation '{value}'; verwenden Sie {options}.</translation>
+        </message>
+        <message>
+            <source>The {kind} transform needs at least {need} active control points; {count} are switched on.</source>
+            <extracomment>algorithms/georef/review.py:174</extracomment>
+            <translation>Die Transformation {kind} braucht mindestens {need} aktive Passpunkte; eingeschaltet sind {count}.</translation>
+        </message>
+        <message>
+            <source>Cannot read the georeferencing result in '{folder}': {error}</source>
+            <extracomment>algorithms/georef/review.py:436</extracomment>
+            <translation>Das Ergebnis der Georeferenzierung in '{folder}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>The active control points do not determine a {kind} transform ({error}); switch on points spread over the image.</source>
+            <extracomment>algorithms/georef/review.py:181</extracomment>
+            <translation>Die aktiven Passpunkte bestimmen keine Transformation {kind} ({error}); schalten Sie über das Bild verteilte Punkte ein.</translation>
+        </message>
+        <message>
+            <source>'{name}' line {number}: {column} '{token}' is not a number.</source>
+            <extracomment>algorithms/georef/review.py:352</extracomment>
+            <translation>'{name}' Zeile {number}: {column} '{token}' ist keine Zahl.</translation>
+        </message>
+        <message>
+            <source>The {what} name '{name}' is not valid UTF-8 text; GDAL cannot open it. Rename the file (or its folder) with UTF-8 characters only.</source>
+            <extracomment>algorithms/input_errors.py:94</extracomment>
+            <translation>Der Name '{name}' ({what}) ist kein gültiger UTF-8-Text; GDAL kann die Datei nicht öffnen. Benennen Sie die Datei (oder ihren Ordner) nur mit UTF-8-Zeichen um.</translation>
+        </message>
+        <message>
+            <source>Cannot use {shown}: {reason}.</source>
+            <extracomment>algorithms/input_errors.py:182</extracomment>
+            <translation>Zugriff auf {shown} nicht möglich: {reason}.</translation>
+        </message>
+        <message>
+            <source>An input file cannot be read ({detail}). Check the file it names (replace a truncated or damaged copy).</source>
+            <extracomment>algorithms/input_errors.py:188</extracomment>
+            <translation>Eine Eingabedatei kann nicht gelesen werden ({detail}). Prüfen Sie die genannte Datei (ersetzen Sie eine abgeschnittene oder beschädigte Kopie).</translation>
+        </message>
+        <message>
+            <source>file</source>
+            <extracomment>algorithms/input_errors.py:81; algorithms/processing/batch.py:140</extracomment>
+            <translation>Datei</translation>
+        </message>
+        <message>
+            <source>raster</source>
+            <extracomment>algorithms/input_errors.py:81</extracomment>
+            <translation>Raster</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <extracomment>algorithms/input_errors.py:81; algorithms/processing/batch.py:140; algorithms/project/model.py:77</extracomment>
+            <translation>Bild</translation>
+        </message>
+        <message>
+            <source>surface</source>
+            <extracomment>algorithms/input_errors.py:81</extracomment>
+            <translation>Oberfläche</translation>
+        </message>
+        <message>
+            <source>output</source>
+            <extracomment>algorithms/input_errors.py:81</extracomment>
+            <translation>Ausgabe</translation>
+        </message>
+        <message>
+            <source>vector file</source>
+            <extracomment>algorithms/input_errors.py:82</extracomment>
+            <translation>Vektordatei</translation>
+        </message>
+        <message>
+            <source>text file</source>
+            <extracomment>algorithms/input_errors.py:82</extracomment>
+            <translation>Textdatei</translation>
+        </message>
+        <message>
+            <source>GeoPackage</source>
+            <extracomment>algorithms/input_errors.py:82</extracomment>
+            <translation>GeoPackage</translation>
+        </message>
+        <message>
+            <source>project file</source>
+            <extracomment>algorithms/input_errors.py:82</extracomment>
+            <translation>Projektdatei</translation>
+        </message>
+        <message>
+            <source>seamline file</source>
+            <extracomment>algorithms/input_errors.py:83</extracomment>
+            <translation>Schnittliniendatei</translation>
+        </message>
+        <message>
+            <source>A file name that is not valid UTF-8 text could not be written into a report; rename the file with UTF-8 characters only.</source>
+            <extracomment>algorithms/input_errors.py:173</extracomment>
+            <translation>Ein Dateiname, der kein gültiger UTF-8-Text ist, konnte nicht in einen Bericht geschrieben werden; benennen Sie die Datei nur mit UTF-8-Zeichen um.</translation>
+        </message>
+        <message>
+            <source>'{path}'</source>
+            <extracomment>algorithms/input_errors.py:179</extracomment>
+            <translation>'{path}'</translation>
+        </message>
+        <message>
+            <source>the {what}</source>
+            <extracomment>algorithms/input_errors.py:180</extracomment>
+            <translation>die Eingabe ({what})</translation>
+        </message>
+        <message>
+            <source>'{path}' is not a readable {what} ({detail}).</source>
+            <extracomment>algorithms/input_errors.py:186</extracomment>
+            <translation>'{path}' kann nicht als {what} gelesen werden ({detail}).</translation>
+        </message>
+        <message>
+            <source>'{path}' is an empty raster (no band or no cells).</source>
+            <extracomment>algorithms/input_errors.py:285</extracomment>
+            <translation>'{path}' ist ein leeres Raster (kein Kanal oder keine Zellen).</translation>
+        </message>
+        <message>
             <source>Parameter '{name}': {error}</source>
-            <extracomment>algorithms/input_errors.py:312; algorithms/input_errors.py:326</extracomment>
+            <extracomment>algorithms/input_errors.py:333; algorithms/input_errors.py:347</extracomment>
             <translation>Parameter '{name}': {error}</translation>
+        </message>
+        <message>
+            <source>The disparity range {min_d}…{max_d} px holds no possible disparity of these images (widths {left_width} and {right_width} px allow {low}…{high}); change {parameter}.</source>
+            <extracomment>algorithms/matching/dense.py:335</extracomment>
+            <translation>Der Disparitätsbereich {min_d}…{max_d} px enthält keine mögliche Disparität dieser Bilder (Breiten {left_width} und {right_width} px erlauben {low}…{high}); ändern Sie {parameter}.</translation>
+        </message>
+        <message>
+            <source>The disparity range is empty (min {min_d} &gt; max {max_d}); give min_disparity ≤ max_disparity.</source>
+            <extracomment>algorithms/matching/dense.py:436</extracomment>
+            <translation>Der Disparitätsbereich ist leer (min {min_d} &gt; max {max_d}); geben Sie min_disparity ≤ max_disparity an.</translation>
+        </message>
+        <message>
+            <source>max_height ({z_max}) must be larger than min_height ({z_min}).</source>
+            <extracomment>algorithms/matching/model_setup.py:142</extracomment>
+            <translation>max_height ({z_max}) muss größer als min_height ({z_min}) sein.</translation>
+        </message>
+        <message>
+            <source>max_height ({z_max:.1f} m) reaches the cameras ({z_cam:.1f} m); give a lower max_height.</source>
+            <extracomment>algorithms/matching/model_setup.py:145</extracomment>
+            <translation>max_height ({z_max:.1f} m) reicht bis zu den Kameras ({z_cam:.1f} m); geben Sie ein niedrigeres max_height an.</translation>
+        </message>
+        <message>
+            <source>The images {left} and {right} of model '{model}' do not overlap; check the model or the orientations.</source>
+            <extracomment>algorithms/matching/model_setup.py:205</extracomment>
+            <translation>Die Bilder {left} und {right} des Modells '{model}' überlappen sich nicht; prüfen Sie das Modell oder die Orientierungen.</translation>
+        </message>
+        <message>
+            <source>The spacing must be positive, got {spacing}.</source>
+            <extracomment>algorithms/matching/model_setup.py:213</extracomment>
+            <translation>Die Gitterweite muss positiv sein, angegeben: {spacing}.</translation>
+        </message>
+        <message>
+            <source>Model '{model}': the height range {z_min:.1f}…{z_max:.1f} m gives no disparity; check min_height/max_height.</source>
+            <extracomment>algorithms/matching/model_setup.py:217</extracomment>
+            <translation>Modell '{model}': Der Höhenbereich {z_min:.1f}…{z_max:.1f} m ergibt keine Disparität; prüfen Sie min_height/max_height.</translation>
+        </message>
+        <message>
+            <source>The boundaries of edits.gpkg do not touch model '{model}'.</source>
+            <extracomment>algorithms/matching/model_setup.py:233</extracomment>
+            <translation>Die Begrenzungen in edits.gpkg berühren das Modell '{model}' nicht.</translation>
         </message>
         <message>
             <source>{label} exists and is {what}; only an earlier '{algorithm}' result is replaced. Choose another file name.</source>
@@ -5386,6 +5801,206 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>{label} liegt unterhalb von '{parent}', das eine Datei ist; wählen Sie einen Pfad in einem Ordner.</translation>
         </message>
         <message>
+            <source>model</source>
+            <extracomment>algorithms/processing/batch.py:140</extracomment>
+            <translation>Modell</translation>
+        </message>
+        <message>
+            <source>models</source>
+            <extracomment>algorithms/processing/batch.py:141</extracomment>
+            <translation>Modelle</translation>
+        </message>
+        <message>
+            <source>images</source>
+            <extracomment>algorithms/processing/batch.py:141</extracomment>
+            <translation>Bilder</translation>
+        </message>
+        <message>
+            <source>files</source>
+            <extracomment>algorithms/processing/batch.py:141</extracomment>
+            <translation>Dateien</translation>
+        </message>
+        <message>
+            <source>step {number}</source>
+            <extracomment>algorithms/processing/batch.py:340</extracomment>
+            <translation>Schritt {number}</translation>
+        </message>
+        <message>
+            <source>Batch file '{path}' does not exist.</source>
+            <extracomment>algorithms/processing/batch.py:227</extracomment>
+            <translation>Die Batch-Datei '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>Batch file: unknown table(s) {tables}; expected [batch] and [[steps]].</source>
+            <extracomment>algorithms/processing/batch.py:249</extracomment>
+            <translation>Batch-Datei: unbekannte Tabelle(n) {tables}; erwartet werden [batch] und [[steps]].</translation>
+        </message>
+        <message>
+            <source>Batch file: batch must be a table: write [batch] on a line of its own with project = …, workers = …, output = … below it.</source>
+            <extracomment>algorithms/processing/batch.py:253</extracomment>
+            <translation>Batch-Datei: batch muss eine Tabelle sein: Schreiben Sie [batch] in eine eigene Zeile und darunter project = …, workers = …, output = ….</translation>
+        </message>
+        <message>
+            <source>Batch file: workers = {value} in [batch] must be a whole number ≥ 1.</source>
+            <extracomment>algorithms/processing/batch.py:268</extracomment>
+            <translation>Batch-Datei: workers = {value} in [batch] muss eine ganze Zahl ≥ 1 sein.</translation>
+        </message>
+        <message>
+            <source>the run folder</source>
+            <extracomment>algorithms/processing/batch.py:281</extracomment>
+            <translation>der Laufordner</translation>
+        </message>
+        <message>
+            <source>Batch file: write each step as [[steps]] (two brackets), not [steps].</source>
+            <extracomment>algorithms/processing/batch.py:286</extracomment>
+            <translation>Batch-Datei: Schreiben Sie jeden Schritt als [[steps]] (zwei Klammern), nicht als [steps].</translation>
+        </message>
+        <message>
+            <source>Batch file: no [[steps]]; add at least one step with algorithm = "id".</source>
+            <extracomment>algorithms/processing/batch.py:289</extracomment>
+            <translation>Batch-Datei: kein [[steps]]; fügen Sie mindestens einen Schritt mit algorithm = "id" hinzu.</translation>
+        </message>
+        <message>
+            <source>Batch file: {key} = {value} in {where} must be a string in quotes, e.g. {key} = "…".</source>
+            <extracomment>algorithms/processing/batch.py:317</extracomment>
+            <translation>Batch-Datei: {key} = {value} in {where} muss eine Zeichenkette in Anführungszeichen sein, z. B. {key} = "…".</translation>
+        </message>
+        <message>
+            <source>Batch file: unknown key(s) {keys} in {where}; allowed are {allowed}.</source>
+            <extracomment>algorithms/processing/batch.py:325</extracomment>
+            <translation>Batch-Datei: unbekannte(r) Schlüssel {keys} in {where}; erlaubt sind {allowed}.</translation>
+        </message>
+        <message>
+            <source>Batch file: step {number} needs algorithm = "id".</source>
+            <extracomment>algorithms/processing/batch.py:343</extracomment>
+            <translation>Batch-Datei: Schritt {number} braucht algorithm = "id".</translation>
+        </message>
+        <message>
+            <source>Batch file: step name {name} may hold only letters, digits, '_', '-' and '.' (it names the log files).</source>
+            <extracomment>algorithms/processing/batch.py:349</extracomment>
+            <translation>Batch-Datei: Der Schrittname {name} darf nur Buchstaben, Ziffern, '_', '-' und '.' enthalten (er benennt die Protokolldateien).</translation>
+        </message>
+        <message>
+            <source>Batch file: two steps are named {name}; give them distinct names.</source>
+            <extracomment>algorithms/processing/batch.py:352</extracomment>
+            <translation>Batch-Datei: Zwei Schritte heißen {name}; geben Sie ihnen verschiedene Namen.</translation>
+        </message>
+        <message>
+            <source>Batch file: params of step '{step}' must be a table.</source>
+            <extracomment>algorithms/processing/batch.py:357</extracomment>
+            <translation>Batch-Datei: params des Schritts '{step}' muss eine Tabelle sein.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' ({algorithm}): unknown parameter(s) {unknown}; known are {known}.</source>
+            <extracomment>algorithms/processing/batch.py:448</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' ({algorithm}): unbekannte(r) Parameter {unknown}; bekannt sind {known}.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' needs files = ["&lt;pattern or path&gt;", …] (the values of its parameter '{parameter}').</source>
+            <extracomment>algorithms/processing/batch.py:559</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' braucht files = ["&lt;Muster oder Pfad&gt;", …] (die Werte seines Parameters '{parameter}').</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': files must be a pattern or a list of patterns/paths.</source>
+            <extracomment>algorithms/processing/batch.py:564</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': files muss ein Muster oder eine Liste von Mustern/Pfaden sein.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' uses {{{key}}}, but it does not run per {key}.</source>
+            <extracomment>algorithms/processing/batch.py:614</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' verwendet {{{key}}}, läuft aber nicht je {key}.</translation>
+        </message>
+        <message>
+            <source>Cannot read batch file '{path}': {error}</source>
+            <extracomment>algorithms/processing/batch.py:231</extracomment>
+            <translation>Die Batch-Datei '{path}' kann nicht gelesen werden: {error}</translation>
+        </message>
+        <message>
+            <source>Batch file: step {number} is not a table.</source>
+            <extracomment>algorithms/processing/batch.py:296</extracomment>
+            <translation>Batch-Datei: Schritt {number} ist keine Tabelle.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' sets {key}, but {algorithm} iterates over {items}.</source>
+            <extracomment>algorithms/processing/batch.py:380</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' setzt {key}, aber {algorithm} läuft über {items}.</translation>
+        </message>
+        <message>
+            <source>step '{step}' ({algorithm})</source>
+            <extracomment>algorithms/processing/batch.py:424</extracomment>
+            <translation>Schritt '{step}' ({algorithm})</translation>
+        </message>
+        <message>
+            <source>step '{step}' ({algorithm}), {kind} '{label}'</source>
+            <extracomment>algorithms/processing/batch.py:426</extracomment>
+            <translation>Schritt '{step}' ({algorithm}), {kind} '{label}'</translation>
+        </message>
+        <message>
+            <source>Batch file: {named} (where the batch writes its logs): {error}</source>
+            <extracomment>algorithms/processing/batch.py:490</extracomment>
+            <translation>Batch-Datei: {named} (dort schreibt der Batch seine Protokolle): {error}</translation>
+        </message>
+        <message>
+            <source>Batch file: {where}: {error}</source>
+            <extracomment>algorithms/processing/batch.py:518</extracomment>
+            <translation>Batch-Datei: {where}: {error}</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': '{first}' and '{second}' have the same name; {{file}} must name one file (rename one).</source>
+            <extracomment>algorithms/processing/batch.py:587</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': '{first}' und '{second}' haben denselben Namen; {{file}} muss eine einzige Datei bezeichnen (benennen Sie eine um).</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' uses {{project}}, but the batch has no project (set project = "…" in [batch]).</source>
+            <extracomment>algorithms/processing/batch.py:612</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' verwendet {{project}}, aber der Batch hat kein Projekt (setzen Sie project = "…" in [batch]).</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' ({algorithm}) needs a project; set project = "&lt;project folder&gt;" in [batch].</source>
+            <extracomment>algorithms/processing/batch.py:362</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' ({algorithm}) braucht ein Projekt; setzen Sie project = "&lt;Projektordner&gt;" in [batch].</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' sets {key}, but {algorithm} does not iterate.</source>
+            <extracomment>algorithms/processing/batch.py:378</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' setzt {key}, aber {algorithm} läuft über nichts.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' runs over the project's {items}; set project = "&lt;project folder&gt;" in [batch].</source>
+            <extracomment>algorithms/processing/batch.py:388</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' läuft über die {items} des Projekts; setzen Sie project = "&lt;Projektordner&gt;" in [batch].</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': the project has no {items}.</source>
+            <extracomment>algorithms/processing/batch.py:409</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': Das Projekt hat keine {items}.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}' ({algorithm}): {error}</source>
+            <extracomment>algorithms/processing/batch.py:456</extracomment>
+            <translation>Batch-Datei: Schritt '{step}' ({algorithm}): {error}</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': no file matches '{pattern}'.</source>
+            <extracomment>algorithms/processing/batch.py:575</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': Keine Datei passt zu '{pattern}'.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': file '{pattern}' does not exist.</source>
+            <extracomment>algorithms/processing/batch.py:581</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': Die Datei '{pattern}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': {items} must be "all" or a list of names.</source>
+            <extracomment>algorithms/processing/batch.py:406</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': {items} muss "all" oder eine Liste von Namen sein.</translation>
+        </message>
+        <message>
+            <source>Batch file: step '{step}': {kind}(s) {missing} not in the project; it has {available}.</source>
+            <extracomment>algorithms/processing/batch.py:399</extracomment>
+            <translation>Batch-Datei: Schritt '{step}': {missing} ({kind}) nicht im Projekt; vorhanden: {available}.</translation>
+        </message>
+        <message>
             <source>No algorithm '{algorithm}'. Known algorithms: {known}.</source>
             <extracomment>algorithms/processing/registry.py:94</extracomment>
             <translation>Es gibt keinen Algorithmus '{algorithm}'. Bekannte Algorithmen: {known}.</translation>
@@ -5456,14 +6071,189 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Parameter '{name}': '{path}' existiert nicht.</translation>
         </message>
         <message>
+            <source>Breakline {number} crosses itself; fix it in edits.gpkg (layer breaklines).</source>
+            <extracomment>algorithms/project/breaklines.py:78</extracomment>
+            <translation>Die Bruchkante {number} kreuzt sich selbst; korrigieren Sie sie in edits.gpkg (Layer breaklines).</translation>
+        </message>
+        <message>
+            <source>Breaklines {first} and {second} cross at ({x:.2f}, {y:.2f}); breaklines must not cross or touch — fix them in edits.gpkg.</source>
+            <extracomment>algorithms/project/breaklines.py:87</extracomment>
+            <translation>Die Bruchkanten {first} und {second} kreuzen sich bei ({x:.2f}, {y:.2f}); Bruchkanten dürfen sich weder kreuzen noch berühren — korrigieren Sie sie in edits.gpkg.</translation>
+        </message>
+        <message>
+            <source>Surface '{path}' not found; choose a DSM or DTM of the project.</source>
+            <extracomment>algorithms/project/edit_tools.py:106</extracomment>
+            <translation>Oberfläche '{path}' nicht gefunden; wählen Sie ein DOM oder DGM des Projekts.</translation>
+        </message>
+        <message>
+            <source>A line needs at least two vertices.</source>
+            <extracomment>algorithms/project/edit_tools.py:269</extracomment>
+            <translation>Eine Linie braucht mindestens zwei Stützpunkte.</translation>
+        </message>
+        <message>
+            <source>Height mode '{mode}' is not one of drape, interpolate.</source>
+            <extracomment>algorithms/project/edit_tools.py:274</extracomment>
+            <translation>Der Höhenmodus '{mode}' ist weder drape noch interpolate.</translation>
+        </message>
+        <message>
+            <source>Choose a surface (DSM or DTM) to drape the line on, or type the end heights to interpolate between them.</source>
+            <extracomment>algorithms/project/edit_tools.py:276</extracomment>
+            <translation>Wählen Sie eine Oberfläche (DOM oder DGM), auf die die Linie gelegt wird, oder geben Sie die Endhöhen ein, um zwischen ihnen zu interpolieren.</translation>
+        </message>
+        <message>
+            <source>Type the heights of the first and the last vertex to interpolate between them.</source>
+            <extracomment>algorithms/project/edit_tools.py:292</extracomment>
+            <translation>Geben Sie die Höhen des ersten und des letzten Stützpunkts ein, um zwischen ihnen zu interpolieren.</translation>
+        </message>
+        <message>
+            <source>The end heights ({z0}, {z1}) must be numbers (m).</source>
+            <extracomment>algorithms/project/edit_tools.py:296</extracomment>
+            <translation>Die Endhöhen ({z0}, {z1}) müssen Zahlen sein (m).</translation>
+        </message>
+        <message>
+            <source>The line has no length; its first and last vertex are the same point.</source>
+            <extracomment>algorithms/project/edit_tools.py:299</extracomment>
+            <translation>Die Linie hat keine Länge; ihr erster und letzter Stützpunkt sind derselbe Punkt.</translation>
+        </message>
+        <message>
+            <source>The layer '{layer}' has no heights to re-drape; use one of {layers}.</source>
+            <extracomment>algorithms/project/edit_tools.py:357</extracomment>
+            <translation>Der Layer '{layer}' hat keine Höhen, die neu abgegriffen werden können; verwenden Sie einen von {layers}.</translation>
+        </message>
+        <message>
+            <source>The snapping tolerance must be positive, got {tolerance}.</source>
+            <extracomment>algorithms/project/edit_tools.py:408</extracomment>
+            <translation>Die Fangtoleranz muss positiv sein, angegeben: {tolerance}.</translation>
+        </message>
+        <message>
+            <source>Surface '{name}' has no CRS, so a point in {crs} cannot be placed on it; assign the surface its CRS first.</source>
+            <extracomment>algorithms/project/edit_tools.py:122</extracomment>
+            <translation>Die Oberfläche '{name}' hat kein KBS, daher kann ein Punkt in {crs} nicht auf ihr platziert werden; weisen Sie der Oberfläche zuerst ihr KBS zu.</translation>
+        </message>
+        <message>
+            <source>The point CRS '{crs}' is not understood: {error}</source>
+            <extracomment>algorithms/project/edit_tools.py:131</extracomment>
+            <translation>Das KBS der Punkte '{crs}' wird nicht verstanden: {error}</translation>
+        </message>
+        <message>
+            <source>'{file}' layer {layer}, feature {fid}</source>
+            <extracomment>algorithms/project/edits.py:74</extracomment>
+            <translation>'{file}' Layer {layer}, Objekt {fid}</translation>
+        </message>
+        <message>
+            <source>{where}: action '{value}' is not one of {actions} (empty = remove); fix it in edits.gpkg.</source>
+            <extracomment>algorithms/project/edits.py:90</extracomment>
+            <translation>{where}: Die Aktion '{value}' ist keine von {actions} (leer = remove); korrigieren Sie sie in edits.gpkg.</translation>
+        </message>
+        <message>
+            <source>{where}: the polygon is invalid ({reason}) and nothing is left after repairing it; redraw it in edits.gpkg.</source>
+            <extracomment>algorithms/project/edits.py:144</extracomment>
+            <translation>{where}: Das Polygon ist ungültig ({reason}), und nach der Reparatur bleibt nichts übrig; zeichnen Sie es in edits.gpkg neu.</translation>
+        </message>
+        <message>
+            <source>'{path}' exists already; PhotoDEM does not overwrite the operator's edits. Delete or rename it first if you really want an empty one.</source>
+            <extracomment>algorithms/project/edits.py:213</extracomment>
+            <translation>'{path}' existiert bereits; PhotoDEM überschreibt keine Bearbeitungen des Operateurs. Löschen oder benennen Sie die Datei zuerst um, wenn Sie wirklich eine leere möchten.</translation>
+        </message>
+        <message>
+            <source>'{layer}' is not an edit layer; use one of {layers}.</source>
+            <extracomment>algorithms/project/edits.py:303; algorithms/project/edits_save.py:361</extracomment>
+            <translation>'{layer}' ist kein Bearbeitungslayer; verwenden Sie einen von {layers}.</translation>
+        </message>
+        <message>
+            <source>Layer '{layer}' has no field(s) {fields}.</source>
+            <extracomment>algorithms/project/edits.py:323</extracomment>
+            <translation>Der Layer '{layer}' hat kein(e) Feld(er) {fields}.</translation>
+        </message>
+        <message>
+            <source>Edits file '{path}' not found; create it with project_create.</source>
+            <extracomment>algorithms/project/edits.py:360</extracomment>
+            <translation>Bearbeitungsdatei '{path}' nicht gefunden; legen Sie sie mit project_create an.</translation>
+        </message>
+        <message>
+            <source>Vector file '{path}' does not exist.</source>
+            <extracomment>algorithms/project/edits.py:385</extracomment>
+            <translation>Die Vektordatei '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>Cannot use the CRS '{crs}' for edits.gpkg: {error}</source>
+            <extracomment>algorithms/project/edits.py:189</extracomment>
+            <translation>Das KBS '{crs}' kann für edits.gpkg nicht verwendet werden: {error}</translation>
+        </message>
+        <message>
+            <source>Layer '{layer}'</source>
+            <extracomment>algorithms/project/edits.py:326</extracomment>
+            <translation>Layer '{layer}'</translation>
+        </message>
+        <message>
+            <source>'{path}' has no layer '{layer}'.</source>
+            <extracomment>algorithms/project/edits.py:365</extracomment>
+            <translation>'{path}' hat keinen Layer '{layer}'.</translation>
+        </message>
+        <message>
+            <source>A geometry of edits.gpkg is not a GeoPackage geometry blob.</source>
+            <extracomment>algorithms/project/edits_save.py:80</extracomment>
+            <translation>Eine Geometrie in edits.gpkg ist kein GeoPackage-Geometrie-Blob.</translation>
+        </message>
+        <message>
+            <source>The edits file '{path}' does not exist.</source>
+            <extracomment>algorithms/project/edits_save.py:199</extracomment>
+            <translation>Die Bearbeitungsdatei '{path}' existiert nicht.</translation>
+        </message>
+        <message>
+            <source>Two features of one edit layer have the same fid.</source>
+            <extracomment>algorithms/project/edits_save.py:241</extracomment>
+            <translation>Zwei Objekte eines Bearbeitungslayers haben dieselbe fid.</translation>
+        </message>
+        <message>
+            <source>Layer '{layer}' of edits.gpkg has no field(s) {fields}.</source>
+            <extracomment>algorithms/project/edits_save.py:257</extracomment>
+            <translation>Der Layer '{layer}' von edits.gpkg hat kein(e) Feld(er) {fields}.</translation>
+        </message>
+        <message>
+            <source>Cannot open the edits file '{path}': {error}</source>
+            <extracomment>algorithms/project/edits_save.py:203</extracomment>
+            <translation>Die Bearbeitungsdatei '{path}' kann nicht geöffnet werden: {error}</translation>
+        </message>
+        <message>
+            <source>The edits file '{path}' is not a readable GeoPackage ({error}); it is damaged or not a GeoPackage.</source>
+            <extracomment>algorithms/project/edits_save.py:214</extracomment>
+            <translation>Die Bearbeitungsdatei '{path}' ist kein lesbares GeoPackage ({error}); sie ist beschädigt oder kein GeoPackage.</translation>
+        </message>
+        <message>
+            <source>The edits file '{path}' holds a geometry that cannot be read ({error}).</source>
+            <extracomment>algorithms/project/edits_save.py:217</extracomment>
+            <translation>Die Bearbeitungsdatei '{path}' enthält eine Geometrie, die nicht gelesen werden kann ({error}).</translation>
+        </message>
+        <message>
+            <source>The new edits.gpkg holds {count} features in '{layer}' instead of {expected}; the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:325</extracomment>
+            <translation>Die neue edits.gpkg enthält {count} Objekte in '{layer}' statt {expected}; die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>Cannot write '{path}': {error}; the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:380</extracomment>
+            <translation>'{path}' kann nicht geschrieben werden: {error}; die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>The new edits.gpkg cannot be read back ({error}); the old file is kept.</source>
+            <extracomment>algorithms/project/edits_save.py:322</extracomment>
+            <translation>Die neue edits.gpkg kann nicht zurückgelesen werden ({error}); die alte Datei bleibt erhalten.</translation>
+        </message>
+        <message>
+            <source>'{path}' does not exist and no CRS was given to create it.</source>
+            <extracomment>algorithms/project/edits_save.py:369</extracomment>
+            <translation>'{path}' existiert nicht, und zum Anlegen wurde kein KBS angegeben.</translation>
+        </message>
+        <message>
+            <source>edits.gpkg has no layer '{layer}' to write.</source>
+            <extracomment>algorithms/project/edits_save.py:308</extracomment>
+            <translation>edits.gpkg hat keinen Layer '{layer}' zum Schreiben.</translation>
+        </message>
+        <message>
             <source>camera</source>
             <extracomment>algorithms/project/model.py:77</extracomment>
             <translation>Kamera</translation>
-        </message>
-        <message>
-            <source>image</source>
-            <extracomment>algorithms/project/model.py:77</extracomment>
-            <translation>Bild</translation>
         </message>
         <message>
             <source>stereo model</source>
@@ -5477,7 +6267,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>{where}: 'format_version' is {version} but this PhotoDEM reads format_version {supported} only: {why}.</source>
-            <extracomment>algorithms/project/model.py:505</extracomment>
+            <extracomment>algorithms/project/model.py:507</extracomment>
             <translation>{where}: 'format_version' ist {version}, diese PhotoDEM-Version liest aber nur format_version {supported}: {why}.</translation>
         </message>
         <message>
@@ -5516,99 +6306,119 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>er ist kein gültiger UTF-8-Text</translation>
         </message>
         <message>
+            <source>Image '{name}' is not in project '{project}'. Images: {images}.</source>
+            <extracomment>algorithms/project/model.py:269</extracomment>
+            <translation>Das Bild '{name}' ist nicht im Projekt '{project}'. Bilder: {images}.</translation>
+        </message>
+        <message>
+            <source>Stereo model '{name}' is not in project '{project}'. Models: {models}.</source>
+            <extracomment>algorithms/project/model.py:281</extracomment>
+            <translation>Das Stereomodell '{name}' ist nicht im Projekt '{project}'. Modelle: {models}.</translation>
+        </message>
+        <message>
             <source>it was written by a newer PhotoDEM; update PhotoDEM to open it</source>
-            <extracomment>algorithms/project/model.py:503</extracomment>
+            <extracomment>algorithms/project/model.py:505</extracomment>
             <translation>die Datei stammt von einer neueren PhotoDEM-Version; aktualisieren Sie PhotoDEM, um sie zu öffnen</translation>
         </message>
         <message>
             <source>no PhotoDEM wrote it; fix the value</source>
-            <extracomment>algorithms/project/model.py:504</extracomment>
+            <extracomment>algorithms/project/model.py:506</extracomment>
             <translation>keine PhotoDEM-Version hat sie geschrieben; korrigieren Sie den Wert</translation>
         </message>
         <message>
             <source>{where}: '{key}' {problem}; fix it in the project file.</source>
-            <extracomment>algorithms/project/model.py:553</extracomment>
+            <extracomment>algorithms/project/model.py:555</extracomment>
             <translation>{where}: '{key}' {problem}; korrigieren Sie dies in der Projektdatei.</translation>
         </message>
         <message>
+            <source>Stereo model '{name}' is not in project '{project}'. Models: none.</source>
+            <extracomment>algorithms/project/model.py:279</extracomment>
+            <translation>Das Stereomodell '{name}' ist nicht im Projekt '{project}'. Das Projekt hat keine Stereomodelle.</translation>
+        </message>
+        <message>
             <source>'{path}' is not a PhotoDEM project: {file} not found. Create one with project_create or synthetic_block.</source>
-            <extracomment>algorithms/project/model.py:405</extracomment>
+            <extracomment>algorithms/project/model.py:407</extracomment>
             <translation>'{path}' ist kein PhotoDEM-Projekt: {file} wurde nicht gefunden. Legen Sie eines mit project_create oder synthetic_block an.</translation>
         </message>
         <message>
             <source>{where} has no [project] table (it is not a PhotoDEM project file); restore it from a copy or create the project again with project_create.</source>
-            <extracomment>algorithms/project/model.py:427</extracomment>
+            <extracomment>algorithms/project/model.py:429</extracomment>
             <translation>{where} hat keine Tabelle [project] (es ist keine PhotoDEM-Projektdatei); stellen Sie die Datei aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
         </message>
         <message>
             <source>{where} is not UTF-8 text (byte 0x{byte:02x} at position {position}); save it as UTF-8.</source>
-            <extracomment>algorithms/project/model.py:412</extracomment>
+            <extracomment>algorithms/project/model.py:414</extracomment>
             <translation>{where} ist kein UTF-8-Text (Byte 0x{byte:02x} an Position {position}); speichern Sie die Datei als UTF-8.</translation>
         </message>
         <message>
             <source>{where} is not valid TOML ({error}); fix the line it names.</source>
-            <extracomment>algorithms/project/model.py:416</extracomment>
+            <extracomment>algorithms/project/model.py:418</extracomment>
             <translation>{where} ist kein gültiges TOML ({error}); korrigieren Sie die genannte Zeile.</translation>
         </message>
         <message>
             <source>Cannot read {where}: {error}.</source>
-            <extracomment>algorithms/project/model.py:419</extracomment>
+            <extracomment>algorithms/project/model.py:421</extracomment>
             <translation>{where} kann nicht gelesen werden: {error}.</translation>
         </message>
         <message>
             <source>{where} has no [project] table (it is empty); restore it from a copy or create the project again with project_create.</source>
-            <extracomment>algorithms/project/model.py:424</extracomment>
+            <extracomment>algorithms/project/model.py:426</extracomment>
             <translation>{where} hat keine Tabelle [project] (die Datei ist leer); stellen Sie sie aus einer Kopie wieder her oder legen Sie das Projekt mit project_create neu an.</translation>
         </message>
         <message>
             <source>{where}: {error}</source>
-            <extracomment>algorithms/project/model.py:435; algorithms/project/model.py:649</extracomment>
+            <extracomment>algorithms/project/model.py:437; algorithms/project/model.py:651</extracomment>
             <translation>{where}: {error}</translation>
         </message>
         <message>
             <source>is missing</source>
-            <extracomment>algorithms/project/model.py:560</extracomment>
+            <extracomment>algorithms/project/model.py:562</extracomment>
             <translation>fehlt</translation>
         </message>
         <message>
             <source>must be text in quotes, not {value}</source>
-            <extracomment>algorithms/project/model.py:568</extracomment>
+            <extracomment>algorithms/project/model.py:570</extracomment>
             <translation>muss Text in Anführungszeichen sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a number, not {value}</source>
-            <extracomment>algorithms/project/model.py:578</extracomment>
+            <extracomment>algorithms/project/model.py:580</extracomment>
             <translation>muss eine Zahl sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a whole number, not {value}</source>
-            <extracomment>algorithms/project/model.py:585</extracomment>
+            <extracomment>algorithms/project/model.py:587</extracomment>
             <translation>muss eine ganze Zahl sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a list of {length} numbers, not {value}</source>
-            <extracomment>algorithms/project/model.py:596</extracomment>
+            <extracomment>algorithms/project/model.py:598</extracomment>
             <translation>muss eine Liste von {length} Zahlen sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a table ([{key}]), not {value}</source>
-            <extracomment>algorithms/project/model.py:604</extracomment>
+            <extracomment>algorithms/project/model.py:606</extracomment>
             <translation>muss eine Tabelle ([{key}]) sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be an array of tables ([[{key}]]), not {value}</source>
-            <extracomment>algorithms/project/model.py:613</extracomment>
+            <extracomment>algorithms/project/model.py:615</extracomment>
             <translation>muss eine Liste von Tabellen ([[{key}]]) sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be a table, not {value}</source>
-            <extracomment>algorithms/project/model.py:622</extracomment>
+            <extracomment>algorithms/project/model.py:624</extracomment>
             <translation>muss eine Tabelle sein, nicht {value}</translation>
         </message>
         <message>
             <source>must be 2 rows of 3 numbers, not {value}</source>
-            <extracomment>algorithms/project/model.py:644</extracomment>
+            <extracomment>algorithms/project/model.py:646</extracomment>
             <translation>muss aus 2 Zeilen mit je 3 Zahlen bestehen, nicht {value}</translation>
+        </message>
+        <message>
+            <source>Cannot read the {what} '{name}': {error}</source>
+            <extracomment>algorithms/project/vector_io.py:61</extracomment>
+            <translation>'{name}' kann nicht als {what} gelesen werden: {error}</translation>
         </message>
         <message>
             <source>The output '{path}' is a file, not a folder; choose a folder.</source>

@@ -718,9 +718,9 @@ def _observations(z: Array, prm: LPParameters, constraints: Any,
         # candidate band) down by metres: cut them before the reduction
         obs0[low_outliers(obs0, prm.low_outlier)] = np.nan
     if np.count_nonzero(np.isfinite(obs0)) + len(gpts) < 10:
-        raise InputError("Fewer than 10 DSM cells are left for the linear prediction (all "
-                         "no data or inside 'remove' exclusion areas); check the input and the "
-                         "exclusion areas.")
+        raise InputError.of("Fewer than 10 DSM cells are left for the linear prediction (all "
+                            "no data or inside 'remove' exclusion areas); check the input and "
+                            "the exclusion areas.")
     return _Observations(z0, keep, remove, gpts, lines, obs0, _noise_scale(sigma))
 
 

@@ -564,7 +564,7 @@ def _filter_tiled(z: Array, spacing: float, params: LowpassParameters,
     overlap = math.ceil(TILE_OVERLAP_WINDOWS * max(params.windows_m) / spacing)
     zall = np.asarray(z)
     if not np.isfinite(zall).any():
-        raise InputError("The DSM holds no height (every cell is nodata).")
+        raise InputError.of("The DSM holds no height (every cell is nodata).")
     # the blunder range of the whole DSM, not of each tile (same test everywhere)
     tile_params = replace(params, height_range=_height_range(zall[np.isfinite(zall)]))
     tiled = filter_in_tiles(_TileRun(spacing, tile_params), z, grid, constraints, overlap,
@@ -643,7 +643,7 @@ def _prepare(z: Array, params: LowpassParameters, cons: FilterConstraints,
                else np.zeros(shape, bool))
     valid = np.isfinite(dsm)
     if int(valid.sum()) == 0:
-        raise InputError("The DSM holds no height (every cell is nodata).")
+        raise InputError.of("The DSM holds no height (every cell is nodata).")
     # manual ground points: their cells take the point height and are protected
     gp = np.asarray(cons.ground_points, float).reshape(-1, 3)
     gp_cells = np.zeros(shape, bool)

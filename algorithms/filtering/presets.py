@@ -197,7 +197,8 @@ def preset(table: Dict[str, Dict[str, Any]], name: str) -> Dict[str, Any]:
     """
     key = (name or "default").strip().lower()
     if key not in table:
-        raise InputError(f"Unknown preset '{name}'; use one of {', '.join(table)}.")
+        raise InputError.of("Unknown preset '{name}'; use one of {options}.", name=name,
+                            options=", ".join(table))
     return dict(table[key])
 
 

@@ -159,8 +159,8 @@ def to_crs(crs: Any) -> Any:
     try:
         return CRS.from_user_input(crs)
     except Exception as exc:  # rasterio.errors.CRSError and friends
-        raise InputError(f"Unknown CRS '{crs}': give an EPSG code (e.g. EPSG:25832), WKT or "
-                         f"a PROJ string ({exc}).") from exc
+        raise InputError.of("Unknown CRS '{crs}': give an EPSG code (e.g. EPSG:25832), WKT or "
+                            "a PROJ string ({error}).", crs=crs, error=exc) from exc
 
 
 # -- reading ------------------------------------------------------------------------------------
@@ -177,11 +177,12 @@ def _read_raster(path: Path, crs: Any) -> FilterInput:
         with rasterio.open(path) as src:
             t = src.transform
             if t.b != 0 or t.d != 0 or t.e >= 0:
-                raise InputError(f"The DSM '{path.name}' is rotated or not north-up; warp it to "
-                                 "a north-up grid first (e.g. gdalwarp).")
+                raise InputError.of("The DSM '{name}' is rotated or not north-up; warp it to "
+                                    "a north-up grid first (e.g. gdalwarp).", name=path.name)
             if not math.isclose(abs(t.a), abs(t.e), rel_tol=1e-6):
-                raise InputError(f"The DSM '{path.name}' has non-square cells ({abs(t.a):g} × "
-                                 f"{abs(t.e):g}); resample it to square cells first.")
+                raise InputError.of("The DSM '{name}' has non-square cells ({width:g} × "
+                                    "{height:g}); resample it to square cells first.",
+                                    name=path.name, width=abs(t.a), height=abs(t.e))
             data = src.read(1, masked=True)
             z = np.ma.filled(data.astype(np.float32), np.nan)
             src_crs = src.crs
@@ -189,16 +190,18 @@ def _read_raster(path: Path, crs: Any) -> FilterInput:
     except InputError:
         raise
     except Exception as exc:  # rasterio.errors.RasterioIOError and driver errors
-        raise InputError(f"Cannot read '{path.name}' as a DSM raster or a points file: "
-                         f"{str(exc).splitlines()[0] if str(exc) else exc}") from exc
+        raise InputError.of("Cannot read '{name}' as a DSM raster or a points file: {error}",
+                            name=path.name,
+                            error=str(exc).splitlines()[0] if str(exc) else exc) from exc
     z[~np.isfinite(z)] = np.nan
     n_valid = int(np.count_nonzero(np.isfinite(z)))
     if n_valid == 0:
-        raise InputError(f"The DSM '{path.name}' holds no height (every cell is nodata); check "
-                         "the input.")
+        raise InputError.of("The DSM '{name}' holds no height (every cell is nodata); check "
+                            "the input.", name=path.name)
     if n_valid < MIN_POINTS:
-        raise InputError(f"The DSM '{path.name}' has only {n_valid} cells with a height; a filter "
-                         f"needs at least {MIN_POINTS}.")
+        raise InputError.of("The DSM '{name}' has only {count} cells with a height; a filter "
+                            "needs at least {minimum}.", name=path.name, count=n_valid,
+                            minimum=MIN_POINTS)
     given = to_crs(crs)
     return FilterInput(z, grid, given if src_crs is None else src_crs, source="raster",
                        path=str(path))
@@ -212,7 +215,8 @@ def _read_las(path: Path) -> Tuple[Array, Any]:
     try:
         las = laspy.read(str(path))
     except Exception as exc:  # laspy raises its own errors
-        raise InputError(f"Cannot read the LAS/LAZ file '{path.name}': {exc}") from exc
+        raise InputError.of("Cannot read the LAS/LAZ file '{name}': {error}", name=path.name,
+                            error=exc) from exc
     xyz = np.column_stack([np.asarray(las.x, float), np.asarray(las.y, float),
                            np.asarray(las.z, float)])
     crs = None
@@ -286,7 +290,8 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
         except InputError:
             raise
         except Exception as exc:  # a binary or garbled file
-            raise InputError(f"Cannot read '{path.name}' as points: {exc}") from exc
+            raise InputError.of("Cannot read '{name}' as points: {error}", name=path.name,
+                                error=exc) from exc
         xyz = np.column_stack([pts.x, pts.y, pts.z])
         file_crs = pts.crs
         if path.suffix.lower() == ".gpkg":
@@ -294,8 +299,8 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     ok = np.all(np.isfinite(xyz), axis=1)
     n = int(ok.sum())
     if n < MIN_POINTS:
-        raise InputError(f"'{path.name}' has only {n} valid point(s); a filter needs at least "
-                         f"{MIN_POINTS}.")
+        raise InputError.of("'{name}' has only {count} valid point(s); a filter needs at "
+                            "least {minimum}.", name=path.name, count=n, minimum=MIN_POINTS)
     n = check_distinct_points(xyz[ok, 0], xyz[ok, 1], path.name, MIN_POINTS, "a filter")
     given = to_crs(crs)
     out_crs = given if given is not None else to_crs(file_crs)
@@ -315,8 +320,9 @@ def _read_points(path: Path, spacing: Optional[float], crs: Any) -> FilterInput:
     cells_max = 20000 * 20000
     x, y = xyz[ok, 0], xyz[ok, 1]
     if np.ptp(x) / spacing * np.ptp(y) / spacing > cells_max:
-        raise InputError(f"A {spacing:g} m grid over the points of '{path.name}' would have more "
-                         "than 400 million cells; give a larger spacing.")
+        raise InputError.of("A {spacing:g} m grid over the points of '{name}' would have more "
+                            "than 400 million cells; give a larger spacing.",
+                            spacing=spacing, name=path.name)
     zg, grid, cells = grid_lowest(xyz, float(spacing))
     return FilterInput(zg, grid, out_crs, points=xyz, point_cells=cells, sigma=sigma,
                        source="points", path=str(path))
@@ -346,7 +352,8 @@ def read_filter_input(path: PathLike, spacing: Optional[float] = None, crs: Any 
     feedback = ensure_feedback(feedback)
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"The filter input '{path}' does not exist or is not a file.")
+        raise InputError.of("The filter input '{path}' does not exist or is not a file.",
+                            path=path)
     if path.suffix.lower() in POINT_SUFFIXES:
         inp = _read_points(path, spacing, crs)
         feedback.info(f"{len(inp.points)} points gridded at {inp.grid.spacing:g} m "
@@ -401,8 +408,9 @@ def read_filter_constraints(project: Optional[PathLike], grid: Grid,
     if not any(features.values()):
         return cons
     if target is None:
-        raise InputError("The filter input has no CRS and neither has the project; give the CRS "
-                         "of the input (e.g. --crs EPSG:25832) so the edits can be placed.")
+        raise InputError.of("The filter input has no CRS and neither has the project; give the "
+                            "CRS of the input (e.g. --crs EPSG:25832) so the edits can be "
+                            "placed.")
 
     def _geoms(name: str) -> List[Tuple[Any, Dict[str, Any]]]:
         out = []

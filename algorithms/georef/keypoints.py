@@ -81,7 +81,7 @@ def to_byte(grey: Array, low: float = 0.5, high: float = 99.5
     a = np.asarray(grey, np.float64)
     ok = np.isfinite(a)
     if not ok.any():
-        raise InputError("The image has no valid pixels.")
+        raise InputError.of("The image has no valid pixels.")
     lo, hi = np.percentile(a[ok], [low, high])
     scale = 255.0 / (hi - lo) if hi > lo else 1.0
     out = np.clip((np.where(ok, a, lo) - lo) * scale, 0, 255).round().astype(np.uint8)
@@ -124,7 +124,8 @@ def make_detector(name: str = "auto") -> Tuple[Any, int, str]:
             return cv2.AKAZE_create(), cv2.NORM_HAMMING, n
         if n == "orb":
             return cv2.ORB_create(MAX_KEYPOINTS), cv2.NORM_HAMMING, n
-    raise InputError(f"Unknown keypoint detector '{name}'; use auto, {', '.join(DETECTORS)}.")
+    raise InputError.of("Unknown keypoint detector '{value}'; use auto, {options}.",
+                        value=name, options=", ".join(DETECTORS))
 
 
 def detect(img8: NDArray[np.uint8], mask: NDArray[np.uint8], det: Any

@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from ..errors import GeometryError, InputError
+from ..errors import GeometryError, InputError, PhotodemError
 from ..feedback import Feedback, StepFeedback
 from ..output_policy import PRODUCT_MARKER
 from .area import area_search, boundary_search, grid_control_points
@@ -98,12 +98,13 @@ def parse_thresholds(text: Union[str, Sequence[float], None]) -> List[float]:
         try:
             vals = [float(t) for t in text.replace(";", ",").split(",") if t.strip()]
         except ValueError as exc:
-            raise InputError(f"Thresholds '{text}': give numbers separated by commas, "
-                             "e.g. 5,6,7,8.") from exc
+            raise InputError.of("Thresholds '{text}': give numbers separated by commas, "
+                                "e.g. 5,6,7,8.", text=text) from exc
     else:
         vals = [float(t) for t in text]
     if not vals or any(v <= 0 for v in vals):
-        raise InputError("Thresholds must be positive grey-value differences, e.g. 5,6,7,8.")
+        raise InputError.of("Thresholds must be positive grey-value differences, e.g. "
+                            "5,6,7,8.")
     return vals
 
 
@@ -191,18 +192,20 @@ class GeorefOptions:
         """Refuse unknown transform and search names; returns the parsed thresholds."""
         thr = parse_thresholds(self.thresholds)
         if self.transform not in ("affine", "projective", "poly2"):
-            raise InputError(f"Unknown transform '{self.transform}'; use affine, projective "
-                             "or poly2.")
+            raise InputError.of("Unknown transform '{value}'; use affine, projective or poly2.",
+                                value=self.transform)
         if self.search not in SEARCH_MODES:
-            raise InputError(f"Unknown search '{self.search}'; use {', '.join(SEARCH_MODES)}.")
+            raise InputError.of("Unknown search '{value}'; use {options}.", value=self.search,
+                                options=", ".join(SEARCH_MODES))
         if self.detector not in ("auto", *DETECTORS):
-            raise InputError(f"Unknown keypoint detector '{self.detector}'; use auto, "
-                             f"{', '.join(DETECTORS)}.")
+            raise InputError.of("Unknown keypoint detector '{value}'; use auto, {options}.",
+                                value=self.detector, options=", ".join(DETECTORS))
         if self.objects not in OBJECT_KINDS:
-            raise InputError(f"Unknown objects '{self.objects}'; use "
-                             f"{', '.join(OBJECT_KINDS)}.")
+            raise InputError.of("Unknown objects '{value}'; use {options}.", value=self.objects,
+                                options=", ".join(OBJECT_KINDS))
         if not self.time_limit_s >= 0:
-            raise InputError(f"The time limit must be ≥ 0 s (0: none), not {self.time_limit_s}.")
+            raise InputError.of("The time limit must be ≥ 0 s (0: none), not {value}.",
+                                value=self.time_limit_s)
         return thr
 
     def report(self, thresholds: List[float], pyramid_level: Optional[int]) -> Dict[str, Any]:
@@ -248,11 +251,11 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
     grey, img_info = load_image(image, opts.band)
     ref_kind = "raster" if is_raster(reference) else "vector"
     if ref_kind == "raster" and opts.search == "area":
-        raise InputError("The area-based search needs a polygon layer as reference, not a "
-                         "raster; use search = objects or auto.")
+        raise InputError.of("The area-based search needs a polygon layer as reference, not a "
+                            "raster; use search = objects or auto.")
     if ref_kind == "vector" and opts.search == "keypoints":
-        raise InputError("The keypoint search needs a georeferenced raster as reference, "
-                         "not a polygon layer; use search = objects, area or auto.")
+        raise InputError.of("The keypoint search needs a georeferenced raster as reference, "
+                            "not a polygon layer; use search = objects, area or auto.")
     ref = None
     if ref_kind == "vector":  # first: a bad layer or class fails before any work
         ref = reference_objects_from_vector(reference, opts.class_field, opts.class_value,
@@ -315,11 +318,12 @@ def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tu
     if not ev.verified:
         why = "; ".join(ev.reasons)
         if not run.options.unverified:
-            raise GeometryError(
-                f"Georeferencing failed: the {result.stage} stage's result is not verified: "
-                f"{why} (RMSE {result.fit.rmse_px:.2f} px of {ev.points} control points; "
-                f"{ev.text()}). No result is better than a wrong one: check that image and "
-                "reference show the same area, or write the result marked unverified.",
+            raise _with_counts(GeometryError.of(
+                "Georeferencing failed: the {stage} stage's result is not verified: {why} "
+                "(RMSE {rmse:.2f} px of {points} control points; {evidence}). No result is "
+                "better than a wrong one: check that image and reference show the same area, "
+                "or write the result marked unverified.", stage=result.stage, why=why,
+                rmse=result.fit.rmse_px, points=ev.points, evidence=ev.text()),
                 {**result.counts, "evidence": ev.to_json()})
         warning = f"UNVERIFIED result (written on request): {why}."
         result.warnings.append(warning)
@@ -380,8 +384,10 @@ def _keypoint_stage(run: _Run, reference: PathLike) -> GeorefResult:
     try:
         return _object_stage(run, reference, "raster", None)
     except GeometryError as exc:
-        raise GeometryError(f"{exc} Before it, the keypoint stage found no result: {kp_why} "
-                            f"({_detail(kp_counts)}).", {**kp_counts, **exc.counts}) from exc
+        raise _with_counts(GeometryError.of(
+            "{error} Before it, the keypoint stage found no result: {why} ({detail}).",
+            error=exc, why=kp_why, detail=_detail(kp_counts)),
+            {**kp_counts, **exc.counts}) from exc
 
 
 def _object_stage(run: _Run, reference: PathLike, ref_kind: str,
@@ -772,10 +778,16 @@ def _check_time(run: _Run, counts: Dict[str, Any], where: str,
 
 def _fail(counts: Dict[str, Any], why: str) -> None:
     """Raise the failure message; the exception's ``counts`` keep the figures as data."""
-    raise GeometryError(
-        f"Georeferencing failed: {why} ({_detail(counts)}). Check that image and reference "
-        "show the same objects completely (class field/value), try other thresholds or a "
-        "larger relative difference.", counts)
+    raise _with_counts(GeometryError.of(
+        "Georeferencing failed: {why} ({detail}). Check that image and reference show the "
+        "same objects completely (class field/value), try other thresholds or a larger "
+        "relative difference.", why=why, detail=_detail(counts)), counts)
+
+
+def _with_counts(error: PhotodemError, counts: Dict[str, Any]) -> PhotodemError:
+    """``error`` with the figures behind its message as data (the report's counts)."""
+    error.counts = dict(counts)
+    return error
 
 
 def _detail(counts: Dict[str, Any]) -> str:
@@ -804,8 +816,8 @@ def run_georeference_polygons(image: PathLike, reference: PathLike, output: Path
     out = Path(output)
     if out.is_file() or (out.is_dir() and any(out.iterdir())
                          and not (out / PRODUCT_MARKER).is_file()):
-        raise InputError(f"The output folder '{out}' holds files PhotoDEM did not "
-                         "write; choose an empty or new folder.")
+        raise InputError.of("The output folder '{path}' holds files PhotoDEM did not write; "
+                            "choose an empty or new folder.", path=out)
     result = georeference(image, reference, options, feedback=StepFeedback(fb, 0, 80))
     paths = write_outputs(out, image, result, feedback=StepFeedback(fb, 80, 100),
                           replace=True)

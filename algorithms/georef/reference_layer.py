@@ -117,16 +117,18 @@ def reference_objects_from_vector(path: PathLike, class_field: Optional[str] = N
     """
     path = Path(path)
     if not path.exists():
-        raise InputError(f"Reference layer '{path}' not found.")
+        raise InputError.of("Reference layer '{path}' not found.", path=path)
     try:
         src = fiona.open(path, layer=layer) if layer else fiona.open(path)
     except Exception as exc:
-        raise InputError(f"Cannot read the reference layer '{path}': {exc}") from exc
+        raise InputError.of("Cannot read the reference layer '{path}': {error}", path=path,
+                            error=exc) from exc
     with src:
         fields = list(src.schema.get("properties", {}))
         if class_field and class_field not in fields:
-            raise InputError(f"The reference layer '{path.name}' has no attribute "
-                             f"'{class_field}'; its attributes are: {', '.join(fields) or '—'}.")
+            raise InputError.of("The reference layer '{name}' has no attribute '{field}'; its "
+                                "attributes are: {fields}.", name=path.name, field=class_field,
+                                fields=", ".join(fields) or "—")
         layer_crs = src.crs_wkt or None
         geoms, ids = [], []
         n_read = 0
@@ -145,12 +147,17 @@ def reference_objects_from_vector(path: PathLike, class_field: Optional[str] = N
             geoms.append(g)
             ids.append(feat.get("id", n_read - 1))
     if not geoms:
-        what = f" with {class_field} = {class_value}" if class_field else ""
-        raise InputError(f"No polygons{what} in the reference layer '{path.name}' "
-                         f"({n_read} features read); check the class field and value.")
+        if class_field:
+            raise InputError.of("No polygons with {field} = {value} in the reference layer "
+                                "'{name}' ({count} features read); check the class field and "
+                                "value.", field=class_field, value=class_value, name=path.name,
+                                count=n_read)
+        raise InputError.of("No polygons in the reference layer '{name}' ({count} features "
+                            "read); check the class field and value.", name=path.name,
+                            count=n_read)
     if layer_crs is None:
-        raise InputError(f"The reference layer '{path.name}' has no CRS; assign one in QGIS "
-                         "first.")
+        raise InputError.of("The reference layer '{name}' has no CRS; assign one in QGIS "
+                            "first.", name=path.name)
     merged = unary_union(geoms)
     cen = merged.centroid
     to_ll = pyproj.Transformer.from_crs(layer_crs, "EPSG:4326", always_xy=True)
@@ -208,12 +215,13 @@ def load_reference(path: PathLike, band: Optional[int] = None
     """
     with rasterio.open(path) as src:
         if src.crs is None or src.transform.is_identity:
-            raise InputError(f"The reference raster '{Path(path).name}' has no georeference; "
-                             "a raster reference must be georeferenced (an orthophoto).")
+            raise InputError.of("The reference raster '{name}' has no georeference; a raster "
+                                "reference must be georeferenced (an orthophoto).",
+                                name=Path(path).name)
         transform, crs = src.transform, pyproj.CRS.from_user_input(src.crs.to_wkt())
     if not crs.is_projected:
-        raise InputError(f"The reference raster '{Path(path).name}' is in a geographic CRS; "
-                         "reproject it to a projected CRS first.")
+        raise InputError.of("The reference raster '{name}' is in a geographic CRS; reproject "
+                            "it to a projected CRS first.", name=Path(path).name)
     grey, info = load_image(path, band)
     return grey, centre_matrix(transform), crs, {**info, "crs": crs.to_string()}
 

@@ -46,7 +46,8 @@ CORNERS = ("lower_left", "upper_left", "lower_right", "upper_right")
 def _flip(a: NDArray[Any], corner: str) -> NDArray[Any]:
     """View of ``a`` (…, rows, cols) whose row-major scan starts at ``corner``."""
     if corner not in CORNERS:
-        raise InputError(f"Unknown scan start corner '{corner}'; use one of {', '.join(CORNERS)}.")
+        raise InputError.of("Unknown scan start corner '{value}'; use one of {options}.",
+                            value=corner, options=", ".join(CORNERS))
     if corner.startswith("lower"):
         a = a[..., ::-1, :]
     if corner.endswith("right"):
@@ -274,7 +275,7 @@ def stretch_to_byte(array: NDArray[Any], low: float = 2.0, high: float = 98.0
     a = np.asarray(array, dtype=np.float64)
     finite = a[np.isfinite(a)]
     if finite.size == 0:
-        raise InputError("The image has no valid pixels.")
+        raise InputError.of("The image has no valid pixels.")
     lo, hi = np.percentile(finite, [low, high])
     if hi <= lo:
         return np.where(np.isfinite(a), 128.0, np.nan)
@@ -423,12 +424,12 @@ def load_image(path: Union[str, Path], band: Optional[int] = None
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"Image '{path}' not found.")
+        raise InputError.of("Image '{path}' not found.", path=path)
     try:
         with open_image(path) as src:
             if band is not None and not 1 <= int(band) <= src.count:
-                raise InputError(f"Band {band} does not exist: '{path.name}' has {src.count} "
-                                 "band(s).")
+                raise InputError.of("Band {band} does not exist: '{name}' has {count} "
+                                    "band(s).", band=band, name=path.name, count=src.count)
             idx = [int(band)] if band is not None else list(range(1, src.count + 1))
             data = src.read(idx, masked=True).astype(np.float64)
             dtype = src.dtypes[0]
@@ -438,7 +439,8 @@ def load_image(path: Union[str, Path], band: Optional[int] = None
     except InputError:
         raise
     except Exception as exc:  # rasterio's own message says what is wrong with the file
-        raise InputError(f"Cannot read image '{path}': {exc}") from exc
+        raise InputError.of("Cannot read image '{path}': {error}", path=path,
+                            error=exc) from exc
     mask = np.ma.getmaskarray(data).any(axis=0)
     grey = np.ma.getdata(data).mean(axis=0)
     grey[mask] = np.nan

@@ -145,7 +145,8 @@ class Review:
         """Add a manual control point (image col/row, map x/y in the result's CRS)."""
         vals = [float(v) for v in (*image, *map_xy)]
         if len(vals) != 4 or not np.all(np.isfinite(vals)):
-            raise InputError("A control point needs four finite numbers: column, row, X, Y.")
+            raise InputError.of("A control point needs four finite numbers: column, row, X, "
+                                "Y.")
         point = ReviewPoint((vals[0], vals[1]), (vals[2], vals[3]))
         self.points.append(point)
         return point
@@ -165,19 +166,21 @@ class Review:
             Too few active points for the transform, or a degenerate point geometry.
         """
         if self.kind not in KINDS:
-            raise InputError(f"Unknown transform '{self.kind}'; use {', '.join(KINDS)}.")
+            raise InputError.of("Unknown transform '{value}'; use {options}.", value=self.kind,
+                                options=", ".join(KINDS))
         active = self.active()
         need = MIN_POINTS[self.kind]
         if active.sum() < need:
-            raise InputError(f"The {self.kind} transform needs at least {need} active control "
-                             f"points; {int(active.sum())} are switched on.")
+            raise InputError.of("The {kind} transform needs at least {need} active control "
+                                "points; {count} are switched on.", kind=self.kind, need=need,
+                                count=int(active.sum()))
         try:
             return fit_transform(self.image_xy(), self.map_xy(), self.kind,
                                  robust=self.drop_outliers, enabled=active)
         except (ValueError, np.linalg.LinAlgError) as exc:
-            raise InputError(f"The active control points do not determine a {self.kind} "
-                             f"transform ({exc}); switch on points spread over the image."
-                             ) from exc
+            raise InputError.of("The active control points do not determine a {kind} "
+                                "transform ({error}); switch on points spread over the image.",
+                                kind=self.kind, error=exc) from exc
 
     def table(self, fit: Optional[TransformFit] = None) -> List[Dict[str, Any]]:
         """One row per point: coordinates, residuals (px, map units), its role.
@@ -289,18 +292,19 @@ def read_check_points(path: PathLike, width: Optional[int] = None,
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"The check-point file '{path}' does not exist.")
+        raise InputError.of("The check-point file '{path}' does not exist.", path=path)
     text = path.read_text(encoding="utf-8-sig", errors="replace")
     crs_line, lines = points_crs(text), numbered_lines(text)
     if not lines:
-        raise InputError(f"The check-point file '{path.name}' holds no check points.")
+        raise InputError.of("The check-point file '{name}' holds no check points.",
+                            name=path.name)
     sep = field_separator(lines[0][1])
     header = split_fields(lines[0][1], sep)
     columns, corner = _check_columns(path.name, header)
     ids, values = _check_values(path.name, lines[1:], sep, header, columns)
     if not ids:
-        raise InputError(f"The check-point file '{path.name}' has a header but no check "
-                         "points.")
+        raise InputError.of("The check-point file '{name}' has a header but no check points.",
+                            name=path.name)
     col, row, x, y = values.T
     if corner:
         col, row = _corner_to_image(path.name, col, row)
@@ -314,8 +318,8 @@ def read_check_points(path: PathLike, width: Optional[int] = None,
 def _check_columns(name: str, header: Sequence[str]) -> Tuple[List[Optional[int]], bool]:
     """Indices of id, col, row, x, y in the header, and whether col/row are corner-based."""
     if all(parse_number(t) is not None for t in header if t):
-        raise InputError(f"'{name}' has no header line; the first line must name the columns, "
-                         "e.g. col,row,x,y or pixel,line,mapX,mapY.")
+        raise InputError.of("'{name}' has no header line; the first line must name the "
+                            "columns, e.g. col,row,x,y or pixel,line,mapX,mapY.", name=name)
     find = {key: find_column(header, names) for key, names in CHECK_COLUMNS.items()}
     corner = find["col"] is None or find["row"] is None
     col, row = (find["corner_col"], find["corner_row"]) if corner else (find["col"], find["row"])
@@ -323,9 +327,9 @@ def _check_columns(name: str, header: Sequence[str]) -> Tuple[List[Optional[int]
                                         ("map x", find["x"]), ("map y", find["y"]))
                if idx is None]
     if missing:
-        raise InputError(f"The header of '{name}' lacks {', '.join(missing)} (found: "
-                         f"{', '.join(header)}); name the columns col,row,x,y or "
-                         "pixel,line,mapX,mapY.")
+        raise InputError.of("The header of '{name}' lacks {missing} (found: {found}); name "
+                            "the columns col,row,x,y or pixel,line,mapX,mapY.", name=name,
+                            missing=", ".join(missing), found=", ".join(header))
     return [find["id"], col, row, find["x"], find["y"]], corner
 
 
@@ -345,8 +349,9 @@ def _check_values(name: str, lines: Sequence[Tuple[int, str]], sep: Optional[str
             token = tokens[c] if c < len(tokens) else ""
             value = parse_number(token.replace(",", ".") if comma else token)
             if value is None:
-                raise InputError(f"'{name}' line {number}: {header[c]} '{token}' is not a "
-                                 "number.")
+                raise InputError.of("'{name}' line {number}: {column} '{token}' is not a "
+                                    "number.", name=name, number=number, column=header[c],
+                                    token=token)
             row.append(value)
         ids.append(tokens[cid] if cid is not None and cid < len(tokens) and tokens[cid]
                    else str(number))
@@ -359,8 +364,9 @@ def _corner_to_image(name: str, col: np.ndarray, row: np.ndarray
     """Corner-based pixel/line → image col/row: QGIS's negative lines through the
     ``.points`` convention, GDAL's positive lines as their negatives."""
     if (row > 0).any() and (row < 0).any():
-        raise InputError(f"'{name}': the line column mixes positive and negative values; "
-                         "a QGIS .points file has negative lines, a GDAL list positive ones.")
+        raise InputError.of("'{name}': the line column mixes positive and negative values; a "
+                            "QGIS .points file has negative lines, a GDAL list positive ones.",
+                            name=name)
     return image_from_points_source(col, row if (row <= 0).all() else -row)
 
 
@@ -372,8 +378,8 @@ def _check_crs(name: str, crs_line: str, crs_wkt: str) -> None:
     except pyproj.exceptions.CRSError:
         return  # an unreadable CRS comment: trust the operator, as for files without one
     if not same:
-        raise InputError(f"'{name}' is in another CRS than the georeferencing result; "
-                         "export the check points in the result's CRS.")
+        raise InputError.of("'{name}' is in another CRS than the georeferencing result; "
+                            "export the check points in the result's CRS.", name=name)
 
 
 def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
@@ -385,9 +391,10 @@ def _inside_image(name: str, points: List[CheckPoint], width: Optional[int],
           for p in points]
     inside = [p for p, k in zip(points, ok) if k]
     if not inside:
-        raise InputError(f"None of the {len(points)} check points in '{name}' lies in the "
-                         f"image ({width} × {height} pixels); col,row count pixel centres "
-                         "from 0, pixel,line are QGIS .points coordinates.")
+        raise InputError.of("None of the {count} check points in '{name}' lies in the image "
+                            "({width} × {height} pixels); col,row count pixel centres from 0, "
+                            "pixel,line are QGIS .points coordinates.", count=len(points),
+                            name=name, width=width, height=height)
     return inside, [p.id for p, k in zip(points, ok) if not k]
 
 
@@ -414,9 +421,9 @@ def load_review(folder: PathLike) -> Review:
     report_path = folder / "report.json"
     points = sorted(folder.glob("*.points"))
     if not report_path.is_file() or not points:
-        raise InputError(f"'{folder}' holds no georeferencing result (report.json and a "
-                         ".points file); choose the output folder of 'Georeference image "
-                         "against polygons'.")
+        raise InputError.of("'{folder}' holds no georeferencing result (report.json and a "
+                            ".points file); choose the output folder of 'Georeference image "
+                            "against polygons'.", folder=folder)
     try:
         rep = json.loads(report_path.read_text(encoding="utf-8"))
         crs_wkt = points_crs(points[0].read_text(encoding="utf-8")) or ""
@@ -426,7 +433,8 @@ def load_review(folder: PathLike) -> Review:
                            _origin(int(g.get("pair", 0)), k in manual, rep.get("stage")))
                for k, g in enumerate(rep["gcps"])]
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InputError(f"Cannot read the georeferencing result in '{folder}': {exc}") from exc
+        raise InputError.of("Cannot read the georeferencing result in '{folder}': {error}",
+                            folder=folder, error=exc) from exc
     state = rep.get("review", {})
     icp = {int(r["pair"]): r for r in rep.get("icp", [])}
     pairs = [{"pair": k, **row, **{key: icp.get(k, {}).get(key) for key in
@@ -463,8 +471,9 @@ def save_review(review: Review, feedback: Optional[Feedback] = None,
     folder, name = review.folder, review.name
     source = folder / f"{name}_gcps.tif"
     if not source.is_file():
-        raise InputError(f"'{source.name}' is missing in '{folder}'; the review resamples that "
-                         "copy of the image. Run the georeferencing again.")
+        raise InputError.of("'{name}' is missing in '{folder}'; the review resamples that copy "
+                            "of the image. Run the georeferencing again.", name=source.name,
+                            folder=folder)
     gcps = [ControlPoint(p.image, p.map, 0.0, p.pair, p.sharp) for p in review.points]
     inverse_fit = inverse_for_resampling(fit, review.image_xy()[fit.used],
                                          review.map_xy()[fit.used])

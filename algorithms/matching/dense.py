@@ -332,11 +332,12 @@ def check_disparity_range(min_d: int, max_d: int, left_shape: Tuple[int, int],
         warn_input(f"The disparity range {min_d}…{max_d} px was cut to {lo}…{hi} px, the "
                    f"disparities images {left_shape[1]} and {right_shape[1]} px wide can have.")
     if lo > hi:
-        raise InputError(
-            f"The disparity range {min_d}…{max_d} px holds no possible disparity of these "
-            f"images (widths {left_shape[1]} and {right_shape[1]} px allow "
-            f"{-(right_shape[1] - 1)}…{left_shape[1] - 1}); change {parameter}."
-        )
+        raise InputError.of(
+            "The disparity range {min_d}…{max_d} px holds no possible disparity of these "
+            "images (widths {left_width} and {right_width} px allow {low}…{high}); change "
+            "{parameter}.", min_d=min_d, max_d=max_d, left_width=left_shape[1],
+            right_width=right_shape[1], low=-(right_shape[1] - 1), high=left_shape[1] - 1,
+            parameter=parameter)
     num_d = _num_disparities(lo, hi)
     side = 64 + 2 * int(margin)
     check_allocation(8.0 * num_d * side * (side + num_d + 16),
@@ -432,8 +433,8 @@ def _checked_settings(options: DenseOptions, min_disparity: int, max_disparity: 
                          f"{', '.join(METHODS)}.")
     min_d, max_d = int(min_disparity), int(max_disparity)
     if max_d < min_d:
-        raise InputError(f"The disparity range is empty (min {min_d} > max {max_d}); "
-                         "give min_disparity ≤ max_disparity.")
+        raise InputError.of("The disparity range is empty (min {min_d} > max {max_d}); "
+                            "give min_disparity ≤ max_disparity.", min_d=min_d, max_d=max_d)
     min_d, max_d = check_disparity_range(min_d, max_d, left_shape, right_shape, margin,
                                          disparity_parameter,
                                          quiet=coarse_above == 0)  # the coarse pass's own cut

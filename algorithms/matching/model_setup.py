@@ -139,10 +139,11 @@ def model_heights(project: Project, m: Any, recs: List[Any],
     z_min = float(terrain) - 0.3 * H if min_height is None else float(min_height)
     z_max = float(terrain) + 0.3 * H if max_height is None else float(max_height)
     if not z_max > z_min:
-        raise InputError(f"max_height ({z_max}) must be larger than min_height ({z_min}).")
+        raise InputError.of("max_height ({z_max}) must be larger than min_height ({z_min}).",
+                            z_max=z_max, z_min=z_min)
     if z_max >= mean_z:
-        raise InputError(f"max_height ({z_max:.1f} m) reaches the cameras ({mean_z:.1f} m); "
-                         "give a lower max_height.")
+        raise InputError.of("max_height ({z_max:.1f} m) reaches the cameras ({z_cam:.1f} m); "
+                            "give a lower max_height.", z_max=z_max, z_cam=mean_z)
     return z_min, float(np.clip(float(terrain), z_min, z_max)), z_max, float(H)
 
 
@@ -201,19 +202,21 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     fp = [footprint(c, r.eo, z_mid) for c, r in zip(cams, recs)]
     overlap = fp[0].intersection(fp[1])
     if overlap.is_empty or overlap.area <= 0:
-        raise GeometryError(f"The images {recs[0].name} and {recs[1].name} of model "
-                            f"'{m.name}' do not overlap; check the model or the orientations.")
+        raise GeometryError.of("The images {left} and {right} of model '{model}' do not "
+                               "overlap; check the model or the orientations.",
+                               left=recs[0].name, right=recs[1].name, model=m.name)
     areas = overlap_areas(cams, recs, (z_min, z_mid, z_max))
     pair = model_pair(cams, recs, areas)
     gsd = m.gsd if np.isfinite(m.gsd) and m.gsd > 0 else H / pair.focal_px
     spacing = float(spacing) if spacing else float(spacing_gsd * gsd)
     if not spacing > 0:
-        raise InputError(f"The spacing must be positive, got {spacing}.")
+        raise InputError.of("The spacing must be positive, got {spacing}.", spacing=spacing)
     ring = np.asarray(overlap.convex_hull.exterior.coords)[:, :2]
     d_lo, d_hi = pair.disparity_range(z_min, z_max, xy=np.vstack([ring, ring.mean(axis=0)]))
     if not (np.isfinite(d_lo) and np.isfinite(d_hi)):
-        raise GeometryError(f"Model '{m.name}': the height range {z_min:.1f}…{z_max:.1f} m "
-                            "gives no disparity; check min_height/max_height.")
+        raise GeometryError.of("Model '{model}': the height range {z_min:.1f}…{z_max:.1f} m "
+                               "gives no disparity; check min_height/max_height.",
+                               model=m.name, z_min=z_min, z_max=z_max)
     widen = 0.1 * (d_hi - d_lo)
     min_d = math.floor(d_lo - widen) - int(disparity_margin)
     max_d = math.ceil(d_hi + widen) + int(disparity_margin)
@@ -227,7 +230,8 @@ def prepare_model(project: Any, model: str, spacing: Optional[float] = None,
     if bounds:
         extent = extent.intersection(unary_union(bounds))
         if extent.is_empty:
-            raise InputError(f"The boundaries of edits.gpkg do not touch model '{m.name}'.")
+            raise InputError.of("The boundaries of edits.gpkg do not touch model '{model}'.",
+                                model=m.name)
     grid = Grid.from_bounds(*extent.bounds, spacing=spacing)
     return ModelSetup(project=project, model=m, records=recs, cameras=cams, pair=pair,
                       z_min=z_min, z_max=z_max, z_mid=z_mid, flying_height=float(H),

@@ -117,7 +117,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, TextIO, Tuple, Union
 
 from .. import output_policy
-from ..errors import Cancelled, InputError, PhotodemError
+from ..errors import Cancelled, InputError, Message, PhotodemError, msg
 from ..feedback import Feedback, ensure_feedback
 from ..project import toml_io
 from ..raster import tiled_dask
@@ -136,6 +136,9 @@ _BATCH_KEYS = {"project", "workers", "output", "scheduler"}
 _STEP_KEYS = {"algorithm", "name", "models", "images", "files", "params"}
 #: Parameter kinds whose values are files: a step over them iterates over ``files``.
 _FILE_ITEM_KINDS = ("raster", "file")
+#: What a step iterates over, one and many, as phrases of the messages (translated by the GUIs).
+_ITEM = {"model": msg("model"), "image": msg("image"), "file": msg("file")}
+_ITEMS = {"model": msg("models"), "image": msg("images"), "file": msg("files")}
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -221,11 +224,12 @@ def load_batch(path: PathLike, run_dir: Optional[PathLike] = None,
     """
     file = Path(path)
     if not file.is_file():
-        raise InputError(f"Batch file '{file}' does not exist.")
+        raise InputError.of("Batch file '{path}' does not exist.", path=file)
     try:
         config = toml_io.loads(file.read_text(encoding="utf-8"))
     except Exception as exc:  # tomllib.TOMLDecodeError
-        raise InputError(f"Cannot read batch file '{file}': {exc}") from exc
+        raise InputError.of("Cannot read batch file '{path}': {error}", path=file,
+                            error=exc) from exc  # the TOML parser's detail stays English
     plan = plan_batch(config, base_dir=file.resolve().parent, run_dir=run_dir, now=now)
     plan.file = file.resolve()
     return plan
@@ -242,12 +246,12 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
 
     unknown = set(config) - {"batch", "steps"}
     if unknown:
-        raise InputError(f"Batch file: unknown table(s) {', '.join(sorted(unknown))}; "
-                         "expected [batch] and [[steps]].")
+        raise InputError.of("Batch file: unknown table(s) {tables}; expected [batch] and "
+                            "[[steps]].", tables=", ".join(sorted(unknown)))
     head = config.get("batch", {})
     if not isinstance(head, dict):
-        raise InputError("Batch file: batch must be a table: write [batch] on a line of its own "
-                         "with project = …, workers = …, output = … below it.")
+        raise InputError.of("Batch file: batch must be a table: write [batch] on a line of its "
+                            "own with project = …, workers = …, output = … below it.")
     head = dict(head)
     _check_keys(head, _BATCH_KEYS, "[batch]")
     for key in ("project", "output", "scheduler"):
@@ -261,8 +265,8 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
     home = project_dir or Path(base_dir).resolve()
     workers = head.get("workers", 1)
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise InputError(f"Batch file: workers = {workers!r} in [batch] must be a whole "
-                         "number ≥ 1.")
+        raise InputError.of("Batch file: workers = {value} in [batch] must be a whole number "
+                            "≥ 1.", value=repr(workers))
     run_auto = run_dir is None and not head.get("output")
     given = run_dir is not None
     if run_dir is None:
@@ -274,20 +278,22 @@ def plan_batch(config: Dict[str, Any], base_dir: PathLike = ".",
         else:
             run_dir = _timestamped(home / "runs", now)
     run = Path(run_dir).resolve()
-    named = "[batch] output" if head.get("output") and not given else "the run folder"
+    named = "[batch] output" if head.get("output") and not given else msg("the run folder")
     _check_run_folder(run, project_dir, named)
 
     steps = config.get("steps", [])
     if isinstance(steps, dict):
-        raise InputError("Batch file: write each step as [[steps]] (two brackets), not [steps].")
+        raise InputError.of("Batch file: write each step as [[steps]] (two brackets), not "
+                            "[steps].")
     if not isinstance(steps, list) or not steps:
-        raise InputError("Batch file: no [[steps]]; add at least one step with algorithm = \"id\".")
+        raise InputError.of("Batch file: no [[steps]]; add at least one step with algorithm = "
+                            "\"id\".")
     plan = BatchPlan(project=project_dir, run_dir=run, workers=workers, steps=[],
                      state_home=home, config=config, base_dir=Path(base_dir),
                      run_auto=run_auto, scheduler=check_scheduler(head.get("scheduler")))
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, dict):
-            raise InputError(f"Batch file: step {number} is not a table.")
+            raise InputError.of("Batch file: step {number} is not a table.", number=number)
         _plan_step(plan, project, step, number, Path(base_dir))
     return plan
 
@@ -305,18 +311,20 @@ def check_scheduler(address: Optional[str]) -> Optional[str]:
     return None if text in ("", "local") else text
 
 
-def _text(table: Dict[str, Any], key: str, where: str) -> None:
+def _text(table: Dict[str, Any], key: str, where: Union[str, Message]) -> None:
     """Refuse a value that is not a string (a number or list where a name or path belongs)."""
     if key in table and not isinstance(table[key], str):
-        raise InputError(f"Batch file: {key} = {table[key]!r} in {where} must be a string in "
-                         f"quotes, e.g. {key} = \"…\".")
+        raise InputError.of("Batch file: {key} = {value} in {where} must be a string in "
+                            "quotes, e.g. {key} = \"…\".", key=key, value=repr(table[key]),
+                            where=where)
 
 
-def _check_keys(table: Dict[str, Any], allowed: set, where: str) -> None:
+def _check_keys(table: Dict[str, Any], allowed: set, where: Union[str, Message]) -> None:
     unknown = set(table) - allowed
     if unknown:
-        raise InputError(f"Batch file: unknown key(s) {', '.join(sorted(unknown))} in {where}; "
-                         f"allowed are {', '.join(sorted(allowed))}.")
+        raise InputError.of("Batch file: unknown key(s) {keys} in {where}; allowed are "
+                            "{allowed}.", keys=", ".join(sorted(unknown)), where=where,
+                            allowed=", ".join(sorted(allowed)))
 
 
 def _timestamped(parent: Path, now: Optional[_dt.datetime]) -> Path:
@@ -329,28 +337,31 @@ def _timestamped(parent: Path, now: Optional[_dt.datetime]) -> Path:
 
 def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
                base_dir: Path) -> None:
-    _check_keys(step, _STEP_KEYS, f"step {number}")
+    at = msg("step {number}", number=number)
+    _check_keys(step, _STEP_KEYS, at)
     if "algorithm" not in step:
-        raise InputError(f"Batch file: step {number} needs algorithm = \"id\".")
+        raise InputError.of("Batch file: step {number} needs algorithm = \"id\".", number=number)
     for key in ("algorithm", "name"):
-        _text(step, key, f"step {number}")
+        _text(step, key, at)
     alg = registry.get(step["algorithm"])
     name = step.get("name") or alg.id
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
-        raise InputError(f"Batch file: step name {name!r} may hold only letters, digits, "
-                         "'_', '-' and '.' (it names the log files).")
+        raise InputError.of("Batch file: step name {name} may hold only letters, digits, "
+                            "'_', '-' and '.' (it names the log files).", name=repr(name))
     if name in plan.steps:
-        raise InputError(f"Batch file: two steps are named {name!r}; give them distinct names.")
+        raise InputError.of("Batch file: two steps are named {name}; give them distinct names.",
+                            name=repr(name))
     plan.steps.append(name)
     params = step.get("params", {})
     if not isinstance(params, dict):
-        raise InputError(f"Batch file: params of step '{name}' must be a table.")
+        raise InputError.of("Batch file: params of step '{step}' must be a table.", step=name)
     params = dict(params)
     for p in alg.parameters:  # the batch project unless the step names another one
         if p.is_project and p.name not in params:
             if project is None and p.required:
-                raise InputError(f"Batch file: step '{name}' ({alg.id}) needs a project; set "
-                                 "project = \"<project folder>\" in [batch].")
+                raise InputError.of("Batch file: step '{step}' ({algorithm}) needs a project; "
+                                    "set project = \"<project folder>\" in [batch].",
+                                    step=name, algorithm=alg.id)
             if project is not None:
                 params[p.name] = "{project}"
 
@@ -363,17 +374,20 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
                              "model, image, raster or file parameter.")
     for key in ("models", "images", "files"):
         if key in step and (item_kind is None or key != item_kind + "s"):
-            raise InputError(
-                f"Batch file: step '{name}' sets {key}, but {alg.id} "
-                + ("does not iterate." if item_kind is None else f"iterates over {item_kind}s.")
-            )
+            if item_kind is None:
+                raise InputError.of("Batch file: step '{step}' sets {key}, but {algorithm} does "
+                                    "not iterate.", step=name, key=key, algorithm=alg.id)
+            raise InputError.of("Batch file: step '{step}' sets {key}, but {algorithm} iterates "
+                                "over {items}.", step=name, key=key, algorithm=alg.id,
+                                items=_ITEMS[item_kind])
     items: List[Optional[str]] = [None]
     if item_kind == "file" and iterate not in params:
         items = _step_files(step.get("files"), base_dir, name, iterate)  # type: ignore[arg-type]
     elif item_kind is not None and iterate not in params:
         if project is None:
-            raise InputError(f"Batch file: step '{name}' runs over the project's "
-                             f"{item_kind}s; set project = \"<project folder>\" in [batch].")
+            raise InputError.of("Batch file: step '{step}' runs over the project's {items}; set "
+                                "project = \"<project folder>\" in [batch].", step=name,
+                                items=_ITEMS[item_kind])
         available = ([m.name for m in project.models] if item_kind == "model"
                      else [i.name for i in project.images])
         chosen = step.get(item_kind + "s", "all")
@@ -382,16 +396,18 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         elif isinstance(chosen, list):
             missing = [c for c in chosen if str(c) not in available]
             if missing:
-                raise InputError(
-                    f"Batch file: step '{name}': {item_kind}(s) {', '.join(map(str, missing))} "
-                    f"not in the project; it has {', '.join(available) or 'none'}."
-                )
+                raise InputError.of(
+                    "Batch file: step '{step}': {kind}(s) {missing} not in the project; it has "
+                    "{available}.", step=name, kind=_ITEM[item_kind],
+                    missing=", ".join(map(str, missing)),
+                    available=", ".join(available) or msg("none"))
             items = [str(c) for c in chosen]
         else:
-            raise InputError(f"Batch file: step '{name}': {item_kind}s must be \"all\" or a "
-                             "list of names.")
+            raise InputError.of("Batch file: step '{step}': {items} must be \"all\" or a list "
+                                "of names.", step=name, items=_ITEMS[item_kind])
         if not items:
-            raise InputError(f"Batch file: step '{name}': the project has no {item_kind}s.")
+            raise InputError.of("Batch file: step '{step}': the project has no {items}.",
+                                step=name, items=_ITEMS[item_kind])
 
     for item in items:
         values = {"run": str(plan.run_dir), "step": name}
@@ -405,8 +421,10 @@ def _plan_step(plan: BatchPlan, project: Any, step: Dict[str, Any], number: int,
         if item is not None:
             task_params[iterate] = item  # type: ignore[index]
         values = _check_params(alg, task_params, name)
-        where = f"step '{name}' ({alg.id})" + ("" if label is None
-                                                  else f", {item_kind} '{label}'")
+        where = (msg("step '{step}' ({algorithm})", step=name, algorithm=alg.id)
+                 if label is None else
+                 msg("step '{step}' ({algorithm}), {kind} '{label}'", step=name,
+                     algorithm=alg.id, kind=_ITEM[item_kind], label=label))
         _check_task_outputs(alg, values, plan.run_dir, where)
         log = plan.run_dir / (f"{name}.log" if label is None else f"{name}/{_safe(label)}.log")
         plan.tasks.append(Task(index=len(plan.tasks), step=name, algorithm=alg.id, item=item,
@@ -427,18 +445,21 @@ def _check_params(alg: Any, params: Dict[str, Any], step: str) -> Dict[str, Any]
     known = {p.name for p in alg.parameters}
     unknown = sorted(set(params) - known)
     if unknown:
-        raise InputError(f"Batch file: step '{step}' ({alg.id}): unknown parameter(s) "
-                         f"{', '.join(unknown)}; known are {', '.join(sorted(known))}.")
+        raise InputError.of("Batch file: step '{step}' ({algorithm}): unknown parameter(s) "
+                            "{unknown}; known are {known}.", step=step, algorithm=alg.id,
+                            unknown=", ".join(unknown), known=", ".join(sorted(known)))
     values = {}
     for p in alg.parameters:
         try:
             values[p.name] = p.convert(params.get(p.name))
         except InputError as exc:
-            raise InputError(f"Batch file: step '{step}' ({alg.id}): {exc}") from None
+            raise InputError.of("Batch file: step '{step}' ({algorithm}): {error}", step=step,
+                                algorithm=alg.id, error=exc) from None
     return values
 
 
-def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
+def _check_run_folder(run: Path, project: Optional[Path], named: Union[str, Message]
+                      ) -> None:
     """Refuse a run folder the output policy forbids, before anything is written.
 
     The batch writes its logs and summary into the run folder but never replaces it, so a
@@ -452,8 +473,9 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
         The resolved run folder.
     project : Path, optional
         The batch project, whose files no run folder may be or contain.
-    named : str
-        Where the run folder comes from, for the message (``[batch] output``).
+    named : str or Message
+        Where the run folder comes from, for the message (``[batch] output``, "the run
+        folder").
 
     Raises
     ------
@@ -465,11 +487,12 @@ def _check_run_folder(run: Path, project: Optional[Path], named: str) -> None:
     try:
         output_policy.check_targets("batch", [target], protected=protected)
     except InputError as exc:
-        raise InputError(f"Batch file: {named} (where the batch writes its logs): {exc}"
-                         ) from None
+        raise InputError.of("Batch file: {named} (where the batch writes its logs): {error}",
+                            named=named, error=exc) from None
 
 
-def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str) -> None:
+def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path,
+                        where: Union[str, Message]) -> None:
     """Check a task's outputs while planning (:func:`.registry.check_outputs` with the run
     folder): a forbidden output stops the batch before its first task.
 
@@ -481,7 +504,7 @@ def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str)
         The task's converted values (from :func:`_check_params`).
     run : Path
         The resolved run folder: no output may be or contain it.
-    where : str
+    where : str or Message
         ``step 'name' (algorithm)[, model 'name']`` for the message.
 
     Raises
@@ -492,7 +515,7 @@ def _check_task_outputs(alg: Any, values: Dict[str, Any], run: Path, where: str)
     try:
         registry.check_outputs(alg, values, run_folder=run)
     except PhotodemError as exc:
-        raise InputError(f"Batch file: {where}: {exc}") from None
+        raise InputError.of("Batch file: {where}: {error}", where=where, error=exc) from None
 
 
 def _item_kind(p: Parameter) -> Optional[str]:
@@ -533,12 +556,13 @@ def _step_files(spec: Union[str, List[Any], None], base_dir: Path, step: str,
                 parameter: str) -> List[str]:
     """The files of a step: glob patterns or paths relative to the batch file, sorted."""
     if spec is None:
-        raise InputError(f"Batch file: step '{step}' needs files = [\"<pattern or path>\", …] "
-                         f"(the values of its parameter '{parameter}').")
+        raise InputError.of("Batch file: step '{step}' needs files = [\"<pattern or path>\", "
+                            "…] (the values of its parameter '{parameter}').", step=step,
+                            parameter=parameter)
     patterns = [spec] if isinstance(spec, str) else spec
     if not isinstance(patterns, list) or not patterns:
-        raise InputError(f"Batch file: step '{step}': files must be a pattern or a list of "
-                         "patterns/paths.")
+        raise InputError.of("Batch file: step '{step}': files must be a pattern or a list of "
+                            "patterns/paths.", step=step)
     found: List[Path] = []
     for pattern in patterns:
         text = str(Path(str(pattern)).expanduser())
@@ -548,18 +572,21 @@ def _step_files(spec: Union[str, List[Any], None], base_dir: Path, step: str,
             matches = sorted(p for p in anchor.glob(str(path.relative_to(anchor)))
                              if p.is_file())
             if not matches:
-                raise InputError(f"Batch file: step '{step}': no file matches '{pattern}'.")
+                raise InputError.of("Batch file: step '{step}': no file matches '{pattern}'.",
+                                    step=step, pattern=pattern)
             found += matches
         elif path.is_file():
             found.append(path)
         else:
-            raise InputError(f"Batch file: step '{step}': file '{pattern}' does not exist.")
+            raise InputError.of("Batch file: step '{step}': file '{pattern}' does not exist.",
+                                step=step, pattern=pattern)
     files = list(dict.fromkeys(p.resolve() for p in found))  # once each, in order
     stems: Dict[str, Path] = {}
     for f in files:
         if f.stem in stems:
-            raise InputError(f"Batch file: step '{step}': '{stems[f.stem]}' and '{f}' have the "
-                             "same name; {file} must name one file (rename one).")
+            raise InputError.of("Batch file: step '{step}': '{first}' and '{second}' have the "
+                                "same name; {{file}} must name one file (rename one).",
+                                step=step, first=stems[f.stem], second=f)
         stems[f.stem] = f
     return [str(f) for f in files]
 
@@ -582,10 +609,10 @@ def _substitute(value: Any, values: Dict[str, str], step: str, keep_others: bool
         if keep_others:
             return match.group(0)
         if key == "project":
-            raise InputError(f"Batch file: step '{step}' uses {{project}}, but the batch has "
-                             "no project (set project = \"…\" in [batch]).")
-        raise InputError(f"Batch file: step '{step}' uses {{{key}}}, but it does not run "
-                         f"per {key}.")
+            raise InputError.of("Batch file: step '{step}' uses {{project}}, but the batch has "
+                                "no project (set project = \"…\" in [batch]).", step=step)
+        raise InputError.of("Batch file: step '{step}' uses {{{key}}}, but it does not run "
+                            "per {key}.", step=step, key=key)
 
     return _PLACEHOLDER.sub(repl, value)
 

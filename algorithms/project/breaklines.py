@@ -75,8 +75,8 @@ def check_breaklines(lines: List[Any]) -> None:
     """
     for i, a in enumerate(lines):
         if not a.is_simple:
-            raise InputError(f"Breakline {i + 1} crosses itself; fix it in edits.gpkg "
-                             "(layer breaklines).")
+            raise InputError.of("Breakline {number} crosses itself; fix it in edits.gpkg "
+                                "(layer breaklines).", number=i + 1)
         for j in range(i + 1, len(lines)):
             b = lines[j]
             if not a.intersects(b):
@@ -84,8 +84,9 @@ def check_breaklines(lines: List[Any]) -> None:
             if line_crossing(a, b) is None:
                 continue
             x, y = a.intersection(b).representative_point().coords[0][:2]
-            raise InputError(f"Breaklines {i + 1} and {j + 1} cross at ({x:.2f}, {y:.2f}); "
-                             "breaklines must not cross or touch — fix them in edits.gpkg.")
+            raise InputError.of("Breaklines {first} and {second} cross at ({x:.2f}, {y:.2f}); "
+                                "breaklines must not cross or touch — fix them in edits.gpkg.",
+                                first=i + 1, second=j + 1, x=x, y=y)
 
 
 __all__ = ["SAME_POINT_M", "check_breaklines", "line_crossing", "self_crossings"]

@@ -183,7 +183,7 @@ def breakline_feature(coords: Sequence[XY], heights: Sequence[Optional[float]], 
                                      end_heights=(heights[0], heights[-1]))
         heights = [c[2] for c in line.coords]
     if any(z is None for z in heights):
-        raise InputError("Every vertex of a breakline needs a height.")
+        raise InputError.of("Every vertex of a breakline needs a height.")
     line = LineString([(x, y, float(z)) for (x, y), z in zip(coords, heights)])
     return line, {"kind": kind}
 

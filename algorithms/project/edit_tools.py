@@ -103,7 +103,8 @@ class DrapedLine:
 def _surface_path(surface: PathLike) -> Path:
     path = Path(surface)
     if not path.is_file():
-        raise InputError(f"Surface '{path}' not found; choose a DSM or DTM of the project.")
+        raise InputError.of("Surface '{path}' not found; choose a DSM or DTM of the project.",
+                            path=path)
     return path
 
 
@@ -118,15 +119,17 @@ def _to_surface_crs(path: Path, surface_crs: Any, x: NDArray, y: NDArray,
     """
     if crs is None or same_horizontal_crs(crs, surface_crs or crs):
         if crs is not None and surface_crs is None:
-            raise InputError(f"Surface '{path.name}' has no CRS, so a point in {crs_label(crs)} "
-                             "cannot be placed on it; assign the surface its CRS first.")
+            raise InputError.of("Surface '{name}' has no CRS, so a point in {crs} cannot be "
+                                "placed on it; assign the surface its CRS first.",
+                                name=path.name, crs=crs_label(crs))
         return x, y
     try:
         tf = pyproj.Transformer.from_crs(pyproj.CRS.from_user_input(crs),
                                          pyproj.CRS.from_user_input(surface_crs.to_wkt()),
                                          always_xy=True)
     except pyproj.exceptions.CRSError as exc:
-        raise InputError(f"The point CRS '{str(crs)[:60]}' is not understood: {exc}") from exc
+        raise InputError.of("The point CRS '{crs}' is not understood: {error}",
+                            crs=str(crs)[:60], error=exc) from exc
     sx, sy = tf.transform(x, y)
     return np.asarray(sx, dtype=float), np.asarray(sy, dtype=float)
 
@@ -263,15 +266,15 @@ def drape_line(surface: Optional[PathLike], coords: Sequence[Sequence[float]], c
     """
     xy = np.asarray([(float(c[0]), float(c[1])) for c in coords], dtype=float).reshape(-1, 2)
     if len(xy) < 2:
-        raise InputError("A line needs at least two vertices.")
+        raise InputError.of("A line needs at least two vertices.")
     if mode == "interpolate":
         z = _interpolated(xy, end_heights)
         return DrapedLine([(x, y, float(h)) for (x, y), h in zip(xy, z)])
     if mode != "drape":
-        raise InputError(f"Height mode '{mode}' is not one of drape, interpolate.")
+        raise InputError.of("Height mode '{mode}' is not one of drape, interpolate.", mode=mode)
     if surface is None:
-        raise InputError("Choose a surface (DSM or DTM) to drape the line on, or type the end "
-                         "heights to interpolate between them.")
+        raise InputError.of("Choose a surface (DSM or DTM) to drape the line on, or type the "
+                            "end heights to interpolate between them.")
     z, outside = surface_heights(surface, xy[:, 0], xy[:, 1], crs)
     missing = [int(i) for i in np.flatnonzero(~np.isfinite(z))]
     reason = None
@@ -286,15 +289,15 @@ def drape_line(surface: Optional[PathLike], coords: Sequence[Sequence[float]], c
 def _interpolated(xy: NDArray, end_heights: Optional[Tuple[float, float]]) -> NDArray:
     """Heights linear in the 2-D length along the line between the two end heights."""
     if end_heights is None or len(end_heights) != 2:
-        raise InputError("Type the heights of the first and the last vertex to interpolate "
-                         "between them.")
+        raise InputError.of("Type the heights of the first and the last vertex to interpolate "
+                            "between them.")
     z0, z1 = (float(v) for v in end_heights)
     if not (math.isfinite(z0) and math.isfinite(z1)):
-        raise InputError(f"The end heights ({z0}, {z1}) must be numbers (m).")
+        raise InputError.of("The end heights ({z0}, {z1}) must be numbers (m).", z0=z0, z1=z1)
     length = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
     if length[-1] <= 0:
-        raise InputError("The line has no length; its first and last vertex are the same "
-                         "point.")
+        raise InputError.of("The line has no length; its first and last vertex are the same "
+                            "point.")
     return z0 + (z1 - z0) * length / length[-1]
 
 
@@ -351,8 +354,8 @@ def redrape_feature(surface: PathLike, layer: str, geometry: Any, crs: Any = Non
         A layer without heights, or the errors of :func:`surface_heights`.
     """
     if layer not in REDRAPE_LAYERS:
-        raise InputError(f"The layer '{layer}' has no heights to re-drape; use one of "
-                         f"{', '.join(REDRAPE_LAYERS)}.")
+        raise InputError.of("The layer '{layer}' has no heights to re-drape; use one of "
+                            "{layers}.", layer=layer, layers=", ".join(REDRAPE_LAYERS))
     if layer == "breaklines":
         parts = []
         for part in getattr(geometry, "geoms", [geometry]):
@@ -402,7 +405,8 @@ def snap_to_lines(point: Sequence[float], lines: Sequence[Any],
         ``None`` when no line is within ``tolerance``.
     """
     if not tolerance > 0:
-        raise InputError(f"The snapping tolerance must be positive, got {tolerance}.")
+        raise InputError.of("The snapping tolerance must be positive, got {tolerance}.",
+                            tolerance=tolerance)
     p = Point(float(point[0]), float(point[1]))
     best_vertex: Optional[Snap] = None
     best_edge: Optional[Snap] = None

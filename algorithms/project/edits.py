@@ -44,7 +44,7 @@ from shapely.geometry import mapping, shape
 from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
-from ..errors import InputError
+from ..errors import InputError, Message, msg
 from ..input_errors import check_encodable, reading, warn_input
 from ..raster.io import atomic_output
 from .vector_io import read_features, to_crs
@@ -70,11 +70,12 @@ EXCLUSION_ACTIONS = ("keep", "remove", "exclude")
 BREAKLINE_KINDS = ("breakline", "structure_line")
 
 
-def _where(path: PathLike, layer: str, fid: Any) -> str:
-    return f"'{Path(path).name}' layer {layer}, feature {fid}"
+def _where(path: PathLike, layer: str, fid: Any) -> Message:
+    return msg("'{file}' layer {layer}, feature {fid}", file=Path(path).name, layer=layer,
+               fid=fid)
 
 
-def check_action(value: Any, where: str) -> Optional[str]:
+def check_action(value: Any, where: Union[str, Message]) -> Optional[str]:
     """The normalised ``action`` of an exclusion area (``None`` when empty = ``remove``).
 
     Raises
@@ -86,8 +87,9 @@ def check_action(value: Any, where: str) -> Optional[str]:
         return None
     text = str(value).strip().lower()
     if text not in EXCLUSION_ACTIONS:
-        raise InputError(f"{where}: action '{value}' is not one of {', '.join(EXCLUSION_ACTIONS)} "
-                         "(empty = remove); fix it in edits.gpkg.")
+        raise InputError.of("{where}: action '{value}' is not one of {actions} (empty = remove); "
+                            "fix it in edits.gpkg.", where=where, value=value,
+                            actions=", ".join(EXCLUSION_ACTIONS))
     return text
 
 
@@ -125,7 +127,7 @@ def repaired_polygon(geom: Any) -> Optional[Any]:
     return fixed
 
 
-def repair_polygon(geom: Any, where: str) -> Any:
+def repair_polygon(geom: Any, where: Union[str, Message]) -> Any:
     """``geom`` if it is a valid polygon, else its repaired form (:func:`repaired_polygon`),
     with a warning.
 
@@ -139,14 +141,15 @@ def repair_polygon(geom: Any, where: str) -> Any:
     reason = explain_validity(geom)
     fixed = repaired_polygon(geom)
     if fixed is None:
-        raise InputError(f"{where}: the polygon is invalid ({reason}) and nothing is left after "
-                         "repairing it; redraw it in edits.gpkg.")
+        raise InputError.of("{where}: the polygon is invalid ({reason}) and nothing is left "
+                            "after repairing it; redraw it in edits.gpkg.", where=where,
+                            reason=reason)  # GEOS's reason stays as it is
     warn_input(f"{where}: the polygon is invalid ({reason}); it is used repaired (area "
                f"{geom.area:.1f} → {fixed.area:.1f} m²). Check it and fix it in QGIS.")
     return fixed
 
 
-def flat_breakline_message(layer: str, geom: Any, where: str) -> Optional[str]:
+def flat_breakline_message(layer: str, geom: Any, where: Union[str, Message]) -> Optional[str]:
     """The warning for a breakline without heights (2-D), or ``None``."""
     if layer == "breaklines" and "LineString" in geom.geom_type and not geom.has_z:
         return (f"{where}: the breakline has no heights (2-D); it only separates the surface "
@@ -183,7 +186,8 @@ def _crs_wkt(crs: str) -> str:
     try:
         return pyproj.CRS.from_user_input(crs).to_wkt()
     except Exception as exc:  # pyproj.exceptions.CRSError
-        raise InputError(f"Cannot use the CRS '{crs}' for edits.gpkg: {exc}") from exc
+        raise InputError.of("Cannot use the CRS '{crs}' for edits.gpkg: {error}", crs=crs,
+                            error=exc) from exc
 
 
 def create_edits(path: PathLike, crs: str) -> Path:
@@ -206,10 +210,9 @@ def create_edits(path: PathLike, crs: str) -> Path:
     """
     path = Path(path)
     if path.exists():
-        raise InputError(
-            f"'{path}' exists already; PhotoDEM does not overwrite the operator's edits. "
-            "Delete or rename it first if you really want an empty one."
-        )
+        raise InputError.of(
+            "'{path}' exists already; PhotoDEM does not overwrite the operator's edits. "
+            "Delete or rename it first if you really want an empty one.", path=path)
     wkt = _crs_wkt(crs)
     with atomic_output(path) as tmp:
         for layer, (geom_type, fields) in EDIT_LAYERS.items():
@@ -297,7 +300,8 @@ def check_layer(layer: str) -> str:
         Naming the layer and the edit layers.
     """
     if layer not in EDIT_LAYERS:
-        raise InputError(f"'{layer}' is not an edit layer; use one of {', '.join(EDIT_LAYERS)}.")
+        raise InputError.of("'{layer}' is not an edit layer; use one of {layers}.", layer=layer,
+                            layers=", ".join(EDIT_LAYERS))
     return layer
 
 
@@ -316,9 +320,10 @@ def check_fields(layer: str, props: Optional[Dict[str, Any]]) -> Dict[str, Any]:
     props = dict(props or {})
     unknown = sorted(set(props) - set(fields))
     if unknown:
-        raise InputError(f"Layer '{layer}' has no field(s) {', '.join(unknown)}.")
+        raise InputError.of("Layer '{layer}' has no field(s) {fields}.", layer=layer,
+                            fields=", ".join(unknown))
     if layer == "exclusion_areas":
-        props["action"] = check_action(props.get("action"), f"Layer '{layer}'")
+        props["action"] = check_action(props.get("action"), msg("Layer '{layer}'", layer=layer))
     return props
 
 
@@ -352,11 +357,12 @@ def read_layer(path: PathLike, layer: str) -> List[Tuple[Any, Dict[str, Any]]]:
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"Edits file '{path}' not found; create it with project_create.")
+        raise InputError.of("Edits file '{path}' not found; create it with project_create.",
+                            path=path)
     out: List[Tuple[Any, Dict[str, Any]]] = []
     with reading(path, "GeoPackage"):
         if layer not in fiona.listlayers(str(path)):
-            raise InputError(f"'{path}' has no layer '{layer}'.")
+            raise InputError.of("'{path}' has no layer '{layer}'.", path=path, layer=layer)
         for feat in read_features(path, (layer,), "GeoPackage"):
             out.append(check_feature(path, layer, feat.fid, shape(feat.geometry),
                                      feat.properties))
@@ -376,7 +382,7 @@ def read_geometries(path: PathLike, kinds: Tuple[str, ...], crs: Any,
         crs = CRS.from_user_input(crs)
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"Vector file '{path}' does not exist.")
+        raise InputError.of("Vector file '{path}' does not exist.", path=path)
     check_encodable(path, "vector file")
     out: List[Any] = []
     with reading(path, "vector file"):

@@ -77,7 +77,7 @@ def blob_to_geometry(blob: Optional[bytes]) -> Any:
         return None
     blob = bytes(blob)
     if blob[:2] != b"GP":
-        raise InputError("A geometry of edits.gpkg is not a GeoPackage geometry blob.")
+        raise InputError.of("A geometry of edits.gpkg is not a GeoPackage geometry blob.")
     flags = blob[3]
     if flags & 0x10:  # the empty flag
         return None
@@ -196,11 +196,12 @@ def read_edits(path: PathLike) -> EditsContent:
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"The edits file '{path}' does not exist.")
+        raise InputError.of("The edits file '{path}' does not exist.", path=path)
     try:
         con = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=2.0)
     except sqlite3.Error as exc:
-        raise InputError(f"Cannot open the edits file '{path}': {exc}") from exc
+        raise InputError.of("Cannot open the edits file '{path}': {error}", path=path,
+                            error=exc) from exc
     try:
         tables = _tables(con)
         content = EditsContent(crs_wkt=_crs_wkt(con, tables))
@@ -210,11 +211,11 @@ def read_edits(path: PathLike) -> EditsContent:
                 content.columns[name] = list(tables[name].columns)
         return content
     except (sqlite3.Error, ValueError, struct.error) as exc:  # also shapely's WKB errors
-        raise InputError(f"The edits file '{path}' is not a readable GeoPackage ({exc}); it "
-                         "is damaged or not a GeoPackage.") from exc
+        raise InputError.of("The edits file '{path}' is not a readable GeoPackage ({error}); "
+                            "it is damaged or not a GeoPackage.", path=path, error=exc) from exc
     except Exception as exc:  # shapely.errors.GEOSException and kin: a damaged geometry
-        raise InputError(f"The edits file '{path}' holds a geometry that cannot be read "
-                         f"({exc}).") from exc
+        raise InputError.of("The edits file '{path}' holds a geometry that cannot be read "
+                            "({error}).", path=path, error=exc) from exc
     finally:
         con.close()
 
@@ -237,7 +238,7 @@ def _numbered(features: Iterable[Sequence[Any]]) -> List[Feature]:
     items = [tuple(f) for f in features]
     given = [int(f[0]) for f in items if len(f) == 3 and f[0] is not None]
     if len(set(given)) != len(given):
-        raise InputError("Two features of one edit layer have the same fid.")
+        raise InputError.of("Two features of one edit layer have the same fid.")
     next_fid = max(given, default=0) + 1
     out: List[Feature] = []
     for item in items:
@@ -253,8 +254,8 @@ def _write_table(con: sqlite3.Connection, table: _Table, features: List[Feature]
     """Replace the rows of one edit layer (fids kept) and update its extent and count."""
     unknown = sorted({k for _, _, a in features for k in a} - set(table.columns))
     if unknown:
-        raise InputError(f"Layer '{table.name}' of edits.gpkg has no field(s) "
-                         f"{', '.join(unknown)}.")
+        raise InputError.of("Layer '{layer}' of edits.gpkg has no field(s) {fields}.",
+                            layer=table.name, fields=", ".join(unknown))
     con.execute(f"DELETE FROM {_quote(table.name)}")
     cols = [table.fid, table.geometry] + table.columns
     sql = (f"INSERT INTO {_quote(table.name)} ({', '.join(_quote(c) for c in cols)}) "
@@ -304,7 +305,8 @@ def _fill(staging: Path, layers: Dict[str, List[Feature]]) -> None:
         with con:
             for name, features in layers.items():
                 if name not in tables:
-                    raise InputError(f"edits.gpkg has no layer '{name}' to write.")
+                    raise InputError.of("edits.gpkg has no layer '{layer}' to write.",
+                                        layer=name)
                 _write_table(con, tables[name], features)
     finally:
         con.close()
@@ -317,11 +319,12 @@ def _check(staging: Path, layers: Dict[str, List[Feature]]) -> None:
             with fiona.open(str(staging), layer=name) as src:
                 count = len(src)
         except Exception as exc:  # fiona's driver errors
-            raise InputError(f"The new edits.gpkg cannot be read back ({exc}); the old file "
-                             "is kept.") from exc
+            raise InputError.of("The new edits.gpkg cannot be read back ({error}); the old "
+                                "file is kept.", error=exc) from exc
         if count != len(features):
-            raise InputError(f"The new edits.gpkg holds {count} features in '{name}' instead "
-                             f"of {len(features)}; the old file is kept.")
+            raise InputError.of("The new edits.gpkg holds {count} features in '{layer}' instead "
+                                "of {expected}; the old file is kept.", count=count, layer=name,
+                                expected=len(features))
 
 
 def save_edits(path: PathLike, layers: Dict[str, Iterable[Sequence[Any]]],
@@ -355,15 +358,16 @@ def save_edits(path: PathLike, layers: Dict[str, Iterable[Sequence[Any]]],
     numbered = {name: _numbered(features) for name, features in layers.items()}
     for name in numbered:
         if name not in EDIT_LAYERS:
-            raise InputError(f"'{name}' is not an edit layer; use one of "
-                             f"{', '.join(EDIT_LAYERS)}.")
+            raise InputError.of("'{layer}' is not an edit layer; use one of {layers}.",
+                                layer=name, layers=", ".join(EDIT_LAYERS))
     staging = path.with_name(output_policy.staging_name(path.stem, suffix=path.suffix))
     try:
         if path.exists():
             _copy(path, staging)
         else:
             if not crs:
-                raise InputError(f"'{path}' does not exist and no CRS was given to create it.")
+                raise InputError.of("'{path}' does not exist and no CRS was given to create it.",
+                                    path=path)
             create_edits(staging, crs)
         missing = [n for n in missing_edit_layers(staging) if n in numbered]
         if missing:
@@ -373,7 +377,8 @@ def save_edits(path: PathLike, layers: Dict[str, Iterable[Sequence[Any]]],
         with output_policy.sigint_blocked():
             os.replace(staging, path)
     except sqlite3.Error as exc:
-        raise InputError(f"Cannot write '{path}': {exc}; the old file is kept.") from exc
+        raise InputError.of("Cannot write '{path}': {error}; the old file is kept.", path=path,
+                            error=exc) from exc
     finally:
         for leftover in (staging, Path(f"{staging}-journal"), Path(f"{staging}-wal"),
                          Path(f"{staging}-shm")):

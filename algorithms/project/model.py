@@ -266,19 +266,21 @@ class Project:
         for rec in self.images:
             if rec.name == name:
                 return rec
-        raise InputError(
-            f"Image '{name}' is not in project '{self.name}'. Images: "
-            f"{', '.join(r.name for r in self.images[:20])}{' …' if len(self.images) > 20 else ''}."
-        )
+        raise InputError.of(
+            "Image '{name}' is not in project '{project}'. Images: {images}.", name=name,
+            project=self.name, images=(", ".join(r.name for r in self.images[:20])
+                                       + (" …" if len(self.images) > 20 else "")))
 
     def model(self, name: str) -> StereoModel:
         for m in self.models:
             if m.name == name:
                 return m
-        raise InputError(
-            f"Stereo model '{name}' is not in project '{self.name}'. Models: "
-            f"{', '.join(m.name for m in self.models) or 'none'}."
-        )
+        if not self.models:
+            raise InputError.of("Stereo model '{name}' is not in project '{project}'. Models: "
+                                "none.", name=name, project=self.name)
+        raise InputError.of("Stereo model '{name}' is not in project '{project}'. Models: "
+                            "{models}.", name=name, project=self.name,
+                            models=", ".join(m.name for m in self.models))
 
     def camera_of(self, image: Union[str, ImageRecord]) -> Camera:
         rec = self.image(image) if isinstance(image, str) else image

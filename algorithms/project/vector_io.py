@@ -17,6 +17,7 @@ from rasterio.crs import CRS
 from rasterio.warp import transform_geom
 
 from ..errors import InputError
+from ..input_errors import role
 
 PathLike = Union[str, Path]
 
@@ -57,7 +58,8 @@ def read_features(path: PathLike, layers: Optional[Sequence[str]] = None,
     try:
         names = fiona.listlayers(str(path))
     except Exception as exc:  # driver-specific errors
-        raise InputError(f"Cannot read the {what} '{path.name}': {exc}") from exc
+        raise InputError.of("Cannot read the {what} '{name}': {error}", what=role(what),
+                            name=path.name, error=exc) from exc
     return list(_features(path, names, layers))
 
 

@@ -472,7 +472,7 @@ class BatchDialog(QtWidgets.QDialog):
             if not self.opened_file:
                 self.write_batch_file()
         except PhotodemError as exc:
-            self.report(str(exc))
+            self.report(error_text(exc))
             return False
         self._remember()
         return self._start(self.batch_file)

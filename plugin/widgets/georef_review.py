@@ -31,7 +31,7 @@ from ...algorithms.georef.products import (
 )
 from ...algorithms.georef.review import Review, load_review, save_review
 from ...algorithms.raster.io import open_image
-from ..i18n import tr
+from ..i18n import error_text, tr
 from ..qt import QtCore, QtGui, QtWidgets, pyqtSignal
 
 #: Tint of the independent check points' table rows.
@@ -404,7 +404,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         try:
             self.review.add_point(values[:2], values[2:])
         except PhotodemError as exc:
-            self._error(str(exc))
+            self._error(error_text(exc))
             return
         self._fill_points()
         self._changed()
@@ -423,7 +423,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         try:
             skipped = self.review.import_check_points(path)
         except PhotodemError as exc:
-            self._error(str(exc))
+            self._error(error_text(exc))
             return False
         warning = self._skipped_note(skipped)
         self._fill_points()
@@ -465,7 +465,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         except PhotodemError as exc:
             self.fit, self.rows = None, []
             self.check = {"count": 0, "points": []}
-            self.summary.setText(f"<span style='color:#c0392b'>{exc}</span>")
+            self.summary.setText(f"<span style='color:#c0392b'>{error_text(exc)}</span>")
             self.save_button.setEnabled(False)
             self._draw()
             return
@@ -601,7 +601,7 @@ class GeorefReviewDialog(QtWidgets.QDialog):
         except Cancelled:
             return False
         except PhotodemError as exc:
-            self._error(str(exc))
+            self._error(error_text(exc))
             return False
         finally:
             progress.close()
@@ -642,7 +642,7 @@ def open_review(parent: Optional[QtWidgets.QWidget], folder: Optional[str] = Non
         dialog = GeorefReviewDialog(folder, parent, message_boxes=message_boxes)
     except PhotodemError as exc:
         if on_error is not None:
-            on_error(str(exc))
+            on_error(error_text(exc))
         return None
     dialog.setAttribute(QtCore.Qt.WA_DeleteOnClose)
     dialog.show()

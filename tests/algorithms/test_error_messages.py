@@ -134,3 +134,155 @@ def test_batch_records_carry_the_message_as_json(tmp_path):
                            what=msg("files PhotoDEM did not write"))
     back = Message.from_dict(json.loads(json.dumps(nested.message.to_dict())))
     assert str(back) == str(nested) and isinstance(back.values["what"], Message)
+
+
+# -- part 2: the errors of the toolbox's main algorithms ------------------------------------------
+def _failure(call, *args, **kwargs):
+    """The operator error ``call(*args, **kwargs)`` raises."""
+    from photodem.algorithms.errors import PhotodemError
+
+    with pytest.raises(PhotodemError) as info:
+        call(*args, **kwargs)
+    return info.value
+
+
+def test_an_unreadable_raster_names_its_role_as_a_phrase(tmp_path):
+    from photodem.algorithms.input_errors import check_raster, check_raster_parameters
+
+    bad = tmp_path / "bad.tif"
+    bad.write_bytes(b"not a tiff at all")
+    exc = _failure(check_raster, bad, "image")
+    assert str(exc).startswith(f"'{bad}' is not a readable image (")
+    assert exc.message.template == "'{path}' is not a readable {what} ({detail})."
+    assert exc.message.values["what"] == Message("image")
+    param = Parameter("dem", "raster", "DEM")
+    wrapped = _failure(check_raster_parameters, [param], {"dem": str(bad)})
+    assert str(wrapped).startswith(f"Parameter 'dem': '{bad}' is not a readable raster (")
+    assert wrapped.message.values["error"].values["what"] == Message("raster")
+    odd = _failure(check_raster, bad, "scan")  # a role without a phrase stays as it is
+    assert odd.message.values["what"] == "scan"
+
+
+def test_model_setup_messages_are_unchanged_and_translatable(chain_project):
+    from photodem.algorithms.matching.model_setup import prepare_model
+
+    root = chain_project("ab")
+    exc = _failure(Project.load(root).model, "x_y")
+    assert str(exc) == "Stereo model 'x_y' is not in project 't'. Models: a_b."
+    assert exc.message.values == {"name": "x_y", "project": "t", "models": "a_b"}
+    exc = _failure(prepare_model, root, "a_b", min_height=100.0, max_height=50.0)
+    assert str(exc) == "max_height (50.0) must be larger than min_height (100.0)."
+    exc = _failure(prepare_model, root, "a_b", min_height=0.0, max_height=1200.0)
+    assert str(exc) == ("max_height (1200.0 m) reaches the cameras (1000.0 m); give a lower "
+                        "max_height.")
+    assert exc.message.values["z_cam"] == 1000.0
+
+
+def test_images_that_do_not_overlap(tmp_path):
+    from photodem.algorithms.errors import GeometryError
+    from photodem.algorithms.geometry.camera import Camera
+    from photodem.algorithms.geometry.orientation import ExteriorOrientation
+    from photodem.algorithms.matching.model_setup import prepare_model
+    from photodem.algorithms.project.model import ImageRecord, StereoModel
+
+    images = [ImageRecord(n, f"{n}.tif", "c", ExteriorOrientation.from_opk(
+        [x, 0.0, 1000.0], 0.0, 0.0, 0.0)) for n, x in (("a", 0.0), ("b", 5000.0))]
+    project = Project(root=tmp_path / "p", name="t", crs="EPSG:25832",
+                      cameras={"c": Camera("c", 100, 80, 1.0, (0.01, 0.01))}, images=images,
+                      models=[StereoModel("a_b", "a", "b")], terrain_height=0.0)
+    exc = _failure(prepare_model, project, "a_b")
+    assert isinstance(exc, GeometryError)
+    assert str(exc) == ("The images a and b of model 'a_b' do not overlap; check the model or "
+                        "the orientations.")
+    assert exc.message.values == {"left": "a", "right": "b", "model": "a_b"}
+
+
+def test_edit_and_breakline_messages_are_unchanged_and_translatable():
+    from shapely.geometry import LineString, Polygon
+
+    from photodem.algorithms.project.breaklines import check_breaklines
+    from photodem.algorithms.project.edits import check_feature, check_fields, check_layer
+
+    exc = _failure(check_layer, "roads")
+    assert str(exc).startswith("'roads' is not an edit layer; use one of ")
+    exc = _failure(check_breaklines, [LineString([(0, 0, 1), (2, 2, 1)]),
+                                      LineString([(0, 2, 1), (2, 0, 1)])])
+    assert str(exc) == ("Breaklines 1 and 2 cross at (1.00, 1.00); breaklines must not cross "
+                        "or touch — fix them in edits.gpkg.")
+    exc = _failure(check_fields, "exclusion_areas", {"action": "burn"})
+    assert str(exc).startswith("Layer 'exclusion_areas': action 'burn' is not one of ")
+    assert exc.message.values["where"] == msg("Layer '{layer}'", layer="exclusion_areas")
+    exc = _failure(check_feature, "/p/edits.gpkg", "exclusion_areas", 7,
+                   Polygon([(0, 0), (1, 0), (1, 1), (0, 1)]), {"action": "burn"})
+    assert str(exc).startswith("'edits.gpkg' layer exclusion_areas, feature 7: action 'burn'")
+
+
+def test_batch_file_messages_are_unchanged_and_translatable(tmp_path):
+    from photodem.algorithms.processing.batch import load_batch, plan_batch
+
+    exc = _failure(load_batch, tmp_path / "none.toml")
+    assert str(exc) == f"Batch file '{tmp_path / 'none.toml'}' does not exist."
+    exc = _failure(plan_batch, {"steps": {"algorithm": "dem_compare"}}, tmp_path)
+    assert str(exc) == ("Batch file: write each step as [[steps]] (two brackets), not "
+                        "[steps].")
+    exc = _failure(plan_batch, {"batch": {"workers": 0}, "steps": []}, tmp_path)
+    assert str(exc) == "Batch file: workers = 0 in [batch] must be a whole number ≥ 1."
+    exc = _failure(plan_batch, {"steps": [{"algorithm": "dem_compare", "colour": 1}]},
+                   tmp_path)
+    assert str(exc).startswith("Batch file: unknown key(s) colour in step 1; allowed are ")
+    assert exc.message.values["where"] == msg("step {number}", number=1)
+    exc = _failure(plan_batch, {"steps": [{"algorithm": "dem_compare",
+                                           "params": {"output": "{model}/x"}}]}, tmp_path)
+    assert str(exc) == ("Batch file: step 'dem_compare' uses {model}, but it does not run per "
+                        "model.")
+
+
+def test_georeferencing_messages_keep_their_counts(tmp_path):
+    from photodem.algorithms.errors import GeometryError
+    from photodem.algorithms.georef import pipeline
+    from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
+
+    exc = _failure(pipeline.GeorefOptions(transform="spline").check)
+    assert str(exc) == "Unknown transform 'spline'; use affine, projective or poly2."
+    exc = _failure(reference_objects_from_vector, tmp_path / "none.gpkg")
+    assert str(exc) == f"Reference layer '{tmp_path / 'none.gpkg'}' not found."
+    with pytest.raises(GeometryError) as info:
+        pipeline._fail({"image_objects": 12, "hypotheses": 0}, "no object pairs")
+    assert str(info.value).startswith("Georeferencing failed: no object pairs (image objects "
+                                      "12, hypotheses 0). Check that image and reference")
+    assert info.value.counts == {"image_objects": 12, "hypotheses": 0}  # the report's data
+    assert info.value.message.values["why"] == "no object pairs"
+
+
+def test_filter_input_messages_are_unchanged_and_translatable(tmp_path):
+    from photodem.algorithms.filtering.surface_input import read_filter_input
+
+    exc = _failure(read_filter_input, tmp_path / "none.tif")
+    template = "The filter input '{path}' does not exist or is not a file."
+    assert exc.message.template == template
+    assert str(exc) == template.format(path=tmp_path / "none.tif")
+
+
+def test_georeferencing_review_messages_are_unchanged_and_translatable(tmp_path):
+    from photodem.algorithms.georef.review import load_review, read_check_points
+
+    exc = _failure(load_review, tmp_path)
+    assert str(exc) == (f"'{tmp_path}' holds no georeferencing result (report.json and a "
+                        ".points file); choose the output folder of 'Georeference image "
+                        "against polygons'.")
+    points = tmp_path / "check.csv"
+    points.write_text("col,row,x,y\n1,2,three,4\n", encoding="utf-8")
+    exc = _failure(read_check_points, points)
+    assert str(exc) == "'check.csv' line 2: x 'three' is not a number."
+    assert exc.message.values == {"name": "check.csv", "number": 2, "column": "x",
+                                  "token": "three"}
+
+
+def test_an_unreadable_vector_file_names_its_role(tmp_path):
+    from photodem.algorithms.project.vector_io import read_features
+
+    bad = tmp_path / "seams.gpkg"
+    bad.write_bytes(b"no geopackage")
+    exc = _failure(read_features, bad, None, "seamline file")
+    assert str(exc).startswith("Cannot read the seamline file 'seams.gpkg': ")
+    assert exc.message.values["what"] == Message("seamline file")

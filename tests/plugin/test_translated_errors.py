@@ -110,3 +110,68 @@ def test_german_run_panel_shows_a_translated_error(qtbot, monkeypatch, tmp_path,
     assert f"Fehler: {expected}" in log and "does not exist" not in log
     assert window.grab().save(str(shots_dir / "run_panel_error_de.png"))
     window.run_panel.wait(10000)
+
+
+def _typical_errors(tmp_path, chain_project) -> list:
+    """One operator error of each area converted in part 2 (input rasters, model setup,
+    edits, batch files, georeferencing, filter inputs)."""
+    from shapely.geometry import LineString
+
+    from photodem.algorithms.errors import PhotodemError
+    from photodem.algorithms.filtering.surface_input import read_filter_input
+    from photodem.algorithms.georef.pipeline import GeorefOptions, _fail
+    from photodem.algorithms.georef.reference_layer import reference_objects_from_vector
+    from photodem.algorithms.input_errors import check_raster
+    from photodem.algorithms.matching.model_setup import prepare_model
+    from photodem.algorithms.processing.batch import plan_batch
+    from photodem.algorithms.project.breaklines import check_breaklines
+    from photodem.algorithms.project.edits import check_layer
+    from photodem.algorithms.project.model import Project
+
+    bad = tmp_path / "bad.tif"
+    bad.write_bytes(b"not a tiff")
+    root = chain_project("ab")
+    calls = [
+        lambda: check_raster(bad, "image"),
+        lambda: Project.load(root).model("x_y"),
+        lambda: prepare_model(root, "a_b", min_height=100.0, max_height=50.0),
+        lambda: check_layer("roads"),
+        lambda: check_breaklines([LineString([(0, 0, 1), (2, 2, 1)]),
+                                  LineString([(0, 2, 1), (2, 0, 1)])]),
+        lambda: plan_batch({"steps": {"algorithm": "dem_compare"}}, tmp_path),
+        lambda: plan_batch({"steps": [{"algorithm": "dem_compare", "colour": 1}]}, tmp_path),
+        lambda: GeorefOptions(transform="spline").check(),
+        lambda: reference_objects_from_vector(tmp_path / "none.gpkg"),
+        lambda: _fail({"hypotheses": 0}, "no object pairs"),
+        lambda: read_filter_input(tmp_path / "none.tif"),
+    ]
+    errors = []
+    for call in calls:
+        with pytest.raises(PhotodemError) as info:
+            call()
+        errors.append(info.value)
+    return errors
+
+
+def test_errors_of_the_main_algorithms_in_german(qapp, german, tmp_path, chain_project):
+    errors = _typical_errors(tmp_path, chain_project)
+    german()
+    texts = [i18n.error_text(e) for e in errors]
+    assert all(text != str(e) for text, e in zip(texts, errors)), texts
+    assert texts[0].startswith(f"'{tmp_path / 'bad.tif'}' kann nicht als Bild gelesen werden (")
+    assert texts[1] == "Das Stereomodell 'x_y' ist nicht im Projekt 't'. Modelle: a_b."
+    assert texts[4] == ("Die Bruchkanten 1 und 2 kreuzen sich bei (1.00, 1.00); Bruchkanten "
+                        "dürfen sich weder kreuzen noch berühren — korrigieren Sie sie in "
+                        "edits.gpkg.")
+    assert texts[6].startswith("Batch-Datei: unbekannte(r) Schlüssel colour in Schritt 1; ")
+
+
+def test_georeferencing_review_reports_in_german(qapp, german, tmp_path):
+    from photodem.plugin.widgets.georef_review import open_review
+
+    german()
+    got: list = []
+    assert open_review(None, str(tmp_path), message_boxes=False, on_error=got.append) is None
+    assert got == [f"'{tmp_path}' enthält kein Ergebnis einer Georeferenzierung (report.json "
+                   "und eine .points-Datei); wählen Sie den Ausgabeordner von 'Bild an "
+                   "Polygonen georeferenzieren'."]
