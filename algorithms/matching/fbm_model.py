@@ -401,6 +401,9 @@ OBJECT_SUPPORT_GROUNDELS = 1.5
 OBJECT_MIN_SUPPORT = 2
 OBJECT_MIN_STEP = 1.5
 OBJECT_MIN_SLOPE = 1.0
+#: Jump edges grow from those of :data:`OBJECT_MIN_SLOPE` along edges this steep
+#: (``weak_slope`` of :func:`..surface.jumps.jump_breaklines`; None: no hysteresis).
+OBJECT_WEAK_SLOPE: Optional[float] = 0.5
 #: Agreeing neighbours every point needs to be used at all (0: groundel inliers stay in).
 OBJECT_LONE = 1
 
@@ -439,7 +442,8 @@ def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = No
     inlier = (~red.outlier & (support >= OBJECT_LONE)) | supported
     idx = np.flatnonzero(inlier)
     lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
-                            OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset)
+                            OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset,
+                            weak_slope=OBJECT_WEAK_SLOPE)
     return inlier, lines
 
 

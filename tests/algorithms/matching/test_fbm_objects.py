@@ -240,3 +240,32 @@ def test_object_height_in_px_of_the_model() -> None:
         found.object_search)
     terrain, surface_t = _options("terrain", {})  # a terrain model looks for no objects
     assert _object_search(terrain, surface_t, setup).object_search is None
+
+
+def test_jump_breaklines_close_across_a_wide_hidden_band() -> None:
+    """A 6 m roof on points every 1 m with a 6 m band of no ground points east of it (ground a
+    wall hides from one image): the edges across the band are flatter than 1 m/m, so without
+    hysteresis the line stays open and the FE plate carries the roof into the band; with
+    ``weak_slope`` the line closes round the roof and the band stays on the ground."""
+    from shapely.geometry import Point
+    from shapely.ops import polygonize, unary_union
+
+    xx, yy = np.meshgrid(np.arange(0.5, 30, 1.0), np.arange(0.5, 24, 1.0))
+    x, y = xx.ravel(), yy.ravel()
+    roof = (np.abs(x - 12) < 4) & (np.abs(y - 12) < 4)
+    keep = ~((x > 16) & (x < 22) & (np.abs(y - 12) < 6))
+    x, y, z = x[keep], y[keep], np.where(roof[keep], 6.0, 0.0)
+    grid = Grid.from_bounds(0, 0, 30, 24, 0.4)
+    cx = grid.transform.c + (np.arange(grid.width) + 0.5) * grid.spacing
+    cy = grid.transform.f - (np.arange(grid.height) + 0.5) * grid.spacing
+    gx, gy = np.meshgrid(cx, cy)
+    band = (gx > 17) & (gx < 21.5) & (np.abs(gy - 12) < 4)
+    spill, closed = {}, {}
+    for weak in (None, 0.5):
+        lines = jump_breaklines(x, y, z, 1.5, 1.0, upper_offset=1.6, weak_slope=weak)
+        closed[weak] = any(p.contains(Point(12, 12)) for p in polygonize(unary_union(lines)))
+        zg, _ = fe_interpolate(x, y, z, grid, smoothing=0.05, breaklines=lines)
+        spill[weak] = float(np.nanmax(zg[band]))
+    # measured: open line, up to 4.7 m in the band; closed line, 0.0 m
+    assert not closed[None] and spill[None] > 3.0
+    assert closed[0.5] and spill[0.5] < 0.3
