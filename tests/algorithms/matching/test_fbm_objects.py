@@ -77,7 +77,7 @@ def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER
              max_d: float = 47.0) -> np.ndarray:
     """The fbm_lsm chain of a preset in disparity space: matching (the preset's object search
     in px at ``px_per_m``), groundels (10 px), object surfaces and automatic breaklines
-    (general, urban; the preset's wall offset), FE surface on a 2 px grid → disparity per pixel
+    (general, urban; the preset's wall offset and jump hysteresis), FE surface on a 2 px grid → disparity per pixel
     (x = column, y = −row)."""
     opts, surface = _options(preset, {})
     if surface.get("object_height_m"):
@@ -91,7 +91,8 @@ def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER
     inlier, lines = ~red.outlier, []
     if surface.get("objects"):
         offset = surface.get("wall_offset_gsd")
-        inlier, lines = object_surfaces(pts, red, None if offset is None else float(offset))
+        inlier, lines = object_surfaces(pts, red, None if offset is None else float(offset),
+                                        surface.get("jump_weak_slope"))
     grid = Grid.from_bounds(0.0, -float(h), float(w), 0.0, SPACING_GSD)
     z, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                           smoothing=float(surface["smoothing"]), breaklines=lines)
