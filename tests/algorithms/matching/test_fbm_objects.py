@@ -77,8 +77,8 @@ def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER
              max_d: float = 47.0) -> np.ndarray:
     """The fbm_lsm chain of a preset in disparity space: matching (the preset's object search
     in px at ``px_per_m``), groundels (10 px), object surfaces and automatic breaklines
-    (general, urban; the preset's wall offset and jump hysteresis), FE surface on a 2 px grid → disparity per pixel
-    (x = column, y = −row)."""
+    (general, urban; the preset's wall offset and jump hysteresis), FE surface on a 2 px grid
+    → disparity per pixel (x = column, y = −row)."""
     opts, surface = _options(preset, {})
     if surface.get("object_height_m"):
         opts = replace(opts, object_search=float(surface["object_height_m"]) * px_per_m)
