@@ -219,7 +219,7 @@ def _options(preset: str, overrides: Dict[str, Any], convergent: bool = False
     values.update({k: v for k, v in overrides.items() if v is not None})
     names = {f.name for f in fields(FbmLsmOptions)}
     surface_keys = ("groundel_gsd", "reduction", "smoothing", "objects", "object_height_m",
-                    "wall_offset_gsd")
+                    "wall_offset_gsd", "jump_weak_slope")
     unknown = set(values) - names - set(surface_keys)
     if unknown:
         raise InputError(f"Unknown matching option(s): {', '.join(sorted(unknown))}.")
@@ -405,8 +405,8 @@ OBJECT_MIN_SLOPE = 1.0
 OBJECT_LONE = 1
 
 
-def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = None
-                    ) -> Tuple[np.ndarray, List[Any]]:
+def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = None,
+                    weak_slope: Optional[float] = None) -> Tuple[np.ndarray, List[Any]]:
     """Inliers that keep consistent upper surfaces, and breaklines at the height jumps.
 
     A groundel outlier with :data:`OBJECT_MIN_SUPPORT` agreeing neighbours (a roof in a
@@ -423,6 +423,10 @@ def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = No
     wall_offset : float, optional
         Breaklines this far (m) from the upper point of each jump instead of halfway
         (``upper_offset`` of :func:`..surface.jumps.jump_breaklines`).
+    weak_slope : float, optional
+        Jump edges grow by hysteresis along edges this steep (``weak_slope`` of
+        :func:`..surface.jumps.jump_breaklines`), so the line closes where the ground behind a
+        wall lies far from the roof points.
 
     Returns
     -------
@@ -439,7 +443,8 @@ def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = No
     inlier = (~red.outlier & (support >= OBJECT_LONE)) | supported
     idx = np.flatnonzero(inlier)
     lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
-                            OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset)
+                            OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset,
+                            weak_slope=weak_slope)
     return inlier, lines
 
 
@@ -451,7 +456,8 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
     if surface.get("objects"):
         offset = surface.get("wall_offset_gsd")
         inlier, auto = object_surfaces(mp.xyz, red,
-                                       None if offset is None else float(offset) * setup.gsd)
+                                       None if offset is None else float(offset) * setup.gsd,
+                                       surface.get("jump_weak_slope"))
         breaklines += auto
     if interpolation == "fe":
         # a point's weight: its matching σ_Z and the scatter of the points about the local

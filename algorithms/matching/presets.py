@@ -13,7 +13,9 @@ from typing import Any, Dict, Optional, Tuple
 #: :func:`.fbm_model.match_model_fbm_lsm` (``groundel_gsd``, ``reduction``, ``smoothing``,
 #: ``objects``; ``object_height_m``: the grid densification's upward search in metres,
 #: converted per model into ``object_search`` px; ``wall_offset_gsd``: automatic breaklines
-#: this far from the upper point of a jump).
+#: this far from the upper point of a jump; ``jump_weak_slope``: jump edges grow by hysteresis
+#: along edges of at least this height difference per metre, so the breakline closes round a
+#: roof whose ground points lie far off, behind the wall).
 PRESETS: Dict[str, Dict[str, Any]] = {
     # terrain only (was "flat"): large windows and groundels, L1 planes, smooth surface — a
     # DTM-like surface: buildings and trees are reduced away as outliers (issue 19)
@@ -26,10 +28,13 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # (0.21 ‰ H against 0.044 here); on the roofs of the small blocks as good (tuning table in
     # docs/decisions.md, "fbm_lsm keeps objects"); urban's upward search and wall placement
     # (below) as well: on the wide-angle aerial block the pull-in alone reaches no roof
-    # (object interior 0.3 % on seed 1)
+    # (object interior 0.3 % on seed 1); the jump hysteresis keeps roofs out of the point-free
+    # ring round buildings (open land of the small block, issue 19 part K; in urban it cost
+    # 3.5 points of roof on small seed 2, so urban stays without)
     "general": {"fbm_window": 32, "bidir_tol": 0.5, "object_pull_in": 20.0, "rho_min": 0.55,
                 "groundel_gsd": 20.0, "reduction": "median", "smoothing": 0.05,
-                "objects": True, "object_height_m": 15.0, "wall_offset_gsd": 8.0},
+                "objects": True, "object_height_m": 15.0, "wall_offset_gsd": 8.0,
+                "jump_weak_slope": 0.7},
     # buildings: small windows, tight bidirectional check, small groundels, median, little
     # smoothing; groundel outliers that form a consistent upper surface stay,
     # and height jumps between points become breaklines (``objects``), so roofs and walls stay;

@@ -77,8 +77,8 @@ def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER
              max_d: float = 47.0) -> np.ndarray:
     """The fbm_lsm chain of a preset in disparity space: matching (the preset's object search
     in px at ``px_per_m``), groundels (10 px), object surfaces and automatic breaklines
-    (general, urban; the preset's wall offset), FE surface on a 2 px grid → disparity per pixel
-    (x = column, y = −row)."""
+    (general, urban; the preset's wall offset and jump hysteresis), FE surface on a 2 px grid
+    → disparity per pixel (x = column, y = −row)."""
     opts, surface = _options(preset, {})
     if surface.get("object_height_m"):
         opts = replace(opts, object_search=float(surface["object_height_m"]) * px_per_m)
@@ -91,7 +91,8 @@ def _surface(scene: Dict[str, np.ndarray], preset: str, px_per_m: float = PX_PER
     inlier, lines = ~red.outlier, []
     if surface.get("objects"):
         offset = surface.get("wall_offset_gsd")
-        inlier, lines = object_surfaces(pts, red, None if offset is None else float(offset))
+        inlier, lines = object_surfaces(pts, red, None if offset is None else float(offset),
+                                        surface.get("jump_weak_slope"))
     grid = Grid.from_bounds(0.0, -float(h), float(w), 0.0, SPACING_GSD)
     z, _ = fe_interpolate(pts[inlier, 0], pts[inlier, 1], pts[inlier, 2], grid,
                           smoothing=float(surface["smoothing"]), breaklines=lines)
@@ -240,3 +241,39 @@ def test_object_height_in_px_of_the_model() -> None:
         found.object_search)
     terrain, surface_t = _options("terrain", {})  # a terrain model looks for no objects
     assert _object_search(terrain, surface_t, setup).object_search is None
+
+
+def test_jump_breaklines_close_across_a_wide_hidden_band() -> None:
+    """A 6 m roof on points every 1 m with a 6 m band of no ground points east of it (ground a
+    wall hides from one image): the edges across the band are flatter than 1 m/m, so without
+    hysteresis the line stays open and the FE plate carries the roof into the band; with
+    ``weak_slope`` the line closes round the roof and the band stays on the ground.
+    (The cut on the hysteresis edges lies halfway: the wall 3 m out here, in the band.)"""
+    from shapely.geometry import Point
+    from shapely.ops import polygonize, unary_union
+
+    xx, yy = np.meshgrid(np.arange(0.5, 30, 1.0), np.arange(0.5, 24, 1.0))
+    x, y = xx.ravel(), yy.ravel()
+    roof = (np.abs(x - 12) < 4) & (np.abs(y - 12) < 4)
+    keep = ~((x > 16) & (x < 22) & (np.abs(y - 12) < 6))
+    x, y, z = x[keep], y[keep], np.where(roof[keep], 6.0, 0.0)
+    grid = Grid.from_bounds(0, 0, 30, 24, 0.4)
+    cx = grid.transform.c + (np.arange(grid.width) + 0.5) * grid.spacing
+    cy = grid.transform.f - (np.arange(grid.height) + 0.5) * grid.spacing
+    gx, gy = np.meshgrid(cx, cy)
+    # beyond the middle of the band (19 m): halfway between the last roof and ground points
+    band = (gx > 19.5) & (gx < 22) & (np.abs(gy - 12) < 4)
+    spill, closed = {}, {}
+    for weak in (None, 0.7):  # 0.7: the `general` preset's jump_weak_slope
+        lines = jump_breaklines(x, y, z, 1.5, 1.0, upper_offset=1.6, weak_slope=weak)
+        closed[weak] = any(p.contains(Point(12, 12)) for p in polygonize(unary_union(lines)))
+        zg, _ = fe_interpolate(x, y, z, grid, smoothing=0.05, breaklines=lines)
+        spill[weak] = float(np.nanmax(zg[band]))
+    # measured: open line, up to 1.9 m in the far half of the band; closed line, 0.0 m
+    assert not closed[None] and spill[None] > 1.5
+    assert closed[0.7] and spill[0.7] < 0.3
+
+
+def test_general_grows_jumps_by_hysteresis_urban_does_not() -> None:
+    assert _options("general", {})[1]["jump_weak_slope"] == 0.7
+    assert "jump_weak_slope" not in _options("urban", {})[1]
