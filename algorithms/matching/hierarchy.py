@@ -15,8 +15,10 @@ right-image data), and the image's shorter side ≥ 2 windows — else fewer lev
 Per level (coarsest first):
 
 0. **Features** in the left image only where the search range can reach right-image data
-   (no overlap = masked, not failed), Förstner weight thresholds **per sub-image**
-   (2 × fbm_window; seed §2.3: strong and weak texture in one image both get points).
+   (no overlap = masked, not failed; below the top level per pixel the span of the coarser
+   own and neighbouring planes ± the pull-in, :func:`_local_range`), Förstner weight
+   thresholds **per sub-image** (2 × fbm_window; seed §2.3: strong and weak texture in one
+   image both get points).
    **Candidates** (default ``candidates="correlation"``): the best local maximum of the 7 × 7
    NCC profile along the right row within the pull-in of each left point (interest operator in
    one image, as the best ISPRS approach, seed §3.4) — on real imagery only about half of the
