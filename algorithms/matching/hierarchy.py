@@ -15,8 +15,10 @@ right-image data), and the image's shorter side ≥ 2 windows — else fewer lev
 Per level (coarsest first):
 
 0. **Features** in the left image only where the search range can reach right-image data
-   (no overlap = masked, not failed), Förstner weight thresholds **per sub-image**
-   (2 × fbm_window; seed §2.3: strong and weak texture in one image both get points).
+   (no overlap = masked, not failed; below the top level per pixel the span of the coarser
+   own and neighbouring planes ± the pull-in, :func:`_local_range`), Förstner weight
+   thresholds **per sub-image** (2 × fbm_window; seed §2.3: strong and weak texture in one
+   image both get points).
    **Candidates** (default ``candidates="correlation"``): the best local maximum of the 7 × 7
    NCC profile along the right row within the pull-in of each left point (interest operator in
    one image, as the best ISPRS approach, seed §3.4) — on real imagery only about half of the
@@ -502,11 +504,14 @@ class _Level:
 
 
 def _level_exclusion(run: _Run, pyr: _Pyramids, k: int, margin: int, valid_right,
-                     prev_matched: NDArray) -> Tuple[NDArray, Optional[NDArray]]:
+                     prev_matched: NDArray, prev: Optional[CoarsePlanes] = None
+                     ) -> Tuple[NDArray, Optional[NDArray]]:
     """Left pixels without stereo overlap, and all excluded pixels of level ``k``.
 
     Left pixels whose search range never reaches right-image data have nothing to match
-    (not a failure); below the top, the range is the coarser level's measured disparities.
+    (not a failure); below the top, the range is the coarser level's measured disparities,
+    and per pixel the range its own and neighbouring coarser planes span
+    (:func:`_local_range`).
     """
     scale = 2.0 ** k
     Lk, Rk = pyr.left[k], pyr.right[k]
@@ -522,11 +527,54 @@ def _level_exclusion(run: _Run, pyr: _Pyramids, k: int, margin: int, valid_right
         lo_all = max(2.0 * float(corners.min()) - run.pull_grow, run.min_d / scale) - 1.0
         hi_all = min(2.0 * float(corners.max()) + run.pull_grow, run.max_d / scale) + 1.0
         no_overlap |= ~_overlap_mask(valid_right, Rk.shape, Lk.shape, lo_all, hi_all, margin)
+    if prev is not None:
+        # no margin here: a partner window that reaches over the right image's border can
+        # still match (the drone pairs lost correct points along it with the margin)
+        lo_px, hi_px = _local_range(run, prev, k, Lk.shape)
+        no_overlap |= ~_overlap_mask(valid_right, Rk.shape, Lk.shape, lo_px, hi_px, 0)
     excl = None
     for m in (pyr.mask[k], pyr.barriers[k], no_overlap if no_overlap.any() else None):
         if m is not None:
             excl = m.copy() if excl is None else (excl | m)
     return no_overlap, excl
+
+
+#: Block side (level px) of the per-pixel disparity intervals (:func:`_local_range`).
+_RANGE_STEP = 4
+
+
+def _local_range(run: _Run, prev: CoarsePlanes, k: int, shape: Tuple[int, int]
+                 ) -> Tuple[NDArray, NDArray]:
+    """Disparity interval (level-k px) each pixel can still take: the lowest and highest of
+    the coarser level's own and neighbouring planes there (:meth:`CoarsePlanes.span`),
+    widened by the growing pull-in (not by the finest level's object search upwards: with it
+    most windows along the far edge stay open; objects that much above the coarser planes
+    are not what these windows fail on).
+
+    Why: on convergent pairs the disparity changes by hundreds of px across the image, so
+    the range over the whole level reaches right-image data for windows along the overlap's
+    far edge whose own partner lies outside the right image (issue 22). The neighbours'
+    planes keep a wrong coarse window open. NaN (no plane anywhere) → the whole range.
+
+    The planes are evaluated at the centres of ``step`` × ``step`` blocks (a plane moves
+    less than a pixel across a block, far less than the pull-in added) and the blocks are
+    filled with their centre's interval: the neighbour planes of every pixel would take five
+    evaluations per pixel.
+    """
+    h, w = shape
+    step = _RANGE_STEP
+    rows, cols = np.mgrid[0:h:step, 0:w:step].astype(float)
+    rows, cols = np.minimum(rows + step // 2, h - 1), np.minimum(cols + step // 2, w - 1)
+    lo, hi = prev.span(cols.ravel(), rows.ravel())
+    _, grow = _level_pulls(run, k)
+    lo = np.where(np.isfinite(lo), lo - grow - 1.0, run.min_d / 2.0 ** k - 1.0)
+    hi = np.where(np.isfinite(hi), hi + grow + 1.0, run.max_d / 2.0 ** k + 1.0)
+
+    def blocks(a: NDArray) -> NDArray:
+        a = a.reshape(rows.shape)
+        return np.repeat(np.repeat(a, step, axis=0), step, axis=1)[:h, :w]
+
+    return blocks(lo), blocks(hi)
 
 
 def _component_masks(grouping: Grouping, shape: Tuple[int, int], mask: Optional[NDArray],
@@ -554,14 +602,16 @@ def _component_masks(grouping: Grouping, shape: Tuple[int, int], mask: Optional[
     return masked, tiny
 
 
-def _setup_level(run: _Run, pyr: _Pyramids, k: int, prev_matched: NDArray) -> _Level:
-    """Exclusions, window components, Förstner features and component masks of level k."""
+def _setup_level(run: _Run, pyr: _Pyramids, k: int, prev_matched: NDArray,
+                 prev: Optional[CoarsePlanes] = None) -> _Level:
+    """Exclusions, window components, Förstner features and component masks of level k
+    (``prev``: the coarser level's filled planes, None at the top)."""
     opt, ws = run.opt, run.ws
     Lk, Rk = pyr.left[k], pyr.right[k]
     validL = ~pyr.nodata_left[k] if pyr.nodata_left[k] is not None else None
     validR = ~pyr.nodata_right[k] if pyr.nodata_right[k] is not None else None
     margin = run.margin0 if k == 0 else run.margin_coarse
-    no_overlap, excl = _level_exclusion(run, pyr, k, margin, validR, prev_matched)
+    no_overlap, excl = _level_exclusion(run, pyr, k, margin, validR, prev_matched, prev)
     grouping = window_components(Lk.shape, ws, pyr.barriers[k])
     fkw = {"window": opt.interest_window, "q_min": opt.q_min, "w_factor": opt.w_factor,
            "nms_window": opt.nms_window, "margin": margin,
@@ -670,10 +720,15 @@ class _LevelState:
 
 
 def _pulls(run: _Run, lv: _Level) -> Tuple[float, float]:
-    """Pull-ins (from the coarser level, growing) of a level: the finest level widens both to
-    ``object_pull_in`` if given."""
+    """Pull-ins (from the coarser level, growing) of a level (:func:`_level_pulls`)."""
+    return _level_pulls(run, lv.k)
+
+
+def _level_pulls(run: _Run, k: int) -> Tuple[float, float]:
+    """Pull-ins (from the coarser level, growing) of level ``k``: the finest level widens both
+    to ``object_pull_in`` if given."""
     extra = run.opt.object_pull_in
-    if lv.k == 0 and extra:
+    if k == 0 and extra:
         return max(run.pull_ref, float(extra)), max(run.pull_grow, float(extra))
     return run.pull_ref, run.pull_grow
 
@@ -1011,7 +1066,7 @@ def match_epipolar_fbm_lsm(left: NDArray, right: NDArray, min_d: float, max_d: f
     n_seeds_used = 0
     for k in range(top, -1, -1):
         t_level = time.perf_counter()
-        lv = _setup_level(run, pyr, k, prev_matched)
+        lv = _setup_level(run, pyr, k, prev_matched, prev)
         mode, seed_d, coarse, n_seeds = _initial_modes(run, lv, prev, approx, seeds, fb)
         n_seeds_used = n_seeds if n_seeds is not None else n_seeds_used
         s = _new_state(lv, mode, seed_d, coarse, top)
@@ -1066,7 +1121,8 @@ def _overlap_mask(valid_right: Optional[NDArray], right_shape: Tuple[int, int],
 
     The right image's data (eroded by ``margin`` so that a correlation window fits) is summed
     cumulatively along the rows; a left pixel overlaps when the sum over the columns
-    [c − hi, c − lo] is positive. Rows beyond the right image have no overlap.
+    [c − hi, c − lo] is positive. Rows beyond the right image have no overlap. ``lo`` and
+    ``hi`` are numbers or per-pixel arrays of the left shape.
     """
     h, w = left_shape
     hr, wr = right_shape
@@ -1082,11 +1138,13 @@ def _overlap_mask(valid_right: Optional[NDArray], right_shape: Tuple[int, int],
     rows = min(h, hr)
     cs = np.zeros((rows, wr + 1), np.int64)
     cs[:, 1:] = np.cumsum(vr[:rows], axis=1)
-    c = np.arange(w, dtype=np.float64)
-    a = np.clip(np.ceil(c - hi), 0, wr).astype(np.int64)  # first right column (incl.)
-    b = np.clip(np.floor(c - lo) + 1, 0, wr).astype(np.int64)  # last right column + 1
+    c = np.broadcast_to(np.arange(w, dtype=np.float64), (h, w))[:rows]
+    lo_r = np.broadcast_to(np.asarray(lo, np.float64), (h, w))[:rows]
+    hi_r = np.broadcast_to(np.asarray(hi, np.float64), (h, w))[:rows]
+    a = np.clip(np.ceil(c - hi_r), 0, wr).astype(np.int64)  # first right column (incl.)
+    b = np.clip(np.floor(c - lo_r) + 1, 0, wr).astype(np.int64)  # last right column + 1
     out = np.zeros((h, w), bool)
-    out[:rows] = (cs[:, b] - cs[:, a]) > 0
+    out[:rows] = (np.take_along_axis(cs, b, 1) - np.take_along_axis(cs, a, 1)) > 0
     return out
 
 
