@@ -714,14 +714,9 @@ class _LevelState:
         """The predictor of the current wave (its own copy of the to-do set)."""
         mid_k = 0.5 * (run.min_d + run.max_d) / lv.scale
         half_k = 0.5 * (run.max_d - run.min_d) / lv.scale + 1.0
-        ref, grow = _pulls(run, lv)
+        ref, grow = _level_pulls(run, lv.k)
         return Predictor(lv.grouping, self.mode, self.plane, self.matched, self.seed_d,
                           self.coarse, mid_k, half_k, ref, grow, self.todo.copy())
-
-
-def _pulls(run: _Run, lv: _Level) -> Tuple[float, float]:
-    """Pull-ins (from the coarser level, growing) of a level (:func:`_level_pulls`)."""
-    return _level_pulls(run, lv.k)
 
 
 def _level_pulls(run: _Run, k: int) -> Tuple[float, float]:
@@ -985,7 +980,7 @@ def _grid_densify(run: _Run, Lf: NDArray, Rf: NDArray, lv: _Level, s: _LevelStat
     """
     t_grid = time.perf_counter()
     g_plane = fill_planes(s.plane, lv.grouping, s.matched, lv.masked)
-    ref, grow = _pulls(run, lv)
+    ref, grow = _level_pulls(run, lv.k)
     g_pull = np.where(s.matched, ref, grow)
     g_parts, g_stats = _grid_points(Lf, Rf, lv.grouping, g_plane, g_pull, lv.excl,
                                     lv.valid_left, lv.margin, int(run.opt.grid_step), run.opt,

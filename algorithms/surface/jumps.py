@@ -28,7 +28,7 @@ Jump breaklines (:func:`jump_breaklines`)
 
 from __future__ import annotations
 
-from typing import Any, List, Optional
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -113,10 +113,8 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
     except QhullError:  # all points on a line
         return []
     simp, nb = tri.simplices, tri.neighbors
-    is_jump = _jump_edges(x, y, z, simp, min_step, min_slope, sup, weak_slope)
+    is_jump, steep = _jump_edges(x, y, z, simp, min_step, min_slope, sup, weak_slope)
     if upper_offset is not None:
-        steep = (is_jump if weak_slope is None
-                 else _jump_edges(x, y, z, simp, min_step, min_slope, sup, None))
         return _upper_contour(x, y, z, simp, is_jump, float(upper_offset), steep)
     cen = np.column_stack([x[simp].mean(1), y[simp].mean(1)])
     pieces = []
@@ -133,9 +131,9 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
 
 
 def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_slope: float,
-                sup: Array, weak_slope: Optional[float]) -> Array:
-    r"""(n_triangles, 3) bool: the edge opposite each vertex is a jump (the same for both
-    triangles of an edge).
+                sup: Array, weak_slope: Optional[float]) -> Tuple[Array, Array]:
+    r"""Two (n_triangles, 3) bool arrays: the edge opposite each vertex is a jump (the same for
+    both triangles of an edge), and it is one by the steep rule alone (without hysteresis).
 
     An edge between supported points is a jump when :math:`|\Delta Z| \ge` ``min_step`` and
     :math:`|\Delta Z| / \text{length} \ge` ``min_slope``. With ``weak_slope``, jumps grow
@@ -155,7 +153,7 @@ def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_
     base = (dz >= min_step) & sup[a] & sup[b]
     jump = base & (dz >= min_slope * length)
     if weak_slope is None or weak_slope >= min_slope:
-        return jump
+        return jump, jump
     weak = base & (dz >= weak_slope * length) & ~jump
     # one id per undirected edge, so that both triangles of an edge agree
     lo, hi = np.minimum(a, b).ravel(), np.maximum(a, b).ravel()
@@ -166,7 +164,7 @@ def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_
     while True:
         grow = weak & on[eid].any(1, keepdims=True) & ~on[eid]
         if not grow.any():
-            return on[eid]
+            return on[eid], jump
         on[eid[grow]] = True
 
 
