@@ -2620,12 +2620,12 @@
         </message>
         <message>
             <source>About PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:405</extracomment>
+            <extracomment>plugin/app/main_window.py:412</extracomment>
             <translation>Über PhotoDEM</translation>
         </message>
         <message>
             <source>PhotoDEM: aerial photogrammetry — DSMs by image matching, DTMs by filtering, orthophoto mosaics and automatic georeferencing.</source>
-            <extracomment>plugin/app/main_window.py:406</extracomment>
+            <extracomment>plugin/app/main_window.py:413</extracomment>
             <translation>PhotoDEM: Luftbildphotogrammetrie — Oberflächenmodelle durch Bildzuordnung, Geländemodelle durch Filterung, Orthophotomosaike und automatische Georeferenzierung.</translation>
         </message>
         <message>
@@ -2635,12 +2635,12 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:298; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:757; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:305; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:757; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
             <source>Batch running – show</source>
-            <extracomment>plugin/app/main_window.py:327</extracomment>
+            <extracomment>plugin/app/main_window.py:334</extracomment>
             <translation>Batch läuft – anzeigen</translation>
         </message>
         <message>
@@ -2655,7 +2655,7 @@
         </message>
         <message>
             <source>Batch {0}: summary in {1}</source>
-            <extracomment>plugin/app/main_window.py:338</extracomment>
+            <extracomment>plugin/app/main_window.py:345</extracomment>
             <translation>Batch {0}: Zusammenfassung in {1}</translation>
         </message>
         <message>

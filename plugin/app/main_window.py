@@ -242,7 +242,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         layout.addStretch(1)
         self.form_area.setWidget(container)
         self.run_panel.setEnabled(True)
-        self.statusBar().showMessage(alg.id)
+        self.statusBar().showMessage(tr(alg.name))
         self._select_in_tree(alg.id)
         self.algorithm_selected.emit(alg.id)
         return self.form
@@ -265,7 +265,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
             return
         self.form.setEnabled(False)
         self.tree.setEnabled(False)
-        self.statusBar().showMessage(tr("Running {0} …").format(self.algorithm.id))
+        self.statusBar().showMessage(tr("Running {0} …").format(tr(self.algorithm.name)))
         self.form.remember(self.settings)
         self.run_panel.start(self.algorithm.id, self.form.values())
 
@@ -275,7 +275,7 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
         self.tree.setEnabled(True)
         messages = {"done": tr("{0} finished."), "failed": tr("{0} failed."),
                     "cancelled": tr("{0} was cancelled.")}
-        text = messages.get(status, "{0}").format(self.run_panel.algorithm_id)
+        text = messages.get(status, "{0}").format(self._run_title())
         self.statusBar().showMessage(text)
         if status == "failed" and self.message_boxes:
             QtWidgets.QMessageBox.warning(self, tr("PhotoDEM"), str(payload))
@@ -286,6 +286,13 @@ class ToolboxWindow(MapWindowMixin, QtWidgets.QMainWindow):
             self.last_georef = str(Path(payload["report"]).parent)
             self.statusBar().showMessage(text + " " + tr("Tools → Review georeferencing checks "
                                                          "and edits its control points."))
+
+    def _run_title(self) -> str:
+        """The operator's name of the algorithm that ran (its id if it is not the selected one)."""
+        run_id = self.run_panel.algorithm_id
+        if self.algorithm is not None and self.algorithm.id == run_id:
+            return tr(self.algorithm.name)
+        return str(run_id)
 
     def open_georef_review(self, folder: Optional[str] = None) -> Optional[QtWidgets.QDialog]:
         """Open the review dialog of a georeferencing output folder (asks for it unless

@@ -100,6 +100,7 @@ def test_window_runs_and_shows_result(qtbot, window, project, tmp_path):
     groups = [window.tree.topLevelItem(i).text(0) for i in range(window.tree.topLevelItemCount())]
     assert "Testing" in groups
     form = window.select_algorithm("fake_sleep_write")
+    assert window.statusBar().currentMessage() == "Fake: sleep and write"  # its name, not id
     out = tmp_path / "gui.json"
     form.set_values({"project": str(project), "model": "b_c", "output": str(out),
                      "seconds": 0.5, "steps": 20})
@@ -116,6 +117,7 @@ def test_window_runs_and_shows_result(qtbot, window, project, tmp_path):
     assert [result.topLevelItem(i).text(0) for i in range(result.topLevelItemCount())] == [
         "output", "value"]
     assert "model b_c done" in window.run_panel.log_view.toPlainText()
+    assert window.statusBar().currentMessage() == "Fake: sleep and write finished."
     assert window.run_panel.run_button.isEnabled() and form.isEnabled()
     window.grab().save("/tmp/photodem_toolbox.png")
 
