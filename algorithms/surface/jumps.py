@@ -24,8 +24,8 @@ Jump breaklines (:func:`jump_breaklines`)
     the first ground point (within about half the point spacing of the true wall). With
     ``weak_slope`` jump edges grow by hysteresis into flatter neighbouring edges, so the line
     also closes where the ground points lie far behind a wall (:func:`_jump_edges`); only into
-    edges no higher than an object (``weak_max_step``) and from upper points that more than
-    the least supported ones agree with (``weak_upper``).
+    edges no higher than the objects looked for (``weak_max_step``) and from upper points with
+    enough agreeing neighbours (``weak_upper``).
 """
 
 from __future__ import annotations
@@ -142,10 +142,12 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
     return [MultiLineString([tuple(map(tuple, s)) for s in segs])]
 
 
-def _edge_ends(simp: Array) -> Tuple[Array, Array]:
-    """The two points of the edge opposite each vertex: (n_triangles, 3) arrays ``a``, ``b``
-    (edge k joins vertices (k + 1) % 3 and (k + 2) % 3)."""
-    return simp[:, [1, 2, 0]], simp[:, [2, 0, 1]]
+def _edge_steps(x: Array, y: Array, z: Array, simp: Array
+                ) -> Tuple[Array, Array, Array, Array]:
+    """For the edge opposite each vertex ((n_triangles, 3) arrays): its two points ``a``, ``b``
+    (edge k joins vertices (k + 1) % 3 and (k + 2) % 3), |ΔZ| and plan length."""
+    a, b = simp[:, [1, 2, 0]], simp[:, [2, 0, 1]]
+    return a, b, np.abs(z[a] - z[b]), np.hypot(x[a] - x[b], y[a] - y[b])
 
 
 def _weak_candidates(x: Array, y: Array, z: Array, simp: Array, min_step: float,
@@ -167,9 +169,7 @@ def _weak_candidates(x: Array, y: Array, z: Array, simp: Array, min_step: float,
     """
     if weak_slope is None:
         return None
-    a, b = _edge_ends(simp)
-    dz = np.abs(z[a] - z[b])
-    length = np.hypot(x[a] - x[b], y[a] - y[b])
+    a, b, dz, length = _edge_steps(x, y, z, simp)
     weak = (dz >= min_step) & sup[a] & sup[b] & (dz >= weak_slope * length)
     if max_step is not None:
         weak &= dz <= max_step
@@ -195,9 +195,7 @@ def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_
     contour has a gap, and the FE plate carries the roof through it into the point-free ring
     round the building (issue 19, part K).
     """
-    a, b = _edge_ends(simp)
-    dz = np.abs(z[a] - z[b])
-    length = np.hypot(x[a] - x[b], y[a] - y[b])
+    a, b, dz, length = _edge_steps(x, y, z, simp)
     jump = (dz >= min_step) & sup[a] & sup[b] & (dz >= min_slope * length)
     if weak is None:
         return jump, jump
