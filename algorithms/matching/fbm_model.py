@@ -403,10 +403,15 @@ OBJECT_MIN_STEP = 1.5
 OBJECT_MIN_SLOPE = 1.0
 #: Agreeing neighbours every point needs to be used at all (0: groundel inliers stay in).
 OBJECT_LONE = 1
+#: Agreeing neighbours the upper point of an edge needs to become a jump by hysteresis: more
+#: than the least supported roof points (a roof of a few barely supported points is not
+#: closed off; issue 19, part M).
+OBJECT_WEAK_SUPPORT = OBJECT_MIN_SUPPORT + 1
 
 
 def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = None,
-                    weak_slope: Optional[float] = None) -> Tuple[np.ndarray, List[Any]]:
+                    weak_slope: Optional[float] = None, object_height: Optional[float] = None
+                    ) -> Tuple[np.ndarray, List[Any]]:
     """Inliers that keep consistent upper surfaces, and breaklines at the height jumps.
 
     A groundel outlier with :data:`OBJECT_MIN_SUPPORT` agreeing neighbours (a roof in a
@@ -426,7 +431,11 @@ def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = No
     weak_slope : float, optional
         Jump edges grow by hysteresis along edges this steep (``weak_slope`` of
         :func:`..surface.jumps.jump_breaklines`), so the line closes where the ground behind a
-        wall lies far from the roof points.
+        wall lies far from the roof points; only from upper points with
+        :data:`OBJECT_WEAK_SUPPORT` agreeing neighbours.
+    object_height : float, optional
+        Hysteresis only along edges no higher than this (m; ``weak_max_step``): higher steps
+        are relief, not the objects looked for.
 
     Returns
     -------
@@ -444,7 +453,8 @@ def object_surfaces(pts: np.ndarray, red: Any, wall_offset: Optional[float] = No
     idx = np.flatnonzero(inlier)
     lines = jump_breaklines(pts[idx, 0], pts[idx, 1], pts[idx, 2], OBJECT_MIN_STEP,
                             OBJECT_MIN_SLOPE, supported=supported[idx], upper_offset=wall_offset,
-                            weak_slope=weak_slope)
+                            weak_slope=weak_slope, weak_max_step=object_height,
+                            weak_upper=support[idx] >= OBJECT_WEAK_SUPPORT)
     return inlier, lines
 
 
@@ -457,7 +467,8 @@ def _surface(setup: ModelSetup, mp: _ModelPoints, red: Any, surface: Dict[str, A
         offset = surface.get("wall_offset_gsd")
         inlier, auto = object_surfaces(mp.xyz, red,
                                        None if offset is None else float(offset) * setup.gsd,
-                                       surface.get("jump_weak_slope"))
+                                       surface.get("jump_weak_slope"),
+                                       surface.get("object_height_m"))
         breaklines += auto
     if interpolation == "fe":
         # a point's weight: its matching σ_Z and the scatter of the points about the local

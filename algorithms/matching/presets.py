@@ -15,7 +15,8 @@ from typing import Any, Dict, Optional, Tuple
 #: converted per model into ``object_search`` px; ``wall_offset_gsd``: automatic breaklines
 #: this far from the upper point of a jump; ``jump_weak_slope``: jump edges grow by hysteresis
 #: along edges of at least this height difference per metre, so the breakline closes round a
-#: roof whose ground points lie far off, behind the wall).
+#: roof whose ground points lie far off, behind the wall; only along steps up to
+#: ``object_height_m``).
 PRESETS: Dict[str, Dict[str, Any]] = {
     # terrain only (was "flat"): large windows and groundels, L1 planes, smooth surface — a
     # DTM-like surface: buildings and trees are reduced away as outliers (issue 19)
@@ -29,8 +30,7 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # docs/decisions.md, "fbm_lsm keeps objects"); urban's upward search and wall placement
     # (below) as well: on the wide-angle aerial block the pull-in alone reaches no roof
     # (object interior 0.3 % on seed 1); the jump hysteresis keeps roofs out of the point-free
-    # ring round buildings (open land of the small block, issue 19 part K; in urban it cost
-    # 3.5 points of roof on small seed 2, so urban stays without)
+    # ring round buildings (open land of the small block, issue 19 part K)
     "general": {"fbm_window": 32, "bidir_tol": 0.5, "object_pull_in": 20.0, "rho_min": 0.55,
                 "groundel_gsd": 20.0, "reduction": "median", "smoothing": 0.05,
                 "objects": True, "object_height_m": 15.0, "wall_offset_gsd": 8.0,
@@ -43,10 +43,12 @@ PRESETS: Dict[str, Dict[str, Any]] = {
     # grid nodes not matched near the plane search up to 15 m above it in px of the model's
     # parallax (≈ 62 px on the wide-angle aerial block, where 20 px is only ≈ 5 m), and the
     # breaklines lie 8 GSD from the upper point of a jump (the ground behind a wall is hidden
-    # from one image; halfway put walls 2–3 m out)
+    # from one image; halfway put walls 2–3 m out); the jump hysteresis as in general (on
+    # since issue 19 part M: it no longer closes lines round roofs of a few barely supported
+    # points, which had cost 3.5 points of roof on small seed 2)
     "urban": {"fbm_window": 16, "bidir_tol": 0.5, "object_pull_in": 20.0, "groundel_gsd": 10.0,
               "reduction": "median", "smoothing": 0.05, "objects": True,
-              "object_height_m": 15.0, "wall_offset_gsd": 8.0},
+              "object_height_m": 15.0, "wall_offset_gsd": 8.0, "jump_weak_slope": 0.7},
     # vegetation: the lower envelope of the points of a groundel is taken as the terrain
     "forest": {"fbm_window": 24, "groundel_gsd": 30.0, "reduction": "lower",
                "smoothing": 0.3},

@@ -23,7 +23,9 @@ Jump breaklines (:func:`jump_breaklines`)
     so each side follows its own points; the wall lies halfway between the last roof point and
     the first ground point (within about half the point spacing of the true wall). With
     ``weak_slope`` jump edges grow by hysteresis into flatter neighbouring edges, so the line
-    also closes where the ground points lie far behind a wall (:func:`_jump_edges`).
+    also closes where the ground points lie far behind a wall (:func:`_jump_edges`); only into
+    edges no higher than the objects looked for (``weak_max_step``) and from upper points with
+    enough agreeing neighbours (``weak_upper``).
 """
 
 from __future__ import annotations
@@ -76,7 +78,9 @@ def point_support(x: ArrayLike, y: ArrayLike, z: ArrayLike, radius: float, tol: 
 def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
                     min_slope: float = 1.0, supported: ArrayLike = None,
                     upper_offset: Optional[float] = None,
-                    weak_slope: Optional[float] = None) -> List[Any]:
+                    weak_slope: Optional[float] = None,
+                    weak_max_step: Optional[float] = None,
+                    weak_upper: ArrayLike = None) -> List[Any]:
     """Breaklines between neighbouring points with a height jump (module notes).
 
     Parameters
@@ -98,6 +102,12 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
         Hysteresis (:func:`_jump_edges`): an edge of at least ``min_step`` and ``weak_slope``
         (< ``min_slope``) per metre is a jump too where it shares a triangle with a jump
         edge, so the line stays closed where the ground points lie far from a wall.
+    weak_max_step : float, optional
+        Hysteresis grows only into edges whose height difference is at most this (m): the
+        height of the objects looked for; higher steps are relief (default: no limit).
+    weak_upper : array_like of bool, optional
+        Points that may be the upper point of an edge that is a jump only by hysteresis
+        (default all supported points).
 
     Returns
     -------
@@ -113,7 +123,9 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
     except QhullError:  # all points on a line
         return []
     simp, nb = tri.simplices, tri.neighbors
-    is_jump, steep = _jump_edges(x, y, z, simp, min_step, min_slope, sup, weak_slope)
+    weak = _weak_candidates(x, y, z, simp, min_step, weak_slope, sup, weak_max_step,
+                            weak_upper)
+    is_jump, steep = _jump_edges(x, y, z, simp, min_step, min_slope, sup, weak)
     if upper_offset is not None:
         return _upper_contour(x, y, z, simp, is_jump, float(upper_offset), steep)
     cen = np.column_stack([x[simp].mean(1), y[simp].mean(1)])
@@ -130,15 +142,52 @@ def jump_breaklines(x: ArrayLike, y: ArrayLike, z: ArrayLike, min_step: float,
     return [MultiLineString([tuple(map(tuple, s)) for s in segs])]
 
 
+def _edge_steps(x: Array, y: Array, z: Array, simp: Array
+                ) -> Tuple[Array, Array, Array, Array]:
+    """For the edge opposite each vertex ((n_triangles, 3) arrays): its two points ``a``, ``b``
+    (edge k joins vertices (k + 1) % 3 and (k + 2) % 3), |ΔZ| and plan length."""
+    a, b = simp[:, [1, 2, 0]], simp[:, [2, 0, 1]]
+    return a, b, np.abs(z[a] - z[b]), np.hypot(x[a] - x[b], y[a] - y[b])
+
+
+def _weak_candidates(x: Array, y: Array, z: Array, simp: Array, min_step: float,
+                     weak_slope: Optional[float], sup: Array, max_step: Optional[float],
+                     upper: Optional[ArrayLike]) -> Optional[Array]:
+    r"""(n_triangles, 3) bool: edges that hysteresis may turn into jumps (None: no hysteresis).
+
+    An edge between supported points with :math:`|\Delta Z| \ge` ``min_step`` and
+    :math:`|\Delta Z| / \text{length} \ge` ``weak_slope``; with ``max_step`` only up to
+    that height difference, with ``upper`` only where its upper point is one of those.
+
+    Why the height limit: on a steep natural slope (the escarpment of NGI 0182/0184, 24 m
+    cells, 40–50°) the jump lines grew along the slope by 15–90 m steps and cut it into pieces
+    the FE plate fitted apart (issue 19, part M). The objects the presets look for are lower
+    than their ``object_height_m``. Why the upper points: a roof shown by a few points that
+    only just pass the support test, with no points over the rest of it (a building cut by
+    the measuring area), is handed to the ground by a closed line; the open line lets the
+    plate carry the roof over it (``urban`` on small seed 2, part M).
+    """
+    if weak_slope is None:
+        return None
+    a, b, dz, length = _edge_steps(x, y, z, simp)
+    weak = (dz >= min_step) & sup[a] & sup[b] & (dz >= weak_slope * length)
+    if max_step is not None:
+        weak &= dz <= max_step
+    if upper is not None:
+        upper = np.ravel(np.asarray(upper, bool))
+        weak &= upper[np.where(z[a] >= z[b], a, b)]
+    return weak
+
+
 def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_slope: float,
-                sup: Array, weak_slope: Optional[float]) -> Tuple[Array, Array]:
+                sup: Array, weak: Optional[Array]) -> Tuple[Array, Array]:
     r"""Two (n_triangles, 3) bool arrays: the edge opposite each vertex is a jump (the same for
     both triangles of an edge), and it is one by the steep rule alone (without hysteresis).
 
     An edge between supported points is a jump when :math:`|\Delta Z| \ge` ``min_step`` and
-    :math:`|\Delta Z| / \text{length} \ge` ``min_slope``. With ``weak_slope``, jumps grow
-    by hysteresis: an edge of at least ``min_step`` and ``weak_slope`` per metre becomes a jump
-    when it shares a triangle with a jump edge, repeated until nothing changes.
+    :math:`|\Delta Z| / \text{length} \ge` ``min_slope``. With ``weak`` (the candidates of
+    :func:`_weak_candidates`), jumps grow by hysteresis: a candidate becomes a jump when it
+    shares a triangle with a jump edge, repeated until nothing changes.
 
     Why: where the ground behind a wall is hidden from one image, the Delaunay edges from the
     last roof points to the first ground points can be 5–8 m long; the jump of a 6 m roof is
@@ -146,15 +195,11 @@ def _jump_edges(x: Array, y: Array, z: Array, simp: Array, min_step: float, min_
     contour has a gap, and the FE plate carries the roof through it into the point-free ring
     round the building (issue 19, part K).
     """
-    a = simp[:, [1, 2, 0]]  # edge k joins vertices (k + 1) % 3 and (k + 2) % 3
-    b = simp[:, [2, 0, 1]]
-    dz = np.abs(z[a] - z[b])
-    length = np.hypot(x[a] - x[b], y[a] - y[b])
-    base = (dz >= min_step) & sup[a] & sup[b]
-    jump = base & (dz >= min_slope * length)
-    if weak_slope is None or weak_slope >= min_slope:
+    a, b, dz, length = _edge_steps(x, y, z, simp)
+    jump = (dz >= min_step) & sup[a] & sup[b] & (dz >= min_slope * length)
+    if weak is None:
         return jump, jump
-    weak = base & (dz >= weak_slope * length) & ~jump
+    weak = weak & ~jump
     # one id per undirected edge, so that both triangles of an edge agree
     lo, hi = np.minimum(a, b).ravel(), np.maximum(a, b).ravel()
     _, eid = np.unique(lo * np.int64(x.size) + hi, return_inverse=True)

@@ -274,6 +274,65 @@ def test_jump_breaklines_close_across_a_wide_hidden_band() -> None:
     assert closed[0.7] and spill[0.7] < 0.3
 
 
-def test_general_grows_jumps_by_hysteresis_urban_does_not() -> None:
+def _roof_with_hidden_band() -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The scene of the test above: a 6 m roof, points every 1 m, a 6 m band east of it
+    without ground points."""
+    xx, yy = np.meshgrid(np.arange(0.5, 30, 1.0), np.arange(0.5, 24, 1.0))
+    x, y = xx.ravel(), yy.ravel()
+    roof = (np.abs(x - 12) < 4) & (np.abs(y - 12) < 4)
+    keep = ~((x > 16) & (x < 22) & (np.abs(y - 12) < 6))
+    return x[keep], y[keep], np.where(roof[keep], 6.0, 0.0)
+
+
+def _closes_round(lines: list, x: float, y: float) -> bool:
+    from shapely.geometry import Point
+    from shapely.ops import polygonize, unary_union
+
+    return bool(lines) and any(p.contains(Point(x, y))
+                               for p in polygonize(unary_union(lines)))
+
+
+def test_hysteresis_only_below_the_object_height_and_from_supported_roofs() -> None:
+    """``object_surfaces`` closes the line round the 6 m roof with the hidden band when the
+    objects looked for are 15 m high, not when they are lower than the roof (5 m: the step
+    counts as relief), and not when the roof points may not be the upper point of a
+    hysteresis edge (``weak_upper``)."""
+    x, y, z = _roof_with_hidden_band()
+    pts = np.column_stack([x, y, z])
+    red = reduce_groundels(x, y, z, 2.0, origin=(0.0, 24.0), mode="median")
+    closed = {h: _closes_round(object_surfaces(pts, red, 1.6, 0.7, h)[1], 12, 12)
+              for h in (15.0, 5.0)}
+    assert closed == {15.0: True, 5.0: False}
+    # roof points that may not start a hysteresis edge (in object_surfaces: fewer than
+    # OBJECT_WEAK_SUPPORT agreeing neighbours): the line stays open
+    for roof_may, want in ((True, True), (False, False)):
+        lines = jump_breaklines(x, y, z, 1.5, 1.0, upper_offset=1.6, weak_slope=0.7,
+                                weak_max_step=15.0, weak_upper=(z == 0) | roof_may)
+        assert _closes_round(lines, 12, 12) == want
+
+
+def test_hysteresis_does_not_grow_along_a_high_escarpment() -> None:
+    """A 90 m escarpment of about 42° (± 2 m) sampled every 20 m (the NGI pair's 24 m cells):
+    its edges are jumps by the steep rule here and there and by hysteresis along most of it;
+    with the steps limited to an object height of 15 m the lines are those of the steep rule
+    alone (issue 19, part M: on NGI 0182/0184 the grown lines cost 0.26 m RMS)."""
+    rng = np.random.default_rng(3)
+    xx, yy = np.meshgrid(np.arange(0.0, 400, 20.0), np.arange(0.0, 400, 20.0))
+    x = xx.ravel() + rng.uniform(-4, 4, xx.size)
+    y = yy.ravel() + rng.uniform(-4, 4, xx.size)
+    z = 90.0 * np.clip((x - 120.0) / 100.0, 0.0, 1.0) + rng.normal(0.0, 2.0, x.size)
+
+    def length(lines: list) -> float:
+        return float(sum(g.length for g in lines))
+
+    steep = length(jump_breaklines(x, y, z, 1.5, 1.0))
+    grown = length(jump_breaklines(x, y, z, 1.5, 1.0, weak_slope=0.7))
+    capped = length(jump_breaklines(x, y, z, 1.5, 1.0, weak_slope=0.7, weak_max_step=15.0))
+    # measured: 240 m of line by the steep rule, 687 m grown, 240 m with the limit
+    assert grown > 2.0 * steep
+    assert capped == pytest.approx(steep)
+
+
+def test_general_and_urban_grow_jumps_by_hysteresis() -> None:
     assert _options("general", {})[1]["jump_weak_slope"] == 0.7
-    assert "jump_weak_slope" not in _options("urban", {})[1]
+    assert _options("urban", {})[1]["jump_weak_slope"] == 0.7
