@@ -6,9 +6,12 @@ import sys
 from typing import List, Optional
 
 from ..i18n import install_translator
-from ..qt import QtWidgets
+from ..qt import QtCore, QtWidgets
 
 _windows: list = []
+#: Who the toolbox is to ``QSettings`` (its settings file).
+ORGANIZATION = "PhotoDEM"
+APPLICATION = "PhotoDEM toolbox"
 
 
 def main(argv: Optional[List[str]] = None, project: Optional[str] = None) -> int:
@@ -19,14 +22,17 @@ def main(argv: Optional[List[str]] = None, project: Optional[str] = None) -> int
     owns_app = app is None
     if owns_app:
         app = QtWidgets.QApplication(argv)
-    app.setOrganizationName("PhotoDEM")
-    app.setApplicationName("PhotoDEM toolbox")
+        app.setOrganizationName(ORGANIZATION)
+        app.setApplicationName(APPLICATION)
     install_translator()  # German when the system locale is German and i18n/*.qm exists
 
     # lazy: imported after the translator is installed, so labels are translated once
     from .main_window import ToolboxWindow
 
-    window = ToolboxWindow()
+    # named settings, not the application's names: a running application (a host, a test
+    # session) is not renamed, else every later ToolboxWindow() of it would read and write
+    # these settings too
+    window = ToolboxWindow(settings=QtCore.QSettings(ORGANIZATION, APPLICATION))
     _windows.append(window)  # keep a reference when the caller runs the event loop
     window.show()
     if project:

@@ -248,6 +248,27 @@ def test_gui_command_opens_a_project_given_on_the_command_line(tiny, qtbot):
     window.map_view.clear_layers()
 
 
+def test_gui_command_leaves_a_running_application_unnamed(tiny, qtbot):
+    """The toolbox started in a running application has settings of its own; the application
+    keeps its names, so later windows of it remember nothing (module order of the tests)."""
+    from photodem.plugin.app import main as app_main
+    from photodem.plugin.app.main_window import ToolboxWindow
+    from photodem.plugin.widgets.parameter_form import SETTINGS_PROJECT
+
+    app = QtCore.QCoreApplication
+    before = (app.organizationName(), app.applicationName())
+    assert app_main.main(["photodem"]) == 0
+    window = app_main._windows.pop()
+    qtbot.addWidget(window)
+    assert (app.organizationName(), app.applicationName()) == before
+    assert window.settings.organizationName() == app_main.ORGANIZATION
+    window.settings.setValue(SETTINGS_PROJECT, str(tiny))
+    later = ToolboxWindow(message_boxes=False)
+    qtbot.addWidget(later)
+    later.select_algorithm("match_model")
+    assert later.settings is None and not later.form.project()
+
+
 def test_added_raster_goes_under_the_vectors_and_becomes_the_surface(window, tiny, tmp_path):
     window.open_project(tiny)
     view, bar = window.map_view, window.editing_toolbar
