@@ -24,7 +24,8 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    side has fewer pixels than cells), and then the points of two *slant passes*: SGM against
    the right image stretched along its rows by :data:`SLANT_SCALES` (slopes that one camera
    sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), kept
-   where they agree with the plain pass's heights around them (:data:`SLANT_GAP_CELLS`).
+   where they agree with the plain pass's heights around them (:data:`SLANT_GAP_CELLS`) —
+   only with ``slant_passes`` (off by default: open terrain NMAD and RMSE rise, issue 22).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
@@ -467,7 +468,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       max_gap: Optional[float] = None, disparity_margin: int = 4,
                       memory_mb: float = 256.0, outlier_radius: Optional[float] = None,
                       outlier_threshold: Optional[float] = None, outlier_k: float = 3.0,
-                      **dense_options: Any) -> Dict[str, Any]:
+                      slant_passes: bool = False, **dense_options: Any) -> Dict[str, Any]:
     """Dense DSM of a stereo model (see the module notes).
 
     Parameters
@@ -496,6 +497,13 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         the height of 1 px of parallax, ``GSD · H / B``.
     outlier_k : float
         Multiple of the local robust spread (1.4826 · MAD) a rejected deviation must exceed.
+    slant_passes : bool
+        Convergent models only: also match against the right image stretched by
+        :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
+        with the plain ones (module notes). Off by default: on the drone bench it measures
+        1.6–5.7 points more of the visible cells, but the open terrain's NMAD rises by
+        0.5–5 % and its RMSE on 9 of 12 model-seeds (up to +7.7 %), and matching takes
+        4–8 × as long (issue 22, part N in docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
@@ -536,7 +544,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
         extra = (GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
                  if setup.convergent else None)
-        guide = _Guide((pair.height, pair.sizes[0][0])) if setup.convergent else None
+        guide = (_Guide((pair.height, pair.sizes[0][0]))
+                 if setup.convergent and slant_passes else None)
         counts = _match_into(setup, grey, acc, memory_mb, options, feedback, extra, guide)
         slant = None
         if guide is not None:

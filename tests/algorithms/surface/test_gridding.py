@@ -170,7 +170,7 @@ def test_deviates_from_checks_candidates_against_a_reference() -> None:
     1.5 m off they go, and the test of a grid against itself is :func:`reject_outliers`."""
     from photodem.algorithms.surface.gridding import deviates_from
 
-    yy, xx = np.mgrid[0:40, 0:40].astype(np.float32)
+    _, xx = np.mgrid[0:40, 0:40].astype(np.float32)
     plane = 100.0 + 0.1 * xx
     ref = plane.copy()
     ref[10:20, 10:20] = np.nan  # a hole the candidates fill
