@@ -502,8 +502,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
         with the plain ones (module notes). Off by default: on the drone bench it measures
         1.6–5.7 points more of the visible cells, but the open terrain's NMAD rises by
-        0.5–5 % and its RMSE on 9 of 12 model-seeds (up to +7.7 %), and matching takes
-        4–8 × as long (issue 22, part N in docs/decisions.md).
+        0.5–5 % and its RMSE on 9 of 12 model-seeds (up to +7.7 %), and a model takes
+        about 5 × as long (issue 22, part N in docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
