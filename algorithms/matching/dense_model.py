@@ -194,10 +194,10 @@ SLANT_SCALES: Tuple[float, ...] = (0.7, 1.4)
 #: A cell that only a slant pass measured is kept where it passes the DSM outlier test
 #: against the plain pass's heights around it (within 1 px of parallax of their median, or
 #: 3 × their spread), interpolated over enclosed gaps up to ``SLANT_GAP_CELLS`` cells wide
-#: (:func:`~..surface.gridding.fill_gaps`). Without the test the slant passes' blunders on
-#: periodic field textures raised the open RMSE by 20 % (drone seed 1, 0201_0203: 0.69 →
-#: 0.85 m); 3 px instead of 1 px kept a few more cells and more blunders (0202_0203: open
-#: RMSE 0.4765 against 0.4728 m).
+#: (:func:`~..surface.gridding.fill_gaps`). Without the test (and with the object fill in
+#: the slant passes) their blunders on periodic field textures raised the open RMSE by 20 %
+#: (drone seed 1, 0201_0203: 0.69 → 0.85 m); 3 px instead of 1 px kept a few more cells and
+#: more blunders (0202_0203: open RMSE 0.4765 against 0.4728 m).
 SLANT_GAP_CELLS = 100
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
