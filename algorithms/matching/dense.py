@@ -502,6 +502,7 @@ def iter_disparity_tiles(
     coarse_above: int = COARSE_ABOVE,
     feedback: Optional[Feedback] = None,
     disparity_parameter: str = "min_disparity/max_disparity",
+    guide: Optional[Tuple[Array, int]] = None,
 ) -> Iterator[Tuple[int, int, Array]]:
     """Disparity of the left image tile by tile: yields ``(row0, col0, block)``.
 
@@ -527,6 +528,10 @@ def iter_disparity_tiles(
     disparity_parameter : str
         What the operator changes for a narrower range, named by the memory check
         (:func:`check_disparity_range`, which also cuts the range to possible disparities).
+    guide : (array, int), optional
+        Disparities known beforehand at a reduced scale (full-resolution px per block of
+        ``factor × factor`` left pixels, NaN = none) and that factor: each tile searches the
+        range they span as with the coarse pass, which is then not run.
     """
     cv2 = _cv2()
     feedback = ensure_feedback(feedback)
@@ -536,9 +541,8 @@ def iter_disparity_tiles(
     num_d = _num_disparities(min_d, max_d)
     # the right source pads with NaN outside its own right_shape
     match = _TileMatcher(cv2, left, right, margin, opts)
-    coarse = None
-    factor = 1
-    if coarse_above > 0 and num_d > coarse_above:
+    coarse, factor = guide if guide is not None else (None, 1)
+    if coarse is None and coarse_above > 0 and num_d > coarse_above:
         factor = _coarse_factor(num_d)
         coarse = _coarse_disparity(left, right, left_shape, right_shape, min_d, max_d, factor,
                                    opts.coarse(), feedback, max_memory_mb, margin)

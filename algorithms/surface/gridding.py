@@ -337,20 +337,46 @@ def reject_outliers(z: Array, spacing: float, radius: float, threshold: float,
     ndarray of bool
         True where a measured cell is an outlier.
     """
+    return deviates_from(z, z, spacing, radius, threshold, k)
+
+
+def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
+                  threshold: float, k: float = 3.0) -> Array:
+    """Mask of the cells of ``z`` that deviate from the neighbourhood of ``reference``.
+
+    The test of :func:`reject_outliers` (deviation from the median of the neighbourhood
+    larger than ``max(threshold, k·1.4826·MAD)``) with the median and MAD taken from another
+    grid, e.g. candidate heights checked against the heights one trusts more.
+
+    Parameters
+    ----------
+    z : ndarray (h, w)
+        Heights to test, NaN = empty (never rejected).
+    reference : ndarray (h, w)
+        Heights of the neighbourhood, NaN = empty; empty cells take the nearest height.
+    spacing, radius, threshold, k : float
+        As :func:`reject_outliers`.
+
+    Returns
+    -------
+    ndarray of bool
+        True where a cell of ``z`` is an outlier; all False without reference heights.
+    """
     from scipy import ndimage  # lazy: keeps photodem list fast
 
     z = np.asarray(z, np.float32)
-    valid = np.isfinite(z)
-    if radius <= 0 or not valid.any() or valid.sum() < 3:
+    ref = np.asarray(reference, np.float32)
+    valid, have = np.isfinite(z), np.isfinite(ref)
+    if radius <= 0 or not valid.any() or have.sum() < 3:
         return np.zeros(z.shape, bool)
     # empty cells take the nearest measured height so that the filters see no NaN
-    _, (nr, nc) = ndimage.distance_transform_edt(~valid, return_indices=True)
-    zf = z[nr, nc]
+    _, (nr, nc) = ndimage.distance_transform_edt(~have, return_indices=True)
+    rf = ref[nr, nc]
     size = 2 * max(1, int(radius / spacing + 0.5)) + 1
-    med = ndimage.median_filter(zf, size=size, mode="nearest")
-    dev = np.abs(zf - med)
-    mad = ndimage.median_filter(dev, size=size, mode="nearest")
-    return valid & (dev > np.maximum(float(threshold), k * 1.4826 * mad))
+    med = ndimage.median_filter(rf, size=size, mode="nearest")
+    mad = ndimage.median_filter(np.abs(rf - med), size=size, mode="nearest")
+    with np.errstate(invalid="ignore"):
+        return valid & (np.abs(z - med) > np.maximum(float(threshold), k * 1.4826 * mad))
 
 
 # -- gap filling -------------------------------------------------------------------------------
@@ -532,5 +558,5 @@ def write_grid(path: PathLike, z: Array, grid: Grid, crs: Any = None,
     return write_raster(path, z, transform=grid.transform, crs=crs, overviews=overviews)
 
 
-__all__ = ["Grid", "GridAccumulator", "GridResult", "fill_gaps", "finish_grid", "grid_points",
-           "line_barrier", "polygon_mask", "reject_outliers", "write_grid"]
+__all__ = ["Grid", "GridAccumulator", "GridResult", "deviates_from", "fill_gaps", "finish_grid",
+           "grid_points", "line_barrier", "polygon_mask", "reject_outliers", "write_grid"]

@@ -162,3 +162,25 @@ def test_grid_points_outlier_cells_are_refilled() -> None:
                         outlier_threshold=1.0)
     assert abs(clean.z[r[0], c[0]] - (100.0 + 0.1 * 25.5 - 0.05 * 24.5)) < 0.05
     assert clean.filled[r[0], c[0]] and clean.count[r[0], c[0]] == 0
+
+
+def test_deviates_from_checks_candidates_against_a_reference() -> None:
+    """Candidate heights are tested against the neighbourhood of other heights (the dense
+    slant passes against the plain pass, issue 22 part N): on the reference's plane they stay,
+    1.5 m off they go, and the test of a grid against itself is :func:`reject_outliers`."""
+    from photodem.algorithms.surface.gridding import deviates_from
+
+    _, xx = np.mgrid[0:40, 0:40].astype(np.float32)
+    plane = 100.0 + 0.1 * xx
+    ref = plane.copy()
+    ref[10:20, 10:20] = np.nan  # a hole the candidates fill
+    cand = np.full_like(plane, np.nan)
+    cand[10:20, 10:20] = plane[10:20, 10:20]
+    cand[14, 14] += 1.5
+    bad = deviates_from(cand, ref, spacing=0.5, radius=2.5, threshold=0.5)
+    assert bad[14, 14] and bad.sum() == 1
+    assert not deviates_from(cand, np.full_like(ref, np.nan), 0.5, 2.5, 0.5).any()
+    z = plane.copy()
+    z[5, 30] += 3.0
+    np.testing.assert_array_equal(deviates_from(z, z, 0.5, 2.5, 1.0),
+                                  reject_outliers(z, 0.5, 2.5, 1.0))
