@@ -91,6 +91,13 @@ class AlgorithmWorker(QObject):
 #: worker referenced until it has ended: a worker nobody else holds (``Feedback`` makes it a
 #: reference cycle) would otherwise be collected by Python's garbage collector, its QObject
 #: deleted before ``run`` and the thread never told to quit (a test hung 1 run in 4).
+#: The worker is deleted in the GUI thread, never in its own: deleting a Python-made QObject
+#: takes Qt's connection locks and the GIL, and the GUI thread holds the GIL whenever it calls
+#: into Qt from Python — a worker deleted in its thread while the GUI thread emitted a signal
+#: deadlocked a test (its stack: the GUI thread in ``QTabWidget.setCurrentIndex``, the worker's
+#: thread in C++ without a Python frame). So ``done`` moves the worker back to the GUI thread
+#: and the GUI thread deletes it once the thread has been joined; after ``run`` the worker's
+#: thread runs no Python and holds no lock the GUI thread waits for.
 _LIVE: Dict[QThread, QObject] = {}
 
 
@@ -99,19 +106,24 @@ def start_in_thread(worker: QObject, on_finished: Optional[Callable[[], None]] =
     """Move ``worker`` to a new QThread, start it, and clean both up when the run is done.
 
     ``worker`` is a QObject with a ``run`` slot and a ``done`` signal emitted last
-    (:class:`AlgorithmWorker`, the batch worker). Qt deletes it in its own thread after
-    ``done``; the thread is joined in the GUI thread and then deleted. ``on_finished`` is
-    called in the GUI thread once the thread has ended — joined, so whatever the caller does
-    next (delete its widget, start the next run) cannot meet a thread still winding down. It
-    is connected before the thread starts: a run that fails at once can end its thread before
-    a connection made after ``start()``.
+    (:class:`AlgorithmWorker`, the batch worker). After ``done`` it moves back to the GUI
+    thread; the thread is joined there, then both are deleted there (see ``_LIVE``).
+    ``on_finished`` is called in the GUI thread once the thread has ended — joined, so
+    whatever the caller does next (delete its widget, start the next run) cannot meet a thread
+    still winding down. It is connected before the thread starts: a run that fails at once can
+    end its thread before a connection made after ``start()``.
     """
     thread = QThread()  # no parent: see _LIVE
     _LIVE[thread] = worker
+    home = worker.thread()  # the GUI thread, where the worker is made and deleted
+
+    def go_home() -> None:  # in the worker's thread, the last thing it does in Python
+        worker.moveToThread(home)
 
     def ended() -> None:
-        thread.wait()  # returns at once; releases the GIL the thread needs to delete its worker
-        _LIVE.pop(thread, None)  # the worker was deleted in its thread after ``done``
+        thread.wait()  # returns at once: the thread has ended
+        _LIVE.pop(thread, None)
+        worker.deleteLater()  # in the GUI thread (see _LIVE)
         thread.deleteLater()
         if on_finished is not None:
             on_finished()
@@ -119,9 +131,9 @@ def start_in_thread(worker: QObject, on_finished: Optional[Callable[[], None]] =
     thread.finished.connect(ended)
     worker.moveToThread(thread)
     thread.started.connect(worker.run)
+    worker.done.connect(go_home, Qt.DirectConnection)
     # Direct: quit() is thread-safe, and the thread then ends even while the GUI thread is
     # blocked in QThread.wait() (a queued quit would only run after that wait timed out).
     worker.done.connect(thread.quit, Qt.DirectConnection)
-    worker.done.connect(worker.deleteLater)
     thread.start()
     return thread

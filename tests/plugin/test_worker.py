@@ -73,3 +73,18 @@ def test_deleting_the_owner_while_the_run_goes_on(qtbot) -> None:
     sip.delete(owner)  # the window closes while its run goes on: the thread is not its child
     release.set()
     qtbot.waitUntil(lambda: ended == [1], timeout=10000)
+
+
+def test_the_worker_is_deleted_in_the_gui_thread(qtbot) -> None:
+    # Deleting a Python-made QObject takes Qt's connection locks and the GIL: deleted in its
+    # own thread while the GUI thread emitted a signal, a worker deadlocked a test. It goes
+    # back to the GUI thread with ``done`` and is deleted there once the thread has ended.
+    gui = QtWidgets.QApplication.instance().thread()
+    seen: list = []
+    for run in range(1, 6):
+        worker = _Instant("none", {})
+        start_in_thread(worker, on_finished=lambda w=worker: seen.append(
+            (w.thread() is gui or w.thread() == gui, sip.isdeleted(w))))
+        qtbot.waitUntil(lambda n=run: len(seen) == n, timeout=5000)
+        qtbot.waitUntil(lambda w=worker: sip.isdeleted(w), timeout=5000)
+    assert seen == [(True, False)] * 5
