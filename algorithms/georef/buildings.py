@@ -120,6 +120,9 @@ MIN_LEAD = 2.0
 MAX_TRIES = 160
 MIN_TRIES = 40
 TRY_BATCH = 20
+#: Grown placements with at least this many centroid matches get their shape count (it
+#: may exceed the centroid count: a site is one per roof, a footprint may have two halves).
+MIN_GROWN = 6
 #: Centre-out refit of the accepted consensus (:func:`_centre_out`): shares of its shape
 #: pairs nearest the image centre fitted in turn, at least this many pairs.
 CENTRE_OUT_SHARES = (0.3, 0.45, 0.6, 0.75, 0.9, 1.0)
@@ -596,7 +599,7 @@ def _consensus(fi: Sequence[ObjectFeatures], use: Sequence[bool], ref: _Referenc
             _add_placement(found, _Placement(len(np.unique(ref.shapes.owner[tj])), T, si,
                                              ref.shapes.owner[tj]))
         for p in found:
-            if p.shapes < 0 and p.n >= MIN_MATCHES:
+            if p.shapes < 0 and p.n >= MIN_GROWN:
                 p.T, p.shapes = _refine(p.T, fi, ref.shapes, ref.rings, ref.base_tol)
         tried = min(start + TRY_BATCH, n_tries)
         counts["tries"] = tried
