@@ -111,7 +111,8 @@ NEIGHBOURS = 8
 #: Acceptance by the shape count (footprints covered by a candidate or by one on a roof half
 #: after :func:`_refine`): at least this many, this share of the footprints inside the image,
 #: and this ratio over the best different placement. Seeds 0–19 at relief 3: right placements
-#: 15–59 shapes and 2.7–48 × the runner-up; the best placements of failing scenes 3–6.
+#: 15–58 shapes, 45–78 % of those inside, ≥ 2.7 × the runner-up; the best wrong ones (seeds
+#: 6, 14, three different towns) 3–10 shapes, ≤ 21 %, ≤ 1.5 ×.
 MIN_MATCHES = 12
 MIN_SHARE = 0.35
 MIN_LEAD = 2.0
