@@ -152,6 +152,11 @@ class MatchModel(Algorithm):
         Parameter("use_start_points", "bool", "Use start points (fbm_lsm)", default=True,
                   help="Start from the start points of edits.gpkg; without any, the whole "
                        "height range is searched at the coarsest level."),
+        Parameter("slant_passes", "bool", "Match foreshortened slopes (dense, convergent)",
+                  default=False,
+                  help="Convergent models only: also match against the right image stretched "
+                       "by 0.7 and 1.4, for slopes one camera sees foreshortened. More cells "
+                       "measured, a slightly higher NMAD on open terrain, about 5 × the time."),
     )
     outputs = (
         Output("dsm", "raster", "DSM"),
@@ -183,7 +188,9 @@ class MatchModel(Algorithm):
         if method == "dense":
             from ...matching.dense_model import match_model_dense
 
-            return match_model_dense(project, model.name, out, **common)
+            return match_model_dense(project, model.name, out,
+                                     slant_passes=bool(params.get("slant_passes", False)),
+                                     **common)
         if method != "fbm_lsm":
             raise InputError(f"Unknown matching method '{method}'; use fbm_lsm or dense.")
         from ...matching.fbm_model import match_model_fbm_lsm

@@ -1,0 +1,24 @@
+"""The match_model algorithm hands its parameters to the matcher it runs."""
+
+from __future__ import annotations
+
+import pytest
+
+from photodem.algorithms.feedback import Feedback
+from photodem.algorithms.matching import dense_model
+from photodem.algorithms.processing import registry
+
+
+@pytest.mark.parametrize("given, expected", [({}, False), ({"slant_passes": True}, True)])
+def test_dense_gets_the_slant_passes(chain_project, tmp_path, monkeypatch, given, expected):
+    seen: dict = {}
+
+    def fake(project, model, out, **kwargs):
+        seen.update(kwargs, model=model)
+        return {}
+
+    monkeypatch.setattr(dense_model, "match_model_dense", fake)
+    root = chain_project("abc")
+    registry.run("match_model", {"project": str(root), "model": "a_b", "method": "dense",
+                                 "output": str(tmp_path / "dsm"), **given}, Feedback())
+    assert seen["model"] == "a_b" and seen["slant_passes"] is expected
