@@ -389,10 +389,12 @@ def _pct(part: int, whole: int) -> float:
 
 
 def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCounts,
-             max_gap: float, outliers: _Outliers) -> Dict[str, Any]:
+             max_gap: float, outliers: _Outliers, slant_cells: Optional[np.ndarray] = None
+             ) -> Dict[str, Any]:
     """Headline figures: points, the valid share of the disparities, and the shares of the
     measuring area that are measured (a cell with a triangulated point), interpolated (a gap
-    filled) and empty; they add up to 100 %, ``coverage_pct`` = measured + interpolated."""
+    filled) and empty; they add up to 100 %, ``coverage_pct`` = measured + interpolated. With
+    slant passes also the share measured by them alone (part of ``measured_pct``)."""
     grid = setup.grid
     area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions, grid)
     n_area = int(area.sum())
@@ -400,7 +402,7 @@ def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCo
     n_have = int(have.sum())
     n_filled = int((have & res.filled).sum())
     n_left, n_valid = counts.n_left, counts.n_valid
-    return {
+    metrics = {
         "points": int(acc.points),
         "coverage_pct": _pct(n_have, n_area),
         "measured_pct": _pct(n_have - n_filled, n_area),
@@ -416,15 +418,20 @@ def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCo
         "outlier_threshold_m": outliers.threshold,
         "epipolar_mpx": setup.pair.sizes[0][0] * setup.pair.sizes[0][1] / 1e6,
     }
+    if slant_cells is not None:
+        metrics["slant_measured_pct"] = _pct(int((slant_cells & have & ~res.filled).sum()),
+                                             n_area)
+    return metrics
 
 
 def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap: float,
                     outliers: _Outliers, feedback: Feedback,
                     footprints: Optional[GridAccumulator] = None,
-                    slant: Optional[GridAccumulator] = None) -> Any:
+                    slant: Optional[GridAccumulator] = None) -> Tuple[Any, Optional[np.ndarray]]:
     """Median per cell (cells without a pixel's point from ``footprints``, then from
     ``slant`` where that agrees with its neighbourhood), outlier test, gap filling; dsm.tif
-    and count.tif written."""
+    and count.tif written. Returns the grid result and the cells the slant passes gave
+    (None without them)."""
     grid, crs = setup.grid, setup.project.crs
     zg, count = acc.reduce(feedback.step(85, 92))
     if footprints is not None:
@@ -440,6 +447,8 @@ def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap:
                             outliers.k)
         take = np.isfinite(zs) & ~bad
         zg[take], count[take] = zs[take], count_s[take]
+    else:
+        take = None
     res = finish_grid(zg, count, grid, max_gap, setup.exclusions, setup.boundaries,
                       setup.breaklines, outlier_radius=outliers.radius,
                       outlier_threshold=outliers.threshold, outlier_k=outliers.k)
@@ -447,7 +456,7 @@ def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap:
     write_grid(tmp / "dsm.tif", res.z, grid, crs=crs)
     write_grid(tmp / "count.tif", np.minimum(res.count, 65535).astype(np.uint16), grid,
                crs=crs, overviews=False)
-    return res
+    return res, take
 
 
 def _report(setup: ModelSetup, metrics: Dict[str, Any], options: DenseOptions,
@@ -546,6 +555,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                  if setup.convergent else None)
         guide = (_Guide((pair.height, pair.sizes[0][0]))
                  if setup.convergent and slant_passes else None)
+        if slant_passes and guide is None:
+            feedback.info(f"Model {m.name}: no slant passes — they are for convergent models "
+                          "only.")
         counts = _match_into(setup, grey, acc, memory_mb, options, feedback, extra, guide)
         slant = None
         if guide is not None:
@@ -555,8 +567,9 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
-        res = _grid_and_write(setup, acc, tmp, max_gap, outliers, feedback, extra, slant)
-        metrics = _metrics(setup, acc, res, counts, max_gap, outliers)
+        res, slant_cells = _grid_and_write(setup, acc, tmp, max_gap, outliers, feedback,
+                                           extra, slant)
+        metrics = _metrics(setup, acc, res, counts, max_gap, outliers, slant_cells)
         timings["gridding"] = time.perf_counter() - t0
         timings["total"] = time.perf_counter() - t_start
         write_model_report(tmp, _report(setup, metrics, options, timings),

@@ -152,8 +152,10 @@ def coverage_sentence(metrics: Dict[str, Any]) -> str:
     """The run log's coverage sentence: what was measured, interpolated and left empty (% of
     the model area), the valid disparities (dense) or the failed windows at the finest level
     (fbm_lsm)."""
-    parts = [f"measured {_number(metrics.get('measured_pct')) or 0.0:.1f} %, interpolated "
-             f"{_number(metrics.get('interpolated_pct')) or 0.0:.1f} %, empty "
+    slant = _number(metrics.get("slant_measured_pct"))
+    alone = f" (slant passes alone {slant:.1f} %)" if slant is not None else ""
+    parts = [f"measured {_number(metrics.get('measured_pct')) or 0.0:.1f} %{alone}, "
+             f"interpolated {_number(metrics.get('interpolated_pct')) or 0.0:.1f} %, empty "
              f"{_number(metrics.get('empty_pct')) or 0.0:.1f} % of the model area"]
     if _number(metrics.get("valid_disparity_pct")) is not None:
         parts.append(f"valid disparities {metrics['valid_disparity_pct']:.1f} %")

@@ -113,3 +113,13 @@ def test_levels_table_is_generic() -> None:
     head = re.findall(r"<th>(.*?)</th>", table)
     assert head == ["module", "b", "a [%]"]
     assert "12.3 %" in table
+
+
+def test_coverage_sentence_says_what_the_slant_passes_measured() -> None:
+    from photodem.algorithms.matching.model_report import coverage_sentence
+
+    plain = {"measured_pct": 70.0, "interpolated_pct": 2.0, "empty_pct": 28.0,
+             "valid_disparity_pct": 75.0}
+    assert "slant" not in coverage_sentence(plain)
+    text = coverage_sentence({**plain, "slant_measured_pct": 4.25})
+    assert "measured 70.0 % (slant passes alone 4.2 %)" in text
