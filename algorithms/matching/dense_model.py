@@ -304,13 +304,14 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
     with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
         left, shape_l = _window_source(src_l)
         right, (h_r, w_r) = _window_source(src_r)
-        for scale in SLANT_SCALES:
+        share = 100.0 / len(SLANT_SCALES)
+        for k, scale in enumerate(SLANT_SCALES):
             lo, hi = _stretched_range(setup, scale)
             shape_r = (h_r, int(np.ceil(scale * (w_r - 1))) + 1)
             t0 = time.perf_counter()
             for r0, c0, block in iter_disparity_tiles(
                     left, stretched_source(right, scale), shape_l, shape_r, lo, hi, options,
-                    max_memory_mb=memory_mb, feedback=feedback,
+                    max_memory_mb=memory_mb, feedback=feedback.step(k * share, (k + 1) * share),
                     guide=(guide.stretched(scale), GUIDE_FACTOR)):
                 ok = np.isfinite(block)
                 if ok.any():
@@ -337,7 +338,7 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 guide: Optional[_Guide] = None) -> _MatchCounts:
     """Tiled SGM of the scratch epipolar images; every tile's points into ``acc``, the
     sub-pixel points of :func:`footprint_points` into ``footprints`` and the disparities
-    into ``guide`` if given.
+    into ``guide`` if given. ``feedback`` covers the matching alone.
 
     The time of the matching (the tile generator) is told apart from the triangulation.
     """
@@ -348,7 +349,7 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
         right, shape_r = _window_source(src_r)
         tiles = iter_disparity_tiles(left, right, shape_l, shape_r, setup.min_d, setup.max_d,
                                      options, max_memory_mb=memory_mb,
-                                     feedback=feedback.step(20, 85))
+                                     feedback=feedback)
         while True:
             t1 = time.perf_counter()
             try:
@@ -558,12 +559,15 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         if slant_passes and guide is None:
             feedback.info(f"Model {m.name}: no slant passes — they are for convergent models "
                           "only.")
-        counts = _match_into(setup, grey, acc, memory_mb, options, feedback, extra, guide)
+        # the slant passes take most of the matching time when they run
+        plain_end = 45.0 if guide is not None else 85.0
+        counts = _match_into(setup, grey, acc, memory_mb, options,
+                             feedback.step(20, plain_end), extra, guide)
         slant = None
         if guide is not None:
             slant = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
             counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide,
-                                          feedback.step(85, 85))
+                                          feedback.step(plain_end, 85))
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
