@@ -50,12 +50,15 @@ test: test-a test-b
 
 test-a: venv
 	$(VENV)/bin/ruff check .
-	$(VENV)/bin/python -m pytest -q tests -m "not qgis" -p no:cacheprovider
+	PHOTODEM_TEST_TRACE=.test-trace/a $(VENV)/bin/python -m pytest -q tests -m "not qgis" \
+	  -p no:cacheprovider || { status=$$?; $(PY) tools/hang_report.py .test-trace/a; exit $$status; }
 
 # While working: tier A without the tests marked slow (end-to-end runs); `make test` runs all.
 test-fast: venv
 	$(VENV)/bin/ruff check .
-	$(VENV)/bin/python -m pytest -q tests -m "not qgis and not slow" -p no:cacheprovider
+	PHOTODEM_TEST_TRACE=.test-trace/fast $(VENV)/bin/python -m pytest -q tests \
+	  -m "not qgis and not slow" -p no:cacheprovider \
+	  || { status=$$?; $(PY) tools/hang_report.py .test-trace/fast; exit $$status; }
 
 test-b: venv-qgis
 	bash tools/run_tier_b.sh $(VENV_QGIS)/bin/python

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import faulthandler
 import os
 import signal
+import sys
 from pathlib import Path
 
 import pytest
@@ -13,23 +15,47 @@ SHARED_DATA = Path(os.environ.get("PHOTODEM_SHARED_DATA", ROOT.parent / "shared"
 
 
 #: Seconds after which a test counts as hung and ends the run (``SIGALRM``'s default action,
-#: which needs no Python, so it works even when a deadlock holds the GIL). pytest's
-#: ``faulthandler_timeout`` (pyproject.toml, 600 s) has printed every thread's stack by then:
-#: a hang costs minutes and says where it is, instead of running into CI's time limit silently.
+#: which needs no Python, so it works even when a deadlock holds the GIL). Every thread's stack
+#: has been dumped 30 s before (a fifth of the time for short limits) (``faulthandler``, from its own C thread): a hang costs minutes
+#: and says where it is, instead of running into CI's time limit silently.
 HUNG_TEST_S = int(os.environ.get("PHOTODEM_HUNG_TEST_S", "660"))
+#: Folder for the hang record (``make test`` sets it): ``current`` holds the running test's id,
+#: ``stacks`` the dump. A run killed by the alarm leaves both for ``tools/hang_report.py``,
+#: which prints them last — CI shows only the end of the output, where pytest's own dump of
+#: all threads would leave the main thread's bottom frames and no test name. Unset: the dump
+#: goes to stderr.
+TRACE_DIR = os.environ.get("PHOTODEM_TEST_TRACE", "")
+_TRACE: dict = {}
+
+
+def pytest_configure(config) -> None:
+    if TRACE_DIR:
+        folder = Path(TRACE_DIR)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "current").unlink(missing_ok=True)
+        _TRACE["current"] = folder / "current"
+        # kept open for the whole run: faulthandler writes to it from its own thread
+        _TRACE["stacks"] = open(folder / "stacks", "w")  # noqa: SIM115
+    else:  # a copy of stderr as it is now: fd 2 is redirected while a test's output is captured
+        _TRACE["stacks"] = os.fdopen(os.dup(sys.stderr.fileno()), "w")
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
-    """Arm the hang alarm for one test (setup, call and teardown)."""
+    """Arm the stack dump and the hang alarm for one test (setup, call and teardown)."""
     armed = hasattr(signal, "alarm") and HUNG_TEST_S > 0
     if armed:
+        if "current" in _TRACE:
+            _TRACE["current"].write_text(item.nodeid + "\n")
+        faulthandler.dump_traceback_later(HUNG_TEST_S - min(30.0, 0.2 * HUNG_TEST_S),
+                                          file=_TRACE["stacks"])
         signal.alarm(HUNG_TEST_S)
     try:
         yield
     finally:
         if armed:
             signal.alarm(0)
+            faulthandler.cancel_dump_traceback_later()
 
 
 def shared_data(name: str) -> Path:

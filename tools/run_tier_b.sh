@@ -37,10 +37,15 @@ fi
 # All tests: the core and GUI ones again on Debian's numpy 1.24, shapely 1.8, scikit-image 0.19
 # and rasterio 1.3 — what a Debian QGIS user has — and then the QGIS ones. Two processes: the
 # GUI tests' QApplication and the QgsApplication of tests/qgis must not share one (crash at exit).
-"$PY" -m pytest -p no:cacheprovider tests --ignore=tests/qgis -ra --durations=10 "$@"
+# A run the hang alarm ends (tests/conftest.py) gets the hung test and its stacks printed last.
+PHOTODEM_TEST_TRACE=.test-trace/b-core \
+  "$PY" -m pytest -p no:cacheprovider tests --ignore=tests/qgis -ra --durations=10 "$@"
 status_core=$?
-"$PY" -m pytest -p no:cacheprovider tests/qgis -ra --durations=15 "$@"
+PHOTODEM_TEST_TRACE=.test-trace/b-qgis \
+  "$PY" -m pytest -p no:cacheprovider tests/qgis -ra --durations=15 "$@"
 status=$?
+"$PY" tools/hang_report.py .test-trace/b-core
+"$PY" tools/hang_report.py .test-trace/b-qgis
 if [ "$status_core" -ne 0 ] && [ "$status_core" -ne 5 ]; then
   echo "tier B: core/GUI tests on Debian's packages FAILED (exit $status_core)" >&2
   exit "$status_core"
