@@ -5918,7 +5918,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         <message>
             <source>Batch file: step '{step}' uses {{{key}}}, but it does not run per {key}.</source>
             <extracomment>algorithms/processing/batch.py:614</extracomment>
-            <translation>Batch-Datei: Schritt '{step}' verwendet {{{key}}}, läuft aber nicht je {key}.</translation>
+            <translation>Batch-Datei: Schritt '{step}' verwendet {{{key}}}, läuft aber nicht einzeln für jedes '{key}'.</translation>
         </message>
         <message>
             <source>Cannot read batch file '{path}': {error}</source>
