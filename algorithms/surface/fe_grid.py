@@ -62,13 +62,19 @@ Solution per tile
     is extended by ``overlap`` nodes on every side and solved; the outer overlap/2 of each
     solution is dropped (the free tile edge bends the plate there) and neighbours are blended
     by linear ramps over the ``overlap`` nodes centred on the tile border (weights add up to
-    one), so there is no seam. ``solver="cg"`` (default): a cascade — the same problem on
-    grids coarsened by 2 (λ/4 per level, the same continuum energy) down to ≤ 64² nodes solved
+    one), so there is no seam. ``solver="cg"`` (default): conjugate gradients on the tile,
+    preconditioned by a geometric multigrid V-cycle (:mod:`.fe_multigrid`: Galerkin coarse
+    grids down to ≤ 64² nodes, Chebyshev smoothing), from the nearest measured heights (or the
+    last solution in robust mode), to ‖r‖ ≤ 1e-9·‖b‖: a few tens of iterations, and the
+    surface is within 0.01 mm of the direct solution (docs/decisions.md, part W).
+    ``solver="cg_jacobi"`` (the former default): a cascade — the same problem on grids
+    coarsened by 2 (λ/4 per level, the same continuum energy) down to ≤ 64² nodes solved
     directly, each level's solution bilinearly prolongated as the start of Jacobi-preconditioned
-    conjugate gradients on the next finer one. ``solver="direct"``: sparse LU (SuperLU,
-    minimum-degree ordering) of the whole tile. Measured on 2000 × 2000 nodes (2 busy cores):
-    4 M points (1 per cell) 13 s with cg against 125 s direct (256-node tiles); 160 k points
-    (1 per 25 cells) 62 s with cg.
+    conjugate gradients on the next finer one; at 1e-7 it stopped up to 0.5 m short of its own
+    solution in large gaps, because the residual no longer sees the smooth error there.
+    ``solver="direct"``: sparse LU (SuperLU, minimum-degree ordering) of the whole tile.
+    Measured on 2000 × 2000 nodes (2 busy cores) with the cascade: 4 M points (1 per cell)
+    13 s against 125 s direct (256-node tiles); 160 k points (1 per 25 cells) 62 s.
 
 Robust IRLS (``robust=True``)
     After each solution the point residuals :math:`e_k = z_k − \hat z(x_k, y_k)` are normalised
@@ -94,12 +100,14 @@ from scipy.sparse.linalg import splu
 from ..errors import InputError
 from ..feedback import Feedback, ensure_feedback
 from ..linalg import CG_FE, jacobi, pcg
+from .fe_multigrid import VCycle
 from .gridding import Grid, polygon_mask
 
 Array = NDArray[Any]
 
 _EPS = 1e-10  # ridge towards the nearest measured height (relative to the median weight)
-_COARSEST = 64  # nodes per side below which the cascade solves directly
+_COARSEST = 64  # nodes per side below which the cascade / the V-cycle solves directly
+_SOLVERS = ("cg", "cg_jacobi", "direct")
 _HUBER = 1.5
 _WELSCH = 2.5
 
@@ -330,6 +338,8 @@ class _TileProblem:
             N, b = lv.normal(w[lv.used])
             x = splu(N.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(b)
             return self._grid(lv, x), 0
+        if solver == "cg":
+            return self._solve_multigrid(w, x0, tol, maxiter, feedback)
         if x0 is not None:  # a warm start (robust iterations): only the finest level
             lv = self.levels[0]
             N, b = lv.normal(w[lv.used])
@@ -349,6 +359,24 @@ class _TileProblem:
             grid = self._grid(lv, x)
         assert grid is not None
         return grid, its
+
+    def _solve_multigrid(self, w: Array, x0: Optional[Array], tol: float, maxiter: int,
+                         feedback: Feedback) -> Tuple[Array, int]:
+        """CG on level 0 preconditioned by a V-cycle (:mod:`.fe_multigrid`).
+
+        Starts from ``x0`` (a warm start) or the ridge targets; nodes that are not unknowns
+        start at their ridge target, their exact solution, so their residual is zero.
+        """
+        lv = self.levels[0]
+        N, b = lv.normal(w[lv.used])
+        keep = np.zeros(lv.n, bool)
+        keep[lv.nodes] = True
+        x = lv.prior.copy()
+        if x0 is not None:
+            x[keep] = _nan_nearest(x0).ravel()[keep]
+        x, its = pcg(N, b, VCycle(N, lv.shape, keep, _COARSEST), x, tol=tol,
+                     max_iter=maxiter, rule=CG_FE, feedback=feedback)
+        return self._grid(lv, x), its
 
     @staticmethod
     def _grid(lv: _Level, x: Array) -> Array:
@@ -404,7 +432,7 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
                    reference_spacing: Optional[float] = None, robust: bool = False,
                    robust_iterations: int = 5, robust_floor: float = 0.0,
                    breakline_weight: float = 100.0, tile: int = 512, overlap: int = 32,
-                   solver: str = "cg", tol: float = 1e-7, maxiter: int = 3000,
+                   solver: str = "cg", tol: float = 1e-9, maxiter: int = 3000,
                    feedback: Optional[Feedback] = None) -> Tuple[Array, Dict[str, Any]]:
     """Interpolate scattered points to a grid by finite elements (see the module notes).
 
@@ -441,10 +469,11 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
         Weight of a densified breakline vertex relative to the median point weight.
     tile, overlap : int
         Tile side and overlap on each side (nodes); peak memory grows with (tile+2·overlap)².
-    solver : {"cg", "direct"}
-        Cascadic Jacobi-preconditioned CG, or sparse LU per tile.
+    solver : {"cg", "cg_jacobi", "direct"}
+        Multigrid-preconditioned CG, the former cascadic Jacobi-preconditioned CG, or sparse
+        LU per tile.
     tol, maxiter : float, int
-        CG stopping rule ‖r‖ ≤ tol·‖b‖ and iteration limit per level.
+        CG stopping rule ‖r‖ ≤ tol·‖b‖ and iteration limit (per level with ``cg_jacobi``).
     feedback : Feedback, optional
 
     Returns
@@ -461,8 +490,8 @@ def fe_interpolate(x: ArrayLike, y: ArrayLike, z: ArrayLike, grid: Grid, *,
     """
     t_start = time.perf_counter()
     feedback = ensure_feedback(feedback)
-    if solver not in ("cg", "direct"):
-        raise InputError(f"Unknown FE solver '{solver}'; use 'cg' or 'direct'.")
+    if solver not in _SOLVERS:
+        raise InputError(f"Unknown FE solver '{solver}'; use one of {', '.join(_SOLVERS)}.")
     if not (smoothing > 0 and math.isfinite(smoothing)):
         raise InputError(f"The smoothing must be a positive number, got {smoothing}.")
     x = np.ravel(np.asarray(x, float))
@@ -637,7 +666,7 @@ class _Mosaic:
         prob = _TileProblem((r1 - r0, c1 - c0), obs.pu[sel] - c0, obs.pv[sel] - r0,
                             obs.pz[sel] - self.zref, obs.pw[sel], self.unknown[r0:r1, c0:c1],
                             lseg, self.lam, obs.wref, self.prior[r0:r1, c0:c1],
-                            cascade=self.opts.solver == "cg")
+                            cascade=self.opts.solver == "cg_jacobi")
         sol, its, rw = self._solve(prob, sel, feedback)
         if self.opts.robust:
             # robust weights of the points whose base node lies in the tile's core
@@ -679,7 +708,7 @@ class _Mosaic:
             rw = _robust_weights(en / sig, it, is_pt)
             wt = pw[sel].copy()
             wt[lv0.used] = wu * rw
-            sol, k = prob.solve(wt, sol if o.solver == "cg" else None, o.solver, o.tol,
+            sol, k = prob.solve(wt, sol if o.solver != "direct" else None, o.solver, o.tol,
                                 o.maxiter, feedback)
             its += k
         return sol, its, rw
