@@ -16,8 +16,9 @@ SHARED_DATA = Path(os.environ.get("PHOTODEM_SHARED_DATA", ROOT.parent / "shared"
 
 #: Seconds after which a test counts as hung and ends the run (``SIGALRM``'s default action,
 #: which needs no Python, so it works even when a deadlock holds the GIL). Every thread's stack
-#: has been dumped 30 s before (a fifth of the time for short limits) (``faulthandler``, from its own C thread): a hang costs minutes
-#: and says where it is, instead of running into CI's time limit silently.
+#: has been dumped 30 s before (a fifth of the time for short limits) (``faulthandler``, from
+#: its own C thread): a hang costs minutes and says where it is, instead of running into CI's
+#: time limit silently.
 HUNG_TEST_S = int(os.environ.get("PHOTODEM_HUNG_TEST_S", "660"))
 #: Folder for the hang record (``make test`` sets it): ``current`` holds the running test's id,
 #: ``stacks`` the dump. A run killed by the alarm leaves both for ``tools/hang_report.py``,
