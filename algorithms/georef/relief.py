@@ -497,7 +497,7 @@ def scale_about(centre: Array, factor: float) -> Array:
 def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
                    centre: Optional[Sequence[float]] = None,
                    max_relief_px: float = MAX_RELIEF_PX, min_edges: int = MIN_EDGES,
-                   min_buildings: int = MIN_BUILDINGS, refit_start: bool = True
+                   min_buildings: int = MIN_BUILDINGS, refit_start: bool = False
                    ) -> ReliefCorrection:
     """Correct a roof-fitted image → map transform for relief displacement.
 
@@ -519,7 +519,10 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     refit_start : bool
         First refit T to the roof edges seen in the image (:func:`roof_refit`): a matched
         start is off the roof-fitted transform by a shift, rotation and shear that spread the
-        ground edges and hide the relief. Kept only together with a relief correction.
+        ground edges and hide the relief. Kept only together with a relief correction. Off
+        by default: from the roof-fitted (truth) starts of ``bench georef_relief`` it biases
+        the relief low (relief 3 px: 100 % → 65 % within 1 px) and once finds relief where
+        there is none (docs/decisions.md, part T).
 
     Returns
     -------
