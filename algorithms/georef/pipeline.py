@@ -499,7 +499,7 @@ def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple
             for g in gcps]
     h, w = run.grey.shape
     return _fit_gcps(gcps, run.options.transform, counts), {
-        "relief_scale": float(rc.correction[0, 0]),
+        "relief_scale": rc.scale,
         "relief_centre": [(w - 1) / 2.0, (h - 1) / 2.0]}
 
 
