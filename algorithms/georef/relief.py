@@ -108,17 +108,6 @@ ROOF_SEARCH_PX = (2.5, 1.2)
 ROOF_TUKEY = 4.685
 #: At least this many roof edges for the roof refit of the start; fewer: the start is kept.
 MIN_ROOF_EDGES = 24
-#: Part U's variants of the roof refit (measurement only; the defaults are part T's refit,
-#: which stays off): fit the isotropic scale (False: a + d = 0, idea a); on edges facing the
-#: nadir take the innermost step of at least this share of the largest (None: the largest,
-#: idea b); one radial displacement per roof as extra unknowns; the step detector's half
-#: window (px); a refit moving no corner more than this (px, scale about the nadir taken out)
-#: is dropped. ``ReliefCorrection.misfit`` (the summed misfit at the optimum) serves idea c.
-REFIT_SCALE = True
-INNER_SHARE: Optional[float] = None
-PER_ROOF = False
-ROOF_HALF = 1.5
-REFIT_MIN_PX = 0.0
 
 
 @dataclass
@@ -174,7 +163,6 @@ class ReliefCorrection:
     relief_se_px: float = float("nan")
     gain: float = float("nan")
     offset_px: float = float("nan")
-    misfit: float = float("nan")
     scale: float = 1.0
     edges: int = 0
     edges_measured: int = 0
@@ -278,42 +266,20 @@ def profile_offsets(max_strip: float) -> Array:
     return np.arange(-max_strip - 2.5, 2 * max_strip + 3.5 + 1e-9, 0.1)
 
 
-def _jumps(P: Array, ts: Array, half: float = 1.5) -> Tuple[Array, Array]:
-    """Step positions (between samples) and signed step sizes of a profile: the difference of
-    the means ``half`` px on either side."""
-    c = np.concatenate([[0.0], np.cumsum(P)])
-    n = round(half / float(ts[1] - ts[0]))
-    k = np.arange(n, len(P) - n + 1)  # step between samples k − 1 and k
-    jump = ((c[k + n] - c[k]) - (c[k] - c[k - n])) / n
-    return ts[k] - 0.5 * float(ts[1] - ts[0]), jump
-
-
 def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
                ) -> Tuple[float, float]:
     """Position and size of the largest step of the profile in [lo, hi]: the difference of
     the means ``half`` px on either side (NaN, 0 when the range is empty)."""
-    pos, jump = _jumps(P, ts, half)
+    c = np.concatenate([[0.0], np.cumsum(P)])
+    n = round(half / float(ts[1] - ts[0]))
+    k = np.arange(n, len(P) - n + 1)  # step between samples k − 1 and k
+    jump = ((c[k + n] - c[k]) - (c[k] - c[k - n])) / n
+    pos = ts[k] - 0.5 * float(ts[1] - ts[0])
     ok = (pos >= lo) & (pos <= hi)
     if not ok.any():
         return float("nan"), 0.0
     j = int(np.argmax(np.abs(jump[ok])))
     return float(pos[ok][j]), float(abs(jump[ok][j]))
-
-
-def _inner_step(P: Array, ts: Array, lo: float, hi: float, share: float,
-                half: float = 1.5) -> Tuple[float, float]:
-    """Position and size of the innermost (lowest ``ts``) local maximum of the step size in
-    [lo, hi] that reaches ``share`` of the largest there (NaN, 0 when the range is empty)."""
-    pos, jump = _jumps(P, ts, half)
-    ok = (pos >= lo) & (pos <= hi)
-    if not ok.any():
-        return float("nan"), 0.0
-    pos, a = pos[ok], np.abs(jump[ok])
-    left = np.concatenate([[-np.inf], a[:-1]])
-    right = np.concatenate([a[1:], [-np.inf]])
-    peak = (a >= left) & (a >= right) & (a >= share * a.max())
-    j = int(np.flatnonzero(peak)[0])
-    return float(pos[j]), float(a[j])
 
 
 def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
@@ -363,9 +329,7 @@ def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
 
 # -- the start refitted to the roof edges -----------------------------------------------------
 def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
-               search: float = ROOF_SEARCH_PX[0], centre: Optional[Array] = None,
-               inner_share: Optional[float] = None
-               ) -> Tuple[Array, Array, Array, Array, Array]:
+               search: float = ROOF_SEARCH_PX[0]) -> Tuple[Array, Array, Array]:
     """The roof edge of every footprint edge (all orientations) against the edge mapped by the
     inverse of ``T``: the profile's largest step within ± ``search`` px (sub-pixel: the centre
     of the parabola through the step sizes around it).
@@ -374,7 +338,7 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
     offset along the normal (n; px)."""
     Tinv = np.linalg.inv(T)
     ts = np.arange(-search - 2.0, search + 2.0 + 1e-9, 0.1)
-    mids, normals, offs, owner, centres = [], [], [], [], []
+    mids, normals, offs = [], [], []
     for ring in footprints:
         ring = np.asarray(ring, float)[:, :2]
         if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
@@ -382,7 +346,6 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
         if len(ring) < 3:
             continue
         img = apply(Tinv, ring)
-        centres.append(img.mean(axis=0))
         nxt = np.roll(img, -1, axis=0)
         area2 = float(np.sum(img[:, 0] * nxt[:, 1] - nxt[:, 0] * img[:, 1]))
         for a, b in zip(img, nxt):
@@ -394,24 +357,17 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
             prof = edge_profile(grey, a, b, n, ts)
             if prof is None:
                 continue
-            mid = 0.5 * (a + b)
-            if inner_share is not None and centre is not None \
-                    and float(np.dot(centre - mid, n)) > 0:
-                pos, jump = _inner_step(prof, ts, -search, search, inner_share, ROOF_HALF)
-            else:
-                pos, jump = _main_step(prof, ts, -search, search, ROOF_HALF)
+            pos, jump = _main_step(prof, ts, -search, search)
             if np.isfinite(pos) and jump > 0:
-                mids.append(mid)
+                mids.append(0.5 * (a + b))
                 normals.append(n)
                 offs.append(pos)
-                owner.append(len(centres) - 1)
     return (np.array(mids).reshape(-1, 2), np.array(normals).reshape(-1, 2),
-            np.array(offs, float), np.array(owner, int), np.array(centres).reshape(-1, 2))
+            np.array(offs, float))
 
 
 def roof_refit(mids: Array, normals: Array, offs: Array, centre: Array,
-               iterations: int = 8, scale: bool = True, owner: Optional[Array] = None,
-               roof_centres: Optional[Array] = None) -> Optional[Array]:
+               iterations: int = 8) -> Optional[Array]:
     """The affine image → image correction C that moves the mapped footprint edges onto the
     roof edges seen (point to line: n·(C(m) − m) = offset), Tukey-reweighted (the roofs
     scatter by their height's difference from the mean, and some steps are not the roof edge);
@@ -426,28 +382,16 @@ def roof_refit(mids: Array, normals: Array, offs: Array, centre: Array,
     A = np.column_stack([normals[:, 0] * q[:, 0], normals[:, 0] * q[:, 1],
                          normals[:, 1] * q[:, 0], normals[:, 1] * q[:, 1],
                          normals[:, 0], normals[:, 1]])
-    # without the isotropic scale: a + d = 0 (a stretch, rotation and shear remain)
-    K = np.eye(6) if scale else np.array(
-        [[1, 0, 0, 0, 0], [0, 1, 0, 0, 0], [0, 0, 1, 0, 0], [-1, 0, 0, 0, 0],
-         [0, 0, 0, 1, 0], [0, 0, 0, 0, 1]], float)
-    A = A @ K
-    if owner is not None and roof_centres is not None:
-        # each roof's own radial displacement (its height's share): k_b · n·(c_b − centre)
-        radial = np.einsum("ij,ij->i", normals, roof_centres[owner] - centre) / 1000.0
-        own = np.zeros((len(offs), len(roof_centres)))
-        own[np.arange(len(offs)), owner] = radial
-        A = np.column_stack([A, own])
     w = np.ones(len(offs))
     for _ in range(iterations):
         sw = np.sqrt(w)
-        y = np.linalg.lstsq(A * sw[:, None], offs * sw, rcond=None)[0]
-        res = offs - A @ y
+        x = np.linalg.lstsq(A * sw[:, None], offs * sw, rcond=None)[0]
+        res = offs - A @ x
         sigma = max(1.4826 * float(np.median(np.abs(res))), 0.05)
         u = res / (ROOF_TUKEY * sigma)
         w = np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
         if w.sum() < MIN_ROOF_EDGES:
             return None
-    x = K @ y[:K.shape[1]]
     C = np.eye(3)
     C[:2, :2] += x[:4].reshape(2, 2)
     C[:2, 2] = x[4:] - x[:4].reshape(2, 2) @ centre
@@ -593,8 +537,6 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     c = np.array([(w - 1) / 2.0, (h - 1) / 2.0]) if centre is None else \
         np.asarray(centre, float)
     R = _start_refit(grey, T, footprints, c) if refit_start else np.eye(3)
-    if _off_scale_px(R, c, grey.shape) < REFIT_MIN_PX:
-        R = np.eye(3)  # within the refit's own noise on roof-fitted starts
     T0, T = T, T @ R
     meas, tried = measure_edges(grey, T, footprints, c, max_relief_px)
     rmax = _corner_distance(c, grey.shape)
@@ -618,7 +560,6 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     gain = float(np.interp(0.0, rho_grid, total) - total.min())
     se = _interval(rho_grid, total)
     out = dict(base, relief_px_corner=rho, relief_se_px=se, gain=gain, offset_px=delta,
-               misfit=float(total.min()),
                scale=float(C[0, 0]),
                edges=len(img),
                buildings=len(set(fps)), image_xy=img, map_xy=mp)
@@ -642,23 +583,10 @@ def _start_refit(grey: Array, T: Array, footprints: Sequence[Array], centre: Arr
     :data:`ROOF_SEARCH_PX`; a pass with too few roof edges changes nothing."""
     R = np.eye(3)
     for search in ROOF_SEARCH_PX:
-        mids, normals, offs, owner, rc = roof_edges(grey, T @ R, footprints, search, centre,
-                                                    INNER_SHARE)
-        C = roof_refit(mids, normals, offs, centre, scale=REFIT_SCALE,
-                       owner=owner if PER_ROOF else None, roof_centres=rc)
+        C = roof_refit(*roof_edges(grey, T @ R, footprints, search), centre)
         if C is not None:
             R = R @ np.linalg.inv(C)
     return R
-
-
-def _off_scale_px(C: Array, centre: Array, shape: Tuple[int, ...]) -> float:
-    """The largest move (px) of an image corner under the image → image transform ``C`` once
-    its isotropic scale about ``centre`` (least squares over the corners) is taken out."""
-    h, w = shape[:2]
-    p = np.array([[0.0, 0.0], [w - 1.0, 0.0], [0.0, h - 1.0], [w - 1.0, h - 1.0]])
-    d, v = apply(C, p) - p, p - centre
-    s = float(np.sum(d * v) / np.sum(v * v))
-    return float(np.max(np.hypot(*(d - s * v).T)))
 
 
 def _interval(rho: Array, total: Array) -> float:

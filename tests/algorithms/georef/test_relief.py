@@ -155,7 +155,7 @@ def test_roof_edges_on_a_small_scene():
     shift = np.array([0.6, -0.4])
     T = np.eye(3)
     T[:2, 2] = shift  # maps image → "map": the footprints land 0.6, −0.4 px off the roofs
-    _, normals, offs, _, _ = roof_edges(img, T, rings)
+    _, normals, offs = roof_edges(img, T, rings)
     assert len(offs) == 16
     expected = np.einsum("ij,j->i", normals, shift)  # roof edge = mapped edge + shift
     assert np.max(np.abs(offs - expected)) < 0.15
