@@ -481,7 +481,8 @@ def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple
                 counts: Dict[str, Any]) -> Tuple[tuple, Dict[str, Any]]:
     """The fit from the ground, not the roofs (:mod:`.relief`): when the walls facing the
     nadir show a relief displacement, the control points (on the roof outlines) are moved by
-    it — the scale about the nadir that the roof fit absorbed — and refitted. ``counts`` gets
+    it — the scale about the nadir that the roof fit absorbed, and the roof refit of a start
+    that was off the roofs — and refitted. ``counts`` gets
     the relief at the image corner and the ground edges that agree. Returns the tuple of
     :func:`_outline_fit` and, when corrected, the scale and its centre (image px) for the
     agreement test of the gate (:func:`_roof_level`)."""

@@ -108,6 +108,14 @@ ROOF_SEARCH_PX = (2.5, 1.2)
 ROOF_TUKEY = 4.685
 #: At least this many roof edges for the roof refit of the start; fewer: the start is kept.
 MIN_ROOF_EDGES = 24
+#: A roof edge is taken only where no other step within the search reaches this share of it
+#: (relief-0 seed 15, truth start: half of the largest steps were 0.3–2.5 px off the roof edge,
+#: where the roof–ground step was weak).
+ROOF_STEP_UNIQUE = 0.5
+#: The roof refit is dropped when it moves no image corner by this much (px) once its scale
+#: about the nadir is taken out: from roof-fitted starts it moves 0.06–0.45 px (its own
+#: error); the matched starts it must correct are 0.43–0.73 px off.
+REFIT_MIN_PX = 0.5
 
 
 @dataclass
@@ -266,20 +274,44 @@ def profile_offsets(max_strip: float) -> Array:
     return np.arange(-max_strip - 2.5, 2 * max_strip + 3.5 + 1e-9, 0.1)
 
 
-def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
-               ) -> Tuple[float, float]:
-    """Position and size of the largest step of the profile in [lo, hi]: the difference of
-    the means ``half`` px on either side (NaN, 0 when the range is empty)."""
+def _step_sizes(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
+                ) -> Tuple[Array, Array]:
+    """Positions in [lo, hi] (between samples) and sizes of the profile's steps there: the
+    absolute difference of the means ``half`` px on either side."""
     c = np.concatenate([[0.0], np.cumsum(P)])
     n = round(half / float(ts[1] - ts[0]))
     k = np.arange(n, len(P) - n + 1)  # step between samples k − 1 and k
     jump = ((c[k + n] - c[k]) - (c[k] - c[k - n])) / n
     pos = ts[k] - 0.5 * float(ts[1] - ts[0])
     ok = (pos >= lo) & (pos <= hi)
-    if not ok.any():
+    return pos[ok], np.abs(jump[ok])
+
+
+def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
+               ) -> Tuple[float, float]:
+    """Position and size of the largest step of the profile in [lo, hi]: the difference of
+    the means ``half`` px on either side (NaN, 0 when the range is empty)."""
+    pos, size = _step_sizes(P, ts, lo, hi, half)
+    if not len(pos):
         return float("nan"), 0.0
-    j = int(np.argmax(np.abs(jump[ok])))
-    return float(pos[ok][j]), float(abs(jump[ok][j]))
+    j = int(np.argmax(size))
+    return float(pos[j]), float(size[j])
+
+
+def _unique_step(P: Array, ts: Array, lo: float, hi: float) -> Tuple[float, float]:
+    """The largest step in [lo, hi] when no other step (a local maximum of the step size at
+    least 1 px away) reaches :data:`ROOF_STEP_UNIQUE` of it; else (NaN, 0): the roof edge is
+    not told from a shadow end, wall base or roof structure."""
+    pos, size = _step_sizes(P, ts, lo, hi)
+    if not len(pos):
+        return float("nan"), 0.0
+    j = int(np.argmax(size))
+    left = np.concatenate([[-np.inf], size[:-1]])
+    right = np.concatenate([size[1:], [-np.inf]])
+    other = (size >= left) & (size >= right) & (np.abs(pos - pos[j]) >= 1.0)
+    if other.any() and size[other].max() >= ROOF_STEP_UNIQUE * size[j]:
+        return float("nan"), 0.0
+    return float(pos[j]), float(size[j])
 
 
 def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
@@ -331,8 +363,8 @@ def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
 def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
                search: float = ROOF_SEARCH_PX[0]) -> Tuple[Array, Array, Array]:
     """The roof edge of every footprint edge (all orientations) against the edge mapped by the
-    inverse of ``T``: the profile's largest step within ± ``search`` px (sub-pixel: the centre
-    of the parabola through the step sizes around it).
+    inverse of ``T``: the profile's largest step within ± ``search`` px, where it is the only
+    large one (:func:`_unique_step`).
 
     Returns the mapped midpoints (n, 2), the unit normals (n, 2; outwards) and the roof edge's
     offset along the normal (n; px)."""
@@ -357,7 +389,7 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
             prof = edge_profile(grey, a, b, n, ts)
             if prof is None:
                 continue
-            pos, jump = _main_step(prof, ts, -search, search)
+            pos, jump = _unique_step(prof, ts, -search, search)
             if np.isfinite(pos) and jump > 0:
                 mids.append(0.5 * (a + b))
                 normals.append(n)
@@ -497,7 +529,7 @@ def scale_about(centre: Array, factor: float) -> Array:
 def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
                    centre: Optional[Sequence[float]] = None,
                    max_relief_px: float = MAX_RELIEF_PX, min_edges: int = MIN_EDGES,
-                   min_buildings: int = MIN_BUILDINGS, refit_start: bool = False
+                   min_buildings: int = MIN_BUILDINGS, refit_start: bool = True
                    ) -> ReliefCorrection:
     """Correct a roof-fitted image → map transform for relief displacement.
 
@@ -517,12 +549,11 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
         The evidence needed to change anything: ground edges that agree with the estimate, on
         this many footprints.
     refit_start : bool
-        First refit T to the roof edges seen in the image (:func:`roof_refit`): a matched
-        start is off the roof-fitted transform by a shift, rotation and shear that spread the
-        ground edges and hide the relief. Kept only together with a relief correction. Off
-        by default: from the roof-fitted (truth) starts of ``bench georef_relief`` it biases
-        the relief low (relief 3 px: 100 % → 65 % within 1 px) and once finds relief where
-        there is none (docs/decisions.md, part T).
+        First refit T to the roof edges seen in the image (:func:`roof_start_refit`): a
+        matched start is off the roof-fitted transform by a shift, rotation and shear that
+        spread the ground edges and hide the relief. Kept only together with a relief
+        correction; a refit within its own error (a start already on the roofs) is dropped
+        (docs/decisions.md, parts T and U).
 
     Returns
     -------
@@ -536,7 +567,7 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     h, w = grey.shape
     c = np.array([(w - 1) / 2.0, (h - 1) / 2.0]) if centre is None else \
         np.asarray(centre, float)
-    R = _start_refit(grey, T, footprints, c) if refit_start else np.eye(3)
+    R = roof_start_refit(grey, T, footprints, c) if refit_start else np.eye(3)
     T0, T = T, T @ R
     meas, tried = measure_edges(grey, T, footprints, c, max_relief_px)
     rmax = _corner_distance(c, grey.shape)
@@ -577,16 +608,31 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     return ReliefCorrection(**out, reason="")
 
 
-def _start_refit(grey: Array, T: Array, footprints: Sequence[Array], centre: Array) -> Array:
+def roof_start_refit(grey: Array, T: Array, footprints: Sequence[Array], centre: Array
+                     ) -> Array:
     """The roof refit of the start as an image → image correction R (``T @ R`` maps the roof
     edges seen onto the footprints), one pass per search distance of
-    :data:`ROOF_SEARCH_PX`; a pass with too few roof edges changes nothing."""
+    :data:`ROOF_SEARCH_PX`; a pass with too few roof edges changes nothing, and a refit that
+    moves no image corner by :data:`REFIT_MIN_PX` apart from a scale about ``centre`` is
+    dropped (the identity: a roof-fitted start stays as it is)."""
     R = np.eye(3)
     for search in ROOF_SEARCH_PX:
         C = roof_refit(*roof_edges(grey, T @ R, footprints, search), centre)
         if C is not None:
             R = R @ np.linalg.inv(C)
+    if _off_scale_px(R, centre, grey.shape) < REFIT_MIN_PX:
+        return np.eye(3)  # within the refit's own error
     return R
+
+
+def _off_scale_px(C: Array, centre: Array, shape: Tuple[int, ...]) -> float:
+    """The largest move (px) of an image corner under the image → image transform ``C`` once
+    its isotropic scale about ``centre`` (least squares over the corners) is taken out."""
+    h, w = shape[:2]
+    p = np.array([[0.0, 0.0], [w - 1.0, 0.0], [0.0, h - 1.0], [w - 1.0, h - 1.0]])
+    d, v = apply(C, p) - p, p - centre
+    s = float(np.sum(d * v) / np.sum(v * v))
+    return float(np.max(np.hypot(*(d - s * v).T)))
 
 
 def _interval(rho: Array, total: Array) -> float:
