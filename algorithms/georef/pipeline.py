@@ -481,7 +481,8 @@ def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple
                 counts: Dict[str, Any]) -> Tuple[tuple, Dict[str, Any]]:
     """The fit from the ground, not the roofs (:mod:`.relief`): when the walls facing the
     nadir show a relief displacement, the control points (on the roof outlines) are moved by
-    it — the scale about the nadir that the roof fit absorbed — and refitted. ``counts`` gets
+    it — the scale about the nadir that the roof fit absorbed, and the roof refit of a start
+    that was off the roofs — and refitted. ``counts`` gets
     the relief at the image corner and the ground edges that agree. Returns the tuple of
     :func:`_outline_fit` and, when corrected, the scale and its centre (image px) for the
     agreement test of the gate (:func:`_roof_level`)."""
@@ -499,7 +500,7 @@ def _relief_fit(run: _Run, rings: List[np.ndarray], T: np.ndarray, fitted: tuple
             for g in gcps]
     h, w = run.grey.shape
     return _fit_gcps(gcps, run.options.transform, counts), {
-        "relief_scale": float(rc.correction[0, 0]),
+        "relief_scale": rc.scale,
         "relief_centre": [(w - 1) / 2.0, (h - 1) / 2.0]}
 
 

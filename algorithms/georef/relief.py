@@ -99,6 +99,23 @@ MIN_ROOF_SHARE = 0.4
 #: Largest plausible relief displacement at the image corner (px); a larger estimate is not
 #: relief (inconsistent evidence).
 MAX_RELIEF_PX = 6.0
+#: The roof edge of every footprint edge is searched within this distance (px) of the mapped
+#: edge for the roof refit of the start (the start's own error plus the roofs' relief scatter),
+#: then again nearer the refitted edge (a wall base or shadow end within 2.5 px can be the
+#: larger step: one pass left seeds 10 and 16 of the buildings bench 0.4 px worse).
+ROOF_SEARCH_PX = (2.5, 1.2)
+#: Edges whose roof edge is this many robust σ off the refit do not count (Tukey biweight).
+ROOF_TUKEY = 4.685
+#: At least this many roof edges for the roof refit of the start; fewer: the start is kept.
+MIN_ROOF_EDGES = 24
+#: A roof edge is taken only where no other step within the search reaches this share of it
+#: (relief-0 seed 15, truth start: half of the largest steps were 0.3–2.5 px off the roof edge,
+#: where the roof–ground step was weak).
+ROOF_STEP_UNIQUE = 0.5
+#: The roof refit is dropped when it moves no image corner by this much (px) once its scale
+#: about the nadir is taken out: from roof-fitted starts it moves 0.06–0.45 px (its own
+#: error); the matched starts it must correct are 0.43–0.73 px off.
+REFIT_MIN_PX = 0.5
 
 
 @dataclass
@@ -142,8 +159,9 @@ class ReliefCorrection:
     ``edges_measured`` (profiles that pin the ground edge down), ``edges_tried``,
     ``buildings`` (footprints with a used edge); ``gain``: how much better the estimate
     explains the profiles than no relief (summed misfit, σ² per px); ``offset_px``: the common
-    offset δ of the ground edges; ``reason`` says why nothing changed (empty when
-    ``applied``)."""
+    offset δ of the ground edges; ``scale``: the relief's scale about the nadir (part of
+    ``correction``, which also holds the roof refit of the start); ``reason`` says why nothing
+    changed (empty when ``applied``)."""
 
     transform: Array
     correction: Array
@@ -153,6 +171,7 @@ class ReliefCorrection:
     relief_se_px: float = float("nan")
     gain: float = float("nan")
     offset_px: float = float("nan")
+    scale: float = 1.0
     edges: int = 0
     edges_measured: int = 0
     edges_tried: int = 0
@@ -255,20 +274,44 @@ def profile_offsets(max_strip: float) -> Array:
     return np.arange(-max_strip - 2.5, 2 * max_strip + 3.5 + 1e-9, 0.1)
 
 
-def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
-               ) -> Tuple[float, float]:
-    """Position and size of the largest step of the profile in [lo, hi]: the difference of
-    the means ``half`` px on either side (NaN, 0 when the range is empty)."""
+def _step_sizes(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
+                ) -> Tuple[Array, Array]:
+    """Positions in [lo, hi] (between samples) and sizes of the profile's steps there: the
+    absolute difference of the means ``half`` px on either side."""
     c = np.concatenate([[0.0], np.cumsum(P)])
     n = round(half / float(ts[1] - ts[0]))
     k = np.arange(n, len(P) - n + 1)  # step between samples k − 1 and k
     jump = ((c[k + n] - c[k]) - (c[k] - c[k - n])) / n
     pos = ts[k] - 0.5 * float(ts[1] - ts[0])
     ok = (pos >= lo) & (pos <= hi)
-    if not ok.any():
+    return pos[ok], np.abs(jump[ok])
+
+
+def _main_step(P: Array, ts: Array, lo: float, hi: float, half: float = 1.5
+               ) -> Tuple[float, float]:
+    """Position and size of the largest step of the profile in [lo, hi]: the difference of
+    the means ``half`` px on either side (NaN, 0 when the range is empty)."""
+    pos, size = _step_sizes(P, ts, lo, hi, half)
+    if not len(pos):
         return float("nan"), 0.0
-    j = int(np.argmax(np.abs(jump[ok])))
-    return float(pos[ok][j]), float(abs(jump[ok][j]))
+    j = int(np.argmax(size))
+    return float(pos[j]), float(size[j])
+
+
+def _unique_step(P: Array, ts: Array, lo: float, hi: float) -> Tuple[float, float]:
+    """The largest step in [lo, hi] when no other step (a local maximum of the step size at
+    least 1 px away) reaches :data:`ROOF_STEP_UNIQUE` of it; else (NaN, 0): the roof edge is
+    not told from a shadow end, wall base or roof structure."""
+    pos, size = _step_sizes(P, ts, lo, hi)
+    if not len(pos):
+        return float("nan"), 0.0
+    j = int(np.argmax(size))
+    left = np.concatenate([[-np.inf], size[:-1]])
+    right = np.concatenate([size[1:], [-np.inf]])
+    other = (size >= left) & (size >= right) & (np.abs(pos - pos[j]) >= 1.0)
+    if other.any() and size[other].max() >= ROOF_STEP_UNIQUE * size[j]:
+        return float("nan"), 0.0
+    return float(pos[j]), float(size[j])
 
 
 def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
@@ -314,6 +357,77 @@ def edge_curve(profile: Array, ts: Array, max_strip: float = MAX_STRIP_PX
     by_g = np.full(len(gs), np.inf)
     np.minimum.at(by_g, gi, sse)
     return gs, (by_g - float(sse.min())) / (per_px * sigma2), float(E[int(np.argmin(sse))])
+
+
+# -- the start refitted to the roof edges -----------------------------------------------------
+def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
+               search: float = ROOF_SEARCH_PX[0]) -> Tuple[Array, Array, Array]:
+    """The roof edge of every footprint edge (all orientations) against the edge mapped by the
+    inverse of ``T``: the profile's largest step within ± ``search`` px, where it is the only
+    large one (:func:`_unique_step`).
+
+    Returns the mapped midpoints (n, 2), the unit normals (n, 2; outwards) and the roof edge's
+    offset along the normal (n; px)."""
+    Tinv = np.linalg.inv(T)
+    ts = np.arange(-search - 2.0, search + 2.0 + 1e-9, 0.1)
+    mids, normals, offs = [], [], []
+    for ring in footprints:
+        ring = np.asarray(ring, float)[:, :2]
+        if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
+            ring = ring[:-1]
+        if len(ring) < 3:
+            continue
+        img = apply(Tinv, ring)
+        nxt = np.roll(img, -1, axis=0)
+        area2 = float(np.sum(img[:, 0] * nxt[:, 1] - nxt[:, 0] * img[:, 1]))
+        for a, b in zip(img, nxt):
+            d = b - a
+            length = float(np.hypot(*d))
+            if length < MIN_EDGE_PX:
+                continue
+            n = np.array([d[1], -d[0]]) / length * (1.0 if area2 > 0 else -1.0)
+            prof = edge_profile(grey, a, b, n, ts)
+            if prof is None:
+                continue
+            pos, jump = _unique_step(prof, ts, -search, search)
+            if np.isfinite(pos) and jump > 0:
+                mids.append(0.5 * (a + b))
+                normals.append(n)
+                offs.append(pos)
+    return (np.array(mids).reshape(-1, 2), np.array(normals).reshape(-1, 2),
+            np.array(offs, float))
+
+
+def roof_refit(mids: Array, normals: Array, offs: Array, centre: Array,
+               iterations: int = 8) -> Optional[Array]:
+    """The affine image → image correction C that moves the mapped footprint edges onto the
+    roof edges seen (point to line: n·(C(m) − m) = offset), Tukey-reweighted (the roofs
+    scatter by their height's difference from the mean, and some steps are not the roof edge);
+    None with fewer than :data:`MIN_ROOF_EDGES` edges.
+
+    This is what a perfect roof matcher gives (the roof-fitted transform of
+    :func:`correct_relief`): a matched start is off it by a shift, rotation and shear (and a
+    little scale) that no relief model explains."""
+    if len(offs) < MIN_ROOF_EDGES:
+        return None
+    q = mids - centre
+    A = np.column_stack([normals[:, 0] * q[:, 0], normals[:, 0] * q[:, 1],
+                         normals[:, 1] * q[:, 0], normals[:, 1] * q[:, 1],
+                         normals[:, 0], normals[:, 1]])
+    w = np.ones(len(offs))
+    for _ in range(iterations):
+        sw = np.sqrt(w)
+        x = np.linalg.lstsq(A * sw[:, None], offs * sw, rcond=None)[0]
+        res = offs - A @ x
+        sigma = max(1.4826 * float(np.median(np.abs(res))), 0.05)
+        u = res / (ROOF_TUKEY * sigma)
+        w = np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
+        if w.sum() < MIN_ROOF_EDGES:
+            return None
+    C = np.eye(3)
+    C[:2, :2] += x[:4].reshape(2, 2)
+    C[:2, 2] = x[4:] - x[:4].reshape(2, 2) @ centre
+    return C
 
 
 # -- the correction ---------------------------------------------------------------------------
@@ -415,7 +529,8 @@ def scale_about(centre: Array, factor: float) -> Array:
 def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
                    centre: Optional[Sequence[float]] = None,
                    max_relief_px: float = MAX_RELIEF_PX, min_edges: int = MIN_EDGES,
-                   min_buildings: int = MIN_BUILDINGS) -> ReliefCorrection:
+                   min_buildings: int = MIN_BUILDINGS, refit_start: bool = True
+                   ) -> ReliefCorrection:
     """Correct a roof-fitted image → map transform for relief displacement.
 
     Parameters
@@ -433,22 +548,31 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     min_edges, min_buildings : int
         The evidence needed to change anything: ground edges that agree with the estimate, on
         this many footprints.
+    refit_start : bool
+        First refit T to the roof edges seen in the image (:func:`roof_start_refit`): a
+        matched start is off the roof-fitted transform by a shift, rotation and shear that
+        spread the ground edges and hide the relief. Kept only together with a relief
+        correction; a refit within its own error (a start already on the roofs) is dropped
+        (docs/decisions.md, parts T and U).
 
     Returns
     -------
     ReliefCorrection
-        ``transform = T @ scale_about(centre, 1 + ρ / rmax)`` when applied (ρ: the relief at
-        the corner, rmax: the corner's distance from the nadir), else T and the reason.
+        ``transform = T @ R @ scale_about(centre, 1 + ρ / rmax)`` when applied (R: the roof
+        refit, the identity without it; ρ: the relief at the corner, rmax: the corner's
+        distance from the nadir), else T and the reason.
     """
     grey = np.asarray(grey, dtype=np.float64)
     T = np.asarray(T, float)
     h, w = grey.shape
     c = np.array([(w - 1) / 2.0, (h - 1) / 2.0]) if centre is None else \
         np.asarray(centre, float)
+    R = roof_start_refit(grey, T, footprints, c) if refit_start else np.eye(3)
+    T0, T = T, T @ R
     meas, tried = measure_edges(grey, T, footprints, c, max_relief_px)
     rmax = _corner_distance(c, grey.shape)
     info = [m for m in meas if m.informative]
-    base: Dict[str, Any] = {"transform": T, "correction": np.eye(3), "applied": False,
+    base: Dict[str, Any] = {"transform": T0, "correction": np.eye(3), "applied": False,
                             "edges_measured": len(info), "edges_tried": tried}
     if len(info) < min_edges:
         return ReliefCorrection(**base, reason=(
@@ -467,6 +591,7 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
     gain = float(np.interp(0.0, rho_grid, total) - total.min())
     se = _interval(rho_grid, total)
     out = dict(base, relief_px_corner=rho, relief_se_px=se, gain=gain, offset_px=delta,
+               scale=float(C[0, 0]),
                edges=len(img),
                buildings=len(set(fps)), image_xy=img, map_xy=mp)
     why = ""
@@ -479,8 +604,35 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
         why = f"no significant relief: {rho:.2f} px at the corner (gain {gain:.1f} over none)"
     if why:
         return ReliefCorrection(**out, reason=why)
-    out.update(transform=T @ C, correction=C, applied=True)
+    out.update(transform=T @ C, correction=R @ C, applied=True)
     return ReliefCorrection(**out, reason="")
+
+
+def roof_start_refit(grey: Array, T: Array, footprints: Sequence[Array], centre: Array
+                     ) -> Array:
+    """The roof refit of the start as an image → image correction R (``T @ R`` maps the roof
+    edges seen onto the footprints), one pass per search distance of
+    :data:`ROOF_SEARCH_PX`; a pass with too few roof edges changes nothing, and a refit that
+    moves no image corner by :data:`REFIT_MIN_PX` apart from a scale about ``centre`` is
+    dropped (the identity: a roof-fitted start stays as it is)."""
+    R = np.eye(3)
+    for search in ROOF_SEARCH_PX:
+        C = roof_refit(*roof_edges(grey, T @ R, footprints, search), centre)
+        if C is not None:
+            R = R @ np.linalg.inv(C)
+    if _off_scale_px(R, centre, grey.shape) < REFIT_MIN_PX:
+        return np.eye(3)  # within the refit's own error
+    return R
+
+
+def _off_scale_px(C: Array, centre: Array, shape: Tuple[int, ...]) -> float:
+    """The largest move (px) of an image corner under the image → image transform ``C`` once
+    its isotropic scale about ``centre`` (least squares over the corners) is taken out."""
+    h, w = shape[:2]
+    p = np.array([[0.0, 0.0], [w - 1.0, 0.0], [0.0, h - 1.0], [w - 1.0, h - 1.0]])
+    d, v = apply(C, p) - p, p - centre
+    s = float(np.sum(d * v) / np.sum(v * v))
+    return float(np.max(np.hypot(*(d - s * v).T)))
 
 
 def _interval(rho: Array, total: Array) -> float:
