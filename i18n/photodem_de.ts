@@ -5417,12 +5417,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Georeferencing failed: {why} ({detail}). Check that image and reference show the same objects completely (class field/value), try other thresholds or a larger relative difference.</source>
-            <extracomment>algorithms/georef/pipeline.py:781</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:782</extracomment>
             <translation>Die Georeferenzierung ist fehlgeschlagen: {why} ({detail}). Prüfen Sie, ob Bild und Referenz dieselben Objekte vollständig zeigen (Klassenfeld/-wert), versuchen Sie andere Schwellen oder eine größere relative Differenz.</translation>
         </message>
         <message>
             <source>The output folder '{path}' holds files PhotoDEM did not write; choose an empty or new folder.</source>
-            <extracomment>algorithms/georef/pipeline.py:819</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:820</extracomment>
             <translation>Der Ausgabeordner '{path}' enthält Dateien, die PhotoDEM nicht geschrieben hat; wählen Sie einen leeren oder neuen Ordner.</translation>
         </message>
         <message>
