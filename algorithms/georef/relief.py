@@ -190,13 +190,10 @@ def _round(x: float) -> Optional[float]:
 
 
 # -- edges facing the nadir -------------------------------------------------------------------
-def facing_edges(ring_img: Array, centre: Array, min_len: float = MIN_EDGE_PX
-                 ) -> List[Tuple[int, Array, Array]]:
-    """Edges of an image-coordinate ring whose outward normal points towards ``centre``.
-
-    Returns (index of the first vertex, midpoint, unit outward normal) per edge at least
-    ``min_len`` px long. Works for either orientation of the ring (mirrored maps).
-    """
+def ring_edges(ring_img: Array, min_len: float = MIN_EDGE_PX) -> List[Tuple[int, Array, Array]]:
+    """Edges of an image-coordinate ring: (index of the first vertex, midpoint, unit outward
+    normal) per edge at least ``min_len`` px long. Works for either orientation of the ring
+    (mirrored maps); a closing vertex equal to the first is dropped."""
     ring = np.asarray(ring_img, float)
     if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
         ring = ring[:-1]
@@ -213,10 +210,15 @@ def facing_edges(ring_img: Array, centre: Array, min_len: float = MIN_EDGE_PX
             continue
         # outward normal: right of the direction for a counter-clockwise ring (x right, y up)
         n = np.array([d[1], -d[0]]) / length * (1.0 if area2 > 0 else -1.0)
-        mid = 0.5 * (a + b)
-        if float(np.dot(centre - mid, n)) > 0:
-            out.append((k, mid, n))
+        out.append((k, 0.5 * (a + b), n))
     return out
+
+
+def facing_edges(ring_img: Array, centre: Array, min_len: float = MIN_EDGE_PX
+                 ) -> List[Tuple[int, Array, Array]]:
+    """The edges of :func:`ring_edges` whose outward normal points towards ``centre``."""
+    return [(k, mid, n) for k, mid, n in ring_edges(ring_img, min_len)
+            if float(np.dot(centre - mid, n)) > 0]
 
 
 def edge_profile(grey: Array, a: Array, b: Array, normal: Array, ts: Array,
@@ -373,25 +375,16 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
     mids, normals, offs = [], [], []
     for ring in footprints:
         ring = np.asarray(ring, float)[:, :2]
-        if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
+        if len(ring) > 1 and np.allclose(ring[0], ring[-1]):  # as measure_edges does
             ring = ring[:-1]
-        if len(ring) < 3:
-            continue
         img = apply(Tinv, ring)
-        nxt = np.roll(img, -1, axis=0)
-        area2 = float(np.sum(img[:, 0] * nxt[:, 1] - nxt[:, 0] * img[:, 1]))
-        for a, b in zip(img, nxt):
-            d = b - a
-            length = float(np.hypot(*d))
-            if length < MIN_EDGE_PX:
-                continue
-            n = np.array([d[1], -d[0]]) / length * (1.0 if area2 > 0 else -1.0)
-            prof = edge_profile(grey, a, b, n, ts)
+        for k, mid, n in ring_edges(img):
+            prof = edge_profile(grey, img[k], img[(k + 1) % len(img)], n, ts)
             if prof is None:
                 continue
             pos, jump = _unique_step(prof, ts, -search, search)
             if np.isfinite(pos) and jump > 0:
-                mids.append(0.5 * (a + b))
+                mids.append(mid)
                 normals.append(n)
                 offs.append(pos)
     return (np.array(mids).reshape(-1, 2), np.array(normals).reshape(-1, 2),
