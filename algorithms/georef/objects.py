@@ -59,11 +59,20 @@ class PolygonObject:
         return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
-def orient_ring(ring: np.ndarray) -> np.ndarray:
-    """Return the ring as float64 (K, 2), unclosed, with positive signed area."""
+def unclosed_ring(ring: np.ndarray) -> np.ndarray:
+    """The ring as float64 without a closing vertex equal to its first one.
+
+    Equal means equal: a tolerance relative to the coordinates (``np.allclose``) is metres on
+    map coordinates and drops a real last corner of a small footprint."""
     ring = np.asarray(ring, dtype=np.float64)
     if len(ring) > 1 and np.array_equal(ring[0], ring[-1]):
         ring = ring[:-1]
+    return ring
+
+
+def orient_ring(ring: np.ndarray) -> np.ndarray:
+    """Return the ring as float64 (K, 2), unclosed, with positive signed area."""
+    ring = unclosed_ring(ring)
     x, y = ring[:, 0], ring[:, 1]
     if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) < 0:
         ring = ring[::-1].copy()

@@ -59,6 +59,7 @@ from scipy import ndimage
 from scipy.special import erf
 
 from .correspondence import apply
+from .objects import unclosed_ring
 
 Array = NDArray[np.float64]
 
@@ -194,9 +195,7 @@ def ring_edges(ring_img: Array, min_len: float = MIN_EDGE_PX) -> List[Tuple[int,
     """Edges of an image-coordinate ring: (index of the first vertex, midpoint, unit outward
     normal) per edge at least ``min_len`` px long. Works for either orientation of the ring
     (mirrored maps); a closing vertex equal to the first is dropped."""
-    ring = np.asarray(ring_img, float)
-    if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
-        ring = ring[:-1]
+    ring = unclosed_ring(ring_img)
     if len(ring) < 3:
         return []
     nxt = np.roll(ring, -1, axis=0)
@@ -374,9 +373,7 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
     ts = np.arange(-search - 2.0, search + 2.0 + 1e-9, 0.1)
     mids, normals, offs = [], [], []
     for ring in footprints:
-        ring = np.asarray(ring, float)[:, :2]
-        if len(ring) > 1 and np.allclose(ring[0], ring[-1]):  # as measure_edges does
-            ring = ring[:-1]
+        ring = unclosed_ring(np.asarray(ring, float)[:, :2])
         img = apply(Tinv, ring)
         for k, mid, n in ring_edges(img):
             prof = edge_profile(grey, img[k], img[(k + 1) % len(img)], n, ts)
@@ -434,9 +431,7 @@ def measure_edges(grey: Array, T: Array, footprints: Sequence[Array], centre: Ar
     out: List[EdgeMeasurement] = []
     tried = 0
     for f, ring in enumerate(footprints):
-        ring = np.asarray(ring, float)[:, :2]
-        if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
-            ring = ring[:-1]
+        ring = unclosed_ring(np.asarray(ring, float)[:, :2])
         img = apply(Tinv, ring)
         for k, mid, n in facing_edges(img, centre):
             tried += 1

@@ -228,3 +228,22 @@ def test_roof_start_refit_keeps_a_roof_fitted_start_and_corrects_an_off_one():
     assert np.hypot(*((corners @ E.T - corners)[:, :2]).T).max() > 1.5
     D = E @ roof_start_refit(img, E, rings, centre)  # the refitted start; the truth is I
     assert np.hypot(*((corners @ D.T - corners)[:, :2]).T).max() < 0.2  # measured 0.09
+
+
+def test_roof_edges_keep_every_corner_of_footprints_in_map_coordinates():
+    """Footprints in projected coordinates (UTM-sized numbers), unclosed as the reference
+    layer gives them: every edge of every footprint is profiled. A relative tolerance on
+    the closing-vertex test was metres there and dropped the last corner of small
+    footprints (a rectangle became a triangle with a diagonal edge)."""
+    from photodem.algorithms.georef.objects import unclosed_ring
+
+    img, rings = _roof_grid()
+    offset = np.array([559700.0, 5929600.0])
+    T = np.array([[1.0, 0.0, offset[0]], [0.0, 1.0, offset[1]], [0.0, 0.0, 1.0]])
+    map_rings = [r + offset for r in rings]
+    assert all(len(unclosed_ring(r)) == 4 for r in map_rings)
+    closed = [np.vstack([r, r[:1]]) for r in map_rings]
+    assert all(len(unclosed_ring(r)) == 4 for r in closed)
+    for footprints in (map_rings, closed):
+        _, _, offs = roof_edges(img, T, footprints)
+        assert len(offs) == 64 and np.max(np.abs(offs)) < 0.15
