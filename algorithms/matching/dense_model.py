@@ -23,9 +23,11 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    centres of 2 × 2 pixel quads on one surface (:func:`footprint_points`; a tilted frame's far
    side has fewer pixels than cells), and then the points of two *slant passes*: SGM against
    the right image stretched along its rows by :data:`SLANT_SCALES` (slopes that one camera
-   sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), kept
-   where they agree with the plain pass's heights around them (:data:`SLANT_GAP_CELLS`) —
-   only with ``slant_passes`` (off by default: open terrain NMAD and RMSE rise, issue 22).
+   sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), each
+   disparity refined by least-squares matching between the original images, whose affine
+   x-scale fits the slope (:mod:`.slant_lsm`), and kept where they agree with the plain pass's
+   heights around them (:data:`SLANT_GAP_CELLS`) — only with ``slant_passes`` (issue 22,
+   parts N and X in docs/decisions.md).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
@@ -66,6 +68,7 @@ from ..surface.gridding import (
 from .dense import DenseOptions, GreySource, iter_disparity_tiles
 from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
+from .slant_lsm import refine_slant
 
 PathLike = Union[str, Path]
 
@@ -197,7 +200,9 @@ SLANT_SCALES: Tuple[float, ...] = (0.7, 1.4)
 #: (:func:`~..surface.gridding.fill_gaps`). Without the test (and with the object fill in
 #: the slant passes) their blunders on periodic field textures raised the open RMSE by 20 %
 #: (drone seed 1, 0201_0203: 0.69 → 0.85 m); 3 px instead of 1 px kept a few more cells and
-#: more blunders (0202_0203: open RMSE 0.4765 against 0.4728 m).
+#: more blunders (0202_0203: open RMSE 0.4765 against 0.4728 m). With the LSM refinement the
+#: test stays at 1 px: without it open RMSE +1.2 / +1.7 % (seed 2 0101_0102, 0202_0203),
+#: with 2 px open NMAD +1.2 % on seed 1 0101_0103 (issue 22, part X).
 SLANT_GAP_CELLS = 100
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
@@ -289,12 +294,26 @@ class _Guide:
         return ((1.0 - scale) * col[None, :] + scale * d).astype(np.float32)
 
 
+def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
+                       left: GreySource, right: GreySource
+                       ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The disparities of the pair from one slant tile, refined by LSM between the original
+    images (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and
+    rows."""
+    ok = np.isfinite(block)
+    rr, cc = np.nonzero(ok)
+    d = unstretch(block[ok], cc + c0, scale)
+    d, keep = refine_slant(left, right, d, cc + c0, rr + r0, scale)
+    return d[keep], cc[keep] + c0, rr[keep] + r0
+
+
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
                 feedback: Feedback) -> float:
     """The slant passes (:data:`SLANT_SCALES`): tiled SGM against the stretched right image
-    in the ranges of ``guide``, every valid disparity's point into ``acc``; returns the
-    matching time (s)."""
+    in the ranges of ``guide``; the valid disparities, refined by LSM
+    (:func:`_slant_disparities`), give their points into ``acc``; returns the matching time
+    (s)."""
     pair = setup.pair
     seconds = triangulation = 0.0  # the caller counts the triangulation apart
     # slopes, not objects: every hole border eroded and no object fill (with the plain pass's
@@ -313,12 +332,11 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                     left, stretched_source(right, scale), shape_l, shape_r, lo, hi, options,
                     max_memory_mb=memory_mb, feedback=feedback.step(k * share, (k + 1) * share),
                     guide=(guide.stretched(scale), GUIDE_FACTOR)):
+                # the LSM refinement counts as matching
+                d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right)
                 t1 = time.perf_counter()
-                ok = np.isfinite(block)
-                if ok.any():
-                    rr, cc = np.nonzero(ok)
-                    d = unstretch(block[ok], cc + c0, scale)
-                    pts = pair.disparity_to_world(d, cc + c0, rr + r0)
+                if d.size:
+                    pts = pair.disparity_to_world(d, cols, rows)
                     acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
                 triangulation += time.perf_counter() - t1
             seconds += time.perf_counter() - t0
@@ -512,10 +530,11 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     slant_passes : bool
         Convergent models only: also match against the right image stretched by
         :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
-        with the plain ones (module notes). Off by default: on the drone bench it measures
-        1.6–5.7 points more of the visible cells, but the open terrain's NMAD rises by
-        0.5–5 % and its RMSE on 9 of 12 model-seeds (up to +7.7 %), and a model takes
-        about 5 × as long (issue 22, part N in docs/decisions.md).
+        with the plain ones (module notes); nadir models have none. With the LSM refinement
+        of their disparities the drone bench measures 0.9–4.4 points more of the visible
+        cells, with open NMAD and RMSE within 1 % of the plain pass's or better on 11 of 12
+        model-seeds (seed 3 0201_0203: RMSE +1.7 %); a convergent model takes about 5–8 × as
+        long (issue 22, parts N and X in docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
@@ -558,9 +577,6 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                  if setup.convergent else None)
         guide = (_Guide((pair.height, pair.sizes[0][0]))
                  if setup.convergent and slant_passes else None)
-        if slant_passes and guide is None:
-            feedback.info(f"Model {m.name}: no slant passes — they are for convergent models "
-                          "only.")
         # the slant passes take most of the matching time when they run
         plain_end = 45.0 if guide is not None else 85.0
         counts = _match_into(setup, grey, acc, memory_mb, options,
