@@ -26,7 +26,7 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), each
    disparity refined by least-squares matching between the original images, whose affine
    x-scale fits the slope (:mod:`.slant_lsm`), and kept where they agree with the plain pass's
-   heights around them (:data:`SLANT_GAP_CELLS`) — only with ``slant_passes`` (issue 22,
+   heights around them (:data:`SLANT_GAP_CELLS`) — ``slant_passes``, on by default (issue 22,
    parts N and X in docs/decisions.md).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
@@ -498,7 +498,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       max_gap: Optional[float] = None, disparity_margin: int = 4,
                       memory_mb: float = 256.0, outlier_radius: Optional[float] = None,
                       outlier_threshold: Optional[float] = None, outlier_k: float = 3.0,
-                      slant_passes: bool = False, **dense_options: Any) -> Dict[str, Any]:
+                      slant_passes: bool = True, **dense_options: Any) -> Dict[str, Any]:
     """Dense DSM of a stereo model (see the module notes).
 
     Parameters
@@ -530,11 +530,11 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     slant_passes : bool
         Convergent models only: also match against the right image stretched by
         :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
-        with the plain ones (module notes); nadir models have none. With the LSM refinement
-        of their disparities the drone bench measures 0.9–4.4 points more of the visible
-        cells, with open NMAD and RMSE within 1 % of the plain pass's or better on 11 of 12
-        model-seeds (seed 3 0201_0203: RMSE +1.7 %); a convergent model takes about 5–8 × as
-        long (issue 22, parts N and X in docs/decisions.md).
+        with the plain ones (module notes); nadir models have none. On by default: with the
+        LSM refinement of their disparities the drone bench measures 0.9–4.4 points more of
+        the visible cells, with open NMAD and RMSE within 1 % of the plain pass's or better
+        on 11 of 12 model-seeds (seed 3 0201_0203: RMSE +1.7 %); a convergent model takes
+        about 5–8 × as long (issue 22, parts N and X in docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
