@@ -23,9 +23,11 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    centres of 2 × 2 pixel quads on one surface (:func:`footprint_points`; a tilted frame's far
    side has fewer pixels than cells), and then the points of two *slant passes*: SGM against
    the right image stretched along its rows by :data:`SLANT_SCALES` (slopes that one camera
-   sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), kept
-   where they agree with the plain pass's heights around them (:data:`SLANT_GAP_CELLS`) —
-   only with ``slant_passes`` (off by default: open terrain NMAD and RMSE rise, issue 22).
+   sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), each
+   disparity refined by least-squares matching between the original images, whose affine
+   x-scale fits the slope (:mod:`.slant_lsm`), and kept where they agree with the plain pass's
+   heights around them (:data:`SLANT_GAP_CELLS`) — ``slant_passes``, on by default (issue 22,
+   parts N and X in docs/decisions.md).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
@@ -66,6 +68,7 @@ from ..surface.gridding import (
 from .dense import DenseOptions, GreySource, iter_disparity_tiles
 from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
+from .slant_lsm import refine_slant
 
 PathLike = Union[str, Path]
 
@@ -199,6 +202,12 @@ SLANT_SCALES: Tuple[float, ...] = (0.7, 1.4)
 #: (drone seed 1, 0201_0203: 0.69 → 0.85 m); 3 px instead of 1 px kept a few more cells and
 #: more blunders (0202_0203: open RMSE 0.4765 against 0.4728 m).
 SLANT_GAP_CELLS = 100
+#: With the LSM refinement of the slant disparities (issue 22, part X) the test allows
+#: ``SLANT_TOLERANCE`` × the DSM outlier threshold (2 px of parallax by default): on drone
+#: seeds 1–2 +0.04 to +1.3 points of the visible cells against 1 px with open NMAD and RMSE
+#: as before (±0.2 %, RMSE up to −0.7 %); without the test open RMSE rose by 1.2 / 1.7 %
+#: (seed 2 0101_0102, 0202_0203).
+SLANT_TOLERANCE = 2.0
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
 
@@ -289,12 +298,26 @@ class _Guide:
         return ((1.0 - scale) * col[None, :] + scale * d).astype(np.float32)
 
 
+def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
+                       left: GreySource, right: GreySource
+                       ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The disparities of the pair from one slant tile, refined by LSM between the original
+    images (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and
+    rows."""
+    ok = np.isfinite(block)
+    rr, cc = np.nonzero(ok)
+    d = unstretch(block[ok], cc + c0, scale)
+    d, keep = refine_slant(left, right, d, cc + c0, rr + r0, scale)
+    return d[keep], cc[keep] + c0, rr[keep] + r0
+
+
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
                 feedback: Feedback) -> float:
     """The slant passes (:data:`SLANT_SCALES`): tiled SGM against the stretched right image
-    in the ranges of ``guide``, every valid disparity's point into ``acc``; returns the
-    matching time (s)."""
+    in the ranges of ``guide``; the valid disparities, refined by LSM
+    (:func:`_slant_disparities`), give their points into ``acc``; returns the matching time
+    (s)."""
     pair = setup.pair
     seconds = triangulation = 0.0  # the caller counts the triangulation apart
     # slopes, not objects: every hole border eroded and no object fill (with the plain pass's
@@ -313,12 +336,11 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                     left, stretched_source(right, scale), shape_l, shape_r, lo, hi, options,
                     max_memory_mb=memory_mb, feedback=feedback.step(k * share, (k + 1) * share),
                     guide=(guide.stretched(scale), GUIDE_FACTOR)):
+                # the LSM refinement counts as matching
+                d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right)
                 t1 = time.perf_counter()
-                ok = np.isfinite(block)
-                if ok.any():
-                    rr, cc = np.nonzero(ok)
-                    d = unstretch(block[ok], cc + c0, scale)
-                    pts = pair.disparity_to_world(d, cc + c0, rr + r0)
+                if d.size:
+                    pts = pair.disparity_to_world(d, cols, rows)
                     acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
                 triangulation += time.perf_counter() - t1
             seconds += time.perf_counter() - t0
@@ -446,8 +468,8 @@ def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap:
         zs, count_s = slant.reduce()
         zs[count > 0] = np.nan
         ref, _ = fill_gaps(zg, grid.spacing, SLANT_GAP_CELLS * grid.spacing)
-        bad = deviates_from(zs, ref, grid.spacing, outliers.radius, outliers.threshold,
-                            outliers.k)
+        bad = deviates_from(zs, ref, grid.spacing, outliers.radius,
+                            SLANT_TOLERANCE * outliers.threshold, outliers.k)
         take = np.isfinite(zs) & ~bad
         zg[take], count[take] = zs[take], count_s[take]
     else:
@@ -480,7 +502,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       max_gap: Optional[float] = None, disparity_margin: int = 4,
                       memory_mb: float = 256.0, outlier_radius: Optional[float] = None,
                       outlier_threshold: Optional[float] = None, outlier_k: float = 3.0,
-                      slant_passes: bool = False, **dense_options: Any) -> Dict[str, Any]:
+                      slant_passes: bool = True, **dense_options: Any) -> Dict[str, Any]:
     """Dense DSM of a stereo model (see the module notes).
 
     Parameters
@@ -512,10 +534,11 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     slant_passes : bool
         Convergent models only: also match against the right image stretched by
         :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
-        with the plain ones (module notes). Off by default: on the drone bench it measures
-        1.6–5.7 points more of the visible cells, but the open terrain's NMAD rises by
-        0.5–5 % and its RMSE on 9 of 12 model-seeds (up to +7.7 %), and a model takes
-        about 5 × as long (issue 22, part N in docs/decisions.md).
+        with the plain ones (module notes); nadir models have none. On by default: with the
+        LSM refinement of their disparities the drone bench measures 0.9–5.4 points more of
+        the visible cells, with open NMAD and RMSE within 1 % of the plain pass's or better
+        on 11 of 12 model-seeds (seed 3 0201_0203: RMSE +1.7 %); a convergent model takes
+        about 5–8 × as long (issue 22, parts N and X in docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
@@ -558,9 +581,6 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                  if setup.convergent else None)
         guide = (_Guide((pair.height, pair.sizes[0][0]))
                  if setup.convergent and slant_passes else None)
-        if slant_passes and guide is None:
-            feedback.info(f"Model {m.name}: no slant passes — they are for convergent models "
-                          "only.")
         # the slant passes take most of the matching time when they run
         plain_end = 45.0 if guide is not None else 85.0
         counts = _match_into(setup, grey, acc, memory_mb, options,

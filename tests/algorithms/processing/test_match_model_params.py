@@ -9,7 +9,7 @@ from photodem.algorithms.matching import dense_model
 from photodem.algorithms.processing import registry
 
 
-@pytest.mark.parametrize("given, expected", [({}, False), ({"slant_passes": True}, True)])
+@pytest.mark.parametrize("given, expected", [({}, True), ({"slant_passes": False}, False)])
 def test_dense_gets_the_slant_passes(chain_project, tmp_path, monkeypatch, given, expected):
     seen: dict = {}
 
