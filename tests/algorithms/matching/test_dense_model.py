@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 import rasterio
+from _slopes import slope_pair
 from shapely.geometry import box
 
 from photodem.algorithms.errors import Cancelled, GeometryError, InputError, PhotodemError
@@ -171,21 +172,6 @@ def test_convergent_model_cells_get_footprint_points(drone_block, tmp_path) -> N
     assert nmad < 0.1
 
 
-def _slope_pair(k: float, h: int = 96, w: int = 128) -> tuple:
-    """A left image of random texture and a right image that sees it foreshortened:
-    left pixel x matches right pixel k·x + 8 (a slope with ``∂x_r/∂x_l = k``)."""
-    from scipy import ndimage
-
-    rng = np.random.default_rng(3)
-    tex = ndimage.gaussian_filter(rng.normal(size=(h, 2 * w)), 1.2)
-    tex = 128.0 + 60.0 * tex / tex.std()
-    src = (np.arange(int(k * w) + 24) - 8.0) / k
-    right = np.stack([np.interp(src, np.arange(2 * w), row, left=np.nan, right=np.nan)
-                      for row in tex])
-    x = np.arange(w, dtype=np.float32)
-    return tex[:, :w].astype(np.float32), right.astype(np.float32), x - (k * x + 8.0)
-
-
 def _right_share(left: np.ndarray, right: Any, right_shape: tuple, lo: int, hi: int,
                  truth: np.ndarray, scale: float = 1.0) -> float:
     """Share of the left pixels whose disparity (against ``right``, stretched by ``scale``)
@@ -211,7 +197,7 @@ def test_slant_pass_matches_a_foreshortened_slope() -> None:
     from photodem.algorithms.matching.dense import array_source
     from photodem.algorithms.matching.dense_model import SLANT_SCALES, stretched_source
 
-    left, right, truth = _slope_pair(2.0)
+    left, right, truth = slope_pair(2.0)
     src_r, shape_r = array_source(right)
     lo, hi = int(truth.min()) - 8, int(truth.max()) + 8
     plain = _right_share(left, src_r, shape_r, lo, hi, truth)

@@ -4,28 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy import ndimage
+from _slopes import slope_pair
 
 from photodem.algorithms.matching.dense import array_source
 from photodem.algorithms.matching.slant_lsm import refine_slant
 
 
-def _slope_pair(k: float, periodic: bool = False, h: int = 80, w: int = 128) -> tuple:
-    """A left image and a right image that sees it foreshortened: left pixel x matches right
-    pixel ``k·x + 8`` (a slope with ``∂x_r/∂x_l = k``); random texture, or stripes of 8 px
-    period across the rows (with a weak texture along the columns)."""
-    rng = np.random.default_rng(5)
-    if periodic:
-        tex = 128.0 + 60.0 * np.sin(2 * np.pi * np.arange(2 * w) / 8.0)[None, :]
-        tex = tex + 20.0 * np.sin(np.arange(h) / 3.0)[:, None] + rng.normal(0, 2, (h, 2 * w))
-    else:
-        tex = ndimage.gaussian_filter(rng.normal(size=(h, 2 * w)), 1.2)
-        tex = 128.0 + 60.0 * tex / tex.std()
-    src = (np.arange(int(k * w) + 24) - 8.0) / k
-    right = np.stack([np.interp(src, np.arange(2 * w), row, left=np.nan, right=np.nan)
-                      for row in tex])
-    x = np.arange(w, dtype=np.float64)
-    return tex[:, :w].astype(np.float32), right.astype(np.float32), x - (k * x + 8.0)
+def _slope_pair(k: float, periodic: bool = False) -> tuple:
+    return slope_pair(k, periodic, h=80, seed=5)
 
 
 def _points(truth: np.ndarray, h: int = 80) -> tuple:
