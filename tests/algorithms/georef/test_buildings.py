@@ -230,10 +230,11 @@ def test_right_placement_by_shapes_and_centre_out(tmp_path):
     support, matches 24 footprints by shape against 3 for any other (by centroid 24 against
     9), and its consensus, 6.9 px off after the refit on all pairs, is pulled in to 1.8 px by
     the centre-out refit. Before: no consensus (lead 10 : 10 within 40 tries). Measured:
-    0.36 px, verified, 18 roofs, 5.6 s."""
+    0.80 px, verified, 18 roofs, 5.6 s (0.36 px while the relief step dropped the last corner
+    of many footprints, docs/decisions.md 2026-11-27)."""
     case = suburban_case(tmp_path, seed=10, bits=8)
     res = georeference(case["image"], case["reference"], objects="buildings")
     assert res.stage == "buildings" and res.verified
     assert res.counts["tries"] > 40 and res.counts["centre_out_refit"]
     assert res.counts["shape_pairs"] >= 20 and res.counts["runner_up_shapes"] <= 6
-    assert _corners(res, case) <= 0.6
+    assert _corners(res, case) <= 0.9
