@@ -120,6 +120,11 @@ WIDE_BASE = 0.5
 _WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
 
 
+def wide_base(setup: ModelSetup) -> bool:
+    """Whether the model's base-to-height ratio is at least :data:`WIDE_BASE`."""
+    return setup.pair.base / setup.flying_height >= WIDE_BASE
+
+
 def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
     """The matching options of the DSM path for one model, built once.
 
@@ -136,7 +141,7 @@ def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
         For an override that is no dense matching option.
     """
     cx = setup.pair.cx
-    wide = setup.pair.base / setup.flying_height >= WIDE_BASE
+    wide = wide_base(setup)
     view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
     values = dict(_DENSE_DEFAULTS, edge_jump=_JUMP_M * setup.parallax_per_metre, wall_view=view)
     if wide:
@@ -208,8 +213,23 @@ SLANT_GAP_CELLS = 100
 #: as before (±0.2 %, RMSE up to −0.7 %); without the test open RMSE rose by 1.2 / 1.7 %
 #: (seed 2 0101_0102, 0202_0203).
 SLANT_TOLERANCE = 2.0
+#: Temporary switch (issue 19, part Z): the slant passes also on wide-base nadir models
+#: (:func:`wide_base`), with :data:`WIDE_SLANT_SCALES`.
+WIDE_SLANT = False
+#: Stretches of the slant passes on wide-base nadir models.
+WIDE_SLANT_SCALES: Tuple[float, ...] = SLANT_SCALES
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
+
+
+def slant_scales(setup: ModelSetup, slant_passes: bool = True) -> Tuple[float, ...]:
+    """The stretches of the model's slant passes: :data:`SLANT_SCALES` for convergent models,
+    :data:`WIDE_SLANT_SCALES` for wide-base nadir ones with :data:`WIDE_SLANT`, else none."""
+    if not slant_passes:
+        return ()
+    if setup.convergent:
+        return SLANT_SCALES
+    return WIDE_SLANT_SCALES if WIDE_SLANT and wide_base(setup) else ()
 
 
 def stretched_source(source: GreySource, scale: float) -> GreySource:
@@ -313,9 +333,9 @@ def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
 
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
-                feedback: Feedback) -> float:
-    """The slant passes (:data:`SLANT_SCALES`): tiled SGM against the stretched right image
-    in the ranges of ``guide``; the valid disparities, refined by LSM
+                scales: Tuple[float, ...], feedback: Feedback) -> float:
+    """The slant passes (stretches ``scales``, :func:`slant_scales`): tiled SGM against the
+    stretched right image in the ranges of ``guide``; the valid disparities, refined by LSM
     (:func:`_slant_disparities`), give their points into ``acc``; returns the matching time
     (s)."""
     pair = setup.pair
@@ -327,8 +347,8 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
     with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
         left, shape_l = _window_source(src_l)
         right, (h_r, w_r) = _window_source(src_r)
-        share = 100.0 / len(SLANT_SCALES)
-        for k, scale in enumerate(SLANT_SCALES):
+        share = 100.0 / len(scales)
+        for k, scale in enumerate(scales):
             lo, hi = _stretched_range(setup, scale)
             shape_r = (h_r, int(np.ceil(scale * (w_r - 1))) + 1)
             t0 = time.perf_counter()
@@ -579,8 +599,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
         extra = (GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
                  if setup.convergent else None)
-        guide = (_Guide((pair.height, pair.sizes[0][0]))
-                 if setup.convergent and slant_passes else None)
+        scales = slant_scales(setup, slant_passes)
+        guide = _Guide((pair.height, pair.sizes[0][0])) if scales else None
         # the slant passes take most of the matching time when they run
         plain_end = 45.0 if guide is not None else 85.0
         counts = _match_into(setup, grey, acc, memory_mb, options,
@@ -589,7 +609,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         if guide is not None:
             slant = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
             counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide,
-                                          feedback.step(plain_end, 85))
+                                          scales, feedback.step(plain_end, 85))
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
