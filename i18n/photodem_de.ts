@@ -1114,14 +1114,14 @@
             <translation>Von den Startpunkten aus edits.gpkg ausgehen; ohne Startpunkte wird auf der gröbsten Stufe der gesamte Höhenbereich durchsucht.</translation>
         </message>
         <message>
-            <source>Match foreshortened slopes (dense, convergent)</source>
+            <source>Match foreshortened slopes (dense, convergent or wide base)</source>
             <extracomment>match_model.slant_passes: description</extracomment>
-            <translation>Verkürzte Hänge zuordnen (dense, konvergent)</translation>
+            <translation>Verkürzte Hänge zuordnen (dense, konvergent oder große Basis)</translation>
         </message>
         <message>
-            <source>Convergent models only: also match against the right image stretched by 0.7 and 1.4, for slopes one camera sees foreshortened, refined by least-squares matching. More cells measured as precisely as the others, about 5 × the time.</source>
+            <source>Convergent models and models with a base of at least half the flying height: also match against the right image stretched by 0.7 and 1.4, for slopes and roof faces one camera sees foreshortened, refined by least-squares matching. More cells measured as precisely as the others, about 5–9 × the time.</source>
             <extracomment>match_model.slant_passes: help</extracomment>
-            <translation>Nur konvergente Modelle: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5 × die Rechenzeit.</translation>
+            <translation>Konvergente Modelle und Modelle mit einer Basis von mindestens der halben Flughöhe: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge und Dachflächen, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5–9 × die Rechenzeit.</translation>
         </message>
         <message>
             <source>DSM</source>
@@ -6449,6 +6449,14 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <source>The output folder '{path}' holds {what}; choose an empty or new folder (PhotoDEM only replaces earlier results of the same algorithm).</source>
             <extracomment>algorithms/raster/io.py:238</extracomment>
             <translation>Der Ausgabeordner '{path}' enthält {what}; wählen Sie einen leeren oder neuen Ordner (PhotoDEM ersetzt nur frühere Ergebnisse desselben Algorithmus).</translation>
+        </message>
+        <message>
+            <source>Match foreshortened slopes (dense, convergent)</source>
+            <translation type="vanished">Verkürzte Hänge zuordnen (dense, konvergent)</translation>
+        </message>
+        <message>
+            <source>Convergent models only: also match against the right image stretched by 0.7 and 1.4, for slopes one camera sees foreshortened, refined by least-squares matching. More cells measured as precisely as the others, about 5 × the time.</source>
+            <translation type="vanished">Nur konvergente Modelle: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5 × die Rechenzeit.</translation>
         </message>
         <message>
             <source>Convergent models only: also match against the right image stretched by 0.7 and 1.4, for slopes one camera sees foreshortened. More cells measured, a slightly higher NMAD on open terrain, about 5 × the time.</source>

@@ -21,13 +21,15 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    ground part of holes is left to the gap interpolation (issue 19).
    Convergent models also give the cells that no pixel's point reached the points of the
    centres of 2 × 2 pixel quads on one surface (:func:`footprint_points`; a tilted frame's far
-   side has fewer pixels than cells), and then the points of two *slant passes*: SGM against
+   side has fewer pixels than cells). Convergent and wide-base models (B/H ≥
+   :data:`WIDE_BASE`: roof faces seen at clearly different scales) then give those cells the
+   points of two *slant passes*: SGM against
    the right image stretched along its rows by :data:`SLANT_SCALES` (slopes that one camera
    sees foreshortened), in the ranges of the plain pass's disparities (:class:`_Guide`), each
    disparity refined by least-squares matching between the original images, whose affine
    x-scale fits the slope (:mod:`.slant_lsm`), and kept where they agree with the plain pass's
    heights around them (:data:`SLANT_GAP_CELLS`) — ``slant_passes``, on by default (issue 22,
-   parts N and X in docs/decisions.md).
+   parts N and X, issue 19, part Z in docs/decisions.md).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
@@ -120,6 +122,11 @@ WIDE_BASE = 0.5
 _WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
 
 
+def wide_base(setup: ModelSetup) -> bool:
+    """Whether the model's base-to-height ratio is at least :data:`WIDE_BASE`."""
+    return setup.pair.base / setup.flying_height >= WIDE_BASE
+
+
 def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
     """The matching options of the DSM path for one model, built once.
 
@@ -136,7 +143,7 @@ def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
         For an override that is no dense matching option.
     """
     cx = setup.pair.cx
-    wide = setup.pair.base / setup.flying_height >= WIDE_BASE
+    wide = wide_base(setup)
     view = (float(cx[0]), float(cx[1])) if _WALL_RULE or wide else None
     values = dict(_DENSE_DEFAULTS, edge_jump=_JUMP_M * setup.parallax_per_metre, wall_view=view)
     if wide:
@@ -188,11 +195,14 @@ def footprint_points(block: np.ndarray, max_step: float = FOOTPRINT_STEP
     return quad[:, rr, cc].mean(axis=0), cc + 0.5, rr + 0.5
 
 
-#: Horizontal scales of the right epipolar image for the slant passes of convergent models
-#: (:func:`stretched_source`): a slope seen at a grazing angle by one camera and facing the
-#: other has ``∂x_r/∂x_l`` of 0.2–1.9 on the synthetic drone pairs (issue 22, part N), so
-#: square windows compare unlike patches there; a pass with the right image stretched by
-#: ``s`` matches slopes with ``∂x_r/∂x_l ≈ 1/s``.
+#: Horizontal scales of the right epipolar image for the slant passes of convergent and
+#: wide-base models (:func:`stretched_source`, :func:`slant_scales`): a slope seen at a
+#: grazing angle by one camera and facing the other has ``∂x_r/∂x_l`` of 0.2–1.9 on the
+#: synthetic drone pairs (issue 22, part N), so square windows compare unlike patches there;
+#: a pass with the right image stretched by ``s`` matches slopes with ``∂x_r/∂x_l ≈ 1/s``.
+#: The wide-base aerial model's roof faces (0.67 and 1.9, issue 19, part V) gain as much
+#: from these scales as from 0.6 / 1.6 or 0.5 / 1.5 (object interior within 1 point, terrain
+#: and open cells slightly better, 0.6 / 1.6 takes 1.35 × the time; issue 19, part Z).
 SLANT_SCALES: Tuple[float, ...] = (0.7, 1.4)
 #: A cell that only a slant pass measured is kept where it passes the DSM outlier test
 #: against the plain pass's heights around it (within 1 px of parallax of their median, or
@@ -210,6 +220,15 @@ SLANT_GAP_CELLS = 100
 SLANT_TOLERANCE = 2.0
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
+
+
+def slant_scales(setup: ModelSetup, slant_passes: bool = True) -> Tuple[float, ...]:
+    """The stretches of the model's slant passes: :data:`SLANT_SCALES` for convergent and
+    wide-base models (:func:`wide_base`), none for narrow-base nadir models or without
+    ``slant_passes``."""
+    if slant_passes and (setup.convergent or wide_base(setup)):
+        return SLANT_SCALES
+    return ()
 
 
 def stretched_source(source: GreySource, scale: float) -> GreySource:
@@ -313,9 +332,9 @@ def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
 
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
-                feedback: Feedback) -> float:
-    """The slant passes (:data:`SLANT_SCALES`): tiled SGM against the stretched right image
-    in the ranges of ``guide``; the valid disparities, refined by LSM
+                scales: Tuple[float, ...], feedback: Feedback) -> float:
+    """The slant passes (stretches ``scales``, :func:`slant_scales`): tiled SGM against the
+    stretched right image in the ranges of ``guide``; the valid disparities, refined by LSM
     (:func:`_slant_disparities`), give their points into ``acc``; returns the matching time
     (s)."""
     pair = setup.pair
@@ -327,8 +346,8 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
     with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
         left, shape_l = _window_source(src_l)
         right, (h_r, w_r) = _window_source(src_r)
-        share = 100.0 / len(SLANT_SCALES)
-        for k, scale in enumerate(SLANT_SCALES):
+        share = 100.0 / len(scales)
+        for k, scale in enumerate(scales):
             lo, hi = _stretched_range(setup, scale)
             shape_r = (h_r, int(np.ceil(scale * (w_r - 1))) + 1)
             t0 = time.perf_counter()
@@ -532,13 +551,16 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     outlier_k : float
         Multiple of the local robust spread (1.4826 · MAD) a rejected deviation must exceed.
     slant_passes : bool
-        Convergent models only: also match against the right image stretched by
-        :data:`SLANT_SCALES` and give the cells no plain point reached the heights that agree
-        with the plain ones (module notes); nadir models have none. On by default: with the
-        LSM refinement of their disparities the drone bench measures 0.9–5.4 points more of
-        the visible cells, with open NMAD and RMSE within 1 % of the plain pass's or better
-        on 11 of 12 model-seeds (seed 3 0201_0203: RMSE +1.7 %); a convergent model takes
-        about 5–8 × as long (issue 22, parts N and X in docs/decisions.md).
+        Convergent and wide-base models (:func:`slant_scales`): also match against the right
+        image stretched by :data:`SLANT_SCALES` and give the cells no plain point reached the
+        heights that agree with the plain ones (module notes); narrow-base nadir models have
+        none. On by default: with the LSM refinement of their disparities the drone bench
+        measures 0.9–5.4 points more of the visible cells, with open NMAD and RMSE within 1 %
+        of the plain pass's or better on 11 of 12 model-seeds (seed 3 0201_0203: RMSE
+        +1.7 %); a convergent model takes about 5–8 × as long (issue 22, parts N and X). On
+        the wide-base aerial block the object interior gains 2.0–3.4 points with the terrain
+        RMS 0.7–0.8 % lower; such a model takes about 8–9 × as long (issue 19, part Z in
+        docs/decisions.md).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
@@ -579,8 +601,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         acc = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
         extra = (GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
                  if setup.convergent else None)
-        guide = (_Guide((pair.height, pair.sizes[0][0]))
-                 if setup.convergent and slant_passes else None)
+        scales = slant_scales(setup, slant_passes)
+        guide = _Guide((pair.height, pair.sizes[0][0])) if scales else None
         # the slant passes take most of the matching time when they run
         plain_end = 45.0 if guide is not None else 85.0
         counts = _match_into(setup, grey, acc, memory_mb, options,
@@ -589,7 +611,7 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         if guide is not None:
             slant = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
             counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide,
-                                          feedback.step(plain_end, 85))
+                                          scales, feedback.step(plain_end, 85))
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()

@@ -152,12 +152,13 @@ class MatchModel(Algorithm):
         Parameter("use_start_points", "bool", "Use start points (fbm_lsm)", default=True,
                   help="Start from the start points of edits.gpkg; without any, the whole "
                        "height range is searched at the coarsest level."),
-        Parameter("slant_passes", "bool", "Match foreshortened slopes (dense, convergent)",
-                  default=True,
-                  help="Convergent models only: also match against the right image stretched "
-                       "by 0.7 and 1.4, for slopes one camera sees foreshortened, refined by "
+        Parameter("slant_passes", "bool",
+                  "Match foreshortened slopes (dense, convergent or wide base)", default=True,
+                  help="Convergent models and models with a base of at least half the flying "
+                       "height: also match against the right image stretched by 0.7 and 1.4, "
+                       "for slopes and roof faces one camera sees foreshortened, refined by "
                        "least-squares matching. More cells measured as precisely as the "
-                       "others, about 5 × the time."),
+                       "others, about 5–9 × the time."),
     )
     outputs = (
         Output("dsm", "raster", "DSM"),
