@@ -213,6 +213,11 @@ def ring_edges(ring_img: Array, min_len: float = MIN_EDGE_PX) -> List[Tuple[int,
     return out
 
 
+def _footprint_in_image(Tinv: Array, ring: Array) -> Array:
+    """A footprint ring (map x, y; further columns ignored) in image coordinates, unclosed."""
+    return apply(Tinv, unclosed_ring(np.asarray(ring, float)[:, :2]))
+
+
 def facing_edges(ring_img: Array, centre: Array, min_len: float = MIN_EDGE_PX
                  ) -> List[Tuple[int, Array, Array]]:
     """The edges of :func:`ring_edges` whose outward normal points towards ``centre``."""
@@ -373,8 +378,7 @@ def roof_edges(grey: Array, T: Array, footprints: Sequence[Array],
     ts = np.arange(-search - 2.0, search + 2.0 + 1e-9, 0.1)
     mids, normals, offs = [], [], []
     for ring in footprints:
-        ring = unclosed_ring(np.asarray(ring, float)[:, :2])
-        img = apply(Tinv, ring)
+        img = _footprint_in_image(Tinv, ring)
         for k, mid, n in ring_edges(img):
             prof = edge_profile(grey, img[k], img[(k + 1) % len(img)], n, ts)
             if prof is None:
@@ -431,8 +435,7 @@ def measure_edges(grey: Array, T: Array, footprints: Sequence[Array], centre: Ar
     out: List[EdgeMeasurement] = []
     tried = 0
     for f, ring in enumerate(footprints):
-        ring = unclosed_ring(np.asarray(ring, float)[:, :2])
-        img = apply(Tinv, ring)
+        img = _footprint_in_image(Tinv, ring)
         for k, mid, n in facing_edges(img, centre):
             tried += 1
             r = abs(float(np.dot(mid - centre, n)))
