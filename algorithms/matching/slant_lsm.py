@@ -22,6 +22,7 @@ from typing import Tuple
 import numpy as np
 
 from .dense import GreySource
+from .fbm import fill_nodata
 from .lsm import lsm_match
 
 #: LSM window side (px) of the refinement.
@@ -56,13 +57,10 @@ def _any_in_box(table: np.ndarray, c0: np.ndarray, c1: np.ndarray, r0: np.ndarra
 
 def _read(source: GreySource, r0: int, r1: int, c0: int, c1: int
           ) -> Tuple[np.ndarray, np.ndarray]:
-    """A window of a grey source with its masked pixels set to their mean (LSM needs finite
-    values) and the summed-area table of the mask."""
-    block = source(r0, r1, c0, c1).astype(np.float32)
-    masked = ~np.isfinite(block)
-    fill = float(np.nanmean(block)) if (~masked).any() else 0.0
-    block[masked] = fill
-    return block, _box_sums(masked)
+    """A window of a grey source with its masked pixels filled from their nearest valid pixel
+    (LSM needs finite values) and the summed-area table of the mask."""
+    block, valid = fill_nodata(source(r0, r1, c0, c1))
+    return block, _box_sums(~valid)
 
 
 def _refine_chunk(left: GreySource, right: GreySource, d: np.ndarray, cols: np.ndarray,

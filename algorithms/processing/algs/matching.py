@@ -191,7 +191,7 @@ class MatchModel(Algorithm):
             from ...matching.dense_model import match_model_dense
 
             return match_model_dense(project, model.name, out,
-                                     slant_passes=bool(params.get("slant_passes", True)),
+                                     slant_passes=bool(params["slant_passes"]),
                                      **common)
         if method != "fbm_lsm":
             raise InputError(f"Unknown matching method '{method}'; use fbm_lsm or dense.")
@@ -202,7 +202,7 @@ class MatchModel(Algorithm):
             project, model.name, out, preset=params.get("preset") or DEFAULT_PRESET,
             groundel=params.get("groundel") or None, reduction=params.get("reduction") or None,
             points_format=params.get("points_format") or "gpkg",
-            use_start_points=bool(params.get("use_start_points", True)),
+            use_start_points=bool(params["use_start_points"]),
             lsm=bool(params.get("lsm", True)), **extra, **common)
 
 

@@ -248,18 +248,6 @@ def test_slant_passes_run_on_convergent_and_wide_base_models_only() -> None:
     assert slant_scales(setup(400.0, convergent=True), slant_passes=False) == ()
 
 
-def _sample(path: str, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Values of a raster at map points (nearest cell)."""
-    import rasterio
-
-    with rasterio.open(path) as src:
-        rows, cols = rasterio.transform.rowcol(src.transform, x, y)
-        z = src.read(1)
-    rows = np.clip(np.asarray(rows), 0, z.shape[0] - 1)
-    cols = np.clip(np.asarray(cols), 0, z.shape[1] - 1)
-    return z[rows, cols]
-
-
 @pytest.mark.slow
 def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
     """A window of the aerial block (seed 1, 384 px, B/H 0.61, nadir): the slant passes run by
@@ -269,6 +257,7 @@ def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
     import rasterio
 
     from photodem.algorithms.matching.dense_model import match_model_dense
+    from photodem.algorithms.quality.points import sample_dem
     from photodem.algorithms.synthetic.block import generate_block
 
     block = generate_block(tmp_path / "block", size="aerial", terrain="gentle", seed=1,
@@ -291,7 +280,7 @@ def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
         count_on, count_off = a.read(1), b.read(1)
     rows, cols = np.mgrid[0:dsm.shape[0], 0:dsm.shape[1]]
     x, y = t.c + (cols + 0.5) * t.a, t.f + (rows + 0.5) * t.e
-    err = np.abs(dsm - _sample(block.truth["dsm"], x.ravel(), y.ravel()).reshape(dsm.shape))
+    err = np.abs(dsm - sample_dem(block.truth["dsm"], x.ravel(), y.ravel()).reshape(dsm.shape))
     new = (count_on > 0) & (count_off == 0) & np.isfinite(dsm)
     plain = (count_off > 0) & np.isfinite(dsm)
     print(f"new cells {new.sum()}: {np.mean(err[new] < 0.5):.4f} within 0.5 m; plain "
