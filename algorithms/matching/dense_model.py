@@ -55,11 +55,13 @@ from typing import Any, Dict, Optional, Tuple, Union
 
 import numpy as np
 from rasterio.windows import Window
+from scipy import ndimage
 
 from ..feedback import Feedback, ensure_feedback
 from ..geometry.epipolar import RESAMPLE_BLOCK_PIXELS, SIDES, EpipolarPair
 from ..raster.io import gtiff_profile, open_image, scratch_folder, staged_folder
 from ..surface.gridding import (
+    Grid,
     GridAccumulator,
     deviates_from,
     fill_gaps,
@@ -70,7 +72,7 @@ from ..surface.gridding import (
 from .dense import DenseOptions, GreySource, iter_disparity_tiles
 from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
-from .slant_lsm import refine_slant
+from .slant_lsm import SLANT_LSM_SHIFT, refine_slant
 
 PathLike = Union[str, Path]
 
@@ -317,26 +319,62 @@ class _Guide:
         return ((1.0 - scale) * col[None, :] + scale * d).astype(np.float32)
 
 
+def _settled_cells(acc: GridAccumulator, footprints: Optional[GridAccumulator]) -> np.ndarray:
+    """Cells the plain pass measured whose eight neighbours it measured too.
+
+    The gridding drops every slant point in a measured cell (:func:`_grid_and_write`), so a
+    slant disparity whose every possible refined position lies in measured cells need not be
+    refined at all (:func:`_may_reach_open_cells`)."""
+    covered = acc.covered()
+    if footprints is not None:
+        covered |= footprints.covered()
+    return ndimage.binary_erosion(covered, np.ones((3, 3), bool), border_value=1)
+
+
+def _may_reach_open_cells(pair: EpipolarPair, grid: Grid, settled: np.ndarray, d: np.ndarray,
+                          cols: np.ndarray, rows: np.ndarray, shift: float) -> np.ndarray:
+    """True for the disparities whose point, moved by up to ± ``shift`` px (the LSM bound),
+    may fall in a cell outside ``settled``.
+
+    Over d ± shift the point runs along a straight piece of the left ray; sampled at no more
+    than one cell apart, every cell the piece crosses is a neighbour of a sampled cell, and a
+    sample in a settled cell has only measured neighbours."""
+    ends = [pair.disparity_to_world(d + s, cols, rows) for s in (-shift, shift)]
+    length = np.hypot(*(ends[1][:, :2] - ends[0][:, :2]).T)
+    finite = np.isfinite(length)
+    n = 2 + int(np.ceil(np.max(length[finite], initial=0.0) / grid.spacing))
+    reach = ~finite  # a point without a position is left to the refinement
+    for t in np.linspace(0.0, 1.0, n):
+        xy = (1.0 - t) * ends[0][:, :2] + t * ends[1][:, :2]
+        r, c = grid.cell_of(xy[:, 0], xy[:, 1])
+        inside = r >= 0  # points outside the grid are dropped by the accumulator
+        reach[inside] |= ~settled[r[inside], c[inside]]
+    return reach
+
+
 def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
-                       left: GreySource, right: GreySource
-                       ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The disparities of the pair from one slant tile, refined by LSM between the original
-    images (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and
-    rows."""
+                       left: GreySource, right: GreySource, pair: EpipolarPair, grid: Grid,
+                       settled: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The disparities of the pair from one slant tile that may reach a cell the plain pass
+    did not measure, refined by LSM between the original images
+    (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and rows."""
     ok = np.isfinite(block)
     rr, cc = np.nonzero(ok)
     d = unstretch(block[ok], cc + c0, scale)
-    d, keep = refine_slant(left, right, d, cc + c0, rr + r0, scale)
-    return d[keep], cc[keep] + c0, rr[keep] + r0
+    cols, rows = cc + c0, rr + r0
+    useful = _may_reach_open_cells(pair, grid, settled, d, cols, rows, SLANT_LSM_SHIFT)
+    d, cols, rows = d[useful], cols[useful], rows[useful]
+    d, keep = refine_slant(left, right, d, cols, rows, scale)
+    return d[keep], cols[keep], rows[keep]
 
 
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
-                scales: Tuple[float, ...], feedback: Feedback) -> float:
+                scales: Tuple[float, ...], settled: np.ndarray, feedback: Feedback) -> float:
     """The slant passes (stretches ``scales``, :func:`slant_scales`): tiled SGM against the
     stretched right image in the ranges of ``guide``; the valid disparities, refined by LSM
-    (:func:`_slant_disparities`), give their points into ``acc``; returns the matching time
-    (s)."""
+    (:func:`_slant_disparities`; only those that may reach a cell outside ``settled``), give
+    their points into ``acc``; returns the matching time (s)."""
     pair = setup.pair
     seconds = triangulation = 0.0  # the caller counts the triangulation apart
     # slopes, not objects: every hole border eroded and no object fill (with the plain pass's
@@ -356,7 +394,8 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                     max_memory_mb=memory_mb, feedback=feedback.step(k * share, (k + 1) * share),
                     guide=(guide.stretched(scale), GUIDE_FACTOR)):
                 # the LSM refinement counts as matching
-                d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right)
+                d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right, pair,
+                                                   setup.grid, settled)
                 t1 = time.perf_counter()
                 if d.size:
                     pts = pair.disparity_to_world(d, cols, rows)
@@ -610,8 +649,10 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
         slant = None
         if guide is not None:
             slant = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
+            settled = _settled_cells(acc, extra)
             counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide,
-                                          scales, feedback.step(plain_end, 85))
+                                          scales, settled, feedback.step(plain_end, 85))
+            del settled
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()

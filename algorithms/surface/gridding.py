@@ -202,6 +202,21 @@ class GridAccumulator:
             parts.insert(0, np.fromfile(self._scratch / f"{t}.bin", dtype=self._DTYPE))
         return np.concatenate(parts) if parts else np.empty(0, self._DTYPE)
 
+    def covered(self) -> Array:
+        """Boolean grid of the cells that hold at least one point so far (nothing consumed)."""
+        g, n = self.grid, self.tile
+        out = np.zeros(g.shape, bool)
+        for t in range(self.tiles_x * self.tiles_y):
+            parts = list(self._buffers.get(t, []))
+            if self._scratch is not None and (self._scratch / f"{t}.bin").is_file():
+                parts.append(np.fromfile(self._scratch / f"{t}.bin", dtype=self._DTYPE))
+            if not parts:
+                continue
+            ty, tx = divmod(t, self.tiles_x)
+            lr, lc = np.divmod(np.concatenate([p["cell"] for p in parts]), n)
+            out[ty * n + lr, tx * n + lc] = True
+        return out
+
     def reduce(self, feedback: Optional[Feedback] = None) -> Tuple[Array, Array]:
         """Per-cell (weighted) median (float32, NaN = empty) and count (uint32) of all points.
 

@@ -260,3 +260,29 @@ def test_narrow_base_nadir_model_has_no_slant_passes(block, dsm) -> None:
     setup = prepare_model(block["project"], MODEL)
     assert not setup.convergent and not wide_base(setup)
     assert "slant_measured_pct" not in dsm["metrics"]
+
+
+def test_slant_disparities_that_cannot_reach_an_open_cell_are_not_refined() -> None:
+    """A slant point whose every position over d ± 1 px lies in measured cells with measured
+    neighbours is dropped by the gridding anyway, so LSM need not refine it; one whose piece
+    of ray crosses an open cell, even between its ends, is refined."""
+    from types import SimpleNamespace
+
+    from photodem.algorithms.matching.dense_model import _may_reach_open_cells
+    from photodem.algorithms.surface.gridding import Grid
+
+    def to_world(d, cols, rows):  # a ray that runs 2.5 m along x per px of disparity
+        return np.column_stack([0.1 * cols + 2.5 * d, 19.5 - 0.1 * rows, np.zeros_like(d)])
+
+    pair = SimpleNamespace(disparity_to_world=to_world)
+    grid = Grid.from_bounds(0.0, 0.0, 40.0, 20.0, 1.0)
+    settled = np.ones(grid.shape, bool)
+    # d = 4 at column 50: x runs 12.5 … 17.5 m in row 0; the cell at x 15 is open
+    d, cols = np.array([4.0, 4.0, 4.0, np.nan]), np.array([50, 50, 9000, 50])
+    rows = np.array([0, 100, 0, 0])
+    assert not _may_reach_open_cells(pair, grid, settled, d[:1], cols[:1], rows[:1], 1.0).any()
+    settled[0, 15] = False
+    reach = _may_reach_open_cells(pair, grid, settled, d, cols, rows, 1.0)
+    # the open cell lies between the ends; another row, or outside the grid: not refined;
+    # no position: refined
+    assert reach.tolist() == [True, False, False, True]

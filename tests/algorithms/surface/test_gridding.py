@@ -70,6 +70,21 @@ def test_streaming_with_spill_equals_in_memory(tmp_path) -> None:
     assert not list(tmp_path.iterdir())  # scratch removed
 
 
+def test_covered_cells_are_those_with_points_in_memory_and_spilled(tmp_path) -> None:
+    """``covered`` reads the buffered and the spilled points without consuming them."""
+    rng = np.random.default_rng(2)
+    x, y = rng.uniform(0, 50, 400), rng.uniform(0, 50, 400)
+    grid = Grid.from_bounds(0, 0, 50, 50, 1.0)
+    acc = GridAccumulator(grid, tile=16, memory_mb=0.002, scratch_dir=tmp_path)
+    for part in np.array_split(np.arange(x.size), 7):
+        acc.add(x[part], y[part], np.ones(part.size))
+    assert any(tmp_path.iterdir())  # some points went to scratch files
+    covered = acc.covered()
+    _, count = acc.reduce()
+    np.testing.assert_array_equal(covered, count > 0)
+    assert 0 < covered.sum() < covered.size
+
+
 def test_only_small_gaps_are_filled_and_exactly_on_a_plane() -> None:
     yy, xx = np.mgrid[0:60, 0:60].astype(float)
     plane = (5.0 + 0.2 * xx - 0.1 * yy).astype(np.float32)
