@@ -1119,9 +1119,9 @@
             <translation>Verkürzte Hänge zuordnen (dense, konvergent oder große Basis)</translation>
         </message>
         <message>
-            <source>Convergent models and models with a base of at least half the flying height: also match against the right image stretched by 0.7 and 1.4, for slopes and roof faces one camera sees foreshortened, refined by least-squares matching. More cells measured as precisely as the others, about 5–9 × the time.</source>
+            <source>Convergent models and models with a base of at least half the flying height: also match against the right image stretched by 0.7 and 1.4, for slopes and roof faces one camera sees foreshortened, refined by least-squares matching. More cells measured as precisely as the others, about 5–6 × the time.</source>
             <extracomment>match_model.slant_passes: help</extracomment>
-            <translation>Konvergente Modelle und Modelle mit einer Basis von mindestens der halben Flughöhe: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge und Dachflächen, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5–9 × die Rechenzeit.</translation>
+            <translation>Konvergente Modelle und Modelle mit einer Basis von mindestens der halben Flughöhe: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge und Dachflächen, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5–6 × die Rechenzeit.</translation>
         </message>
         <message>
             <source>DSM</source>

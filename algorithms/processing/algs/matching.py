@@ -158,7 +158,7 @@ class MatchModel(Algorithm):
                        "height: also match against the right image stretched by 0.7 and 1.4, "
                        "for slopes and roof faces one camera sees foreshortened, refined by "
                        "least-squares matching. More cells measured as precisely as the "
-                       "others, about 5–9 × the time."),
+                       "others, about 5–6 × the time."),
     )
     outputs = (
         Output("dsm", "raster", "DSM"),
