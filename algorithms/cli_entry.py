@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import sys
 
+from .proj_env import use_own_proj_data  # standard library only: loads in no time
+
 
 def main() -> int:
     """Load the command line and run it; a Ctrl-C before the run starts exits with 130.
@@ -18,8 +20,6 @@ def main() -> int:
     The command handles a Ctrl-C during a run itself; one that comes while its modules load or
     its parser is built escapes it and ends here, before anything was written.
     """
-    from .proj_env import use_own_proj_data
-
     note = use_own_proj_data()  # before rasterio is loaded: it reads PROJ_DATA on import
     if note:
         print(f"photodem: warning: {note}", file=sys.stderr)

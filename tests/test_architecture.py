@@ -23,7 +23,7 @@ MAX_LINES = 120
 
 #: Layer of each top-level unit of ``algorithms/`` (a package or a module), low to high.
 GROUND = ("errors", "compat", "feedback", "jsonable", "linalg", "memory", "output_policy",
-          "input_errors", "crs_check")
+          "input_errors", "crs_check", "proj_env")
 LAYERS: Dict[str, int] = {
     **dict.fromkeys(GROUND, 0),
     "raster": 1,
