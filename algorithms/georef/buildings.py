@@ -21,6 +21,11 @@ shadows and trees cut them, relief displacement moves them. One pair says little
    a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
    other candidate sites mapped by it must land on footprint centroids (tolerance grows with
    the distance) — the affine-invariant constellation of the neighbours, tested directly.
+   When these give no consensus (a town whose roofs are seen only as narrow halves, too
+   irregular to give the whole affine from one shape), **pair hypotheses**
+   (:func:`_pair_hypotheses`): two neighbouring elongated candidates against the shapes of
+   two neighbouring footprints, matched by their area ratio and the directions of their long
+   sides against the line joining them; each match gives a similarity, scored the same way.
 3. **Consensus** (:func:`match_buildings`): the best-supported hypotheses are grown over the
    whole image (map all sites, nearest footprint within a tolerance, one-to-one, affine fit,
    repeated with a shrinking tolerance), in batches of :data:`TRY_BATCH` up to
