@@ -548,6 +548,8 @@ def _pair_hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array
     keep = (shapes.elongation[ma] >= PAIR_MIN_SHAPE_ELONGATION) & \
         (shapes.elongation[mb] >= PAIR_MIN_SHAPE_ELONGATION)
     ma, mb = ma[keep], mb[keep]
+    if not len(ma):
+        return []
     di = _pair_descriptors(sites[ia], sites[ib], ang_i[ia], ang_i[ib], area_i[ia] / area_i[ib])
     dm = _pair_descriptors(shapes.centroid[ma], shapes.centroid[mb], shapes.axis[ma],
                            shapes.axis[mb], shapes.area[ma] / shapes.area[mb])
