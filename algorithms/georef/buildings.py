@@ -21,6 +21,11 @@ shadows and trees cut them, relief displacement moves them. One pair says little
    a square, so all D4 alternatives). Each is scored by its **neighbourhood**: the k nearest
    other candidate sites mapped by it must land on footprint centroids (tolerance grows with
    the distance) — the affine-invariant constellation of the neighbours, tested directly.
+   When these give no consensus (a town whose roofs are seen only as narrow halves, too
+   irregular to give the whole affine from one shape), **pair hypotheses**
+   (:func:`_pair_hypotheses`): two neighbouring elongated candidates against the shapes of
+   two neighbouring footprints, matched by their area ratio and the directions of their long
+   sides against the line joining them; each match gives a similarity, scored the same way.
 3. **Consensus** (:func:`match_buildings`): the best-supported hypotheses are grown over the
    whole image (map all sites, nearest footprint within a tolerance, one-to-one, affine fit,
    repeated with a shrinking tolerance), in batches of :data:`TRY_BATCH` up to
@@ -106,8 +111,25 @@ MIRROR_MIN_ELONGATION = 1.8
 SITE_RECTANGULARITY = 0.7
 #: Candidates at least this rectangular seed hypotheses (all are neighbours).
 SOURCE_RECTANGULARITY = 0.8
+#: Rounds of the consensus, each tried when the ones before give none: (rectangularity of the
+#: candidates that are sites, mirrored wholes among the sites, pair hypotheses instead of
+#: one-pair ones). The last: pairs of any candidates elongated enough — narrow roof halves
+#: whose pixel outlines are too irregular to seed a one-pair hypothesis (seeds 6, 14 of the
+#: buildings bench: 0 right one-pair hypotheses, 9 / 7 right pair ones).
+CONSENSUS_ROUNDS = ((SITE_RECTANGULARITY, False, False), (SITE_RECTANGULARITY, True, False),
+                    (MIN_RECTANGULARITY, False, True))
 #: Neighbours scored per hypothesis.
 NEIGHBOURS = 8
+#: Pair hypotheses (:func:`_pair_hypotheses`): an elongated site (long / short side) with its
+#: nearest elongated sites, against the shapes of a footprint and its nearest footprints
+#: (those elongated enough to have a long side); descriptors within a log area ratio and a
+#: direction of the long sides this far apart match.
+PAIR_NEIGHBOURS = 8
+PAIR_REF_NEIGHBOURS = 6
+PAIR_MIN_ELONGATION = 1.4
+PAIR_MIN_SHAPE_ELONGATION = 1.25
+PAIR_AREA_LOG = 0.3
+PAIR_ANGLE_DEG = 10.0
 #: Acceptance by the shape count (footprints covered by a candidate or by one on a roof half
 #: after :func:`_refine`): at least this many, this share of the footprints inside the image,
 #: and this ratio over the best different placement. Seeds 0–19 at relief 3: right placements
@@ -383,14 +405,29 @@ class _Shapes:
     centroid: Array  # (m, 2)
     area: Array  # (m,)
     owner: NDArray[np.int64]  # (m,)
+    axis: Array  # (m,) direction of the long side (rad)
+    elongation: Array  # (m,) long / short side
 
 
 def _shapes(fr: Sequence[ObjectFeatures], fh: Sequence[ObjectFeatures],
             owner_h: Sequence[int]) -> _Shapes:
     both = list(fr) + list(fh)
+    axis, elongation = _long_axes(both)
     return _Shapes(np.linalg.inv(np.array([f.normaliser for f in both])),
                    np.array([f.centroid for f in both]), np.array([f.area for f in both]),
-                   np.array(list(range(len(fr))) + list(owner_h), np.int64))
+                   np.array(list(range(len(fr))) + list(owner_h), np.int64), axis, elongation)
+
+
+def _long_axes(fs: Sequence[ObjectFeatures]) -> Tuple[Array, Array]:
+    """Direction (rad) of the long side of every object's minimum bounding rectangle and its
+    elongation (long / short side)."""
+    axis, elongation = np.zeros(len(fs)), np.ones(len(fs))
+    for k, f in enumerate(fs):
+        _, ax, half = f.mbr
+        i = int(np.argmax(half))
+        axis[k] = math.atan2(ax[i][1], ax[i][0])
+        elongation[k] = float(half[i]) / max(float(half[1 - i]), 1e-9)
+    return axis, elongation
 
 
 def _hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array,
@@ -405,12 +442,8 @@ def _hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array,
     (no clutter), so their constellation is the one to test; the image has clutter besides
     the roofs, which only adds a few chance hits.
     """
-    stree = cKDTree(sites)
-    k = min(NEIGHBOURS + 1, len(cr))
-    _, rn = cKDTree(cr).query(cr, k)
-    W = cr[rn[:, 1:]] - cr[:, None, :]  # (n_ref, k-1, 2) vectors to the neighbours
+    nb = _Neighbourhood.of(sites, cr, len(sites) / image_area)
     D4 = np.array(_D4)
-    density = len(sites) / image_area
     out = []
     for i in sources:
         f = fi[i]
@@ -422,24 +455,169 @@ def _hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array,
         if not len(mi):
             continue
         Ls = L[mi, di]  # (h, 2, 2)
-        own = shapes.owner[mi]
-        # the footprint's neighbours relative to the shape's centroid, into the image
-        Wh = W[own] + (cr[own] - shapes.centroid[mi])[:, None, :]
-        img = f.centroid + np.einsum("hab,hnb->hna", np.linalg.inv(Ls), Wh)
-        tol = (base_tol + 0.06 * np.linalg.norm(Wh, axis=2)) / np.sqrt(det[mi, di])[:, None]
-        d, j = stree.query(img.reshape(-1, 2), distance_upper_bound=float(tol.max()))
-        j = j.reshape(tol.shape)
-        hit = (d.reshape(tol.shape) <= tol) & (j != site_of[i])
-        # minus the hits expected by chance (the sites' density over the tolerance discs)
-        chance = np.minimum(1.0, density * np.pi * tol**2).sum(axis=1)
-        support = _distinct(np.where(hit, j, -1)) - chance
+        support = nb.support(Ls, np.broadcast_to(f.centroid, (len(mi), 2)), mi, shapes,
+                             base_tol, np.full((len(mi), 1), site_of[i]))
         for h in np.nonzero(support >= 2)[0]:
-            T = np.eye(3)
-            T[:2, :2] = Ls[h]
-            T[:2, 2] = shapes.centroid[mi[h]] - Ls[h] @ f.centroid
-            out.append((float(support[h]), T, shapes.centroid[mi[h]]))
+            out.append((float(support[h]), _affine(Ls[h], f.centroid,
+                                                   shapes.centroid[mi[h]]),
+                        shapes.centroid[mi[h]]))
     out.sort(key=lambda t: -t[0])
     return out
+
+
+def _affine(L: Array, src: Array, dst: Array) -> Array:
+    """3 × 3 affine with linear part ``L`` that maps the point ``src`` onto ``dst``."""
+    T = np.eye(3)
+    T[:2, :2] = L
+    T[:2, 2] = dst - L @ src
+    return T
+
+
+@dataclass
+class _Neighbourhood:
+    """The test of a hypothesis by its neighbourhood: the vectors from every footprint to its
+    :data:`NEIGHBOURS` nearest footprints, the sites (image) and their density."""
+
+    stree: cKDTree  #: the candidate sites (image)
+    W: Array  #: (n_ref, k, 2) vectors from each footprint to its nearest ones (map)
+    cr: Array  #: footprint centroids (map)
+    density: float  #: sites per px²
+
+    @classmethod
+    def of(cls, sites: Array, cr: Array, density: float) -> _Neighbourhood:
+        k = min(NEIGHBOURS + 1, len(cr))
+        _, rn = cKDTree(cr).query(cr, k)
+        return cls(cKDTree(sites), cr[rn[:, 1:]] - cr[:, None, :], cr, density)
+
+    def support(self, L: Array, xy: Array, mi: NDArray[np.int64], shapes: _Shapes,
+                base_tol: float, exclude: NDArray[np.int64]) -> Array:
+        """Support of the hypotheses ``L`` (h, 2, 2) that put the image point ``xy`` (h, 2)
+        on shape ``mi`` (h,): the owning footprint's neighbours mapped into the image that
+        land on distinct sites other than ``exclude`` (h, e), minus the hits expected by
+        chance (the sites' density over the tolerance discs)."""
+        own = shapes.owner[mi]
+        # the footprint's neighbours relative to the shape's centroid, into the image
+        Wh = self.W[own] + (self.cr[own] - shapes.centroid[mi])[:, None, :]
+        img = xy[:, None, :] + np.einsum("hab,hnb->hna", np.linalg.inv(L), Wh)
+        det = np.abs(np.linalg.det(L))
+        tol = (base_tol + 0.06 * np.linalg.norm(Wh, axis=2)) / np.sqrt(det)[:, None]
+        d, j = self.stree.query(img.reshape(-1, 2), distance_upper_bound=float(tol.max()))
+        j = j.reshape(tol.shape)
+        hit = (d.reshape(tol.shape) <= tol) & ~np.any(j[:, :, None] == exclude[:, None, :],
+                                                      axis=2)
+        chance = np.minimum(1.0, self.density * np.pi * tol**2).sum(axis=1)
+        return _distinct(np.where(hit, j, -1)) - chance
+
+
+def _pair_hypotheses(fi: Sequence[ObjectFeatures], shapes: _Shapes, sites: Array,
+                     site_of: NDArray[np.int64], cr: Array, base_tol: float,
+                     image_area: float) -> List[Tuple[float, Array, Array]]:
+    """(support, transform, map position) of the *pair* hypotheses with support ≥ 2: two
+    neighbouring elongated sites matched to two shapes (footprints or roof halves) of
+    neighbouring footprints by a descriptor that a similarity (mirrored or not) leaves
+    unchanged — the log ratio of their areas and the direction of each one's long side
+    against the line joining them (:func:`_pair_descriptors`). Each match gives the
+    similarity of the two centroids; the support is that of :func:`_hypotheses`, the two
+    sites themselves not counted.
+
+    A one-pair hypothesis needs one candidate that is a whole roof or a clean half whose
+    shape gives the whole affine; this needs only centroids, areas and long sides, which
+    narrow roof halves (pixel outlines of low rectangularity) still give.
+    """
+    rep = _site_representatives(fi, site_of, len(sites))
+    ang_i, el_i = _long_axes([fi[r] for r in rep])
+    area_i = np.array([fi[r].area for r in rep])
+    ends = np.nonzero(el_i >= PAIR_MIN_ELONGATION)[0]
+    if len(ends) < 2 or len(cr) < 2:
+        return []
+    # image: every elongated site with its nearest elongated sites (both orders)
+    k = min(PAIR_NEIGHBOURS + 1, len(ends))
+    _, nn = cKDTree(sites[ends]).query(sites[ends], k)
+    ia, ib = ends[np.repeat(np.arange(len(ends)), k - 1)], ends[nn[:, 1:].ravel()]
+    # map: the shapes of every footprint with those of its nearest footprints
+    k = min(PAIR_REF_NEIGHBOURS + 1, len(cr))
+    _, rn = cKDTree(cr).query(cr, k)
+    fa, fb = np.repeat(np.arange(len(cr)), k - 1), rn[:, 1:].ravel()
+    of = [np.nonzero(shapes.owner == j)[0] for j in range(len(cr))]
+    ma, mb = [], []
+    for a, b in zip(fa, fb):
+        for sa in of[a]:
+            ma += [sa] * len(of[b])
+            mb += list(of[b])
+    ma, mb = np.array(ma, np.int64), np.array(mb, np.int64)
+    keep = (shapes.elongation[ma] >= PAIR_MIN_SHAPE_ELONGATION) & \
+        (shapes.elongation[mb] >= PAIR_MIN_SHAPE_ELONGATION)
+    ma, mb = ma[keep], mb[keep]
+    if not len(ma):
+        return []
+    di = _pair_descriptors(sites[ia], sites[ib], ang_i[ia], ang_i[ib], area_i[ia] / area_i[ib])
+    dm = _pair_descriptors(shapes.centroid[ma], shapes.centroid[mb], shapes.axis[ma],
+                           shapes.axis[mb], shapes.area[ma] / shapes.area[mb])
+    itree = cKDTree(di)
+    out = []
+    nb = _Neighbourhood.of(sites, cr, len(sites) / image_area)
+    for mirror in (1.0, -1.0):  # a mirrored similarity turns the directions the other way
+        hits = cKDTree(dm * np.array([1.0, 1.0, mirror, 1.0, mirror])).query_ball_tree(
+            itree, 1.0)
+        pm = np.array([m for m, h in enumerate(hits) for _ in h], np.int64)
+        pi = np.array([x for h in hits for x in h], np.int64)
+        if not len(pm):
+            continue
+        a, b, sa, sb = ia[pi], ib[pi], ma[pm], mb[pm]
+        L = _similarities(sites[b] - sites[a], shapes.centroid[sb] - shapes.centroid[sa],
+                          mirror)
+        det = np.abs(np.linalg.det(L))
+        ok = np.isfinite(det) & (det > 0)  # footprints of one building share a centroid
+        for i, m in ((a, sa), (b, sb)):
+            ratio = det * area_i[i] / shapes.area[m]
+            ok &= (ratio > 0.6) & (ratio < 1.6)
+        a, b, sa, L = a[ok], b[ok], sa[ok], L[ok]
+        if not len(L):
+            continue
+        support = nb.support(L, sites[a], sa, shapes, base_tol, np.stack([a, b], axis=1))
+        for h in np.nonzero(support >= 2)[0]:
+            out.append((float(support[h]), _affine(L[h], sites[a[h]],
+                                                   shapes.centroid[sa[h]]),
+                        shapes.centroid[sa[h]]))
+    out.sort(key=lambda t: -t[0])
+    return out
+
+
+def _site_representatives(fi: Sequence[ObjectFeatures], site_of: NDArray[np.int64],
+                          n_sites: int) -> NDArray[np.int64]:
+    """The largest candidate of every site (the one :func:`_sites` placed it at)."""
+    rep = -np.ones(n_sites, np.int64)
+    for k in np.argsort([-f.area for f in fi], kind="stable"):
+        if site_of[k] >= 0 and rep[site_of[k]] < 0:
+            rep[site_of[k]] = k
+    return rep
+
+
+def _pair_descriptors(p: Array, q: Array, ang_p: Array, ang_q: Array, area_ratio: Array
+                      ) -> Array:
+    """(n, 5) descriptors of object pairs that a similarity leaves unchanged (a mirrored one
+    negates the 3rd and 5th component): the log area ratio and, for each object, the
+    direction of its long side against the line from ``p`` to ``q`` as (cos 2θ, sin 2θ)
+    (a long side has no sign), scaled so that a distance of 1 is :data:`PAIR_AREA_LOG` or
+    :data:`PAIR_ANGLE_DEG` apart."""
+    v = q - p
+    phi = np.arctan2(v[:, 1], v[:, 0])
+    chord = 2.0 * math.sin(math.radians(PAIR_ANGLE_DEG))
+    tp, tq = 2.0 * (ang_p - phi), 2.0 * (ang_q - phi)
+    return np.column_stack([np.log(area_ratio) / PAIR_AREA_LOG, np.cos(tp) / chord,
+                            np.sin(tp) / chord, np.cos(tq) / chord, np.sin(tq) / chord])
+
+
+def _similarities(v: Array, V: Array, mirror: float) -> Array:
+    """(n, 2, 2) linear parts of the similarities that turn the image vectors ``v`` into the
+    map vectors ``V``; ``mirror`` −1: mirrored (the image y axis flipped first)."""
+    w = v * np.array([1.0, mirror])
+    zv, zV = w[:, 0] + 1j * w[:, 1], V[:, 0] + 1j * V[:, 1]
+    z = zV / zv
+    L = np.empty((len(z), 2, 2))
+    L[:, 0, 0], L[:, 0, 1] = z.real, -z.imag * mirror
+    L[:, 1, 0], L[:, 1, 1] = z.imag, z.real * mirror
+    return L
 
 
 def _distinct(j: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -539,13 +717,15 @@ def match_buildings(grey: Array, ref_objs: Sequence[PolygonObject],
     sources = [i for i in range(len(cands)) if rect[i] >= SOURCE_RECTANGULARITY
                and not mirrored[i]]
     T, why = None, ""
-    for with_mirrored in (False, True):
-        use = [r >= SITE_RECTANGULARITY and (with_mirrored or not m)
-               for r, m in zip(rect, mirrored)]
-        T, why = _consensus(fi, use, _Reference(shapes, rings, cr, base_tol), sources,
-                            grey.shape, counts, max_tries, fb)
+    for min_rect, with_mirrored, pairs in CONSENSUS_ROUNDS:
+        if with_mirrored and not any(mirrored):
+            continue
+        use = [r >= min_rect and (with_mirrored or not m) for r, m in zip(rect, mirrored)]
+        T, why = _consensus(fi, use, _Reference(shapes, rings, cr, base_tol),
+                            None if pairs else sources, grey.shape, counts, max_tries, fb)
         counts["consensus_mirrored_sites"] = with_mirrored
-        if T is not None or not any(mirrored):
+        counts["consensus_pair_hypotheses"] = pairs
+        if T is not None:
             break
     fb.progress(50)
     if T is None:
@@ -576,15 +756,19 @@ class _Placement:
 
 
 def _consensus(fi: Sequence[ObjectFeatures], use: Sequence[bool], ref: _Reference,
-               sources: Sequence[int], shape: Tuple[int, int], counts: Dict[str, Any],
+               sources: Optional[Sequence[int]], shape: Tuple[int, int], counts: Dict[str, Any],
                max_tries: int, fb: Feedback) -> Tuple[Optional[Array], str]:
-    """Hypotheses on the sites of the candidates in ``use``, grown over the image, ranked and
+    """Hypotheses on the sites of the candidates in ``use`` — one-pair hypotheses of the
+    candidates ``sources`` (:func:`_hypotheses`), or pair hypotheses (:func:`_pair_hypotheses`)
+    when ``sources`` is None — grown over the image, ranked and
     accepted by their shape count (module notes, steps 2–4). The tries go on in batches until
     one placement has a clear lead (:func:`_decision`) or ``max_tries`` are spent. Returns the
     accepted (refined) transform, or None and why not; ``counts`` gets the figures."""
     sites, site_of = _sites(fi, 3.0, use)
-    hyps = _hypotheses(fi, ref.shapes, sites, site_of, ref.cr, ref.base_tol, sources,
-                       float(shape[0] * shape[1]))
+    area = float(shape[0] * shape[1])
+    hyps = _pair_hypotheses(fi, ref.shapes, sites, site_of, ref.cr, ref.base_tol, area) \
+        if sources is None else _hypotheses(fi, ref.shapes, sites, site_of, ref.cr,
+                                            ref.base_tol, sources, area)
     counts.update(sites=len(sites), hypotheses=len(hyps),
                   best_support=round(float(hyps[0][0]), 3) if hyps else 0)
     # targets of the growth: footprint centroids and roof-half centroids (a site is often one
