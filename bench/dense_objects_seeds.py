@@ -5,8 +5,8 @@ dense options this script builds the ``small`` / ``aerial`` blocks of the given 
 (into a folder that is kept, so later runs reuse them) and matches only dense, with optional
 :class:`~photodem.algorithms.matching.dense.DenseOptions` fields as JSON. The figures are
 those of the bench (``bench_dsm_objects._judge``): object interior and open cells within
-0.5 m, terrain RMS in ‰ of the flying height, outline IoU, wall error (GSD), and the time of
-``match_model_dense``.
+0.5 m, terrain RMS in ‰ of the flying height (and the terrain NMAD in m), outline IoU, wall
+error (GSD), and the time of ``match_model_dense``.
 
 Usage (from the repository root)::
 
@@ -66,6 +66,7 @@ def dense_row(info: Dict[str, Any], options: Dict[str, Any]) -> Dict[str, Any]:
     """The bench's figures of one dense DSM of the block ``info``."""
     from photodem.algorithms.matching.dense_model import match_model_dense
 
+    from .bench_dsm_accuracy import _terrain_errors
     from .bench_dsm_objects import _judge
 
     model = MODELS[info["size"]]
@@ -74,9 +75,11 @@ def dense_row(info: Dict[str, Any], options: Dict[str, Any]) -> Dict[str, Any]:
         r = match_model_dense(info["project"], model, tmp, **info["heights"], **options)
         seconds = time.perf_counter() - t0
         j = _judge(info, model, r["dsm"])
+        nmad = _terrain_errors(r["dsm"], info["truth"])["nmad_m"]
     return {"block": info["size"], "seed": info["seed"], "options": options,
             "interior_0_5_pct": j["interior_0_5_pct"], "open_0_5_pct": j["open_0_5_pct"],
-            "terrain_permille_h": j["terrain_permille_h"], "iou": j["iou"],
+            "terrain_permille_h": j["terrain_permille_h"], "terrain_nmad_m": nmad,
+            "iou": j["iou"],
             "wall_gsd": j["wall_gsd"], "seconds": seconds}
 
 

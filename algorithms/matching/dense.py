@@ -151,17 +151,19 @@ class DenseOptions:
         left–right check): the right image is warped along its rows by the first pass's
         disparities (holes filled from the nearest valid pixel or from ``refine_guide`` of
         :func:`iter_disparity_tiles`, median over ``refine_smooth`` px) and each pixel
-        searches only that guide ± ``refine`` px (:func:`_refine_frame`); default 0 = off.
+        searches only that guide ± ``refine`` px (:func:`_refine_frame`); default 0 = off;
+        8 in the DSM path of wide-base nadir models (issue 19, part AA).
     refine_smooth : int
         Side (px) of the median filter of the refinement's guide; default 9.
     refine_warp : {"cubic", "linear", "integer"}
         How the right image is warped by the guide: interpolated at the fractional guide
         (default "cubic") or shifted by the rounded one ("integer", which duplicates or skips
-        a column wherever the guide steps).
+        a column wherever the guide steps: re-matched pixels then lose precision, issue 19
+        part AA).
     refine_all : bool
         False (default): only the first pass's holes on objects take the refined disparity;
         True: also its valid pixels where the right image's first pass confirms the refined
-        value (:func:`_refined_pixels`).
+        value (:func:`_refined_pixels`; True in the DSM path of wide-base nadir models).
     """
 
     method: str = "sgm"
