@@ -30,6 +30,11 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
    x-scale fits the slope (:mod:`.slant_lsm`), and kept where they agree with the plain pass's
    heights around them (:data:`SLANT_GAP_CELLS`) — ``slant_passes``, on by default (issue 22,
    parts N and X, issue 19, part Z in docs/decisions.md).
+   Wide-base nadir models finally match the plain pass once more with a *refinement pass*
+   (:data:`_REFINE_OPTIONS`): SGM ± 8 px around the first pass's smoothed disparities, the
+   slant passes' disparities filling its holes, against the right image interpolated at them;
+   every pixel the right image confirms takes the refined disparity, a hole only on an
+   object (issue 19, part AA).
 4. With about one point per cell the median cannot remove blunders: measured cells that deviate
    from their neighbourhood median by more than ``max(t, 3·1.4826·MAD)`` are emptied
    (:func:`~..surface.gridding.reject_outliers`; window ±``outlier_radius`` m, default 5
@@ -122,6 +127,17 @@ _CONVERGENT_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "block_size": 7}
 #: window cost 3.6 points of interior on held-out seed 11.
 WIDE_BASE = 0.5
 _WIDE_BASE_OPTIONS: Dict[str, Any] = {"normalise_window": 21, "wall_erosion": False}
+#: Wide-base *nadir* models also re-match every pixel in a refinement pass (``refine`` of
+#: :class:`.dense.DenseOptions`, after the slant passes, whose disparities fill the guide's
+#: holes): SGM ± 8 px around the smoothed first-pass disparities against the right image
+#: interpolated (cubic) at them; a pixel takes the refined value where the right image's own
+#: first pass confirms it, a hole only on an object. Aerial seeds 1 / 2 / 11: object interior
+#: +3.0 / +2.2 / +2.5 points, terrain RMS −9 / −9 / −12 %, open cells within ±0.01 points, IoU
+#: up, about 1.2 × the time. With the integer warp of part V only holes could take it (every
+#: pixel: terrain NMAD 0.039 → 0.063 m). Narrow-base models (the ``small`` block: open cells
+#: −0.02 / −0.04 points on seeds 11 / 2, walls of seed 1 1.1 → 1.4 GSD, 1.5–2 × the time) and
+#: convergent ones (not measured) keep the first pass. Issue 19, part AA in docs/decisions.md.
+_REFINE_OPTIONS: Dict[str, Any] = {"refine": 8, "refine_all": True}
 
 
 def wide_base(setup: ModelSetup) -> bool:
@@ -134,10 +150,11 @@ def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
 
     :data:`_DENSE_DEFAULTS` and the height step of 1.5 m in px of the model's parallax
     (:attr:`~.model_setup.ModelSetup.parallax_per_metre`) as ``edge_jump``; for wide-base
-    models (B/H ≥ :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`; for convergent models
-    :data:`_CONVERGENT_OPTIONS`; with :data:`_WALL_RULE` or a wide base also the epipolar
-    principal points as ``wall_view`` (where the left camera sees the walls of the objects in
-    its occlusions). ``overrides`` (fields of :class:`~.dense.DenseOptions`) win.
+    models (B/H ≥ :data:`WIDE_BASE`) :data:`_WIDE_BASE_OPTIONS`, and if nadir also
+    :data:`_REFINE_OPTIONS`; for convergent models :data:`_CONVERGENT_OPTIONS`; with
+    :data:`_WALL_RULE` or a wide base also the epipolar principal points as ``wall_view``
+    (where the left camera sees the walls of the objects in its occlusions). ``overrides``
+    (fields of :class:`~.dense.DenseOptions`) win.
 
     Raises
     ------
@@ -150,6 +167,8 @@ def dsm_dense_options(setup: ModelSetup, **overrides: Any) -> DenseOptions:
     values = dict(_DENSE_DEFAULTS, edge_jump=_JUMP_M * setup.parallax_per_metre, wall_view=view)
     if wide:
         values.update(_WIDE_BASE_OPTIONS)
+        if not setup.convergent:
+            values.update(_REFINE_OPTIONS)
     if setup.convergent:
         values.update(_CONVERGENT_OPTIONS)
     values.update(overrides)
@@ -352,35 +371,77 @@ def _may_reach_open_cells(pair: EpipolarPair, grid: Grid, settled: np.ndarray, d
     return reach
 
 
+class _SlantImage:
+    """Scratch image (left epipolar geometry, float32, NaN = none) of the slant passes'
+    kept disparities, read back tile by tile as the refinement pass's guide
+    (``refine_guide`` of :func:`.dense.iter_disparity_tiles`); the first scale that gives a
+    pixel a disparity keeps it."""
+
+    def __init__(self, path: Path, shape: Tuple[int, int]) -> None:
+        h, w = shape
+        profile = gtiff_profile(w, h, 1, "float32", nodata=float("nan"), compress="none")
+        self._ctx = open_image(path, "w+", **profile)
+        self.src = self._ctx.__enter__()
+        rows = max(1, RESAMPLE_BLOCK_PIXELS // max(w, 1))
+        for r0 in range(0, h, rows):
+            n = min(rows, h - r0)
+            self.src.write(np.full((1, n, w), np.nan, np.float32), window=Window(0, r0, w, n))
+
+    def add(self, d: np.ndarray, cols: np.ndarray, rows: np.ndarray) -> None:
+        """Disparities ``d`` at left pixels (``cols``, ``rows``) where there is none yet."""
+        if not d.size:
+            return
+        r0, c0 = int(rows.min()), int(cols.min())
+        win = Window(c0, r0, int(cols.max()) - c0 + 1, int(rows.max()) - r0 + 1)
+        block = self.src.read(1, window=win)
+        rr, cc = rows - r0, cols - c0
+        empty = ~np.isfinite(block[rr, cc])
+        block[rr[empty], cc[empty]] = d[empty]
+        self.src.write(block[None], window=win)
+
+    def source(self) -> GreySource:
+        """A window reader of the image."""
+        return _window_source(self.src)[0]
+
+    def close(self) -> None:
+        """Close the scratch image."""
+        self._ctx.__exit__(None, None, None)
+
+
 def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
                        left: GreySource, right: GreySource, pair: EpipolarPair, grid: Grid,
-                       settled: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The disparities of the pair from one slant tile that may reach a cell the plain pass
-    did not measure, refined by LSM between the original images
+                       settled: Optional[np.ndarray]
+                       ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The disparities of the pair from one slant tile (with ``settled``: those that may reach
+    a cell outside it), refined by LSM between the original images
     (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and rows."""
     ok = np.isfinite(block)
     rr, cc = np.nonzero(ok)
     d = unstretch(block[ok], cc + c0, scale)
     cols, rows = cc + c0, rr + r0
-    useful = _may_reach_open_cells(pair, grid, settled, d, cols, rows, SLANT_LSM_SHIFT)
-    d, cols, rows = d[useful], cols[useful], rows[useful]
+    if settled is not None:
+        useful = _may_reach_open_cells(pair, grid, settled, d, cols, rows, SLANT_LSM_SHIFT)
+        d, cols, rows = d[useful], cols[useful], rows[useful]
     d, keep = refine_slant(left, right, d, cols, rows, scale)
     return d[keep], cols[keep], rows[keep]
 
 
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 memory_mb: float, options: DenseOptions, guide: _Guide,
-                scales: Tuple[float, ...], settled: np.ndarray, feedback: Feedback) -> float:
+                scales: Tuple[float, ...], feedback: Feedback,
+                settled: Optional[np.ndarray] = None,
+                image: Optional[_SlantImage] = None) -> float:
     """The slant passes (stretches ``scales``, :func:`slant_scales`): tiled SGM against the
     stretched right image in the ranges of ``guide``; the valid disparities, refined by LSM
-    (:func:`_slant_disparities`; only those that may reach a cell outside ``settled``), give
-    their points into ``acc``; returns the matching time (s)."""
+    (:func:`_slant_disparities`; if ``settled`` is given, only those that may reach a cell
+    outside it), give their points into ``acc`` and, if given, into ``image``; returns the
+    matching time (s)."""
     pair = setup.pair
     seconds = triangulation = 0.0  # the caller counts the triangulation apart
     # slopes, not objects: every hole border eroded and no object fill (with the plain pass's
     # upper-side rule and fill, roofs ran onto the ground beside buildings: 13 % of the new
     # field cells of 0202_0203 > 2 m off)
-    options = replace(options, edge_jump=0.0, plane_fill=0.0)
+    options = replace(options, edge_jump=0.0, plane_fill=0.0, refine=0)
     with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
         left, shape_l = _window_source(src_l)
         right, (h_r, w_r) = _window_source(src_r)
@@ -396,6 +457,8 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 # the LSM refinement counts as matching
                 d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right, pair,
                                                    setup.grid, settled)
+                if image is not None:
+                    image.add(d, cols, rows)
                 t1 = time.perf_counter()
                 if d.size:
                     pts = pair.disparity_to_world(d, cols, rows)
@@ -414,13 +477,15 @@ class _MatchCounts:
     seconds: float = 0.0
 
 
-def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
+def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: Optional[GridAccumulator],
                 memory_mb: float, options: DenseOptions, feedback: Feedback,
                 footprints: Optional[GridAccumulator] = None,
-                guide: Optional[_Guide] = None) -> _MatchCounts:
+                guide: Optional[_Guide] = None,
+                refine_guide: Optional[GreySource] = None) -> _MatchCounts:
     """Tiled SGM of the scratch epipolar images; every tile's points into ``acc``, the
     sub-pixel points of :func:`footprint_points` into ``footprints`` and the disparities
-    into ``guide`` if given. ``feedback`` covers the matching alone.
+    into ``guide`` if given (``refine_guide`` as :func:`.dense.iter_disparity_tiles`).
+    ``feedback`` covers the matching alone.
 
     The time of the matching (the tile generator) is told apart from the triangulation.
     """
@@ -431,7 +496,7 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
         right, shape_r = _window_source(src_r)
         tiles = iter_disparity_tiles(left, right, shape_l, shape_r, setup.min_d, setup.max_d,
                                      options, max_memory_mb=memory_mb,
-                                     feedback=feedback)
+                                     feedback=feedback, refine_guide=refine_guide)
         while True:
             t1 = time.perf_counter()
             try:
@@ -446,8 +511,9 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
             if not ok.any():
                 continue
             rr, cc = np.nonzero(ok)
-            pts = pair.disparity_to_world(block[ok], cc + c0, rr + r0)
-            acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
+            if acc is not None:
+                pts = pair.disparity_to_world(block[ok], cc + c0, rr + r0)
+                acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
             if guide is not None:
                 guide.add(block[ok], cc + c0, rr + r0)
             if footprints is not None:
@@ -455,6 +521,48 @@ def _match_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 pts = pair.disparity_to_world(d, fc + c0, fr + r0)
                 footprints.add(pts[:, 0], pts[:, 1], pts[:, 2])
     return counts
+
+
+def _all_passes(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
+                memory_mb: float, options: DenseOptions, feedback: Feedback, work: Path,
+                footprints: Optional[GridAccumulator], guide: Optional[_Guide],
+                scales: Tuple[float, ...]) -> Tuple[_MatchCounts, Optional[GridAccumulator]]:
+    """The plain pass into ``acc`` (and ``footprints``), then the slant passes (with
+    ``guide``) into an accumulator of their own, which is returned with the counts.
+
+    With the refinement (``options.refine``) and slant passes, the plain pass only gives the
+    slant passes their ranges; the plain pass is then matched once more, refined with the
+    slant disparities in its guide (:class:`_SlantImage`), and that gives ``acc`` its
+    points — so the refinement sees what the slant passes found.
+    """
+    if guide is None:
+        return _match_into(setup, grey, acc, memory_mb, options, feedback.step(20, 85),
+                           footprints), None
+    refine = options.ours and options.refine > 0
+    # the slant passes take most of the matching time when they run
+    slant = GridAccumulator(setup.grid, memory_mb=memory_mb, scratch_dir=work)
+    if not refine:
+        counts = _match_into(setup, grey, acc, memory_mb, options, feedback.step(20, 45),
+                             footprints, guide)
+        settled = _settled_cells(acc, footprints)
+        counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide, scales,
+                                      feedback.step(45, 85), settled)
+        return counts, slant
+    # the refined pass's cells are not known yet, and the refinement's guide takes the slant
+    # disparities of every hole: each of them is refined (no ``settled`` cells)
+    first = _match_into(setup, grey, None, memory_mb, replace(options, refine=0),
+                        feedback.step(20, 35), None, guide)
+    image = _SlantImage(work / "slant_disparity.tif", (setup.pair.height,
+                                                       setup.pair.sizes[0][0]))
+    try:
+        seconds = _slant_into(setup, grey, slant, memory_mb, options, guide, scales,
+                              feedback.step(35, 75), image=image)
+        counts = _match_into(setup, grey, acc, memory_mb, options, feedback.step(75, 85),
+                             footprints, refine_guide=image.source())
+    finally:
+        image.close()
+    counts.seconds += first.seconds + seconds
+    return counts, slant
 
 
 @dataclass
@@ -642,17 +750,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                  if setup.convergent else None)
         scales = slant_scales(setup, slant_passes)
         guide = _Guide((pair.height, pair.sizes[0][0])) if scales else None
-        # the slant passes take most of the matching time when they run
-        plain_end = 45.0 if guide is not None else 85.0
-        counts = _match_into(setup, grey, acc, memory_mb, options,
-                             feedback.step(20, plain_end), extra, guide)
-        slant = None
-        if guide is not None:
-            slant = GridAccumulator(grid, memory_mb=memory_mb, scratch_dir=work)
-            settled = _settled_cells(acc, extra)
-            counts.seconds += _slant_into(setup, grey, slant, memory_mb, options, guide,
-                                          scales, settled, feedback.step(plain_end, 85))
-            del settled
+        counts, slant = _all_passes(setup, grey, acc, memory_mb, options, feedback, work,
+                                    extra, guide, scales)
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
