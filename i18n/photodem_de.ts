@@ -2645,7 +2645,7 @@
         </message>
         <message>
             <source>PhotoDEM</source>
-            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:305; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:757; plugin/widgets/georef_review.py:433; plugin/widgets/georef_review.py:616; plugin/widgets/georef_review.py:621; plugin/widgets/map_edit_tools.py:358</extracomment>
+            <extracomment>plugin/app/main_window.py:281; plugin/app/main_window.py:305; plugin/app/map_window.py:171; plugin/widgets/batch_dialog.py:757; plugin/widgets/georef_review.py:436; plugin/widgets/georef_review.py:619; plugin/widgets/georef_review.py:624; plugin/widgets/map_edit_tools.py:358</extracomment>
             <translation>PhotoDEM</translation>
         </message>
         <message>
@@ -3555,12 +3555,12 @@
         </message>
         <message>
             <source>Cancel</source>
-            <extracomment>plugin/widgets/batch_dialog.py:264; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:593; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:264; plugin/widgets/edit_session.py:92; plugin/widgets/georef_review.py:596; plugin/widgets/qc_panel.py:159; plugin/widgets/run_panel.py:51</extracomment>
             <translation>Abbrechen</translation>
         </message>
         <message>
             <source>Close</source>
-            <extracomment>plugin/widgets/batch_dialog.py:265; plugin/widgets/georef_review.py:276</extracomment>
+            <extracomment>plugin/widgets/batch_dialog.py:265; plugin/widgets/georef_review.py:279</extracomment>
             <translation>Schließen</translation>
         </message>
         <message>
@@ -3977,7 +3977,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Save</source>
-            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:272</extracomment>
+            <extracomment>plugin/widgets/edit_session.py:90; plugin/widgets/georef_review.py:275</extracomment>
             <translation>Speichern</translation>
         </message>
         <message>
@@ -4166,108 +4166,113 @@ Erneut ausführen mit: photodem batch {0}</translation>
             <translation>Bild und Referenz stimmen neben dem Ergebnis am besten überein im {quadrants} (höchstens {max_px:g} px)</translation>
         </message>
         <message>
+            <source>building footprints cannot confirm a result of the area-based search (roof edges displaced by relief, walls and cast shadows agree with the footprints a few pixels apart)</source>
+            <extracomment>plugin/widgets/georef_review.py:97</extracomment>
+            <translation>Gebäudegrundrisse können ein Ergebnis der flächenbasierten Suche nicht bestätigen (durch Reliefversatz verschobene Dachkanten, Wände und Schlagschatten stimmen wenige Pixel auseinander mit den Grundrissen überein)</translation>
+        </message>
+        <message>
             <source>top left quadrant ({0} px)</source>
-            <extracomment>plugin/widgets/georef_review.py:107</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:110</extracomment>
             <translation>Quadranten oben links ({0} px)</translation>
         </message>
         <message>
             <source>top right quadrant ({0} px)</source>
-            <extracomment>plugin/widgets/georef_review.py:107</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:110</extracomment>
             <translation>Quadranten oben rechts ({0} px)</translation>
         </message>
         <message>
             <source>bottom left quadrant ({0} px)</source>
-            <extracomment>plugin/widgets/georef_review.py:108</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:111</extracomment>
             <translation>Quadranten unten links ({0} px)</translation>
         </message>
         <message>
             <source>bottom right quadrant ({0} px)</source>
-            <extracomment>plugin/widgets/georef_review.py:108</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:111</extracomment>
             <translation>Quadranten unten rechts ({0} px)</translation>
         </message>
         <message>
             <source>edge peak ratio {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:147</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
             <translation>Kantenspitzenverhältnis {0}</translation>
         </message>
         <message>
             <source>correlation peak margin {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:148</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:151</extracomment>
             <translation>Korrelationsvorsprung der Spitze {0}</translation>
         </message>
         <message>
             <source>Evidence of the automatic result:</source>
-            <extracomment>plugin/widgets/georef_review.py:157; plugin/widgets/georef_review.py:159</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:160; plugin/widgets/georef_review.py:162</extracomment>
             <translation>Belege des automatischen Ergebnisses:</translation>
         </message>
         <message>
             <source>Figures:</source>
-            <extracomment>plugin/widgets/georef_review.py:159</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:162</extracomment>
             <translation>Kennzahlen:</translation>
         </message>
         <message>
             <source>Add control point</source>
-            <extracomment>plugin/widgets/georef_review.py:168</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:171</extracomment>
             <translation>Passpunkt hinzufügen</translation>
         </message>
         <message>
             <source>Drop outliers (&gt; 3 σ0)</source>
-            <extracomment>plugin/widgets/georef_review.py:230</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:233</extracomment>
             <translation>Ausreißer entfernen (&gt; 3 σ0)</translation>
         </message>
         <message>
             <source>Control points</source>
-            <extracomment>plugin/widgets/georef_review.py:257</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:260</extracomment>
             <translation>Passpunkte</translation>
         </message>
         <message>
             <source>Object pairs</source>
-            <extracomment>plugin/widgets/georef_review.py:258</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:261</extracomment>
             <translation>Objektpaare</translation>
         </message>
         <message>
             <source>Add control point…</source>
-            <extracomment>plugin/widgets/georef_review.py:265</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:268</extracomment>
             <translation>Passpunkt hinzufügen…</translation>
         </message>
         <message>
             <source>Import check points…</source>
-            <extracomment>plugin/widgets/georef_review.py:266</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:269</extracomment>
             <translation>Kontrollpunkte importieren…</translation>
         </message>
         <message>
             <source>Independent check points from a CSV/TXT file with a header: col,row,x,y (pixel centres at whole numbers) or pixel,line,mapX,mapY (a QGIS .points file); they are never used in the fit.</source>
-            <extracomment>plugin/widgets/georef_review.py:267</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:270</extracomment>
             <translation>Unabhängige Kontrollpunkte aus einer CSV-/TXT-Datei mit Kopfzeile: col,row,x,y (Pixelmitten auf ganzen Zahlen) oder pixel,line,mapX,mapY (eine .points-Datei von QGIS); sie gehen nie in die Ausgleichung ein.</translation>
         </message>
         <message>
             <source>Switch off largest residual</source>
-            <extracomment>plugin/widgets/georef_review.py:271</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:274</extracomment>
             <translation>Größten Restfehler abschalten</translation>
         </message>
         <message>
             <source>Write the control points, the georeferenced image and the report again (the automatic result is kept as report_auto.json).</source>
-            <extracomment>plugin/widgets/georef_review.py:273</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:276</extracomment>
             <translation>Passpunkte, georeferenziertes Bild und Bericht neu schreiben (das automatische Ergebnis bleibt als report_auto.json erhalten).</translation>
         </message>
         <message>
             <source>Writing the georeferenced image …</source>
-            <extracomment>plugin/widgets/georef_review.py:592</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:595</extracomment>
             <translation>Georeferenziertes Bild wird geschrieben …</translation>
         </message>
         <message>
             <source>Output folder of a georeferencing</source>
-            <extracomment>plugin/widgets/georef_review.py:638</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:641</extracomment>
             <translation>Ausgabeordner einer Georeferenzierung</translation>
         </message>
         <message>
             <source>yes</source>
-            <extracomment>plugin/widgets/georef_review.py:674</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:677</extracomment>
             <translation>ja</translation>
         </message>
         <message>
             <source>no</source>
-            <extracomment>plugin/widgets/georef_review.py:674</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:677</extracomment>
             <translation>nein</translation>
         </message>
         <message>
@@ -4307,127 +4312,127 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Verified: yes</source>
-            <extracomment>plugin/widgets/georef_review.py:134</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:137</extracomment>
             <translation>Bestätigt: ja</translation>
         </message>
         <message>
             <source>UNVERIFIED</source>
-            <extracomment>plugin/widgets/georef_review.py:136</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:139</extracomment>
             <translation>UNBESTÄTIGT</translation>
         </message>
         <message>
             <source>control points from a grid through the search transform</source>
-            <extracomment>plugin/widgets/georef_review.py:145</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:148</extracomment>
             <translation>Passpunkte aus einem Raster durch die Transformation der Suche</translation>
         </message>
         <message>
             <source>Image column [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:171</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:174</extracomment>
             <translation>Bildspalte [px]</translation>
         </message>
         <message>
             <source>Image row [px]</source>
-            <extracomment>plugin/widgets/georef_review.py:172</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:175</extracomment>
             <translation>Bildzeile [px]</translation>
         </message>
         <message>
             <source>Map X</source>
-            <extracomment>plugin/widgets/georef_review.py:173</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:176</extracomment>
             <translation>Karte X</translation>
         </message>
         <message>
             <source>Map Y</source>
-            <extracomment>plugin/widgets/georef_review.py:174</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:177</extracomment>
             <translation>Karte Y</translation>
         </message>
         <message>
             <source>Transform:</source>
-            <extracomment>plugin/widgets/georef_review.py:239</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:242</extracomment>
             <translation>Transformation:</translation>
         </message>
         <message>
             <source>Skipped check points outside the image ({0}): {1}.</source>
-            <extracomment>plugin/widgets/georef_review.py:444</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:447</extracomment>
             <translation>Kontrollpunkte außerhalb des Bildes übersprungen ({0}): {1}.</translation>
         </message>
         <message>
             <source>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} of {4} points in the fit</source>
-            <extracomment>plugin/widgets/georef_review.py:500</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:503</extracomment>
             <translation>RMSE &lt;b&gt;{0:.3f} px&lt;/b&gt; = {1:.3f} m, σ0 {2:.3f} m; {3} von {4} Punkten in der Ausgleichung</translation>
         </message>
         <message>
             <source>Discard the changes that are not saved?</source>
-            <extracomment>plugin/widgets/georef_review.py:621</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:624</extracomment>
             <translation>Nicht gespeicherte Änderungen verwerfen?</translation>
         </message>
         <message>
             <source>control points cover {0} % of the image, {1} of 4 quadrants</source>
-            <extracomment>plugin/widgets/georef_review.py:139</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:142</extracomment>
             <translation>Passpunkte überdecken {0} % des Bildes, {1} von 4 Quadranten</translation>
         </message>
         <message>
             <source>quadrant offsets {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:156</extracomment>
             <translation>Versätze je Quadrant {0} px</translation>
         </message>
         <message>
             <source>corner misfit {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:155</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:158</extracomment>
             <translation>Fehlanpassung an den Ecken {0} px</translation>
         </message>
         <message>
             <source>Map coordinates in {0}; pixel centres at whole numbers, the top-left pixel is (0, 0).</source>
-            <extracomment>plugin/widgets/georef_review.py:180</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:183</extracomment>
             <translation>Kartenkoordinaten in {0}; Pixelmitten auf ganzen Zahlen, das Pixel oben links ist (0, 0).</translation>
         </message>
         <message>
             <source>Review georeferencing — {0}</source>
-            <extracomment>plugin/widgets/georef_review.py:222</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:225</extracomment>
             <translation>Georeferenzierung prüfen — {0}</translation>
         </message>
         <message>
             <source>Import check points</source>
-            <extracomment>plugin/widgets/georef_review.py:419</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:422</extracomment>
             <translation>Kontrollpunkte importieren</translation>
         </message>
         <message>
             <source>Check points (*.csv *.txt *.points);;All files (*)</source>
-            <extracomment>plugin/widgets/georef_review.py:420</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:423</extracomment>
             <translation>Kontrollpunkte (*.csv *.txt *.points);;Alle Dateien (*)</translation>
         </message>
         <message>
             <source>; {0} check points: RMSE {1:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:504</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:507</extracomment>
             <translation>; {0} Kontrollpunkte: RMSE {1:.3f} m</translation>
         </message>
         <message>
             <source>; {0} independent check points: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</source>
-            <extracomment>plugin/widgets/georef_review.py:506</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:509</extracomment>
             <translation>; {0} unabhängige Kontrollpunkte: RMSE &lt;b&gt;{1:.3f} px&lt;/b&gt; = {2:.3f} m</translation>
         </message>
         <message>
             <source>not saved</source>
-            <extracomment>plugin/widgets/georef_review.py:510</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:513</extracomment>
             <translation>nicht gespeichert</translation>
         </message>
         <message>
             <source>corners disagree by {0} px between halves</source>
-            <extracomment>plugin/widgets/georef_review.py:142</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:145</extracomment>
             <translation>Ecken weichen zwischen den Hälften um {0} px ab</translation>
         </message>
         <message>
             <source>at {0} px</source>
-            <extracomment>plugin/widgets/georef_review.py:150</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:153</extracomment>
             <translation>bei {0} px</translation>
         </message>
         <message>
             <source>Residuals (×{0:g})</source>
-            <extracomment>plugin/widgets/georef_review.py:544</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:547</extracomment>
             <translation>Restfehler (×{0:g})</translation>
         </message>
         <message>
             <source>control point ({0})</source>
-            <extracomment>plugin/widgets/georef_review.py:564</extracomment>
+            <extracomment>plugin/widgets/georef_review.py:567</extracomment>
             <translation>Passpunkt ({0})</translation>
         </message>
         <message>
@@ -5417,12 +5422,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Georeferencing failed: {why} ({detail}). Check that image and reference show the same objects completely (class field/value), try other thresholds or a larger relative difference.</source>
-            <extracomment>algorithms/georef/pipeline.py:782</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:786</extracomment>
             <translation>Die Georeferenzierung ist fehlgeschlagen: {why} ({detail}). Prüfen Sie, ob Bild und Referenz dieselben Objekte vollständig zeigen (Klassenfeld/-wert), versuchen Sie andere Schwellen oder eine größere relative Differenz.</translation>
         </message>
         <message>
             <source>The output folder '{path}' holds files PhotoDEM did not write; choose an empty or new folder.</source>
-            <extracomment>algorithms/georef/pipeline.py:820</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:824</extracomment>
             <translation>Der Ausgabeordner '{path}' enthält Dateien, die PhotoDEM nicht geschrieben hat; wählen Sie einen leeren oder neuen Ordner.</translation>
         </message>
         <message>
@@ -5452,12 +5457,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Georeferencing failed: the {stage} stage's result is not verified: {why} (RMSE {rmse:.2f} px of {points} control points; {evidence}). No result is better than a wrong one: check that image and reference show the same area, or write the result marked unverified.</source>
-            <extracomment>algorithms/georef/pipeline.py:321</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:325</extracomment>
             <translation>Die Georeferenzierung ist fehlgeschlagen: Das Ergebnis der Stufe {stage} ist nicht bestätigt: {why} (RMSE {rmse:.2f} px aus {points} Passpunkten; {evidence}). Kein Ergebnis ist besser als ein falsches: Prüfen Sie, ob Bild und Referenz dasselbe Gebiet zeigen, oder schreiben Sie das Ergebnis als unbestätigt markiert.</translation>
         </message>
         <message>
             <source>{error} Before it, the keypoint stage found no result: {why} ({detail}).</source>
-            <extracomment>algorithms/georef/pipeline.py:387</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:391</extracomment>
             <translation>{error} Zuvor hat die Merkmalspunktstufe kein Ergebnis gefunden: {why} ({detail}).</translation>
         </message>
         <message>
@@ -5697,12 +5702,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The disparity range {min_d}…{max_d} px holds no possible disparity of these images (widths {left_width} and {right_width} px allow {low}…{high}); change {parameter}.</source>
-            <extracomment>algorithms/matching/dense.py:335</extracomment>
+            <extracomment>algorithms/matching/dense.py:366</extracomment>
             <translation>Der Disparitätsbereich {min_d}…{max_d} px enthält keine mögliche Disparität dieser Bilder (Breiten {left_width} und {right_width} px erlauben {low}…{high}); ändern Sie {parameter}.</translation>
         </message>
         <message>
             <source>The disparity range is empty (min {min_d} &gt; max {max_d}); give min_disparity ≤ max_disparity.</source>
-            <extracomment>algorithms/matching/dense.py:436</extracomment>
+            <extracomment>algorithms/matching/dense.py:476</extracomment>
             <translation>Der Disparitätsbereich ist leer (min {min_d} &gt; max {max_d}); geben Sie min_disparity ≤ max_disparity an.</translation>
         </message>
         <message>

@@ -104,6 +104,8 @@ class Evidence:
     reasons: List[str]  #: why not verified, in English (empty when verified)
     points: int = 0  #: control points used by the fit
     independent_points: bool = True  #: False: points from a grid through a search transform
+    #: The reference is building footprints (the edge agreement cannot verify grid points)
+    buildings: bool = False
     hull_share: Optional[float] = None  #: convex-hull share of the image (0–1)
     quadrants: Optional[int] = None  #: quadrants with ≥ QUADRANT_POINTS points
     corner_disagreement_px: Optional[float] = None  #: halves' transforms at the corners
@@ -183,8 +185,8 @@ def hull_share(xy: Array, shape: Sequence[int]) -> float:
         return 0.0
 
 
-def assess(result: GeorefResult, reference: Union[PathLike, Sequence[Array], None] = None
-           ) -> Evidence:
+def assess(result: GeorefResult, reference: Union[PathLike, Sequence[Array], None] = None,
+           buildings: bool = False) -> Evidence:
     """Independent evidence for ``result`` (see the module notes).
 
     Parameters
@@ -194,6 +196,11 @@ def assess(result: GeorefResult, reference: Union[PathLike, Sequence[Array], Non
     reference : path or sequence of (n, 2) arrays, optional
         A georeferenced raster (path), or polygon outlines in map coordinates (the reference
         polygons' rings). ``None``: no agreement test (not verified: the agreement is needed).
+    buildings : bool
+        The polygons are building footprints. Their edge agreement has several peaks a few
+        pixels apart (roof outlines displaced by relief, walls, cast shadows), so it cannot
+        verify a result whose control points are not independent (the area stage's grid):
+        such a result is not verified (reason ``buildings_area``).
 
     Returns
     -------
@@ -206,7 +213,7 @@ def assess(result: GeorefResult, reference: Union[PathLike, Sequence[Array], Non
     img = np.array([g.image for g in result.gcps], float).reshape(-1, 2)[used]
     mp = np.array([g.map for g in result.gcps], float).reshape(-1, 2)[used]
     ev = Evidence(verified=False, reasons=[], points=int(used.sum()),
-                  independent_points=result.stage != "area")
+                  independent_points=result.stage != "area", buildings=buildings)
     if ev.independent_points:
         ev.hull_share = hull_share(img, shape)
         ev.quadrants = int((np.bincount(_quadrant(img, shape), minlength=4)
@@ -250,6 +257,9 @@ REASON_TEXTS = {
                      "an image corner (extrapolated from the quadrants; at most {max_px:g} px)",
     "local_offsets": "image and reference agree best away from the result in the {quadrants} "
                      "(at most {max_px:g} px)",
+    "buildings_area": "building footprints cannot confirm a result of the area-based search "
+                      "(roof edges displaced by relief, walls and cast shadows agree with "
+                      "the footprints a few pixels apart)",
 }
 
 
@@ -266,6 +276,8 @@ def _reasons(ev: Evidence) -> List[Tuple[str, Dict[str, Any]]]:
     """Why ``ev`` does not verify its result (empty: verified): (key, figures) pairs, the
     figures rounded as they are shown."""
     why: List[Tuple[str, Dict[str, Any]]] = []
+    if ev.buildings and not ev.independent_points:
+        why.append(("buildings_area", {}))
     if ev.independent_points:
         if ev.hull_share < MIN_HULL or ev.quadrants < MIN_QUADRANTS:
             why.append(("spread", {"hull_pct": round(100 * ev.hull_share, 1),

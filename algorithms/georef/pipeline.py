@@ -263,17 +263,19 @@ def georeference(image: PathLike, reference: PathLike, options: Optional[GeorefO
     fb.progress(5)
     limit = opts.time_limit_s
     run = _Run(opts, thr, grey, img_info, fb, t0, t0 + limit if limit > 0 else float("inf"))
-    result = _search(run, reference, ref_kind, ref)
-    return _gate(run, result, reference, ref)
+    buildings = ref is not None and (opts.objects == "buildings"
+                                     or (opts.objects == "auto" and is_buildings(ref[0])))
+    result = _search(run, reference, ref_kind, ref, buildings)
+    return _gate(run, result, reference, ref, buildings)
 
 
-def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple]
-            ) -> GeorefResult:
-    """The stages in their order; the first result wins."""
+def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple],
+            buildings: bool) -> GeorefResult:
+    """The stages in their order; the first result wins. ``buildings``: the reference is
+    building footprints (the buildings mode first)."""
     opts, fb = run.options, run.fb
     buildings_failure = None
-    if ref is not None and (opts.objects == "buildings"
-                            or (opts.objects == "auto" and is_buildings(ref[0]))):
+    if buildings:
         try:
             return _buildings_stage(run, ref)
         except GeometryError as exc:
@@ -300,10 +302,12 @@ def _search(run: _Run, reference: PathLike, ref_kind: str, ref: Optional[tuple]
         return _area_stage(run, ref, why)
 
 
-def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tuple]
-          ) -> GeorefResult:
+def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tuple],
+          buildings: bool = False) -> GeorefResult:
     """The acceptance gate (:mod:`.evidence`): a result the independent evidence does not
-    support fails with the figures — or, with ``unverified``, is returned marked."""
+    support fails with the figures — or, with ``unverified``, is returned marked.
+    ``buildings``: the reference is building footprints (an area-stage result is then not
+    verified: :func:`.evidence.assess`)."""
     fb = run.fb
     fb.check()
     if ref is not None:
@@ -311,7 +315,7 @@ def _gate(run: _Run, result: GeorefResult, reference: PathLike, ref: Optional[tu
                                            for b in o.attributes.get("outlines", [o.ring])])
     else:
         source = reference
-    ev = assess(result, source)
+    ev = assess(result, source, buildings=buildings)
     result.evidence, result.verified = ev, ev.verified
     result.counts["verified"] = ev.verified
     fb.info(f"Evidence ({ev.seconds:.1f} s): {ev.text()}.")

@@ -94,6 +94,9 @@ def reason_texts() -> Dict[str, str]:
                             "most {max_px:g} px)"),
         "local_offsets": tr("image and reference agree best away from the result in the "
                             "{quadrants} (at most {max_px:g} px)"),
+        "buildings_area": tr("building footprints cannot confirm a result of the area-based "
+                             "search (roof edges displaced by relief, walls and cast shadows "
+                             "agree with the footprints a few pixels apart)"),
     }
 
 

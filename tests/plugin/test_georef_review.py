@@ -279,3 +279,17 @@ def test_unverified_reasons_go_through_the_translation(monkeypatch) -> None:
     old = georef_review.evidence_html({"verified": False, "evidence": {
         "reasons": ["the corners disagree by 5.3 px between halves"]}})
     assert "</b> — the corners disagree by 5.3 px between halves" in old
+
+
+def test_every_reason_of_the_gate_has_a_translatable_text() -> None:
+    """The dialog knows every reason key of the core, with the same figures."""
+    import string
+
+    from photodem.algorithms.georef import evidence
+    from photodem.plugin.widgets import georef_review
+
+    ours = georef_review.reason_texts()
+    assert set(ours) == set(evidence.REASON_TEXTS)
+    for key, text in evidence.REASON_TEXTS.items():
+        fields = {f for _, f, _, _ in string.Formatter().parse(text) if f}
+        assert fields == {f for _, f, _, _ in string.Formatter().parse(ours[key]) if f}, key
