@@ -2404,9 +2404,9 @@
             <translation>Referenzobjekte</translation>
         </message>
         <message>
-            <source>buildings: many small footprints (cadastre, OpenStreetMap) matched by the configuration of neighbouring buildings; areas: forests, fields, lakes, glaciers; auto: buildings when the layer has at least 15 mostly rectangular polygons whose median area is below 0.2 % of the layer's extent and below 5000 m².</source>
+            <source>buildings: many small footprints (cadastre, OpenStreetMap) matched by the configuration of neighbouring buildings; areas: forests, fields, lakes, glaciers; auto: buildings when the layer has at least 15 mostly rectangular polygons whose median area is below 0.4 % of the layer's extent and below 5000 m².</source>
             <extracomment>georeference_polygons.objects: help</extracomment>
-            <translation>buildings: viele kleine Gebäudegrundrisse (Kataster, OpenStreetMap), zugeordnet über die Anordnung benachbarter Gebäude; areas: Wälder, Felder, Seen, Gletscher; auto: Gebäude, wenn die Ebene mindestens 15 überwiegend rechteckige Polygone hat, deren mittlere Fläche (Median) unter 0,2 % der Ausdehnung der Ebene und unter 5000 m² liegt.</translation>
+            <translation>buildings: viele kleine Gebäudegrundrisse (Kataster, OpenStreetMap), zugeordnet über die Anordnung benachbarter Gebäude; areas: Wälder, Felder, Seen, Gletscher; auto: Gebäude, wenn die Ebene mindestens 15 überwiegend rechteckige Polygone hat, deren mittlere Fläche (Median) unter 0,4 % der Ausdehnung der Ebene und unter 5000 m² liegt.</translation>
         </message>
         <message>
             <source>areas</source>

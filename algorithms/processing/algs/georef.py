@@ -83,7 +83,7 @@ class GeoreferencePolygons(Algorithm):
                   help="buildings: many small footprints (cadastre, OpenStreetMap) matched "
                        "by the configuration of neighbouring buildings; areas: forests, "
                        "fields, lakes, glaciers; auto: buildings when the layer has at least "
-                       "15 mostly rectangular polygons whose median area is below 0.2 % of the "
+                       "15 mostly rectangular polygons whose median area is below 0.4 % of the "
                        "layer's extent and below 5000 m²."),
         Parameter("sigma_np", "number", "Control point tolerance σ_NP [px]", default=2.0,
                   minimum=0.1, maximum=50.0, unit="px",
