@@ -48,8 +48,9 @@ GOALS: Dict[str, Dict[str, float]] = {
 F1_GOAL = 0.85
 
 
-def _block(tmp: Path, size: str) -> Dict[str, Any]:
-    """A held-out block; the aerial one with a start point and the truth's height range."""
+def _block(folder: Path, size: str, seed: int = SEED) -> Dict[str, Any]:
+    """A block of ``size`` and ``seed`` built in ``folder`` (gentle terrain); the aerial one with
+    a start point and the truth's height range."""
     import rasterio
 
     from photodem.algorithms.processing import registry
@@ -57,8 +58,8 @@ def _block(tmp: Path, size: str) -> Dict[str, Any]:
     from .bench_dsm_accuracy import _start_point
 
     t0 = time.perf_counter()
-    b = registry.run("synthetic_block", {"size": size, "terrain": "gentle", "seed": SEED,
-                                         "output": str(tmp / size)})
+    b = registry.run("synthetic_block", {"size": size, "terrain": "gentle", "seed": seed,
+                                         "output": str(folder)})
     truth = {"dsm": b["truth_dsm"], "dtm": b["truth_dtm"], "landcover": b["truth_landcover"],
              "buildings": b["truth_buildings"]}
     heights: Dict[str, float] = {}
@@ -68,8 +69,8 @@ def _block(tmp: Path, size: str) -> Dict[str, Any]:
         heights = {"min_height": float(np.nanmin(z)) - 5.0,
                    "max_height": float(np.nanmax(z)) + 5.0}
         _start_point(Path(b["project"]), truth, heights["min_height"], heights["max_height"])
-    return {"size": size, "project": b["project"], "truth": truth, "heights": heights,
-            "H": float(b["flying_height_m"]), "gsd": float(b["gsd_m"]),
+    return {"size": size, "seed": seed, "project": b["project"], "truth": truth,
+            "heights": heights, "H": float(b["flying_height_m"]), "gsd": float(b["gsd_m"]),
             "seconds": time.perf_counter() - t0}
 
 
@@ -203,7 +204,7 @@ def run() -> dict:
     with tempfile.TemporaryDirectory(prefix="bench-objects-") as tmp:
         tmp = Path(tmp)
         for size, model in BLOCKS:
-            block = _block(tmp, size)
+            block = _block(tmp / size, size)
             ours = _methods(block, model, tmp)
             peer = _peer(block, model, tmp)
             rows += ours + [peer]

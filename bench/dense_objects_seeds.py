@@ -26,38 +26,20 @@ import time
 from pathlib import Path
 from typing import Any, Dict, List
 
-import numpy as np
-
 #: the model of each block size (as ``bench_dsm_objects.BLOCKS``)
 MODELS = {"small": "0102_0103", "aerial": "0101_0102"}
 
 
 def block(root: Path, size: str, seed: int) -> Dict[str, Any]:
-    """The block of ``size`` and ``seed`` under ``root``, built once (as the bench builds it:
-    gentle terrain; the aerial one with a start point and the truth's height range)."""
-    import rasterio
-
-    from photodem.algorithms.processing import registry
-
-    from .bench_dsm_accuracy import _start_point
+    """The block of ``size`` and ``seed`` under ``root``, built once as the bench builds it
+    (``bench_dsm_objects._block``)."""
+    from .bench_dsm_objects import _block
 
     folder = root / f"{size}{seed}"
     info_file = folder / "bench_block.json"
     if info_file.exists():
         return json.loads(info_file.read_text())
-    b = registry.run("synthetic_block", {"size": size, "terrain": "gentle", "seed": seed,
-                                         "output": str(folder)})
-    truth = {"dsm": b["truth_dsm"], "dtm": b["truth_dtm"], "landcover": b["truth_landcover"],
-             "buildings": b["truth_buildings"]}
-    heights: Dict[str, float] = {}
-    if size == "aerial":
-        with rasterio.open(truth["dsm"]) as src:
-            z = src.read(1)
-        heights = {"min_height": float(np.nanmin(z)) - 5.0,
-                   "max_height": float(np.nanmax(z)) + 5.0}
-        _start_point(Path(b["project"]), truth, heights["min_height"], heights["max_height"])
-    info = {"size": size, "seed": seed, "project": b["project"], "truth": truth,
-            "heights": heights, "H": float(b["flying_height_m"]), "gsd": float(b["gsd_m"])}
+    info = _block(folder, size, seed)
     info_file.write_text(json.dumps(info))
     return info
 
