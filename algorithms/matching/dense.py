@@ -775,13 +775,14 @@ def _guide_disparity(disp: Array, lmask: Array, smooth: int,
     ``smooth`` px that removes the blunder specks; None without any valid one."""
     from scipy import ndimage  # lazy: only the refinement pass needs it
 
+    from .fbm import fill_nodata  # lazy: fbm is loaded only where a refinement runs
+
     if extra is not None:
         disp = np.where(np.isfinite(disp), disp, extra)
     ok = np.isfinite(disp) & ~lmask
     if not ok.any():
         return None
-    idx = ndimage.distance_transform_edt(~ok, return_distances=False, return_indices=True)
-    full = disp[tuple(idx)]
+    full, _ = fill_nodata(np.where(ok, disp, np.nan))
     if smooth > 1:
         full = ndimage.median_filter(full, size=int(smooth), mode="nearest")
     return full.astype(np.float32)
