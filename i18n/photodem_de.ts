@@ -4168,7 +4168,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         <message>
             <source>building footprints cannot confirm a result of the area-based search (roof edges displaced by relief, walls and cast shadows agree with the footprints a few pixels apart)</source>
             <extracomment>plugin/widgets/georef_review.py:97</extracomment>
-            <translation>Gebäudegrundrisse können ein Ergebnis der flächenbasierten Suche nicht bestätigen (durch Reliefversatz verschobene Dachkanten, Wände und Schlagschatten stimmen wenige Pixel auseinander mit den Grundrissen überein)</translation>
+            <translation>Gebäudegrundrisse können ein Ergebnis der flächenbasierten Suche nicht bestätigen (durch Reliefversatz verschobene Dachkanten, Wände und Schlagschatten passen an mehreren, wenige Pixel auseinanderliegenden Stellen zu den Grundrissen)</translation>
         </message>
         <message>
             <source>top left quadrant ({0} px)</source>

@@ -293,3 +293,46 @@ def test_every_reason_of_the_gate_has_a_translatable_text() -> None:
     for key, text in evidence.REASON_TEXTS.items():
         fields = {f for _, f, _, _ in string.Formatter().parse(text) if f}
         assert fields == {f for _, f, _, _ in string.Formatter().parse(ours[key]) if f}, key
+
+
+def test_area_result_on_footprints_shows_its_reason_in_both_languages(qtbot, folder,
+                                                                      monkeypatch,
+                                                                      tmp_path) -> None:
+    """An area-stage result against building footprints written unverified: the dialog gives
+    the gate's reason, in English and in German (screenshots of both)."""
+    import shutil as sh
+    import subprocess
+    from pathlib import Path
+
+    from photodem.algorithms.georef import evidence
+    from photodem.plugin import i18n
+
+    rep = json.loads((folder / "report.json").read_text())
+    rep["verified"] = False
+    rep["evidence"]["reason_items"] = [["buildings_area", {}]]
+    rep["evidence"]["reasons"] = [evidence.reason_text("buildings_area", {})]
+    (folder / "report.json").write_text(json.dumps(rep))
+    dialog = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(dialog)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    assert "building footprints cannot confirm a result" in dialog.evidence_label.text()
+    dialog.grab().save("/tmp/photodem_georef_review_buildings_area.png")
+    lrelease = sh.which("lrelease") or sh.which("/usr/lib/qt5/bin/lrelease")
+    if lrelease is None:
+        pytest.skip("lrelease not installed (Debian package qttools5-dev-tools)")
+    ts = Path(i18n.__file__).resolve().parents[1] / "i18n" / "photodem_de.ts"
+    subprocess.run([lrelease, "-silent", str(ts), "-qm", str(tmp_path / "photodem_de.qm")],
+                   check=True)
+    monkeypatch.setattr(i18n, "I18N_DIR", tmp_path)
+    try:
+        assert i18n.install_translator("de_DE") is not None
+        german = GeorefReviewDialog(folder, message_boxes=False)
+        qtbot.addWidget(german)
+        german.show()
+        qtbot.waitExposed(german)
+        assert "Gebäudegrundrisse können ein Ergebnis" in german.evidence_label.text()
+        german.grab().save("/tmp/photodem_georef_review_buildings_area_de.png")
+        german.dirty = False
+    finally:
+        i18n.remove_translator()
