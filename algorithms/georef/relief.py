@@ -32,13 +32,17 @@ The chain (:func:`correct_relief`):
 4. **Relief** (:func:`search_relief`): one scale about the nadir explains all edges: the ground
    edge of an edge at distance r from the nadir (along its normal) lies at g = ρ·r/rmax + δ
    (ρ: the relief at the farthest corner, δ: a common offset between the image's and the
-   footprints' edges — blur, eaves). ρ minimises the sum of the capped misfit curves over all
-   edges (grid search, δ profiled out): a global estimate, no edge has to be decided on its
-   own. T' = T·S with S the scale by 1 + ρ/rmax about the nadir.
+   footprints' edges — the step model's bias). ρ minimises the sum of the capped misfit
+   curves over all edges (grid search, δ profiled out): a global estimate, no edge has to be
+   decided on its own. Twice: with δ free (:data:`FREE_OFFSET_PX`) for the decision, with δ
+   held near zero (:data:`MAX_OFFSET_PX`) for the size — a free δ trades against ρ, a held
+   one would let a common offset pass for relief. T' = T·S with S the scale by 1 + ρ/rmax
+   about the nadir.
 5. **Decision**: T changes only when the roofs sit on the mapped footprints (the start fits:
    :data:`MIN_ROOF_SHARE`), enough edges on enough footprints agree with ρ (their
-   misfit ≤ 1 there), ρ > 0 lowers the summed misfit by at least :data:`MIN_GAIN` against
-   ρ = 0, and ρ stays below the plausible limit; otherwise T is returned with the reason.
+   misfit ≤ 1 there), ρ > 0 with δ free and held, the free one lowers the summed misfit by at
+   least :data:`MIN_GAIN` against ρ = 0, and ρ stays below the plausible limit; otherwise T is
+   returned with the reason.
    Without relief the ground edges coincide with the roof edges and ρ = 0 wins.
 
 The control points reported are the ground edges that agree (image) with their feet on the
@@ -97,6 +101,15 @@ MIN_BUILDINGS = 6
 #: within 0.5 px of the mapped footprint edge (measured: 53–75 % with the right footprints,
 #: 22–30 % with footprints of another place).
 MIN_ROOF_SHARE = 0.4
+#: Whether there is relief at all is decided with the common offset δ of the ground edges
+#: free within ± this (px): an offset the step model sees on every edge (the ground edge of a
+#: profile without a wall lands 0.3–0.4 px beyond the roof edge) then cannot pass for relief.
+FREE_OFFSET_PX = 0.6
+#: How much relief is then measured with δ held within ± this (px): a free δ trades against ρ
+#: (the edges' mean distance from the nadir is a third of the corner's), which left ρ 0.9–1.0 px
+#: too high on buildings seeds 6 and 13 (δ −0.3 to −0.45) and 0.6 px too low on seeds 9
+#: and 10 (δ +0.2 to +0.35).
+MAX_OFFSET_PX = 0.1
 #: Largest plausible relief displacement at the image corner (px); a larger estimate is not
 #: relief (inconsistent evidence).
 MAX_RELIEF_PX = 6.0
@@ -457,15 +470,17 @@ def _corner_distance(centre: Array, shape: Tuple[int, ...]) -> float:
     return float(np.hypot(*np.maximum(centre + 0.5, np.array([w, h]) - 0.5 - centre)))
 
 
-def search_relief(meas: Sequence[EdgeMeasurement], rmax: float, max_relief_px: float
-                  ) -> Tuple[Array, Array, Array]:
+def search_relief(meas: Sequence[EdgeMeasurement], rmax: float, max_relief_px: float,
+                  max_offset_px: Optional[float] = None) -> Tuple[Array, Array, Array]:
     """The summed misfit of all edges for relief ρ (px at the image corner) on a grid from
     −1 px to ``max_relief_px``: every edge's ground edge at g = ρ·r/rmax + δ (r: its distance
     from the nadir along its normal; δ: an offset common to all edges — where the image shows
-    an edge against where the footprint puts it, blur and eaves — searched in ± 0.6 px).
+    a wall base against where the footprint puts it: the step model's sub-pixel bias —
+    searched in ± ``max_offset_px``, default :data:`MAX_OFFSET_PX`).
     Returns the ρ grid, the least sum over δ for each ρ and the δ that gives it."""
+    span = MAX_OFFSET_PX if max_offset_px is None else float(max_offset_px)
     rho = np.arange(-1.0, max_relief_px + 1e-9, 0.05)
-    delta = np.arange(-0.6, 0.6 + 1e-9, 0.05)
+    delta = np.arange(-span, span + 1e-9, 0.05) if span > 0 else np.zeros(1)
     R, D = np.meshgrid(rho, delta, indexing="ij")
     total = np.zeros(R.shape)
     for m in meas:
@@ -574,12 +589,15 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
             f"the roofs do not sit on the mapped footprints ({100 * roof_share:.0f} % of the "
             f"edges within 0.5 px, at least {100 * MIN_ROOF_SHARE:.0f} % needed): the start "
             "transform or the footprints do not fit"))
+    # whether: δ free (:data:`FREE_OFFSET_PX`); how much: δ held near zero
+    rho_grid, total, _ = search_relief(info, rmax, max_relief_px, FREE_OFFSET_PX)
+    rho_free = _refine_rho(rho_grid, total)
+    gain = float(np.interp(0.0, rho_grid, total) - total.min())
     rho_grid, total, deltas = search_relief(info, rmax, max_relief_px)
     rho = _refine_rho(rho_grid, total)
     delta = float(deltas[int(np.argmin(total))])
     C = scale_about(c, 1.0 + rho / rmax)
     img, mp, fps = _control_points(info, rho, delta, rmax, T @ C)
-    gain = float(np.interp(0.0, rho_grid, total) - total.min())
     se = _interval(rho_grid, total)
     out = dict(base, relief_px_corner=rho, relief_se_px=se, gain=gain, offset_px=delta,
                scale=float(C[0, 0]),
@@ -591,8 +609,9 @@ def correct_relief(grey: Array, T: Array, footprints: Sequence[Array],
                f"least {min_edges} on {min_buildings} needed)")
     elif rho >= max_relief_px - 0.1:
         why = f"implausible relief: the estimate reaches the limit ({max_relief_px:g} px)"
-    elif rho <= 0 or gain < max(MIN_GAIN, MIN_GAIN_PER_EDGE * len(info)):
-        why = f"no significant relief: {rho:.2f} px at the corner (gain {gain:.1f} over none)"
+    elif min(rho, rho_free) <= 0 or gain < max(MIN_GAIN, MIN_GAIN_PER_EDGE * len(info)):
+        why = (f"no significant relief: {rho_free:.2f} px at the corner with a free offset "
+               f"(gain {gain:.1f} over none)")
     if why:
         return ReliefCorrection(**out, reason=why)
     out.update(transform=T @ C, correction=R @ C, applied=True)

@@ -7,6 +7,9 @@ import pytest
 
 from photodem.algorithms.georef.fit import corner_error
 from photodem.algorithms.georef.relief import (
+    CHI_CAP,
+    FREE_OFFSET_PX,
+    EdgeMeasurement,
     correct_relief,
     edge_curve,
     facing_edges,
@@ -15,6 +18,7 @@ from photodem.algorithms.georef.relief import (
     roof_refit,
     roof_start_refit,
     scale_about,
+    search_relief,
 )
 from photodem.bench.bench_georef_relief import truth_case
 
@@ -99,6 +103,39 @@ def test_weak_evidence_leaves_the_transform(relief_scenes):
     moved = [r + np.array([37.0, -23.0]) for r in case["rings"]]
     rc = correct_relief(case["grey"], case["start"], moved)
     assert not rc.applied
+
+
+def _edges(rho: float, offset: float, rmax: float = 636.0, n: int = 300,
+           seed: int = 5) -> list:
+    """Misfit curves of ``n`` edges whose ground edges lie at ρ·r/rmax + offset (± 0.4 px)."""
+    rng = np.random.default_rng(seed)
+    gs = np.arange(-1.0, 4.5 + 1e-9, 0.1)
+    out = []
+    for k in range(n):
+        r = rng.uniform(0.0, 0.7) * rmax
+        g = rho * r / rmax + offset + rng.normal(0.0, 0.4)
+        chi = np.minimum(((gs - g) / 0.3) ** 2, 2 * CHI_CAP)
+        out.append(EdgeMeasurement(np.zeros(2), np.array([1.0, 0.0]), r, gs, chi, k,
+                                   np.zeros((2, 2))))
+    return out
+
+
+def _best(rho, total):
+    return float(rho[int(np.argmin(total))])
+
+
+def test_relief_size_with_the_offset_held_near_zero():
+    """Held near zero, the common offset leaves ρ to the edges' alignment; but a common offset
+    alone then passes for relief, while the search with the offset free sees none — which is
+    why that search decides whether there is relief at all."""
+    rmax = 636.0
+    edges = _edges(1.8, 0.0, rmax)
+    held = _best(*search_relief(edges, rmax, 6.0)[:2])
+    assert abs(held - 1.8) < 0.35
+    offset_only = _edges(0.0, 0.35, rmax)
+    free = _best(*search_relief(offset_only, rmax, 6.0, FREE_OFFSET_PX)[:2])
+    assert free <= 0.1
+    assert _best(*search_relief(offset_only, rmax, 6.0)[:2]) > 0.3
 
 
 def test_scale_about_keeps_the_centre():
