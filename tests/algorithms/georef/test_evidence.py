@@ -202,3 +202,48 @@ def test_poly2_result_judged_with_its_own_kind(right) -> None:
     assert corner_error(poly.fit, case["truth"], SIZE, SIZE).max() < 1.0
     assert evidence.holdout_kind("poly2", evidence.POLY2_SUBSET_POINTS) == "projective"
     assert evidence.holdout_kind("affine", 8) == "affine"
+
+
+def _roofs(shift_right_px: float = 0.0, scatter_px: float = 0.3, n_roofs: int = 20,
+           seed: int = 2):
+    """Control points on ``n_roofs`` roofs of a 900 px image (16 outline points each), the map
+    at 0.5 m per px; every roof displaced by its own error (± ``scatter_px``, the relief of its
+    height), and the right half of the image bent by ``shift_right_px`` (an inconsistent
+    transform). Returns image points, map points and the roof of each point."""
+    rng = np.random.default_rng(seed)
+    centres = rng.uniform(60, 840, (n_roofs, 2))
+    ang = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    ring = 12 * np.column_stack([np.cos(ang), np.sin(ang)])
+    img = np.vstack([c + ring for c in centres])
+    roofs = np.repeat(np.arange(n_roofs), 16)
+    err = rng.normal(0.0, scatter_px, (n_roofs, 2))[roofs]
+    bend = np.where(img[:, :1] > 450, shift_right_px, 0.0) * np.array([[1.0, 0.0]])
+    mp = 0.5 * (img + err + bend)
+    return img, mp, roofs
+
+
+def test_halves_against_footprints_allow_the_roofs_own_scatter() -> None:
+    """Points on a few roofs, each off by its own relief: the halves may disagree beyond the
+    fixed 1.5 px by up to three of their standard deviations (the roofs are the independent
+    observations, not the points); a bent transform still fails."""
+    shape = (900, 900)
+    img, mp, roofs = _roofs()
+    fit = fit_transform(img, mp, "affine")
+    d = evidence._corner_disagreement(img, mp, fit, shape)
+    limit = evidence._buildings_corner_limit(img, mp, roofs, fit, shape)
+    assert d > evidence.MAX_CORNER_PX  # the fixed limit refuses a right result
+    assert evidence.MAX_CORNER_PX < limit <= evidence.MAX_BUILDINGS_CORNER_PX
+    assert d <= limit
+    # each point its own "roof": the points look independent, the deviation shrinks
+    single = evidence._buildings_corner_limit(img, mp, np.arange(len(img)), fit, shape)
+    assert single < limit
+    # a transform bent by 6 px between the halves is refused whatever the scatter
+    img, mp, roofs = _roofs(shift_right_px=6.0)
+    fit = fit_transform(img, mp, "affine")
+    d = evidence._corner_disagreement(img, mp, fit, shape)
+    assert d > evidence._buildings_corner_limit(img, mp, roofs, fit, shape)
+    # fewer than 4 roofs in a half: the fixed limit
+    few = roofs < 3
+    assert evidence._buildings_corner_limit(img[few], mp[few], roofs[few],
+                                            fit_transform(img[few], mp[few], "affine"),
+                                            shape) == evidence.MAX_CORNER_PX
