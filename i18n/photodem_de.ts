@@ -5397,7 +5397,7 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Unknown keypoint detector '{value}'; use auto, {options}.</source>
-            <extracomment>algorithms/georef/keypoints.py:127; algorithms/georef/pipeline.py:201</extracomment>
+            <extracomment>algorithms/georef/keypoints.py:127; algorithms/georef/pipeline.py:205</extracomment>
             <translation>Unbekannter Merkmalsdetektor '{value}'; verwenden Sie auto, {options}.</translation>
         </message>
         <message>
@@ -5407,62 +5407,62 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>Thresholds must be positive grey-value differences, e.g. 5,6,7,8.</source>
-            <extracomment>algorithms/georef/pipeline.py:106</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:110</extracomment>
             <translation>Die Schwellen müssen positive Grauwertdifferenzen sein, z. B. 5,6,7,8.</translation>
         </message>
         <message>
             <source>The area-based search needs a polygon layer as reference, not a raster; use search = objects or auto.</source>
-            <extracomment>algorithms/georef/pipeline.py:254</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:258</extracomment>
             <translation>Die flächenbasierte Suche braucht einen Polygonlayer als Referenz, kein Raster; verwenden Sie search = objects oder auto.</translation>
         </message>
         <message>
             <source>The keypoint search needs a georeferenced raster as reference, not a polygon layer; use search = objects, area or auto.</source>
-            <extracomment>algorithms/georef/pipeline.py:257</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:261</extracomment>
             <translation>Die Merkmalspunktsuche braucht ein georeferenziertes Raster als Referenz, keinen Polygonlayer; verwenden Sie search = objects, area oder auto.</translation>
         </message>
         <message>
             <source>Georeferencing failed: {why} ({detail}). Check that image and reference show the same objects completely (class field/value), try other thresholds or a larger relative difference.</source>
-            <extracomment>algorithms/georef/pipeline.py:786</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:790</extracomment>
             <translation>Die Georeferenzierung ist fehlgeschlagen: {why} ({detail}). Prüfen Sie, ob Bild und Referenz dieselben Objekte vollständig zeigen (Klassenfeld/-wert), versuchen Sie andere Schwellen oder eine größere relative Differenz.</translation>
         </message>
         <message>
             <source>The output folder '{path}' holds files PhotoDEM did not write; choose an empty or new folder.</source>
-            <extracomment>algorithms/georef/pipeline.py:824</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:828</extracomment>
             <translation>Der Ausgabeordner '{path}' enthält Dateien, die PhotoDEM nicht geschrieben hat; wählen Sie einen leeren oder neuen Ordner.</translation>
         </message>
         <message>
             <source>Unknown transform '{value}'; use affine, projective or poly2.</source>
-            <extracomment>algorithms/georef/pipeline.py:195</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:199</extracomment>
             <translation>Unbekannte Transformation '{value}'; verwenden Sie affine, projective oder poly2.</translation>
         </message>
         <message>
             <source>Unknown search '{value}'; use {options}.</source>
-            <extracomment>algorithms/georef/pipeline.py:198</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:202</extracomment>
             <translation>Unbekannte Suche '{value}'; verwenden Sie {options}.</translation>
         </message>
         <message>
             <source>Unknown objects '{value}'; use {options}.</source>
-            <extracomment>algorithms/georef/pipeline.py:204</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:208</extracomment>
             <translation>Unbekannte Objekte '{value}'; verwenden Sie {options}.</translation>
         </message>
         <message>
             <source>The time limit must be ≥ 0 s (0: none), not {value}.</source>
-            <extracomment>algorithms/georef/pipeline.py:207</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:211</extracomment>
             <translation>Das Zeitlimit muss ≥ 0 s sein (0: keines), nicht {value}.</translation>
         </message>
         <message>
             <source>Thresholds '{text}': give numbers separated by commas, e.g. 5,6,7,8.</source>
-            <extracomment>algorithms/georef/pipeline.py:101</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:105</extracomment>
             <translation>Schwellen '{text}': Geben Sie durch Kommas getrennte Zahlen an, z. B. 5,6,7,8.</translation>
         </message>
         <message>
             <source>Georeferencing failed: the {stage} stage's result is not verified: {why} (RMSE {rmse:.2f} px of {points} control points; {evidence}). No result is better than a wrong one: check that image and reference show the same area, or write the result marked unverified.</source>
-            <extracomment>algorithms/georef/pipeline.py:325</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:329</extracomment>
             <translation>Die Georeferenzierung ist fehlgeschlagen: Das Ergebnis der Stufe {stage} ist nicht bestätigt: {why} (RMSE {rmse:.2f} px aus {points} Passpunkten; {evidence}). Kein Ergebnis ist besser als ein falsches: Prüfen Sie, ob Bild und Referenz dasselbe Gebiet zeigen, oder schreiben Sie das Ergebnis als unbestätigt markiert.</translation>
         </message>
         <message>
             <source>{error} Before it, the keypoint stage found no result: {why} ({detail}).</source>
-            <extracomment>algorithms/georef/pipeline.py:391</extracomment>
+            <extracomment>algorithms/georef/pipeline.py:395</extracomment>
             <translation>{error} Zuvor hat die Merkmalspunktstufe kein Ergebnis gefunden: {why} ({detail}).</translation>
         </message>
         <message>

@@ -59,9 +59,13 @@ BORDER_MARGIN = 3.0
 #: Search modes: object-based, area-based, keypoints (raster references), or ``auto``:
 #: keypoints then objects for a raster, objects then the area-based search for polygons.
 SEARCH_MODES = ("auto", "objects", "area", "keypoints")
-#: Largest joint-ICP RMS (px) of the buildings mode's verified roofs: results within 2.4 px
-#: at the corners had 0.74–1.19 px, results 4–50 px off 1.37–4.0 px (9 synthetic scenes).
-MAX_BUILDINGS_ICP_RMS_PX = 1.25
+#: Largest joint-ICP RMS (px) of the buildings mode's verified roofs (each roof off its
+#: footprint by its own relief). Measured on 40 scenes of 900 px: right placements up to
+#: 1.48 px (seven of them refused at the former 1.25 px, all 0.27–0.50 px off once let
+#: through), the one wrong placement that reached this test 1.91 px (4.9 px off; the gate
+#: refused it as well). An early calibration (9 scenes) had wrong ones from 1.37 px: the gate
+#: behind this test is what refuses those.
+MAX_BUILDINGS_ICP_RMS_PX = 1.6
 #: Kinds of reference polygons (:attr:`GeorefOptions.objects`).
 OBJECT_KINDS = ("auto", "areas", "buildings")
 #: Smallest ECC correlation of an area-based result (below: the boundary-orientation search,
