@@ -365,6 +365,15 @@ def _corners(shape: Sequence[int]) -> Array:
                      [cols - 0.5, rows - 0.5]])
 
 
+def _halves(img: Array) -> List[Tuple[NDArray[np.int64], NDArray[np.int64]]]:
+    """The two splits of the points into halves: at the median column, at the median row."""
+    out = []
+    for axis in (0, 1):
+        order = np.argsort(img[:, axis], kind="stable")
+        out.append((order[:len(order) // 2], order[len(order) // 2:]))
+    return out
+
+
 def _corner_disagreement(img: Array, mp: Array, fit: Any, shape: Sequence[int]
                          ) -> Optional[float]:
     """Largest distance (px) at the image corners between the transforms of two halves of
@@ -373,10 +382,7 @@ def _corner_disagreement(img: Array, mp: Array, fit: Any, shape: Sequence[int]
     need = MIN_POINTS[kind] + 1
     corners = _corners(shape)
     worst = None
-    for axis in (0, 1):
-        order = np.argsort(img[:, axis], kind="stable")
-        half = len(order) // 2
-        a, b = order[:half], order[half:]
+    for a, b in _halves(img):
         if len(a) < need or len(b) < need:
             return None
         try:
@@ -398,11 +404,9 @@ def _halves_sd(img: Array, mp: Array, roofs: NDArray[np.int64], shape: Sequence[
     halves independent. ``None`` with fewer than 4 roofs in a half."""
     corners = np.column_stack([_corners(shape), np.ones(4)])
     worst: Optional[Tuple[float, float]] = None  # (disagreement, its standard deviation)
-    for axis in (0, 1):
-        order = np.argsort(img[:, axis], kind="stable")
-        half = len(order) // 2
+    for a, b in _halves(img):
         diff, var = np.zeros((4, 2)), np.zeros(4)
-        for sign, idx in ((1.0, order[:half]), (-1.0, order[half:])):
+        for sign, idx in ((1.0, a), (-1.0, b)):
             if len(np.unique(roofs[idx])) < 4:
                 return None
             A = np.column_stack([img[idx], np.ones(len(idx))])
