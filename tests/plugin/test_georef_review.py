@@ -181,6 +181,105 @@ def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path, ger
     dialog.dirty = False
 
 
+def test_review_shows_the_evidence(qtbot, folder) -> None:
+    """The automatic result's evidence above the tables: verified, then marked UNVERIFIED."""
+    dialog = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(dialog)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    text = dialog.evidence_label.text()
+    assert "Verified: yes" in text and "% of the image, 4 of 4 quadrants" in text
+    assert "corners disagree by" in text and "edge peak ratio" in text
+    dialog.grab().save("/tmp/photodem_georef_review_evidence.png")
+    rep = json.loads((folder / "report.json").read_text())
+    rep["verified"] = False
+    rep["evidence"]["reasons"] = ["the corners disagree by 5.3 px between halves"]
+    (folder / "report.json").write_text(json.dumps(rep))
+    marked = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(marked)
+    assert "UNVERIFIED</b> — the corners disagree by 5.3 px" in marked.evidence_label.text()
+
+
+def _as_keypoint_result(folder) -> int:
+    """The folder's report turned into a keypoint stage's: its points without object pairs
+    (``pair = -1``), no pairs. Returns the number of points."""
+    rep = json.loads((folder / "report.json").read_text())
+    rep["stage"] = "keypoints"
+    for g in rep["gcps"]:
+        g["pair"] = -1
+    rep["pairs"], rep["icp"] = [], []
+    (folder / "report.json").write_text(json.dumps(rep))
+    return len(rep["gcps"])
+
+
+def test_keypoint_points_are_not_manual(qtbot, folder) -> None:
+    """Control points of the keypoint stage (no object pair) are labelled as keypoints, with
+    their own colour and legend entry; only points the operator adds are manual, also after
+    saving and opening again."""
+    from photodem.plugin.widgets.georef_review import STAGE_POINT_COLOUR
+
+    n = _as_keypoint_result(folder)
+    dialog = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(dialog)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    assert all(not p.manual and p.origin == "keypoints" for p in dialog.review.points)
+    assert {dialog.point_table.item(r, 3).text() for r in range(n)} == {"keypoints"}
+    legend = [t.get_text() for t in dialog.axes.get_legend().get_texts()]
+    assert "control point (keypoints)" in legend and "control point" not in legend
+    assert any(line.get_color() == STAGE_POINT_COLOUR for line in dialog.axes.lines)
+    p = dialog.review.points[3]
+    dialog.add_point([p.image[0] + 0.2, p.image[1], p.map[0], p.map[1]])
+    assert dialog.point_table.item(n, 3).text() == "manual"
+    dialog.grab().save("/tmp/photodem_georef_review_keypoints.png")
+    with qtbot.waitSignal(dialog.saved, timeout=60000):
+        assert dialog.save()
+    rep = json.loads((folder / "report.json").read_text())
+    assert rep["review"]["manual"] == [n]
+    again = GeorefReviewDialog(folder, message_boxes=False)
+    qtbot.addWidget(again)
+    assert [p.origin for p in again.review.points] == ["keypoints"] * n + ["manual"]
+    assert again.point_table.item(0, 3).text() == "keypoints"
+
+
+def test_unverified_reasons_go_through_the_translation(monkeypatch) -> None:
+    """The gate's reasons are built from their keys and figures with translatable format
+    strings; a report without the keys shows the core's sentences."""
+    from photodem.algorithms.georef import evidence
+    from photodem.plugin.widgets import georef_review
+
+    items = [["spread", {"hull_pct": 13.2, "min_hull_pct": 25.0, "quadrants": 1,
+                         "min_quadrants": 2}],
+             ["local_offsets", {"quadrants": [[1, 2.26]], "max_px": 1.5}]]
+    ev = {"reasons": [evidence.reason_text(k, v) for k, v in items], "reason_items": items,
+          "hull_share": 0.132, "quadrants": 1, "independent_points": True}
+    report = {"verified": False, "evidence": ev}
+    english = georef_review.evidence_html(report)
+    assert "UNVERIFIED</b> — the control points cover 13 % of the image (needs ≥ 25 %)" in english
+    assert "in the top right quadrant (2.3 px) (at most 1.5 px)" in english
+    monkeypatch.setattr(georef_review, "tr", lambda text: f"«{text}»")
+    marked = georef_review.evidence_html(report)
+    assert "«the control points cover 13 % of the image (needs ≥ 25 %) and 1 of 4" in marked
+    assert "the «top right quadrant (2.3 px)» (at most 1.5 px)»" in marked
+    old = georef_review.evidence_html({"verified": False, "evidence": {
+        "reasons": ["the corners disagree by 5.3 px between halves"]}})
+    assert "</b> — the corners disagree by 5.3 px between halves" in old
+
+
+def test_every_reason_of_the_gate_has_a_translatable_text() -> None:
+    """The dialog knows every reason key of the core, with the same figures."""
+    import string
+
+    from photodem.algorithms.georef import evidence
+    from photodem.plugin.widgets import georef_review
+
+    ours = georef_review.reason_texts()
+    assert set(ours) == set(evidence.REASON_TEXTS)
+    for key, text in evidence.REASON_TEXTS.items():
+        fields = {f for _, f, _, _ in string.Formatter().parse(text) if f}
+        assert fields == {f for _, f, _, _ in string.Formatter().parse(ours[key]) if f}, key
+
+
 def test_area_result_on_footprints_shows_its_reason_in_both_languages(qtbot, folder, german,
                                                                       shots_dir) -> None:
     """An area-stage result against building footprints written unverified: the dialog gives
