@@ -471,14 +471,14 @@ def _corner_distance(centre: Array, shape: Tuple[int, ...]) -> float:
 
 
 def search_relief(meas: Sequence[EdgeMeasurement], rmax: float, max_relief_px: float,
-                  max_offset_px: Optional[float] = None) -> Tuple[Array, Array, Array]:
+                  max_offset_px: float = MAX_OFFSET_PX) -> Tuple[Array, Array, Array]:
     """The summed misfit of all edges for relief ρ (px at the image corner) on a grid from
     −1 px to ``max_relief_px``: every edge's ground edge at g = ρ·r/rmax + δ (r: its distance
     from the nadir along its normal; δ: an offset common to all edges — where the image shows
     a wall base against where the footprint puts it: the step model's sub-pixel bias —
-    searched in ± ``max_offset_px``, default :data:`MAX_OFFSET_PX`).
+    searched in ± ``max_offset_px``).
     Returns the ρ grid, the least sum over δ for each ρ and the δ that gives it."""
-    span = MAX_OFFSET_PX if max_offset_px is None else float(max_offset_px)
+    span = float(max_offset_px)
     rho = np.arange(-1.0, max_relief_px + 1e-9, 0.05)
     delta = np.arange(-span, span + 1e-9, 0.05) if span > 0 else np.zeros(1)
     R, D = np.meshgrid(rho, delta, indexing="ij")

@@ -21,8 +21,6 @@ from photodem.algorithms.georef.refinement import ControlPoint
 from photodem.algorithms.processing import registry
 from photodem.algorithms.synthetic.polygon_scene import georef_case, ortho_case
 
-pytestmark = pytest.mark.slow
-
 SIZE = 600
 
 
@@ -67,6 +65,7 @@ def _clustered(res, box, noise):
     return _refit(res, img[keep], noisy)
 
 
+@pytest.mark.slow
 def test_right_result_is_verified_and_reported(right, tmp_path) -> None:
     res, case = right
     assert res.verified is True and res.evidence.verified and not res.evidence.reasons
@@ -80,6 +79,7 @@ def test_right_result_is_verified_and_reported(right, tmp_path) -> None:
 
 
 @pytest.mark.parametrize("d", [3.0, 6.0])
+@pytest.mark.slow
 def test_corner_perturbed_result_is_rejected(right, d) -> None:
     res, case = right
     wrong = _corner_perturbed(res, d)
@@ -89,6 +89,7 @@ def test_corner_perturbed_result_is_rejected(right, d) -> None:
     assert any("agree best" in r for r in ev.reasons), ev.reasons
 
 
+@pytest.mark.slow
 def test_area_results_against_building_footprints_are_not_verified(right) -> None:
     """Grid control points of the area stage are judged by the agreement alone; against
     building footprints that agreement has several peaks (relief, walls, shadows: on 500 px
@@ -106,6 +107,7 @@ def test_area_results_against_building_footprints_are_not_verified(right) -> Non
     assert assess(res, outlines, buildings=True).verified
 
 
+@pytest.mark.slow
 def test_clustered_points_are_rejected(right) -> None:
     res, case = right
     ev = assess(_clustered(res, 0.35, 1.0), _outlines(case["reference"]))
@@ -121,6 +123,7 @@ def test_clustered_points_are_rejected(right) -> None:
     assert json.loads(json.dumps(ev.to_json()))["reason_items"][0][0] == keys[0]
 
 
+@pytest.mark.slow
 def test_different_scene_is_rejected(right, tmp_path) -> None:
     res, _case = right
     other = georef_case(tmp_path / "other", seed=5, scene_seed=105, width=SIZE, height=SIZE)
@@ -129,6 +132,7 @@ def test_different_scene_is_rejected(right, tmp_path) -> None:
     assert ev.agreement is None or ev.peak < evidence.MIN_EDGE_PEAK
 
 
+@pytest.mark.slow
 def test_raster_reference_agreement(tmp_path) -> None:
     """Against an orthophoto: the true transform (control points on a grid through it) is
     verified by the correlation, the same perturbed at a corner is not."""
@@ -152,6 +156,7 @@ def test_raster_reference_agreement(tmp_path) -> None:
     assert not wrong.verified and wrong.corner_misfit_px > 3.0
 
 
+@pytest.mark.slow
 def test_unverified_option_writes_marked_products(right, tmp_path, monkeypatch) -> None:
     _res, case = right
     monkeypatch.setattr(evidence, "MIN_EDGE_PEAK", 1e6)  # no result can pass
@@ -168,6 +173,7 @@ def test_unverified_option_writes_marked_products(right, tmp_path, monkeypatch) 
     assert "UNVERIFIED" in (out / "report.html").read_text()
 
 
+@pytest.mark.slow
 def test_hopeless_run_fails_within_the_time_limit(right, tmp_path) -> None:
     """Image against an unrelated map: the failure comes within the budget (plus the step
     that was running: a segmentation is not interrupted)."""
@@ -191,6 +197,7 @@ def test_reason_texts() -> None:
         "(at most 1.5 px)")
 
 
+@pytest.mark.slow
 def test_poly2_result_judged_with_its_own_kind(right) -> None:
     """A poly2 result with many control points: its held-out quadrants are predicted by a
     poly2 fit (not a projective one) and the right result stays verified."""
