@@ -160,13 +160,12 @@ def test_mirrored_16bit_small_scene(tmp_path):
     assert _corners(res, case) <= 0.6
 
 
-
 @pytest.mark.slow
 def test_gate_refuses_a_buildings_result_moved_by_a_few_pixels(tmp_path):
     """A right buildings result (seed 0, 900 × 900 px, relief 3 px) moved by a similarity —
     shift, rotation or scale alone — that puts its worst corner 2.5 px off, its control points
     moved with it (a consistently wrong result): the gate refuses each. Measured on seeds
-    0–11 with random similarities: 0 of 87 results 2–6 px off verified, 2 of 25 at 1.5–2 px
+    0–11 with random similarities: 0 of 103 results 2–6 px off verified, 2 of 25 at 1.5–2 px
     (docs/decisions.md)."""
     from dataclasses import replace
 
