@@ -37,11 +37,17 @@ def folder(result_folder, tmp_path):
     return copy
 
 
-def test_review_edits_update_the_fit_and_save(qtbot, folder) -> None:
+def _shown(qtbot, folder) -> GeorefReviewDialog:
+    """The review dialog of ``folder``, shown and exposed (no message boxes)."""
     dialog = GeorefReviewDialog(folder, message_boxes=False)
     qtbot.addWidget(dialog)
     dialog.show()
     qtbot.waitExposed(dialog)
+    return dialog
+
+
+def test_review_edits_update_the_fit_and_save(qtbot, folder) -> None:
+    dialog = _shown(qtbot, folder)
     n = dialog.point_table.rowCount()
     assert n == len(dialog.review.points) >= 50
     assert dialog.pair_table.rowCount() == len(dialog.review.pairs) >= 6
@@ -120,10 +126,7 @@ def _import_through_file_dialog(qtbot, dialog, monkeypatch, path) -> None:
 
 
 def test_import_independent_check_points(qtbot, folder, monkeypatch, tmp_path) -> None:
-    dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(dialog)
-    dialog.show()
-    qtbot.waitExposed(dialog)
+    dialog = _shown(qtbot, folder)
     n = dialog.point_table.rowCount()
     matrix = dialog.fit.matrix.copy()
     inside = _survey_file(dialog, tmp_path / "survey.csv")
@@ -165,10 +168,7 @@ def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path, ger
                                        shots_dir) -> None:
     """The German dialog (the committed .ts compiled with lrelease, as the build does)."""
     german()
-    dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(dialog)
-    dialog.show()
-    qtbot.waitExposed(dialog)
+    dialog = _shown(qtbot, folder)
     assert dialog.import_button.text() == "Kontrollpunkte importieren…"
     n = dialog.point_table.rowCount()
     _survey_file(dialog, tmp_path / "survey.csv")
@@ -183,10 +183,7 @@ def test_import_check_points_in_german(qtbot, folder, monkeypatch, tmp_path, ger
 
 def test_review_shows_the_evidence(qtbot, folder) -> None:
     """The automatic result's evidence above the tables: verified, then marked UNVERIFIED."""
-    dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(dialog)
-    dialog.show()
-    qtbot.waitExposed(dialog)
+    dialog = _shown(qtbot, folder)
     text = dialog.evidence_label.text()
     assert "Verified: yes" in text and "% of the image, 4 of 4 quadrants" in text
     assert "corners disagree by" in text and "edge peak ratio" in text
@@ -219,10 +216,7 @@ def test_keypoint_points_are_not_manual(qtbot, folder) -> None:
     from photodem.plugin.widgets.georef_review import STAGE_POINT_COLOUR
 
     n = _as_keypoint_result(folder)
-    dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(dialog)
-    dialog.show()
-    qtbot.waitExposed(dialog)
+    dialog = _shown(qtbot, folder)
     assert all(not p.manual and p.origin == "keypoints" for p in dialog.review.points)
     assert {dialog.point_table.item(r, 3).text() for r in range(n)} == {"keypoints"}
     legend = [t.get_text() for t in dialog.axes.get_legend().get_texts()]
@@ -291,17 +285,11 @@ def test_area_result_on_footprints_shows_its_reason_in_both_languages(qtbot, fol
     rep["evidence"]["reason_items"] = [["buildings_area", {}]]
     rep["evidence"]["reasons"] = [evidence.reason_text("buildings_area", {})]
     (folder / "report.json").write_text(json.dumps(rep))
-    dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(dialog)
-    dialog.show()
-    qtbot.waitExposed(dialog)
+    dialog = _shown(qtbot, folder)
     assert "building footprints cannot confirm a result" in dialog.evidence_label.text()
     dialog.grab().save(str(shots_dir / "photodem_georef_review_buildings_area.png"))
     german()
-    german_dialog = GeorefReviewDialog(folder, message_boxes=False)
-    qtbot.addWidget(german_dialog)
-    german_dialog.show()
-    qtbot.waitExposed(german_dialog)
+    german_dialog = _shown(qtbot, folder)
     assert "Gebäudegrundrisse können ein Ergebnis" in german_dialog.evidence_label.text()
     german_dialog.grab().save(str(shots_dir / "photodem_georef_review_buildings_area_de.png"))
     german_dialog.dirty = False

@@ -169,6 +169,7 @@ def test_gate_refuses_a_buildings_result_moved_by_a_few_pixels(tmp_path):
     (docs/decisions.md)."""
     from dataclasses import replace
 
+    from photodem.algorithms.georef.area import similarity
     from photodem.algorithms.georef.evidence import assess
     from photodem.algorithms.georef.fit import fit_transform, inverse_for_resampling
     from photodem.algorithms.georef.pipeline import _roof_level
@@ -185,9 +186,7 @@ def test_gate_refuses_a_buildings_result_moved_by_a_few_pixels(tmp_path):
     half_diagonal = float(np.hypot(w, h) / 2)
     for shift, turn, grow in (((1.77, 1.77), 0.0, 0.0), ((0.0, 0.0), 2.5, 0.0),
                               ((0.0, 0.0), 0.0, 2.5)):
-        a, s = turn / half_diagonal, 1.0 + grow / half_diagonal
-        S = np.eye(3)
-        S[:2, :2] = s * np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        S = similarity(turn / half_diagonal, 1.0 + grow / half_diagonal)
         S[:2, 2] = centre + np.array(shift) - S[:2, :2] @ centre
         moved = res.fit.forward(apply(S, img)) - (res.fit.forward(img) - mp)
         fit = fit_transform(img, moved, res.fit.kind)
