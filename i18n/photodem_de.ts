@@ -1124,6 +1124,16 @@
             <translation>Konvergente Modelle und Modelle mit einer Basis von mindestens der halben Flughöhe: zusätzlich gegen das um 0,7 und 1,4 gestreckte rechte Bild zuordnen, für Hänge und Dachflächen, die eine Kamera verkürzt sieht, verfeinert durch Kleinste-Quadrate-Zuordnung. Mehr Zellen gemessen, so genau wie die übrigen, etwa 5–6 × die Rechenzeit.</translation>
         </message>
         <message>
+            <source>Match once more along the first DSM (dense, convergent)</source>
+            <extracomment>match_model.guided_pass: description</extracomment>
+            <translation>Noch einmal entlang des ersten DOM zuordnen (dense, konvergent)</translation>
+        </message>
+        <message>
+            <source>Convergent models: match again within ± 8 px of the first DSM's disparities, against the right image warped by them, and keep the new heights where least-squares matching and a uniqueness test along the row confirm them. Measures slopes across the base (embankments, ditch sides) that the first pass flattens; about 1.3–1.4 × the time.</source>
+            <extracomment>match_model.guided_pass: help</extracomment>
+            <translation>Konvergente Modelle: noch einmal innerhalb von ± 8 px der Disparitäten des ersten DOM zuordnen, gegen das mit ihnen entzerrte rechte Bild, und die neuen Höhen dort behalten, wo Kleinste-Quadrate-Zuordnung und ein Eindeutigkeitstest entlang der Zeile sie bestätigen. Misst Hänge quer zur Basis (Dämme, Grabenböschungen), die der erste Durchgang einebnet; etwa 1,3–1,4 × die Rechenzeit.</translation>
+        </message>
+        <message>
             <source>DSM</source>
             <extracomment>match_model output dsm; mosaic.dsm: description; plugin/app/map_window.py:456; plugin/qgis/workspace.py:426</extracomment>
             <translation>DOM</translation>
@@ -5702,12 +5712,12 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>The disparity range {min_d}…{max_d} px holds no possible disparity of these images (widths {left_width} and {right_width} px allow {low}…{high}); change {parameter}.</source>
-            <extracomment>algorithms/matching/dense.py:366</extracomment>
+            <extracomment>algorithms/matching/dense.py:374</extracomment>
             <translation>Der Disparitätsbereich {min_d}…{max_d} px enthält keine mögliche Disparität dieser Bilder (Breiten {left_width} und {right_width} px erlauben {low}…{high}); ändern Sie {parameter}.</translation>
         </message>
         <message>
             <source>The disparity range is empty (min {min_d} &gt; max {max_d}); give min_disparity ≤ max_disparity.</source>
-            <extracomment>algorithms/matching/dense.py:476</extracomment>
+            <extracomment>algorithms/matching/dense.py:484</extracomment>
             <translation>Der Disparitätsbereich ist leer (min {min_d} &gt; max {max_d}); geben Sie min_disparity ≤ max_disparity an.</translation>
         </message>
         <message>

@@ -164,6 +164,13 @@ class DenseOptions:
         False (default): only the first pass's holes on objects take the refined disparity;
         True: also its valid pixels where the right image's first pass confirms the refined
         value (:func:`_refined_pixels`; True in the DSM path of wide-base nadir models).
+    refine_holes : {"objects", "verified"}
+        Which holes of the first pass take the refined disparity: "objects" (default) those
+        above their row neighbours that the right image's first pass confirms
+        (:func:`_refined_pixels`); "verified" every hole that least-squares matching and a
+        uniqueness test along the row confirm, with the refinement's guide taken from
+        ``refine_guide`` wherever that has a value (the DSM-guided pass of convergent
+        models, :mod:`.dense_guided`).
     """
 
     method: str = "sgm"
@@ -189,6 +196,7 @@ class DenseOptions:
     refine_smooth: int = 9
     refine_warp: str = "cubic"
     refine_all: bool = False
+    refine_holes: str = "objects"
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any]) -> DenseOptions:
@@ -487,6 +495,9 @@ def _checked_settings(options: DenseOptions, min_disparity: int, max_disparity: 
     if o.refine_warp not in WARPS:
         raise InputError(f"Unknown warp of the refinement '{o.refine_warp}'; use one of "
                          f"{', '.join(WARPS)}.")
+    if o.refine_holes not in REFINE_HOLES:
+        raise InputError(f"Unknown choice of refined holes '{o.refine_holes}'; use one of "
+                         f"{', '.join(REFINE_HOLES)}.")
     return min_d, max_d, replace(
         o, block_size=block, p1=p1, p2=p2, speckle_range=int(o.speckle_range),
         edge_erosion=int(o.edge_erosion), range_guard=float(o.range_guard),
@@ -769,15 +780,19 @@ def _borders_and_fill(cv2: Any, disp: Array, lg: Array, options: DenseOptions,
 
 
 def _guide_disparity(disp: Array, lmask: Array, smooth: int,
-                     extra: Optional[Array] = None) -> Optional[Array]:
+                     extra: Optional[Array] = None, extra_first: bool = False
+                     ) -> Optional[Array]:
     """Guide disparities of a frame: the first pass's ``disp``, its holes from ``extra``
-    where that has a value, the rest from the nearest valid pixel, then a median over
+    where that has a value (with ``extra_first``: ``extra`` wherever it has one, ``disp``
+    only where it has none), the rest from the nearest valid pixel, then a median over
     ``smooth`` px that removes the blunder specks; None without any valid one."""
     from scipy import ndimage  # lazy: only the refinement pass needs it
 
     from .fbm import fill_nodata  # lazy: fbm is loaded only where a refinement runs
 
-    if extra is not None:
+    if extra is not None and extra_first:
+        disp = np.where(np.isfinite(extra), extra, disp)
+    elif extra is not None:
         disp = np.where(np.isfinite(disp), disp, extra)
     ok = np.isfinite(disp) & ~lmask
     if not ok.any():
@@ -790,6 +805,8 @@ def _guide_disparity(disp: Array, lmask: Array, smooth: int,
 
 #: Interpolations of :func:`_warp_rows`.
 WARPS = ("cubic", "linear", "integer")
+#: Choices of ``DenseOptions.refine_holes``.
+REFINE_HOLES = ("objects", "verified")
 
 
 def _row_taps(t: Array, warp: str) -> Tuple[int, Array]:
@@ -840,10 +857,13 @@ def _refine_frame(cv2: Any, lg: Array, rg: Array, disp: Array, options: DenseOpt
     under a roof, a stripe further along); the SGM, uniqueness, left–right and speckle tests
     run on the residual, the border filters and fills on the sum. Which pixels take the
     result: :func:`_refined_pixels`, checked against the first pass's right-image
-    disparities ``right_disp``.
+    disparities ``right_disp``; with ``refine_holes="verified"`` the guide is ``extra``
+    wherever that has a value, and the holes where ``extra`` has one take what
+    :func:`.dense_guided.verified_holes` confirms.
     """
     lmask = ~np.isfinite(lg)
-    guide = _guide_disparity(disp, lmask, options.refine_smooth, extra)
+    verified = options.refine_holes == "verified"
+    guide = _guide_disparity(disp, lmask, options.refine_smooth, extra, extra_first=verified)
     if guide is None:
         return disp
     if options.refine_warp == "integer":
@@ -853,10 +873,20 @@ def _refine_frame(cv2: Any, lg: Array, rg: Array, disp: Array, options: DenseOpt
     matcher = _sgbm(cv2, -m, n_d, o.block_size, o.p1, o.p2, o.uniqueness, 0, 0,
                     cv2.STEREO_SGBM_MODE_HH)
     plain = replace(o, edge_erosion=0, plane_fill=0.0, fill_max_width=0, range_guard=0.0)
-    res = _match_frame(cv2, matcher, lg, _warp_rows(rg, guide, o.refine_warp),
-                       (-m, m, n_d), plain)
+    warped = _warp_rows(rg, guide, o.refine_warp)
+    res = _match_frame(cv2, matcher, lg, warped, (-m, m, n_d), plain)
     refined = _borders_and_fill(cv2, guide + res, lg, o, wall_share)
-    take = _refined_pixels(disp, refined, right_disp, lmask, o)
+    if verified:
+        from .dense_guided import verified_holes  # lazy: it imports this module
+
+        holes = ~np.isfinite(disp) & ~lmask
+        if extra is not None:
+            holes &= np.isfinite(extra)  # the guide trusts no membrane between two surfaces
+        refined, take = verified_holes(lg, rg, guide, res, refined, holes, warped)
+        if o.refine_all:
+            take |= _refined_pixels(disp, refined, right_disp, lmask, o) & np.isfinite(disp)
+    else:
+        take = _refined_pixels(disp, refined, right_disp, lmask, o)
     return np.where(take, refined, disp)
 
 

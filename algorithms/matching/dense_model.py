@@ -43,6 +43,11 @@ r"""Dense DSM of one stereo model: epipolar resampling → SGM → triangulation
 5. Exclusion areas (NaN) and boundaries (NaN outside) from ``edits.gpkg``; breaklines are
    barriers of the gap interpolation (gaps up to ``max_gap`` m), which also re-fills the
    rejected cells.
+6. Convergent models are then matched once more along this first DSM (``guided``,
+   :mod:`.dense_guided`): SGM ± 8 px around its disparities against the right image warped
+   by them; a hole takes the new disparity where least-squares matching and a uniqueness
+   test along the row confirm it, and only in the DSM's holes bordered by one surface
+   (slopes across the base, issue 22, part AD). Steps 4 and 5 run again.
 
 Outputs in a staged folder (nothing is left behind on error or cancel): ``dsm.tif`` (float32,
 NaN, project CRS, overviews), ``count.tif`` (points per cell, uint16), ``report.json`` and
@@ -74,7 +79,8 @@ from ..surface.gridding import (
     polygon_mask,
     write_grid,
 )
-from .dense import DenseOptions, GreySource, iter_disparity_tiles
+from .dense import DenseOptions, GreySource, array_source, iter_disparity_tiles
+from .dense_guided import dsm_guide, terrain_holes
 from .model_report import coverage_sentence, write_model_report
 from .model_setup import ModelSetup, prepare_model
 from .slant_lsm import SLANT_LSM_SHIFT, refine_slant
@@ -241,6 +247,9 @@ SLANT_GAP_CELLS = 100
 SLANT_TOLERANCE = 2.0
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
+#: Half width (px) of the guided pass's search around the first DSM's disparities
+#: (:func:`guided_pass`; as the refinement of wide-base nadir models).
+GUIDED_REFINE = 8
 
 
 def slant_scales(setup: ModelSetup, slant_passes: bool = True) -> Tuple[float, ...]:
@@ -341,7 +350,7 @@ class _Guide:
 def _settled_cells(acc: GridAccumulator, footprints: Optional[GridAccumulator]) -> np.ndarray:
     """Cells the plain pass measured whose eight neighbours it measured too.
 
-    The gridding drops every slant point in a measured cell (:func:`_grid_and_write`), so a
+    The gridding drops every slant point in a measured cell (:func:`_grid`), so a
     slant disparity whose every possible refined position lies in measured cells need not be
     refined at all (:func:`_may_reach_open_cells`)."""
     covered = acc.covered()
@@ -580,12 +589,13 @@ def _pct(part: int, whole: int) -> float:
 
 
 def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCounts,
-             max_gap: float, outliers: _Outliers, slant_cells: Optional[np.ndarray] = None
-             ) -> Dict[str, Any]:
+             max_gap: float, outliers: _Outliers, slant_cells: Optional[np.ndarray] = None,
+             guided_cells: Optional[np.ndarray] = None) -> Dict[str, Any]:
     """Headline figures: points, the valid share of the disparities, and the shares of the
     measuring area that are measured (a cell with a triangulated point), interpolated (a gap
     filled) and empty; they add up to 100 %, ``coverage_pct`` = measured + interpolated. With
-    slant passes also the share measured by them alone (part of ``measured_pct``)."""
+    slant passes also the share measured by them alone, with the guided pass the share it
+    added to the first DSM (both part of ``measured_pct``)."""
     grid = setup.grid
     area = polygon_mask([setup.measuring_area()], grid) & ~polygon_mask(setup.exclusions, grid)
     n_area = int(area.sum())
@@ -612,42 +622,97 @@ def _metrics(setup: ModelSetup, acc: GridAccumulator, res: Any, counts: _MatchCo
     if slant_cells is not None:
         metrics["slant_measured_pct"] = _pct(int((slant_cells & have & ~res.filled).sum()),
                                              n_area)
+    if guided_cells is not None:
+        metrics["guided_measured_pct"] = _pct(int((guided_cells & have).sum()), n_area)
     return metrics
 
 
-def _grid_and_write(setup: ModelSetup, acc: GridAccumulator, tmp: Path, max_gap: float,
-                    outliers: _Outliers, feedback: Feedback,
-                    footprints: Optional[GridAccumulator] = None,
-                    slant: Optional[GridAccumulator] = None) -> Tuple[Any, Optional[np.ndarray]]:
-    """Median per cell (cells without a pixel's point from ``footprints``, then from
-    ``slant`` where that agrees with its neighbourhood), outlier test, gap filling; dsm.tif
-    and count.tif written. Returns the grid result and the cells the slant passes gave
-    (None without them)."""
-    grid, crs = setup.grid, setup.project.crs
-    zg, count = acc.reduce(feedback.step(85, 92))
+def _reduced(acc: Optional[GridAccumulator]) -> Optional[Tuple[np.ndarray, np.ndarray]]:
+    """Median and count per cell of an accumulator (consumed), None without one."""
+    return None if acc is None else acc.reduce()
+
+
+def _grid(setup: ModelSetup, plain: Tuple[np.ndarray, np.ndarray], max_gap: float,
+          outliers: _Outliers, feedback: Feedback,
+          footprints: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+          slant: Optional[Tuple[np.ndarray, np.ndarray]] = None
+          ) -> Tuple[Any, Optional[np.ndarray]]:
+    """The DSM of the reduced accumulators (median and count per cell): the ``plain`` pass's
+    cells, cells without a pixel's point from ``footprints``, then from ``slant`` where that
+    agrees with its neighbourhood; outlier test and gap filling. Returns the grid result and
+    the cells the slant passes gave (None without them)."""
+    grid = setup.grid
+    zg, count = plain[0].copy(), plain[1].copy()
     if footprints is not None:
-        zf, count_f = footprints.reduce()
+        zf, count_f = footprints
         take = (count == 0) & (count_f > 0)
         zg[take], count[take] = zf[take], count_f[take]
     if slant is not None:
         # the slant passes' cells only where they agree with the plain pass's neighbourhood
-        zs, count_s = slant.reduce()
-        zs[count > 0] = np.nan
+        zs = np.where(count > 0, np.nan, slant[0])
         ref, _ = fill_gaps(zg, grid.spacing, SLANT_GAP_CELLS * grid.spacing)
         bad = deviates_from(zs, ref, grid.spacing, outliers.radius,
                             SLANT_TOLERANCE * outliers.threshold, outliers.k)
         take = np.isfinite(zs) & ~bad
-        zg[take], count[take] = zs[take], count_s[take]
+        zg[take], count[take] = zs[take], slant[1][take]
     else:
         take = None
     res = finish_grid(zg, count, grid, max_gap, setup.exclusions, setup.boundaries,
                       setup.breaklines, outlier_radius=outliers.radius,
                       outlier_threshold=outliers.threshold, outlier_k=outliers.k)
     feedback.check()
+    return res, take
+
+
+def _write(setup: ModelSetup, res: Any, tmp: Path) -> None:
+    """dsm.tif and count.tif of a grid result into ``tmp``."""
+    grid, crs = setup.grid, setup.project.crs
     write_grid(tmp / "dsm.tif", res.z, grid, crs=crs)
     write_grid(tmp / "count.tif", np.minimum(res.count, 65535).astype(np.uint16), grid,
                crs=crs, overviews=False)
-    return res, take
+
+
+def guided_pass(setup: ModelSetup, guided: bool = True) -> bool:
+    """Whether the model gets the DSM-guided pass (:mod:`.dense_guided`): convergent models
+    with ``guided``."""
+    return bool(guided and setup.convergent)
+
+
+def _guided_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator, res: Any,
+                 memory_mb: float, options: DenseOptions, feedback: Feedback
+                 ) -> Tuple[_MatchCounts, np.ndarray]:
+    """The DSM-guided pass: the plain pass once more, refined within ± :data:`GUIDED_REFINE`
+    px of the first DSM's disparities (:func:`.dense_guided.dsm_guide`), its holes filled
+    where least-squares matching and uniqueness confirm them; every point into ``acc``.
+    Returns the counts and the cells the pass may add: the first DSM's
+    :func:`.dense_guided.terrain_holes` (a left pixel whose guide is the ground in front of
+    an unmeasured roof may see the roof)."""
+    measured = (res.count > 0) & ~res.filled
+    area = polygon_mask([setup.measuring_area()], setup.grid)
+    holes = terrain_holes(res.z, measured, area, _JUMP_M)
+    guide = dsm_guide(setup.pair, res.z, measured, setup.grid, measured | holes)
+    source, _ = array_source(guide)
+    opts = replace(options, refine=GUIDED_REFINE, refine_all=False, refine_holes="verified")
+    counts = _match_into(setup, grey, acc, memory_mb, opts, feedback, refine_guide=source)
+    return counts, holes
+
+
+def _regrid(setup: ModelSetup, acc: GridAccumulator, first: Any,
+            plain: Tuple[np.ndarray, np.ndarray], holes: np.ndarray, max_gap: float,
+            outliers: _Outliers, feedback: Feedback,
+            footprints: Optional[Tuple[np.ndarray, np.ndarray]],
+            slant: Optional[Tuple[np.ndarray, np.ndarray]]
+            ) -> Tuple[Any, Optional[np.ndarray], np.ndarray]:
+    """The DSM of the guided pass's points (``acc``, consumed) as :func:`_grid`, new cells
+    only in the first DSM's terrain ``holes`` (``plain``: the first pass's median and count).
+    Returns the grid result, the slant passes' cells and the cells the pass added to the
+    ``first`` grid result."""
+    z, count = acc.reduce()
+    off = (plain[1] == 0) & ~holes
+    z[off], count[off] = np.nan, 0
+    res, slant_cells = _grid(setup, (z, count), max_gap, outliers, feedback, footprints, slant)
+    added = (res.count > 0) & ~res.filled & ~((first.count > 0) & ~first.filled)
+    return res, slant_cells, added
 
 
 def _report(setup: ModelSetup, metrics: Dict[str, Any], options: DenseOptions,
@@ -668,7 +733,8 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                       max_gap: Optional[float] = None, disparity_margin: int = 4,
                       memory_mb: float = 256.0, outlier_radius: Optional[float] = None,
                       outlier_threshold: Optional[float] = None, outlier_k: float = 3.0,
-                      slant_passes: bool = True, **dense_options: Any) -> Dict[str, Any]:
+                      slant_passes: bool = True, guided: bool = True,
+                      **dense_options: Any) -> Dict[str, Any]:
     """Dense DSM of a stereo model (see the module notes).
 
     Parameters
@@ -700,14 +766,12 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
     slant_passes : bool
         Convergent and wide-base models (:func:`slant_scales`): also match against the right
         image stretched by :data:`SLANT_SCALES` and give the cells no plain point reached the
-        heights that agree with the plain ones (module notes); narrow-base nadir models have
-        none. On by default: with the LSM refinement of their disparities the drone bench
-        measures 0.9–5.4 points more of the visible cells, with open NMAD and RMSE within 1 %
-        of the plain pass's or better on 11 of 12 model-seeds (seed 3 0201_0203: RMSE
-        +1.7 %); a convergent model takes about 5–8 × as long (issue 22, parts N and X). On
-        the wide-base aerial block the object interior gains 2.0–3.4 points with the terrain
-        RMS 0.7–0.8 % lower; such a model takes about 8–9 × as long (issue 19, part Z in
-        docs/decisions.md).
+        heights that agree with the plain ones (module notes). On by default: 0.9–5.4 points
+        more of the drone models' visible cells, open accuracy as before, about 5–8 × the
+        time (issue 22, parts N and X; issue 19, part Z in docs/decisions.md).
+    guided : bool
+        Convergent models: match once more along the first DSM (:func:`guided_pass`, module
+        notes, step 6). On by default (issue 22, part AD).
     **dense_options
         Fields of :class:`~.dense.DenseOptions` (method, block_size, p1, p2, …) that replace
         the DSM path's values for this model (:func:`dsm_dense_options`).
@@ -750,15 +814,30 @@ def match_model_dense(project: Any, model: str, output_dir: PathLike,
                  if setup.convergent else None)
         scales = slant_scales(setup, slant_passes)
         guide = _Guide((pair.height, pair.sizes[0][0])) if scales else None
-        counts, slant = _all_passes(setup, grey, acc, memory_mb, options, feedback, work,
+        second = guided_pass(setup, guided)
+        counts, slant = _all_passes(setup, grey, acc, memory_mb, options,
+                                    feedback.step(0, 76 if second else 100), work,
                                     extra, guide, scales)
         timings["matching"] = counts.seconds
         timings["triangulation"] = time.perf_counter() - t0 - counts.seconds
         t0 = time.perf_counter()
-        res, slant_cells = _grid_and_write(setup, acc, tmp, max_gap, outliers, feedback,
-                                           extra, slant)
-        metrics = _metrics(setup, acc, res, counts, max_gap, outliers, slant_cells)
-        timings["gridding"] = time.perf_counter() - t0
+        plain = acc.reduce(feedback.step(85, 92))
+        footprints, slanted = _reduced(extra), _reduced(slant)
+        res, slant_cells = _grid(setup, plain, max_gap, outliers, feedback, footprints,
+                                 slanted)
+        guided_cells = None
+        if second:
+            t1 = time.perf_counter()
+            acc = GridAccumulator(setup.grid, memory_mb=memory_mb, scratch_dir=work)
+            counts, holes = _guided_into(setup, grey, acc, res, memory_mb, options,
+                                         feedback.step(76, 85))
+            timings["guided"] = time.perf_counter() - t1
+            res, slant_cells, guided_cells = _regrid(setup, acc, res, plain, holes, max_gap,
+                                                     outliers, feedback, footprints, slanted)
+        _write(setup, res, tmp)
+        metrics = _metrics(setup, acc, res, counts, max_gap, outliers, slant_cells,
+                           guided_cells)
+        timings["gridding"] = time.perf_counter() - t0 - timings.get("guided", 0.0)
         timings["total"] = time.perf_counter() - t_start
         write_model_report(tmp, _report(setup, metrics, options, timings),
                            dsm=tmp / "dsm.tif", count=tmp / "count.tif",

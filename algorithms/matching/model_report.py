@@ -153,7 +153,10 @@ def coverage_sentence(metrics: Dict[str, Any]) -> str:
     the model area), the valid disparities (dense) or the failed windows at the finest level
     (fbm_lsm)."""
     slant = _number(metrics.get("slant_measured_pct"))
-    alone = f" (slant passes alone {slant:.1f} %)" if slant is not None else ""
+    guided = _number(metrics.get("guided_measured_pct"))
+    extras = ([f"slant passes alone {slant:.1f} %"] if slant is not None else []) + \
+        ([f"guided pass {guided:.1f} %"] if guided is not None else [])
+    alone = f" ({'; '.join(extras)})" if extras else ""
     parts = [f"measured {_number(metrics.get('measured_pct')) or 0.0:.1f} %{alone}, "
              f"interpolated {_number(metrics.get('interpolated_pct')) or 0.0:.1f} %, empty "
              f"{_number(metrics.get('empty_pct')) or 0.0:.1f} % of the model area"]

@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .dense import GreySource
 from .fbm import fill_nodata
@@ -64,8 +65,8 @@ def _read(source: GreySource, r0: int, r1: int, c0: int, c1: int
 
 
 def _refine_chunk(left: GreySource, right: GreySource, d: np.ndarray, cols: np.ndarray,
-                  rows: np.ndarray, scale: float, window: int, min_corr: float,
-                  max_shift: float) -> Tuple[np.ndarray, np.ndarray]:
+                  rows: np.ndarray, scale: np.ndarray, shear: np.ndarray, window: int,
+                  min_corr: float, max_shift: float) -> Tuple[np.ndarray, np.ndarray]:
     """:func:`refine_slant` for one chunk of points, on the windows of their bounding box."""
     n = d.size
     half = window // 2
@@ -81,6 +82,7 @@ def _refine_chunk(left: GreySource, right: GreySource, d: np.ndarray, cols: np.n
     start = np.zeros((n, 8))
     start[:, 0] = x_r - rc0
     start[:, 1] = 1.0 / scale
+    start[:, 2] = shear
     start[:, 3] = rows - r0
     start[:, 5] = start[:, 7] = 1.0
     res = lsm_match(tpl, srch, cols - lc0, rows - r0, None, window=window, model="epipolar",
@@ -99,9 +101,9 @@ def _refine_chunk(left: GreySource, right: GreySource, d: np.ndarray, cols: np.n
 
 
 def refine_slant(left: GreySource, right: GreySource, d: np.ndarray, cols: np.ndarray,
-                 rows: np.ndarray, scale: float, window: int = SLANT_LSM_WINDOW,
-                 min_corr: float = SLANT_LSM_CORR, max_shift: float = SLANT_LSM_SHIFT
-                 ) -> Tuple[np.ndarray, np.ndarray]:
+                 rows: np.ndarray, scale: ArrayLike, window: int = SLANT_LSM_WINDOW,
+                 min_corr: float = SLANT_LSM_CORR, max_shift: float = SLANT_LSM_SHIFT,
+                 shear: ArrayLike = 0.0) -> Tuple[np.ndarray, np.ndarray]:
     """LSM refinement of disparities found against the right image stretched by ``scale``.
 
     Points are refined in chunks of :data:`CHUNK_POINTS` in the given order (row by row from
@@ -115,14 +117,18 @@ def refine_slant(left: GreySource, right: GreySource, d: np.ndarray, cols: np.nd
         Disparities of the pair, ``x_l − x_r`` (px; already unstretched).
     cols, rows : ndarray
         Their left pixels (integers).
-    scale : float
-        The stretch of the pass: the start of the x-scale is ``1 / scale``.
+    scale : float or ndarray
+        The stretch of the pass: the start of the x-scale is ``1 / scale`` (one per point, or
+        one for all).
     window : int
         LSM window side (odd).
     min_corr : float
         Smallest correlation coefficient kept.
     max_shift : float
         Largest move (px) from the start that is kept.
+    shear : float or ndarray
+        Start of the shear along the row, ``∂x_r/∂y`` (px per row; default 0): a slope
+        across the base moves the right image's rows against each other.
 
     Returns
     -------
@@ -132,12 +138,14 @@ def refine_slant(left: GreySource, right: GreySource, d: np.ndarray, cols: np.nd
     d = np.asarray(d, np.float64)
     cols = np.asarray(cols, np.int64)
     rows = np.asarray(rows, np.int64)
+    scale = np.broadcast_to(np.asarray(scale, np.float64), d.shape)
+    shear = np.broadcast_to(np.asarray(shear, np.float64), d.shape)
     out = np.full(d.size, np.nan)
     keep = np.zeros(d.size, bool)
     for i in range(0, d.size, CHUNK_POINTS):
         sl = slice(i, i + CHUNK_POINTS)
-        out[sl], keep[sl] = _refine_chunk(left, right, d[sl], cols[sl], rows[sl], scale,
-                                          window, min_corr, max_shift)
+        out[sl], keep[sl] = _refine_chunk(left, right, d[sl], cols[sl], rows[sl], scale[sl],
+                                          shear[sl], window, min_corr, max_shift)
     return out, keep
 
 

@@ -123,3 +123,5 @@ def test_coverage_sentence_says_what_the_slant_passes_measured() -> None:
     assert "slant" not in coverage_sentence(plain)
     text = coverage_sentence({**plain, "slant_measured_pct": 4.25})
     assert "measured 70.0 % (slant passes alone 4.2 %)" in text
+    text = coverage_sentence({**plain, "slant_measured_pct": 4.25, "guided_measured_pct": 1.5})
+    assert "measured 70.0 % (slant passes alone 4.2 %; guided pass 1.5 %)" in text

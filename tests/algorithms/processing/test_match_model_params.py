@@ -9,8 +9,11 @@ from photodem.algorithms.matching import dense_model
 from photodem.algorithms.processing import registry
 
 
-@pytest.mark.parametrize("given, expected", [({}, True), ({"slant_passes": False}, False)])
-def test_dense_gets_the_slant_passes(chain_project, tmp_path, monkeypatch, given, expected):
+@pytest.mark.parametrize("given, key, expected", [
+    ({}, "slant_passes", True), ({"slant_passes": False}, "slant_passes", False),
+    ({}, "guided", True), ({"guided_pass": False}, "guided", False)])
+def test_dense_gets_the_slant_and_guided_passes(chain_project, tmp_path, monkeypatch, given,
+                                                key, expected):
     seen: dict = {}
 
     def fake(project, model, out, **kwargs):
@@ -21,4 +24,4 @@ def test_dense_gets_the_slant_passes(chain_project, tmp_path, monkeypatch, given
     root = chain_project("abc")
     registry.run("match_model", {"project": str(root), "model": "a_b", "method": "dense",
                                  "output": str(tmp_path / "dsm"), **given}, Feedback())
-    assert seen["model"] == "a_b" and seen["slant_passes"] is expected
+    assert seen["model"] == "a_b" and seen[key] is expected
