@@ -37,12 +37,14 @@ from __future__ import annotations
 from typing import Any, Optional, Tuple
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
 from scipy import ndimage
 
 from ..geometry.epipolar import EpipolarPair
 from ..surface.gridding import Grid, fill_gaps
 from .dense import array_source
+from .ncc import gather_windows, ncc_surface
 from .slant_lsm import refine_slant
 
 Array = NDArray[Any]
@@ -53,6 +55,8 @@ UNIQUE_REACH = 40
 UNIQUE_RATIO = 0.97
 #: Window side (px) of the uniqueness correlation.
 UNIQUE_WINDOW = 9
+#: Points whose correlation profiles are computed together (bounds the memory).
+UNIQUE_CHUNK = 4096
 #: Median filter (px) of the guide, which removes the specks of single blunder cells.
 GUIDE_SMOOTH = 5
 #: Largest gap (cells) interpolated into the guide; beyond it the nearest guide value.
@@ -168,38 +172,29 @@ def unique_along_rows(left: Array, warped: Array, rows: Array, cols: Array, resi
     ``warped`` is the right frame warped by the guide (:func:`.dense._warp_rows`), so that
     the match of a left pixel lies at the residual shift ``residual``. The normalised
     cross-correlation of the left window with the warped window at every integer shift
-    within ± ``reach`` px gives a profile; a match is unique where its best correlation
-    within 1 px of ``residual`` is positive and no shift 3 px or more away reaches ``ratio``
-    × that. Windows touching masked pixels count as −1.
+    within ± ``reach`` px gives a profile (:func:`.ncc.ncc_surface` of each left window over
+    its row of the warped frame); a match is unique where its best correlation within 1 px
+    of ``residual`` is positive and no shift 3 px or more away reaches ``ratio`` × that.
+    Windows touching masked pixels or the frame's edge count as −1.
     """
-    lv = np.isfinite(left)
-    lf = np.where(lv, left, 0.0).astype(np.float64)
-    n = float(window * window)
-
-    def box(a: Array) -> Array:
-        return ndimage.uniform_filter(a, window, mode="constant")
-
-    m_l = box(lf)
-    v_l = box(lf * lf) - m_l * m_l
-    l_ok = box(lv.astype(np.float64)) > 1.0 - 0.5 / n
+    half = window // 2
+    pad = reach + half  # NaN beyond the frame: windows reaching out of it are masked
+    lp = np.pad(np.asarray(left, np.float32), half, constant_values=np.nan)
+    wp = np.pad(np.asarray(warped, np.float32), ((half, half), (pad, pad)),
+                constant_values=np.nan)
     shifts = np.arange(-reach, reach + 1)
     profile = np.full((rows.size, shifts.size), -1.0)
-    w = left.shape[1]
-    for j, k in enumerate(shifts):
-        # left column x meets the warped column x − k (the residual disparity k)
-        s = np.full(warped.shape, np.nan, np.float64)
-        if k >= 0:
-            s[:, k:] = warped[:, :w - k]
-        else:
-            s[:, :k] = warped[:, -k:]
-        sv = np.isfinite(s)
-        sf = np.where(sv, s, 0.0)
-        m_s = box(sf)
-        cov = box(lf * sf) - m_l * m_s
-        var = v_l * (box(sf * sf) - m_s * m_s)
-        ok = l_ok & (box(sv.astype(np.float64)) > 1.0 - 0.5 / n) & (var > 1e-9)
-        ncc = np.where(ok, cov / np.sqrt(np.maximum(var, 1e-9)), -1.0)
-        profile[:, j] = ncc[rows, cols]
+    for i in range(0, rows.size, UNIQUE_CHUNK):
+        r, c = rows[i:i + UNIQUE_CHUNK], cols[i:i + UNIQUE_CHUNK]
+        tpl = gather_windows(lp, r, c, window, window)
+        srch = gather_windows(wp, r, c, window, window + 2 * reach)
+        masked = ~np.isfinite(srch)
+        rho = ncc_surface(np.nan_to_num(tpl), np.where(masked, 0.0, srch))[:, 0]
+        touched = sliding_window_view(masked, window, axis=2).any(axis=(1, 3))
+        touched |= ~np.isfinite(tpl).all(axis=(1, 2))[:, None] | ~np.isfinite(rho)
+        # surface column j is the window centred on the warped column x − reach + j: shift
+        # reach − j
+        profile[i:i + UNIQUE_CHUNK] = np.where(touched, -1.0, rho)[:, ::-1]
     dist = np.abs(shifts[None, :] - np.asarray(residual, np.float64)[:, None])
     best = np.where(dist <= 1.0, profile, -1.0).max(axis=1)
     other = np.where(dist >= 3.0, profile, -1.0).max(axis=1)

@@ -52,7 +52,7 @@ class NCCResult(NamedTuple):
     valid: NDArray
 
 
-def _gather(image: NDArray, row0: NDArray, col0: NDArray, h: int, w: int):
+def gather_windows(image: NDArray, row0: NDArray, col0: NDArray, h: int, w: int) -> NDArray:
     """Windows image[row0:row0+h, col0:col0+w] for many points (clipped at the edges)."""
     rr = np.clip(row0[:, None, None] + np.arange(h)[None, :, None], 0, image.shape[0] - 1)
     cc = np.clip(col0[:, None, None] + np.arange(w)[None, None, :], 0, image.shape[1] - 1)
@@ -231,8 +231,8 @@ def _search(left, right, cols, rows, pred_cols, pred_rows, dmin, dmax, radius, w
     H, W = R.shape
     for s0 in range(0, n, chunk):
         sl = slice(s0, min(n, s0 + chunk))
-        tpl = _gather(L, ri[sl] - h, ci[sl] - h, window, window)
-        srch = _gather(R, start_r[sl] - h, start_c[sl] - h, ry + 2 * h, rx + 2 * h)
+        tpl = gather_windows(L, ri[sl] - h, ci[sl] - h, window, window)
+        srch = gather_windows(R, start_r[sl] - h, start_c[sl] - h, ry + 2 * h, rx + 2 * h)
         rho = ncc_surface(tpl, srch)
         # offsets whose window leaves the right image, or beyond a point's own range: invalid
         oc = start_c[sl, None, None] + np.arange(rx)[None, None, :]
