@@ -80,11 +80,12 @@ def _max_filters(dsm: Array, levels: Sequence[int]) -> Tuple[Tuple[int, Array], 
     return tuple(out)
 
 
-def _nearest_valid(z: Array, valid: NDArray[np.bool_], axis: int, reverse: bool,
-                   max_size: int) -> Tuple[Array, NDArray[np.bool_]]:
+def nearest_valid_along(z: Array, valid: NDArray[np.bool_], axis: int, reverse: bool,
+                        max_size: int) -> Tuple[Array, Array]:
     """Height of the nearest valid cell in one direction along ``axis`` (towards higher
     indices with ``reverse``, else towards lower ones) at most ``max_size`` cells away, and
-    where there is one.
+    its distance in cells (0 on a valid cell; ``inf`` and a height of NaN where there is
+    none).
 
     A running maximum of the valid cells' indices finds them for all cells in one pass.
     """
@@ -99,9 +100,9 @@ def _nearest_valid(z: Array, valid: NDArray[np.bool_], axis: int, reverse: bool,
     else:
         near = np.maximum.accumulate(np.where(valid, idx, -1), axis=axis)
     found = (near >= 0) & (np.abs(idx - near) <= max_size)
-    near = np.where(found, near, 0)
-    heights = np.take_along_axis(z, near, axis=axis)
-    return heights, found
+    heights = np.take_along_axis(z, np.where(found, near, 0), axis=axis)
+    return (np.where(found, heights, np.nan),
+            np.where(found, np.abs(idx - near), np.inf).astype(np.float64))
 
 
 def fill_from_below(dsm: ArrayLike, max_size: int) -> Array:
@@ -141,7 +142,8 @@ def fill_from_below(dsm: ArrayLike, max_size: int) -> Array:
     found = []
     for axis in (0, 1):
         for reverse in (False, True):
-            heights, ok = _nearest_valid(z, valid, axis, reverse, max_size)
+            heights, dist = nearest_valid_along(z, valid, axis, reverse, max_size)
+            ok = np.isfinite(dist)
             low = np.where(ok, np.minimum(low, heights), low)
             found.append(ok)
     # enclosed: valid cells on both sides along a column or a row
@@ -250,4 +252,4 @@ def occluded(
     return result.reshape(shape)
 
 
-__all__ = ["fill_from_below", "march_margin", "occluded"]
+__all__ = ["fill_from_below", "march_margin", "nearest_valid_along", "occluded"]

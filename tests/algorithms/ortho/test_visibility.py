@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 from affine import Affine
 
-from photodem.algorithms.ortho.visibility import fill_from_below, march_margin, occluded
+from photodem.algorithms.ortho.visibility import (
+    fill_from_below,
+    march_margin,
+    nearest_valid_along,
+    occluded,
+)
 
 CELL = 0.1
 X0, Y1 = 1000.0, 2000.0
@@ -148,3 +153,15 @@ def test_fill_from_below_is_local_and_never_extends_the_border() -> None:
     assert np.array_equal(part[40:-40, 40:-40], full[r0:r1, c0:c1], equal_nan=True)
     # holes farther than max_size from valid cells on every side stay empty
     assert np.isnan(fill_from_below(_ringed(ring=30), 10)[~np.isfinite(_ringed())]).any()
+
+
+def test_nearest_valid_along_gives_the_height_and_distance_in_each_direction() -> None:
+    z = np.array([[1.0, np.nan, np.nan, 4.0, np.nan]])
+    valid = np.isfinite(z)
+    left, d_left = nearest_valid_along(z, valid, 1, False, 3)
+    right, d_right = nearest_valid_along(z, valid, 1, True, 1)
+    np.testing.assert_array_equal(left[0], [1.0, 1.0, 1.0, 4.0, 4.0])
+    np.testing.assert_array_equal(d_left[0], [0, 1, 2, 0, 1])
+    # looking right at most one cell: the cell two before 4 finds nothing
+    np.testing.assert_array_equal(right[0], [1.0, np.nan, 4.0, 4.0, np.nan])
+    np.testing.assert_array_equal(d_right[0], [0, np.inf, 1, 0, np.inf])
