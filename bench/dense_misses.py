@@ -18,7 +18,7 @@ trial recorded in ``docs/decisions.md`` (2026-11-28, occlusion rings).
 
 Usage (from the repository root)::
 
-    .venv/bin/python -m bench.dense_misses BLOCKS_DIR aerial:11 WORK [--fill]
+    .venv/bin/python -m bench.dense_misses BLOCKS_DIR aerial:11 WORK [--options JSON] [--fill]
 
 Not part of ``make bench``; the numbers go to ``docs/decisions.md``.
 """
@@ -157,13 +157,15 @@ def main(argv: List[str]) -> int:
     ap.add_argument("blocks", help="folder of the built blocks (kept between runs)")
     ap.add_argument("spec", help="SIZE:SEED, e.g. aerial:11")
     ap.add_argument("work", help="folder of the dense DSM (matched unless dsm.tif is there)")
+    ap.add_argument("--options", default="{}", help="dense options as JSON (a new WORK)")
     ap.add_argument("--fill", action="store_true", help="also judge the low-side fill")
     args = ap.parse_args(argv)
     size, seed = args.spec.split(":")
     info = block(Path(args.blocks), size, int(seed))
     model, work = MODELS[size], Path(args.work)
     if not (work / "dsm.tif").exists():
-        match_model_dense(info["project"], model, str(work), **info["heights"])
+        match_model_dense(info["project"], model, str(work), **info["heights"],
+                          **json.loads(args.options))
     dsm = work / "dsm.tif"
     print(json.dumps(breakdown(info, model, dsm, work / "count.tif"), indent=1))
     print(json.dumps({k: v for k, v in _judge(info, model, str(dsm)).items()
