@@ -8,6 +8,7 @@ that ``bench_dsm_objects`` judges into
 * by what the DSM has there: a *measured* cell (``count.tif`` > 0), an *interpolated* one
   (a height, count 0) or an *empty* one (NaN) — each right (within 0.5 m of the true DSM),
   too low or too high;
+* crown cells of the interior by the true surface's slope (right and empty shares);
 * open cells that miss, by their distance from the nearest object (occlusion rings lie
   1–4 m from a wall).
 
@@ -41,6 +42,10 @@ from scipy import ndimage
 BUILDING, TREE = 3, 4
 #: distance bands (m) of the open cells from the nearest object
 OPEN_BANDS = ((1.0, 2.0), (2.0, 4.0), (4.0, 8.0), (8.0, np.inf))
+#: slope bands (degrees) of the crowns, and the smoothing (m) of the true DSM for the slope
+#: (the leaf clumps' relief, λ ≈ 0.6 m, is not the crown's slope)
+SLOPE_BANDS = ((0.0, 30.0), (30.0, 45.0), (45.0, 60.0), (60.0, 90.1))
+SLOPE_SMOOTHING_M = 0.2
 
 
 def _on_grid(path: Path, ref: Any, how: Resampling) -> np.ndarray:
@@ -64,6 +69,23 @@ def _shares(sel: np.ndarray, err: np.ndarray, measured: np.ndarray) -> Dict[str,
         row[f"{state}_high"] = 100.0 * np.count_nonzero(k & (e > 0.5)) / n
     row["empty"] = 100.0 * np.count_nonzero(np.isnan(e)) / n
     return {k: round(v, 2) for k, v in row.items()}
+
+
+def _by_slope(true_dsm: np.ndarray, cell: float, sel: np.ndarray, err: np.ndarray
+              ) -> List[Dict[str, float]]:
+    """Shares of ``sel`` per slope band of the (smoothed) true surface, and right / empty
+    within each band."""
+    gy, gx = np.gradient(ndimage.gaussian_filter(true_dsm, SLOPE_SMOOTHING_M / cell), cell)
+    slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    n = max(int(sel.sum()), 1)
+    rows = []
+    for lo, hi in SLOPE_BANDS:
+        k = sel & (slope >= lo) & (slope < hi)
+        m = max(int(k.sum()), 1)
+        rows.append({"from_deg": lo, "to_deg": hi, "cells_pct": round(100.0 * k.sum() / n, 1),
+                     "right_pct": round(100.0 * np.count_nonzero(k & (np.abs(err) <= 0.5)) / m, 1),
+                     "empty_pct": round(100.0 * np.count_nonzero(k & np.isnan(err)) / m, 1)})
+    return rows
 
 
 def breakdown(info: Dict[str, Any], model: str, dsm: Path, count: Path) -> Dict[str, Any]:
@@ -93,6 +115,7 @@ def breakdown(info: Dict[str, Any], model: str, dsm: Path, count: Path) -> Dict[
         sel = interior & (cover == code)
         out[name] = {"share_of_interior": round(100.0 * sel.sum() / max(interior.sum(), 1), 1),
                      **_shares(sel, err, measured)}
+    out["trees_by_slope"] = _by_slope(true_dsm, cell, interior & (cover == TREE), err)
     open_ = masks.open & area
     out["open"] = _shares(open_, err, measured)
     dist = ndimage.distance_transform_edt(~masks.objects) * cell
