@@ -78,13 +78,15 @@ def _judge(block: Dict[str, Any], model: str, dsm: str) -> Dict[str, Any]:
     """Object figures in the model's measuring area and the open-terrain RMS."""
     from photodem.algorithms.matching.model_setup import prepare_model
     from photodem.algorithms.quality.objects_run import object_figures, object_metrics
+    from photodem.algorithms.synthetic.objects import INTERIOR_CLASSES
 
     from .bench_dsm_accuracy import _terrain_errors
 
     t = block["truth"]
     setup = prepare_model(block["project"], model, **block["heights"])
     fig = object_figures(object_metrics(dsm, t["dsm"], t["dtm"], buildings=t["buildings"],
-                                        area=setup.measuring_area(), gsd=float(setup.gsd)))
+                                        area=setup.measuring_area(), gsd=float(setup.gsd),
+                                        cover=t["landcover"], cover_classes=INTERIOR_CLASSES))
     terrain = _terrain_errors(dsm, t)
     return {**fig, "_area": setup.measuring_area(), "terrain_rms_m": terrain["rms_m"],
             "terrain_permille_h": 1000.0 * terrain["rms_m"] / block["H"]}
@@ -215,7 +217,9 @@ def run() -> dict:
                 f"{_fmt(_ratio(dense['interior_0_5_pct'], peer['interior_0_5_pct']))}, open "
                 f"{_fmt(_ratio(dense['open_0_5_pct'], peer['open_0_5_pct']))}, seconds "
                 f"{_fmt(_ratio(dense['seconds'], peer['seconds']))}")
-    notes += ["interior/objects/open = % of the cells within 0.5 m of the true DSM (truth grid "
+    notes += ["interior_buildings / interior_crowns = the interior on roofs and on tree crowns "
+              "apart (truth land cover)",
+              "interior/objects/open = % of the cells within 0.5 m of the true DSM (truth grid "
               "0.1 m, model's measuring area; empty cells are misses); iou = pooled outline "
               "IoU, wall_gsd = median wall position error (GSD); terrain = DSM − true DTM on "
               "open textured land cover ≥ 2 m from objects",

@@ -12,7 +12,7 @@ from __future__ import annotations
 import contextlib
 import math
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 from affine import Affine
@@ -45,7 +45,9 @@ class _Sources:
     """The open DSM (on the truth grid), truth DSM and DTM, and the area mask per window."""
 
     def __init__(self, stack: contextlib.ExitStack, dsm: PathLike, truth_dsm: PathLike,
-                 truth_dtm: PathLike, area: Any, object_height: float) -> None:
+                 truth_dtm: PathLike, area: Any, object_height: float,
+                 cover: Optional[PathLike] = None,
+                 cover_classes: Optional[Mapping[str, Sequence[int]]] = None) -> None:
         self.ref = _open_raster(stack, truth_dsm, "true DSM")
         src = _open_raster(stack, dsm, "DSM")
         self.grid = _ComparisonGrid(src, self.ref)
@@ -58,6 +60,21 @@ class _Sources:
         self.dtm = _GridReader(stack, _open_raster(stack, truth_dtm, "true DTM"), self.ref.crs,
                                g.transform, g.width, g.height, Resampling.bilinear)
         self.area = area
+        # land cover on the comparison grid (nearest: codes are not to be averaged)
+        self.cover = None if cover is None else _GridReader(
+            stack, _open_raster(stack, cover, "land cover"), self.ref.crs, g.transform,
+            g.width, g.height, Resampling.nearest)
+        self.cover_classes = dict(cover_classes or {}) if cover is not None else {}
+
+    def interior_by_cover(self, interior: Array, r: int, c: int, h: int, w: int
+                          ) -> Dict[str, Array]:
+        """The interior mask of the window split by the land-cover classes, keyed
+        ``interior_<name>`` (empty without a land cover)."""
+        if self.cover is None:
+            return {}
+        codes = self.cover.read(r, c, h, w)
+        return {f"interior_{name}": interior & np.isin(codes, list(values))
+                for name, values in self.cover_classes.items()}
 
     def area_mask(self, r: int, c: int, h: int, w: int) -> Array:
         """True inside the area (everywhere without one)."""
@@ -78,9 +95,11 @@ def _completeness(s: _Sources, window_size: int, fb: Feedback) -> Dict[str, Any]
         zt = s.truth(r, c, h, w)
         dz = s.dsm.read(r, c, h, w) - zt
         valid = np.isfinite(zt) & s.area_mask(r, c, h, w)
+        interior = codes == 1
         with np.errstate(invalid="ignore"):
-            acc.add(dz, {"interior": codes == 1, "objects": (codes == 1) | (codes == 2),
-                         "open": codes == 3}, valid)
+            acc.add(dz, {"interior": interior, "objects": interior | (codes == 2),
+                         "open": codes == 3, **s.interior_by_cover(interior, r, c, h, w)},
+                    valid)
         fb.progress(70.0 * (i + 1) / len(wins))
     return acc.result()
 
@@ -124,6 +143,8 @@ def object_metrics(dsm: PathLike, truth_dsm: PathLike, truth_dtm: PathLike, *,
                    buildings: Optional[PathLike] = None, area: Any = None,
                    object_height: float = OBJECT_HEIGHT, gsd: Optional[float] = None,
                    margin: float = 5.0, window_size: int = 1024,
+                   cover: Optional[PathLike] = None,
+                   cover_classes: Optional[Mapping[str, Sequence[int]]] = None,
                    feedback: Optional[Feedback] = None) -> Dict[str, Any]:
     """Completeness and building outlines of a DSM against truth rasters.
 
@@ -144,19 +165,26 @@ def object_metrics(dsm: PathLike, truth_dsm: PathLike, truth_dtm: PathLike, *,
         As :func:`.objects.object_masks` and :func:`.objects.outline_metrics`.
     window_size : int
         Window edge (cells) of the completeness pass.
+    cover : path, optional
+        Land-cover raster (class codes); with ``cover_classes`` the object interior is also
+        judged per class, e.g. ``{"buildings": [3], "crowns": [4]}``: on a block whose
+        interior is part roofs, part tree crowns one figure hides which of them is lost.
+    cover_classes : mapping of str to sequence of int, optional
+        Name → land-cover codes of each class (``interior_<name>`` in the result).
     feedback : Feedback, optional
 
     Returns
     -------
     dict
-        ``{"completeness": {"interior", "objects", "open"}, "outlines": … or None,
-        "cell": truth cell size}`` (see :mod:`.objects`).
+        ``{"completeness": {"interior", "objects", "open"[, "interior_<name>" …]},
+        "outlines": … or None, "cell": truth cell size}`` (see :mod:`.objects`).
     """
     fb = ensure_feedback(feedback)
     if not object_height > 0:
         raise InputError("The object height must be positive (metres above the DTM).")
     with contextlib.ExitStack() as stack:
-        s = _Sources(stack, dsm, truth_dsm, truth_dtm, area, object_height)
+        s = _Sources(stack, dsm, truth_dsm, truth_dtm, area, object_height, cover,
+                     cover_classes)
         comp = _completeness(s, window_size, fb)
         outlines = _outlines(s, buildings, margin, gsd, fb) if buildings is not None else None
         cell = abs(s.grid.transform.a)
@@ -169,7 +197,8 @@ def object_figures(metrics: Dict[str, Any]) -> Dict[str, Any]:
 
     ``interior_0_5_pct``, ``interior_measured_pct``, ``objects_0_5_pct``, ``open_0_5_pct``,
     ``iou`` (pooled outline IoU), ``wall_gsd`` (median wall position error in GSD),
-    ``buildings`` (judged footprints); None where a figure has no cells.
+    ``buildings`` (judged footprints), and ``interior_<name>_0_5_pct`` for each land-cover
+    class of the interior; None where a figure has no cells.
     """
     comp = metrics["completeness"]
     out = metrics.get("outlines") or {}
@@ -183,7 +212,9 @@ def object_figures(metrics: Dict[str, Any]) -> Dict[str, Any]:
             "objects_0_5_pct": pct("objects", "within_0_5"),
             "open_0_5_pct": pct("open", "within_0_5"),
             "iou": out.get("iou_pooled"), "wall_gsd": out.get("wall_median_gsd"),
-            "buildings": out.get("count", 0)}
+            "buildings": out.get("count", 0),
+            **{f"{key}_0_5_pct": pct(key, "within_0_5") for key in comp
+               if key.startswith("interior_")}}
 
 
 __all__ = ["object_figures", "object_metrics"]

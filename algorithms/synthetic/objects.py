@@ -49,6 +49,9 @@ LANDCOVER: Dict[int, str] = {
     7: "field",
 }
 OPEN, ROAD, BUILDING, TREE, WATER, EMBANKMENT, FIELD = 1, 2, 3, 4, 5, 6, 7
+#: The land-cover classes a DSM's object interior is judged on apart (roofs and crowns:
+#: ``objects_run.object_metrics(cover_classes=…)``; one figure hides which of them is lost).
+INTERIOR_CLASSES: Dict[str, Tuple[int, ...]] = {"buildings": (BUILDING,), "crowns": (TREE,)}
 #: Map colours of the land-cover codes (the legend style written beside the raster).
 LANDCOVER_COLOURS: Dict[int, str] = {1: "#c7dc8f", 2: "#8c8c8c", 3: "#d6604d", 4: "#1b7837",
                                      5: "#4393c3", 6: "#b08850", 7: "#f0d98a"}

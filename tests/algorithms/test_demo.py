@@ -28,7 +28,8 @@ def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
     assert [r["dsm"] for r in objects] == [m["name"] for m in s["models"]] + ["merged"]
     for r in objects:
         assert set(r) >= {"interior_0_5_pct", "objects_0_5_pct", "open_0_5_pct", "iou",
-                          "wall_gsd", "buildings"}
+                          "wall_gsd", "buildings", "interior_buildings_0_5_pct",
+                          "interior_crowns_0_5_pct"}
         assert r["open_0_5_pct"] is not None and 0.0 <= r["open_0_5_pct"] <= 100.0
     occ = surfaces["mosaic"]["occlusion"]
     assert len(occ["images"]) == s["images"]
@@ -36,6 +37,7 @@ def test_demo_runs_the_whole_chain_on_a_tiny_block(tmp_path) -> None:
     assert len(kept) == s["images"] and occ["all"]["cells"] > 0
     assert occ["all"]["cells"] == sum(a["cells"] for a in occ["images"])
     assert "object interior within 0.5 m" in text and "truth visibility" in text
+    assert "on tree crowns" in text
 
 
 def test_demo_refuses_a_foreign_folder(tmp_path) -> None:

@@ -190,3 +190,39 @@ def test_object_metrics_of_files(tmp_path):
     area = box(500000.0 + 8.0, 5400000.0 - 12.0, 500000.0 + 12.0, 5400000.0 - 8.0)
     r = object_metrics(good, t_dsm, t_dtm, buildings=b, area=area)
     assert r["outlines"]["count"] == 0 and r["completeness"]["interior"]["cells"] == 0
+
+
+def test_object_metrics_split_the_interior_by_land_cover(tmp_path):
+    """A land cover that calls the left part of the building a crown: the DSM that lost that
+    part keeps the building class whole and the crown class none."""
+    import rasterio
+
+    from photodem.algorithms.quality.objects_run import object_figures, object_metrics
+
+    t_dsm, t_dtm, _, good, _ = _files(tmp_path)
+    with rasterio.open(t_dsm) as src:
+        prof, truth = src.profile, src.read(1)
+    cover = np.full(truth.shape, 1, np.uint8)
+    cover[30:70, 30:49] = 4  # "crown": the building's left part
+    cover[30:70, 49:70] = 3
+    prof.update(dtype="uint8", nodata=0)
+    with rasterio.open(tmp_path / "cover.tif", "w", **prof) as dst:
+        dst.write(cover, 1)
+    with rasterio.open(good) as src:
+        half, gprof = src.read(1), src.profile
+    with rasterio.open(t_dtm) as src:
+        # the DSM lost the left part: 0.1 m columns up to 48 (bilinear from 0.2 m cells)
+        half[:, :24] = src.read(1)[::2, ::2][:, :24]
+    with rasterio.open(tmp_path / "half.tif", "w", **gprof) as dst:
+        dst.write(half, 1)
+    classes = {"buildings": [3], "crowns": [4]}
+    r = object_metrics(tmp_path / "half.tif", t_dsm, t_dtm, cover=tmp_path / "cover.tif",
+                       cover_classes=classes, window_size=16)
+    c = r["completeness"]
+    assert c["interior_buildings"]["cells"] + c["interior_crowns"]["cells"] == 400
+    f = object_figures(r)
+    assert f["interior_buildings_0_5_pct"] == 100.0 and f["interior_crowns_0_5_pct"] == 0.0
+    assert f["interior_0_5_pct"] == pytest.approx(55.0)  # interior columns 40…59, 49…59 right
+    # without a land cover: no split
+    assert "interior_crowns_0_5_pct" not in object_figures(
+        object_metrics(tmp_path / "half.tif", t_dsm, t_dtm, window_size=16))
