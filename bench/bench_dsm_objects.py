@@ -220,9 +220,9 @@ def run() -> dict:
     notes += ["interior_buildings / interior_crowns = the interior on roofs and on tree crowns "
               "apart (truth land cover)",
               "interior/objects/open = % of the cells within 0.5 m of the true DSM (truth grid "
-              "0.1 m, model's measuring area; empty cells are misses); iou = pooled outline "
-              "IoU, wall_gsd = median wall position error (GSD); terrain = DSM − true DTM on "
-              "open textured land cover ≥ 2 m from objects",
+              "0.1 m small, 0.075 m aerial; model's measuring area; empty cells are misses); "
+              "iou = pooled outline IoU, wall_gsd = median wall position error (GSD); "
+              "terrain = DSM − true DTM on open textured land cover ≥ 2 m from objects",
               "ortho_f1 (small block): the model's two images as true orthos on the DSM, "
               "occlusion mask against the truth visibility from the true DSM, pooled over "
               "every cell of the model's measuring area whose true point lies in the image; a "
