@@ -3,8 +3,9 @@
 On HELD-OUT seeds (not 1 or 2, on which the matchers were diagnosed) of the ``small`` block
 (model 0102_0103) and the ``aerial`` block (model 0101_0102, one start point and the truth's
 height range, as ``bench_dsm_accuracy``), each DSM from the registry (``match_model``, so the
-figures follow the matchers) — fbm_lsm with the default preset, fbm_lsm ``urban``, dense — is
-judged on the truth grid inside the model's measuring area
+figures follow the matchers) — fbm_lsm with the default preset, fbm_lsm ``urban``, dense, and
+the dense DSMs of all the block's models merged (``dsm_merge``) — is judged on the truth grid
+inside the model's measuring area
 (:func:`photodem.algorithms.quality.objects_run.object_metrics`):
 
 - object interior (true DSM ≥ 2.5 m above the true DTM, ≥ 1 m inside the object) and all object
@@ -45,6 +46,10 @@ GOALS: Dict[str, Dict[str, float]] = {
     "fbm_lsm urban": {"interior": 85.0, "open": 97.0, "iou": 0.90, "wall": 1.0},
     "dense": {"interior": 90.0, "open": 97.0, "iou": 0.90, "wall": 1.0, "terrain": 0.040},
 }
+#: the row of the block's dense DSMs merged (judged in the model's measuring area, goals as
+#: dense's): what an operator's block DSM holds there
+MERGED = "dense, block merged"
+GOALS[MERGED] = GOALS["dense"]
 F1_GOAL = 0.85
 
 
@@ -177,6 +182,28 @@ def _methods(block: Dict[str, Any], model: str, tmp: Path) -> List[Dict[str, Any
     return rows
 
 
+def _merged(block: Dict[str, Any], model: str, tmp: Path) -> Dict[str, Any]:
+    """Dense DSMs of every model of the block (the judged model's from :func:`_methods`)
+    merged by ``dsm_merge`` and judged in ``model``'s measuring area: the ground one model's
+    images cannot see behind a wall, and roofs one pair cannot match, may come from another."""
+    from photodem.algorithms.processing import registry
+    from photodem.algorithms.project.model import Project
+
+    dsms = [str(tmp / f"{block['size']}_dense" / "dsm.tif")]
+    t0 = time.perf_counter()
+    for m in Project.load(block["project"]).models:
+        if m.name != model:
+            r = registry.run("match_model", {"project": block["project"], "model": m.name,
+                                             "method": "dense", **block["heights"],
+                                             "output": str(tmp / f"{block['size']}_{m.name}")})
+            dsms.append(r["dsm"])
+    merged = registry.run("dsm_merge", {"inputs": dsms, "output": str(
+        tmp / f"{block['size']}_merged" / "dsm.tif")})
+    row = _row(block, model, MERGED, merged["dsm"], time.perf_counter() - t0,
+               tmp / f"{block['size']}_merged" / "orthos", block["size"] == "small")
+    return {**row, "merged_models": len(dsms)}
+
+
 def _peer(block: Dict[str, Any], model: str, tmp: Path) -> Dict[str, Any]:
     """OpenCV StereoSGBM through the same dense pipeline and gridding."""
     from photodem.algorithms.matching.dense_model import match_model_dense
@@ -209,7 +236,7 @@ def run() -> dict:
             block = _block(tmp / size, size)
             ours = _methods(block, model, tmp)
             peer = _peer(block, model, tmp)
-            rows += ours + [peer]
+            rows += ours + [_merged(block, model, tmp), peer]
             dense = next(r for r in ours if r["method"] == "dense")
             notes.append(
                 f"{size} (seed {SEED}, block {block['seconds']:.0f} s, H {block['H']:.0f} m, GSD "
@@ -219,6 +246,8 @@ def run() -> dict:
                 f"{_fmt(_ratio(dense['seconds'], peer['seconds']))}")
     notes += ["interior_buildings / interior_crowns = the interior on roofs and on tree crowns "
               "apart (truth land cover)",
+              f"{MERGED}: dense DSMs of all the block's models merged (dsm_merge, median), "
+              "judged in the model's measuring area; seconds = the other models and the merge",
               "interior/objects/open = % of the cells within 0.5 m of the true DSM (truth grid "
               "0.1 m small, 0.075 m aerial; model's measuring area; empty cells are misses); "
               "iou = pooled outline IoU, wall_gsd = median wall position error (GSD); "
