@@ -47,6 +47,7 @@ from .processing.batch import load_batch, run_batch
 from .project.edits import add_features
 from .project.model import Project
 from .quality.objects_run import object_figures, object_metrics
+from .quality.stereo_overlap import stereo_overlap
 from .quality.targets import target_centroids
 from .raster.io import PRODUCT_MARKER, open_image
 from .synthetic.objects import EMBANKMENT, INTERIOR_CLASSES, TREE
@@ -233,13 +234,14 @@ def _surfaces(project: Project, info: Dict[str, Any], block: Dict[str, Any], out
         "output": str(out / "mosaic.tif")})
     feedback.info("Object completeness of the DSMs and true-ortho occlusions against the "
                   "truth …")
+    overlaps = _stereo_overlaps(project, info, block["truth_dsm"])
     return {
         "mosaic": {**{k: mosaic.get(k) for k in ("mosaic", "seamlines", "report", "gsd",
                                                   "balance")},
                    "images": len(info["images"]),
                    "occlusion": _occlusion_figures(project, info, orthos,
-                                                   block["truth_dsm"])},
-        "objects": _object_figures(project, info, dsms, merged["dsm"], block),
+                                                   block["truth_dsm"], overlaps)},
+        "objects": _object_figures(project, info, dsms, merged["dsm"], block, overlaps),
         "models": [{"name": r["model"], "points": r["metrics"]["points_raw"],
                     "coverage_pct": r["metrics"]["coverage_pct"],
                     "measured_pct": r["metrics"].get("measured_pct"),
@@ -260,13 +262,24 @@ def _true_orthos(project: Project, info: Dict[str, Any], dsm: Path, folder: Path
         for im in info["images"]]
 
 
+def _stereo_overlaps(project: Project, info: Dict[str, Any], truth_dsm: str) -> List[Any]:
+    """Each model's stereo overlap on the true surface: the cells of its measuring area whose
+    true point lies inside both frames (a roof at the area's edge can stand outside one, and
+    no stereo method measures it; :func:`.quality.stereo_overlap.stereo_overlap`)."""
+    out = []
+    for m in info["models"]:
+        setup = prepare_model(project, m["name"])
+        frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+        out.append(stereo_overlap(frames, truth_dsm, setup.measuring_area()))
+    return out
+
+
 def _occlusion_figures(project: Project, info: Dict[str, Any], orthos: List[Dict[str, Any]],
-                       truth_dsm: str) -> Dict[str, Any]:
+                       truth_dsm: str, overlaps: List[Any]) -> Dict[str, Any]:
     """Each true ortho's occlusion mask against the truth visibility (every cell of the
-    models' measuring areas whose true point is in the image, DSM holes included), and all
+    models' stereo overlaps whose true point is in the image, DSM holes included), and all
     pooled."""
-    area = unary_union([prepare_model(project, m["name"]).measuring_area()
-                        for m in info["models"]])
+    area = unary_union(overlaps)
     per = []
     for im, o in zip(info["images"], orthos):
         rec = project.image(im["name"])
@@ -276,21 +289,20 @@ def _occlusion_figures(project: Project, info: Dict[str, Any], orthos: List[Dict
 
 
 def _object_figures(project: Project, info: Dict[str, Any], dsms: List[Path], merged: str,
-                    block: Dict[str, Any]) -> List[Dict[str, Any]]:
+                    block: Dict[str, Any], overlaps: List[Any]) -> List[Dict[str, Any]]:
     """Object completeness and outlines (:func:`.quality.objects_run.object_metrics`) of each
-    model DSM in its measuring area and of the merged DSM in all of them together."""
+    model DSM in its stereo overlap and of the merged DSM in all of them together."""
     truth = (block["truth_dsm"], block["truth_dtm"])
     # roofs and crowns apart: one interior figure hides which of them a DSM loses
     split = {"cover": block["truth_landcover"], "cover_classes": INTERIOR_CLASSES}
-    rows, areas = [], []
-    for m, dsm in zip(info["models"], dsms):
+    rows = []
+    for m, dsm, area in zip(info["models"], dsms, overlaps):
         setup = prepare_model(project, m["name"])
-        areas.append(setup.measuring_area())
-        res = object_metrics(dsm, *truth, buildings=block["truth_buildings"], area=areas[-1],
+        res = object_metrics(dsm, *truth, buildings=block["truth_buildings"], area=area,
                              gsd=float(setup.gsd), **split)
         rows.append({"dsm": m["name"], **object_figures(res)})
     res = object_metrics(merged, *truth, buildings=block["truth_buildings"],
-                         area=unary_union(areas), gsd=float(block["gsd_m"]), **split)
+                         area=unary_union(overlaps), gsd=float(block["gsd_m"]), **split)
     rows.append({"dsm": "merged", **object_figures(res)})
     return rows
 
@@ -401,8 +413,9 @@ def _fmt(v: Any, spec: str = ".1f") -> str:
 
 def _object_markdown(f: Dict[str, Any]) -> List[str]:
     """The object rows of each DSM and the true-ortho occlusion agreement (issue 19)."""
-    lines = ["", "Objects in the DSMs against the true DSM (truth grid, each model's measuring "
-             "area; the merged DSM in all of them): object interior = ≥ 2.5 m above the true "
+    lines = ["", "Objects in the DSMs against the true DSM (truth grid, each model's stereo "
+             "overlap = the cells of its measuring area whose true point lies inside both "
+             "frames; the merged DSM in all of them): object interior = ≥ 2.5 m above the true "
              "DTM and ≥ 1 m inside the object, open = < 0.3 m above it and ≥ 1 m from any "
              "object; outlines = footprint from the DSM (height above the true DTM ≥ half the "
              "building's) against the true footprints:", "",
@@ -419,7 +432,7 @@ def _object_markdown(f: Dict[str, Any]) -> List[str]:
                      f"{r['buildings']} |")
     occ = f["mosaic"]["occlusion"]
     lines += ["", "True orthos (on the merged DSM) against the truth visibility (the same "
-              "occlusion test on the true DSM), every cell of the models' measuring areas whose "
+              "occlusion test on the true DSM), every cell of the models' stereo overlaps whose "
               "true point lies in the image; a cell without a DSM height counts as not "
               "occluded:", "",
               "| image | occluded % (ortho) | occluded % (truth) | no DSM height % | precision "

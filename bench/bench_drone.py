@@ -32,19 +32,14 @@ OBJECTS = (3, 4)
 
 
 def _truth_on(grid_path: str, truth: str, nearest: bool = False) -> Tuple[np.ndarray, Any]:
-    """A truth raster resampled onto the grid of ``grid_path``."""
+    """A truth raster resampled onto the grid of ``grid_path``, and that grid's transform."""
     import rasterio
-    from rasterio.warp import Resampling, reproject
+
+    from .truth_grid import on_grid
 
     with rasterio.open(grid_path) as ds:
         shape, tr, crs = ds.shape, ds.transform, ds.crs
-    out = np.full(shape, np.nan, np.float32)
-    with rasterio.open(truth) as src:
-        reproject(src.read(1).astype(np.float32), out, src_transform=src.transform,
-                  src_crs=src.crs, dst_transform=tr, dst_crs=crs, src_nodata=np.nan,
-                  dst_nodata=np.nan,
-                  resampling=Resampling.nearest if nearest else Resampling.bilinear)
-    return out, tr
+    return on_grid(truth, shape, tr, crs, nearest=nearest), tr
 
 
 def overlap_cells(project: Any, model: Any, dsm_path: str, truth_dsm: str) -> np.ndarray:
@@ -52,19 +47,14 @@ def overlap_cells(project: Any, model: Any, dsm_path: str, truth_dsm: str) -> np
     test: an occluded cell counts as not measured)."""
     from rasterio.transform import xy
 
-    from photodem.algorithms.geometry.projection import world_to_pixel
+    from photodem.algorithms.quality.stereo_overlap import inside_frames
 
     z, tr = _truth_on(dsm_path, truth_dsm)
     rows, cols = np.mgrid[0:z.shape[0], 0:z.shape[1]]
     xs, ys = xy(tr, rows.ravel(), cols.ravel())
-    pts = np.column_stack([xs, ys, z.ravel()])
-    inside = np.isfinite(pts[:, 2])
-    for name in (model.left, model.right):
-        rec = project.image(name)
-        cam = project.camera_of(rec)
-        c, r = world_to_pixel(pts, cam, rec.eo)
-        inside &= (c >= 0) & (c <= cam.width - 1) & (r >= 0) & (r <= cam.height - 1)
-    return inside.reshape(z.shape)
+    frames = [(project.camera_of(rec), rec.eo)
+              for rec in (project.image(model.left), project.image(model.right))]
+    return inside_frames(frames, np.column_stack([xs, ys, z.ravel()])).reshape(z.shape)
 
 
 def visible_cells(project: Any, model: Any, dsm_path: str, truth_dsm: str,

@@ -5,8 +5,12 @@ On HELD-OUT seeds (not 1 or 2, on which the matchers were diagnosed) of the ``sm
 height range, as ``bench_dsm_accuracy``), each DSM from the registry (``match_model``, so the
 figures follow the matchers) — fbm_lsm with the default preset, fbm_lsm ``urban``, dense, and
 the dense DSMs of all the block's models merged (``dsm_merge``) — is judged on the truth grid
-inside the model's measuring area
-(:func:`photodem.algorithms.quality.objects_run.object_metrics`):
+over the model's stereo overlap: the cells of its measuring area (the overlap at the mid
+height) whose true surface point lies inside both frames
+(:func:`photodem.algorithms.quality.stereo_overlap.stereo_overlap`; roofs near the area's edge
+stand outside one frame, and no stereo method can measure them),
+with :func:`photodem.algorithms.quality.objects_run.object_metrics`. The interior and open
+figures over the whole measuring area, as judged before, are kept beside them (``area_``):
 
 - object interior (true DSM ≥ 2.5 m above the true DTM, ≥ 1 m inside the object) and all object
   cells within 0.5 m of the true DSM, open cells (< 0.3 m above the DTM, ≥ 1 m from objects)
@@ -46,11 +50,14 @@ GOALS: Dict[str, Dict[str, float]] = {
     "fbm_lsm urban": {"interior": 85.0, "open": 97.0, "iou": 0.90, "wall": 1.0},
     "dense": {"interior": 90.0, "open": 97.0, "iou": 0.90, "wall": 1.0, "terrain": 0.040},
 }
-#: the row of the block's dense DSMs merged (judged in the model's measuring area, goals as
+#: the row of the block's dense DSMs merged (judged in the model's stereo overlap, goals as
 #: dense's): what an operator's block DSM holds there
 MERGED = "dense, block merged"
 GOALS[MERGED] = GOALS["dense"]
 F1_GOAL = 0.85
+#: figures also given over the whole measuring area (``area_`` keys): the row as judged before
+#: the stereo overlap (cells outside a frame at their true height count as misses there)
+AREA_KEYS = ("interior_0_5_pct", "open_0_5_pct")
 
 
 def _block(folder: Path, size: str, seed: int = SEED) -> Dict[str, Any]:
@@ -80,20 +87,33 @@ def _block(folder: Path, size: str, seed: int = SEED) -> Dict[str, Any]:
 
 
 def _judge(block: Dict[str, Any], model: str, dsm: str) -> Dict[str, Any]:
-    """Object figures in the model's measuring area and the open-terrain RMS."""
+    """Object figures over the model's stereo overlap (cells of its measuring area whose true
+    surface point lies inside both frames), the interior and open figures over the whole
+    measuring area as before (``area_`` keys), and the open-terrain RMS."""
     from photodem.algorithms.matching.model_setup import prepare_model
     from photodem.algorithms.quality.objects_run import object_figures, object_metrics
+    from photodem.algorithms.quality.stereo_overlap import stereo_overlap
     from photodem.algorithms.synthetic.objects import INTERIOR_CLASSES
 
     from .bench_dsm_accuracy import _terrain_errors
 
     t = block["truth"]
     setup = prepare_model(block["project"], model, **block["heights"])
-    fig = object_figures(object_metrics(dsm, t["dsm"], t["dtm"], buildings=t["buildings"],
-                                        area=setup.measuring_area(), gsd=float(setup.gsd),
-                                        cover=t["landcover"], cover_classes=INTERIOR_CLASSES))
+    frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+    overlap = stereo_overlap(frames, t["dsm"], setup.measuring_area())
+
+    def figures(area: Any) -> Dict[str, Any]:
+        return object_figures(object_metrics(dsm, t["dsm"], t["dtm"], buildings=t["buildings"],
+                                             area=area, gsd=float(setup.gsd),
+                                             cover=t["landcover"],
+                                             cover_classes=INTERIOR_CLASSES))
+
+    fig = figures(overlap)
+    whole = figures(setup.measuring_area())
     terrain = _terrain_errors(dsm, t)
-    return {**fig, "_area": setup.measuring_area(), "terrain_rms_m": terrain["rms_m"],
+    return {**fig, **{f"area_{k}": whole[k] for k in AREA_KEYS},
+            "overlap_share_pct": 100.0 * overlap.area / setup.measuring_area().area,
+            "_area": overlap, "terrain_rms_m": terrain["rms_m"],
             "terrain_permille_h": 1000.0 * terrain["rms_m"] / block["H"]}
 
 
@@ -184,7 +204,7 @@ def _methods(block: Dict[str, Any], model: str, tmp: Path) -> List[Dict[str, Any
 
 def _merged(block: Dict[str, Any], model: str, tmp: Path) -> Dict[str, Any]:
     """Dense DSMs of every model of the block (the judged model's from :func:`_methods`)
-    merged by ``dsm_merge`` and judged in ``model``'s measuring area: the ground one model's
+    merged by ``dsm_merge`` and judged in ``model``'s stereo overlap: the ground one model's
     images cannot see behind a wall, and roofs one pair cannot match, may come from another."""
     from photodem.algorithms.processing import registry
     from photodem.algorithms.project.model import Project
@@ -247,14 +267,18 @@ def run() -> dict:
     notes += ["interior_buildings / interior_crowns = the interior on roofs and on tree crowns "
               "apart (truth land cover)",
               f"{MERGED}: dense DSMs of all the block's models merged (dsm_merge, median), "
-              "judged in the model's measuring area; seconds = the other models and the merge",
+              "judged in the model's stereo overlap; seconds = the other models and the merge",
               "interior/objects/open = % of the cells within 0.5 m of the true DSM (truth grid "
-              "0.1 m small, 0.075 m aerial; model's measuring area; empty cells are misses); "
+              "0.1 m small, 0.075 m aerial; empty cells are misses) over the model's stereo "
+              "overlap: the cells of its measuring area (overlap at the mid height) whose "
+              "true surface point lies inside both frames (overlap_share_pct of the area); "
+              "area_interior / area_open = the same over the whole measuring area (as judged "
+              "before 2026-11-28: cells outside a frame at their true height are misses); "
               "iou = pooled outline IoU, wall_gsd = median wall position error (GSD); "
               "terrain = DSM − true DTM on open textured land cover ≥ 2 m from objects",
               "ortho_f1 (small block): the model's two images as true orthos on the DSM, "
               "occlusion mask against the truth visibility from the true DSM, pooled over "
-              "every cell of the model's measuring area whose true point lies in the image; a "
+              "every cell of the model's stereo overlap whose true point lies in the image; a "
               "cell without a DSM height counts as not occluded (ortho_no_height_pct of them; "
               "ortho_f1_with_height leaves out the hidden ones among them)",
               "the terrain goals are the issue's figures on seed 1 of the aerial block "

@@ -2,7 +2,8 @@
 
 For one block of ``dense_objects_seeds`` (built there and kept) this script matches the
 block's model with dense (or reads a DSM matched before into ``WORK``) and splits the cells
-that ``bench_dsm_objects`` judges into
+that ``bench_dsm_objects`` judges (the model's stereo overlap; the shares of the measuring
+area outside a frame at their true height are given first) into
 
 * by land cover: object-interior cells on buildings and on trees;
 * by what the DSM has there: a *measured* cell (``count.tif`` > 0), an *interpolated* one
@@ -35,7 +36,6 @@ from typing import Any, Dict, List
 import numpy as np
 import rasterio
 from rasterio.features import geometry_mask
-from rasterio.warp import Resampling, reproject
 from scipy import ndimage
 
 #: land-cover codes of the truth (``algorithms.synthetic.objects.LANDCOVER``)
@@ -46,15 +46,6 @@ OPEN_BANDS = ((1.0, 2.0), (2.0, 4.0), (4.0, 8.0), (8.0, np.inf))
 #: (the leaf clumps' relief, λ ≈ 0.6 m, is not the crown's slope)
 SLOPE_BANDS = ((0.0, 30.0), (30.0, 45.0), (45.0, 60.0), (60.0, 90.1))
 SLOPE_SMOOTHING_M = 0.2
-
-
-def _on_grid(path: Path, ref: Any, how: Resampling) -> np.ndarray:
-    """Band 1 of ``path`` on the grid of the open dataset ``ref`` (NaN outside)."""
-    out = np.full((ref.height, ref.width), np.nan, np.float32)
-    with rasterio.open(path) as src:
-        reproject(rasterio.band(src, 1), out, src_nodata=src.nodata, dst_transform=ref.transform,
-                  dst_crs=ref.crs, dst_nodata=np.nan, resampling=how)
-    return out
 
 
 def _shares(sel: np.ndarray, err: np.ndarray, measured: np.ndarray) -> Dict[str, float]:
@@ -90,9 +81,12 @@ def _by_slope(true_dsm: np.ndarray, cell: float, sel: np.ndarray, err: np.ndarra
 
 def breakdown(info: Dict[str, Any], model: str, dsm: Path, count: Path) -> Dict[str, Any]:
     """The split of the interior and open cells of ``dsm`` on the truth grid, in the model's
-    measuring area."""
+    stereo overlap."""
     from photodem.algorithms.matching.model_setup import prepare_model
     from photodem.algorithms.quality.objects import object_masks
+    from photodem.algorithms.quality.stereo_overlap import stereo_overlap
+
+    from .truth_grid import on_grid
 
     t = info["truth"]
     with rasterio.open(t["dsm"]) as ref:
@@ -101,16 +95,26 @@ def breakdown(info: Dict[str, Any], model: str, dsm: Path, count: Path) -> Dict[
         setup = prepare_model(info["project"], model, **info["heights"])
         area = geometry_mask([setup.measuring_area()], out_shape=true_dsm.shape,
                              transform=ref.transform, invert=True)
-        z = _on_grid(dsm, ref, Resampling.bilinear)
-        measured = np.nan_to_num(_on_grid(count, ref, Resampling.nearest)) > 0
+        grid = (true_dsm.shape, ref.transform, ref.crs)
+        z = on_grid(dsm, *grid)
+        measured = np.nan_to_num(on_grid(count, *grid, nearest=True)) > 0
+        frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+        in_frames = geometry_mask([stereo_overlap(frames, t["dsm"])], out_shape=true_dsm.shape,
+                                  transform=ref.transform, invert=True)
     with rasterio.open(t["dtm"]) as src:
         true_dtm = src.read(1).astype(np.float64)
     with rasterio.open(t["landcover"]) as src:
         cover = src.read(1)
     masks = object_masks(true_dsm, true_dtm, cell)
     err = z - true_dsm
+    # cells outside a frame at their true height: no stereo method measures them
+    out: Dict[str, Any] = {
+        f"{name}_outside_frames_pct": round(
+            100.0 * (cls & area & ~in_frames).sum() / max((cls & area).sum(), 1), 2)
+        for name, cls in (("interior", masks.interior), ("open", masks.open))}
+    area &= in_frames
     interior = masks.interior & area
-    out: Dict[str, Any] = {"interior_cells": int(interior.sum())}
+    out["interior_cells"] = int(interior.sum())
     for name, code in (("buildings", BUILDING), ("trees", TREE)):
         sel = interior & (cover == code)
         out[name] = {"share_of_interior": round(100.0 * sel.sum() / max(interior.sum(), 1), 1),

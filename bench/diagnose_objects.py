@@ -48,7 +48,6 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 import rasterio
 from rasterio.features import geometry_mask, rasterize
-from rasterio.warp import Resampling, reproject
 from scipy import ndimage
 
 from photodem.algorithms.feedback import Feedback
@@ -158,11 +157,9 @@ def stereo_cells(setup: Any, dsm: np.ndarray, area: np.ndarray, transform: Any,
 
 def on_truth_grid(path: Path, truth: Truth) -> np.ndarray:
     """A DSM resampled (bilinear) onto the truth grid, NaN where it has no height."""
-    out = np.full(truth.dsm.shape, np.nan)
-    with rasterio.open(path) as src:
-        reproject(rasterio.band(src, 1), out, dst_transform=truth.transform,
-                  dst_crs=truth.crs, dst_nodata=np.nan, resampling=Resampling.bilinear)
-    return out
+    from .truth_grid import on_grid
+
+    return on_grid(path, truth.dsm.shape, truth.transform, truth.crs).astype(np.float64)
 
 
 def dsm_row(name: str, dsm: np.ndarray, truth: Truth, gsd: float) -> Dict[str, Any]:
