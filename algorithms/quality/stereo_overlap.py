@@ -52,7 +52,7 @@ def inside_frames(frames: Sequence[Frame], points: np.ndarray) -> np.ndarray:
 
 
 def stereo_overlap(frames: Sequence[Frame], surface: PathLike, area: Optional[Any] = None,
-                   rows_per_band: int = 512) -> Any:
+                   cells_per_band: int = 1 << 20) -> Any:
     """The cells of a surface raster whose surface point lies inside every frame, as polygons.
 
     Parameters
@@ -63,8 +63,9 @@ def stereo_overlap(frames: Sequence[Frame], surface: PathLike, area: Optional[An
         Heights (e.g. a true DSM); nodata cells are outside.
     area : shapely geometry, optional
         Clip the result to it (e.g. the model's measuring area), in the surface's CRS.
-    rows_per_band : int
-        Rows read at a time (the raster is passed in bands of rows).
+    cells_per_band : int
+        About this many cells are read and projected at a time (bands of whole rows, at
+        least one): the memory is bounded for any raster width.
 
     Returns
     -------
@@ -73,6 +74,7 @@ def stereo_overlap(frames: Sequence[Frame], surface: PathLike, area: Optional[An
     """
     parts = []
     with rasterio.open(surface) as src:
+        rows_per_band = max(1, cells_per_band // src.width)
         for r0 in range(0, src.height, rows_per_band):
             win = Window(0, r0, src.width, min(rows_per_band, src.height - r0))
             z = src.read(1, window=win, masked=True).astype(np.float64).filled(np.nan)

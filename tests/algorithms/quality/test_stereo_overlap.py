@@ -67,3 +67,6 @@ def test_stereo_overlap_shrinks_where_the_surface_stands_higher(tmp_path: Path) 
     clipped = stereo_overlap(FRAMES, _surface(tmp_path, 4.0), area=box(X0 - 1, Y0 - 1, X0 + 1,
                                                                       Y0 + 1))
     assert abs(clipped.area - 4.0) < 1e-6
+    # read in bands of a few rows: the same cells
+    banded = stereo_overlap(FRAMES, _surface(tmp_path, 4.0), cells_per_band=3 * 200)
+    assert banded.symmetric_difference(roofed).area < 1e-6
