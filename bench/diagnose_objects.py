@@ -55,7 +55,7 @@ from photodem.algorithms.geometry.epipolar import SIDES
 from photodem.algorithms.matching import dense as dense_mod
 from photodem.algorithms.matching import fbm_model
 from photodem.algorithms.matching.dense_model import dsm_dense_options
-from photodem.algorithms.matching.model_setup import footprint, prepare_model
+from photodem.algorithms.matching.model_setup import prepare_model
 from photodem.algorithms.processing import registry
 from photodem.algorithms.quality.objects import (
     completeness,
@@ -124,35 +124,32 @@ def load_truth(block: Path, setup: Any) -> Truth:
                        transform=t, fill=0, dtype="int32") if geoms else \
         np.zeros(dsm.shape, np.int32)
     return Truth(dsm, dtm, t, crs, cell, m.objects, m.interior, m.open, area, labels,
-                 np.asarray(heights), lc, stereo_cells(setup, dsm, area, t, cell))
+                 np.asarray(heights), lc, stereo_cells(setup, dsm, area, t))
 
 
 def stereo_cells(setup: Any, dsm: np.ndarray, area: np.ndarray, transform: Any,
-                 cell: float, step: float = 0.5, inside: float = 1.0) -> np.ndarray:
-    """Cells of the measuring area whose true surface point lies in both images' footprints
-    at its own height, at least ``inside`` m from the footprints' edge.
+                 inside: float = 1.0) -> np.ndarray:
+    """Cells of the measuring area whose true surface point lies in both images, at least
+    ``inside`` m (in pixels of the model's GSD) from their borders.
 
     The measuring area is the overlap at the mid height; where the true surface is higher or
     lower, a strip along the overlap's edge has no partner in the other image, and no stereo
-    method can measure it (issue 19: most open and object cells lost at the area's border).
+    method can measure it (issue 19: most open and object cells lost at the area's border;
+    :mod:`photodem.algorithms.quality.stereo_overlap`).
     """
-    cams, recs = setup.cameras, setup.records
-    z = np.where(area, dsm, np.nan)
+    from rasterio.transform import xy
+
+    from photodem.algorithms.quality.stereo_overlap import inside_frames
+
+    rows, cols = np.nonzero(area & np.isfinite(dsm))
+    xs, ys = xy(transform, rows, cols)
+    frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+    ok = inside_frames(frames, np.column_stack([np.asarray(xs), np.asarray(ys),
+                                                dsm[rows, cols]]),
+                       margin_px=inside / float(setup.gsd))
     out = np.zeros(dsm.shape, bool)
-    if not np.isfinite(z).any():
-        return out
-    for h in np.arange(np.floor(np.nanmin(z)), np.nanmax(z) + step, step):
-        sel = np.abs(z - h) <= step / 2
-        if not sel.any():
-            continue
-        both = footprint(cams[0], recs[0].eo, h).intersection(footprint(cams[1], recs[1].eo, h))
-        if both.is_empty:
-            continue
-        inner = both.buffer(-inside)
-        if not inner.is_empty:
-            out |= sel & geometry_mask([inner], out_shape=dsm.shape, transform=transform,
-                                       invert=True)
-    return out & area
+    out[rows[ok], cols[ok]] = True
+    return out
 
 
 def on_truth_grid(path: Path, truth: Truth) -> np.ndarray:

@@ -28,8 +28,10 @@ Frame = Tuple[Camera, ExteriorOrientation]
 PathLike = Union[str, Path]
 
 
-def inside_frames(frames: Sequence[Frame], points: np.ndarray) -> np.ndarray:
-    """Whether each world point projects inside every frame.
+def inside_frames(frames: Sequence[Frame], points: np.ndarray, margin_px: float = 0.0
+                  ) -> np.ndarray:
+    """Whether each world point projects inside every frame (at least ``margin_px`` from its
+    border).
 
     Parameters
     ----------
@@ -37,6 +39,8 @@ def inside_frames(frames: Sequence[Frame], points: np.ndarray) -> np.ndarray:
         The frames, e.g. a stereo model's left and right image.
     points : ndarray, shape (n, 3)
         World points (X, Y, Z in the project CRS); a point with a NaN is inside none.
+    margin_px : float
+        Distance (px, of each frame) a point must keep from the frame's border.
 
     Returns
     -------
@@ -47,7 +51,8 @@ def inside_frames(frames: Sequence[Frame], points: np.ndarray) -> np.ndarray:
     safe = np.where(inside[:, None], pts, 0.0)
     for cam, eo in frames:
         c, r = world_to_pixel(safe, cam, eo)  # NaN behind the camera: in no frame
-        inside &= (c >= 0) & (c <= cam.width - 1) & (r >= 0) & (r <= cam.height - 1)
+        m = margin_px
+        inside &= (c >= m) & (c <= cam.width - 1 - m) & (r >= m) & (r <= cam.height - 1 - m)
     return inside
 
 

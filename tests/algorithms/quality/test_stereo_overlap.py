@@ -70,3 +70,11 @@ def test_stereo_overlap_shrinks_where_the_surface_stands_higher(tmp_path: Path) 
     # read in bands of a few rows: the same cells
     banded = stereo_overlap(FRAMES, _surface(tmp_path, 4.0), cells_per_band=3 * 200)
     assert banded.symmetric_difference(roofed).area < 1e-6
+
+
+def test_inside_frames_keeps_a_margin_from_the_border() -> None:
+    # 1 px (0.1 m on the ground) inside the right frame's left border at the ground
+    p = np.array([[X0 + 5 - _half_width(ZT) + 0.1, Y0, ZT]])
+    assert inside_frames(FRAMES, p).tolist() == [True]
+    assert inside_frames(FRAMES, p, margin_px=0.5).tolist() == [True]
+    assert inside_frames(FRAMES, p, margin_px=2.0).tolist() == [False]
