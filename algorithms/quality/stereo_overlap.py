@@ -14,9 +14,11 @@ from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import rasterio
+from affine import Affine
 from rasterio.features import shapes
 from rasterio.transform import xy
 from rasterio.windows import Window
+from shapely.affinity import affine_transform
 from shapely.geometry import shape
 from shapely.ops import unary_union
 
@@ -79,17 +81,20 @@ def stereo_overlap(frames: Sequence[Frame], surface: PathLike, area: Optional[An
     """
     parts = []
     with rasterio.open(surface) as src:
+        t = src.transform
         rows_per_band = max(1, cells_per_band // src.width)
         for r0 in range(0, src.height, rows_per_band):
             win = Window(0, r0, src.width, min(rows_per_band, src.height - r0))
             z = src.read(1, window=win, masked=True).astype(np.float64).filled(np.nan)
-            tr = src.window_transform(win)
             rows, cols = np.mgrid[0:z.shape[0], 0:z.shape[1]]
-            xs, ys = xy(tr, rows.ravel(), cols.ravel())
+            xs, ys = xy(src.window_transform(win), rows.ravel(), cols.ravel())
             pts = np.column_stack([np.asarray(xs), np.asarray(ys), z.ravel()])
             mask = inside_frames(frames, pts).reshape(z.shape)
             if mask.any():
+                # outlines in whole (col, row) numbers, so that the bands' edges meet exactly
+                # (world coordinates of two bands differ in the last bits and leave slivers)
                 parts += [shape(g) for g, v in shapes(mask.astype(np.uint8), mask=mask,
-                                                      transform=tr) if v == 1]
-    geom = unary_union(parts)
+                                                      transform=Affine.translation(0, r0))
+                          if v == 1]
+    geom = affine_transform(unary_union(parts), [t.a, t.b, t.d, t.e, t.c, t.f])
     return geom.intersection(area) if area is not None else geom

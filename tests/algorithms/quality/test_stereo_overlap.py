@@ -67,9 +67,12 @@ def test_stereo_overlap_shrinks_where_the_surface_stands_higher(tmp_path: Path) 
     clipped = stereo_overlap(FRAMES, _surface(tmp_path, 4.0), area=box(X0 - 1, Y0 - 1, X0 + 1,
                                                                       Y0 + 1))
     assert abs(clipped.area - 4.0) < 1e-6
-    # read in bands of a few rows: the same cells
+    # read in bands of a few rows: the same cells, and one polygon — no slivers along the
+    # bands' edges (a footprint across them must lie within it)
     banded = stereo_overlap(FRAMES, _surface(tmp_path, 4.0), cells_per_band=3 * 200)
     assert banded.symmetric_difference(roofed).area < 1e-6
+    assert banded.geom_type == "Polygon"
+    assert banded.contains(box(X0 - 4.0, Y0 - 7.0, X0 + 2.0, Y0 + 7.0))
 
 
 def test_inside_frames_keeps_a_margin_from_the_border() -> None:
