@@ -269,7 +269,7 @@ def _stereo_overlaps(project: Project, info: Dict[str, Any], truth_dsm: str) -> 
     out = []
     for m in info["models"]:
         setup = prepare_model(project, m["name"])
-        frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+        frames = setup.frames
         out.append(stereo_overlap(frames, truth_dsm, setup.measuring_area()))
     return out
 

@@ -99,7 +99,7 @@ def _judge(block: Dict[str, Any], model: str, dsm: str) -> Dict[str, Any]:
 
     t = block["truth"]
     setup = prepare_model(block["project"], model, **block["heights"])
-    frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+    frames = setup.frames
     overlap = stereo_overlap(frames, t["dsm"], setup.measuring_area())
 
     def figures(area: Any) -> Dict[str, Any]:

@@ -98,7 +98,7 @@ def breakdown(info: Dict[str, Any], model: str, dsm: Path, count: Path) -> Dict[
         grid = (true_dsm.shape, ref.transform, ref.crs)
         z = on_grid(dsm, *grid)
         measured = np.nan_to_num(on_grid(count, *grid, nearest=True)) > 0
-        frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+        frames = setup.frames
         in_frames = geometry_mask([stereo_overlap(frames, t["dsm"])], out_shape=true_dsm.shape,
                                   transform=ref.transform, invert=True)
     with rasterio.open(t["dtm"]) as src:

@@ -143,7 +143,7 @@ def stereo_cells(setup: Any, dsm: np.ndarray, area: np.ndarray, transform: Any,
 
     rows, cols = np.nonzero(area & np.isfinite(dsm))
     xs, ys = xy(transform, rows, cols)
-    frames = [(cam, rec.eo) for cam, rec in zip(setup.cameras, setup.records)]
+    frames = setup.frames
     ok = inside_frames(frames, np.column_stack([np.asarray(xs), np.asarray(ys),
                                                 dsm[rows, cols]]),
                        margin_px=inside / float(setup.gsd))

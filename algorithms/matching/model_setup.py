@@ -60,6 +60,11 @@ class ModelSetup:
         return [r.name for r in self.records]
 
     @property
+    def frames(self) -> List[Tuple[Any, Any]]:
+        """(camera, exterior orientation) of the left and the right image."""
+        return [(cam, rec.eo) for cam, rec in zip(self.cameras, self.records)]
+
+    @property
     def convergence(self) -> float:
         """Angle between the two optical axes, degrees."""
         return convergence_deg(self.records[0].eo, self.records[1].eo)
