@@ -231,6 +231,19 @@ def footprint_points(block: np.ndarray, max_step: float = FOOTPRINT_STEP
 #: from these scales as from 0.6 / 1.6 or 0.5 / 1.5 (object interior within 1 point, terrain
 #: and open cells slightly better, 0.6 / 1.6 takes 1.35 × the time; issue 19, part Z).
 SLANT_SCALES: Tuple[float, ...] = (0.7, 1.4)
+#: Slant passes of convergent models that also shear the right image along its rows
+#: (stretch, shear in px per row; :func:`slant_passes`): a slope across the epipolar lines
+#: changes the disparity from row to row — 0.71 px per row on the embankment of the drone
+#: pair 0202_0203, seed 1 — which neither a square window nor a stretch follows; there SGM put
+#: 84 % of the pixels more than 1 px off even when searched within 8 px of the truth, and a
+#: pass stretched and sheared like the slope matched 67 % right. The shears lean the way the
+#: model's ground leans (the sign of the plain pass's disparity change per row). Measured on
+#: the four drone models of seeds 1 and 2 (docs/decisions.md, 2026-11-28).
+SLANT_SHEARS: Tuple[Tuple[float, float], ...] = ((0.7, 0.35), (0.7, 0.7), (1.0, 0.35))
+#: Largest disparity step (px) within a 2 × 2 quad of the slant passes' disparities that gives
+#: a footprint point (:func:`footprint_points`) on convergent models: a slope stretched 1.55 ×
+#: changes the disparity by 0.55 px per column, so the plain pass's 0.5 px would split it.
+SLANT_FOOTPRINT_STEP = 1.0
 #: A cell that only a slant pass measured is kept where it passes the DSM outlier test
 #: against the plain pass's heights around it (within 1 px of parallax of their median, or
 #: 3 × their spread), interpolated over enclosed gaps up to ``SLANT_GAP_CELLS`` cells wide
@@ -261,36 +274,57 @@ def slant_scales(setup: ModelSetup, slant_passes: bool = True) -> Tuple[float, .
     return ()
 
 
-def stretched_source(source: GreySource, scale: float) -> GreySource:
-    """A grey source of the right epipolar image stretched along its rows by ``scale``.
+def slant_passes(setup: ModelSetup, scales: Tuple[float, ...], row_slope: float
+                 ) -> Tuple[Tuple[float, float], ...]:
+    """The (stretch, shear) of each slant pass: the ``scales`` unsheared, and for convergent
+    models also :data:`SLANT_SHEARS`, leaning the way ``row_slope`` (the plain pass's
+    disparity change per row, :meth:`_Guide.row_slope`) does."""
+    passes = tuple((s, 0.0) for s in scales)
+    if scales and setup.convergent:
+        sign = 1.0 if row_slope >= 0 else -1.0
+        passes += tuple((s, sign * k) for s, k in SLANT_SHEARS)
+    return passes
 
-    Column ``x'`` of the stretched image is column ``x' / scale`` of the original (linear
-    interpolation, NaN where either neighbour is masked or outside); rows stay, so the pair
-    stays epipolar and a disparity ``d'`` against it is ``d = x_l − (x_l − d') / scale``
-    (:func:`unstretch`).
+
+def stretched_source(source: GreySource, scale: float, shear: float = 0.0) -> GreySource:
+    """A grey source of the right epipolar image stretched along its rows by ``scale`` (and
+    sheared by ``shear`` px per row).
+
+    Column ``x'`` of row ``y`` of the stretched image is column ``x' / scale − shear·y`` of the
+    original (linear interpolation, NaN where either neighbour is masked or outside); rows
+    stay, so the pair stays epipolar and a disparity ``d'`` against it is
+    ``d = x_l − (x_l − d') / scale + shear·y`` (:func:`unstretch`).
     """
     def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
         x = np.arange(c0, c1, dtype=np.float64) / scale
-        a0 = int(np.floor(x[0]))
+        if shear:
+            x = x[None, :] - shear * np.arange(r0, r1, dtype=np.float64)[:, None]
+        a0 = int(np.floor(x.min()))
         base = np.floor(x).astype(np.int64)
-        block = source(r0, r1, a0, int(base[-1]) + 2)
+        block = source(r0, r1, a0, int(base.max()) + 2)
         i, f = base - a0, (x - base).astype(np.float32)
-        return block[:, i] * (1.0 - f) + block[:, i + 1] * f
+        if not shear:
+            return block[:, i] * (1.0 - f) + block[:, i + 1] * f
+        rows = np.arange(r1 - r0)[:, None]
+        return block[rows, i] * (1.0 - f) + block[rows, i + 1] * f
 
     return read
 
 
-def unstretch(d: np.ndarray, col: np.ndarray, scale: float) -> np.ndarray:
-    """Disparities against the image stretched by ``scale`` → disparities of the pair."""
-    return col - (col - d) / scale
+def unstretch(d: np.ndarray, col: np.ndarray, scale: float, row: Any = 0.0,
+              shear: float = 0.0) -> np.ndarray:
+    """Disparities against the image stretched by ``scale`` and sheared by ``shear``
+    (:func:`stretched_source`) at left pixels (``col``, ``row``) → disparities of the pair."""
+    return col - (col - d) / scale + shear * np.asarray(row)
 
 
-def _stretched_range(setup: ModelSetup, scale: float) -> Tuple[int, int]:
-    """Search range against the right image stretched by ``scale``: ``d' = (1 − s)·x_l +
-    s·d`` over the left image's columns and the model's range."""
-    w = setup.pair.sizes[0][0]
-    ends = [(1.0 - scale) * x + scale * d for x in (0.0, w - 1.0)
-            for d in (setup.min_d, setup.max_d)]
+def _stretched_range(setup: ModelSetup, scale: float, shear: float = 0.0) -> Tuple[int, int]:
+    """Search range against the right image stretched by ``scale`` and sheared by ``shear``:
+    ``d' = (1 − s)·x_l + s·d − s·k·y`` over the left image's columns and rows and the
+    model's range."""
+    w, h = setup.pair.sizes[0][0], setup.pair.height
+    ends = [(1.0 - scale) * x + scale * d - scale * shear * y for x in (0.0, w - 1.0)
+            for d in (setup.min_d, setup.max_d) for y in (0.0, h - 1.0)]
     return int(np.floor(min(ends))), int(np.ceil(max(ends)))
 
 
@@ -339,12 +373,29 @@ class _Guide:
         np.add.at(self.total, at, d)
         np.add.at(self.count, at, 1)
 
-    def stretched(self, scale: float) -> np.ndarray:
-        """The block means as disparities against the right image stretched by ``scale``."""
+    def _means(self) -> np.ndarray:
         with np.errstate(invalid="ignore", divide="ignore"):
-            d = np.where(self.count > 0, self.total / self.count, np.nan)
+            return np.where(self.count > 0, self.total / self.count, np.nan)
+
+    def stretched(self, scale: float, shear: float = 0.0) -> np.ndarray:
+        """The block means as disparities against the right image stretched by ``scale``
+        and sheared by ``shear`` (:func:`stretched_source`)."""
+        d = self._means()
         col = (np.arange(d.shape[1]) + 0.5) * GUIDE_FACTOR - 0.5
-        return ((1.0 - scale) * col[None, :] + scale * d).astype(np.float32)
+        row = (np.arange(d.shape[0]) + 0.5) * GUIDE_FACTOR - 0.5
+        return ((1.0 - scale) * col[None, :] + scale * d
+                - scale * shear * row[:, None]).astype(np.float32)
+
+    def row_slope(self) -> float:
+        """The disparity change per left row of a plane fitted to the block means (px per
+        row; 0 with fewer than three blocks)."""
+        d = self._means()
+        rr, cc = np.nonzero(np.isfinite(d))
+        if rr.size < 3:
+            return 0.0
+        A = np.column_stack([cc, rr, np.ones(rr.size)]).astype(np.float64)
+        coef = np.linalg.lstsq(A, d[rr, cc], rcond=None)[0]
+        return float(coef[1]) / GUIDE_FACTOR
 
 
 def _settled_cells(acc: GridAccumulator, footprints: Optional[GridAccumulator]) -> np.ndarray:
@@ -417,22 +468,34 @@ class _SlantImage:
         self._ctx.__exit__(None, None, None)
 
 
-def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float,
+def _slant_disparities(block: np.ndarray, r0: int, c0: int, scale: float, shear: float,
                        left: GreySource, right: GreySource, pair: EpipolarPair, grid: Grid,
                        settled: Optional[np.ndarray]
                        ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The disparities of the pair from one slant tile (with ``settled``: those that may reach
     a cell outside it), refined by LSM between the original images
-    (:func:`.slant_lsm.refine_slant`), those it keeps. Returns ``d``, columns and rows."""
+    (:func:`.slant_lsm.refine_slant`, started with the pass's stretch and shear), those it
+    keeps. Returns ``d``, columns and rows."""
     ok = np.isfinite(block)
     rr, cc = np.nonzero(ok)
-    d = unstretch(block[ok], cc + c0, scale)
     cols, rows = cc + c0, rr + r0
+    d = unstretch(block[ok], cols, scale, rows, shear)
     if settled is not None:
         useful = _may_reach_open_cells(pair, grid, settled, d, cols, rows, SLANT_LSM_SHIFT)
         d, cols, rows = d[useful], cols[useful], rows[useful]
-    d, keep = refine_slant(left, right, d, cols, rows, scale)
+    # the right image's rows move by −shear px per row against the left's (∂x_r/∂y)
+    d, keep = refine_slant(left, right, d, cols, rows, scale, shear=-shear)
     return d[keep], cols[keep], rows[keep]
+
+
+def _slant_footprints(d: np.ndarray, cols: np.ndarray, rows: np.ndarray, shape: Tuple[int, int],
+                      r0: int, c0: int) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`footprint_points` of the kept slant disparities of a tile (``shape`` at
+    ``r0``, ``c0``) with :data:`SLANT_FOOTPRINT_STEP`: disparities, columns and rows."""
+    block = np.full(shape, np.nan)
+    block[rows - r0, cols - c0] = d
+    fd, fc, fr = footprint_points(block, SLANT_FOOTPRINT_STEP)
+    return fd, fc + c0, fr + r0
 
 
 def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
@@ -440,11 +503,13 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                 scales: Tuple[float, ...], feedback: Feedback,
                 settled: Optional[np.ndarray] = None,
                 image: Optional[_SlantImage] = None) -> float:
-    """The slant passes (stretches ``scales``, :func:`slant_scales`): tiled SGM against the
-    stretched right image in the ranges of ``guide``; the valid disparities, refined by LSM
+    """The slant passes (stretches ``scales``, :func:`slant_scales`, and on convergent models
+    the sheared ones of :func:`slant_passes`): tiled SGM against the stretched right image in
+    the ranges of ``guide``; the valid disparities, refined by LSM
     (:func:`_slant_disparities`; if ``settled`` is given, only those that may reach a cell
-    outside it), give their points into ``acc`` and, if given, into ``image``; returns the
-    matching time (s)."""
+    outside it), give their points into ``acc`` (convergent models: with their footprint
+    points, :func:`_slant_footprints`) and, if given, into ``image``; returns the matching
+    time (s)."""
     pair = setup.pair
     seconds = triangulation = 0.0  # the caller counts the triangulation apart
     # slopes, not objects: every hole border eroded and no object fill (with the plain pass's
@@ -454,24 +519,31 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
     with open_image(grey["left"]) as src_l, open_image(grey["right"]) as src_r:
         left, shape_l = _window_source(src_l)
         right, (h_r, w_r) = _window_source(src_r)
-        share = 100.0 / len(scales)
-        for k, scale in enumerate(scales):
-            lo, hi = _stretched_range(setup, scale)
-            shape_r = (h_r, int(np.ceil(scale * (w_r - 1))) + 1)
+        passes = slant_passes(setup, scales, guide.row_slope())
+        share = 100.0 / len(passes)
+        for k, (scale, shear) in enumerate(passes):
+            lo, hi = _stretched_range(setup, scale, shear)
+            shape_r = (h_r, int(np.ceil(scale * (w_r - 1 + max(shear, 0.0) * (h_r - 1)))) + 1)
             t0 = time.perf_counter()
             for r0, c0, block in iter_disparity_tiles(
-                    left, stretched_source(right, scale), shape_l, shape_r, lo, hi, options,
-                    max_memory_mb=memory_mb, feedback=feedback.step(k * share, (k + 1) * share),
-                    guide=(guide.stretched(scale), GUIDE_FACTOR)):
+                    left, stretched_source(right, scale, shear), shape_l, shape_r, lo, hi,
+                    options, max_memory_mb=memory_mb,
+                    feedback=feedback.step(k * share, (k + 1) * share),
+                    guide=(guide.stretched(scale, shear), GUIDE_FACTOR)):
                 # the LSM refinement counts as matching
-                d, cols, rows = _slant_disparities(block, r0, c0, scale, left, right, pair,
-                                                   setup.grid, settled)
+                d, cols, rows = _slant_disparities(block, r0, c0, scale, shear, left, right,
+                                                   pair, setup.grid, settled)
                 if image is not None:
                     image.add(d, cols, rows)
                 t1 = time.perf_counter()
                 if d.size:
                     pts = pair.disparity_to_world(d, cols, rows)
                     acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
+                    if setup.convergent:
+                        fd, fc, fr = _slant_footprints(d, cols, rows, block.shape, r0, c0)
+                        if fd.size:
+                            pts = pair.disparity_to_world(fd, fc, fr)
+                            acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
                 triangulation += time.perf_counter() - t1
             seconds += time.perf_counter() - t0
     return seconds - triangulation

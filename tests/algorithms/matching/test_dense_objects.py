@@ -252,6 +252,22 @@ def test_slant_passes_run_on_convergent_and_wide_base_models_only() -> None:
     assert slant_scales(setup(400.0, convergent=True), slant_passes=False) == ()
 
 
+def test_convergent_models_also_get_sheared_slant_passes() -> None:
+    """Convergent models add :data:`SLANT_SHEARS`, leaning the way their ground does (issue
+    22); wide-base nadir models keep the unsheared stretches; no stretches, no passes."""
+    from types import SimpleNamespace
+
+    from photodem.algorithms.matching.dense_model import SLANT_SCALES, SLANT_SHEARS, slant_passes
+
+    plain = tuple((s, 0.0) for s in SLANT_SCALES)
+    convergent = SimpleNamespace(convergent=True)
+    assert slant_passes(convergent, SLANT_SCALES, 0.2) == plain + SLANT_SHEARS
+    assert slant_passes(convergent, SLANT_SCALES, -0.2) == plain + tuple(
+        (s, -k) for s, k in SLANT_SHEARS)
+    assert slant_passes(SimpleNamespace(convergent=False), SLANT_SCALES, 0.2) == plain
+    assert slant_passes(convergent, (), 0.2) == ()
+
+
 @pytest.mark.slow
 def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
     """A window of the aerial block (seed 1, 384 px, B/H 0.61, nadir): the slant passes run by
