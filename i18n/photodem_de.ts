@@ -5722,32 +5722,32 @@ Erneut ausführen mit: photodem batch {0}</translation>
         </message>
         <message>
             <source>max_height ({z_max}) must be larger than min_height ({z_min}).</source>
-            <extracomment>algorithms/matching/model_setup.py:142</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:147</extracomment>
             <translation>max_height ({z_max}) muss größer als min_height ({z_min}) sein.</translation>
         </message>
         <message>
             <source>max_height ({z_max:.1f} m) reaches the cameras ({z_cam:.1f} m); give a lower max_height.</source>
-            <extracomment>algorithms/matching/model_setup.py:145</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:150</extracomment>
             <translation>max_height ({z_max:.1f} m) reicht bis zu den Kameras ({z_cam:.1f} m); geben Sie ein niedrigeres max_height an.</translation>
         </message>
         <message>
             <source>The images {left} and {right} of model '{model}' do not overlap; check the model or the orientations.</source>
-            <extracomment>algorithms/matching/model_setup.py:205</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:210</extracomment>
             <translation>Die Bilder {left} und {right} des Modells '{model}' überlappen sich nicht; prüfen Sie das Modell oder die Orientierungen.</translation>
         </message>
         <message>
             <source>The spacing must be positive, got {spacing}.</source>
-            <extracomment>algorithms/matching/model_setup.py:213</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:218</extracomment>
             <translation>Die Gitterweite muss positiv sein, angegeben: {spacing}.</translation>
         </message>
         <message>
             <source>Model '{model}': the height range {z_min:.1f}…{z_max:.1f} m gives no disparity; check min_height/max_height.</source>
-            <extracomment>algorithms/matching/model_setup.py:217</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:222</extracomment>
             <translation>Modell '{model}': Der Höhenbereich {z_min:.1f}…{z_max:.1f} m ergibt keine Disparität; prüfen Sie min_height/max_height.</translation>
         </message>
         <message>
             <source>The boundaries of edits.gpkg do not touch model '{model}'.</source>
-            <extracomment>algorithms/matching/model_setup.py:233</extracomment>
+            <extracomment>algorithms/matching/model_setup.py:238</extracomment>
             <translation>Die Begrenzungen in edits.gpkg berühren das Modell '{model}' nicht.</translation>
         </message>
         <message>

@@ -173,9 +173,10 @@ def test_convergent_model_cells_get_footprint_points(drone_block, tmp_path) -> N
 
 
 def _right_share(left: np.ndarray, right: Any, right_shape: tuple, lo: int, hi: int,
-                 truth: np.ndarray, scale: float = 1.0) -> float:
-    """Share of the left pixels whose disparity (against ``right``, stretched by ``scale``)
-    is within 1 px of ``truth``, with the convergent models' windows."""
+                 truth: np.ndarray, scale: float = 1.0, shear: float = 0.0) -> float:
+    """Share of the left pixels whose disparity (against ``right``, stretched by ``scale`` and
+    sheared by ``shear``) is within 1 px of ``truth`` (per column or per pixel), with the
+    convergent models' windows."""
     from photodem.algorithms.matching.dense import DenseOptions, array_source, iter_disparity_tiles
     from photodem.algorithms.matching.dense_model import unstretch
 
@@ -185,9 +186,10 @@ def _right_share(left: np.ndarray, right: Any, right_shape: tuple, lo: int, hi: 
     for r0, c0, blk in iter_disparity_tiles(src_l, right, shape_l, right_shape, lo, hi, opts,
                                             coarse_above=0):
         out[r0:r0 + blk.shape[0], c0:c0 + blk.shape[1]] = blk
-    cols = np.arange(shape_l[1], dtype=np.float32)[None, :]
+    rows, cols = np.mgrid[0:shape_l[0], 0:shape_l[1]].astype(np.float64)
     with np.errstate(invalid="ignore"):
-        return float(np.mean(np.abs(unstretch(out, cols, scale) - truth[None, :]) <= 1.0))
+        d = unstretch(out, cols, scale, rows, shear)
+        return float(np.mean(np.abs(d - np.broadcast_to(truth, shape_l)) <= 1.0))
 
 
 def test_slant_pass_matches_a_foreshortened_slope() -> None:
@@ -253,24 +255,6 @@ def _sheared_pair(k: float, shear: float, h: int = 96, w: int = 128, seed: int =
             x - (k * x - shear * y + 40.0))
 
 
-def _right_share_2d(left: np.ndarray, right: Any, right_shape: tuple, lo: int, hi: int,
-                    truth: np.ndarray, scale: float = 1.0, shear: float = 0.0) -> float:
-    """As :func:`_right_share`, with a true disparity per pixel and a sheared pass."""
-    from photodem.algorithms.matching.dense import DenseOptions, array_source, iter_disparity_tiles
-    from photodem.algorithms.matching.dense_model import unstretch
-
-    src_l, shape_l = array_source(left)
-    out = np.full(shape_l, np.nan, np.float32)
-    opts = DenseOptions(block_size=7, normalise_window=21)
-    for r0, c0, blk in iter_disparity_tiles(src_l, right, shape_l, right_shape, lo, hi, opts,
-                                            coarse_above=0):
-        out[r0:r0 + blk.shape[0], c0:c0 + blk.shape[1]] = blk
-    rows, cols = np.mgrid[0:shape_l[0], 0:shape_l[1]].astype(np.float64)
-    with np.errstate(invalid="ignore"):
-        d = unstretch(out, cols, scale, rows, shear)
-        return float(np.mean(np.abs(d - truth) <= 1.0))
-
-
 def test_sheared_slant_pass_matches_a_slope_across_the_epipolar_lines() -> None:
     """A slope foreshortened 1.43 × and turned so that the disparity changes by 0.7 px per
     row (the embankment of drone pair 0202_0203): the stretch alone gets less than half of it
@@ -288,7 +272,7 @@ def test_sheared_slant_pass_matches_a_slope_across_the_epipolar_lines() -> None:
     for shear in (0.0, k):
         d_s = cols - s * (cols - truth) - s * shear * rows  # against the sheared image
         width = int(np.ceil(s * (shape_r[1] - 1 + shear * (shape_r[0] - 1)))) + 1
-        shares[shear] = _right_share_2d(left, stretched_source(src_r, s, shear),
+        shares[shear] = _right_share(left, stretched_source(src_r, s, shear),
                                         (shape_r[0], width), int(d_s.min()) - 8,
                                         int(d_s.max()) + 8, truth, s, shear)
     print(f"right: stretched {shares[0.0]:.3f}, stretched and sheared {shares[k]:.3f}")
@@ -391,9 +375,11 @@ def test_slant_disparities_that_cannot_reach_an_open_cell_are_not_refined() -> N
 def test_guided_pass_measures_slopes_of_a_strongly_convergent_model(drone_block,
                                                                      tmp_path) -> None:
     """The DSM-guided pass (issue 22, part AD) gives the 47° drone pair 0101_0103 (seed 1)
-    1.3 points more of its measuring area (67.6 → 68.8 %, measured), the cells it adds
-    within 1 m of the true DSM but for 0.1 % of them (3401 open cells: RMSE 0.15 m), and it
-    adds no cell to the unmeasured roofs (whose neighbourhood jumps between two surfaces)."""
+    more of its measuring area (67.6 → 68.8 % when it came; 68.7 → 69.4 % since the sheared
+    slant passes measure some of the same slopes, measured), the cells it adds within 1 m of
+    the true DSM but for 0.1–0.2 % of them (3401 open cells when it came, RMSE 0.15 m; 2511
+    since), and it adds no cell
+    to the unmeasured roofs (whose neighbourhood jumps between two surfaces)."""
     from photodem.algorithms.matching.dense_model import match_model_dense
 
     runs = {flag: match_model_dense(str(drone_block), "0101_0103", tmp_path / str(flag),
@@ -402,8 +388,8 @@ def test_guided_pass_measures_slopes_of_a_strongly_convergent_model(drone_block,
     print(f"measured {off['measured_pct']:.2f} → {on['measured_pct']:.2f} %, guided pass "
           f"{on['guided_measured_pct']:.2f} %")
     assert "guided_measured_pct" not in off
-    assert on["measured_pct"] > off["measured_pct"] + 0.8
-    assert on["guided_measured_pct"] > 0.8
+    assert on["measured_pct"] > off["measured_pct"] + 0.5
+    assert on["guided_measured_pct"] > 0.6
     grids = {}
     for flag, res in runs.items():
         with rasterio.open(res["dsm"]) as ds:
