@@ -296,15 +296,12 @@ def stretched_source(source: GreySource, scale: float, shear: float = 0.0) -> Gr
     ``d = x_l − (x_l − d') / scale + shear·y`` (:func:`unstretch`).
     """
     def read(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
-        x = np.arange(c0, c1, dtype=np.float64) / scale
-        if shear:
-            x = x[None, :] - shear * np.arange(r0, r1, dtype=np.float64)[:, None]
+        x = (np.arange(c0, c1, dtype=np.float64)[None, :] / scale
+             - shear * np.arange(r0, r1, dtype=np.float64)[:, None])
         a0 = int(np.floor(x.min()))
         base = np.floor(x).astype(np.int64)
         block = source(r0, r1, a0, int(base.max()) + 2)
         i, f = base - a0, (x - base).astype(np.float32)
-        if not shear:
-            return block[:, i] * (1.0 - f) + block[:, i + 1] * f
         rows = np.arange(r1 - r0)[:, None]
         return block[rows, i] * (1.0 - f) + block[rows, i + 1] * f
 
@@ -537,13 +534,12 @@ def _slant_into(setup: ModelSetup, grey: Dict[str, Path], acc: GridAccumulator,
                     image.add(d, cols, rows)
                 t1 = time.perf_counter()
                 if d.size:
+                    if setup.convergent:  # with the points between four matched pixels
+                        fd, fc, fr = _slant_footprints(d, cols, rows, block.shape, r0, c0)
+                        d, cols, rows = (np.concatenate(p) for p in ((d, fd), (cols, fc),
+                                                                     (rows, fr)))
                     pts = pair.disparity_to_world(d, cols, rows)
                     acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
-                    if setup.convergent:
-                        fd, fc, fr = _slant_footprints(d, cols, rows, block.shape, r0, c0)
-                        if fd.size:
-                            pts = pair.disparity_to_world(fd, fc, fr)
-                            acc.add(pts[:, 0], pts[:, 1], pts[:, 2])
                 triangulation += time.perf_counter() - t1
             seconds += time.perf_counter() - t0
     return seconds - triangulation
