@@ -268,6 +268,32 @@ def test_convergent_models_also_get_sheared_slant_passes() -> None:
     assert slant_passes(convergent, (), 0.2) == ()
 
 
+def test_slant_cells_grow_up_a_slope_from_its_foot_and_refuse_a_blunder() -> None:
+    """An embankment the plain pass left empty, 0.08 m a cell (32°) up from its measured foot:
+    the first round tests it against the foot's height filled in over it and keeps only its
+    lowest columns; the kept cells join the reference, so later rounds climb it. A 5 m blunder
+    patch on measured flat ground stays refused in every round (issue 22)."""
+    from photodem.algorithms.matching.dense_model import slant_cells
+
+    h, w, spacing = 40, 70, 0.1
+    cols = np.arange(w)
+    slope = np.where(cols >= 20, 0.08 * (cols - 20), 0.0)[None, :].repeat(h, 0)
+    plain = np.where(cols[None, :] < 20, 0.0, np.nan).repeat(h, 0)
+    z_slant = np.where(np.isnan(plain), slope, np.nan)
+    plain[:, 8:12] = np.nan  # a blunder patch in the measured ground
+    z_slant[18:22, 8:12] = 5.0
+    args = (spacing, 0.5, 0.3, 3.0)
+    ramp = np.isfinite(z_slant) & (cols[None, :] >= 20)
+    one = slant_cells(plain, z_slant, *args, rounds=1)
+    grown = slant_cells(plain, z_slant, *args)
+    assert one[ramp].mean() < 0.15
+    assert grown[ramp].mean() > 0.45  # measured: 0.08 after one round, 0.50 after eight
+    assert grown[ramp].sum() > 4 * one[ramp].sum()
+    assert not grown[18:22, 8:12].any()
+    # every kept cell lies on the slope it was kept from
+    assert np.all(np.abs(z_slant[grown] - slope[grown]) < 1e-9)
+
+
 @pytest.mark.slow
 def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
     """A window of the aerial block (seed 1, 384 px, B/H 0.61, nadir): the slant passes run by
