@@ -263,9 +263,9 @@ SLANT_TOLERANCE = 2.0
 #: slant cells kept so far, until no more are kept or this many rounds have run: a slope the
 #: plain pass left empty (an embankment) is filled in from its foot in the first round, metres
 #: off its upper part, so one round refused it. Eight rounds against one on the drone models
-#: of seeds 1 and 2: +0.03 to +2.9 points of the visible cells, open NMAD unchanged, open RMSE
-#: −0.7 to +1.3 % (+1.3 %: a roof spread over 18 occluded ground cells), object RMSE −5 to
-#: 0 %, 8–15 % more time (docs/decisions.md, 2026-11-28, growing slant cells).
+#: of seeds 1–3: +0.03 to +2.9 points of the visible cells, open NMAD within 0.0005 m, open
+#: RMSE −0.7 to +1.3 % (+1.3 %: a roof spread over 18 occluded ground cells), object RMSE −5
+#: to 0 %, 13–17 % more time (docs/decisions.md, 2026-11-28, slant cells kept in rounds).
 SLANT_GROW_ROUNDS = 8
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8
