@@ -280,7 +280,7 @@ def test_slant_cells_grow_up_a_slope_from_its_foot_and_refuse_a_blunder() -> Non
     slope = np.where(cols >= 20, 0.08 * (cols - 20), 0.0)[None, :].repeat(h, 0)
     plain = np.where(cols[None, :] < 20, 0.0, np.nan).repeat(h, 0)
     z_slant = np.where(np.isnan(plain), slope, np.nan)
-    plain[:, 8:12] = np.nan  # a blunder patch in the measured ground
+    plain[18:22, 8:12] = np.nan  # a blunder patch in a hole of the measured ground
     z_slant[18:22, 8:12] = 5.0
     args = (spacing, 0.5, 0.3, 3.0)
     ramp = np.isfinite(z_slant) & (cols[None, :] >= 20)
