@@ -736,8 +736,8 @@ def slant_cells(z: np.ndarray, z_slant: np.ndarray, spacing: float, radius: floa
     z = np.array(z, np.float32)
     candidate = np.isfinite(z_slant)
     take = np.zeros(z.shape, bool)
-    for _ in range(rounds):
-        ref, _ = fill_gaps(z, spacing, SLANT_GAP_CELLS * spacing)
+    for _round in range(rounds):
+        ref = fill_gaps(z, spacing, SLANT_GAP_CELLS * spacing)[0]
         new = candidate & ~take & ~deviates_from(z_slant, ref, spacing, radius, threshold, k)
         if not new.any():
             break
