@@ -356,7 +356,7 @@ def reject_outliers(z: Array, spacing: float, radius: float, threshold: float,
 
 
 def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
-                  threshold: float, k: float = 3.0) -> Array:
+                  threshold: float, k: float = 3.0, where: Optional[Array] = None) -> Array:
     """Mask of the cells of ``z`` that deviate from the neighbourhood of ``reference``.
 
     The test of :func:`reject_outliers` (deviation from the median of the neighbourhood
@@ -371,6 +371,9 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
         Heights of the neighbourhood, NaN = empty; empty cells take the nearest height.
     spacing, radius, threshold, k : float
         As :func:`reject_outliers`.
+    where : ndarray of bool (h, w), optional
+        Test only these cells (the others are returned False). A few scattered cells are
+        tested from their own windows, with the same result as over the whole grid.
 
     Returns
     -------
@@ -380,18 +383,60 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
     from scipy import ndimage  # lazy: keeps photodem list fast
 
     z = np.asarray(z, np.float32)
-    ref = np.asarray(reference, np.float32)
-    valid, have = np.isfinite(z), np.isfinite(ref)
-    if radius <= 0 or not valid.any() or have.sum() < 3:
+    valid = np.isfinite(z) if where is None else np.isfinite(z) & where
+    rf = nearest_filled(reference)
+    if radius <= 0 or not valid.any() or rf is None:
         return np.zeros(z.shape, bool)
-    # empty cells take the nearest measured height so that the filters see no NaN
-    _, (nr, nc) = ndimage.distance_transform_edt(~have, return_indices=True)
-    rf = ref[nr, nc]
-    size = 2 * max(1, int(radius / spacing + 0.5)) + 1
-    med = ndimage.median_filter(rf, size=size, mode="nearest")
-    mad = ndimage.median_filter(np.abs(rf - med), size=size, mode="nearest")
+    half = max(1, int(radius / spacing + 0.5))
+    size = 2 * half + 1
+    if where is not None and valid.mean() < _SPARSE_SHARE:
+        # the medians only where the tested cells' MADs need them: within ``half`` of them
+        need = ndimage.binary_dilation(valid, np.ones((size, size), bool))
+        med = np.full(z.shape, np.nan, np.float32)
+        med[need] = _window_medians(rf, *np.nonzero(need), half)
+        rows, cols = np.nonzero(valid)
+        mad = np.zeros(z.shape, np.float32)
+        mad[valid] = _window_medians(np.abs(rf - med), rows, cols, half)
+        med = np.where(valid, med, 0.0).astype(np.float32)
+    else:
+        med = ndimage.median_filter(rf, size=size, mode="nearest")
+        mad = ndimage.median_filter(np.abs(rf - med), size=size, mode="nearest")
     with np.errstate(invalid="ignore"):
         return valid & (np.abs(z - med) > np.maximum(float(threshold), k * 1.4826 * mad))
+
+
+#: Below this share of tested cells :func:`deviates_from` takes the medians window by window.
+_SPARSE_SHARE = 0.1
+#: Cells per chunk of :func:`_window_medians` (memory: chunk × window cells × 4 bytes).
+_MEDIAN_CHUNK = 20000
+
+
+def nearest_filled(reference: Array) -> Optional[Array]:
+    """``reference`` (float32) with each empty cell at the nearest finite height; None with
+    fewer than three finite heights."""
+    from scipy import ndimage  # lazy: keeps photodem list fast
+
+    ref = np.asarray(reference, np.float32)
+    have = np.isfinite(ref)
+    if have.sum() < 3:
+        return None
+    if have.all():
+        return ref
+    _, (nr, nc) = ndimage.distance_transform_edt(~have, return_indices=True)
+    return ref[nr, nc]
+
+
+def _window_medians(a: Array, rows: Array, cols: Array, half: int) -> Array:
+    """Medians of the ``(2·half + 1)²`` windows of ``a`` centred on the cells ``rows, cols``,
+    the edge cells repeated beyond the border (as ``ndimage.median_filter``'s ``nearest``)."""
+    h, w = a.shape
+    off = np.arange(-half, half + 1)
+    out = np.empty(rows.size, a.dtype)
+    for s in range(0, rows.size, _MEDIAN_CHUNK):
+        r = np.clip(rows[s:s + _MEDIAN_CHUNK, None, None] + off[None, :, None], 0, h - 1)
+        c = np.clip(cols[s:s + _MEDIAN_CHUNK, None, None] + off[None, None, :], 0, w - 1)
+        out[s:s + _MEDIAN_CHUNK] = np.median(a[r, c].reshape(r.shape[0], -1), axis=1)
+    return out
 
 
 # -- gap filling -------------------------------------------------------------------------------
@@ -574,4 +619,5 @@ def write_grid(path: PathLike, z: Array, grid: Grid, crs: Any = None,
 
 
 __all__ = ["Grid", "GridAccumulator", "GridResult", "deviates_from", "fill_gaps", "finish_grid",
-           "grid_points", "line_barrier", "polygon_mask", "reject_outliers", "write_grid"]
+           "grid_points", "line_barrier", "nearest_filled", "polygon_mask", "reject_outliers",
+           "write_grid"]

@@ -294,6 +294,41 @@ def test_slant_cells_grow_up_a_slope_from_its_foot_and_refuse_a_blunder() -> Non
     assert np.all(np.abs(z_slant[grown] - slope[grown]) < 1e-9)
 
 
+def test_slant_cells_rounds_only_retest_cells_near_a_change() -> None:
+    """The rounds retest only the candidates within reach of a changed reference; the cells
+    kept are those of testing every candidate in every round (a rough random scene with
+    slopes, blunders and holes)."""
+    from photodem.algorithms.matching.dense_model import SLANT_GAP_CELLS, slant_cells
+    from photodem.algorithms.surface.gridding import deviates_from, fill_gaps
+
+    def every_cell(z, z_slant, spacing, radius, threshold, k, rounds=8):
+        z = np.array(z, np.float32)
+        take = np.zeros(z.shape, bool)
+        for _ in range(rounds):
+            ref = fill_gaps(z, spacing, SLANT_GAP_CELLS * spacing)[0]
+            new = (np.isfinite(z_slant) & ~take
+                   & ~deviates_from(z_slant, ref, spacing, radius, threshold, k))
+            if not new.any():
+                break
+            take |= new
+            z[new] = z_slant[new]
+        return take
+
+    rng = np.random.default_rng(11)
+    yy, xx = np.mgrid[0:90, 0:120].astype(np.float32)
+    surface = np.where(xx > 60, 0.15 * (xx - 60), 0.0) + 0.05 * yy
+    plain = np.where(rng.random(surface.shape) < 0.5, surface, np.nan)
+    plain[:, 70:] = np.nan  # the slope's upper part only the slant pass has
+    z_slant = np.where(np.isnan(plain), surface + rng.normal(0.0, 0.05, surface.shape), np.nan)
+    blunders = np.isfinite(z_slant) & (rng.random(surface.shape) < 0.05)
+    z_slant[blunders] += rng.uniform(-4.0, 4.0, blunders.sum())
+    args = (0.2, 1.0, 0.3, 3.0)
+    kept = slant_cells(plain, z_slant, *args)
+    np.testing.assert_array_equal(kept, every_cell(plain, z_slant, *args))
+    assert kept.sum() > slant_cells(plain, z_slant, *args, rounds=1).sum()  # rounds mattered
+    assert kept[blunders].mean() < 0.5 * kept[np.isfinite(z_slant) & ~blunders].mean()
+
+
 @pytest.mark.slow
 def test_wide_base_nadir_model_runs_the_slant_passes(tmp_path) -> None:
     """A window of the aerial block (seed 1, 384 px, B/H 0.61, nadir): the slant passes run by

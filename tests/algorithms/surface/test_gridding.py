@@ -199,3 +199,23 @@ def test_deviates_from_checks_candidates_against_a_reference() -> None:
     z[5, 30] += 3.0
     np.testing.assert_array_equal(deviates_from(z, z, 0.5, 2.5, 1.0),
                                   reject_outliers(z, 0.5, 2.5, 1.0))
+
+
+def test_deviates_from_at_a_few_cells_is_the_whole_grid_test_there() -> None:
+    """``where`` tests a few scattered cells from their own windows (the rounds of the dense
+    slant cells): the verdicts equal the whole-grid test's at those cells, at the borders and
+    next to big holes of the reference too, and nothing else is tested."""
+    from photodem.algorithms.surface.gridding import deviates_from
+
+    rng = np.random.default_rng(5)
+    _, xx = np.mgrid[0:60, 0:80].astype(np.float32)
+    ref = (100.0 + 0.2 * xx + rng.normal(0.0, 0.3, xx.shape)).astype(np.float32)
+    ref[20:45, 30:60] = np.nan  # a big hole: its cells take the nearest height
+    ref[rng.random(ref.shape) < 0.2] = np.nan
+    cand = (100.0 + 0.2 * xx + rng.normal(0.0, 1.0, xx.shape)).astype(np.float32)
+    full = deviates_from(cand, ref, 0.5, 2.0, 0.5)
+    for share in (0.003, 0.03, 0.5):
+        where = rng.random(ref.shape) < share
+        where[0, :3] = where[-1, -3:] = where[30, 40] = True  # corners, inside the hole
+        np.testing.assert_array_equal(deviates_from(cand, ref, 0.5, 2.0, 0.5, where=where),
+                                      full & where)
