@@ -267,7 +267,7 @@ SLANT_TOLERANCE = 2.0
 #: of seeds 1–3: +0.03 to +2.9 points of the visible cells, open NMAD within 0.0005 m, open
 #: RMSE −0.7 to +1.3 % (+1.3 %: a roof spread over 18 occluded ground cells), object RMSE −5
 #: to 0 %, 13–17 % more time (docs/decisions.md, 2026-11-28, slant cells kept in rounds) —
-#: since the rounds retest only the cells near a change, 2.4 instead of 9.3 s a grid.
+#: since the rounds retest only the cells near a change, 2.2 instead of 9.4 s a grid.
 SLANT_GROW_ROUNDS = 8
 #: Side (left pixels) of the blocks of :class:`_Guide`.
 GUIDE_FACTOR = 8

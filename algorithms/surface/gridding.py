@@ -389,9 +389,10 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
         return np.zeros(z.shape, bool)
     half = max(1, int(radius / spacing + 0.5))
     size = 2 * half + 1
-    if where is not None and valid.mean() < _SPARSE_SHARE:
-        # the medians only where the tested cells' MADs need them: within ``half`` of them
-        need = ndimage.binary_dilation(valid, np.ones((size, size), bool))
+    # the medians the tested cells' MADs read: within ``half`` of them
+    need = (ndimage.maximum_filter(valid.view(np.uint8), size=size, mode="constant") > 0
+            if where is not None else None)
+    if need is not None and need.mean() < _SPARSE_SHARE:
         med = np.full(z.shape, np.nan, np.float32)
         med[need] = _window_medians(rf, *np.nonzero(need), half)
         rows, cols = np.nonzero(valid)
@@ -405,10 +406,12 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
         return valid & (np.abs(z - med) > np.maximum(float(threshold), k * 1.4826 * mad))
 
 
-#: Below this share of tested cells :func:`deviates_from` takes the medians window by window.
-_SPARSE_SHARE = 0.1
-#: Cells per chunk of :func:`_window_medians` (memory: chunk × window cells × 4 bytes).
-_MEDIAN_CHUNK = 20000
+#: Below this share of the grid in reach of the tested cells :func:`deviates_from` takes the
+#: medians window by window (2.4 µs a cell against 1.5 µs for ``median_filter``'s whole grid,
+#: 11 × 11 windows).
+_SPARSE_SHARE = 0.5
+#: Window values gathered at a time by :func:`_window_medians` (4 bytes each).
+_MEDIAN_VALUES = 2_500_000
 
 
 def nearest_filled(reference: Array) -> Optional[Array]:
@@ -432,10 +435,11 @@ def _window_medians(a: Array, rows: Array, cols: Array, half: int) -> Array:
     h, w = a.shape
     off = np.arange(-half, half + 1)
     out = np.empty(rows.size, a.dtype)
-    for s in range(0, rows.size, _MEDIAN_CHUNK):
-        r = np.clip(rows[s:s + _MEDIAN_CHUNK, None, None] + off[None, :, None], 0, h - 1)
-        c = np.clip(cols[s:s + _MEDIAN_CHUNK, None, None] + off[None, None, :], 0, w - 1)
-        out[s:s + _MEDIAN_CHUNK] = np.median(a[r, c].reshape(r.shape[0], -1), axis=1)
+    chunk = max(1, _MEDIAN_VALUES // off.size ** 2)
+    for s in range(0, rows.size, chunk):
+        r = np.clip(rows[s:s + chunk, None, None] + off[None, :, None], 0, h - 1)
+        c = np.clip(cols[s:s + chunk, None, None] + off[None, None, :], 0, w - 1)
+        out[s:s + chunk] = np.median(a[r, c].reshape(r.shape[0], -1), axis=1)
     return out
 
 
