@@ -79,6 +79,7 @@ from ..surface.gridding import (
     finish_grid,
     nearest_filled,
     polygon_mask,
+    window_half,
     write_grid,
 )
 from .dense import DenseOptions, GreySource, array_source, iter_disparity_tiles
@@ -740,7 +741,7 @@ def slant_cells(z: np.ndarray, z_slant: np.ndarray, spacing: float, radius: floa
     take = np.zeros(z.shape, bool)
     # a verdict reads the reference within two half windows (the median of each neighbour's
     # window): where the reference did not change that far, last round's verdict stands
-    reach = 2 * max(1, int(radius / spacing + 0.5))
+    reach = 2 * window_half(radius, spacing)
     before = None
     for _round in range(rounds):
         ref = fill_gaps(z, spacing, SLANT_GAP_CELLS * spacing)[0]

@@ -387,7 +387,7 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
     rf = nearest_filled(reference)
     if radius <= 0 or not valid.any() or rf is None:
         return np.zeros(z.shape, bool)
-    half = max(1, int(radius / spacing + 0.5))
+    half = window_half(radius, spacing)
     size = 2 * half + 1
     # the medians the tested cells' MADs read: within ``half`` of them
     need = (ndimage.maximum_filter(valid.view(np.uint8), size=size, mode="constant") > 0
@@ -398,7 +398,6 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
         rows, cols = np.nonzero(valid)
         mad = np.zeros(z.shape, np.float32)
         mad[valid] = _window_medians(np.abs(rf - med), rows, cols, half)
-        med = np.where(valid, med, 0.0).astype(np.float32)
     else:
         med = ndimage.median_filter(rf, size=size, mode="nearest")
         mad = ndimage.median_filter(np.abs(rf - med), size=size, mode="nearest")
@@ -412,6 +411,11 @@ def deviates_from(z: Array, reference: Array, spacing: float, radius: float,
 _SPARSE_SHARE = 0.5
 #: Window values gathered at a time by :func:`_window_medians` (4 bytes each).
 _MEDIAN_VALUES = 2_500_000
+
+
+def window_half(radius: float, spacing: float) -> int:
+    """Half side (cells, at least one) of the square neighbourhood of :func:`deviates_from`."""
+    return max(1, int(radius / spacing + 0.5))
 
 
 def nearest_filled(reference: Array) -> Optional[Array]:
@@ -624,4 +628,4 @@ def write_grid(path: PathLike, z: Array, grid: Grid, crs: Any = None,
 
 __all__ = ["Grid", "GridAccumulator", "GridResult", "deviates_from", "fill_gaps", "finish_grid",
            "grid_points", "line_barrier", "nearest_filled", "polygon_mask", "reject_outliers",
-           "write_grid"]
+           "window_half", "write_grid"]
